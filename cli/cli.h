@@ -1,0 +1,37 @@
+/* What every cadmorph subcommand shares: exit codes, how errors and progress reach the user,
+ * and the checks on output paths. Only cli/ prints or exits. */
+#ifndef CADMORPH_CLI_H
+#define CADMORPH_CLI_H
+
+#include "cadmorph/core.h"
+
+enum {
+    CLI_EXIT_OK = 0,
+    CLI_EXIT_USAGE = 1,
+    CLI_EXIT_BAD_INPUT = 2,
+    CLI_EXIT_REJECTED = 3,
+    CLI_EXIT_INTERNAL = 4
+};
+
+/* A context whose log goes to stderr (debug lines only when verbose) and whose progress is
+ * drawn on stderr when stderr is a terminal. NULL when out of memory. */
+cm_context *cli_context_create(int verbose);
+
+/* Prints "cadmorph <cmd>: <context message>" on one line to stderr, returns the exit code
+ * for the status (2 for bad input, 4 for internal errors). */
+int cli_fail(cm_context *ctx, const char *cmd, cm_status s);
+
+/* Prints "cadmorph <cmd>: <message>" and the usage hint to stderr; returns CLI_EXIT_USAGE. */
+int cli_usage(const char *cmd, const char *usage, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* Non-zero if the two paths name the same file (an existing output that is an input). */
+int cli_same_file(const char *a, const char *b);
+
+/* Argument helpers: the value after an option, or NULL (and a usage message) if missing. */
+const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char *usage);
+
+/* Subcommands: argv[0] is the subcommand name. */
+int cli_cmd_quality(int argc, char **argv);
+
+#endif

@@ -1,0 +1,83 @@
+/* Exit codes, error lines, progress drawing and path checks shared by the subcommands. */
+#include "cli.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+typedef struct cli_sink {
+    int verbose;
+    int tty;
+    double last_draw;
+} cli_sink;
+
+static cli_sink sink;
+
+static void log_to_stderr(void *user, cm_log_level level, const char *message)
+{
+    cli_sink *s = user;
+    if (level == CM_LOG_DEBUG && !s->verbose) return;
+    if (s->tty) fputs("\r\033[K", stderr);
+    fprintf(stderr, "%s%s\n", level == CM_LOG_WARNING ? "warning: " : "", message);
+}
+
+static void progress_to_stderr(void *user, const char *stage, double done, double total)
+{
+    cli_sink *s = user;
+    if (!s->tty) return;
+    double now = cm_wtime();
+    int finished = done >= total;
+    if (!finished && now - s->last_draw < 0.1) return;
+    s->last_draw = now;
+    fprintf(stderr, "\r\033[K%s %5.1f%%", stage, total > 0 ? 100.0 * done / total : 100.0);
+    if (finished) fputs("\r\033[K", stderr);
+    fflush(stderr);
+}
+
+cm_context *cli_context_create(int verbose)
+{
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return NULL;
+    sink.verbose = verbose;
+    sink.tty = isatty(fileno(stderr));
+    cm_context_set_log(ctx, log_to_stderr, &sink);
+    cm_context_set_progress(ctx, progress_to_stderr, &sink);
+    return ctx;
+}
+
+int cli_fail(cm_context *ctx, const char *cmd, cm_status s)
+{
+    const char *msg = cm_context_message(ctx);
+    fprintf(stderr, "cadmorph %s: %s\n", cmd, msg && *msg ? msg : cm_status_name(s));
+    if (s == CM_ERR_ARGUMENT) return CLI_EXIT_USAGE;
+    return cm_status_is_input_error(s) ? CLI_EXIT_BAD_INPUT : CLI_EXIT_INTERNAL;
+}
+
+int cli_usage(const char *cmd, const char *usage, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "cadmorph %s: ", cmd);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\nusage: %s\n", usage);
+    return CLI_EXIT_USAGE;
+}
+
+int cli_same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return strcmp(a, b) == 0;
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char *usage)
+{
+    if (*i + 1 >= argc) {
+        cli_usage(cmd, usage, "option %s needs a value", argv[*i]);
+        return NULL;
+    }
+    return argv[++*i];
+}

@@ -1,0 +1,39 @@
+/* The cadmorph program: picks the subcommand; each lives in its own cmd_<name>.c. */
+#include "cli.h"
+
+#include <stdio.h>
+#include <string.h>
+
+typedef struct cli_command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} cli_command;
+
+static const cli_command commands[] = {
+    {"quality", cli_cmd_quality, "scaled Jacobian report of a mesh"},
+};
+
+static int usage(FILE *out)
+{
+    fprintf(out, "usage: cadmorph <command> [options]\n\ncommands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; ++i)
+        fprintf(out, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    fprintf(out, "\n'cadmorph <command> --help' describes a command.\n");
+    return out == stdout ? 0 : 1;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) return usage(stderr);
+    if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "help"))
+        return usage(stdout);
+    if (!strcmp(argv[1], "--version")) {
+        printf("cadmorph %s\n", CADMORPH_VERSION);
+        return 0;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; ++i)
+        if (!strcmp(argv[1], commands[i].name)) return commands[i].run(argc - 1, argv + 1);
+    fprintf(stderr, "cadmorph: unknown command '%s'\n", argv[1]);
+    return usage(stderr);
+}

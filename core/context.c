@@ -1,0 +1,120 @@
+/* The context: last message, thread count and the callbacks through which the library
+ * talks to its caller (it never prints itself). */
+#include "cadmorph/core.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define CM_MESSAGE_MAX 2048
+
+struct cm_context {
+    char message[CM_MESSAGE_MAX];
+    int threads;
+    cm_log_fn log;
+    void *log_user;
+    cm_progress_fn progress;
+    void *progress_user;
+};
+
+const char *cm_status_name(cm_status s)
+{
+    switch (s) {
+    case CM_OK: return "ok";
+    case CM_WARNING: return "warning";
+    case CM_ERR_NOMEM: return "out of memory";
+    case CM_ERR_ARGUMENT: return "invalid argument";
+    case CM_ERR_IO: return "i/o error";
+    case CM_ERR_FORMAT: return "format error";
+    case CM_ERR_UNSUPPORTED: return "unsupported";
+    case CM_ERR_MISMATCH: return "mismatch";
+    case CM_ERR_NUMERIC: return "numerical error";
+    case CM_ERR_CAD: return "CAD error";
+    case CM_ERR_INTERNAL: return "internal error";
+    }
+    return "unknown status";
+}
+
+int cm_status_is_input_error(cm_status s)
+{
+    return s == CM_ERR_IO || s == CM_ERR_FORMAT || s == CM_ERR_UNSUPPORTED ||
+           s == CM_ERR_MISMATCH || s == CM_ERR_CAD || s == CM_ERR_NUMERIC;
+}
+
+cm_status cm_context_create(cm_context **ctx)
+{
+    if (!ctx) return CM_ERR_ARGUMENT;
+    *ctx = calloc(1, sizeof **ctx);
+    return *ctx ? CM_OK : CM_ERR_NOMEM;
+}
+
+void cm_context_destroy(cm_context **ctx)
+{
+    if (!ctx || !*ctx) return;
+    free(*ctx);
+    *ctx = NULL;
+}
+
+const char *cm_context_message(const cm_context *ctx) { return ctx ? ctx->message : ""; }
+
+void cm_context_clear(cm_context *ctx)
+{
+    if (ctx) ctx->message[0] = '\0';
+}
+
+void cm_context_set_threads(cm_context *ctx, int threads)
+{
+    if (ctx) ctx->threads = threads > 0 ? threads : 0;
+}
+
+int cm_context_threads(const cm_context *ctx) { return ctx ? ctx->threads : 0; }
+
+void cm_context_set_log(cm_context *ctx, cm_log_fn fn, void *user)
+{
+    if (!ctx) return;
+    ctx->log = fn;
+    ctx->log_user = user;
+}
+
+void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user)
+{
+    if (!ctx) return;
+    ctx->progress = fn;
+    ctx->progress_user = user;
+}
+
+cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
+{
+    if (ctx) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(ctx->message, sizeof ctx->message, fmt, ap);
+        va_end(ap);
+    }
+    return code;
+}
+
+void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
+{
+    if (!ctx || !ctx->log) return;
+    char buf[CM_MESSAGE_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    ctx->log(ctx->log_user, level, buf);
+}
+
+void cm_progress(cm_context *ctx, const char *stage, double done, double total)
+{
+    if (ctx && ctx->progress) ctx->progress(ctx->progress_user, stage, done, total);
+}
+
+double cm_wtime(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}

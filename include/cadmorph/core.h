@@ -1,0 +1,83 @@
+/* cadmorph core: status codes, the context every call takes first, logging and progress.
+ *
+ * Conventions of the whole library (every public header follows them):
+ *  - Names: cm_<module>_<verb> for functions, cm_<noun> for types, CM_ for macros/enums.
+ *  - Every fallible call returns cm_status: CM_OK (0), an error (< 0) or a warning (> 0).
+ *    The message of the last error or warning is in the context: cm_context_message().
+ *  - Parameter order: context, inputs, outputs. Inputs are borrowed for the call.
+ *  - Arrays: row-major, 0-based; documented with their shape, e.g. "xyz: #V x 3 double".
+ *  - Ownership: cm_X_create(ctx, ..., &out) allocates, cm_X_destroy(&p) frees, accepts NULL
+ *    and sets the pointer to NULL. On failure nothing leaks and outputs are NULL.
+ *  - The library never prints, exits or aborts; the log callback decides what a user sees.
+ */
+#ifndef CADMORPH_CORE_H
+#define CADMORPH_CORE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum cm_status {
+    CM_OK = 0,
+    CM_WARNING = 1,            /* finished, but the message says what was odd */
+    CM_ERR_NOMEM = -1,         /* allocation failed */
+    CM_ERR_ARGUMENT = -2,      /* a caller error: NULL where data was required, bad option */
+    CM_ERR_IO = -3,            /* a file could not be opened, read or written */
+    CM_ERR_FORMAT = -4,        /* a file is malformed: the message has file and line/offset */
+    CM_ERR_UNSUPPORTED = -5,   /* valid input that cadmorph does not handle */
+    CM_ERR_MISMATCH = -6,      /* inputs that do not belong together (CAD vs mesh, G vs G') */
+    CM_ERR_NUMERIC = -7,       /* singular or indefinite system, non-finite values */
+    CM_ERR_CAD = -8,           /* OpenCASCADE failed */
+    CM_ERR_INTERNAL = -9       /* a bug or an exception from a dependency */
+} cm_status;
+
+/* Short fixed name of a status, e.g. "format error". */
+const char *cm_status_name(cm_status s);
+
+/* True for errors that mean "the input is bad" (exit code 2 in the CLI). */
+int cm_status_is_input_error(cm_status s);
+
+typedef enum cm_log_level { CM_LOG_DEBUG = 0, CM_LOG_INFO = 1, CM_LOG_WARNING = 2 } cm_log_level;
+
+typedef void (*cm_log_fn)(void *user, cm_log_level level, const char *message);
+/* stage: short name ("sample", "solve"); done/total: units of work. */
+typedef void (*cm_progress_fn)(void *user, const char *stage, double done, double total);
+
+typedef struct cm_context cm_context;
+
+cm_status cm_context_create(cm_context **ctx);
+void cm_context_destroy(cm_context **ctx);
+
+/* Message of the last error or warning set on this context ("" if none). */
+const char *cm_context_message(const cm_context *ctx);
+void cm_context_clear(cm_context *ctx);
+
+/* Threads for OpenMP leaf loops and BLAS; 0 = all available (default). */
+void cm_context_set_threads(cm_context *ctx, int threads);
+int cm_context_threads(const cm_context *ctx);
+
+void cm_context_set_log(cm_context *ctx, cm_log_fn fn, void *user);
+void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user);
+
+/* ---- for module code ---- */
+
+/* Sets the context message (printf-style) and returns code, so that errors read
+ * `return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: expected ...", ...);` */
+cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+void cm_progress(cm_context *ctx, const char *stage, double done, double total);
+
+/* Wall clock in seconds (monotonic), for stage timings in reports and benchmarks. */
+double cm_wtime(void);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

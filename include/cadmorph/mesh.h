@@ -1,0 +1,232 @@
+/* cadmorph mesh: mixed-cell volume meshes (plus the lower-dimensional elements that gmsh
+ * files carry), file I/O chosen by extension, boundary extraction and scaled Jacobian.
+ * Conventions: see core.h. Node indices are 0-based everywhere in this API.
+ */
+#ifndef CADMORPH_MESH_H
+#define CADMORPH_MESH_H
+
+#include "cadmorph/core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Node order inside a cell is VTK's for every type (gmsh readers/writers permute). */
+typedef enum cm_cell_type {
+    CM_CELL_POINT = 0,
+    CM_CELL_LINE2,
+    CM_CELL_LINE3,
+    CM_CELL_TRI3,
+    CM_CELL_TRI6,
+    CM_CELL_QUAD4,
+    CM_CELL_QUAD8,
+    CM_CELL_QUAD9,
+    CM_CELL_TET4,
+    CM_CELL_TET10,
+    CM_CELL_HEX8,
+    CM_CELL_HEX20,
+    CM_CELL_HEX27,
+    CM_CELL_WEDGE6,
+    CM_CELL_WEDGE15,
+    CM_CELL_WEDGE18,
+    CM_CELL_PYR5,
+    CM_CELL_PYR13,
+    CM_CELL_PYR14,
+    CM_CELL_POLYGON,    /* conn: the n nodes in order */
+    CM_CELL_POLYHEDRON, /* conn: face stream  nf, n0, ids of face 0, n1, ids of face 1, ...;
+                           faces oriented outward (right-hand rule), as VTK's */
+    CM_CELL_TYPE_COUNT
+} cm_cell_type;
+
+typedef struct cm_cell_info {
+    const char *name;    /* "tet4", "hex20", ... */
+    int dim;             /* 0..3 */
+    int nodes;           /* nodes per cell, -1 for polygon/polyhedron */
+    int corners;         /* corner (linear) nodes: the first `corners` of the cell's nodes */
+    cm_cell_type linear; /* the linear type with these corners */
+    int vtk;             /* VTK cell type id */
+    int gmsh;            /* gmsh element type id, 0 if gmsh has none */
+} cm_cell_info;
+
+/* Table entry of a type; NULL for an out-of-range value. */
+const cm_cell_info *cm_cell_type_info(cm_cell_type type);
+/* Type from VTK / gmsh id; returns CM_CELL_TYPE_COUNT for ids cadmorph does not know. */
+cm_cell_type cm_cell_type_from_vtk(int vtk_id);
+cm_cell_type cm_cell_type_from_gmsh(int gmsh_id);
+
+typedef enum cm_field_location { CM_FIELD_NODE = 0, CM_FIELD_CELL = 1 } cm_field_location;
+
+/* A named array of doubles attached to nodes or cells: #nodes|#cells x components. */
+typedef struct cm_field {
+    char *name;
+    cm_field_location location;
+    int components;
+    double *data;
+} cm_field;
+
+/* A named physical group (gmsh $PhysicalNames, Medit references). */
+typedef struct cm_mesh_group {
+    int dim;
+    int tag;
+    char *name;
+} cm_mesh_group;
+
+/* A gmsh 4 geometric entity, kept so that a .msh round trip keeps $Entities. */
+typedef struct cm_mesh_entity {
+    int dim;
+    int tag;
+    double bbox[6];     /* xmin ymin zmin xmax ymax zmax (points: x y z x y z) */
+    int n_physical;
+    int *physical;      /* physical tags of the entity */
+    int n_bounding;
+    int *bounding;      /* signed tags of bounding entities (dim-1) */
+} cm_mesh_entity;
+
+/* The mesh. Fields are public for reading; grow it only through the functions below. */
+typedef struct cm_mesh {
+    size_t n_nodes;
+    double *xyz;         /* #nodes x 3 */
+    int64_t *node_tag;   /* #nodes: the id the file gave each node; NULL means index + 1 */
+
+    size_t n_cells;      /* all elements, any dimension, in file order */
+    uint8_t *type;       /* #cells, cm_cell_type */
+    int64_t *offset;     /* #cells + 1: cell c's nodes are conn[offset[c] .. offset[c+1]) */
+    int64_t *conn;       /* 0-based node indices (polyhedra: face stream, see above) */
+    int *physical;       /* #cells: physical group tag, 0 if none */
+    int *entity;         /* #cells: geometric (elementary) entity tag, 0 if none */
+    int64_t *cell_tag;   /* #cells: the id the file gave each element; NULL means index + 1 */
+
+    size_t n_fields;
+    cm_field *fields;
+    size_t n_groups;
+    cm_mesh_group *groups;
+    size_t n_entities;
+    cm_mesh_entity *entities;
+
+    /* private: allocated lengths */
+    size_t cap_nodes, cap_cells, cap_conn;
+} cm_mesh;
+
+cm_status cm_mesh_create(cm_context *ctx, cm_mesh **mesh);
+void cm_mesh_destroy(cm_mesh **mesh);
+
+/* Sets the node count; xyz is (re)allocated and left uninitialised beyond the old count.
+ * with_tags: also allocate node_tag (left for the caller to fill). */
+cm_status cm_mesh_resize_nodes(cm_context *ctx, cm_mesh *mesh, size_t n_nodes, int with_tags);
+/* Reserves room for more cells and connectivity entries (optional: add_cell grows). */
+cm_status cm_mesh_reserve_cells(cm_context *ctx, cm_mesh *mesh, size_t n_cells, size_t n_conn);
+/* Appends a cell. nodes: n entries, 0-based, VTK order (polyhedra: the face stream).
+ * tag: the file's element id or 0 to use index + 1. */
+cm_status cm_mesh_add_cell(cm_context *ctx, cm_mesh *mesh, cm_cell_type type, const int64_t *nodes,
+                           size_t n, int physical, int entity, int64_t tag);
+/* Adds (or replaces) a field; *data points to its zeroed array, owned by the mesh. */
+cm_status cm_mesh_add_field(cm_context *ctx, cm_mesh *mesh, const char *name,
+                            cm_field_location location, int components, double **data);
+cm_field *cm_mesh_find_field(const cm_mesh *mesh, const char *name, cm_field_location location);
+cm_status cm_mesh_add_group(cm_context *ctx, cm_mesh *mesh, int dim, int tag, const char *name);
+/* Appends an entity; the arrays are copied. */
+cm_status cm_mesh_add_entity(cm_context *ctx, cm_mesh *mesh, const cm_mesh_entity *entity);
+
+/* Deep copy. */
+cm_status cm_mesh_copy(cm_context *ctx, const cm_mesh *mesh, cm_mesh **copy);
+
+/* Node indices in range, node counts match types, coordinates finite, polyhedron streams
+ * consistent. what: a name for messages (usually the file path). */
+cm_status cm_mesh_validate(cm_context *ctx, const cm_mesh *mesh, const char *what);
+
+/* Number of cells of dimension dim. */
+size_t cm_mesh_count_dim(const cm_mesh *mesh, int dim);
+
+/* ---- files ----
+ * Formats by extension: .msh (gmsh 2.2 / 4.1, ASCII / binary little-endian), .vtu (VTK XML),
+ * .vtk (legacy UNSTRUCTURED_GRID, ASCII / binary), .mesh (Medit ASCII).
+ * Readers report the file, the line (text) or byte offset (binary) and what was expected.
+ * Writers write a temporary file beside the target and rename it: a failed write leaves
+ * no partial file. */
+
+typedef enum cm_mesh_format {
+    CM_FORMAT_UNKNOWN = 0,
+    CM_FORMAT_MSH,
+    CM_FORMAT_VTU,
+    CM_FORMAT_VTK,
+    CM_FORMAT_MEDIT
+} cm_mesh_format;
+
+cm_mesh_format cm_mesh_format_from_path(const char *path);
+
+typedef struct cm_mesh_write_options {
+    int msh_version; /* 22 or 41 (default 41) */
+    int binary;      /* msh, vtk: binary; vtu: base64 data (appended raw if also `appended`) */
+    int compress;    /* vtu: zlib compression (default on) */
+    int appended;    /* vtu: appended raw data section */
+} cm_mesh_write_options;
+
+void cm_mesh_write_options_init(cm_mesh_write_options *opt);
+
+cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh);
+/* opt may be NULL for defaults. */
+cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                        const cm_mesh_write_options *opt);
+
+/* Per-format entry points (cm_mesh_read/write dispatch to these). */
+cm_status cm_mesh_read_msh(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_msh(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_vtu(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_vtu(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_vtk(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_vtk(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_medit(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_medit(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                              const cm_mesh_write_options *opt);
+
+/* ---- boundary and components (volume cells only: dim 3) ---- */
+
+typedef struct cm_mesh_boundary {
+    size_t n_faces;         /* faces used by exactly one volume cell */
+    int64_t *face_offset;   /* #faces + 1 into face_nodes */
+    int64_t *face_nodes;    /* corner nodes of each face, oriented outward */
+    int64_t *face_cell;     /* #faces: the cell the face belongs to */
+    size_t n_nodes;         /* boundary nodes (corner and higher-order nodes of boundary faces) */
+    int64_t *nodes;         /* sorted ascending */
+    size_t n_components;    /* connected components of volume cells (sharing a face) */
+    int *cell_component;    /* #cells: component of each volume cell, -1 for other cells */
+    size_t n_nonmanifold;   /* faces shared by three or more cells */
+    size_t n_duplicate;     /* volume cells with exactly the node set of another cell */
+} cm_mesh_boundary;
+
+/* Returns CM_WARNING (with counts in the message) for non-manifold faces or duplicates. */
+cm_status cm_mesh_boundary_create(cm_context *ctx, const cm_mesh *mesh, cm_mesh_boundary **b);
+void cm_mesh_boundary_destroy(cm_mesh_boundary **b);
+
+/* ---- quality: Verdict's scaled Jacobian ---- */
+
+/* Scaled Jacobian of one cell from its corner coordinates (VTK order, corners x 3).
+ * Types: tet, hex, wedge, pyramid (higher-order types use their corners).
+ * Returns NaN for types without a definition (use cm_quality_polyhedron for polyhedra). */
+double cm_quality_scaled_jacobian(cm_cell_type type, const double *xyz);
+
+/* Polyhedron: decomposed into tets (cell centre, face centre, edge) - minimum of their
+ * scaled Jacobians. face_stream as in CM_CELL_POLYHEDRON; coordinates from mesh xyz. */
+double cm_quality_polyhedron(const double *mesh_xyz, const int64_t *face_stream);
+
+/* sj: #cells output; NaN for cells of dimension < 3. OpenMP over cells. */
+cm_status cm_mesh_quality(cm_context *ctx, const cm_mesh *mesh, double *sj);
+
+typedef struct cm_quality_stats {
+    size_t count;
+    double min, mean, p01; /* p01: 1st percentile */
+    size_t inverted;       /* scaled Jacobian <= 0 */
+} cm_quality_stats;
+
+/* Stats over volume cells: per_type[CM_CELL_TYPE_COUNT] (by linear type) and all. Either
+ * output may be NULL. sj as from cm_mesh_quality. */
+cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const double *sj,
+                               cm_quality_stats *per_type, cm_quality_stats *all);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

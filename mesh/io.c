@@ -1,0 +1,263 @@
+/* Mesh file dispatch by extension and the helpers every reader and writer shares. */
+#define _POSIX_C_SOURCE 200809L
+#include "io_internal.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+cm_mesh_format cm_mesh_format_from_path(const char *path)
+{
+    const char *dot = path ? strrchr(path, '.') : NULL;
+    if (!dot || strchr(dot, '/')) return CM_FORMAT_UNKNOWN;
+    char ext[8] = {0};
+    for (size_t i = 0; i < sizeof ext - 1 && dot[1 + i]; ++i) ext[i] = (char)tolower((unsigned char)dot[1 + i]);
+    if (strlen(dot + 1) >= sizeof ext) return CM_FORMAT_UNKNOWN;
+    if (!strcmp(ext, "msh")) return CM_FORMAT_MSH;
+    if (!strcmp(ext, "vtu")) return CM_FORMAT_VTU;
+    if (!strcmp(ext, "vtk")) return CM_FORMAT_VTK;
+    if (!strcmp(ext, "mesh")) return CM_FORMAT_MEDIT;
+    return CM_FORMAT_UNKNOWN;
+}
+
+void cm_mesh_write_options_init(cm_mesh_write_options *opt)
+{
+    if (!opt) return;
+    opt->msh_version = 41;
+    opt->binary = 1;
+    opt->compress = 1;
+    opt->appended = 0;
+}
+
+static cm_status unknown_extension(cm_context *ctx, const char *fn, const char *path)
+{
+    return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                    "%s: %s: unknown mesh extension (expected .msh, .vtu, .vtk or .mesh)", fn,
+                    path ? path : "(null)");
+}
+
+cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh)
+{
+    if (!mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_read: mesh is NULL");
+    *mesh = NULL;
+    cm_status s;
+    switch (cm_mesh_format_from_path(path)) {
+    case CM_FORMAT_MSH: s = cm_mesh_read_msh(ctx, path, mesh); break;
+    case CM_FORMAT_VTU: s = cm_mesh_read_vtu(ctx, path, mesh); break;
+    case CM_FORMAT_VTK: s = cm_mesh_read_vtk(ctx, path, mesh); break;
+    case CM_FORMAT_MEDIT: s = cm_mesh_read_medit(ctx, path, mesh); break;
+    default: return unknown_extension(ctx, "cm_mesh_read", path);
+    }
+    if (s < 0) return s;
+    /* Every reader's output goes through the same checks, so no reader can let an out-of-range
+     * index or a NaN through to the algorithms. */
+    cm_status v = cm_mesh_validate(ctx, *mesh, path);
+    if (v != CM_OK) {
+        cm_mesh_destroy(mesh);
+        return v;
+    }
+    return s;
+}
+
+cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                        const cm_mesh_write_options *opt)
+{
+    cm_mesh_write_options defaults;
+    cm_mesh_write_options_init(&defaults);
+    if (!opt) opt = &defaults;
+    if (!mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: mesh is NULL");
+    switch (cm_mesh_format_from_path(path)) {
+    case CM_FORMAT_MSH: return cm_mesh_write_msh(ctx, mesh, path, opt);
+    case CM_FORMAT_VTU: return cm_mesh_write_vtu(ctx, mesh, path, opt);
+    case CM_FORMAT_VTK: return cm_mesh_write_vtk(ctx, mesh, path, opt);
+    case CM_FORMAT_MEDIT: return cm_mesh_write_medit(ctx, mesh, path, opt);
+    default: return unknown_extension(ctx, "cm_mesh_write", path);
+    }
+}
+
+cm_status cm_io_read_file(cm_context *ctx, const char *path, char **data, size_t *size)
+{
+    *data = NULL;
+    *size = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return cm_error(ctx, CM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    char *buf = NULL;
+    size_t len = 0, cap = 0;
+    for (;;) {
+        if (cap - len < 65536) {
+            size_t ncap = cap ? 2 * cap : 1 << 20;
+            char *nb = realloc(buf, ncap + 1);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory reading the file", path);
+            }
+            buf = nb;
+            cap = ncap;
+        }
+        size_t r = fread(buf + len, 1, cap - len, f);
+        len += r;
+        if (r == 0) break;
+    }
+    int err = ferror(f);
+    fclose(f);
+    if (err) {
+        free(buf);
+        return cm_error(ctx, CM_ERR_IO, "%s: read error", path);
+    }
+    buf[len] = '\0';
+    *data = buf;
+    *size = len;
+    return CM_OK;
+}
+
+void cm_text_init(cm_text *t, const char *path, const char *data, size_t size)
+{
+    t->path = path;
+    t->data = data;
+    t->size = size;
+    t->pos = 0;
+    t->line = 1;
+}
+
+int cm_text_skip_space(cm_text *t)
+{
+    while (t->pos < t->size) {
+        char c = t->data[t->pos];
+        if (c == '\n') ++t->line;
+        else if (c != ' ' && c != '\t' && c != '\r' && c != '\f' && c != '\v') return 1;
+        ++t->pos;
+    }
+    return 0;
+}
+
+int cm_text_token(cm_text *t, const char **tok, size_t *len)
+{
+    if (!cm_text_skip_space(t)) return 0;
+    size_t b = t->pos;
+    while (t->pos < t->size && !isspace((unsigned char)t->data[t->pos])) ++t->pos;
+    *tok = t->data + b;
+    *len = t->pos - b;
+    return 1;
+}
+
+static cm_status token_error(cm_context *ctx, cm_text *t, const char *what, const char *tok,
+                             size_t len)
+{
+    if (!tok) return cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: expected %s, got end of file", t->path, t->line, what);
+    return cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: expected %s, got '%.*s'", t->path, t->line, what,
+                    (int)(len > 40 ? 40 : len), tok);
+}
+
+cm_status cm_text_int(cm_context *ctx, cm_text *t, const char *what, int64_t *v)
+{
+    const char *tok = NULL;
+    size_t len = 0;
+    if (!cm_text_token(t, &tok, &len)) return token_error(ctx, t, what, NULL, 0);
+    char buf[32], *end;
+    if (len >= sizeof buf) return token_error(ctx, t, what, tok, len);
+    memcpy(buf, tok, len);
+    buf[len] = '\0';
+    errno = 0;
+    long long x = strtoll(buf, &end, 10);
+    if (*end || errno) return token_error(ctx, t, what, tok, len);
+    *v = (int64_t)x;
+    return CM_OK;
+}
+
+cm_status cm_text_double(cm_context *ctx, cm_text *t, const char *what, double *v)
+{
+    const char *tok = NULL;
+    size_t len = 0;
+    if (!cm_text_token(t, &tok, &len)) return token_error(ctx, t, what, NULL, 0);
+    char buf[64], *end;
+    if (len >= sizeof buf) return token_error(ctx, t, what, tok, len);
+    memcpy(buf, tok, len);
+    buf[len] = '\0';
+    *v = strtod(buf, &end);
+    if (*end) return token_error(ctx, t, what, tok, len);
+    return CM_OK;
+}
+
+void cm_text_next_line(cm_text *t)
+{
+    while (t->pos < t->size && t->data[t->pos] != '\n') ++t->pos;
+    if (t->pos < t->size) {
+        ++t->pos;
+        ++t->line;
+    }
+}
+
+cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out)
+{
+    memset(out, 0, sizeof *out);
+    size_t n = strlen(path);
+    out->path = malloc(n + 1);
+    out->tmp = malloc(n + 16);
+    if (!out->path || !out->tmp) {
+        cm_outfile_abort(out);
+        return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", path);
+    }
+    memcpy(out->path, path, n + 1);
+    snprintf(out->tmp, n + 16, "%s.tmp.XXXXXX", path);
+    int fd = mkstemp(out->tmp);
+    if (fd < 0) {
+        cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot create: %s", path, strerror(errno));
+        free(out->tmp);
+        out->tmp = NULL;
+        cm_outfile_abort(out);
+        return s;
+    }
+    out->f = fdopen(fd, "wb");
+    if (!out->f) {
+        close(fd);
+        cm_outfile_abort(out);
+        return cm_error(ctx, CM_ERR_IO, "%s: cannot open for writing", path);
+    }
+    setvbuf(out->f, NULL, _IOFBF, 1 << 20);
+    return CM_OK;
+}
+
+cm_status cm_outfile_commit(cm_context *ctx, cm_outfile *out)
+{
+    int bad = ferror(out->f);
+    bad |= fclose(out->f) != 0;
+    out->f = NULL;
+    if (bad) {
+        cm_status s = cm_error(ctx, CM_ERR_IO, "%s: write failed: %s", out->path, strerror(errno));
+        cm_outfile_abort(out);
+        return s;
+    }
+    /* mkstemp creates 0600; a mesh is an ordinary user file. */
+    mode_t mask = umask(0);
+    umask(mask);
+    chmod(out->tmp, 0666 & ~mask);
+    if (rename(out->tmp, out->path) != 0) {
+        cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot rename the temporary file: %s",
+                               out->path, strerror(errno));
+        cm_outfile_abort(out);
+        return s;
+    }
+    free(out->tmp);
+    free(out->path);
+    out->tmp = out->path = NULL;
+    return CM_OK;
+}
+
+void cm_outfile_abort(cm_outfile *out)
+{
+    if (out->f) fclose(out->f);
+    if (out->tmp) remove(out->tmp);
+    free(out->tmp);
+    free(out->path);
+    memset(out, 0, sizeof *out);
+}
+
+int cm_host_little_endian(void)
+{
+    const uint16_t one = 1;
+    return *(const uint8_t *)&one == 1;
+}

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Installs, by Debian package name, everything cadmorph needs to build, test and benchmark.
+# Idempotent: packages already installed are skipped, and apt-get runs only when needed.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libocct-foundation-dev libocct-modeling-data-dev libocct-modeling-algorithms-dev
+  libocct-data-exchange-dev libocct-ocaf-dev
+  libflann-dev libtet1.5-dev liblapacke-dev libopenblas-dev zlib1g-dev
+  gmsh python3-gmsh python3-numpy python3-scipy python3-vtk9 python3-meshio
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "setup: run as root or install sudo" >&2; exit 1; }
+  sudo=sudo
+fi
+echo "setup: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
