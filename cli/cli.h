@@ -33,5 +33,7 @@ const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char
 
 /* Subcommands: argv[0] is the subcommand name. */
 int cli_cmd_quality(int argc, char **argv);
+int cli_cmd_warp(int argc, char **argv);
+int cli_cmd_info(int argc, char **argv);
 
 #endif

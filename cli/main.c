@@ -12,6 +12,8 @@ typedef struct cli_command {
 
 static const cli_command commands[] = {
     {"quality", cli_cmd_quality, "scaled Jacobian report of a mesh"},
+    {"warp", cli_cmd_warp, "move interior nodes by an RBF warp of given boundary displacements"},
+    {"info", cli_cmd_info, "topology summary of a STEP file, correspondence with another"},
 };
 
 static int usage(FILE *out)
