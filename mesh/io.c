@@ -84,29 +84,25 @@ cm_status cm_io_read_file(cm_context *ctx, const char *path, char **data, size_t
     *size = 0;
     FILE *f = fopen(path, "rb");
     if (!f) return cm_error(ctx, CM_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    char *buf = NULL;
-    size_t len = 0, cap = 0;
-    for (;;) {
-        if (cap - len < 65536) {
-            size_t ncap = cap ? 2 * cap : 1 << 20;
-            char *nb = realloc(buf, ncap + 1);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory reading the file", path);
-            }
-            buf = nb;
-            cap = ncap;
-        }
-        size_t r = fread(buf + len, 1, cap - len, f);
-        len += r;
-        if (r == 0) break;
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        fclose(f);
+        return cm_error(ctx, CM_ERR_IO, "%s: not a regular file", path);
     }
+    /* One allocation of the file's size: a 1M-cell mesh is ~50 MB, and growing a buffer by
+     * doubling costs as much as parsing it. */
+    size_t len = (size_t)st.st_size;
+    char *buf = malloc(len + 1);
+    if (!buf) {
+        fclose(f);
+        return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory for %zu bytes", path, len);
+    }
+    size_t got = fread(buf, 1, len, f);
     int err = ferror(f);
     fclose(f);
-    if (err) {
+    if (err || got != len) {
         free(buf);
-        return cm_error(ctx, CM_ERR_IO, "%s: read error", path);
+        return cm_error(ctx, CM_ERR_IO, "%s: read error after %zu of %zu bytes", path, got, len);
     }
     buf[len] = '\0';
     *data = buf;
