@@ -1,0 +1,17 @@
+# Tests of the volume warp (volume/warp.c, volume/displacement_csv.c).
+cm_add_unit_test(test_warp_csv test_warp_csv.c LIBS cm_volume)
+cm_add_unit_test(test_warp test_warp.c LIBS cm_volume)
+
+# Cross-check on a real mesh: gmsh meshes a sphere cut out of a box (setup, also used by the
+# CLI tests), cadmorph warps it (test_warp_sphere), scipy's RBFInterpolator redoes it (scipy).
+add_test(NAME warp_sphere_setup
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/warp_sphere.py setup ${CM_TEST_WORK}
+          ${CM_TEST_DATA}/warp/sphere_in_box.geo)
+set_tests_properties(warp_sphere_setup PROPERTIES FIXTURES_SETUP warp_sphere LABELS "unit")
+cm_add_unit_test(test_warp_sphere test_warp_sphere.c LIBS cm_volume)
+set_tests_properties(test_warp_sphere PROPERTIES
+  FIXTURES_REQUIRED warp_sphere FIXTURES_SETUP warp_sphere_result)
+add_test(NAME warp_sphere_scipy
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/warp_sphere.py compare ${CM_TEST_WORK})
+set_tests_properties(warp_sphere_scipy PROPERTIES
+  FIXTURES_REQUIRED "warp_sphere;warp_sphere_result" LABELS "unit")
