@@ -4,6 +4,9 @@
 #define CADMORPH_CLI_H
 
 #include "cadmorph/core.h"
+#include "cadmorph/mesh.h"
+
+#include <stdio.h>
 
 enum {
     CLI_EXIT_OK = 0,
@@ -31,9 +34,20 @@ int cli_same_file(const char *a, const char *b);
 /* Argument helpers: the value after an option, or NULL (and a usage message) if missing. */
 const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char *usage);
 
+/* Quality report shared by quality, warp and morph. The line every mesh-producing command
+ * ends with (DESIGN.md): "min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k>
+ * cells=<n>" (%.6g; cells = volume cells). */
+void cli_print_quality_line(FILE *out, const cm_quality_stats *all);
+/* One row per present (linear) cell type - type, cells, min, mean, 1st percentile, inverted -
+ * then the line above. sj: #cells as from cm_mesh_quality; all (may be NULL) receives the
+ * overall stats. */
+cm_status cli_print_quality(cm_context *ctx, const cm_mesh *mesh, const double *sj, FILE *out,
+                            cm_quality_stats *all);
+
 /* Subcommands: argv[0] is the subcommand name. */
 int cli_cmd_quality(int argc, char **argv);
 int cli_cmd_warp(int argc, char **argv);
 int cli_cmd_info(int argc, char **argv);
+int cli_cmd_mesh(int argc, char **argv);
 
 #endif

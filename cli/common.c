@@ -81,3 +81,27 @@ const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char
     }
     return argv[++*i];
 }
+
+void cli_print_quality_line(FILE *out, const cm_quality_stats *all)
+{
+    fprintf(out, "min_scaled_jacobian=%.6g mean_scaled_jacobian=%.6g inverted=%zu cells=%zu\n", all->min,
+            all->mean, all->inverted, all->count);
+}
+
+cm_status cli_print_quality(cm_context *ctx, const cm_mesh *mesh, const double *sj, FILE *out,
+                            cm_quality_stats *all_out)
+{
+    cm_quality_stats per[CM_CELL_TYPE_COUNT], all;
+    cm_status s = cm_quality_summarize(ctx, mesh, sj, per, &all);
+    if (s < 0) return s;
+    fprintf(out, "%-12s %10s %12s %12s %12s %10s\n", "type", "cells", "min_sj", "mean_sj", "p01_sj",
+            "inverted");
+    for (int t = 0; t < CM_CELL_TYPE_COUNT; ++t) {
+        if (per[t].count == 0) continue;
+        fprintf(out, "%-12s %10zu %12.6g %12.6g %12.6g %10zu\n", cm_cell_type_info((cm_cell_type)t)->name,
+                per[t].count, per[t].min, per[t].mean, per[t].p01, per[t].inverted);
+    }
+    cli_print_quality_line(out, &all);
+    if (all_out) *all_out = all;
+    return s;
+}

@@ -8,15 +8,20 @@
 /* vtk[i] = gmsh[perm[i]]. Derived by matching each higher-order node to the corners it is
  * the centroid of, in gmsh's reference element (gmsh.model.mesh.getElementProperties) and in
  * VTK's (vtkCell::GetParametricCoords); tests/data/msh/check_perm.py recomputes them.
- * The ones meshio also has (tet10, hex20, hex27, wedge15, pyramid13) agree with it.
+ * The ones meshio also has (tet10, hex20, hex27, pyramid13) agree with it.
  * Gmsh numbers edges differently from VTK (e.g. tet: gmsh edge 5 is 1-3, VTK's 8 is 0-3...),
- * so each type needs its own table; linear and 2D quadratic types agree. */
+ * so each type needs its own table; the other linear and 2D quadratic types agree. */
 static const int perm_tet10[10] = {0, 1, 2, 3, 4, 5, 6, 7, 9, 8};
 static const int perm_hex20[20] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 11, 13, 9, 16, 18, 19, 17, 10, 12, 14, 15};
 static const int perm_hex27[27] = {0,  1,  2,  3,  4,  5,  6,  7,  8,  11, 13, 9,  16, 18,
                                    19, 17, 10, 12, 14, 15, 22, 23, 21, 24, 20, 25, 26};
-static const int perm_wedge15[15] = {0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11};
-static const int perm_wedge18[18] = {0, 1, 2, 3, 4, 5, 6, 9, 7, 12, 14, 13, 8, 10, 11, 15, 17, 16};
+/* Wedges are mirrored as well: gmsh winds the triangle (0,1,2) towards (3,4,5), VTK winds it
+ * away (vtkWedge's documentation; meshio and gmsh's own VTK export swap 1<->2, 4<->5 too),
+ * even though vtkWedge's parametric coordinates follow gmsh. Without the mirror every gmsh
+ * prism reads as inverted. tests/data/msh/check_perm.py recomputes these with the mirror. */
+static const int perm_wedge6[6] = {0, 2, 1, 3, 5, 4};
+static const int perm_wedge15[15] = {0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10};
+static const int perm_wedge18[18] = {0, 2, 1, 3, 5, 4, 7, 9, 6, 13, 14, 12, 8, 11, 10, 16, 17, 15};
 static const int perm_pyr13[13] = {0, 1, 2, 3, 4, 5, 8, 10, 6, 7, 9, 11, 12};
 static const int perm_pyr14[14] = {0, 1, 2, 3, 4, 5, 8, 10, 6, 7, 9, 11, 12, 13};
 
@@ -26,6 +31,7 @@ const int *cm_msh_perm(cm_cell_type type)
     case CM_CELL_TET10: return perm_tet10;
     case CM_CELL_HEX20: return perm_hex20;
     case CM_CELL_HEX27: return perm_hex27;
+    case CM_CELL_WEDGE6: return perm_wedge6;
     case CM_CELL_WEDGE15: return perm_wedge15;
     case CM_CELL_WEDGE18: return perm_wedge18;
     case CM_CELL_PYR13: return perm_pyr13;

@@ -1,0 +1,21 @@
+// three small blocks: extruded recombined (hexes), extruded triangles (prisms), free tets
+SetFactory("Built-in");
+Mesh.CharacteristicLengthMax = 0.5;
+Point(1) = {0, 0, 0}; Point(2) = {1, 0, 0}; Point(3) = {1, 1, 0}; Point(4) = {0, 1, 0};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4}; Plane Surface(1) = {1};
+Transfinite Surface{1}; Recombine Surface{1};
+Transfinite Curve{1, 2, 3, 4} = 3;
+hex[] = Extrude {0, 0, 1} { Surface{1}; Layers{2}; Recombine; };
+Point(101) = {2, 0, 0}; Point(102) = {3, 0, 0}; Point(103) = {3, 1, 0}; Point(104) = {2, 1, 0};
+Line(101) = {101, 102}; Line(102) = {102, 103}; Line(103) = {103, 104}; Line(104) = {104, 101};
+Curve Loop(101) = {101, 102, 103, 104}; Plane Surface(101) = {101};
+pri[] = Extrude {0, 0, 1} { Surface{101}; Layers{2}; Recombine; };
+Point(201) = {4, 0, 0}; Point(202) = {5, 0, 0}; Point(203) = {5, 1, 0}; Point(204) = {4, 1, 0};
+Line(201) = {201, 202}; Line(202) = {202, 203}; Line(203) = {203, 204}; Line(204) = {204, 201};
+Curve Loop(201) = {201, 202, 203, 204}; Plane Surface(201) = {201};
+tet[] = Extrude {0, 0, 1} { Surface{201}; };
+Physical Volume("hexes", 1) = {hex[1]};
+Physical Volume("prisms", 2) = {pri[1]};
+Physical Volume("tets", 3) = {tet[1]};
+Physical Surface("bottom", 10) = {1, 101, 201};
