@@ -1,0 +1,218 @@
+/* cadmorph cad: STEP models through OpenCASCADE — topology, correspondence of G and G',
+ * evaluation, trimmed dense sampling with a kD-tree, projection (paper section 4).
+ * Conventions: see core.h. Faces, edges and vertices are numbered once per model, 0-based,
+ * in OpenCASCADE's TopExp::MapShapes order; a model re-exported after a dimension change
+ * keeps that order, which is what cm_cad_compare verifies.
+ * Lengths are in the model's target unit (cm_cad_read_options.unit, millimetre by default).
+ * Parameters: faces (u, v), edges t, both in OpenCASCADE's parameterisation of the
+ * underlying surface/curve; s in [0, 1] is the normalised arc length along an edge in its
+ * own (forward) direction.
+ */
+#ifndef CADMORPH_CAD_H
+#define CADMORPH_CAD_H
+
+#include "cadmorph/core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct cm_cad_model cm_cad_model;
+
+/* ---- reading and writing ---- */
+
+typedef struct cm_cad_read_options {
+    /* Target length unit of the model coordinates: "mm" (default), "cm", "m", "km", "in",
+     * "ft", "mi", "um". The file's own unit is converted to it. */
+    const char *unit;
+} cm_cad_read_options;
+
+void cm_cad_read_options_init(cm_cad_read_options *opt);
+
+/* Reads a STEP file (all roots transferred into one compound). Errors: CM_ERR_IO (missing,
+ * unreadable), CM_ERR_FORMAT (not STEP, no face in it), CM_ERR_CAD (transfer failed).
+ * opt may be NULL for defaults. */
+cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_options *opt,
+                      cm_cad_model **model);
+/* Writes the model as STEP (AP214) in the model's target unit, via a temporary file. */
+cm_status cm_cad_write(cm_context *ctx, const cm_cad_model *model, const char *path);
+void cm_cad_destroy(cm_cad_model **model);
+
+/* The length unit named in the file ("millimetre", "metre", "inch", ... as the file says;
+ * "" if none) and the target unit of the coordinates ("mm", ...). Owned by the model. */
+const char *cm_cad_file_unit(const cm_cad_model *model);
+const char *cm_cad_unit(const cm_cad_model *model);
+
+/* ---- topology ---- */
+
+typedef struct cm_cad_counts {
+    int solids, shells, faces, wires, edges, vertices;
+} cm_cad_counts;
+
+void cm_cad_get_counts(const cm_cad_model *model, cm_cad_counts *counts);
+
+/* Surface and curve types follow OpenCASCADE's GeomAbs enumerations. */
+typedef enum cm_cad_surface_type {
+    CM_CAD_PLANE = 0, CM_CAD_CYLINDER, CM_CAD_CONE, CM_CAD_SPHERE, CM_CAD_TORUS,
+    CM_CAD_BEZIER_SURFACE, CM_CAD_BSPLINE_SURFACE, CM_CAD_REVOLUTION, CM_CAD_EXTRUSION,
+    CM_CAD_OFFSET_SURFACE, CM_CAD_OTHER_SURFACE
+} cm_cad_surface_type;
+
+typedef enum cm_cad_curve_type {
+    CM_CAD_LINE = 0, CM_CAD_CIRCLE, CM_CAD_ELLIPSE, CM_CAD_HYPERBOLA, CM_CAD_PARABOLA,
+    CM_CAD_BEZIER_CURVE, CM_CAD_BSPLINE_CURVE, CM_CAD_OFFSET_CURVE, CM_CAD_OTHER_CURVE
+} cm_cad_curve_type;
+
+/* "plane", "cylinder", ..., "line", "circle", ... */
+const char *cm_cad_surface_type_name(cm_cad_surface_type type);
+const char *cm_cad_curve_type_name(cm_cad_curve_type type);
+
+typedef struct cm_cad_face_info {
+    cm_cad_surface_type type;
+    double uv_range[4];   /* umin umax vmin vmax of the trimmed face (BRepTools::UVBounds) */
+    int periodic[2];      /* u, v periodic */
+    double period[2];     /* periods (0 if not periodic) */
+    int reversed;         /* face orientation opposite to the surface normal */
+    int n_wires;          /* wire 0 is the outer wire */
+    double area;
+    double bbox[6];       /* xmin ymin zmin xmax ymax zmax */
+} cm_cad_face_info;
+
+typedef struct cm_cad_edge_info {
+    cm_cad_curve_type type;   /* CM_CAD_OTHER_CURVE for degenerate edges */
+    double t_range[2];
+    int vertex[2];            /* first and last vertex (-1 if none) */
+    int degenerate;           /* collapsed edge, e.g. at a sphere pole (no 3D curve) */
+    int closed;               /* first vertex == last vertex */
+    double length;
+    double bbox[6];
+} cm_cad_edge_info;
+
+cm_status cm_cad_face_get_info(cm_context *ctx, const cm_cad_model *model, int face,
+                               cm_cad_face_info *info);
+cm_status cm_cad_edge_get_info(cm_context *ctx, const cm_cad_model *model, int edge,
+                               cm_cad_edge_info *info);
+/* xyz: 3 doubles. */
+cm_status cm_cad_vertex_point(cm_context *ctx, const cm_cad_model *model, int vertex, double *xyz);
+/* Bounding box of the whole model: 6 doubles. */
+void cm_cad_bbox(const cm_cad_model *model, double *bbox);
+
+/* Oriented edges of wire w of a face, in the wire's order. edges/reversed point into the
+ * model (valid until it is destroyed): n entries, edge indices and 1 where the edge runs
+ * against its own direction in this face. A seam edge of a periodic face appears twice,
+ * once each way. */
+cm_status cm_cad_face_wire(cm_context *ctx, const cm_cad_model *model, int face, int wire,
+                           const int **edges, const int **reversed, int *n);
+
+/* Faces adjacent to an edge (1 for a free edge, 2 for a manifold edge, 1 for a seam):
+ * faces points into the model, n entries. */
+cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge,
+                            const int **faces, int *n);
+
+/* G and G' correspond: counts, surface and curve types, edge -> vertices and
+ * face -> wires -> oriented edges all match. CM_OK if so; CM_ERR_MISMATCH with up to
+ * max_report differences in the message ("face 12: plane in G, cylinder in G'") if not. */
+cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+                         int max_report);
+
+/* ---- evaluation (arrays; OpenMP with one adaptor per thread) ---- */
+
+/* uv: n x 2; xyz: n x 3 output; normal: n x 3 unit normals oriented as the face (outward for
+ * the faces of a solid), may be NULL. */
+cm_status cm_cad_face_eval(cm_context *ctx, const cm_cad_model *model, int face, const double *uv,
+                           size_t n, double *xyz, double *normal);
+/* t: n; xyz: n x 3 output. */
+cm_status cm_cad_edge_eval(cm_context *ctx, const cm_cad_model *model, int edge, const double *t,
+                           size_t n, double *xyz);
+/* Trimming: inside[i] = 1 if uv[i] (n x 2) lies in the face's trimmed domain or on its
+ * boundary, 0 outside. Periodic parameters are taken modulo the period. */
+cm_status cm_cad_face_inside(cm_context *ctx, const cm_cad_model *model, int face,
+                             const double *uv, size_t n, int *inside);
+
+/* Arc length: s = length(t_first .. t) / length(edge) and its inverse (GCPnts_AbscissaPoint).
+ * Degenerate edges map linearly between t and s. t, s: n entries. */
+cm_status cm_cad_edge_t_to_s(cm_context *ctx, const cm_cad_model *model, int edge, const double *t,
+                             size_t n, double *s);
+cm_status cm_cad_edge_s_to_t(cm_context *ctx, const cm_cad_model *model, int edge, const double *s,
+                             size_t n, double *t);
+
+/* ---- face boundaries in parameter space ---- */
+
+/* Samples of the (u,v) boundary of a face: for each wire, each oriented edge, per_edge[e]
+ * points at equal arc-length fractions i / per_edge[e], i = 0 .. per_edge[e]-1, taken along
+ * the edge's orientation in the face (so sample i of an edge of G corresponds to sample i of
+ * the same edge of G'). Degenerate edges are sampled uniformly in t. A seam edge gives both
+ * copies (one per pcurve).  All arrays are owned by the struct. */
+typedef struct cm_cad_boundary {
+    size_t n;
+    double *uv;   /* n x 2 */
+    double *xyz;  /* n x 3 (the 3D point of the edge) */
+    int *edge;    /* n */
+    double *s;    /* n: normalised arc length in the edge's own direction */
+    int *wire;    /* n */
+} cm_cad_boundary;
+
+/* per_edge: #edges counts (indexed by edge; at least 1 each), or NULL to use `count` for
+ * every edge. */
+cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model, int face,
+                               const int *per_edge, int count, cm_cad_boundary **boundary);
+void cm_cad_boundary_destroy(cm_cad_boundary **boundary);
+
+/* ---- projection ---- */
+
+/* Onto one face, seeded: uv0 (n x 2, may be NULL: a coarse grid search seeds), Newton on the
+ * surface, kept inside the trimmed domain (a foot point outside the trimming is replaced by
+ * the nearest point on the face's boundary edges). xyz: n x 3. Outputs uv: n x 2, dist: n,
+ * foot: n x 3; each may be NULL. */
+cm_status cm_cad_project_face(cm_context *ctx, const cm_cad_model *model, int face,
+                              const double *xyz, size_t n, const double *uv0, double *uv,
+                              double *dist, double *foot);
+/* Onto one edge (global search on the curve, then Newton): t, dist: n. */
+cm_status cm_cad_project_edge(cm_context *ctx, const cm_cad_model *model, int edge,
+                              const double *xyz, size_t n, double *t, double *dist);
+
+/* Dense samples of the trimmed faces plus a kD-tree on them, for projections of many points. */
+typedef struct cm_cad_locator cm_cad_locator;
+
+typedef struct cm_cad_sample_options {
+    /* Target 3D spacing; <= 0: bbox diagonal / 200. For projecting a mesh, pass a quarter of
+     * its smallest boundary edge (the CAD layer knows no mesh). */
+    double h;
+    size_t max_samples;  /* cap; 0: 20,000,000. If h would exceed it, h grows and the
+                            create call returns CM_WARNING saying so. */
+} cm_cad_sample_options;
+
+void cm_cad_sample_options_init(cm_cad_sample_options *opt);
+
+/* Samples every face inside its trimmed domain on a grid whose step adapts to the surface
+ * metric (3D spacing close to h) plus points on every edge (each with the uv of its pcurve in
+ * each adjacent face), then builds the kD-trees. The model must outlive the locator. */
+cm_status cm_cad_locator_create(cm_context *ctx, const cm_cad_model *model,
+                                const cm_cad_sample_options *opt, cm_cad_locator **locator);
+void cm_cad_locator_destroy(cm_cad_locator **locator);
+
+/* The samples: n, and borrowed arrays xyz (n x 3), face (n), uv (n x 2); h actually used. */
+size_t cm_cad_locator_samples(const cm_cad_locator *locator, const double **xyz,
+                              const int **face, const double **uv);
+double cm_cad_locator_h(const cm_cad_locator *locator);
+
+/* Nearest face of each point (paper section 4): the nearest sample is the start value of a
+ * Newton projection onto its face; the faces of the next nearest samples (up to 4 samples,
+ * within h of the nearest) are projected onto too, and the closest foot point wins. The foot
+ * stays in the trimmed domain (outside it, the nearest point of the face's boundary edges is
+ * taken). Periodic u, v are returned in the face's range. face: n (0-based), uv: n x 2,
+ * dist: n, foot: n x 3; each output may be NULL. */
+cm_status cm_cad_locate_faces(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
+                              size_t n, int *face, double *uv, double *dist, double *foot);
+/* Nearest edge of each point (a kD-tree on edge samples, then Newton on the curves of the
+ * nearest samples' edges): edge (0-based), t, dist: n. s follows from cm_cad_edge_t_to_s. */
+cm_status cm_cad_locate_edges(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
+                              size_t n, int *edge, double *t, double *dist);
+/* Nearest vertex of each point: vertex, dist: n. */
+cm_status cm_cad_locate_vertices(cm_context *ctx, const cm_cad_locator *locator,
+                                 const double *xyz, size_t n, int *vertex, double *dist);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

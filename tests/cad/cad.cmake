@@ -1,0 +1,37 @@
+# Tests of cad/: shapes built in code with OpenCASCADE (gen_shapes, C++) and written as STEP
+# into the work dir, gmsh-written STEP fixtures in tests/data/cad; assertions go through the
+# C API (cadmorph/cad.h) or the CLI.
+set(CM_CAD_WORK ${CM_TEST_WORK}/cad)
+file(MAKE_DIRECTORY ${CM_CAD_WORK})
+
+add_executable(gen_shapes gen_shapes.cpp)
+target_link_libraries(gen_shapes PRIVATE cm_warnings cm_occ)
+add_test(NAME cad_gen_shapes COMMAND gen_shapes ${CM_CAD_WORK})
+set_tests_properties(cad_gen_shapes PROPERTIES FIXTURES_SETUP cad_shapes LABELS "unit;cad")
+
+foreach(t model project sample boundary)
+  cm_add_unit_test(test_cad_${t} test_cad_${t}.c LIBS cm_cad LABELS cad)
+  set_tests_properties(test_cad_${t} PROPERTIES FIXTURES_REQUIRED cad_shapes)
+endforeach()
+
+# cadmorph info: exit codes and one-line messages on real files.
+set(CM_EXPECT ${CMAKE_CURRENT_LIST_DIR}/expect_exit.cmake)
+function(cm_cad_cli name code regex)
+  add_test(NAME ${name} COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:cadmorph> "-DARGS=${ARGN}"
+           -DCODE=${code} "-DREGEX=${regex}" -P ${CM_EXPECT})
+  set_tests_properties(${name} PROPERTIES LABELS "cad;cli" FIXTURES_REQUIRED cad_shapes)
+endfunction()
+set(D ${CM_TEST_DATA}/cad)
+cm_cad_cli(cad_cli_info 0 "faces 9 +wires [0-9]+ +edges [0-9]+ +vertices" info ${D}/bore_a.step)
+cm_cad_cli(cad_cli_info_unit 0 "unit: m " info ${D}/bore_a.step --cad-unit m)
+cm_cad_cli(cad_cli_compare_same 0 "correspond" info ${D}/bore_a.step --compare ${D}/bore_b.step)
+cm_cad_cli(cad_cli_compare_hole 2 "^cadmorph info: .*faces: 9 in G, 10 in G'" info ${D}/bore_a.step --compare ${D}/bore_2holes.step)
+cm_cad_cli(cad_cli_missing 2 "^cadmorph info: .*no_such.step: No such file" info ${CM_CAD_WORK}/no_such.step)
+cm_cad_cli(cad_cli_not_step 2 "^cadmorph info: .*not a STEP file" info ${CM_CAD_WORK}/not_step.step)
+cm_cad_cli(cad_cli_no_solid 2 "^cadmorph info: .*no solid, shell or face" info ${CM_CAD_WORK}/edge_only.step)
+cm_cad_cli(cad_cli_broken 2 "^cadmorph info: .*broken.step: " info ${D}/broken.step)
+cm_cad_cli(cad_cli_usage 1 "usage" info)
+cm_cad_cli(cad_cli_bad_unit 1 "unknown length unit" info ${D}/bore_a.step --cad-unit parsec)
+
+# The benchmark builds with the tests until benchmarks/CMakeLists.txt includes it.
+include(${PROJECT_SOURCE_DIR}/benchmarks/bench_cad.cmake)

@@ -1,0 +1,144 @@
+// Test generator: builds shapes with OpenCASCADE, writes them as STEP into the work dir, and
+// writes points near each shape with their expected projection (built as P = S(u,v) + d N
+// with N the outward normal, so the foot point, (u,v) and distance are known by construction).
+// Also writes the bad inputs the CLI must refuse. The assertions live in the C tests.
+#include <BRepAlgoAPI_Cut.hxx>
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepClass_FaceClassifier.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRepPrimAPI_MakeSphere.hxx>
+#include <BRepPrimAPI_MakeTorus.hxx>
+#include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <GeomAPI_PointsToBSplineSurface.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <Interface_Static.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <STEPControl_Writer.hxx>
+#include <Standard_Failure.hxx>
+#include <TColgp_Array2OfPnt.hxx>
+#include <TopExp.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Shell.hxx>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+static bool write_step(const TopoDS_Shape &s, const std::string &path)
+{
+    STEPControl_Writer w;
+    if (w.Transfer(s, STEPControl_AsIs) != IFSelect_RetDone) return false;
+    return w.Write(path.c_str()) == IFSelect_RetDone;
+}
+
+// n points: random face (by area share ~ equal per face), random (u,v) inside its trimming,
+// offset d in [0, dmax] along the outward normal (both signs if two_sided).
+static bool write_points(const TopoDS_Shape &s, const std::string &path, int n, double dmax,
+                         bool two_sided, unsigned seed)
+{
+    TopTools_IndexedMapOfShape faces;
+    TopExp::MapShapes(s, TopAbs_FACE, faces);
+    FILE *f = fopen(path.c_str(), "w");
+    if (!f) return false;
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    fprintf(f, "# x y z face u v dist fx fy fz\n");
+    for (int i = 0; i < n;) {
+        int k = (int)(U(rng) * faces.Extent());
+        TopoDS_Face face = TopoDS::Face(faces(k + 1));
+        double u0, u1, v0, v1;
+        BRepTools::UVBounds(face, u0, u1, v0, v1);
+        double u = u0 + (u1 - u0) * U(rng), v = v0 + (v1 - v0) * U(rng);
+        BRepClass_FaceClassifier cl(face, gp_Pnt2d(u, v), 1e-9);
+        if (cl.State() != TopAbs_IN) continue;
+        BRepAdaptor_Surface S(face);
+        gp_Pnt p;
+        gp_Vec du, dv;
+        S.D1(u, v, p, du, dv);
+        gp_Vec nrm = du.Crossed(dv);
+        if (nrm.Magnitude() < 1e-6) continue;  // near a pole the normal is ill-defined
+        nrm.Normalize();
+        if (face.Orientation() == TopAbs_REVERSED) nrm.Reverse();
+        // a tenth of the points lie on the surface, as mesh nodes do
+        double d = (i % 10 == 0) ? 0.0 : dmax * U(rng);
+        if (two_sided && U(rng) < 0.5) d = -d;
+        gp_Pnt q = p.Translated(nrm * d);
+        fprintf(f, "%.17g %.17g %.17g %d %.17g %.17g %.17g %.17g %.17g %.17g\n", q.X(), q.Y(),
+                q.Z(), k, u, v, std::fabs(d), p.X(), p.Y(), p.Z());
+        ++i;
+    }
+    return fclose(f) == 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: gen_shapes OUTDIR\n");
+        return 1;
+    }
+    Message::DefaultMessenger()->ChangePrinters().Clear();
+    Interface_Static::SetCVal("write.step.schema", "AP214IS");
+    std::string dir = argv[1];
+    try {
+        const int n = 10000;
+        TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(-1, -2, -0.5), 3, 4, 2).Shape();
+        TopoDS_Shape cyl =
+            BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(1, 2, 3), gp_Dir(0, 0, 1)), 2, 5).Shape();
+        TopoDS_Shape sph = BRepPrimAPI_MakeSphere(gp_Pnt(0.5, -1, 2), 3).Shape();
+        TopoDS_Shape tor =
+            BRepPrimAPI_MakeTorus(gp_Ax2(gp_Pnt(1, 1, 1), gp_Dir(0, 0, 1)), 5, 1.5).Shape();
+        TopoDS_Shape block = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 10, 8, 4).Shape();
+        TopoDS_Shape bore =
+            BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(5, 4, -1), gp_Dir(0, 0, 1)), 2, 6).Shape();
+        TopoDS_Shape holed = BRepAlgoAPI_Cut(block, bore).Shape();
+
+        TColgp_Array2OfPnt pts(1, 8, 1, 8);
+        for (int i = 1; i <= 8; ++i)
+            for (int j = 1; j <= 8; ++j) {
+                double x = 4.0 * (i - 1) / 7, y = 3.0 * (j - 1) / 7;
+                pts(i, j) = gp_Pnt(x, y, 0.3 * std::sin(x) * std::cos(1.3 * y));
+            }
+        Handle(Geom_BSplineSurface) bs = GeomAPI_PointsToBSplineSurface(pts).Surface();
+        TopoDS_Face bface = BRepBuilderAPI_MakeFace(bs, 1e-7).Face();
+        TopoDS_Shell shell;
+        BRep_Builder bb;
+        bb.MakeShell(shell);
+        bb.Add(shell, bface);
+
+        struct {
+            const char *name;
+            TopoDS_Shape s;
+            double dmax;
+            bool two;
+        } shapes[] = {{"box", box, 0.3, false},   {"cylinder", cyl, 0.2, false},
+                      {"sphere", sph, 0.3, false}, {"torus", tor, 0.15, false},
+                      {"holed", holed, 0.2, false}, {"bspline", shell, 0.05, true}};
+        unsigned seed = 1;
+        for (auto &s : shapes) {
+            std::string base = dir + "/" + s.name;
+            if (!write_step(s.s, base + ".step") ||
+                !write_points(s.s, base + ".pts", n, s.dmax, s.two, seed++)) {
+                fprintf(stderr, "gen_shapes: cannot write %s\n", base.c_str());
+                return 1;
+            }
+        }
+        // bad inputs: a STEP with only an edge (no solid, shell or face), a text file
+        TopoDS_Shape edge = BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(1, 2, 3)).Shape();
+        if (!write_step(edge, dir + "/edge_only.step")) return 1;
+        FILE *t = fopen((dir + "/not_step.step").c_str(), "w");
+        if (!t) return 1;
+        fprintf(t, "This is a text file, not a STEP file.\nsolid box\nendsolid\n");
+        fclose(t);
+    } catch (const Standard_Failure &e) {
+        fprintf(stderr, "gen_shapes: OpenCASCADE: %s\n", e.GetMessageString());
+        return 1;
+    }
+    return 0;
+}
