@@ -3,7 +3,7 @@
 # usage: benchmarks/bench_quality.sh [BUILD_DIR]   (default: build)
 # Generates BUILD_DIR/bench/box_1m.msh once (gmsh, binary msh 4.1; not committed), then times
 # the whole command with /usr/bin/time -v (wall time, peak memory) at 1 and 2 threads, and
-# the stages alone with bench_quality.c (compiled here against the build's static libraries).
+# the stages alone with bench_quality (built with the project).
 set -eu
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=$(cd "${1:-$ROOT/build}" && pwd)
@@ -28,8 +28,6 @@ gmsh.write(sys.argv[1])
 gmsh.finalize()
 PY
 fi
-cc -O2 -fopenmp -I"$ROOT/include" "$ROOT/benchmarks/bench_quality.c" \
-  "$BUILD/mesh/libcm_mesh.a" "$BUILD/core/libcm_core.a" -lz -lm -o "$OUT/bench_quality"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p')"
 ls -l "$MESH"
 for t in 1 2; do
@@ -37,5 +35,5 @@ for t in 1 2; do
   /usr/bin/time -v "$BUILD/cli/cadmorph" quality "$MESH" --threads $t 2> "$OUT/time_$t.txt"
   grep -E "Elapsed \(wall|Maximum resident|User time|System time" "$OUT/time_$t.txt"
   echo "== stages, $t threads"
-  "$OUT/bench_quality" "$MESH" $t
+  "$BUILD/benchmarks/bench_quality" "$MESH" $t
 done

@@ -8,6 +8,5 @@ add_test(NAME test_vtk_crosscheck
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_vtk_crosscheck.py ${CM_TEST_DATA} ${CM_TEST_WORK})
 set_tests_properties(test_vtk_crosscheck PROPERTIES FIXTURES_REQUIRED vtk_outputs LABELS "unit")
 cm_add_unit_test(test_vtk_errors test_vtk_errors.c LIBS cm_mesh)
-cm_add_unit_test(test_vtk_perf test_vtk_perf.c LIBS cm_mesh LABELS slow)
 # gmsh .msh (read by msh_read.c) -> .vtu -> read, and against gmsh's own .vtk export
 cm_add_unit_test(test_vtk_msh_cross test_vtk_msh_cross.c LIBS cm_mesh)
