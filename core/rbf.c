@@ -1,0 +1,571 @@
+/* RBF interpolation with polyharmonic kernels and a linear polynomial (paper section 3, 3D;
+ * section 4, 2D thin plate): fit by null-space projection + Cholesky, solve, evaluate.
+ *
+ * Why the projection: the saddle-point system [A P; P' 0] is indefinite, but A is
+ * conditionally positive definite on the null space of P'. With P = QR (Householder),
+ * Q = [Q1 Q2] and w = Q2 z, the system becomes (Q2' A Q2) z = Q2' f, SPD for r^3 and
+ * r^2 log r, negative definite for r; then R q = Q1'(f - A w). Q = I - V T V' (compact WY),
+ * so Q' A Q = A - V Z' - Z V' with W = A V and Z = W T - V (T' V' W T) / 2: one pass of
+ * kernel sums for W and one pass that writes the projected block directly, so no m x m
+ * copy of A is ever stored and the only O(m^3) step is the Cholesky factorisation. That
+ * factor is kept in LAPACK's rectangular full packed format (dpftrf/dpftrs): half the
+ * memory of full storage at the same BLAS-3 speed, which matters twice here: m = 20k takes
+ * 1.6 GB instead of 3.2 GB, and first touch of fresh memory costs seconds per GB on the VMs
+ * we run on. */
+#if defined(__linux__) && !defined(_DEFAULT_SOURCE)
+#define _DEFAULT_SOURCE /* madvise(MADV_HUGEPAGE) */
+#endif
+#include "rbf_internal.h"
+
+#include <cblas.h>
+#include <lapacke.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
+/* Centres closer than this times the bounding-box diagonal are one centre. */
+#define CM_RBF_MERGE_TOL 1e-12
+/* |R_ii| below this times max |R_jj|: the polynomial block is singular. */
+#define CM_RBF_UNISOLVENT_TOL 1e-10
+/* Merged centres must carry values that agree to this, relative to the largest value. */
+#define CM_RBF_VALUE_TOL 1e-12
+
+/* The m x m factor: on 2 MB boundaries, marked for transparent huge pages and populated by
+ * one madvise call. On the VMs we run on, first touch of fresh memory page by page cost
+ * about as much as assembling the matrix; populating it in the kernel in one call is
+ * cheaper, and huge pages also spare dpftrf TLB misses. Both are hints: if they fail, the
+ * memory is simply faulted in on first touch. */
+static double *alloc_matrix(size_t count)
+{
+    size_t bytes = count * sizeof(double);
+    const size_t huge = (size_t)2 << 20;
+    if (bytes < huge) return malloc(bytes ? bytes : 1);
+    bytes = (bytes + huge - 1) / huge * huge;
+    double *p = aligned_alloc(huge, bytes);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    if (p) (void)madvise(p, bytes, MADV_HUGEPAGE);
+#endif
+#if defined(__linux__)
+#ifndef MADV_POPULATE_WRITE
+#define MADV_POPULATE_WRITE 23 /* Linux 5.14; older kernels return EINVAL, harmless */
+#endif
+    if (p) (void)madvise(p, bytes, MADV_POPULATE_WRITE);
+#endif
+    return p;
+}
+
+/* OpenBLAS threads: many for the O(m^3) dpftrf only. Its idle workers spin (sched_yield)
+ * for ~0.1 s after each threaded call and then compete with our OpenMP loops for the cores,
+ * so the small O(m k) and O(m^2) LAPACK calls run on one thread. create and solve restore
+ * the caller's setting before they return. */
+static void blas_threads(int n) { openblas_set_num_threads(n > 0 ? n : 1); }
+
+static const char *kernel_name(cm_rbf_kernel k)
+{
+    switch (k) {
+    case CM_RBF_TRIHARMONIC: return "triharmonic";
+    case CM_RBF_BIHARMONIC: return "biharmonic";
+    case CM_RBF_THIN_PLATE: return "thin-plate";
+    }
+    return "unknown";
+}
+
+void cm_rbf_destroy(cm_rbf **rbf)
+{
+    if (!rbf || !*rbf) return;
+    cm_rbf *r = *rbf;
+    free(r->c);
+    free(r->rep);
+    free(r->first);
+    free(r->qr);
+    free(r->tau);
+    free(r->chol);
+    free(r->w);
+    free(r->q);
+    free(r);
+    *rbf = NULL;
+}
+
+size_t cm_rbf_centre_count(const cm_rbf *rbf) { return rbf ? rbf->m : 0; }
+
+/* Unit-box map and merging; fills r->c, rep, first, m. */
+static cm_status place_centres(cm_context *ctx, cm_rbf *r, const double *centres)
+{
+    const int dim = r->dim;
+    const size_t m_in = r->m_in;
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (size_t i = 0; i < m_in; ++i) {
+        for (int d = 0; d < dim; ++d) {
+            double x = centres[i * (size_t)dim + (size_t)d];
+            if (!isfinite(x))
+                return cm_error(ctx, CM_ERR_NUMERIC,
+                                "cm_rbf_create: centre %zu coordinate %d is not finite", i, d);
+            if (i == 0 || x < lo[d]) lo[d] = x;
+            if (i == 0 || x > hi[d]) hi[d] = x;
+        }
+    }
+    double extent = 0.0, diag2 = 0.0;
+    for (int d = 0; d < dim; ++d) {
+        extent = fmax(extent, hi[d] - lo[d]);
+        diag2 += (hi[d] - lo[d]) * (hi[d] - lo[d]);
+    }
+    if (!(extent > 0.0))
+        return cm_error(ctx, CM_ERR_NUMERIC,
+                        "cm_rbf_create: all %zu centres coincide; a linear polynomial needs "
+                        "%d centres in general position",
+                        m_in, dim + 1);
+    /* one scale for all axes keeps distances (and so the kernel) isotropic */
+    r->scale = 1.0 / extent;
+    for (int d = 0; d < 3; ++d) r->shift[d] = d < dim ? lo[d] : 0.0;
+
+    double *tmp = malloc(m_in * (size_t)dim * sizeof *tmp);
+    r->rep = malloc(m_in * sizeof *r->rep);
+    r->first = malloc(m_in * sizeof *r->first);
+    if (!tmp || !r->rep || !r->first) {
+        free(tmp);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory for %zu centres", m_in);
+    }
+    for (size_t i = 0; i < m_in; ++i)
+        for (int d = 0; d < dim; ++d)
+            tmp[(size_t)d * m_in + i] = (centres[i * (size_t)dim + (size_t)d] - lo[d]) * r->scale;
+
+    const double tol = CM_RBF_MERGE_TOL * sqrt(diag2) * r->scale;
+    long mm = cm_rbf_merge_duplicates(dim, m_in, tmp, tol, r->rep, r->first);
+    if (mm < 0) {
+        free(tmp);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory merging centres");
+    }
+    r->m = (size_t)mm;
+    r->c = malloc(r->m * (size_t)dim * sizeof *r->c);
+    if (!r->c) {
+        free(tmp);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory for %zu centres", r->m);
+    }
+    for (int d = 0; d < dim; ++d)
+        for (size_t u = 0; u < r->m; ++u)
+            r->c[(size_t)d * r->m + u] = tmp[(size_t)d * m_in + r->first[u]];
+    free(tmp);
+    if (r->m < m_in)
+        cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_create: merged %zu duplicate centres (%zu left)",
+               m_in - r->m, r->m);
+    return CM_OK;
+}
+
+/* P = QR and the unisolvency check. */
+static cm_status factor_polynomial(cm_context *ctx, cm_rbf *r)
+{
+    const size_t m = r->m;
+    const int k = r->k;
+    r->qr = malloc(m * (size_t)k * sizeof *r->qr);
+    r->tau = malloc((size_t)k * sizeof *r->tau);
+    if (!r->qr || !r->tau) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+    for (size_t i = 0; i < m; ++i) r->qr[i] = 1.0;
+    memcpy(r->qr + m, r->c, m * (size_t)r->dim * sizeof *r->qr);
+    blas_threads(1);
+    lapack_int info = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, (lapack_int)m, k, r->qr, (lapack_int)m,
+                                     r->tau);
+    if (info != 0)
+        return cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: dgeqrf failed (info %d)",
+                        (int)info);
+    double rmax = 0.0;
+    for (int i = 0; i < k; ++i) rmax = fmax(rmax, fabs(r->qr[(size_t)i * m + (size_t)i]));
+    for (int i = 0; i < k; ++i) {
+        if (!(fabs(r->qr[(size_t)i * m + (size_t)i]) > CM_RBF_UNISOLVENT_TOL * rmax))
+            return cm_error(ctx, CM_ERR_NUMERIC,
+                            "cm_rbf_create: the %zu centres are all %s, so the linear "
+                            "polynomial is not determined (|R_%d%d| = %.3g vs max %.3g)",
+                            m, r->dim == 3 ? "coplanar (or collinear)" : "collinear", i, i,
+                            fabs(r->qr[(size_t)i * m + (size_t)i]), rmax);
+    }
+    return CM_OK;
+}
+
+/* For the message when the Cholesky factorisation fails: two centres closer than 1e-6 of the unit box (input
+ * indices a, b; dist in unit-box units). Returns 0 if there are none. */
+static int closest_pair(const cm_rbf *r, size_t *a, size_t *b, double *dist)
+{
+    int found = 0;
+    size_t *rep = malloc(r->m * sizeof *rep), *first = malloc(r->m * sizeof *first);
+    if (rep && first && cm_rbf_merge_duplicates(r->dim, r->m, r->c, 1e-6, rep, first) < (long)r->m) {
+        for (size_t u = 0; u < r->m && !found; ++u) {
+            size_t v = first[rep[u]];
+            if (v == u) continue;
+            double d2 = 0.0;
+            for (int d = 0; d < r->dim; ++d) {
+                double t = r->c[(size_t)d * r->m + u] - r->c[(size_t)d * r->m + v];
+                d2 += t * t;
+            }
+            *a = r->first[v];
+            *b = r->first[u];
+            *dist = sqrt(d2);
+            found = 1;
+        }
+    }
+    free(rep);
+    free(first);
+    return found;
+}
+
+/* Builds sign * Q2' A Q2 (lower triangle, packed) and factors it. */
+static cm_status factor_projected(cm_context *ctx, cm_rbf *r, int threads)
+{
+    const size_t m = r->m;
+    const int k = r->k;
+    const size_t n2 = m - (size_t)k;
+    if (n2 == 0) return CM_OK; /* k centres: the interpolant is the linear polynomial */
+    /* LAPACK's 32-bit indices address the packed factor up to n(n+1)/2 < 2^31 */
+    if (n2 > 60000)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "cm_rbf_create: %zu centres is too many for one dense system (at most "
+                        "60000; split the mesh into components)",
+                        m);
+
+    cm_status st = CM_OK;
+    double *v = calloc(m * (size_t)k, sizeof *v);
+    double *wv = malloc(m * (size_t)k * sizeof *wv);
+    double *z = malloc(m * (size_t)k * sizeof *z);
+    double t[16] = {0}, s[16] = {0}, vw[16] = {0}, tmp[16] = {0};
+    double ta = cm_wtime();
+    r->chol = alloc_matrix(n2 * (n2 + 1) / 2);
+    ta = cm_wtime() - ta;
+    if (!v || !wv || !z || !r->chol) {
+        st = cm_error(ctx, CM_ERR_NOMEM,
+                      "cm_rbf_create: out of memory for the %zu x %zu system (%.2f GB)", n2, n2,
+                      (double)n2 * (double)(n2 + 1) * 4e-9);
+        goto done;
+    }
+    /* explicit V: unit diagonal, zeros above */
+    for (int q = 0; q < k; ++q) {
+        v[(size_t)q * m + (size_t)q] = 1.0;
+        for (size_t i = (size_t)q + 1; i < m; ++i) v[(size_t)q * m + i] = r->qr[(size_t)q * m + i];
+    }
+    lapack_int info = LAPACKE_dlarft(LAPACK_COL_MAJOR, 'F', 'C', (lapack_int)m, k, v,
+                                     (lapack_int)m, r->tau, t, k);
+    if (info != 0) {
+        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: dlarft failed (info %d)", (int)info);
+        goto done;
+    }
+    double t0 = cm_wtime();
+    /* W = A V (row-major m x k), by kernel sums: A is never stored */
+    cm_rbf_kernel_sum(r->kernel, r->dim, m, r->c, v, k, m, r->c, m, wv, (size_t)k, threads);
+    /* vw = V' W (k x k), s = T' vw T */
+    for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) {
+            double acc = 0.0;
+            for (size_t i = 0; i < m; ++i) acc += v[(size_t)a * m + i] * wv[i * (size_t)k + (size_t)b];
+            vw[a * k + b] = acc;
+        }
+    for (int a = 0; a < k; ++a) /* tmp = vw T; t is col-major upper: T(i,j) = t[i + j k] */
+        for (int b = 0; b < k; ++b) {
+            double acc = 0.0;
+            for (int c = 0; c < k; ++c) acc += vw[a * k + c] * t[c + b * k];
+            tmp[a * k + b] = acc;
+        }
+    for (int a = 0; a < k; ++a)
+        for (int b = 0; b < k; ++b) {
+            double acc = 0.0;
+            for (int c = 0; c < k; ++c) acc += t[c + a * k] * tmp[c * k + b];
+            s[a * k + b] = acc;
+        }
+    /* Z = W T - V s / 2 (col-major m x k) */
+    for (size_t i = 0; i < m; ++i)
+        for (int b = 0; b < k; ++b) {
+            double acc = 0.0;
+            for (int c = 0; c < k; ++c)
+                acc += wv[i * (size_t)k + (size_t)c] * t[c + b * k] - 0.5 * v[(size_t)c * m + i] * s[c * k + b];
+            z[(size_t)b * m + i] = acc;
+        }
+    cm_rbf_assemble_projected(r->kernel, r->dim, m, r->c, k, v, z, r->sign, r->chol, threads);
+    double t1 = cm_wtime();
+
+    blas_threads(threads);
+    cm_progress(ctx, "rbf factor", 0.0, 1.0);
+    info = LAPACKE_dpftrf_work(LAPACK_COL_MAJOR, 'N', 'L', (lapack_int)n2, r->chol);
+    cm_progress(ctx, "rbf factor", 1.0, 1.0);
+    double t2 = cm_wtime();
+    blas_threads(1);
+    cm_log(ctx, CM_LOG_DEBUG,
+           "cm_rbf_create: %zu centres, %d threads: memory %.3f s, projection + assembly %.3f s, "
+           "dpftrf %.3f s",
+           m, threads, ta, t1 - t0, t2 - t1);
+    if (info > 0) {
+        size_t a, b;
+        double dist;
+        if (closest_pair(r, &a, &b, &dist))
+            st = cm_error(ctx, CM_ERR_NUMERIC,
+                          "cm_rbf_create: Cholesky of the projected %zu x %zu %s system failed "
+                          "at pivot %d (not definite): centres %zu and %zu are only %.3g apart "
+                          "(%.2g of the bounding box), too close to resolve but not close "
+                          "enough to merge; merge or remove near-duplicate centres",
+                          n2, n2, kernel_name(r->kernel), (int)info, a, b, dist / r->scale,
+                          dist);
+        else
+            st = cm_error(ctx, CM_ERR_NUMERIC,
+                          "cm_rbf_create: Cholesky of the projected %zu x %zu %s system failed "
+                          "at pivot %d (not definite): most likely near-duplicate centres "
+                          "(closer than about 1e-6 of the bounding box but not merged)",
+                          n2, n2, kernel_name(r->kernel), (int)info);
+    } else if (info < 0) {
+        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: dpftrf argument %d invalid",
+                      (int)-info);
+    }
+done:
+    free(v);
+    free(wv);
+    free(z);
+    return st;
+}
+
+cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
+                        const double *centres, cm_rbf **rbf)
+{
+    if (!rbf) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: rbf is NULL");
+    *rbf = NULL;
+    if (kernel != CM_RBF_TRIHARMONIC && kernel != CM_RBF_BIHARMONIC &&
+        kernel != CM_RBF_THIN_PLATE)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: unknown kernel %d", (int)kernel);
+    int want = kernel == CM_RBF_THIN_PLATE ? 2 : 3;
+    if (dim != want)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: the %s kernel needs dim %d, got %d",
+                        kernel_name(kernel), want, dim);
+    if (m > 0 && !centres) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: centres is NULL");
+    if (m < (size_t)dim + 1)
+        return cm_error(ctx, CM_ERR_NUMERIC,
+                        "cm_rbf_create: %zu centres, but a linear polynomial in %d dimensions "
+                        "needs at least %d",
+                        m, dim, dim + 1);
+
+    cm_rbf *r = calloc(1, sizeof *r);
+    if (!r) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+    r->kernel = kernel;
+    r->dim = dim;
+    r->k = dim + 1;
+    r->m_in = m;
+    r->sign = kernel == CM_RBF_BIHARMONIC ? -1.0 : 1.0;
+    const int threads = cm_rbf_threads(ctx);
+    const int saved_blas_threads = openblas_get_num_threads();
+
+    cm_status st = place_centres(ctx, r, centres);
+    if (st == CM_OK && r->m < (size_t)r->k)
+        st = cm_error(ctx, CM_ERR_NUMERIC,
+                      "cm_rbf_create: only %zu distinct centres after merging duplicates; a "
+                      "linear polynomial in %d dimensions needs at least %d",
+                      r->m, dim, dim + 1);
+    if (st == CM_OK) st = factor_polynomial(ctx, r);
+    if (st == CM_OK) st = factor_projected(ctx, r, threads);
+    openblas_set_num_threads(saved_blas_threads);
+    if (st != CM_OK) {
+        cm_rbf_destroy(&r);
+        return st;
+    }
+    *rbf = r;
+    return CM_OK;
+}
+
+/* Kernel sums for any number of components, four at a time. */
+static void kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
+                           const double *p, size_t ldp, double *out, int threads)
+{
+    for (int g = 0; g < ncomp; g += 4) {
+        int nc = ncomp - g < 4 ? ncomp - g : 4;
+        cm_rbf_kernel_sum(r->kernel, r->dim, r->m, r->c, w + (size_t)g * r->m, nc, n, p, ldp,
+                          out + g, (size_t)ncomp, threads);
+    }
+}
+
+/* Refuses merged centres whose values disagree. */
+static cm_status check_merged_values(cm_context *ctx, const cm_rbf *r, int ncomp,
+                                     const double *values)
+{
+    double vmax = 0.0;
+    for (size_t i = 0; i < r->m_in * (size_t)ncomp; ++i) {
+        if (!isfinite(values[i]))
+            return cm_error(ctx, CM_ERR_NUMERIC,
+                            "cm_rbf_solve: value %d of centre %zu is not finite",
+                            (int)(i % (size_t)ncomp), i / (size_t)ncomp);
+        vmax = fmax(vmax, fabs(values[i]));
+    }
+    const double tol = CM_RBF_VALUE_TOL * vmax;
+    for (size_t i = 0; i < r->m_in; ++i) {
+        size_t j = r->first[r->rep[i]];
+        if (j == i) continue;
+        for (int q = 0; q < ncomp; ++q) {
+            double a = values[j * (size_t)ncomp + (size_t)q];
+            double b = values[i * (size_t)ncomp + (size_t)q];
+            if (fabs(a - b) > tol)
+                return cm_error(ctx, CM_ERR_NUMERIC,
+                                "cm_rbf_solve: centres %zu and %zu coincide (merged as "
+                                "duplicates) but their values differ: component %d is %.17g "
+                                "vs %.17g",
+                                j, i, q, a, b);
+        }
+    }
+    return CM_OK;
+}
+
+/* One pass of the projected solve: f (m x nc col-major) -> w (nc x m SoA, i.e. m x nc
+ * col-major) and q (nc x k); aw receives A w (row-major m x nc), g is m x nc scratch. */
+static cm_status solve_pass(cm_context *ctx, const cm_rbf *r, size_t nc, const double *f,
+                            double *w, double *q, double *aw, double *g, int threads)
+{
+    const size_t m = r->m;
+    const int k = r->k;
+    const size_t n2 = m - (size_t)k;
+    memcpy(w, f, m * nc * sizeof *w);
+    lapack_int info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', (lapack_int)m, (lapack_int)nc,
+                                     k, r->qr, (lapack_int)m, r->tau, w, (lapack_int)m);
+    if (info == 0 && n2 > 0)
+        info = LAPACKE_dpftrs_work(LAPACK_COL_MAJOR, 'N', 'L', (lapack_int)n2, (lapack_int)nc,
+                                   r->chol, w + k, (lapack_int)m);
+    /* w = Q [0; sign z] */
+    for (size_t c = 0; c < nc && info == 0; ++c) {
+        for (int i = 0; i < k; ++i) w[c * m + (size_t)i] = 0.0;
+        for (size_t i = (size_t)k; i < m; ++i) w[c * m + i] *= r->sign;
+    }
+    if (info == 0)
+        info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'N', (lapack_int)m, (lapack_int)nc, k,
+                              r->qr, (lapack_int)m, r->tau, w, (lapack_int)m);
+    if (info != 0)
+        return cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_solve: LAPACK failed (info %d)", (int)info);
+    /* R q = Q1'(f - A w), with A w by kernel sums at the centres */
+    kernel_sum_all(r, w, (int)nc, m, r->c, m, aw, threads);
+    for (size_t u = 0; u < m; ++u)
+        for (size_t c = 0; c < nc; ++c) g[c * m + u] = f[c * m + u] - aw[u * nc + c];
+    info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', (lapack_int)m, (lapack_int)nc, k, r->qr,
+                          (lapack_int)m, r->tau, g, (lapack_int)m);
+    if (info != 0)
+        return cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_solve: dormqr failed (info %d)", (int)info);
+    for (size_t c = 0; c < nc; ++c) {
+        for (int i = k - 1; i >= 0; --i) {
+            double acc = g[c * m + (size_t)i];
+            for (int j = i + 1; j < k; ++j)
+                acc -= r->qr[(size_t)j * m + (size_t)i] * q[c * (size_t)k + (size_t)j];
+            q[c * (size_t)k + (size_t)i] = acc / r->qr[(size_t)i * m + (size_t)i];
+        }
+    }
+    return CM_OK;
+}
+
+/* res = f - A w - P q at the centres (col-major m x nc); returns max |res|. */
+static double residual(const cm_rbf *r, size_t nc, const double *f, const double *aw,
+                       const double *q, double *res)
+{
+    const size_t m = r->m, k = (size_t)r->k;
+    double worst = 0.0;
+    for (size_t c = 0; c < nc; ++c) {
+        for (size_t u = 0; u < m; ++u) {
+            double p = q[c * k];
+            for (int d = 0; d < r->dim; ++d) p += q[c * k + (size_t)d + 1] * r->c[(size_t)d * m + u];
+            double e = f[c * m + u] - aw[u * nc + c] - p;
+            res[c * m + u] = e;
+            worst = fmax(worst, fabs(e));
+        }
+    }
+    return worst;
+}
+
+/* Refinement runs only while the residual at the centres is above this, relative to the
+ * data: smooth data on well-spread centres (1e-12 after one pass) skip it and save two
+ * O(m^2) packed triangular solves; dense or noisy sets (1e-10 seen) get one or two steps. */
+#define CM_RBF_REFINE_TOL 1e-11
+#define CM_RBF_REFINE_STEPS 3
+
+cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values)
+{
+    if (!rbf || !values || ncomp < 1)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_solve: %s",
+                        !rbf ? "rbf is NULL" : !values ? "values is NULL" : "ncomp < 1");
+    cm_status st = check_merged_values(ctx, rbf, ncomp, values);
+    if (st != CM_OK) return st;
+
+    const size_t m = rbf->m, nc = (size_t)ncomp, k = (size_t)rbf->k;
+    const int threads = cm_rbf_threads(ctx);
+    double *f = malloc(m * nc * sizeof *f); /* m x nc col-major */
+    double *res = malloc(m * nc * sizeof *res);
+    double *g = malloc(m * nc * sizeof *g);
+    double *w = malloc(m * nc * sizeof *w);
+    double *dw = malloc(m * nc * sizeof *dw);
+    double *aw = malloc(m * nc * sizeof *aw); /* row-major m x nc */
+    double *adw = malloc(m * nc * sizeof *adw);
+    double *q = malloc(k * nc * sizeof *q), *dq = malloc(k * nc * sizeof *dq);
+    if (!f || !res || !g || !w || !dw || !aw || !adw || !q || !dq) {
+        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_solve: out of memory");
+        goto done;
+    }
+    double fmaxabs = 0.0;
+    for (size_t u = 0; u < m; ++u)
+        for (size_t c = 0; c < nc; ++c) {
+            f[c * m + u] = values[rbf->first[u] * nc + c];
+            fmaxabs = fmax(fmaxabs, fabs(f[c * m + u]));
+        }
+    const int saved_blas_threads = openblas_get_num_threads();
+    blas_threads(1);
+    st = solve_pass(ctx, rbf, nc, f, w, q, aw, g, threads);
+    /* Iterative refinement with the same factorisation: the cubic kernel's system is badly
+     * conditioned for dense centres, and one or two cheap O(m^2) passes recover digits the
+     * O(m^3) factorisation lost. Skipped when the first residual is already tiny. */
+    double prev = INFINITY, first = -1.0, e = 0.0;
+    int steps = 0;
+    for (; st == CM_OK; ++steps) {
+        e = residual(rbf, nc, f, aw, q, res) / (fmaxabs > 0.0 ? fmaxabs : 1.0);
+        if (first < 0.0) first = e;
+        if (e <= CM_RBF_REFINE_TOL || !(e < 0.5 * prev) || steps == CM_RBF_REFINE_STEPS) break;
+        prev = e;
+        st = solve_pass(ctx, rbf, nc, res, dw, dq, adw, g, threads);
+        if (st != CM_OK) break;
+        for (size_t i = 0; i < m * nc; ++i) {
+            w[i] += dw[i];
+            aw[i] += adw[i]; /* A is linear: no further kernel sums */
+        }
+        for (size_t i = 0; i < k * nc; ++i) q[i] += dq[i];
+    }
+    if (st == CM_OK)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "cm_rbf_solve: relative residual at the centres %.2g, after %d refinement "
+               "steps %.2g",
+               first, steps, e);
+    if (st == CM_OK) {
+        free(rbf->w);
+        free(rbf->q);
+        rbf->w = w;
+        rbf->q = q;
+        rbf->ncomp = ncomp;
+        w = q = NULL;
+    }
+    openblas_set_num_threads(saved_blas_threads);
+done:
+    free(f), free(res), free(g), free(w), free(dw), free(aw), free(adw), free(q), free(dq);
+    return st;
+}
+
+cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const double *points,
+                          double *out)
+{
+    if (!rbf || (n > 0 && (!points || !out)))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_evaluate: %s",
+                        !rbf ? "rbf is NULL" : !points ? "points is NULL" : "out is NULL");
+    if (rbf->ncomp == 0)
+        return cm_error(ctx, CM_ERR_ARGUMENT,
+                        "cm_rbf_evaluate: no weights yet; call cm_rbf_solve first");
+    if (n == 0) return CM_OK;
+    const int dim = rbf->dim, k = rbf->k, ncomp = rbf->ncomp;
+    double *p = malloc(n * (size_t)dim * sizeof *p); /* dim x n SoA, unit-box coordinates */
+    if (!p) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_evaluate: out of memory for %zu points", n);
+    for (size_t i = 0; i < n; ++i)
+        for (int d = 0; d < dim; ++d)
+            p[(size_t)d * n + i] = (points[i * (size_t)dim + (size_t)d] - rbf->shift[d]) * rbf->scale;
+    kernel_sum_all(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx));
+    for (size_t i = 0; i < n; ++i) {
+        for (int c = 0; c < ncomp; ++c) {
+            const double *qc = rbf->q + (size_t)c * (size_t)k;
+            double acc = qc[0];
+            for (int d = 0; d < dim; ++d) acc += qc[d + 1] * p[(size_t)d * n + i];
+            out[i * (size_t)ncomp + (size_t)c] += acc;
+        }
+    }
+    free(p);
+    return CM_OK;
+}

@@ -1,0 +1,56 @@
+/* Internal state of cm_rbf and the kernel-sum primitives shared by fit, solve and evaluation
+ * (paper section 3 for 3D, section 4 for the 2D thin-plate warp). Not a public header. */
+#ifndef CADMORPH_RBF_INTERNAL_H
+#define CADMORPH_RBF_INTERNAL_H
+
+#include "cadmorph/rbf.h"
+
+#include <stddef.h>
+
+/* Below this many point-centre pairs a loop runs on one thread: forking costs more. */
+#define CM_RBF_PARALLEL_MIN_PAIRS 200000.0
+
+struct cm_rbf {
+    cm_rbf_kernel kernel;
+    int dim;          /* 2 or 3 */
+    int k;            /* polynomial terms, dim + 1 */
+    size_t m_in;      /* centres given to create */
+    size_t m;         /* centres after merging duplicates */
+    double shift[3];  /* unit-box map: s = (x - shift) * scale */
+    double scale;
+    double *c;        /* dim x m, SoA, unit-box coordinates of the merged centres */
+    size_t *rep;      /* m_in: merged index of each input centre */
+    size_t *first;    /* m: first input index that maps to each merged centre */
+    double *qr;       /* m x k col-major: dgeqrf of P (Householder vectors below, R above) */
+    double *tau;      /* k */
+    double sign;      /* +1 (r^3, r^2 log r) or -1 (r): chol holds sign * Q2' A Q2 */
+    double *chol;     /* (m-k)(m-k+1)/2, RFP ('N', 'L'): Cholesky factor of sign * Q2' A Q2 */
+    int ncomp;        /* components of the current weights, 0 before the first solve */
+    double *w;        /* ncomp x m, SoA: kernel weights */
+    double *q;        /* ncomp x k: polynomial coefficients in unit-box coordinates */
+};
+
+/* Threads for a leaf loop: the context's count, or all that OpenMP offers for 0. */
+int cm_rbf_threads(const cm_context *ctx);
+
+/* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (1..4), i < n.
+ * p: dim x n SoA with stride ldp (p + d * ldp is coordinate d), centres as in rbf (SoA,
+ * stride m). The sum over j runs in the same order for every i whatever the thread count. */
+void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                       const double *w, int nc, size_t n, const double *p, size_t ldp,
+                       double *out, size_t ldo, int threads);
+
+/* Lower triangle of B = sign * (A - V Z' - Z V') restricted to rows/columns k..m-1, into
+ * rfp (n = m - k; n(n+1)/2 doubles, LAPACK rectangular full packed, TRANSR 'N', UPLO 'L').
+ * A_ij = phi(|c_i - c_j|); v and z: m x k col-major. */
+void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                               int k, const double *v, const double *z, double sign,
+                               double *rfp, int threads);
+
+/* Merges centres closer than tol (unit-box coordinates, dim x m_in SoA in c). Fills rep
+ * (m_in) and returns the number of merged centres; first (>= that many) gets the first input
+ * index of each. -1 on allocation failure. */
+long cm_rbf_merge_duplicates(int dim, size_t m_in, const double *c, double tol, size_t *rep,
+                             size_t *first);
+
+#endif
