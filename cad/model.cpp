@@ -258,6 +258,14 @@ const char *what_error(int err) { return strerror(err); }
 
 }  // namespace
 
+/* A circle is an ellipse with equal axes: tilting a cylindrical bore turns its circular rims
+ * into ellipses while the topology stays the same, so the two types correspond. */
+static bool same_curve_family(cm_cad_curve_type a, cm_cad_curve_type b)
+{
+    auto conic = [](cm_cad_curve_type t) { return t == CM_CAD_CIRCLE || t == CM_CAD_ELLIPSE; };
+    return a == b || (conic(a) && conic(b));
+}
+
 extern "C" {
 
 void cm_cad_read_options_init(cm_cad_read_options *opt)
@@ -523,7 +531,7 @@ cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_mo
         }
         for (int i = 0; i < ne; ++i) {
             const cm_cad_edge_info &p = g->edge_info[i], &q = g2->edge_info[i];
-            if (p.type != q.type || p.degenerate != q.degenerate) {
+            if (!same_curve_family(p.type, q.type) || p.degenerate != q.degenerate) {
                 snprintf(line, sizeof line, "edge %d: %s in G, %s in G'", i,
                          p.degenerate ? "degenerate" : cm_cad_curve_type_name(p.type),
                          q.degenerate ? "degenerate" : cm_cad_curve_type_name(q.type));

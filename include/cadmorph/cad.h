@@ -109,8 +109,8 @@ cm_status cm_cad_face_wire(cm_context *ctx, const cm_cad_model *model, int face,
 cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge,
                             const int **faces, int *n);
 
-/* G and G' correspond: counts, surface and curve types, edge -> vertices and
- * face -> wires -> oriented edges all match. CM_OK if so; CM_ERR_MISMATCH with up to
+/* G and G' correspond: counts, surface and curve types (a circle may become an ellipse),
+ * edge -> vertices and face -> wires -> oriented edges all match. CM_OK if so; CM_ERR_MISMATCH with up to
  * max_report differences in the message ("face 12: plane in G, cylinder in G'") if not. */
 cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
                          int max_report);
@@ -211,6 +211,48 @@ cm_status cm_cad_locate_edges(cm_context *ctx, const cm_cad_locator *locator, co
 /* Nearest vertex of each point: vertex, dist: n. */
 cm_status cm_cad_locate_vertices(cm_context *ctx, const cm_cad_locator *locator,
                                  const double *xyz, size_t n, int *vertex, double *dist);
+
+/* ---- surface triangulation (for tet meshing) and volume ---- */
+
+typedef struct cm_cad_triangulate_options {
+    double size;        /* target edge length; <= 0: bbox diagonal / 20 */
+    /* BRepMesh's chord (linear) and angular deflection; <= 0: size / 10 and 0.3 rad (about
+     * 17 degrees, so that a circle of radius r gets edges of about 0.3 r). */
+    double linear_deflection;
+    double angular_deflection;
+    double min_size;    /* BRepMesh's smallest edge (MinSize); <= 0: size / 4 */
+} cm_cad_triangulate_options;
+
+void cm_cad_triangulate_options_init(cm_cad_triangulate_options *opt);
+
+/* One node per CAD vertex, per interior point of an edge's discretisation (shared by the
+ * faces on both sides) and per interior point of a face: the triangulation is watertight
+ * wherever the model is. All arrays are owned by the struct. */
+typedef struct cm_cad_triangulation {
+    size_t n_nodes;
+    double *xyz;        /* #nodes x 3 */
+    int *node_dim;      /* #nodes: 0 on a CAD vertex, 1 inside an edge, 2 inside a face */
+    int *node_entity;   /* #nodes: the vertex, edge or face index */
+    size_t n_triangles;
+    int64_t *tri;       /* #triangles x 3, 0-based, oriented by the face's orientation in its
+                           solid (outward normal by the right-hand rule) */
+    int *tri_face;      /* #triangles: the face */
+    double *tri_uv;     /* #triangles x 6: (u, v) of each corner on the triangle's face (seeds
+                           for projections onto the face) */
+    size_t n_open_edges;   /* triangle edges not shared by exactly two triangles with
+                              opposite directions: 0 for the boundary of a closed solid */
+} cm_cad_triangulation;
+
+/* Meshes every face of the model (BRepMesh_IncrementalMesh; a triangulation left on the
+ * shape by an earlier call is discarded first, so do not call it concurrently on the same
+ * model). Errors: CM_ERR_UNSUPPORTED for a model without faces, CM_ERR_CAD when BRepMesh
+ * fails or leaves a face without triangles (message names the face). */
+cm_status cm_cad_triangulate(cm_context *ctx, const cm_cad_model *model,
+                             const cm_cad_triangulate_options *opt, cm_cad_triangulation **out);
+void cm_cad_triangulation_destroy(cm_cad_triangulation **t);
+
+/* Total volume of the model's solids (BRepGProp); CM_ERR_UNSUPPORTED if it has no solid. */
+cm_status cm_cad_volume(cm_context *ctx, const cm_cad_model *model, double *volume);
 
 #ifdef __cplusplus
 }

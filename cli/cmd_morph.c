@@ -1,0 +1,206 @@
+/* `cadmorph morph`: morphs a volume mesh of G onto G' (surface morph on the CAD, then the
+ * RBF warp of the interior), writes it, reports its quality and, on request, a CSV of stages. */
+#include "cli.h"
+
+#include "cadmorph/surface.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const usage_line =
+    "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
+    "[--surface rbf|project] [--kernel triharmonic|biharmonic] [--report R.csv] "
+    "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
+
+static void print_help(void)
+{
+    printf("usage: %s\n\n", usage_line);
+    printf(
+        "Moves the volume mesh M0 of the CAD model G0 onto G1 (same topology, other dimensions):\n"
+        "boundary nodes on CAD vertices go to the matching vertex, nodes on edges keep their\n"
+        "arc length, nodes on faces are moved in the face's (u,v) by a 2D thin-plate RBF fitted\n"
+        "on the face boundaries; the interior follows by an RBF space warp per component.\n"
+        "Writes M1 (.msh .vtu .vtk .mesh) with per-node 'displacement' and per-cell\n"
+        "'scaled_jacobian', then prints the quality summary line.\n\n"
+        "options:\n"
+        "  --from G0.step       the geometry M0 was meshed from\n"
+        "  --to G1.step         the edited geometry (same topology)\n"
+        "  --mesh M0            input volume mesh\n"
+        "  -o, --output M1      output mesh (must not be an input)\n"
+        "  --steps K            split the boundary motion into K equal increments (default 1)\n"
+        "  --surface S          rbf (parameter warp, default) or project (closest point)\n"
+        "  --kernel K           volume warp: triharmonic (r^3, default) or biharmonic (r)\n"
+        "  --report R.csv       one row per step: quality, distance to G1, stage times\n"
+        "  --fail-on-inverted   exit 3 without writing M1 if a cell is inverted\n"
+        "  --cad-unit U         unit of the mesh coordinates: the STEP files are converted to\n"
+        "                       it (mm default; cm m in ft um ...)\n"
+        "  --threads N          threads (default: all)\n"
+        "  --verbose            debug messages on stderr\n\n"
+        "exit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
+        "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted.\n");
+}
+
+typedef struct morph_args {
+    const char *from, *to, *mesh, *out, *report, *unit;
+    cm_morph_options opt;
+    int fail_on_inverted, threads, verbose;
+} morph_args;
+
+static int parse_args(int argc, char **argv, morph_args *a)
+{
+    static const char *cmd = "morph";
+    memset(a, 0, sizeof *a);
+    cm_morph_options_init(&a->opt);
+    for (int i = 1; i < argc; ++i) {
+        const char *o = argv[i], *v;
+        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
+            print_help();
+            return CLI_EXIT_OK;
+        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
+            a->verbose = 1;
+        } else if (!strcmp(o, "--fail-on-inverted")) {
+            a->fail_on_inverted = 1;
+        } else if (!strcmp(o, "--from")) {
+            if (!(a->from = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--to")) {
+            if (!(a->to = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--mesh")) {
+            if (!(a->mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
+            if (!(a->out = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--report")) {
+            if (!(a->report = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--cad-unit")) {
+            if (!(a->unit = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            a->opt.cad_unit = a->unit;
+        } else if (!strcmp(o, "--surface")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            if (!strcmp(v, "rbf"))
+                a->opt.surface = CM_SURFACE_RBF;
+            else if (!strcmp(v, "project"))
+                a->opt.surface = CM_SURFACE_PROJECT;
+            else
+                return cli_usage(cmd, usage_line, "unknown surface method '%s'", v);
+        } else if (!strcmp(o, "--kernel")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            if (!strcmp(v, "triharmonic"))
+                a->opt.kernel = CM_RBF_TRIHARMONIC;
+            else if (!strcmp(v, "biharmonic"))
+                a->opt.kernel = CM_RBF_BIHARMONIC;
+            else
+                return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
+        } else if (!strcmp(o, "--steps") || !strcmp(o, "--threads")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            char *end;
+            long n = strtol(v, &end, 10);
+            if (*end || n < 1 || n > 4096)
+                return cli_usage(cmd, usage_line, "%s: expected a positive integer, got '%s'", o, v);
+            if (!strcmp(o, "--steps"))
+                a->opt.steps = (int)n;
+            else
+                a->threads = (int)n;
+        } else {
+            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
+        }
+    }
+    if (!a->from) return cli_usage(cmd, usage_line, "--from is required");
+    if (!a->to) return cli_usage(cmd, usage_line, "--to is required");
+    if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
+    if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
+    if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
+        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)", a->out);
+    const char *inputs[] = {a->from, a->to, a->mesh};
+    for (int k = 0; k < 3; ++k) {
+        if (cli_same_file(a->out, inputs[k]))
+            return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it", a->out);
+        if (a->report && cli_same_file(a->report, inputs[k]))
+            return cli_usage(cmd, usage_line, "report %s is an input: refusing to overwrite it",
+                             a->report);
+    }
+    if (a->report && cli_same_file(a->report, a->out))
+        return cli_usage(cmd, usage_line, "--report and -o name the same file");
+    return -1;
+}
+
+/* The CSV report: written to a temporary file and renamed, like the meshes. */
+static int write_report(const char *path, const cm_morph_result *r)
+{
+    size_t n = strlen(path) + 16;
+    char *tmp = malloc(n);
+    if (!tmp) return -1;
+    snprintf(tmp, n, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        free(tmp);
+        return -1;
+    }
+    fprintf(f, "step,min_scaled_jacobian,mean_scaled_jacobian,inverted,max_distance_to_g1,"
+               "t_read,t_sample,t_classify,t_surface_morph,t_volume_solve,t_evaluation,t_write\n");
+    for (int k = 0; k < r->n_steps; ++k) {
+        const cm_morph_step *s = &r->steps[k];
+        fprintf(f, "%d,%.9g,%.9g,%zu,%.6g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", s->step, s->min_sj,
+                s->mean_sj, s->inverted, s->max_dist, s->t_read, s->t_sample, s->t_classify,
+                s->t_surface, s->t_volume_solve, s->t_evaluation, s->t_write);
+    }
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (!bad) bad = rename(tmp, path) != 0;
+    if (bad) remove(tmp);
+    free(tmp);
+    return bad ? -1 : 0;
+}
+
+int cli_cmd_morph(int argc, char **argv)
+{
+    morph_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc >= 0) return rc;
+    cm_context *ctx = cli_context_create(a.verbose);
+    if (!ctx) {
+        fprintf(stderr, "cadmorph morph: out of memory\n");
+        return CLI_EXIT_INTERNAL;
+    }
+    cm_context_set_threads(ctx, a.threads);
+    cm_morph_result *r = NULL;
+    cm_status s = cm_morph_run(ctx, a.from, a.to, a.mesh, &a.opt, &r);
+    if (s < 0) {
+        rc = cli_fail(ctx, "morph", s);
+        cm_context_destroy(&ctx);
+        return rc;
+    }
+    /* warnings were logged as they happened */
+    const cm_morph_step *last = &r->steps[r->n_steps - 1];
+    cm_log(ctx, CM_LOG_DEBUG,
+           "morph: boundary nodes on vertices %zu, edges %zu, faces %zu; largest distance to "
+           "G1 %.3g (%.3g x diagonal)",
+           r->counts[0], r->counts[1], r->counts[2], r->max_dist,
+           r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
+    rc = CLI_EXIT_OK;
+    if (a.fail_on_inverted && last->inverted > 0) {
+        fprintf(stderr, "cadmorph morph: %zu inverted cells (min scaled Jacobian %.6g); %s not written\n",
+                last->inverted, last->min_sj, a.out);
+        rc = CLI_EXIT_REJECTED;
+    }
+    if (rc == CLI_EXIT_OK) {
+        double t = cm_wtime();
+        s = cm_mesh_write(ctx, r->mesh, a.out, NULL);
+        r->steps[r->n_steps - 1].t_write = cm_wtime() - t;
+        if (s < 0) rc = cli_fail(ctx, "morph", s);
+    }
+    if (a.report && write_report(a.report, r) != 0) {
+        fprintf(stderr, "cadmorph morph: %s: cannot write the report\n", a.report);
+        if (rc == CLI_EXIT_OK) rc = CLI_EXIT_BAD_INPUT;
+    }
+    if (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED) {
+        printf("boundary nodes: %zu on vertices, %zu on edges, %zu on faces; "
+               "largest distance to G1: %.3g (%.3g x diagonal)\n",
+               r->counts[0], r->counts[1], r->counts[2], r->max_dist,
+               r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
+        s = cli_print_quality(ctx, r->mesh, r->sj, stdout, NULL);
+        if (s < 0 && rc == CLI_EXIT_OK) rc = cli_fail(ctx, "morph", s);
+    }
+    cm_morph_result_destroy(&r);
+    cm_context_destroy(&ctx);
+    return rc;
+}

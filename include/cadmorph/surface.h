@@ -1,0 +1,160 @@
+/* cadmorph surface: classification of the boundary nodes of a volume mesh against the CAD
+ * model G (vertex | edge | face) and the CAD-aware surface morph G -> G' (paper section 4):
+ * vertices go to the matching vertex, edge nodes keep their normalised arc length, face
+ * nodes are moved in parameter space by a 2D thin-plate RBF fitted on the face's boundary
+ * samples and evaluated on the matching face of G'.
+ * Conventions: see core.h. Node indices are 0-based mesh node indices.
+ */
+#ifndef CADMORPH_SURFACE_H
+#define CADMORPH_SURFACE_H
+
+#include "cadmorph/cad.h"
+#include "cadmorph/mesh.h"
+#include "cadmorph/rbf.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- classification ---- */
+
+typedef enum cm_surface_kind {
+    CM_SURFACE_ON_VERTEX = 0,
+    CM_SURFACE_ON_EDGE = 1,
+    CM_SURFACE_ON_FACE = 2
+} cm_surface_kind;
+
+typedef struct cm_classify_options {
+    /* A node lies on an entity when its distance is at most
+     *   rel_tol x (shortest boundary edge at the node) + abs_tol x (model bbox diagonal).
+     * Defaults 1e-6 and 1e-9. */
+    double rel_tol, abs_tol;
+} cm_classify_options;
+
+void cm_classify_options_init(cm_classify_options *opt);
+
+/* The boundary nodes of a mesh, each on one entity of G. Arrays owned by the struct. */
+typedef struct cm_surface_nodes {
+    size_t n;              /* boundary nodes */
+    int64_t *node;         /* n: mesh node index (ascending, as cm_mesh_boundary.nodes) */
+    double *xyz;           /* n x 3: position when classified */
+    unsigned char *kind;   /* n: cm_surface_kind */
+    int *entity;           /* n: vertex, edge or face of G (0-based) */
+    double *param;         /* n x 2: face (u, v); edge (t, s); vertex (0, 0) */
+    double *dist;          /* n: distance to the entity */
+    double *h;             /* n: shortest boundary edge at the node */
+    size_t count[3];       /* nodes per kind */
+    double max_dist;       /* largest dist */
+} cm_surface_nodes;
+
+/* Shortest boundary-face edge at each boundary node: h_node (b->n_nodes, in the order of
+ * b->nodes), and the shortest over all, *h_min (either may be NULL). Edges of zero length
+ * are ignored (a node with only such edges gets the global minimum). */
+cm_status cm_surface_edge_lengths(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
+                                  double *h_node, double *h_min);
+
+/* Classifies the boundary nodes of b: vertex if within tolerance of a CAD vertex, else edge
+ * if within tolerance of an edge (t from the projection, s its arc length), else face (u,v).
+ * locator: built on g (its h about a quarter of the shortest boundary edge). A node farther
+ * than the tolerance from every face is CM_ERR_MISMATCH; the message gives their count, the
+ * worst distance and node, and suggests a unit mismatch when the mesh and model sizes differ
+ * by a unit factor (10, 100, 1000, 25.4, 304.8). opt may be NULL for defaults. */
+cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_cad_locator *locator,
+                              const cm_mesh *mesh, const cm_mesh_boundary *b,
+                              const cm_classify_options *opt, cm_surface_nodes **nodes);
+void cm_surface_nodes_destroy(cm_surface_nodes **nodes);
+
+/* ---- morph ---- */
+
+typedef enum cm_surface_method {
+    CM_SURFACE_RBF = 0,     /* parameter-space thin-plate warp per face (the method) */
+    CM_SURFACE_PROJECT = 1  /* baseline: closest point on the matching entity of G' */
+} cm_surface_method;
+
+typedef struct cm_surface_morph_options {
+    cm_surface_method method;
+    /* Boundary samples per edge for the parameter warp: about length / spacing, clamped to
+     * [min_per_edge, max_per_edge]. spacing <= 0: the median of the nodes' h, else
+     * bbox diagonal / 100. Defaults: 0, 8, 200. */
+    double spacing;
+    int min_per_edge, max_per_edge;
+} cm_surface_morph_options;
+
+void cm_surface_morph_options_init(cm_surface_morph_options *opt);
+
+typedef struct cm_surface_morph_stats {
+    size_t faces_warped;     /* faces with nodes, one 2D RBF each (RBF method) */
+    size_t faces_skipped;    /* faces without interior nodes */
+    size_t outside;          /* face nodes whose (u',v') left the trimmed domain of f'_k;
+                                they are put on the closest point of f'_k instead */
+    int64_t worst_outside_node;  /* mesh node, -1 if none */
+    double worst_outside_dist;   /* how far f'_k(u',v') was from the trimmed face */
+} cm_surface_morph_stats;
+
+/* Morphs the classified nodes from G to G' (models that correspond: cm_cad_compare).
+ * xyz: nodes->n x 3 output, the new positions in the order of nodes->node. Returns
+ * CM_WARNING (message with count and worst node) when face nodes left their trimmed domain.
+ * opt and stats may be NULL. */
+cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+                           const cm_surface_nodes *nodes, const cm_surface_morph_options *opt,
+                           double *xyz, cm_surface_morph_stats *stats);
+
+/* Distance of points (n x 3) to the model of the locator: the largest, and the index of the
+ * point where it occurs (either may be NULL). */
+cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
+                                  size_t n, double *max_dist, size_t *worst);
+
+/* ==== the morph pipeline (DESIGN.md: volume/; here until volume/ is free) ====
+ * Read G, G' and M, check that G and G' correspond, sample and classify, morph the surface,
+ * warp the interior per component (cm_warp), in `steps` increments. Library target cm_morph
+ * (links cm_surface and cm_volume, so that cm_surface itself knows no volume). */
+
+typedef struct cm_morph_options {
+    cm_surface_method surface;  /* default CM_SURFACE_RBF */
+    cm_rbf_kernel kernel;       /* volume warp: CM_RBF_TRIHARMONIC (default) or BIHARMONIC */
+    int steps;                  /* >= 1 (default 1): equal increments of the boundary motion */
+    const char *cad_unit;       /* target unit of both STEP files; NULL = "mm" */
+    cm_classify_options classify;
+    cm_surface_morph_options morph;
+} cm_morph_options;
+
+void cm_morph_options_init(cm_morph_options *opt);
+
+/* One row of the report per step. Stage times in seconds; read, sample, classify and surface
+ * are spent once and counted in step 1; volume_solve = warp assembly and factorisation,
+ * evaluation = solve for the step's displacements, evaluation at the interior nodes and the
+ * scaled Jacobian; write is left for the caller (who writes the mesh). */
+typedef struct cm_morph_step {
+    int step;
+    double min_sj, mean_sj;
+    size_t inverted, cells;
+    double max_dist;   /* largest distance of the boundary nodes to G' after this step */
+    double t_read, t_sample, t_classify, t_surface, t_volume_solve, t_evaluation, t_write;
+} cm_morph_step;
+
+typedef struct cm_morph_result {
+    cm_mesh *mesh;          /* the morphed mesh, with per-node "displacement" (from M0) and
+                               per-cell "scaled_jacobian" fields */
+    double *sj;             /* #cells: the scaled_jacobian field's data (owned by mesh) */
+    int n_steps;
+    cm_morph_step *steps;   /* n_steps rows */
+    size_t counts[3];       /* boundary nodes on vertices, edges, faces */
+    cm_surface_morph_stats surface;
+    double max_dist;        /* largest distance of the final boundary nodes to G' */
+    double diagonal;        /* bbox diagonal of G' (for relative tolerances) */
+    double h;               /* sampling h actually used on G */
+} cm_morph_result;
+
+/* Runs the pipeline. Errors: CM_ERR_MISMATCH when G and G' do not correspond (up to 5
+ * differences in the message) or M is not a mesh of G (see cm_surface_classify); file
+ * errors from the readers. Returns CM_WARNING (the first warning's message) when a stage
+ * warned (nodes left a trimmed domain, sample cap reached) but the result is complete. */
+cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,
+                       const char *mesh_path, const cm_morph_options *opt,
+                       cm_morph_result **result);
+void cm_morph_result_destroy(cm_morph_result **result);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

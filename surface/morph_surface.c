@@ -1,0 +1,260 @@
+/* The CAD-aware surface morph G -> G' (paper section 4): vertex nodes to the matching vertex,
+ * edge nodes to the same arc length, face nodes by a 2D thin-plate warp of their (u,v) fitted
+ * on corresponding boundary samples of f_k and f'_k; or, as a baseline, closest points. */
+#include "surface_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+void cm_surface_morph_options_init(cm_surface_morph_options *opt)
+{
+    opt->method = CM_SURFACE_RBF;
+    opt->spacing = 0;
+    opt->min_per_edge = 8;
+    opt->max_per_edge = 200;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Boundary samples per edge: about length / spacing, from G's lengths so G and G' agree. */
+static cm_status samples_per_edge(cm_context *ctx, const cm_cad_model *g, const cm_surface_nodes *s,
+                                  const cm_surface_morph_options *o, int *per_edge)
+{
+    double spacing = o->spacing;
+    if (!(spacing > 0) && s->n) {
+        double *h = malloc(s->n * sizeof *h);
+        if (!h) return cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+        memcpy(h, s->h, s->n * sizeof *h);
+        qsort(h, s->n, sizeof *h, cmp_double);
+        spacing = h[s->n / 2];
+        free(h);
+    }
+    if (!(spacing > 0)) {
+        double bb[6];
+        cm_cad_bbox(g, bb);
+        spacing = sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) + (bb[4] - bb[1]) * (bb[4] - bb[1]) +
+                       (bb[5] - bb[2]) * (bb[5] - bb[2])) / 100;
+    }
+    cm_cad_counts c;
+    cm_cad_get_counts(g, &c);
+    for (int e = 0; e < c.edges; ++e) {
+        cm_cad_edge_info ei;
+        cm_status st = cm_cad_edge_get_info(ctx, g, e, &ei);
+        if (st < 0) return st;
+        double k = ei.degenerate ? 0 : ceil(ei.length / spacing);
+        if (k < o->min_per_edge) k = o->min_per_edge;
+        if (k > o->max_per_edge) k = o->max_per_edge;
+        per_edge[e] = (int)k;
+    }
+    return CM_OK;
+}
+
+/* Periodic parameters of G' may sit a whole period away from G's (another pcurve of the same
+ * seam, another range): shift each run of samples of one edge by the multiple of the period
+ * that brings it closest to G's run. Runs, not single samples, so that a legitimately large
+ * change inside a run is never cut at half a period. */
+static void unwrap_runs(const cm_cad_boundary *a, cm_cad_boundary *b, const cm_cad_face_info *fi)
+{
+    for (int d = 0; d < 2; ++d) {
+        if (!fi->periodic[d] || !(fi->period[d] > 0)) continue;
+        double P = fi->period[d];
+        for (size_t i = 0; i < a->n;) {
+            size_t j = i;
+            double sum = 0;
+            while (j < a->n && a->edge[j] == a->edge[i] && a->wire[j] == a->wire[i]) {
+                sum += b->uv[2 * j + d] - a->uv[2 * j + d];
+                ++j;
+            }
+            double shift = -P * round(sum / (double)(j - i) / P);
+            for (size_t k = i; k < j; ++k) b->uv[2 * k + d] += shift;
+            i = j;
+        }
+    }
+}
+
+/* Face nodes idx[0..k) of face f: warp their (u,v), evaluate f'_k; those that left the
+ * trimmed domain go to the closest point of f'_k. */
+static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2, int f,
+                            const int *per_edge, const cm_surface_nodes *s, const size_t *idx,
+                            size_t k, double *xyz, cm_surface_morph_stats *st)
+{
+    cm_cad_boundary *ba = NULL, *bb = NULL;
+    cm_rbf *rbf = NULL;
+    double *uv = malloc(2 * k * sizeof *uv), *d = malloc(2 * k * sizeof *d);
+    double *p = malloc(3 * k * sizeof *p), *values = NULL;
+    int *inside = malloc(k * sizeof *inside);
+    cm_status r = uv && d && p && inside ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    cm_cad_face_info fi;
+    if (r == CM_OK) r = cm_cad_face_get_info(ctx, g2, f, &fi);
+    if (r == CM_OK) r = cm_cad_face_boundary(ctx, g, f, per_edge, 0, &ba);
+    if (r == CM_OK) r = cm_cad_face_boundary(ctx, g2, f, per_edge, 0, &bb);
+    if (r == CM_OK && ba->n != bb->n)
+        r = cm_error(ctx, CM_ERR_MISMATCH, "face %d: %zu boundary samples in G, %zu in G'", f,
+                     ba->n, bb->n);
+    if (r == CM_OK && !(values = malloc(2 * ba->n * sizeof *values)))
+        r = cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    if (r == CM_OK) {
+        unwrap_runs(ba, bb, &fi);
+        for (size_t i = 0; i < 2 * ba->n; ++i) values[i] = bb->uv[i] - ba->uv[i];
+        for (size_t j = 0; j < k; ++j) memcpy(uv + 2 * j, s->param + 2 * idx[j], 2 * sizeof(double));
+        r = cm_rbf_create(ctx, CM_RBF_THIN_PLATE, 2, ba->n, ba->uv, &rbf);
+        if (r >= 0) r = cm_rbf_solve(ctx, rbf, 2, values);
+        if (r >= 0) r = cm_rbf_evaluate(ctx, rbf, k, uv, d);
+        if (r < 0) {
+            char msg[1024];
+            snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
+            r = cm_error(ctx, r, "face %d: parameter warp: %s", f, msg);
+        }
+    }
+    if (r >= 0) {
+        for (size_t j = 0; j < 2 * k; ++j) uv[j] += d[j];
+        r = cm_cad_face_inside(ctx, g2, f, uv, k, inside);
+    }
+    if (r >= 0) r = cm_cad_face_eval(ctx, g2, f, uv, k, p, NULL);
+    for (size_t j = 0; j < k && r >= 0; ++j) {
+        memcpy(xyz + 3 * idx[j], p + 3 * j, 3 * sizeof(double));
+        if (inside[j]) continue;
+        double foot[3], dist;
+        r = cm_cad_project_face(ctx, g2, f, p + 3 * j, 1, uv + 2 * j, NULL, &dist, foot);
+        if (r < 0) break;
+        memcpy(xyz + 3 * idx[j], foot, sizeof foot);
+        st->outside++;
+        if (dist > st->worst_outside_dist || st->worst_outside_node < 0) {
+            st->worst_outside_dist = dist;
+            st->worst_outside_node = s->node[idx[j]];
+        }
+    }
+    cm_rbf_destroy(&rbf);
+    cm_cad_boundary_destroy(&ba);
+    cm_cad_boundary_destroy(&bb);
+    free(uv);
+    free(d);
+    free(p);
+    free(values);
+    free(inside);
+    return r;
+}
+
+/* Edge nodes: rbf keeps their arc length s, project takes the closest point on the edge. */
+static cm_status morph_edge(cm_context *ctx, const cm_cad_model *g2, int e, cm_surface_method m,
+                            const cm_surface_nodes *s, const size_t *idx, size_t k, double *xyz)
+{
+    double *t = malloc(k * sizeof *t), *q = malloc(3 * k * sizeof *q), *p = malloc(3 * k * sizeof *p);
+    cm_status r = t && q && p ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    if (r == CM_OK && m == CM_SURFACE_RBF) {
+        for (size_t j = 0; j < k; ++j) q[j] = s->param[2 * idx[j] + 1];
+        r = cm_cad_edge_s_to_t(ctx, g2, e, q, k, t);
+    } else if (r == CM_OK) {
+        for (size_t j = 0; j < k; ++j) memcpy(q + 3 * j, s->xyz + 3 * idx[j], 3 * sizeof(double));
+        r = cm_cad_project_edge(ctx, g2, e, q, k, t, NULL);
+    }
+    if (r >= 0) r = cm_cad_edge_eval(ctx, g2, e, t, k, p);
+    for (size_t j = 0; j < k && r >= 0; ++j) memcpy(xyz + 3 * idx[j], p + 3 * j, 3 * sizeof(double));
+    free(t);
+    free(q);
+    free(p);
+    return r;
+}
+
+/* Face nodes of the baseline: closest point on the matching face of G'. */
+static cm_status project_face(cm_context *ctx, const cm_cad_model *g2, int f,
+                              const cm_surface_nodes *s, const size_t *idx, size_t k, double *xyz)
+{
+    double *q = malloc(3 * k * sizeof *q), *p = malloc(3 * k * sizeof *p);
+    cm_status r = q && p ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    for (size_t j = 0; j < k && r == CM_OK; ++j)
+        memcpy(q + 3 * j, s->xyz + 3 * idx[j], 3 * sizeof(double));
+    if (r == CM_OK) r = cm_cad_project_face(ctx, g2, f, q, k, NULL, NULL, NULL, p);
+    for (size_t j = 0; j < k && r >= 0; ++j) memcpy(xyz + 3 * idx[j], p + 3 * j, 3 * sizeof(double));
+    free(q);
+    free(p);
+    return r;
+}
+
+cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+                           const cm_surface_nodes *s, const cm_surface_morph_options *opt,
+                           double *xyz, cm_surface_morph_stats *stats)
+{
+    const char *fn = "cm_surface_morph";
+    cm_surface_morph_stats st = {0, 0, 0, -1, 0};
+    if (stats) *stats = st;
+    if (!g || !g2 || !s || !xyz) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL input", fn);
+    cm_surface_morph_options o;
+    cm_surface_morph_options_init(&o);
+    if (opt) o = *opt;
+    if (o.min_per_edge < 2 || o.max_per_edge < o.min_per_edge)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: samples per edge must satisfy 2 <= min <= max", fn);
+    cm_cad_counts c, c2;
+    cm_cad_get_counts(g, &c);
+    cm_cad_get_counts(g2, &c2);
+    if (c.faces != c2.faces || c.edges != c2.edges || c.vertices != c2.vertices)
+        return cm_error(ctx, CM_ERR_MISMATCH, "%s: G and G' have different topology", fn);
+    size_t *first[3] = {NULL, NULL, NULL}, *idx[3] = {NULL, NULL, NULL};
+    int count[3] = {c.vertices, c.edges, c.faces};
+    int *per_edge = malloc((c.edges > 0 ? c.edges : 1) * sizeof *per_edge);
+    cm_status r = per_edge ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", fn);
+    for (int k = 0; k < 3 && r == CM_OK; ++k)
+        r = cm_surface_group(ctx, s, (cm_surface_kind)k, count[k], &first[k], &idx[k]);
+    if (r == CM_OK) r = samples_per_edge(ctx, g, s, &o, per_edge);
+    for (int v = 0; v < c.vertices && r >= 0; ++v) {
+        const size_t *in = idx[0] + first[0][v], k = first[0][v + 1] - first[0][v];
+        double p[3];
+        if (k) r = cm_cad_vertex_point(ctx, g2, v, p);
+        for (size_t j = 0; j < k && r >= 0; ++j) memcpy(xyz + 3 * in[j], p, sizeof p);
+    }
+    for (int e = 0; e < c.edges && r >= 0; ++e) {
+        size_t k = first[1][e + 1] - first[1][e];
+        if (k) r = morph_edge(ctx, g2, e, o.method, s, idx[1] + first[1][e], k, xyz);
+    }
+    for (int f = 0; f < c.faces && r >= 0; ++f) {
+        cm_progress(ctx, "surface", f, c.faces);
+        size_t k = first[2][f + 1] - first[2][f];
+        const size_t *in = idx[2] + first[2][f];
+        if (!k) {
+            st.faces_skipped++;
+            continue;
+        }
+        if (o.method == CM_SURFACE_RBF) {
+            r = morph_face(ctx, g, g2, f, per_edge, s, in, k, xyz, &st);
+            st.faces_warped++;
+        } else {
+            r = project_face(ctx, g2, f, s, in, k, xyz);
+        }
+    }
+    cm_progress(ctx, "surface", c.faces, c.faces);
+    for (int k = 0; k < 3; ++k) {
+        free(first[k]);
+        free(idx[k]);
+    }
+    free(per_edge);
+    if (stats) *stats = st;
+    if (r < 0) return r;
+    if (st.outside)
+        return cm_error(ctx, CM_WARNING,
+                        "surface morph: %zu face nodes left the trimmed domain of their face in G' "
+                        "and were put on its closest point (worst: node %lld, %.3g away)",
+                        st.outside, (long long)st.worst_outside_node, st.worst_outside_dist);
+    return CM_OK;
+}
+
+cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
+                                  size_t n, double *max_dist, size_t *worst)
+{
+    double *d = malloc((n ? n : 1) * sizeof *d);
+    if (!d) return cm_error(ctx, CM_ERR_NOMEM, "cm_surface_max_distance: out of memory");
+    cm_status r = n ? cm_cad_locate_faces(ctx, locator, xyz, n, NULL, NULL, d, NULL) : CM_OK;
+    double m = 0;
+    size_t w = 0;
+    for (size_t i = 0; i < n && r >= 0; ++i)
+        if (d[i] > m) m = d[i], w = i;
+    free(d);
+    if (max_dist) *max_dist = m;
+    if (worst) *worst = w;
+    return r;
+}

@@ -1,0 +1,85 @@
+#!/usr/bin/python3
+"""Independent checks of `cadmorph morph` outputs (tools nobody here wrote: gmsh, meshio).
+  check_morph.py ongeom M0.msh M1 G1.step REL   boundary nodes of M1 (those of M0's surface
+      triangles) lie on G1 within REL x G1's bbox diagonal, measured by gmsh's closest point
+      on every surface of G1; M1's 'displacement' field is M1 - M0 and 'scaled_jacobian' has
+      no inverted cell
+  check_morph.py report R.csv K                 R.csv has the header and K step rows"""
+import csv
+import sys
+
+import numpy as np
+
+
+def ongeom(m0_path, m1_path, step, rel):
+    import gmsh
+    import meshio
+    m0, m1 = meshio.read(m0_path), meshio.read(m1_path)
+    assert m0.points.shape == m1.points.shape, "node counts differ"
+    tri = np.concatenate([c.data.ravel() for c in m0.cells
+                          if c.type.startswith("triangle") or c.type.startswith("quad")])
+    nodes = np.unique(tri)
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.occ.importShapes(step)
+    gmsh.model.occ.synchronize()
+    lo = np.array(gmsh.model.getBoundingBox(-1, -1)[:3])
+    hi = np.array(gmsh.model.getBoundingBox(-1, -1)[3:])
+    diag = np.linalg.norm(hi - lo)
+    best = np.full(len(nodes), np.inf)
+    pts = m1.points[nodes].ravel().tolist()
+    for dim, tag in gmsh.model.getEntities(2):
+        cp, _ = gmsh.model.getClosestPoint(dim, tag, pts)
+        d = np.linalg.norm(np.array(cp).reshape(-1, 3) - m1.points[nodes], axis=1)
+        best = np.minimum(best, d)
+    gmsh.finalize()
+    worst = best.max()
+    print("%d boundary nodes, largest distance to %s: %.3g (%.3g x diagonal)"
+          % (len(nodes), step, worst, worst / diag))
+    ok = worst <= rel * diag
+    disp = m1.point_data.get("displacement")
+    if disp is None or np.abs(m0.points + disp - m1.points).max() > 1e-12 * diag:
+        print("FAIL: displacement field missing or not M1 - M0")
+        ok = False
+    sj = [c for c in m1.cell_data.get("scaled_jacobian", [])]
+    if not sj:
+        print("FAIL: no scaled_jacobian cell field")
+        ok = False
+    else:
+        vals = np.concatenate([np.asarray(a).ravel() for a in sj])
+        vals = vals[np.isfinite(vals)]
+        if len(vals) == 0 or vals.min() <= 0:
+            print("FAIL: inverted cells in scaled_jacobian")
+            ok = False
+    return ok
+
+
+def report(path, k):
+    rows = list(csv.reader(open(path)))
+    want = ["step", "min_scaled_jacobian", "mean_scaled_jacobian", "inverted",
+            "max_distance_to_g1", "t_read", "t_sample", "t_classify", "t_surface_morph",
+            "t_volume_solve", "t_evaluation", "t_write"]
+    if rows[0] != want:
+        print("FAIL: header %s" % rows[0])
+        return False
+    if len(rows) != k + 1 or [int(r[0]) for r in rows[1:]] != list(range(1, k + 1)):
+        print("FAIL: %d rows, expected steps 1..%d" % (len(rows) - 1, k))
+        return False
+    for r in rows[1:]:
+        v = [float(x) for x in r]
+        if not (0 < v[1] <= v[2] <= 1) or v[3] != 0 or min(v[5:]) < 0:
+            print("FAIL: row %s" % r)
+            return False
+    if float(rows[-1][4]) > 1e-9 or float(rows[1][4]) <= float(rows[-1][4]):
+        print("FAIL: distance to G1 does not end at ~0: %s" % [r[4] for r in rows[1:]])
+        return False
+    return True
+
+
+if __name__ == "__main__":
+    a = sys.argv[1:]
+    if a[:1] == ["ongeom"] and len(a) == 5:
+        sys.exit(0 if ongeom(a[1], a[2], a[3], float(a[4])) else 1)
+    if a[:1] == ["report"] and len(a) == 3:
+        sys.exit(0 if report(a[1], int(a[2])) else 1)
+    sys.exit(__doc__)

@@ -1,0 +1,341 @@
+// TetGen bridge: the watertight OpenCASCADE triangulation of a solid's faces is the PLC that
+// TetGen fills with quality tets (switches p, q, a; Y keeps the surface as it is). Nodes that
+// TetGen adds on the surface lie on the flat triangles; they are projected onto their CAD
+// face or edge so that every boundary node lies on the model. Exceptions stop here (STYLE 8);
+// OpenCASCADE is reached only through cad's C API, which already maps Standard_Failure, so
+// no OpenCASCADE header is seen here (DESIGN: OpenCASCADE only in cad/).
+#include "cadmorph/kdtree.h"
+#include "cadmorph/volume.h"
+
+#include <tetgen.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <map>
+#include <new>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace {
+
+const char *tetgen_reason(int code)
+{
+    switch (code) {
+    case 1: return "out of memory";
+    case 2: return "internal error";
+    case 3: return "the surface intersects itself";
+    case 4: return "a very small input feature";
+    case 5: return "two very close input facets";
+    case 10: return "invalid input";
+    default: return "unknown error";
+    }
+}
+
+struct cad_guard {
+    cm_cad_triangulation *t = nullptr;
+    ~cad_guard() { cm_cad_triangulation_destroy(&t); }
+};
+
+struct mesh_guard {
+    cm_mesh *m = nullptr;
+    ~mesh_guard() { cm_mesh_destroy(&m); }
+};
+
+double orient(const double *a, const double *b, const double *c, const double *d)
+{
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+           u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
+// Projects the boundary nodes TetGen added (index >= first) onto the CAD model: onto the face
+// when all their boundary triangles lie on one face, else onto the nearest edge between
+// those faces.
+cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
+                            const cm_cad_triangulation &surf, size_t first,
+                            std::vector<double> &xyz, const std::vector<int64_t> &tri,
+                            const std::vector<int> &tri_face, size_t *n_projected)
+{
+    *n_projected = 0;
+    const char *fn = "cm_tetmesh_create";
+    std::map<int64_t, std::set<int>> faces_of;  // new boundary node -> its CAD faces
+    for (size_t t = 0; t < tri_face.size(); ++t)
+        for (int k = 0; k < 3; ++k)
+            if ((size_t)tri[3 * t + k] >= first) faces_of[tri[3 * t + k]].insert(tri_face[t]);
+    std::map<int, std::vector<int64_t>> on_face;
+    std::vector<int64_t> on_edge;
+    for (const auto &nf : faces_of)
+        (nf.second.size() == 1 ? on_face[*nf.second.begin()] : on_edge).push_back(nf.first);
+
+    for (const auto &fn_nodes : on_face) {
+        const std::vector<int64_t> &nodes = fn_nodes.second;
+        // TetGen's points on the triangles of a planar face are on the plane already
+        cm_cad_face_info info;
+        cm_status s = cm_cad_face_get_info(ctx, model, fn_nodes.first, &info);
+        if (s < 0) return s;
+        if (info.type == CM_CAD_PLANE) continue;
+        *n_projected += nodes.size();
+        std::vector<double> p(3 * nodes.size()), foot(3 * nodes.size());
+        for (size_t i = 0; i < nodes.size(); ++i)
+            for (int k = 0; k < 3; ++k) p[3 * i + k] = xyz[3 * nodes[i] + k];
+        // seeds: (u, v) of the nearest corner of OpenCASCADE's triangles on this face
+        // (unseeded, the projection searches a grid first: ten times slower)
+        std::vector<double> cxyz, cuv, seed(2 * nodes.size());
+        for (size_t t = 0; t < surf.n_triangles; ++t)
+            if (surf.tri_face[t] == fn_nodes.first)
+                for (int k = 0; k < 3; ++k) {
+                    cxyz.insert(cxyz.end(), &surf.xyz[3 * surf.tri[3 * t + k]],
+                                &surf.xyz[3 * surf.tri[3 * t + k]] + 3);
+                    cuv.insert(cuv.end(), &surf.tri_uv[6 * t + 2 * k], &surf.tri_uv[6 * t + 2 * k] + 2);
+                }
+        cm_kdtree *tree = nullptr;
+        if ((s = cm_kdtree_create(ctx, cxyz.data(), cxyz.size() / 3, &tree)) < 0) return s;
+        std::vector<int64_t> near(nodes.size());
+        s = cm_kdtree_nearest(ctx, tree, p.data(), nodes.size(), 1, near.data(), nullptr);
+        cm_kdtree_destroy(&tree);
+        if (s < 0) return s;
+        for (size_t i = 0; i < nodes.size(); ++i)
+            seed[2 * i] = cuv[2 * near[i]], seed[2 * i + 1] = cuv[2 * near[i] + 1];
+        s = cm_cad_project_face(ctx, model, fn_nodes.first, p.data(), nodes.size(), seed.data(),
+                                nullptr, nullptr, foot.data());
+        if (s < 0) return s;
+        for (size_t i = 0; i < nodes.size(); ++i)
+            for (int k = 0; k < 3; ++k) xyz[3 * nodes[i] + k] = foot[3 * i + k];
+    }
+    if (on_edge.empty()) return CM_OK;
+
+    cm_cad_counts counts;
+    cm_cad_get_counts(model, &counts);
+    std::map<std::pair<int, int>, std::vector<int>> edges_between;  // face pair -> edges
+    for (int e = 0; e < counts.edges; ++e) {
+        const int *ef = nullptr;
+        int n = 0;
+        cm_status s = cm_cad_edge_faces(ctx, model, e, &ef, &n);
+        if (s < 0) return s;
+        for (int i = 0; i < n; ++i)
+            for (int j = i + 1; j < n; ++j)
+                edges_between[{std::min(ef[i], ef[j]), std::max(ef[i], ef[j])}].push_back(e);
+    }
+    std::vector<cm_cad_edge_info> einfo(counts.edges);
+    for (int e = 0; e < counts.edges; ++e) {
+        cm_status s = cm_cad_edge_get_info(ctx, model, e, &einfo[e]);
+        if (s < 0) return s;
+    }
+    for (int64_t node : on_edge) {
+        const std::set<int> &fs = faces_of[node];
+        std::set<int> cand;
+        for (auto a = fs.begin(); a != fs.end(); ++a)
+            for (auto b = std::next(a); b != fs.end(); ++b) {
+                auto it = edges_between.find({*a, *b});
+                if (it != edges_between.end()) cand.insert(it->second.begin(), it->second.end());
+            }
+        if (cand.empty())
+            return cm_error(ctx, CM_ERR_INTERNAL,
+                            "%s: TetGen put node %lld where faces meet that share no edge", fn,
+                            (long long)node);
+        double best = INFINITY, bt = 0;
+        int be = -1;
+        for (int e : cand) {
+            double t = 0, d = 0;
+            cm_status s = cm_cad_project_edge(ctx, model, e, &xyz[3 * node], 1, &t, &d);
+            if (s < 0) return s;
+            if (d < best) best = d, bt = t, be = e;
+        }
+        // a point TetGen put on a straight segment is on the line already
+        if (einfo[be].type == CM_CAD_LINE) continue;
+        ++*n_projected;
+        cm_status s = cm_cad_edge_eval(ctx, model, be, &bt, 1, &xyz[3 * node]);
+        if (s < 0) return s;
+    }
+    return CM_OK;
+}
+
+cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
+                cm_mesh **out)
+{
+    const char *fn = "cm_tetmesh_create";
+    cm_cad_counts counts;
+    cm_cad_get_counts(model, &counts);
+    if (counts.solids == 0)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: the model has no solid (%d faces)", fn,
+                        counts.faces);
+    double bb[6];
+    cm_cad_bbox(model, bb);
+    const double h = o.size > 0 ? o.size
+                                : std::sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) +
+                                            (bb[4] - bb[1]) * (bb[4] - bb[1]) +
+                                            (bb[5] - bb[2]) * (bb[5] - bb[2])) / 20;
+    const double q = o.quality > 0 ? o.quality : 1.4;
+    if (!std::isfinite(h) || !std::isfinite(q) || q < 1.0)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: size %g or quality %g out of range (quality >= 1)",
+                        fn, h, q);
+
+    const double t0 = cm_wtime();
+    cad_guard surf;
+    cm_cad_triangulate_options topt;
+    cm_cad_triangulate_options_init(&topt);
+    topt.size = h;
+    cm_status s = cm_cad_triangulate(ctx, model, &topt, &surf.t);
+    if (s < 0) return s;
+    const cm_cad_triangulation &T = *surf.t;
+    if (T.n_open_edges)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "%s: the faces do not close a solid (%zu open or non-manifold edges)", fn,
+                        T.n_open_edges);
+    const double t1 = cm_wtime();
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: surface %zu nodes, %zu triangles (%.3f s)", T.n_nodes,
+           T.n_triangles, t1 - t0);
+    cm_progress(ctx, "tetgen", 0, 1);
+
+    tetgenio in, tv;
+    in.firstnumber = 0;
+    in.numberofpoints = (int)T.n_nodes;
+    in.pointlist = new REAL[3 * T.n_nodes];
+    std::copy(T.xyz, T.xyz + 3 * T.n_nodes, in.pointlist);
+    in.numberoffacets = (int)T.n_triangles;
+    in.facetlist = new tetgenio::facet[T.n_triangles];
+    in.facetmarkerlist = new int[T.n_triangles];
+    for (size_t t = 0; t < T.n_triangles; ++t) {
+        tetgenio::facet &f = in.facetlist[t];
+        tetgenio::init(&f);
+        f.numberofpolygons = 1;
+        f.polygonlist = new tetgenio::polygon[1];
+        tetgenio::init(&f.polygonlist[0]);
+        f.polygonlist[0].numberofvertices = 3;
+        f.polygonlist[0].vertexlist = new int[3];
+        for (int k = 0; k < 3; ++k) f.polygonlist[0].vertexlist[k] = (int)T.tri[3 * t + k];
+        in.facetmarkerlist[t] = T.tri_face[t] + 1;  // 0 would mean "no marker"
+    }
+    const double vmax = h * h * h * std::sqrt(2.0) / 12.0;  // regular tet of edge h
+    char sw[128];
+    std::snprintf(sw, sizeof sw, "pzq%.6ga%.6g%sQ", q, vmax, o.preserve_surface ? "Y" : "");
+    try {
+        tetrahedralize(sw, &in, &tv);
+    } catch (int code) {
+        return cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen failed with code %d (%s), switches %s",
+                        fn, code, tetgen_reason(code), sw);
+    }
+    if (tv.numberoftetrahedra <= 0 || tv.numberofcorners != 4)
+        return cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen made no linear tets (switches %s)", fn, sw);
+
+    const size_t nn = (size_t)tv.numberofpoints, nt = (size_t)tv.numberoftetrahedra,
+                 nb = (size_t)tv.numberoftrifaces;
+    std::vector<double> xyz(tv.pointlist, tv.pointlist + 3 * nn);
+    std::vector<int64_t> tri(nb * 3);
+    std::vector<int> tri_face(nb);
+    for (size_t t = 0; t < nb; ++t) {
+        for (int k = 0; k < 3; ++k) tri[3 * t + k] = tv.trifacelist[3 * t + k];
+        tri_face[t] = tv.trifacemarkerlist ? tv.trifacemarkerlist[t] - 1 : -1;
+        if (tri_face[t] < 0 || tri_face[t] >= counts.faces)
+            return cm_error(ctx, CM_ERR_INTERNAL, "%s: boundary triangle %zu without a CAD face", fn, t);
+    }
+    const double t2 = cm_wtime();
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -%s: %zu nodes, %zu tets (%.3f s)", sw, nn, nt, t2 - t1);
+    // TetGen keeps the input points first and in order; the others are its Steiner points
+    size_t n_projected = 0;
+    if (!o.preserve_surface &&
+        (s = project_new_nodes(ctx, model, T, T.n_nodes, xyz, tri, tri_face, &n_projected)) < 0)
+        return s;
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu new boundary nodes projected onto curved faces and edges (%.3f s)",
+           n_projected, cm_wtime() - t2);
+
+    // tets positively oriented (VTK), boundary triangles outward: away from their tet's
+    // fourth node
+    std::vector<std::array<int64_t, 4>> tets(nt);
+    for (size_t t = 0; t < nt; ++t) {
+        std::array<int64_t, 4> &c = tets[t];
+        for (int k = 0; k < 4; ++k) c[k] = tv.tetrahedronlist[4 * t + k];
+        if (orient(&xyz[3 * c[0]], &xyz[3 * c[1]], &xyz[3 * c[2]], &xyz[3 * c[3]]) < 0)
+            std::swap(c[2], c[3]);
+    }
+    std::vector<std::array<int64_t, 4>> keys;  // sorted face, then (tet's other node | -1 - tri)
+    keys.reserve(4 * nt + nb);
+    for (size_t t = 0; t < nb; ++t) {
+        std::array<int64_t, 4> k = {tri[3 * t], tri[3 * t + 1], tri[3 * t + 2], -1 - (int64_t)t};
+        std::sort(k.begin(), k.begin() + 3);
+        keys.push_back(k);
+    }
+    for (const auto &c : tets)
+        for (int f = 0; f < 4; ++f) {
+            std::array<int64_t, 4> k = {c[(f + 1) % 4], c[(f + 2) % 4], c[(f + 3) % 4], c[f]};
+            std::sort(k.begin(), k.begin() + 3);
+            keys.push_back(k);
+        }
+    std::sort(keys.begin(), keys.end());
+    for (size_t i = 0; i < keys.size(); ++i) {
+        if (keys[i][3] >= 0) continue;
+        const size_t t = (size_t)(-1 - keys[i][3]);
+        int64_t apex = -1;
+        for (size_t j = i + 1; j < keys.size() && std::equal(keys[i].begin(), keys[i].begin() + 3,
+                                                             keys[j].begin()); ++j)
+            if (keys[j][3] >= 0) apex = keys[j][3];
+        if (apex < 0)
+            return cm_error(ctx, CM_ERR_INTERNAL, "%s: boundary triangle %zu is on no tet", fn, t);
+        int64_t *f = &tri[3 * t];
+        if (orient(&xyz[3 * f[0]], &xyz[3 * f[1]], &xyz[3 * f[2]], &xyz[3 * apex]) > 0)
+            std::swap(f[1], f[2]);
+    }
+
+    mesh_guard m;
+    if ((s = cm_mesh_create(ctx, &m.m)) < 0) return s;
+    if ((s = cm_mesh_resize_nodes(ctx, m.m, nn, 0)) < 0) return s;
+    std::copy(xyz.begin(), xyz.end(), m.m->xyz);
+    if ((s = cm_mesh_reserve_cells(ctx, m.m, nt + nb, 4 * nt + 3 * nb)) < 0) return s;
+    for (const auto &c : tets)
+        if ((s = cm_mesh_add_cell(ctx, m.m, CM_CELL_TET4, c.data(), 4, 1, 1, 0)) < 0) return s;
+    for (size_t t = 0; t < nb; ++t)
+        if ((s = cm_mesh_add_cell(ctx, m.m, CM_CELL_TRI3, &tri[3 * t], 3, tri_face[t] + 1,
+                                  tri_face[t] + 1, 0)) < 0)
+            return s;
+    if ((s = cm_mesh_add_group(ctx, m.m, 3, 1, "solid")) < 0) return s;
+    std::vector<char> used(counts.faces, 0);
+    for (int f : tri_face) used[f] = 1;
+    for (int f = 0; f < counts.faces; ++f) {
+        if (!used[f]) continue;
+        const std::string name = "face_" + std::to_string(f);
+        if ((s = cm_mesh_add_group(ctx, m.m, 2, f + 1, name.c_str())) < 0) return s;
+    }
+    cm_progress(ctx, "tetgen", 1, 1);
+    *out = m.m;
+    m.m = nullptr;
+    return CM_OK;
+}
+
+}  // namespace
+
+extern "C" void cm_tetmesh_options_init(cm_tetmesh_options *opt)
+{
+    if (!opt) return;
+    opt->size = 0;
+    opt->quality = 1.4;
+    opt->preserve_surface = 0;
+}
+
+extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
+                                       const cm_tetmesh_options *opt, cm_mesh **mesh)
+{
+    const char *fn = "cm_tetmesh_create";
+    if (mesh) *mesh = nullptr;
+    if (!model || !mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL model or output", fn);
+    cm_tetmesh_options o;
+    cm_tetmesh_options_init(&o);
+    if (opt) o = *opt;
+    try {
+        return build(ctx, model, o, mesh);
+    } catch (const std::bad_alloc &) {
+        return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", fn);
+    } catch (const std::exception &e) {
+        return cm_error(ctx, CM_ERR_INTERNAL, "%s: %s", fn, e.what());
+    } catch (int code) {
+        return cm_error(ctx, code == 1 ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
+                        "%s: TetGen failed with code %d (%s)", fn, code, tetgen_reason(code));
+    } catch (...) {
+        return cm_error(ctx, CM_ERR_INTERNAL, "%s: unknown exception", fn);
+    }
+}
