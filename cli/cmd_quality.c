@@ -2,7 +2,6 @@
  * volume cell, a per-type table and the summary line; optionally one CSV row per volume cell. */
 #include "cli.h"
 
-#include "../mesh/io_internal.h"
 
 #include <errno.h>
 #include <stdlib.h>

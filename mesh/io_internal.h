@@ -1,14 +1,11 @@
-/* Shared by the mesh readers and writers (not public): whole-file reading, a line-aware
- * text cursor, and output through a temporary file that is renamed only on success. */
+/* Shared by the mesh readers and writers (not public): a line-aware text cursor. Whole-file
+ * reading and atomic output are in core.h (cm_file_read, cm_outfile). */
 #ifndef CADMORPH_MESH_IO_INTERNAL_H
 #define CADMORPH_MESH_IO_INTERNAL_H
 
 #include "cadmorph/mesh.h"
 
 #include <stdio.h>
-
-/* Reads a whole file; data is NUL-terminated (size excludes the NUL). Caller frees data. */
-cm_status cm_io_read_file(cm_context *ctx, const char *path, char **data, size_t *size);
 
 /* A cursor over text held in memory; line counts from 1. */
 typedef struct cm_text {
@@ -30,21 +27,5 @@ cm_status cm_text_int(cm_context *ctx, cm_text *t, const char *what, int64_t *v)
 cm_status cm_text_double(cm_context *ctx, cm_text *t, const char *what, double *v);
 /* Moves to the start of the next line. */
 void cm_text_next_line(cm_text *t);
-
-/* Output through path + ".tmp.XXXXXX" renamed onto path by cm_outfile_commit. */
-typedef struct cm_outfile {
-    FILE *f;
-    char *path;
-    char *tmp;
-} cm_outfile;
-
-cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out);
-/* Flushes, closes and renames; on any error removes the temporary file. */
-cm_status cm_outfile_commit(cm_context *ctx, cm_outfile *out);
-/* Closes and removes the temporary file (after an error). Safe to call twice. */
-void cm_outfile_abort(cm_outfile *out);
-
-/* True on a little-endian host (binary formats are written little-endian). */
-int cm_host_little_endian(void);
 
 #endif

@@ -187,7 +187,7 @@ cm_status cm_mesh_read_medit(cm_context *ctx, const char *path, cm_mesh **mesh)
     *mesh = NULL;
     char *data = NULL;
     size_t size = 0;
-    cm_status s = cm_io_read_file(ctx, path, &data, &size);
+    cm_status s = cm_file_read(ctx, path, &data, &size);
     if (s != CM_OK) return s;
     cm_text t;
     cm_text_init(&t, path, data, size);

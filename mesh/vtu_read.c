@@ -277,7 +277,7 @@ cm_status cm_mesh_read_vtu(cm_context *ctx, const char *path, cm_mesh **mesh)
     *mesh = NULL;
     char *data = NULL;
     size_t size = 0;
-    cm_status s = cm_io_read_file(ctx, path, &data, &size);
+    cm_status s = cm_file_read(ctx, path, &data, &size);
     if (s != CM_OK) return s;
     vtu_reader r;
     memset(&r, 0, sizeof r);

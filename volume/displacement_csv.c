@@ -1,7 +1,6 @@
 /* The displacement table D.csv (DESIGN.md, command line contract): `node,dx,dy,dz` rows with
  * 0-based node indices, read strictly so that a typo is reported at its line, not warped. */
 #include "cadmorph/volume.h"
-#include "mesh/io_internal.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -122,7 +121,7 @@ cm_status cm_warp_read_displacements(cm_context *ctx, const char *path, size_t n
     if (!row_line) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_read_displacements: out of memory");
     char *data = NULL;
     size_t size = 0;
-    cm_status s = cm_io_read_file(ctx, path, &data, &size);
+    cm_status s = cm_file_read(ctx, path, &data, &size);
     if (s < 0) {
         free(row_line);
         return s;

@@ -15,6 +15,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -76,6 +77,29 @@ void cm_progress(cm_context *ctx, const char *stage, double done, double total);
 
 /* Wall clock in seconds (monotonic), for stage timings in reports and benchmarks. */
 double cm_wtime(void);
+
+/* ---- files ---- */
+
+/* Reads a whole regular file into *data (NUL-terminated; *size excludes the NUL). The caller
+ * frees *data. CM_ERR_IO with the path and the reason on failure. */
+cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *size);
+
+/* Output through path + ".tmp.XXXXXX", renamed onto path by cm_outfile_commit, so that a
+ * failed write never leaves a partial file. Write with fprintf/fwrite to f. */
+typedef struct cm_outfile {
+    FILE *f;
+    char *path;
+    char *tmp;
+} cm_outfile;
+
+cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out);
+/* Flushes, closes and renames; on any error removes the temporary file. */
+cm_status cm_outfile_commit(cm_context *ctx, cm_outfile *out);
+/* Closes and removes the temporary file (after an error). Safe to call twice. */
+void cm_outfile_abort(cm_outfile *out);
+
+/* True on a little-endian host (binary formats are written little-endian). */
+int cm_host_little_endian(void);
 
 #ifdef __cplusplus
 }
