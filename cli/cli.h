@@ -33,6 +33,9 @@ int cli_same_file(const char *a, const char *b);
 
 /* Argument helpers: the value after an option, or NULL (and a usage message) if missing. */
 const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char *usage);
+/* The value of --threads (1..4096) into *threads: 0, or CLI_EXIT_USAGE after a usage message. */
+int cli_threads_value(int argc, char **argv, int *i, const char *cmd, const char *usage,
+                      int *threads);
 
 /* Quality report shared by quality, warp and morph. The line every mesh-producing command
  * ends with (DESIGN.md): "min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k>

@@ -78,13 +78,7 @@ int cli_cmd_mesh(int argc, char **argv)
             if (!(v = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
             if (parse_double(cmd, a, v, 1, &opt.quality)) return CLI_EXIT_USAGE;
         } else if (!strcmp(a, "--threads")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
-            char *end = NULL;
-            errno = 0;
-            const long t = strtol(v, &end, 10);
-            if (errno || *end || t < 1 || t > 4096)
-                return cli_usage(cmd, usage, "--threads needs a positive integer, got '%s'", v);
-            threads = (int)t;
+            if (cli_threads_value(argc, argv, &i, cmd, usage, &threads)) return CLI_EXIT_USAGE;
         } else if (a[0] == '-' && a[1] != '\0') {
             return cli_usage(cmd, usage, "unknown option '%s'", a);
         } else if (in) {

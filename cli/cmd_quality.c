@@ -49,14 +49,7 @@ int cli_cmd_quality(int argc, char **argv)
         if (!strcmp(a, "--csv")) {
             if (!(csv = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
         } else if (!strcmp(a, "--threads")) {
-            const char *v = cli_value(argc, argv, &i, cmd, usage);
-            if (!v) return CLI_EXIT_USAGE;
-            char *end = NULL;
-            errno = 0;
-            const long t = strtol(v, &end, 10);
-            if (errno || *end || t < 1 || t > 4096)
-                return cli_usage(cmd, usage, "--threads needs a positive integer, got '%s'", v);
-            threads = (int)t;
+            if (cli_threads_value(argc, argv, &i, cmd, usage, &threads)) return CLI_EXIT_USAGE;
         } else if (a[0] == '-' && a[1] != '\0') {
             return cli_usage(cmd, usage, "unknown option '%s'", a);
         } else if (mesh_path) {

@@ -68,13 +68,8 @@ static int parse_args(int argc, char **argv, warp_args *a)
             else
                 return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
         } else if (!strcmp(o, "--threads")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            long n = strtol(v, &end, 10);
-            if (*end || n < 1 || n > 4096)
-                return cli_usage(cmd, usage_line,
-                                 "--threads: expected a positive integer, got '%s'", v);
-            a->threads = (int)n;
+            if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
+                return CLI_EXIT_USAGE;
         } else {
             return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
         }

@@ -1,7 +1,9 @@
 /* Exit codes, error lines, progress drawing and path checks shared by the subcommands. */
 #include "cli.h"
 
+#include <errno.h>
 #include <stdarg.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -71,6 +73,20 @@ int cli_same_file(const char *a, const char *b)
     struct stat sa, sb;
     if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return strcmp(a, b) == 0;
     return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+int cli_threads_value(int argc, char **argv, int *i, const char *cmd, const char *usage,
+                      int *threads)
+{
+    const char *v = cli_value(argc, argv, i, cmd, usage);
+    if (!v) return CLI_EXIT_USAGE;
+    char *end = NULL;
+    errno = 0;
+    long t = strtol(v, &end, 10);
+    if (errno || end == v || *end || t < 1 || t > 4096)
+        return cli_usage(cmd, usage, "--threads needs a positive integer, got '%s'", v);
+    *threads = (int)t;
+    return 0;
 }
 
 const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char *usage)
