@@ -25,7 +25,7 @@ test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE slow
 
 bench: build
-	bash benchmarks/run_all.sh $(BUILD)
+	sh benchmarks/run_all.sh $(BUILD)
 
 clean:
 	rm -rf $(BUILD)

@@ -15,7 +15,6 @@ threads=${2:-0}
 sizes=${*:-1000 2000 5000 10000 20000}
 here=$(cd "$(dirname "$0")" && pwd)
 bench=$build/benchmarks/bench_rbf
-[ -x "$bench" ] || bench=$build/bench_rbf
 scipy_max=${SCIPY_MAX:-10000}
 scipy_threads=$threads; [ "$threads" -gt 0 ] || scipy_threads=$(nproc)
 work=$(mktemp -d /tmp/bench_rbf.XXXXXX)

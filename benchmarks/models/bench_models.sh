@@ -1,6 +1,6 @@
 #!/bin/sh
 # Meshes the three benchmark models at t = 0 at two sizes each (about 20k and 150k nodes) with
-# `cadmorph mesh -v` and prints one table row per run; results in benchmarks/results_models.md.
+# `cadmorph mesh -v` and prints one table row per run; results in benchmarks/RESULTS.md.
 # usage: bench_models.sh BUILD_DIR [WORK_DIR]
 set -eu
 build=${1:?usage: bench_models.sh BUILD_DIR [WORK_DIR]}

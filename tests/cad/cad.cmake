@@ -33,5 +33,3 @@ cm_cad_cli(cad_cli_broken 2 "^cadmorph info: .*broken.step: " info ${D}/broken.s
 cm_cad_cli(cad_cli_usage 1 "usage" info)
 cm_cad_cli(cad_cli_bad_unit 1 "unknown length unit" info ${D}/bore_a.step --cad-unit parsec)
 
-# The benchmark builds with the tests until benchmarks/CMakeLists.txt includes it.
-include(${PROJECT_SOURCE_DIR}/benchmarks/bench_cad.cmake)
