@@ -18,8 +18,7 @@ build: setup
 	cmake --build $(BUILD) -j $(JOBS)
 
 demo: build
-	# Until `cadmorph demo` exists (benchmarks issue): the quality report of a bundled mesh.
-	$(BUILD)/cli/cadmorph quality tests/data/demo/bore.msh
+	sh scripts/demo.sh $(BUILD)
 
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE slow
