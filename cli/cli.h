@@ -53,5 +53,6 @@ int cli_cmd_warp(int argc, char **argv);
 int cli_cmd_info(int argc, char **argv);
 int cli_cmd_mesh(int argc, char **argv);
 int cli_cmd_morph(int argc, char **argv);
+int cli_cmd_sweep(int argc, char **argv);
 
 #endif
