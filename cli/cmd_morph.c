@@ -95,7 +95,8 @@ static int parse_args(int argc, char **argv, morph_args *a)
             char *end;
             long n = strtol(v, &end, 10);
             if (*end || n < 1 || n > 4096)
-                return cli_usage(cmd, usage_line, "%s: expected a positive integer, got '%s'", o, v);
+                return cli_usage(cmd, usage_line, "%s: expected a positive integer, got '%s'", o,
+                                 v);
             if (!strcmp(o, "--steps"))
                 a->opt.steps = (int)n;
             else
@@ -109,11 +110,13 @@ static int parse_args(int argc, char **argv, morph_args *a)
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
     if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)", a->out);
+        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
+                         a->out);
     const char *inputs[] = {a->from, a->to, a->mesh};
     for (int k = 0; k < 3; ++k) {
         if (cli_same_file(a->out, inputs[k]))
-            return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it", a->out);
+            return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
+                             a->out);
         if (a->report && cli_same_file(a->report, inputs[k]))
             return cli_usage(cmd, usage_line, "report %s is an input: refusing to overwrite it",
                              a->report);
@@ -123,32 +126,22 @@ static int parse_args(int argc, char **argv, morph_args *a)
     return -1;
 }
 
-/* The CSV report: written to a temporary file and renamed, like the meshes. */
-static int write_report(const char *path, const cm_morph_result *r)
+/* The CSV report, written through a temporary file like the meshes. */
+static cm_status write_report(cm_context *ctx, const char *path, const cm_morph_result *r)
 {
-    size_t n = strlen(path) + 16;
-    char *tmp = malloc(n);
-    if (!tmp) return -1;
-    snprintf(tmp, n, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        free(tmp);
-        return -1;
-    }
-    fprintf(f, "step,min_scaled_jacobian,mean_scaled_jacobian,inverted,max_distance_to_g1,"
-               "t_read,t_sample,t_classify,t_surface_morph,t_volume_solve,t_evaluation,t_write\n");
+    cm_outfile out;
+    cm_status s = cm_outfile_open(ctx, path, &out);
+    if (s < 0) return s;
+    fprintf(out.f, "step,min_scaled_jacobian,mean_scaled_jacobian,inverted,max_distance_to_g1,"
+                   "t_read,t_sample,t_classify,t_surface_morph,t_volume_solve,t_evaluation,"
+                   "t_write\n");
     for (int k = 0; k < r->n_steps; ++k) {
-        const cm_morph_step *s = &r->steps[k];
-        fprintf(f, "%d,%.9g,%.9g,%zu,%.6g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", s->step, s->min_sj,
-                s->mean_sj, s->inverted, s->max_dist, s->t_read, s->t_sample, s->t_classify,
-                s->t_surface, s->t_volume_solve, s->t_evaluation, s->t_write);
+        const cm_morph_step *st = &r->steps[k];
+        fprintf(out.f, "%d,%.9g,%.9g,%zu,%.6g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", st->step,
+                st->min_sj, st->mean_sj, st->inverted, st->max_dist, st->t_read, st->t_sample,
+                st->t_classify, st->t_surface, st->t_volume_solve, st->t_evaluation, st->t_write);
     }
-    int bad = ferror(f);
-    bad |= fclose(f) != 0;
-    if (!bad) bad = rename(tmp, path) != 0;
-    if (bad) remove(tmp);
-    free(tmp);
-    return bad ? -1 : 0;
+    return cm_outfile_commit(ctx, &out);
 }
 
 int cli_cmd_morph(int argc, char **argv)
@@ -178,7 +171,8 @@ int cli_cmd_morph(int argc, char **argv)
            r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
     rc = CLI_EXIT_OK;
     if (a.fail_on_inverted && last->inverted > 0) {
-        fprintf(stderr, "cadmorph morph: %zu inverted cells (min scaled Jacobian %.6g); %s not written\n",
+        fprintf(stderr,
+                "cadmorph morph: %zu inverted cells (min scaled Jacobian %.6g); %s not written\n",
                 last->inverted, last->min_sj, a.out);
         rc = CLI_EXIT_REJECTED;
     }
@@ -188,9 +182,9 @@ int cli_cmd_morph(int argc, char **argv)
         r->steps[r->n_steps - 1].t_write = cm_wtime() - t;
         if (s < 0) rc = cli_fail(ctx, "morph", s);
     }
-    if (a.report && write_report(a.report, r) != 0) {
-        fprintf(stderr, "cadmorph morph: %s: cannot write the report\n", a.report);
-        if (rc == CLI_EXIT_OK) rc = CLI_EXIT_BAD_INPUT;
+    if (a.report && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED)) {
+        s = write_report(ctx, a.report, r);
+        if (s < 0) rc = cli_fail(ctx, "morph", s);
     }
     if (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED) {
         printf("boundary nodes: %zu on vertices, %zu on edges, %zu on faces; "

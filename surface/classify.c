@@ -49,7 +49,8 @@ cm_status cm_surface_edge_lengths(cm_context *ctx, const cm_mesh *mesh, const cm
     if (!mesh || !b) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_surface_edge_lengths: NULL input");
     double global = INFINITY;
     if (h_node)
-        for (size_t i = 0; i < b->n_nodes; ++i) h_node[i] = INFINITY;
+        for (size_t i = 0; i < b->n_nodes; ++i)
+            h_node[i] = INFINITY;
     for (size_t f = 0; f < b->n_faces; ++f) {
         int64_t a = b->face_offset[f], e = b->face_offset[f + 1];
         for (int64_t k = a; k < e; ++k) {
@@ -101,8 +102,8 @@ static double diag6(const double *bb)
 static const struct {
     const char *name;
     double mm;
-} units[] = {{"um", 1e-3}, {"mm", 1}, {"cm", 10}, {"in", 25.4}, {"ft", 304.8}, {"m", 1000},
-             {"km", 1e6}, {"mi", 1609344}};
+} units[] = {{"um", 1e-3},  {"mm", 1},   {"cm", 10},  {"in", 25.4},
+             {"ft", 304.8}, {"m", 1000}, {"km", 1e6}, {"mi", 1609344}};
 
 /* "; the mesh is 1000x smaller than the model: a unit mismatch? (mesh in m: read the CAD in
  * m)" when the sizes of the boundary and the model differ by the ratio of two units; ""
@@ -129,11 +130,15 @@ static void unit_hint(const cm_surface_nodes *s, const cm_cad_model *g, char *ou
     for (size_t i = 0; i < nu; ++i) {
         if (units[i].mm == model_mm || fabs(mesh_mm / units[i].mm - 1) > 0.05) continue;
         if (r > 1)
-            snprintf(out, len, "; the mesh is %.4gx larger than the model: a unit mismatch? "
-                     "(mesh in %s: read the CAD in %s)", r, units[i].name, units[i].name);
+            snprintf(out, len,
+                     "; the mesh is %.4gx larger than the model: a unit mismatch? "
+                     "(mesh in %s: read the CAD in %s)",
+                     r, units[i].name, units[i].name);
         else
-            snprintf(out, len, "; the mesh is %.4gx smaller than the model: a unit mismatch? "
-                     "(mesh in %s: read the CAD in %s)", 1 / r, units[i].name, units[i].name);
+            snprintf(out, len,
+                     "; the mesh is %.4gx smaller than the model: a unit mismatch? "
+                     "(mesh in %s: read the CAD in %s)",
+                     1 / r, units[i].name, units[i].name);
         return;
     }
 }
@@ -152,9 +157,11 @@ static cm_status edge_arc_lengths(cm_context *ctx, const cm_cad_model *g, cm_sur
     for (int e = 0; e < c.edges && st == CM_OK; ++e) {
         size_t a = first[e], k = first[e + 1] - a;
         if (!k) continue;
-        for (size_t j = 0; j < k; ++j) t[j] = s->param[2 * idx[a + j]];
+        for (size_t j = 0; j < k; ++j)
+            t[j] = s->param[2 * idx[a + j]];
         st = cm_cad_edge_t_to_s(ctx, g, e, t, k, t + ne);
-        for (size_t j = 0; j < k && st == CM_OK; ++j) s->param[2 * idx[a + j] + 1] = t[ne + j];
+        for (size_t j = 0; j < k && st == CM_OK; ++j)
+            s->param[2 * idx[a + j] + 1] = t[ne + j];
     }
     free(first);
     free(idx);
@@ -187,7 +194,8 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
 {
     const char *fn = "cm_surface_classify";
     if (out) *out = NULL;
-    if (!g || !locator || !mesh || !b || !out) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL input", fn);
+    if (!g || !locator || !mesh || !b || !out)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL input", fn);
     cm_classify_options o;
     cm_classify_options_init(&o);
     if (opt) o = *opt;
@@ -219,7 +227,8 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
     cm_cad_get_counts(g, &c);
     size_t nr = n;
     for (int pass = 0; pass < 3 && nr; ++pass) {
-        for (size_t j = 0; j < nr; ++j) memcpy(q + 3 * j, s->xyz + 3 * rest[j], 3 * sizeof(double));
+        for (size_t j = 0; j < nr; ++j)
+            memcpy(q + 3 * j, s->xyz + 3 * rest[j], 3 * sizeof(double));
         cm_progress(ctx, "classify", pass, 3);
         if (pass == 0 && c.vertices > 0) {
             st = cm_cad_locate_vertices(ctx, locator, q, nr, ent, dist);
@@ -245,8 +254,8 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
                 char hint[192];
                 unit_hint(s, g, hint, sizeof hint);
                 st = cm_error(ctx, CM_ERR_MISMATCH,
-                              "the mesh does not lie on the CAD model: %zu of %zu boundary nodes "
-                              "are off it (worst: node %lld at distance %.6g %s, tolerance %.3g)%s",
+                              "%zu of %zu boundary nodes are off the CAD model (worst: node %lld "
+                              "at distance %.6g %s, tolerance %.3g)%s",
                               off, n, (long long)s->node[worst], wd, cm_cad_unit(g), tol[worst],
                               hint);
                 goto done;

@@ -21,12 +21,14 @@ cm_status cm_surface_group(cm_context *ctx, const cm_surface_nodes *s, cm_surfac
     for (size_t i = 0; i < s->n; ++i)
         if (s->kind[i] == kind && s->entity[i] >= 0 && (size_t)s->entity[i] < ne)
             f[s->entity[i] + 1]++;
-    for (size_t e = 0; e < ne; ++e) f[e + 1] += f[e];
+    for (size_t e = 0; e < ne; ++e)
+        f[e + 1] += f[e];
     for (size_t i = 0; i < s->n; ++i)
         if (s->kind[i] == kind && s->entity[i] >= 0 && (size_t)s->entity[i] < ne)
             x[f[s->entity[i]]++] = i;
     /* the fill advanced each start to the next group's: shift back */
-    for (size_t e = ne; e > 0; --e) f[e] = f[e - 1];
+    for (size_t e = ne; e > 0; --e)
+        f[e] = f[e - 1];
     f[0] = 0;
     return CM_OK;
 }

@@ -13,12 +13,18 @@
  * locator grows h instead and says so (a warning, never silent). */
 #define CM_MORPH_MAX_SAMPLES ((size_t)4000000)
 
+static size_t sample_cap(const cm_morph_options *o)
+{
+    return o->max_samples ? o->max_samples : CM_MORPH_MAX_SAMPLES;
+}
+
 void cm_morph_options_init(cm_morph_options *opt)
 {
     opt->surface = CM_SURFACE_RBF;
     opt->kernel = CM_RBF_TRIHARMONIC;
     opt->steps = 1;
     opt->cad_unit = NULL;
+    opt->max_samples = 0;
     cm_classify_options_init(&opt->classify);
     cm_surface_morph_options_init(&opt->morph);
 }
@@ -61,7 +67,8 @@ typedef struct pipeline {
 static void note_warning(cm_context *ctx, pipeline *p, cm_status s)
 {
     if (s != CM_WARNING) return;
-    if (p->warned != CM_WARNING) snprintf(p->warning, sizeof p->warning, "%s", cm_context_message(ctx));
+    if (p->warned != CM_WARNING)
+        snprintf(p->warning, sizeof p->warning, "%s", cm_context_message(ctx));
     p->warned = CM_WARNING;
     if (!p->held)
         cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
@@ -71,7 +78,8 @@ static void note_warning(cm_context *ctx, pipeline *p, cm_status s)
 
 static void release_warnings(cm_context *ctx, pipeline *p)
 {
-    for (int i = 0; i < p->n_held; ++i) cm_log(ctx, CM_LOG_WARNING, "%s", p->held_msg[i]);
+    for (int i = 0; i < p->n_held; ++i)
+        cm_log(ctx, CM_LOG_WARNING, "%s", p->held_msg[i]);
     p->held = p->n_held = 0;
 }
 
@@ -100,16 +108,18 @@ static cm_status read_inputs(cm_context *ctx, pipeline *p, const char *g0, const
     return CM_OK;
 }
 
-static cm_status sample(cm_context *ctx, pipeline *p, const char *mesh, double *h_used)
+static cm_status sample(cm_context *ctx, pipeline *p, const char *mesh, const cm_morph_options *o,
+                        double *h_used)
 {
     double hmin = 0;
     cm_status s = cm_surface_edge_lengths(ctx, p->mesh, p->b, NULL, &hmin);
     if (s < 0) return s;
-    if (!(hmin > 0)) return cm_error(ctx, CM_ERR_FORMAT, "%s: all boundary edges have zero length", mesh);
+    if (!(hmin > 0))
+        return cm_error(ctx, CM_ERR_FORMAT, "%s: all boundary edges have zero length", mesh);
     cm_cad_sample_options so;
     cm_cad_sample_options_init(&so);
     so.h = hmin / 4;
-    so.max_samples = CM_MORPH_MAX_SAMPLES;
+    so.max_samples = sample_cap(o);
     s = cm_cad_locator_create(ctx, p->g0, &so, &p->loc0);
     if (s < 0) return s;
     note_warning(ctx, p, s);
@@ -118,12 +128,12 @@ static cm_status sample(cm_context *ctx, pipeline *p, const char *mesh, double *
 }
 
 /* G' is sampled like G, for measuring the distance of the morphed nodes to it. */
-static cm_status sample_g1(cm_context *ctx, pipeline *p, double h)
+static cm_status sample_g1(cm_context *ctx, pipeline *p, const cm_morph_options *o, double h)
 {
     cm_cad_sample_options so;
     cm_cad_sample_options_init(&so);
     so.h = h;
-    so.max_samples = CM_MORPH_MAX_SAMPLES;
+    so.max_samples = sample_cap(o);
     cm_status s = cm_cad_locator_create(ctx, p->g1, &so, &p->loc1);
     if (s < 0) return s;
     note_warning(ctx, p, s);
@@ -154,7 +164,8 @@ static cm_status step(cm_context *ctx, pipeline *p, const cm_morph_options *o, d
     if (s >= 0) s = cm_warp_apply(ctx, w, p->disp);
     cm_warp_destroy(&w);
     if (s < 0) return s;
-    for (size_t i = 0; i < 3 * m->n_nodes; ++i) m->xyz[i] += p->disp[i];
+    for (size_t i = 0; i < 3 * m->n_nodes; ++i)
+        m->xyz[i] += p->disp[i];
     /* boundary nodes exactly where they were sent (no round-off from the increments) */
     for (size_t i = 0; i < n->n; ++i)
         memcpy(m->xyz + 3 * n->node[i], p->bxyz + 3 * i, 3 * sizeof(double));
@@ -188,8 +199,7 @@ static void pipeline_free(pipeline *p)
 }
 
 cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,
-                       const char *mesh_path, const cm_morph_options *opt,
-                       cm_morph_result **result)
+                       const char *mesh_path, const cm_morph_options *opt, cm_morph_result **result)
 {
     if (result) *result = NULL;
     if (!g0_path || !g1_path || !mesh_path || !result)
@@ -209,7 +219,7 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
     if (s >= 0) s = read_inputs(ctx, &p, g0_path, g1_path, mesh_path, &o);
     if (rows) rows[0].t_read = cm_wtime() - t;
     t = cm_wtime();
-    if (s >= 0) s = sample(ctx, &p, mesh_path, &r->h);
+    if (s >= 0) s = sample(ctx, &p, mesh_path, &o, &r->h);
     if (rows) rows[0].t_sample = cm_wtime() - t;
     t = cm_wtime();
     if (s >= 0) {
@@ -224,14 +234,15 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
         r->counts[0] = p.nodes->count[0];
         r->counts[1] = p.nodes->count[1];
         r->counts[2] = p.nodes->count[2];
-        cm_log(ctx, CM_LOG_DEBUG, "classify: %zu boundary nodes: %zu on vertices, %zu on edges, "
+        cm_log(ctx, CM_LOG_DEBUG,
+               "classify: %zu boundary nodes: %zu on vertices, %zu on edges, "
                "%zu on faces (largest distance to G %.3g); sampling h %.4g",
                p.nodes->n, r->counts[0], r->counts[1], r->counts[2], p.nodes->max_dist, r->h);
     }
     if (s >= 0) release_warnings(ctx, &p);
     if (rows) rows[0].t_classify = cm_wtime() - t;
     t = cm_wtime();
-    if (s >= 0) s = sample_g1(ctx, &p, r->h);
+    if (s >= 0) s = sample_g1(ctx, &p, &o, r->h);
     if (rows) rows[0].t_sample += cm_wtime() - t;
     t = cm_wtime();
     size_t nn = p.mesh ? p.mesh->n_nodes : 0, nb = p.nodes ? p.nodes->n : 0;
@@ -257,7 +268,11 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
         cm_progress(ctx, "morph", k - 1, o.steps);
         rows[k - 1].step = k;
         s = step(ctx, &p, &o, (double)k / o.steps, sj, &rows[k - 1]);
-        if (s < 0 && o.steps > 1) s = prefixed(ctx, s, "step");
+        if (s < 0) {
+            char what[2048];
+            snprintf(what, sizeof what, "%s: step %d of %d", mesh_path, k, o.steps);
+            s = prefixed(ctx, s, what);
+        }
     }
     if (s >= 0) cm_progress(ctx, "morph", o.steps, o.steps);
     double *field = NULL;
@@ -265,12 +280,14 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
     if (s >= 0) {
         /* the scaled_jacobian field may have moved when the displacement field was added */
         r->sj = cm_mesh_find_field(p.mesh, "scaled_jacobian", CM_FIELD_CELL)->data;
-        for (size_t i = 0; i < 3 * nn; ++i) field[i] = p.mesh->xyz[i] - p.start[i];
+        for (size_t i = 0; i < 3 * nn; ++i)
+            field[i] = p.mesh->xyz[i] - p.start[i];
         if (p.b) {
             double bb[6];
             cm_cad_bbox(p.g1, bb);
-            r->diagonal = sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) + (bb[4] - bb[1]) * (bb[4] - bb[1]) +
-                               (bb[5] - bb[2]) * (bb[5] - bb[2]));
+            r->diagonal =
+                sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) + (bb[4] - bb[1]) * (bb[4] - bb[1]) +
+                     (bb[5] - bb[2]) * (bb[5] - bb[2]));
         }
         r->max_dist = rows[o.steps - 1].max_dist;
         r->mesh = p.mesh;

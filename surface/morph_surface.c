@@ -39,7 +39,8 @@ static cm_status samples_per_edge(cm_context *ctx, const cm_cad_model *g, const 
         double bb[6];
         cm_cad_bbox(g, bb);
         spacing = sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) + (bb[4] - bb[1]) * (bb[4] - bb[1]) +
-                       (bb[5] - bb[2]) * (bb[5] - bb[2])) / 100;
+                       (bb[5] - bb[2]) * (bb[5] - bb[2])) /
+                  100;
     }
     cm_cad_counts c;
     cm_cad_get_counts(g, &c);
@@ -72,7 +73,8 @@ static void unwrap_runs(const cm_cad_boundary *a, cm_cad_boundary *b, const cm_c
                 ++j;
             }
             double shift = -P * round(sum / (double)(j - i) / P);
-            for (size_t k = i; k < j; ++k) b->uv[2 * k + d] += shift;
+            for (size_t k = i; k < j; ++k)
+                b->uv[2 * k + d] += shift;
             i = j;
         }
     }
@@ -89,7 +91,9 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
     double *uv = malloc(2 * k * sizeof *uv), *d = malloc(2 * k * sizeof *d);
     double *p = malloc(3 * k * sizeof *p), *values = NULL;
     int *inside = malloc(k * sizeof *inside);
-    cm_status r = uv && d && p && inside ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    cm_status r = uv && d && p && inside
+                      ? CM_OK
+                      : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
     cm_cad_face_info fi;
     if (r == CM_OK) r = cm_cad_face_get_info(ctx, g2, f, &fi);
     if (r == CM_OK) r = cm_cad_face_boundary(ctx, g, f, per_edge, 0, &ba);
@@ -101,8 +105,10 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
         r = cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
     if (r == CM_OK) {
         unwrap_runs(ba, bb, &fi);
-        for (size_t i = 0; i < 2 * ba->n; ++i) values[i] = bb->uv[i] - ba->uv[i];
-        for (size_t j = 0; j < k; ++j) memcpy(uv + 2 * j, s->param + 2 * idx[j], 2 * sizeof(double));
+        for (size_t i = 0; i < 2 * ba->n; ++i)
+            values[i] = bb->uv[i] - ba->uv[i];
+        for (size_t j = 0; j < k; ++j)
+            memcpy(uv + 2 * j, s->param + 2 * idx[j], 2 * sizeof(double));
         r = cm_rbf_create(ctx, CM_RBF_THIN_PLATE, 2, ba->n, ba->uv, &rbf);
         if (r >= 0) r = cm_rbf_solve(ctx, rbf, 2, values);
         if (r >= 0) r = cm_rbf_evaluate(ctx, rbf, k, uv, d);
@@ -113,7 +119,8 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
         }
     }
     if (r >= 0) {
-        for (size_t j = 0; j < 2 * k; ++j) uv[j] += d[j];
+        for (size_t j = 0; j < 2 * k; ++j)
+            uv[j] += d[j];
         r = cm_cad_face_inside(ctx, g2, f, uv, k, inside);
     }
     if (r >= 0) r = cm_cad_face_eval(ctx, g2, f, uv, k, p, NULL);
@@ -145,17 +152,22 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
 static cm_status morph_edge(cm_context *ctx, const cm_cad_model *g2, int e, cm_surface_method m,
                             const cm_surface_nodes *s, const size_t *idx, size_t k, double *xyz)
 {
-    double *t = malloc(k * sizeof *t), *q = malloc(3 * k * sizeof *q), *p = malloc(3 * k * sizeof *p);
-    cm_status r = t && q && p ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    double *t = malloc(k * sizeof *t), *q = malloc(3 * k * sizeof *q),
+           *p = malloc(3 * k * sizeof *p);
+    cm_status r =
+        t && q && p ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
     if (r == CM_OK && m == CM_SURFACE_RBF) {
-        for (size_t j = 0; j < k; ++j) q[j] = s->param[2 * idx[j] + 1];
+        for (size_t j = 0; j < k; ++j)
+            q[j] = s->param[2 * idx[j] + 1];
         r = cm_cad_edge_s_to_t(ctx, g2, e, q, k, t);
     } else if (r == CM_OK) {
-        for (size_t j = 0; j < k; ++j) memcpy(q + 3 * j, s->xyz + 3 * idx[j], 3 * sizeof(double));
+        for (size_t j = 0; j < k; ++j)
+            memcpy(q + 3 * j, s->xyz + 3 * idx[j], 3 * sizeof(double));
         r = cm_cad_project_edge(ctx, g2, e, q, k, t, NULL);
     }
     if (r >= 0) r = cm_cad_edge_eval(ctx, g2, e, t, k, p);
-    for (size_t j = 0; j < k && r >= 0; ++j) memcpy(xyz + 3 * idx[j], p + 3 * j, 3 * sizeof(double));
+    for (size_t j = 0; j < k && r >= 0; ++j)
+        memcpy(xyz + 3 * idx[j], p + 3 * j, 3 * sizeof(double));
     free(t);
     free(q);
     free(p);
@@ -171,7 +183,8 @@ static cm_status project_face(cm_context *ctx, const cm_cad_model *g2, int f,
     for (size_t j = 0; j < k && r == CM_OK; ++j)
         memcpy(q + 3 * j, s->xyz + 3 * idx[j], 3 * sizeof(double));
     if (r == CM_OK) r = cm_cad_project_face(ctx, g2, f, q, k, NULL, NULL, NULL, p);
-    for (size_t j = 0; j < k && r >= 0; ++j) memcpy(xyz + 3 * idx[j], p + 3 * j, 3 * sizeof(double));
+    for (size_t j = 0; j < k && r >= 0; ++j)
+        memcpy(xyz + 3 * idx[j], p + 3 * j, 3 * sizeof(double));
     free(q);
     free(p);
     return r;
@@ -189,7 +202,8 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
     cm_surface_morph_options_init(&o);
     if (opt) o = *opt;
     if (o.min_per_edge < 2 || o.max_per_edge < o.min_per_edge)
-        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: samples per edge must satisfy 2 <= min <= max", fn);
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: samples per edge must satisfy 2 <= min <= max",
+                        fn);
     cm_cad_counts c, c2;
     cm_cad_get_counts(g, &c);
     cm_cad_get_counts(g2, &c2);
@@ -206,7 +220,8 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
         const size_t *in = idx[0] + first[0][v], k = first[0][v + 1] - first[0][v];
         double p[3];
         if (k) r = cm_cad_vertex_point(ctx, g2, v, p);
-        for (size_t j = 0; j < k && r >= 0; ++j) memcpy(xyz + 3 * in[j], p, sizeof p);
+        for (size_t j = 0; j < k && r >= 0; ++j)
+            memcpy(xyz + 3 * in[j], p, sizeof p);
     }
     for (int e = 0; e < c.edges && r >= 0; ++e) {
         size_t k = first[1][e + 1] - first[1][e];

@@ -35,16 +35,16 @@ void cm_classify_options_init(cm_classify_options *opt);
 
 /* The boundary nodes of a mesh, each on one entity of G. Arrays owned by the struct. */
 typedef struct cm_surface_nodes {
-    size_t n;              /* boundary nodes */
-    int64_t *node;         /* n: mesh node index (ascending, as cm_mesh_boundary.nodes) */
-    double *xyz;           /* n x 3: position when classified */
-    unsigned char *kind;   /* n: cm_surface_kind */
-    int *entity;           /* n: vertex, edge or face of G (0-based) */
-    double *param;         /* n x 2: face (u, v); edge (t, s); vertex (0, 0) */
-    double *dist;          /* n: distance to the entity */
-    double *h;             /* n: shortest boundary edge at the node */
-    size_t count[3];       /* nodes per kind */
-    double max_dist;       /* largest dist */
+    size_t n;            /* boundary nodes */
+    int64_t *node;       /* n: mesh node index (ascending, as cm_mesh_boundary.nodes) */
+    double *xyz;         /* n x 3: position when classified */
+    unsigned char *kind; /* n: cm_surface_kind */
+    int *entity;         /* n: vertex, edge or face of G (0-based) */
+    double *param;       /* n x 2: face (u, v); edge (t, s); vertex (0, 0) */
+    double *dist;        /* n: distance to the entity */
+    double *h;           /* n: shortest boundary edge at the node */
+    size_t count[3];     /* nodes per kind */
+    double max_dist;     /* largest dist */
 } cm_surface_nodes;
 
 /* Shortest boundary-face edge at each boundary node: h_node (b->n_nodes, in the order of
@@ -67,8 +67,8 @@ void cm_surface_nodes_destroy(cm_surface_nodes **nodes);
 /* ---- morph ---- */
 
 typedef enum cm_surface_method {
-    CM_SURFACE_RBF = 0,     /* parameter-space thin-plate warp per face (the method) */
-    CM_SURFACE_PROJECT = 1  /* baseline: closest point on the matching entity of G' */
+    CM_SURFACE_RBF = 0,    /* parameter-space thin-plate warp per face (the method) */
+    CM_SURFACE_PROJECT = 1 /* baseline: closest point on the matching entity of G' */
 } cm_surface_method;
 
 typedef struct cm_surface_morph_options {
@@ -83,12 +83,12 @@ typedef struct cm_surface_morph_options {
 void cm_surface_morph_options_init(cm_surface_morph_options *opt);
 
 typedef struct cm_surface_morph_stats {
-    size_t faces_warped;     /* faces with nodes, one 2D RBF each (RBF method) */
-    size_t faces_skipped;    /* faces without interior nodes */
-    size_t outside;          /* face nodes whose (u',v') left the trimmed domain of f'_k;
-                                they are put on the closest point of f'_k instead */
-    int64_t worst_outside_node;  /* mesh node, -1 if none */
-    double worst_outside_dist;   /* how far f'_k(u',v') was from the trimmed face */
+    size_t faces_warped;        /* faces with nodes, one 2D RBF each (RBF method) */
+    size_t faces_skipped;       /* faces without interior nodes */
+    size_t outside;             /* face nodes whose (u',v') left the trimmed domain of f'_k;
+                                   they are put on the closest point of f'_k instead */
+    int64_t worst_outside_node; /* mesh node, -1 if none */
+    double worst_outside_dist;  /* how far f'_k(u',v') was from the trimmed face */
 } cm_surface_morph_stats;
 
 /* Morphs the classified nodes from G to G' (models that correspond: cm_cad_compare).
@@ -110,10 +110,13 @@ cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *locator
  * (links cm_surface and cm_volume, so that cm_surface itself knows no volume). */
 
 typedef struct cm_morph_options {
-    cm_surface_method surface;  /* default CM_SURFACE_RBF */
-    cm_rbf_kernel kernel;       /* volume warp: CM_RBF_TRIHARMONIC (default) or BIHARMONIC */
-    int steps;                  /* >= 1 (default 1): equal increments of the boundary motion */
-    const char *cad_unit;       /* target unit of both STEP files; NULL = "mm" */
+    cm_surface_method surface; /* default CM_SURFACE_RBF */
+    cm_rbf_kernel kernel;      /* volume warp: CM_RBF_TRIHARMONIC (default) or BIHARMONIC */
+    int steps;                 /* >= 1 (default 1): equal increments of the boundary motion */
+    const char *cad_unit;      /* target unit of both STEP files; NULL = "mm" */
+    /* Samples of each model for the locators: h is a quarter of the shortest boundary edge,
+     * raised (with a warning) if that needs more than max_samples; 0: 4,000,000. */
+    size_t max_samples;
     cm_classify_options classify;
     cm_surface_morph_options morph;
 } cm_morph_options;
@@ -128,27 +131,32 @@ typedef struct cm_morph_step {
     int step;
     double min_sj, mean_sj;
     size_t inverted, cells;
-    double max_dist;   /* largest distance of the boundary nodes to G' after this step */
+    double max_dist; /* largest distance of the boundary nodes to G' after this step (by
+                        projection through a locator on G'); before the last step the
+                        boundary is a linear blend, so this is how far it still is */
     double t_read, t_sample, t_classify, t_surface, t_volume_solve, t_evaluation, t_write;
 } cm_morph_step;
 
 typedef struct cm_morph_result {
-    cm_mesh *mesh;          /* the morphed mesh, with per-node "displacement" (from M0) and
-                               per-cell "scaled_jacobian" fields */
-    double *sj;             /* #cells: the scaled_jacobian field's data (owned by mesh) */
+    cm_mesh *mesh; /* the morphed mesh, with per-node "displacement" (from M0) and
+                      per-cell "scaled_jacobian" fields */
+    double *sj;    /* #cells: the scaled_jacobian field's data (owned by mesh) */
     int n_steps;
-    cm_morph_step *steps;   /* n_steps rows */
-    size_t counts[3];       /* boundary nodes on vertices, edges, faces */
+    cm_morph_step *steps; /* n_steps rows */
+    size_t counts[3];     /* boundary nodes on vertices, edges, faces */
     cm_surface_morph_stats surface;
-    double max_dist;        /* largest distance of the final boundary nodes to G' */
-    double diagonal;        /* bbox diagonal of G' (for relative tolerances) */
-    double h;               /* sampling h actually used on G */
+    double max_dist; /* largest distance of the final boundary nodes to G' */
+    double diagonal; /* bbox diagonal of G' (for relative tolerances) */
+    double h;        /* sampling h actually used on G */
 } cm_morph_result;
 
 /* Runs the pipeline. Errors: CM_ERR_MISMATCH when G and G' do not correspond (up to 5
  * differences in the message) or M is not a mesh of G (see cm_surface_classify); file
  * errors from the readers. Returns CM_WARNING (the first warning's message) when a stage
- * warned (nodes left a trimmed domain, sample cap reached) but the result is complete. */
+ * warned (nodes left a trimmed domain, sample cap reached) but the result is complete.
+ * Warnings also go to the context's log (CM_LOG_WARNING) as they happen; those of the
+ * sampling of G only once the mesh is known to lie on G (a mesh in the wrong unit makes the
+ * sampling warn, and the real error is the mismatch). */
 cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,
                        const char *mesh_path, const cm_morph_options *opt,
                        cm_morph_result **result);

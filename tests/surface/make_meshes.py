@@ -2,14 +2,16 @@
 """Test-time meshes for tests/surface: gmsh -3 on the STEP fixtures of tests/data/surface
 (kept small: a few thousand nodes), plus the bad-input variants.
   make_meshes.py DATA_DIR WORK_DIR
-writes WORK_DIR/surface/<model>.msh for hole_a holes2_a cyl_a sphere_a, and
+writes WORK_DIR/surface/<model>.msh for hole_a holes2_a cyl_a sphere_a cone_a torus_a,
 hole_a_metres.msh (the hole_a mesh in metres: the CAD is in millimetres) and cyl_a_o2.msh
-(second order: tet10 with mid-edge nodes on the curved boundary)."""
+(second order: tet10 with mid-edge nodes on the curved boundary), bore_a.msh (of
+tests/data/cad/bore_a.step)."""
 import os
 import subprocess
 import sys
 
-SIZES = {"hole_a": 1.0, "holes2_a": 0.9, "cyl_a": 0.9, "sphere_a": 1.0}
+SIZES = {"hole_a": 1.0, "holes2_a": 0.9, "cyl_a": 0.9, "sphere_a": 1.0, "cone_a": 0.8,
+         "torus_a": 0.8}
 
 
 def gmsh(args):
@@ -28,6 +30,9 @@ def main(data, work):
     gmsh(["-3", os.path.join(data, "surface", "hole_a.step"), "-clmax", "1.0",
           "-setnumber", "Mesh.ScalingFactor", "0.001", "-format", "msh41",
           "-o", os.path.join(out, "hole_a_metres.msh")])
+    # the bore of tests/data/cad (sphere-capped boss: sphere, seams, a bore)
+    gmsh(["-3", os.path.join(data, "cad", "bore_a.step"), "-clmax", "0.8", "-format", "msh41",
+          "-o", os.path.join(out, "bore_a.msh")])
     gmsh(["-3", "-order", "2", os.path.join(data, "surface", "cyl_a.step"), "-clmax", "1.2",
           "-format", "msh41", "-o", os.path.join(out, "cyl_a_o2.msh")])
 

@@ -17,13 +17,13 @@ function(cm_morph_cli name)
 endfunction()
 
 # each edit, one output format each; then gmsh measures the distance of the boundary to G1
-foreach(case hole:vtu holes2:msh cyl:vtk sphere:vtu)
+foreach(case hole:vtu holes2:msh cyl:vtk sphere:vtu cone:mesh torus:msh)
   string(REPLACE ":" ";" parts ${case})
   list(GET parts 0 m)
   list(GET parts 1 ext)
   cm_morph_cli(cli_morph_${m} ${RUN} --exit 0 --stdout "${SUMMARY}" --
     $<TARGET_FILE:cadmorph> morph --from ${SD}/${m}_a.step --to ${SD}/${m}_b.step
-    --mesh ${SW}/${m}_a.msh -o ${SW}/cli_${m}.${ext})
+    --mesh ${SW}/${m}_a.msh -o ${SW}/cli_${m}.${ext} --fail-on-inverted)
   cm_morph_cli(cli_morph_${m}_on_g1 ${CHECK} ongeom ${SW}/${m}_a.msh ${SW}/cli_${m}.${ext}
     ${SD}/${m}_b.step 1e-9)
   set_tests_properties(cli_morph_${m}_on_g1 PROPERTIES DEPENDS cli_morph_${m})
@@ -58,7 +58,7 @@ cm_morph_cli(cli_morph_topology ${RUN} --exit 2 --stderr-lines 1
   $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/holes2_a.step
   --mesh ${SW}/hole_a.msh -o ${SW}/cli_bad1.vtu)
 cm_morph_cli(cli_morph_other_model ${RUN} --exit 2 --stderr-lines 1
-  --stderr "^cadmorph morph: .*cyl_a.msh is not a mesh of .*hole_a.step: .*boundary nodes are off it \\(worst: node [0-9]+ at distance"
+  --stderr "^cadmorph morph: .*cyl_a.msh is not a mesh of .*hole_a.step: .*boundary nodes are off the CAD model \\(worst: node [0-9]+ at distance"
   --absent ${SW}/cli_bad2.vtu --
   $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
   --mesh ${SW}/cyl_a.msh -o ${SW}/cli_bad2.vtu)

@@ -62,9 +62,11 @@ static inline void fx_rigid(const double *x, double *y)
 {
     double k[3] = {0.3, 0.5, 1.0}, c[3] = {1, 2, 0}, t[3] = {3.5, -2.0, 1.25}, a = 0.7;
     double kn = sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);
-    for (int i = 0; i < 3; ++i) k[i] /= kn;
+    for (int i = 0; i < 3; ++i)
+        k[i] /= kn;
     double p[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
-    double kxp[3] = {k[1] * p[2] - k[2] * p[1], k[2] * p[0] - k[0] * p[2], k[0] * p[1] - k[1] * p[0]};
+    double kxp[3] = {k[1] * p[2] - k[2] * p[1], k[2] * p[0] - k[0] * p[2],
+                     k[0] * p[1] - k[1] * p[0]};
     double kp = k[0] * p[0] + k[1] * p[1] + k[2] * p[2];
     for (int i = 0; i < 3; ++i)
         y[i] = p[i] * cos(a) + kxp[i] * sin(a) + k[i] * kp * (1 - cos(a)) + c[i] + t[i];

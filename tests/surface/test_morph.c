@@ -1,7 +1,8 @@
 /* The morph pipeline (surface/morph_pipeline.c) end to end on gmsh meshes of the STEP pairs:
  * identity keeps the mesh, a rigid motion of G moves it rigidly, the edits of a bore, a plate
  * with two holes, a cylinder and a sphere give no inverted cell, boundary nodes on G', and
- * the RBF surface morph at least as good as closest-point projection; increments agree. */
+ * the RBF surface morph at least as good as closest-point projection; increments agree.
+ * Also the bore pair of tests/data/cad (tests/data/cad/gen_fixtures.py). */
 #include "surface_fixture.h"
 
 static cm_morph_result *run(cm_context *ctx, const char *from, const char *to, const char *mesh,
@@ -43,7 +44,8 @@ static double motion_error(cm_context *ctx, const char *mesh, const cm_morph_res
         double d = fx_dist(y, p);
         if (d > worst) worst = d;
         if (f) {
-            double q[3] = {x[0] + f->data[3 * i], x[1] + f->data[3 * i + 1], x[2] + f->data[3 * i + 2]};
+            double q[3] = {x[0] + f->data[3 * i], x[1] + f->data[3 * i + 1],
+                           x[2] + f->data[3 * i + 2]};
             double e = fx_dist(q, p);
             if (e > fe) fe = e;
         }
@@ -81,11 +83,11 @@ static void test_identity_and_rigid(cm_context *ctx)
     cm_morph_result_destroy(&r);
 }
 
-static void test_edit(cm_context *ctx, const char *from, const char *to)
+static void test_edit(cm_context *ctx, const char *from, const char *to, const char *mesh)
 {
-    cm_morph_result *rbf = run(ctx, from, to, from, CM_SURFACE_RBF, 1);
-    cm_morph_result *prj = run(ctx, from, to, from, CM_SURFACE_PROJECT, 1);
-    cm_morph_result *inc = run(ctx, from, to, from, CM_SURFACE_RBF, 3);
+    cm_morph_result *rbf = run(ctx, from, to, mesh, CM_SURFACE_RBF, 1);
+    cm_morph_result *prj = run(ctx, from, to, mesh, CM_SURFACE_PROJECT, 1);
+    cm_morph_result *inc = run(ctx, from, to, mesh, CM_SURFACE_RBF, 3);
     if (rbf && prj && inc) {
         const cm_morph_step *a = &rbf->steps[0], *b = &prj->steps[0], *c = &inc->steps[2];
         CHECK_MSG(a->inverted == 0, "%s -> %s: %zu inverted", from, to, a->inverted);
@@ -107,7 +109,8 @@ static void test_edit(cm_context *ctx, const char *from, const char *to)
         CHECK(cm_mesh_boundary_create(ctx, rbf->mesh, &bd) == CM_OK);
         double worst = 0;
         for (size_t i = 0; bd && i < bd->n_nodes; ++i) {
-            double d = fx_dist(rbf->mesh->xyz + 3 * bd->nodes[i], inc->mesh->xyz + 3 * bd->nodes[i]);
+            double d =
+                fx_dist(rbf->mesh->xyz + 3 * bd->nodes[i], inc->mesh->xyz + 3 * bd->nodes[i]);
             if (d > worst) worst = d;
         }
         CHECK_MSG(worst <= 1e-12 * rbf->diagonal, "steps 3 vs 1: boundary differs by %g", worst);
@@ -129,7 +132,8 @@ static void test_errors(cm_context *ctx)
     fx_mesh_path(m, sizeof m, "hole_a");
     CHECK(cm_morph_run(ctx, g0, g1, m, NULL, &r) == CM_ERR_MISMATCH && r == NULL);
     CHECK_MSG(strstr(cm_context_message(ctx), "do not correspond: ") &&
-              strstr(cm_context_message(ctx), "faces: 7 in G, 8 in G'"), "%s", cm_context_message(ctx));
+                  strstr(cm_context_message(ctx), "faces: 7 in G, 8 in G'"),
+              "%s", cm_context_message(ctx));
     fx_step_path(g1, sizeof g1, "hole_b");
     fx_mesh_path(m, sizeof m, "cyl_a");
     CHECK(cm_morph_run(ctx, g0, g1, m, NULL, &r) == CM_ERR_MISMATCH && r == NULL);
@@ -146,6 +150,19 @@ static void test_errors(cm_context *ctx)
     cm_morph_result_destroy(&r);
     o.steps = 0;
     CHECK(cm_morph_run(ctx, g0, g1, m, &o, &r) == CM_ERR_ARGUMENT && r == NULL);
+
+    /* a sample cap below what h needs: h grows, the run says so and still ends on G' */
+    fx_mesh_path(m, sizeof m, "hole_a");
+    cm_morph_options_init(&o);
+    o.max_samples = 3000;
+    CHECK(cm_morph_run(ctx, g0, g1, m, &o, &r) == CM_WARNING && r);
+    CHECK_MSG(strstr(cm_context_message(ctx), "over the cap of 3000"), "%s",
+              cm_context_message(ctx));
+    if (r) {
+        CHECK(r->h > 0.2);
+        CHECK(r->steps[0].inverted == 0 && r->max_dist <= 1e-9 * r->diagonal);
+    }
+    cm_morph_result_destroy(&r);
 }
 
 int main(int argc, char **argv)
@@ -156,10 +173,14 @@ int main(int argc, char **argv)
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
     test_identity_and_rigid(ctx);
-    test_edit(ctx, "hole_a", "hole_b");
-    test_edit(ctx, "holes2_a", "holes2_b");
-    test_edit(ctx, "cyl_a", "cyl_b");
-    test_edit(ctx, "sphere_a", "sphere_b");
+    test_edit(ctx, "hole_a", "hole_b", "hole_a");
+    test_edit(ctx, "holes2_a", "holes2_b", "holes2_a");
+    test_edit(ctx, "cyl_a", "cyl_b", "cyl_a");
+    test_edit(ctx, "sphere_a", "sphere_b", "sphere_a");
+    test_edit(ctx, "cone_a", "cone_b", "cone_a");
+    test_edit(ctx, "torus_a", "torus_b", "torus_a");
+    /* the bore of the CAD tests: bore, boss with a seam, sphere cap */
+    test_edit(ctx, "../cad/bore_a", "../cad/bore_b", "bore_a");
     test_errors(ctx);
     cm_context_destroy(&ctx);
     return TEST_REPORT();

@@ -149,8 +149,8 @@ static void test_morph(cm_context *ctx, const char *from, const char *to,
                 if (c > closed) closed = c;
             }
         }
-        CHECK_MSG(off <= 1e-9 * diag2, "%s -> %s (%s): a node is %g off its entity of G'", from,
-                  to, method ? "project" : "rbf", off);
+        CHECK_MSG(off <= 1e-9 * diag2, "%s -> %s (%s): a node is %g off its entity of G'", from, to,
+                  method ? "project" : "rbf", off);
         CHECK_MSG(ds <= 1e-9, "%s -> %s: edge nodes moved along the edge by s = %g", from, to, ds);
         CHECK_MSG(closed <= 1e-9 * diag2, "%s -> %s: %g from the closed form", from, to, closed);
         if (method == 0) CHECK_MSG(ms.outside == 0, "%s -> %s: %zu outside", from, to, ms.outside);
@@ -207,14 +207,16 @@ static void test_mismatch(cm_context *ctx)
     /* a mesh of another model: off G, count and worst node in the message */
     cm_status st = setup_create(ctx, "hole_a", "cyl_a", &s);
     CHECK(st == CM_ERR_MISMATCH && s.nodes == NULL);
-    CHECK_MSG(strstr(cm_context_message(ctx), "boundary nodes are off it (worst: node "),
+    CHECK_MSG(strstr(cm_context_message(ctx), "boundary nodes are off the CAD model (worst: node "),
               "%s", cm_context_message(ctx));
     setup_destroy(&s);
     /* the same mesh in metres against the model in millimetres */
     st = setup_create(ctx, "hole_a", "hole_a_metres", &s);
     CHECK(st == CM_ERR_MISMATCH);
-    CHECK_MSG(strstr(cm_context_message(ctx), "1000x smaller than the model: a unit mismatch? (mesh in m: read the CAD in m)"),
-              "%s", cm_context_message(ctx));
+    CHECK_MSG(
+        strstr(cm_context_message(ctx),
+               "1000x smaller than the model: a unit mismatch? (mesh in m: read the CAD in m)"),
+        "%s", cm_context_message(ctx));
     setup_destroy(&s);
 }
 
@@ -226,12 +228,15 @@ int main(int argc, char **argv)
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
     const char *models[] = {"hole_a", "holes2_a", "cyl_a", "sphere_a"};
-    for (int i = 0; i < 4; ++i) test_classify(ctx, models[i]);
+    for (int i = 0; i < 4; ++i)
+        test_classify(ctx, models[i]);
     test_morph(ctx, "hole_a", "hole_rigid", fx_rigid);
     test_morph(ctx, "cyl_a", "cyl_b", fx_cylinder);
     test_morph(ctx, "sphere_a", "sphere_b", fx_sphere);
     test_morph(ctx, "hole_a", "hole_b", NULL);
     test_morph(ctx, "holes2_a", "holes2_b", NULL);
+    test_morph(ctx, "cone_a", "cone_b", NULL);
+    test_morph(ctx, "torus_a", "torus_b", NULL);
     test_outside(ctx);
     test_mismatch(ctx);
     cm_context_destroy(&ctx);

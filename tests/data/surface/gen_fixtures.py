@@ -7,6 +7,8 @@ so G and G' have the same topology in the same order (checked by the tests):
   holes2_a/b    plate whose top face has two holes; b: holes grown and moved, plate longer
   cyl_a/b       cylinder (periodic seam); b: longer, larger radius
   sphere_a/b    ball (poles, seam); b: larger radius, centre moved by half the radius
+  cone_a/b      cone with its apex (a singular point); b: taller, wider
+  torus_a/b     torus (periodic in u and v, two seams); b: both radii larger, centre moved
 Meshes are made at test time by gmsh -3 (tests/surface/make_meshes.py).
 """
 import math
@@ -49,6 +51,14 @@ def sphere(occ, cx, r):
     occ.addSphere(cx, 0, 0, r)
 
 
+def cone(occ, h, r):
+    occ.addCone(0, 0, 0, 0, 0, h, r, 0)
+
+
+def torus(occ, cx, r1, r2):
+    occ.addTorus(cx, 0, 0, r1, r2)
+
+
 write("hole_a", hole, 10, 8, 4, 5, 4, 2)
 write("hole_b", hole, 10, 8, 4, 5.6, 3.7, 2.6)
 write("hole_rigid", hole, 10, 8, 4, 5, 4, 2, rigid=True)
@@ -58,3 +68,7 @@ write("cyl_a", cyl, 6, 2)
 write("cyl_b", cyl, 8, 2.6)
 write("sphere_a", sphere, 0, 3)
 write("sphere_b", sphere, 1.5, 3.3)
+write("cone_a", cone, 4, 2)
+write("cone_b", cone, 5, 2.5)
+write("torus_a", torus, 0, 4, 1.2)
+write("torus_b", torus, 0.5, 4.5, 1.4)
