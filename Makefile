@@ -18,7 +18,7 @@ build: setup
 	cmake --build $(BUILD) -j $(JOBS)
 
 demo: build
-	sh scripts/demo.sh $(BUILD)
+	$(BUILD)/cli/cadmorph demo -o $(BUILD)/demo
 
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE slow

@@ -54,5 +54,6 @@ int cli_cmd_info(int argc, char **argv);
 int cli_cmd_mesh(int argc, char **argv);
 int cli_cmd_morph(int argc, char **argv);
 int cli_cmd_sweep(int argc, char **argv);
+int cli_cmd_demo(int argc, char **argv);
 
 #endif

@@ -1,0 +1,1 @@
+target_link_libraries(cadmorph PRIVATE cm_sweep)
