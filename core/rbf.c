@@ -31,7 +31,7 @@
 /* |R_ii| below this times max |R_jj|: the polynomial block is singular. */
 #define CM_RBF_UNISOLVENT_TOL 1e-10
 /* Merged centres must carry values that agree to this, relative to the largest value. */
-#define CM_RBF_VALUE_TOL 1e-12
+#define CM_RBF_VALUE_TOL 1e-8
 
 /* The m x m factor: on 2 MB boundaries, marked for transparent huge pages and populated by
  * one madvise call. On the VMs we run on, first touch of fresh memory page by page cost

@@ -343,7 +343,9 @@ cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const doubl
     for (size_t c = 0; c < mesh->n_cells; ++c) {
         const cm_cell_info *info = cm_cell_type_info((cm_cell_type)mesh->type[c]);
         if (!info || info->dim < 3 || isnan(sj[c])) continue;
-        v[fill[info->linear]++] = sj[c];
+        /* Verdict's +-1e30 marks a collapsed cell (zero-length edges), not a quality: 0 here,
+         * so that it counts as inverted and shows in the minimum instead of in the mean. */
+        v[fill[info->linear]++] = fabs(sj[c]) >= VERDICT_DBL_MAX ? 0.0 : sj[c];
     }
     if (per_type)
         for (int t = 0; t < CM_CELL_TYPE_COUNT; ++t)

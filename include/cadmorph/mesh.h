@@ -218,7 +218,8 @@ cm_status cm_mesh_quality(cm_context *ctx, const cm_mesh *mesh, double *sj);
 typedef struct cm_quality_stats {
     size_t count;
     double min, mean, p01; /* p01: 1st percentile */
-    size_t inverted;       /* scaled Jacobian <= 0 */
+    size_t inverted;       /* scaled Jacobian <= 0; collapsed cells (Verdict's +-1e30) count as
+                              0, NaN (a polyhedron without faces) as inverted */
 } cm_quality_stats;
 
 /* Stats over volume cells: per_type[CM_CELL_TYPE_COUNT] (by linear type) and all. Either

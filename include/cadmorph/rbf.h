@@ -34,7 +34,8 @@ void cm_rbf_destroy(cm_rbf **rbf);
 
 /* Solves for values at the m centres given to create (values: m x ncomp row-major) and keeps
  * the weights in rbf, replacing earlier ones. Merged duplicate centres whose values differ
- * by more than 1e-12 relative are an error naming both indices. */
+ * by more than 1e-8 of the largest value are an error naming both indices (smaller
+ * differences are round-off, e.g. of projections that put two nodes on one point). */
 cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values);
 
 /* Evaluates the current interpolant at n points (points: n x dim) into out (n x ncomp).

@@ -295,6 +295,13 @@ static void test_mesh_and_summary(void)
     for (int i = 0; i < N; ++i) v[i] = i < 500 ? 0.5 : 0.25;
     CHECK(cm_quality_summarize(ctx, m, v, NULL, &all) == CM_OK);
     CHECK_NEAR(all.p01, 0.25, 0);
+    /* Verdict's 1e30 for a collapsed cell is no quality: 0 in the summary, inverted */
+    v[3] = 1e30;
+    v[4] = -1e30;
+    CHECK(cm_quality_summarize(ctx, m, v, NULL, &all) == CM_OK);
+    CHECK(all.inverted == 2);
+    CHECK_NEAR(all.min, 0.0, 0);
+    CHECK(all.mean < 0.5);
     cm_mesh_destroy(&m);
     cm_context_destroy(&ctx);
 }
