@@ -1,1 +1,0 @@
-target_link_libraries(cadmorph PRIVATE cm_cad)
