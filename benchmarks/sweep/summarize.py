@@ -1,4 +1,4 @@
-"""Markdown tables of results_sweep.md from the sweep.csv files of run_sweeps.sh.
+"""Markdown tables of the sweep section of RESULTS.md from the sweep.csv files of run_sweeps.sh.
 
 Table 1, per model x mesh x mode x method: the first step with an inverted cell (of 20), min
 scaled Jacobian at 50 and 100 %, worst boundary distance to G(t) over the sweep (x diagonal),
