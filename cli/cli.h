@@ -16,9 +16,10 @@ enum {
     CLI_EXIT_INTERNAL = 4
 };
 
-/* A context whose log goes to stderr (debug lines only when verbose) and whose progress is
- * drawn on stderr when stderr is a terminal. NULL when out of memory. */
-cm_context *cli_context_create(int verbose);
+/* A context whose log goes to stderr (debug lines only when verbose), whose progress is drawn
+ * on stderr when stderr is a terminal, with `threads` threads (0: all). NULL, after a line
+ * on stderr naming cmd, when out of memory. */
+cm_context *cli_context_create(const char *cmd, int verbose, int threads);
 
 /* Prints "cadmorph <cmd>: <context message>" on one line to stderr, returns the exit code
  * for the status (2 for bad input, 4 for internal errors). */

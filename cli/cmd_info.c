@@ -119,11 +119,8 @@ int cli_cmd_info(int argc, char **argv)
     }
     if (!path) return cli_usage(cmd, usage_line, "no STEP file given");
 
-    cm_context *ctx = cli_context_create(0);
-    if (!ctx) {
-        fprintf(stderr, "cadmorph info: out of memory\n");
-        return CLI_EXIT_INTERNAL;
-    }
+    cm_context *ctx = cli_context_create("info", 0, 0);
+    if (!ctx) return CLI_EXIT_INTERNAL;
     cm_cad_model *g = NULL, *g2 = NULL;
     int rc = CLI_EXIT_OK;
     cm_status st = cm_cad_read(ctx, path, &opt, &g);

@@ -94,12 +94,8 @@ int cli_cmd_mesh(int argc, char **argv)
     if (cli_same_file(out, in))
         return cli_usage(cmd, usage, "output %s is the input: refusing to overwrite it", out);
 
-    cm_context *ctx = cli_context_create(verbose);
-    if (!ctx) {
-        fprintf(stderr, "cadmorph %s: out of memory\n", cmd);
-        return CLI_EXIT_INTERNAL;
-    }
-    cm_context_set_threads(ctx, threads);
+    cm_context *ctx = cli_context_create(cmd, verbose, threads);
+    if (!ctx) return CLI_EXIT_INTERNAL;
     cm_cad_read_options ro;
     cm_cad_read_options_init(&ro);
     if (unit) ro.unit = unit;

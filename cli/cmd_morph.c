@@ -149,12 +149,8 @@ int cli_cmd_morph(int argc, char **argv)
     morph_args a;
     int rc = parse_args(argc, argv, &a);
     if (rc >= 0) return rc;
-    cm_context *ctx = cli_context_create(a.verbose);
-    if (!ctx) {
-        fprintf(stderr, "cadmorph morph: out of memory\n");
-        return CLI_EXIT_INTERNAL;
-    }
-    cm_context_set_threads(ctx, a.threads);
+    cm_context *ctx = cli_context_create("morph", a.verbose, a.threads);
+    if (!ctx) return CLI_EXIT_INTERNAL;
     cm_morph_result *r = NULL;
     cm_status s = cm_morph_run(ctx, a.from, a.to, a.mesh, &a.opt, &r);
     if (s < 0) {

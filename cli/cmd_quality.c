@@ -61,12 +61,8 @@ int cli_cmd_quality(int argc, char **argv)
     if (csv && cli_same_file(csv, mesh_path))
         return cli_usage(cmd, usage, "--csv %s is the input mesh; refusing to overwrite it", csv);
 
-    cm_context *ctx = cli_context_create(0);
-    if (!ctx) {
-        fprintf(stderr, "cadmorph %s: out of memory\n", cmd);
-        return CLI_EXIT_INTERNAL;
-    }
-    cm_context_set_threads(ctx, threads);
+    cm_context *ctx = cli_context_create(cmd, 0, threads);
+    if (!ctx) return CLI_EXIT_INTERNAL;
     int rc = CLI_EXIT_OK;
     cm_mesh *mesh = NULL;
     double *sj = NULL;

@@ -199,12 +199,8 @@ int cli_cmd_sweep(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc >= 0) return rc;
     if ((rc = make_dir(a.opt.out_dir)) != 0) return rc;
-    cm_context *ctx = cli_context_create(a.verbose);
-    if (!ctx) {
-        fprintf(stderr, "cadmorph sweep: out of memory\n");
-        return CLI_EXIT_INTERNAL;
-    }
-    cm_context_set_threads(ctx, a.threads);
+    cm_context *ctx = cli_context_create("sweep", a.verbose, a.threads);
+    if (!ctx) return CLI_EXIT_INTERNAL;
     cm_sweep_result *r = NULL;
     cm_status s = cm_sweep_run(ctx, &a.opt, &r);
     if (s < 0) {

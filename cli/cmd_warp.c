@@ -142,12 +142,8 @@ int cli_cmd_warp(int argc, char **argv)
     warp_args a;
     int rc = parse_args(argc, argv, &a);
     if (rc >= 0) return rc;
-    cm_context *ctx = cli_context_create(a.verbose);
-    if (!ctx) {
-        fprintf(stderr, "cadmorph warp: out of memory\n");
-        return CLI_EXIT_INTERNAL;
-    }
-    cm_context_set_threads(ctx, a.threads);
+    cm_context *ctx = cli_context_create("warp", a.verbose, a.threads);
+    if (!ctx) return CLI_EXIT_INTERNAL;
     cm_mesh *mesh = NULL;
     double *disp = NULL;
     unsigned char *listed = NULL;

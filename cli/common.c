@@ -38,10 +38,14 @@ static void progress_to_stderr(void *user, const char *stage, double done, doubl
     fflush(stderr);
 }
 
-cm_context *cli_context_create(int verbose)
+cm_context *cli_context_create(const char *cmd, int verbose, int threads)
 {
     cm_context *ctx = NULL;
-    if (cm_context_create(&ctx) != CM_OK) return NULL;
+    if (cm_context_create(&ctx) != CM_OK) {
+        fprintf(stderr, "cadmorph %s: out of memory\n", cmd);
+        return NULL;
+    }
+    cm_context_set_threads(ctx, threads);
     sink.verbose = verbose;
     sink.tty = isatty(fileno(stderr));
     cm_context_set_log(ctx, log_to_stderr, &sink);
