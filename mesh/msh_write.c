@@ -349,6 +349,17 @@ static void write_entities41(writer *w, const ent *e, size_t n)
     fprintf(w->f, "%s$EndEntities\n", w->bin ? "\n" : "");
 }
 
+/* "$Nodes" / "$Elements" and the 4.1 block header: blocks, count, smallest and largest tag. */
+static void write_header41(writer *w, const char *section, size_t blocks, size_t count,
+                           int64_t lo, int64_t hi)
+{
+    fprintf(w->f, "%s\n", section);
+    w_size(w, (int64_t)blocks, ' ');
+    w_size(w, (int64_t)count, ' ');
+    w_size(w, count ? lo : 0, ' ');
+    w_size(w, hi, '\n');
+}
+
 static void write_nodes41(writer *w, const ent *e, const int *node_ent)
 {
     const cm_mesh *m = w->m;
@@ -359,12 +370,7 @@ static void write_nodes41(writer *w, const ent *e, const int *node_ent)
         if (node_tag(m, i) < lo) lo = node_tag(m, i);
         if (node_tag(m, i) > hi) hi = node_tag(m, i);
     }
-    if (!m->n_nodes) lo = 0;
-    fprintf(w->f, "$Nodes\n");
-    w_size(w, (int64_t)nb, ' ');
-    w_size(w, (int64_t)m->n_nodes, ' ');
-    w_size(w, lo, ' ');
-    w_size(w, hi, '\n');
+    write_header41(w, "$Nodes", nb, m->n_nodes, lo, hi);
     for (size_t i = 0; i < m->n_nodes;) {
         size_t j = i + 1;
         while (j < m->n_nodes && node_ent[j] == node_ent[i]) ++j;
@@ -399,12 +405,7 @@ static void write_elements41(writer *w)
         if (cell_tag(m, c) < lo) lo = cell_tag(m, c);
         if (cell_tag(m, c) > hi) hi = cell_tag(m, c);
     }
-    if (!m->n_cells) lo = 0;
-    fprintf(w->f, "$Elements\n");
-    w_size(w, (int64_t)nb, ' ');
-    w_size(w, (int64_t)m->n_cells, ' ');
-    w_size(w, lo, ' ');
-    w_size(w, hi, '\n');
+    write_header41(w, "$Elements", nb, m->n_cells, lo, hi);
     for (size_t c = 0; c < m->n_cells;) {
         size_t e = c + 1;
         while (e < m->n_cells && m->type[e] == m->type[c] && m->entity[e] == m->entity[c]) ++e;

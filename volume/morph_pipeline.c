@@ -9,10 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Samples on G beyond this are not worth their memory for meshes cadmorph morphs; the
- * locator grows h instead and says so (a warning, never silent). */
-#define CM_MORPH_MAX_SAMPLES ((size_t)4000000)
-
 static size_t sample_cap(const cm_morph_options *o)
 {
     return o->max_samples ? o->max_samples : CM_MORPH_MAX_SAMPLES;

@@ -125,7 +125,7 @@ static cm_status make_locator(cm_context *ctx, const sweep *w, const cm_cad_mode
     cm_cad_sample_options so;
     cm_cad_sample_options_init(&so);
     so.h = w->h;
-    so.max_samples = 4000000; /* as cm_morph_run: beyond this h grows, with a warning */
+    so.max_samples = CM_MORPH_MAX_SAMPLES; /* as cm_morph_run: beyond it h grows, with a warning */
     cm_status s = cm_cad_locator_create(ctx, g, &so, loc);
     if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
     return s < 0 ? s : CM_OK;

@@ -88,6 +88,10 @@ cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
  * `steps` increments. Library target cm_morph (volume/morph_pipeline.c), apart from cm_volume
  * so that the warp and the mesher do not pull in the surface module. ---- */
 
+/* Samples on G beyond this are not worth their memory for the meshes cadmorph morphs; the
+ * locator grows h instead and says so (a warning, never silent). Sweeps use it too. */
+#define CM_MORPH_MAX_SAMPLES ((size_t)4000000)
+
 typedef struct cm_morph_options {
     cm_surface_method surface; /* default CM_SURFACE_RBF */
     cm_rbf_kernel kernel;      /* volume warp: CM_RBF_TRIHARMONIC (default) or BIHARMONIC */
