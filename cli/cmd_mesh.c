@@ -4,7 +4,7 @@
 #include "cli.h"
 
 #include "cadmorph/cad.h"
-#include "cadmorph/volume.h"
+#include "cadmorph/tetmesh.h"
 
 #include <errno.h>
 #include <math.h>

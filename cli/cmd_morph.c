@@ -2,7 +2,7 @@
  * RBF warp of the interior), writes it, reports its quality and, on request, a CSV of stages. */
 #include "cli.h"
 
-#include "cadmorph/volume.h"
+#include "cadmorph/morph.h"
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -2,7 +2,7 @@
  * displacements given in a CSV table, writes the moved mesh and reports its quality. */
 #include "cli.h"
 
-#include "cadmorph/volume.h"
+#include "cadmorph/warp.h"
 
 #include <stdio.h>
 #include <stdlib.h>

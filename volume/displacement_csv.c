@@ -1,6 +1,6 @@
 /* The displacement table D.csv (DESIGN.md, command line contract): `node,dx,dy,dz` rows with
  * 0-based node indices, read strictly so that a typo is reported at its line, not warped. */
-#include "cadmorph/volume.h"
+#include "cadmorph/warp.h"
 
 #include <ctype.h>
 #include <errno.h>

@@ -2,7 +2,7 @@
  * sample G and classify M's boundary nodes; morph them onto G' (section 4); carry the motion
  * into the interior per component with the RBF warp (section 3), in equal increments. */
 #include "cadmorph/surface.h"
-#include "cadmorph/volume.h"
+#include "cadmorph/morph.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -5,7 +5,7 @@
 // OpenCASCADE is reached only through cad's C API, which already maps Standard_Failure, so
 // no OpenCASCADE header is seen here (DESIGN: OpenCASCADE only in cad/).
 #include "cadmorph/kdtree.h"
-#include "cadmorph/volume.h"
+#include "cadmorph/tetmesh.h"
 
 #include <tetgen.h>
 

@@ -1,6 +1,6 @@
 /* The volume warp (paper section 3): one polyharmonic RBF per connected component of volume
  * cells, centred at the component's constrained nodes, carries their displacement inside. */
-#include "cadmorph/volume.h"
+#include "cadmorph/warp.h"
 
 #include <stdio.h>
 #include <stdlib.h>

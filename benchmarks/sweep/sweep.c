@@ -4,7 +4,8 @@
  * on M(t - dt) against G(t - dt) each step). */
 #include "sweep.h"
 
-#include "cadmorph/volume.h"
+#include "cadmorph/morph.h"
+#include "cadmorph/tetmesh.h"
 #include "hexmesh.h"
 #include "models.h"
 

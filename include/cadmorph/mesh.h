@@ -168,20 +168,6 @@ cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
                         const cm_mesh_write_options *opt);
 
-/* Per-format entry points (cm_mesh_read/write dispatch to these). */
-cm_status cm_mesh_read_msh(cm_context *ctx, const char *path, cm_mesh **mesh);
-cm_status cm_mesh_write_msh(cm_context *ctx, const cm_mesh *mesh, const char *path,
-                            const cm_mesh_write_options *opt);
-cm_status cm_mesh_read_vtu(cm_context *ctx, const char *path, cm_mesh **mesh);
-cm_status cm_mesh_write_vtu(cm_context *ctx, const cm_mesh *mesh, const char *path,
-                            const cm_mesh_write_options *opt);
-cm_status cm_mesh_read_vtk(cm_context *ctx, const char *path, cm_mesh **mesh);
-cm_status cm_mesh_write_vtk(cm_context *ctx, const cm_mesh *mesh, const char *path,
-                            const cm_mesh_write_options *opt);
-cm_status cm_mesh_read_medit(cm_context *ctx, const char *path, cm_mesh **mesh);
-cm_status cm_mesh_write_medit(cm_context *ctx, const cm_mesh *mesh, const char *path,
-                              const cm_mesh_write_options *opt);
-
 /* ---- boundary and components (volume cells only: dim 3) ---- */
 
 typedef struct cm_mesh_boundary {

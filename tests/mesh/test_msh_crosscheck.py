@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Cross-checks cadmorph's gmsh .msh I/O against code nobody here wrote.
 
-usage: test_msh_crosscheck.py <tests/data> <work dir> <mesh/msh_common.c>
+usage: test_msh_crosscheck.py <tests/data> <work dir> <mesh/io/msh_common.c>
 
 1. The gmsh -> VTK node permutations in msh_common.c equal the ones derived from gmsh's own
    reference elements (gmsh.model.mesh.getElementProperties) and VTK's

@@ -4,7 +4,7 @@
  * the RBF surface morph at least as good as closest-point projection; increments agree.
  * Also the bore pair of tests/data/cad (tests/data/cad/gen_fixtures.py). */
 #include "surface_fixture.h"
-#include "cadmorph/volume.h"
+#include "cadmorph/morph.h"
 
 static cm_morph_result *run(cm_context *ctx, const char *from, const char *to, const char *mesh,
                             cm_surface_method method, int steps)

@@ -4,7 +4,7 @@
  * the boundary triangles are exactly the tets' free faces, outward (their divergence-theorem
  * volume equals the tets'); tet volume = BRepGProp volume = 4*4*2 - pi*0.6^2*2 (1e-2 rel.);
  * more nodes for a smaller size; also with the surface kept as OpenCASCADE made it. And a STEP without a solid is refused. */
-#include "cadmorph/volume.h"
+#include "cadmorph/tetmesh.h"
 #include "test_util.h"
 
 #include <stdlib.h>

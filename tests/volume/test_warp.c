@@ -1,7 +1,7 @@
 /* cm_warp: affine boundary motion is reproduced inside (the linear polynomial makes it exact),
  * prescribed nodes keep their values, components move independently, thread count does not
  * change the result, degenerate and empty inputs are errors. Meshes are built in code. */
-#include "cadmorph/volume.h"
+#include "cadmorph/warp.h"
 #include "test_util.h"
 #include "warp_meshes.h"
 

@@ -1,6 +1,6 @@
 /* cm_warp_read_displacements: a valid table (spaces, CRLF, blank lines, BOM) and every kind of
  * bad row, each reported as path:line with the right status. Files go to the work dir. */
-#include "cadmorph/volume.h"
+#include "cadmorph/warp.h"
 #include "test_util.h"
 
 #include <stdio.h>

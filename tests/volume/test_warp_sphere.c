@@ -1,7 +1,7 @@
 /* The warp of a real gmsh mesh (sphere in a box, made by warp_sphere.py setup): reads the mesh
  * and the sphere's displacements, warps as `cadmorph warp` does (boundary and listed nodes
  * constrained) and writes every node's displacement for warp_sphere.py compare (scipy). */
-#include "cadmorph/volume.h"
+#include "cadmorph/warp.h"
 #include "test_util.h"
 
 #include <math.h>

@@ -1,6 +1,7 @@
 /* Writer of VTK XML UnstructuredGrid (.vtu): ascii, inline base64 or appended raw data,
  * optionally zlib-compressed in VTK's block format; header_type UInt64, Int64 ids. */
 #include "vtk_internal.h"
+#include "formats.h"
 
 #include <omp.h>
 #include <stdlib.h>

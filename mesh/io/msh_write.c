@@ -2,6 +2,7 @@
  * temporary file renamed on success. Cells go out in file order with their tags; fields go
  * out as $NodeData / $ElementData. */
 #include "msh_internal.h"
+#include "formats.h"
 
 #include <stdlib.h>
 #include <string.h>

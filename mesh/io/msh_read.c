@@ -2,6 +2,7 @@
  * Sections: $MeshFormat, $PhysicalNames, $Entities, $Nodes, $Elements, $NodeData and
  * $ElementData; other sections are skipped. Node order inside cells is converted to VTK's. */
 #include "msh_read_internal.h"
+#include "formats.h"
 
 #include <math.h>
 #include <stdarg.h>

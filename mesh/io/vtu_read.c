@@ -1,6 +1,7 @@
 /* Reader of VTK XML UnstructuredGrid (.vtu) files as ParaView, VTK and meshio write them:
  * ascii, inline base64 and appended (raw or base64) data, optionally zlib-compressed. */
 #include "vtk_internal.h"
+#include "formats.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -1,7 +1,7 @@
-/* Shared by the mesh readers and writers (not public): a line-aware text cursor. Whole-file
+/* Shared by the text mesh readers (not public): a line-aware text cursor. Whole-file
  * reading and atomic output are in core.h (cm_file_read, cm_outfile). */
-#ifndef CADMORPH_MESH_IO_INTERNAL_H
-#define CADMORPH_MESH_IO_INTERNAL_H
+#ifndef CADMORPH_MESH_IO_TEXT_H
+#define CADMORPH_MESH_IO_TEXT_H
 
 #include "cadmorph/mesh.h"
 

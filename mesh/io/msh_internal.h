@@ -3,7 +3,7 @@
 #ifndef CADMORPH_MESH_MSH_INTERNAL_H
 #define CADMORPH_MESH_MSH_INTERNAL_H
 
-#include "io_internal.h"
+#include "text.h"
 
 /* vtk[i] = gmsh[perm[i]] for the cell's nodes; NULL where both orders agree. */
 const int *cm_msh_perm(cm_cell_type type);

@@ -1,6 +1,7 @@
 /* Writer of legacy VTK (.vtk) files in the VTK 5.1 layout (OFFSETS/CONNECTIVITY, vtktypeint64),
  * which VTK 9 and meshio both read; BINARY data is big-endian as the format requires. */
 #include "vtk_internal.h"
+#include "formats.h"
 
 #include <stdlib.h>
 #include <string.h>

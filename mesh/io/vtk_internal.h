@@ -3,7 +3,7 @@
 #ifndef CADMORPH_MESH_VTK_INTERNAL_H
 #define CADMORPH_MESH_VTK_INTERNAL_H
 
-#include "io_internal.h"
+#include "text.h"
 
 /* ---- base64 (RFC 4648, standard alphabet) ---- */
 

@@ -1,6 +1,7 @@
 /* Reader of legacy VTK (.vtk) DATASET UNSTRUCTURED_GRID files, ASCII and BINARY (big-endian):
  * classic "CELLS n size" and VTK 5.1 OFFSETS/CONNECTIVITY layouts, SCALARS, VECTORS, FIELD. */
 #include "vtk_internal.h"
+#include "formats.h"
 
 #include <stdlib.h>
 #include <string.h>

@@ -5,7 +5,8 @@
  * tests/mesh/test_vtk_io.c against the same meshes as .vtk/.vtu). Prisms are in gmsh's
  * order (meshio writes them so; gmsh 4.8 does not write prisms to .mesh at all): the
  * triangle (0,1,2) is wound the other way than VTK's wedge, so nodes 1<->2 and 4<->5 swap. */
-#include "io_internal.h"
+#include "formats.h"
+#include "text.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,0 +1,44 @@
+/* cadmorph tet meshing: a tet mesh of a STEP solid, the OpenCASCADE surface triangulation
+ * (cad.h) filled with tetrahedra by TetGen. Conventions: see core.h.
+ */
+#ifndef CADMORPH_TETMESH_H
+#define CADMORPH_TETMESH_H
+
+#include "cadmorph/cad.h"
+#include "cadmorph/mesh.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct cm_tetmesh_options {
+    double size;       /* target edge length; <= 0: bbox diagonal / 20. The surface is
+                          triangulated with chord deflection size / 10, the tets' volume is
+                          bounded by that of a regular tet of edge `size`. */
+    double quality;    /* bound on TetGen's radius-edge ratio (switch q); <= 0: 1.4 */
+    /* 1: TetGen may not add nodes on the boundary (switch Y): the boundary nodes are
+     * exactly OpenCASCADE's triangulation. 0 (default): TetGen refines the surface too,
+     * and each node it adds there is projected onto its CAD face (or edge), so that every
+     * boundary node lies on the CAD model either way. BRepMesh puts no interior nodes on
+     * planes, and TetGen adds no interior node that would encroach on a boundary triangle:
+     * with 1, a model with large planar faces gets a coarse mesh whatever the size. */
+    int preserve_surface;
+} cm_tetmesh_options;
+
+void cm_tetmesh_options_init(cm_tetmesh_options *opt);
+
+/* Tet mesh of the model's solids. The mesh holds the nodes, the tets (physical 1, entity 1,
+ * group "solid") and the boundary triangles, outward, each with physical and entity tag
+ * face + 1 of the CAD face it lies on (groups "face_<k>", k 0-based as in cad.h).
+ * Errors: CM_ERR_UNSUPPORTED for a model without a solid or whose faces do not close
+ * (message: number of open edges), CM_ERR_CAD for a surface triangulation failure,
+ * CM_ERR_NUMERIC with TetGen's code and its meaning when TetGen gives up (self-intersecting
+ * or too close facets, tiny features), CM_ERR_NOMEM. TetGen itself may print a line on
+ * stdout before it fails (it does so unconditionally). Not thread-safe on one model. */
+cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
+                            const cm_tetmesh_options *opt, cm_mesh **mesh);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

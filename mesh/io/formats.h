@@ -1,0 +1,22 @@
+/* The per-format readers and writers (not public): only the dispatcher (io.c) calls them,
+ * so that every mesh read goes through cm_mesh_validate. Adding a format is one file here
+ * and one case in io.c. */
+#ifndef CADMORPH_MESH_IO_FORMATS_H
+#define CADMORPH_MESH_IO_FORMATS_H
+
+#include "cadmorph/mesh.h"
+
+cm_status cm_mesh_read_msh(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_msh(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_vtu(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_vtu(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_vtk(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_vtk(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_medit(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_medit(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                              const cm_mesh_write_options *opt);
+
+#endif

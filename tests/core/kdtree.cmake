@@ -1,2 +1,0 @@
-# kD-tree: exact nearest neighbours against a brute-force scan.
-cm_add_unit_test(test_kdtree test_kdtree.c LABELS core)
