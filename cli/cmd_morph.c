@@ -10,8 +10,8 @@
 
 static const char *const usage_line =
     "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
-    "[--surface rbf|project] [--kernel triharmonic|biharmonic] [--report R.csv] "
-    "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
+    "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] "
+    "[--report R.csv] [--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
 
 static void print_help(void)
 {
@@ -28,9 +28,14 @@ static void print_help(void)
         "  --to G1.step         the edited geometry (same topology)\n"
         "  --mesh M0            input volume mesh\n"
         "  -o, --output M1      output mesh (must not be an input)\n"
-        "  --steps K            split the boundary motion into K equal increments (default 1)\n"
+        "  --steps K            split the boundary motion into K equal increments (default 1);\n"
+        "                       each increment after the first refits the warp on the last mesh\n"
+        "  --relative --via L   morph relatively through the intermediate geometries of the\n"
+        "                       comma-separated list L (same topology): G0 -> Ga -> ... -> G1,\n"
+        "                       each leg from the previous result (K increments per leg)\n"
         "  --surface S          rbf (parameter warp, default) or project (closest point)\n"
-        "  --kernel K           volume warp: triharmonic (r^3, default) or biharmonic (r)\n"
+        "  --method M           interior warp: %s (default rbf)\n"
+        "  --kernel K           triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)\n"
         "  --report R.csv       one row per step: quality, distance to G1, stage times\n"
         "  --fail-on-inverted   exit 3 without writing M1 if a cell is inverted\n"
         "  --cad-unit U         unit of the mesh coordinates: the STEP files are converted to\n"
@@ -38,14 +43,40 @@ static void print_help(void)
         "  --threads N          threads (default: all)\n"
         "  --verbose            debug messages on stderr\n\n"
         "exit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
-        "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted.\n");
+        "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted.\n",
+        cm_warp_method_list());
 }
+
+#define MORPH_MAX_VIA 256
 
 typedef struct morph_args {
     const char *from, *to, *mesh, *out, *report, *unit;
     cm_morph_options opt;
-    int fail_on_inverted, threads, verbose;
+    int fail_on_inverted, threads, verbose, relative;
+    char via_list[8192]; /* --via, split in place at the commas */
+    const char *via[MORPH_MAX_VIA];
+    size_t n_via;
 } morph_args;
+
+/* Splits --via's value at commas into a->via. */
+static int parse_via(const char *cmd, morph_args *a, const char *v)
+{
+    if (strlen(v) >= sizeof a->via_list)
+        return cli_usage(cmd, usage_line, "--via: list longer than %zu characters",
+                         sizeof a->via_list - 1);
+    snprintf(a->via_list, sizeof a->via_list, "%s", v);
+    a->n_via = 0;
+    for (char *p = a->via_list; p;) {
+        char *comma = strchr(p, ',');
+        if (comma) *comma = 0;
+        if (!*p) return cli_usage(cmd, usage_line, "--via: empty path in '%s'", v);
+        if (a->n_via == MORPH_MAX_VIA)
+            return cli_usage(cmd, usage_line, "--via: more than %d geometries", MORPH_MAX_VIA);
+        a->via[a->n_via++] = p;
+        p = comma ? comma + 1 : NULL;
+    }
+    return -1;
+}
 
 static int parse_args(int argc, char **argv, morph_args *a)
 {
@@ -77,19 +108,32 @@ static int parse_args(int argc, char **argv, morph_args *a)
         } else if (!strcmp(o, "--surface")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             if (!strcmp(v, "rbf"))
-                a->opt.surface = CM_SURFACE_RBF;
+                a->opt.method.surface = CM_SURFACE_RBF;
             else if (!strcmp(v, "project"))
-                a->opt.surface = CM_SURFACE_PROJECT;
+                a->opt.method.surface = CM_SURFACE_PROJECT;
             else
                 return cli_usage(cmd, usage_line, "unknown surface method '%s'", v);
         } else if (!strcmp(o, "--kernel")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             if (!strcmp(v, "triharmonic"))
-                a->opt.kernel = CM_RBF_TRIHARMONIC;
+                a->opt.method.warp.method = CM_WARP_RBF;
             else if (!strcmp(v, "biharmonic"))
-                a->opt.kernel = CM_RBF_BIHARMONIC;
+                a->opt.method.warp.method = CM_WARP_RBF_BIHARMONIC;
             else
                 return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
+        } else if (!strcmp(o, "--method")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            int m = cm_warp_method_from_name(v);
+            if (m < 0)
+                return cli_usage(cmd, usage_line, "unknown method '%s' (%s)", v,
+                                 cm_warp_method_list());
+            a->opt.method.warp.method = (cm_warp_method)m;
+        } else if (!strcmp(o, "--relative")) {
+            a->relative = 1;
+        } else if (!strcmp(o, "--via")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            int rc = parse_via(cmd, a, v);
+            if (rc >= 0) return rc;
         } else if (!strcmp(o, "--steps") || !strcmp(o, "--threads")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             char *end;
@@ -109,11 +153,15 @@ static int parse_args(int argc, char **argv, morph_args *a)
     if (!a->to) return cli_usage(cmd, usage_line, "--to is required");
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
+    if (a->n_via && !a->relative)
+        return cli_usage(cmd, usage_line, "--via needs --relative (a morph through them)");
     if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
         return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
                          a->out);
-    const char *inputs[] = {a->from, a->to, a->mesh};
-    for (int k = 0; k < 3; ++k) {
+    const char *inputs[3 + MORPH_MAX_VIA] = {a->from, a->to, a->mesh};
+    for (size_t k = 0; k < a->n_via; ++k)
+        inputs[3 + k] = a->via[k];
+    for (size_t k = 0; k < 3 + a->n_via; ++k) {
         if (cli_same_file(a->out, inputs[k]))
             return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
                              a->out);
@@ -152,7 +200,7 @@ int cli_cmd_morph(int argc, char **argv)
     cm_context *ctx = cli_context_create("morph", a.verbose, a.threads);
     if (!ctx) return CLI_EXIT_INTERNAL;
     cm_morph_result *r = NULL;
-    cm_status s = cm_morph_run(ctx, a.from, a.to, a.mesh, &a.opt, &r);
+    cm_status s = cm_morph_run(ctx, a.from, a.to, a.mesh, a.via, a.n_via, &a.opt, &r);
     if (s < 0) {
         rc = cli_fail(ctx, "morph", s);
         cm_context_destroy(&ctx);

@@ -9,7 +9,7 @@
 #include <string.h>
 
 static const char *const usage_line =
-    "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--kernel triharmonic|biharmonic] "
+    "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] "
     "[--threads N] [--verbose]";
 
 static void print_help(void)
@@ -28,15 +28,17 @@ static void print_help(void)
         "  --mesh M0            input volume mesh\n"
         "  --displacements D    displacement table (CSV)\n"
         "  -o, --output M1      output mesh (must not be an input)\n"
-        "  --kernel K           triharmonic (r^3, default) or biharmonic (r)\n"
+        "  --method M           interior warp: %s (default rbf: r^3)\n"
+        "  --kernel K           triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)\n"
         "  --threads N          threads for evaluation and quality (default: all)\n"
         "  --verbose            debug messages on stderr\n\n"
-        "exit codes: 0 done, 1 usage, 2 bad input (malformed file, degenerate boundary).\n");
+        "exit codes: 0 done, 1 usage, 2 bad input (malformed file, degenerate boundary).\n",
+        cm_warp_method_list());
 }
 
 typedef struct warp_args {
     const char *mesh, *csv, *out;
-    cm_rbf_kernel kernel;
+    cm_warp_method method;
     int threads, verbose;
 } warp_args;
 
@@ -45,7 +47,7 @@ static int parse_args(int argc, char **argv, warp_args *a)
 {
     static const char *cmd = "warp";
     memset(a, 0, sizeof *a);
-    a->kernel = CM_RBF_TRIHARMONIC;
+    a->method = CM_WARP_RBF;
     for (int i = 1; i < argc; ++i) {
         const char *o = argv[i], *v;
         if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
@@ -62,11 +64,18 @@ static int parse_args(int argc, char **argv, warp_args *a)
         } else if (!strcmp(o, "--kernel")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             if (!strcmp(v, "triharmonic"))
-                a->kernel = CM_RBF_TRIHARMONIC;
+                a->method = CM_WARP_RBF;
             else if (!strcmp(v, "biharmonic"))
-                a->kernel = CM_RBF_BIHARMONIC;
+                a->method = CM_WARP_RBF_BIHARMONIC;
             else
                 return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
+        } else if (!strcmp(o, "--method")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            int m = cm_warp_method_from_name(v);
+            if (m < 0)
+                return cli_usage(cmd, usage_line, "unknown method '%s' (%s)", v,
+                                 cm_warp_method_list());
+            a->method = (cm_warp_method)m;
         } else if (!strcmp(o, "--threads")) {
             if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
                 return CLI_EXIT_USAGE;
@@ -84,57 +93,6 @@ static int parse_args(int argc, char **argv, warp_args *a)
         return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
                          a->out);
     return -1;
-}
-
-/* Warps disp in place: constrained = boundary nodes and listed nodes. */
-static cm_status warp_mesh(cm_context *ctx, const warp_args *a, const cm_mesh *mesh,
-                           const unsigned char *listed, double *disp)
-{
-    cm_mesh_boundary *b = NULL;
-    cm_warp *w = NULL;
-    unsigned char *constrained = malloc(mesh->n_nodes ? mesh->n_nodes : 1);
-    if (!constrained) return cm_error(ctx, CM_ERR_NOMEM, "out of memory");
-    cm_status s = cm_mesh_boundary_create(ctx, mesh, &b);
-    if (s > 0) cm_log(ctx, CM_LOG_WARNING, "%s: %s", a->mesh, cm_context_message(ctx));
-    if (s >= 0) {
-        memcpy(constrained, listed, mesh->n_nodes);
-        for (size_t i = 0; i < b->n_nodes; ++i)
-            constrained[b->nodes[i]] = 1;
-        cm_log(ctx, CM_LOG_DEBUG, "warp: %zu nodes, %zu boundary nodes, %zu components",
-               mesh->n_nodes, b->n_nodes, b->n_components);
-        cm_warp_options opt;
-        cm_warp_options_init(&opt);
-        opt.kernel = a->kernel;
-        double t0 = cm_wtime();
-        s = cm_warp_create(ctx, mesh, b, constrained, &opt, &w);
-        double t1 = cm_wtime();
-        if (s >= 0) s = cm_warp_apply(ctx, w, disp);
-        cm_log(ctx, CM_LOG_DEBUG, "warp: factorise %.3f s, solve and evaluate %.3f s", t1 - t0,
-               cm_wtime() - t1);
-        if (s < 0) {
-            char msg[1024];
-            snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
-            s = cm_error(ctx, s, "%s: %s", a->mesh, msg);
-        }
-    }
-    cm_warp_destroy(&w);
-    cm_mesh_boundary_destroy(&b);
-    free(constrained);
-    return s;
-}
-
-/* Moves the nodes and attaches the fields; *sj: the scaled Jacobian field's data. */
-static cm_status finish_mesh(cm_context *ctx, cm_mesh *mesh, const double *disp, double **sj)
-{
-    double *field = NULL;
-    for (size_t i = 0; i < 3 * mesh->n_nodes; ++i)
-        mesh->xyz[i] += disp[i];
-    cm_status s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &field);
-    if (s < 0) return s;
-    memcpy(field, disp, 3 * mesh->n_nodes * sizeof *disp);
-    s = cm_mesh_add_field(ctx, mesh, "scaled_jacobian", CM_FIELD_CELL, 1, sj);
-    if (s < 0) return s;
-    return cm_mesh_quality(ctx, mesh, *sj);
 }
 
 int cli_cmd_warp(int argc, char **argv)
@@ -155,8 +113,20 @@ int cli_cmd_warp(int argc, char **argv)
         s = disp && listed ? cm_warp_read_displacements(ctx, a.csv, mesh->n_nodes, disp, listed)
                            : cm_error(ctx, CM_ERR_NOMEM, "out of memory");
     }
-    if (s >= 0) s = warp_mesh(ctx, &a, mesh, listed, disp);
-    if (s >= 0) s = finish_mesh(ctx, mesh, disp, &sj);
+    cm_warp_options opt;
+    cm_warp_options_init(&opt);
+    opt.method = a.method;
+    cm_warp_mesh_stats st;
+    if (s >= 0) {
+        s = cm_warp_mesh(ctx, mesh, disp, listed, &opt, &sj, &st);
+        if (s < 0) s = cm_error_prefix(ctx, s, "%s", a.mesh);
+    }
+    if (s >= 0)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "warp: %s, %zu nodes, %zu boundary nodes, %zu components: create %.3f s, "
+               "apply %.3f s",
+               cm_warp_method_name(a.method), mesh->n_nodes, st.boundary_nodes, st.components,
+               st.t_create, st.t_apply);
     if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
     /* the report only once the mesh is written: its last line is what scripts parse */
     if (s >= 0) s = cli_print_quality(ctx, mesh, sj, stdout, NULL);

@@ -2,6 +2,8 @@
  * talks to its caller (it never prints itself). */
 #include "cadmorph/core.h"
 
+#include <math.h>
+#include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -94,6 +96,43 @@ cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
         va_end(ap);
     }
     return code;
+}
+
+cm_status cm_error_prefix(cm_context *ctx, cm_status code, const char *fmt, ...)
+{
+    if (!ctx) return code;
+    char prefix[CM_MESSAGE_MAX], old[CM_MESSAGE_MAX];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(prefix, sizeof prefix, fmt, ap);
+    va_end(ap);
+    /* copy first: the message is rewritten from itself */
+    snprintf(old, sizeof old, "%s", ctx->message);
+    size_t n = strlen(prefix), size = sizeof ctx->message;
+    if (n > size - 3) n = size - 3;
+    memcpy(ctx->message, prefix, n);
+    memcpy(ctx->message + n, ": ", 2);
+    n += 2;
+    size_t k = strlen(old);
+    if (k > size - 1 - n) k = size - 1 - n; /* a long message loses its end, not its start */
+    memcpy(ctx->message + n, old, k);
+    ctx->message[n + k] = 0;
+    return code;
+}
+
+int cm_context_threads_for(const cm_context *ctx, size_t n, size_t min_per_thread)
+{
+    int t = ctx ? cm_context_threads(ctx) : 0;
+    if (t <= 0) t = omp_get_max_threads();
+    size_t useful = min_per_thread ? n / min_per_thread : n;
+    if (useful < (size_t)t) t = useful > 1 ? (int)useful : 1;
+    return t;
+}
+
+double cm_bbox_diagonal(const double bb[6])
+{
+    double dx = bb[3] - bb[0], dy = bb[4] - bb[1], dz = bb[5] - bb[2];
+    return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
 void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)

@@ -1,222 +1,52 @@
-/* The volume warp (paper section 3): one polyharmonic RBF per connected component of volume
- * cells, centred at the component's constrained nodes, carries their displacement inside. */
-#include "cadmorph/warp.h"
+/* The warp interface (warp.h): the method table, argument checks every method shares, and
+ * the whole-mesh warp behind `cadmorph warp`. */
+#include "warp_method.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* One component: the RBF is centred at `fixed`; `free_nodes` receive its values. */
-typedef struct warp_component {
-    cm_rbf *rbf; /* NULL when every node of the component is constrained */
-    size_t n_fixed;
-    int64_t *fixed; /* constrained nodes of the component, ascending */
-    size_t n_free;
-    int64_t *free_nodes; /* unconstrained nodes owned by the component, ascending */
-    double *free_xyz;    /* n_free x 3, copied: the mesh is only borrowed by create */
-} warp_component;
+/* One row per cm_warp_method, in enum order. */
+static const cm_warp_method_ops *const methods[CM_WARP_N_METHODS] = {
+    [CM_WARP_RBF] = &cm_warp_rbf_triharmonic,
+    [CM_WARP_RBF_BIHARMONIC] = &cm_warp_rbf_biharmonic,
+};
 
 struct cm_warp {
-    size_t n_nodes;
-    size_t n_components;
-    warp_component *comp;
-    double *values; /* scratch: max n_fixed x 3 */
-    double *out;    /* scratch: max n_free x 3 */
+    cm_warp_method method;
+    const cm_warp_method_ops *ops;
+    void *state;
+    double residual;
 };
+
+const char *cm_warp_method_name(cm_warp_method method)
+{
+    return (int)method >= 0 && method < CM_WARP_N_METHODS ? methods[method]->name : NULL;
+}
+
+int cm_warp_method_from_name(const char *name)
+{
+    for (int m = 0; name && m < CM_WARP_N_METHODS; ++m)
+        if (!strcmp(name, methods[m]->name)) return m;
+    return -1;
+}
+
+const char *cm_warp_method_list(void)
+{
+    static char list[256];
+    if (!list[0])
+        for (int m = 0; m < CM_WARP_N_METHODS; ++m) {
+            size_t n = strlen(list);
+            snprintf(list + n, sizeof list - n, "%s%s", m ? "|" : "", methods[m]->name);
+        }
+    return list;
+}
 
 void cm_warp_options_init(cm_warp_options *opt)
 {
     if (!opt) return;
     memset(opt, 0, sizeof *opt);
-    opt->kernel = CM_RBF_TRIHARMONIC;
-}
-
-void cm_warp_destroy(cm_warp **warp)
-{
-    if (!warp || !*warp) return;
-    cm_warp *w = *warp;
-    for (size_t k = 0; w->comp && k < w->n_components; ++k) {
-        cm_rbf_destroy(&w->comp[k].rbf);
-        free(w->comp[k].fixed);
-        free(w->comp[k].free_nodes);
-        free(w->comp[k].free_xyz);
-    }
-    free(w->comp);
-    free(w->values);
-    free(w->out);
-    free(w);
-    *warp = NULL;
-}
-
-/* Calls visit(node) for each node of cell c, possibly repeatedly (polyhedra list a node once
- * per face); callers deduplicate. */
-typedef struct node_visitor {
-    int *stamp;    /* #nodes: last component that saw the node, + 1 */
-    int mark;      /* component + 1 */
-    int64_t *list; /* nodes seen for the first time in this component */
-    size_t n;
-} node_visitor;
-
-static void visit_cell(const cm_mesh *mesh, size_t c, node_visitor *v)
-{
-    const int64_t *conn = mesh->conn;
-    int64_t b = mesh->offset[c], e = mesh->offset[c + 1];
-    if (mesh->type[c] == CM_CELL_POLYHEDRON) {
-        /* face stream: nf, then per face its node count and nodes */
-        int64_t p = b + 1;
-        for (int64_t f = 0; f < conn[b] && p < e; ++f) {
-            int64_t n = conn[p++];
-            for (int64_t i = 0; i < n && p < e; ++i, ++p)
-                if (v->stamp[conn[p]] != v->mark) {
-                    v->stamp[conn[p]] = v->mark;
-                    v->list[v->n++] = conn[p];
-                }
-        }
-        return;
-    }
-    for (int64_t p = b; p < e; ++p)
-        if (v->stamp[conn[p]] != v->mark) {
-            v->stamp[conn[p]] = v->mark;
-            v->list[v->n++] = conn[p];
-        }
-}
-
-static int cmp_i64(const void *a, const void *b)
-{
-    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
-    return (x > y) - (x < y);
-}
-
-/* Splits the node list of component k into constrained centres and owned free nodes.
- * owner: #nodes, the component that evaluates an unconstrained node (-1: none yet); a free
- * node shared by two components (only possible with a caller's mask that leaves a boundary
- * node free) goes to the first one, so that every node has exactly one displacement. */
-static cm_status split_component(cm_context *ctx, const cm_mesh *mesh,
-                                 const unsigned char *constrained, int k, const int64_t *list,
-                                 size_t n, int *owner, warp_component *wc, size_t *n_shared_free)
-{
-    size_t nf = 0, nu = 0;
-    for (size_t i = 0; i < n; ++i) {
-        if (constrained[list[i]])
-            ++nf;
-        else if (owner[list[i]] < 0)
-            ++nu;
-        else
-            ++*n_shared_free;
-    }
-    wc->fixed = malloc((nf ? nf : 1) * sizeof *wc->fixed);
-    wc->free_nodes = malloc((nu ? nu : 1) * sizeof *wc->free_nodes);
-    wc->free_xyz = malloc((nu ? nu : 1) * 3 * sizeof *wc->free_xyz);
-    if (!wc->fixed || !wc->free_nodes || !wc->free_xyz)
-        return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-    for (size_t i = 0; i < n; ++i) {
-        int64_t v = list[i];
-        if (constrained[v]) {
-            wc->fixed[wc->n_fixed++] = v;
-        } else if (owner[v] < 0) {
-            owner[v] = k;
-            memcpy(wc->free_xyz + 3 * wc->n_free, mesh->xyz + 3 * v, 3 * sizeof(double));
-            wc->free_nodes[wc->n_free++] = v;
-        }
-    }
-    return CM_OK;
-}
-
-/* The RBF of component k; its errors (coplanar centres, failed factorisation) get the
- * component number in front. */
-static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel, size_t k,
-                               warp_component *wc)
-{
-    if (wc->n_free == 0) return CM_OK; /* nothing to interpolate: every node is prescribed */
-    if (wc->n_fixed == 0)
-        return cm_error(ctx, CM_ERR_NUMERIC,
-                        "cm_warp_create: component %zu: no constrained node, %zu free nodes", k,
-                        wc->n_free);
-    double *centres = malloc(wc->n_fixed * 3 * sizeof *centres);
-    if (!centres) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-    for (size_t i = 0; i < wc->n_fixed; ++i)
-        memcpy(centres + 3 * i, mesh->xyz + 3 * wc->fixed[i], 3 * sizeof(double));
-    cm_status s = cm_rbf_create(ctx, kernel, 3, wc->n_fixed, centres, &wc->rbf);
-    free(centres);
-    if (s < 0) {
-        /* copy first: the message is rewritten from itself */
-        char msg[1024];
-        snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
-        return cm_error(ctx, s, "cm_warp_create: component %zu (%zu constrained nodes): %s", k,
-                        wc->n_fixed, msg);
-    }
-    return CM_OK;
-}
-
-/* Nodes of volume cells grouped by component: cells are bucketed by component first so that
- * one pass per component with a stamp array deduplicates its nodes. */
-static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
-                                  const unsigned char *constrained, cm_rbf_kernel kernel,
-                                  cm_warp *w, size_t *n_shared_free)
-{
-    size_t nc = b->n_components, nn = mesh->n_nodes;
-    size_t *start = calloc(nc + 1, sizeof *start);
-    size_t *cells = malloc((mesh->n_cells ? mesh->n_cells : 1) * sizeof *cells);
-    int *stamp = calloc(nn ? nn : 1, sizeof *stamp);
-    int *owner = malloc((nn ? nn : 1) * sizeof *owner);
-    int64_t *list = malloc((nn ? nn : 1) * sizeof *list);
-    cm_status s = CM_OK;
-    if (!start || !cells || !stamp || !owner || !list) {
-        s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-        goto done;
-    }
-    for (size_t c = 0; c < mesh->n_cells; ++c) {
-        int k = b->cell_component[c];
-        if (k >= 0 && (size_t)k < nc) ++start[k + 1];
-    }
-    for (size_t k = 0; k < nc; ++k)
-        start[k + 1] += start[k];
-    {
-        size_t *fill = malloc((nc ? nc : 1) * sizeof *fill);
-        if (!fill) {
-            s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-            goto done;
-        }
-        memcpy(fill, start, nc * sizeof *fill);
-        for (size_t c = 0; c < mesh->n_cells; ++c) {
-            int k = b->cell_component[c];
-            if (k >= 0 && (size_t)k < nc) cells[fill[k]++] = c;
-        }
-        free(fill);
-    }
-    for (size_t v = 0; v < nn; ++v)
-        owner[v] = -1;
-    for (size_t k = 0; k < nc; ++k) {
-        node_visitor vis = {stamp, (int)k + 1, list, 0};
-        for (size_t i = start[k]; i < start[k + 1]; ++i)
-            visit_cell(mesh, cells[i], &vis);
-        /* ascending order: the centres, hence the result, do not depend on cell order */
-        qsort(list, vis.n, sizeof *list, cmp_i64);
-        s = split_component(ctx, mesh, constrained, (int)k, list, vis.n, owner, &w->comp[k],
-                            n_shared_free);
-        if (s < 0) goto done;
-        s = fit_component(ctx, mesh, kernel, k, &w->comp[k]);
-        if (s < 0) goto done;
-        cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc);
-    }
-    /* nodes of no volume cell and not constrained: nothing defines their motion */
-    {
-        size_t stray = 0;
-        for (size_t v = 0; v < nn; ++v)
-            if (!stamp[v] && !constrained[v]) ++stray;
-        if (stray)
-            cm_log(ctx, CM_LOG_WARNING,
-                   "cm_warp_create: %zu unconstrained nodes belong to no volume cell; they are "
-                   "left where they are",
-                   stray);
-    }
-done:
-    free(start);
-    free(cells);
-    free(stamp);
-    free(owner);
-    free(list);
-    return s;
+    opt->method = CM_WARP_RBF;
 }
 
 cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
@@ -230,84 +60,102 @@ cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_bou
     cm_warp_options defaults;
     cm_warp_options_init(&defaults);
     if (!opt) opt = &defaults;
-    if (opt->kernel != CM_RBF_TRIHARMONIC && opt->kernel != CM_RBF_BIHARMONIC)
-        return cm_error(ctx, CM_ERR_ARGUMENT,
-                        "cm_warp_create: kernel %d is not a 3D kernel (triharmonic or biharmonic)",
-                        (int)opt->kernel);
+    if ((int)opt->method < 0 || opt->method >= CM_WARP_N_METHODS)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_create: unknown method %d",
+                        (int)opt->method);
     if (b->n_components == 0)
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_warp_create: the mesh has no volume cells");
-    if (b->n_components > (size_t)(~0u >> 1))
-        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_warp_create: too many components");
-
     cm_warp *w = calloc(1, sizeof *w);
     unsigned char *own_mask = NULL;
-    if (!w) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-    w->n_nodes = mesh->n_nodes;
-    w->n_components = b->n_components;
-    w->comp = calloc(b->n_components, sizeof *w->comp);
-    cm_status s = CM_OK;
-    if (!w->comp) {
-        s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-        goto fail;
-    }
     if (!constrained) {
         own_mask = calloc(mesh->n_nodes ? mesh->n_nodes : 1, 1);
-        if (!own_mask) {
-            s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-            goto fail;
-        }
-        for (size_t i = 0; i < b->n_nodes; ++i)
-            if (b->nodes[i] >= 0 && (size_t)b->nodes[i] < mesh->n_nodes) own_mask[b->nodes[i]] = 1;
+        if (own_mask)
+            for (size_t i = 0; i < b->n_nodes; ++i)
+                if (b->nodes[i] >= 0 && (size_t)b->nodes[i] < mesh->n_nodes)
+                    own_mask[b->nodes[i]] = 1;
         constrained = own_mask;
     }
-    size_t n_shared_free = 0;
-    s = build_components(ctx, mesh, b, constrained, opt->kernel, w, &n_shared_free);
-    if (s < 0) goto fail;
-    if (n_shared_free)
-        cm_log(ctx, CM_LOG_WARNING,
-               "cm_warp_create: %zu unconstrained nodes are shared by several components; each "
-               "follows the first",
-               n_shared_free);
-
-    size_t max_fixed = 1, max_free = 1;
-    for (size_t k = 0; k < w->n_components; ++k) {
-        if (w->comp[k].n_fixed > max_fixed) max_fixed = w->comp[k].n_fixed;
-        if (w->comp[k].n_free > max_free) max_free = w->comp[k].n_free;
+    if (!w || !constrained) {
+        free(w);
+        free(own_mask);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
     }
-    w->values = malloc(max_fixed * 3 * sizeof *w->values);
-    w->out = malloc(max_free * 3 * sizeof *w->out);
-    if (!w->values || !w->out) {
-        s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-        goto fail;
-    }
+    w->method = opt->method;
+    w->ops = methods[opt->method];
+    cm_status s = w->ops->create(ctx, mesh, b, constrained, opt, &w->state);
     free(own_mask);
+    if (s < 0) {
+        free(w);
+        return s;
+    }
     *warp = w;
-    return CM_OK;
-fail:
-    free(own_mask);
-    cm_warp_destroy(&w);
     return s;
+}
+
+void cm_warp_destroy(cm_warp **warp)
+{
+    if (!warp || !*warp) return;
+    (*warp)->ops->destroy((*warp)->state);
+    free(*warp);
+    *warp = NULL;
 }
 
 cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp)
 {
     if (!warp || !disp)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply: warp or disp is NULL");
-    for (size_t k = 0; k < warp->n_components; ++k) {
-        warp_component *wc = &warp->comp[k];
-        if (!wc->rbf) continue;
-        for (size_t i = 0; i < wc->n_fixed; ++i)
-            memcpy(warp->values + 3 * i, disp + 3 * wc->fixed[i], 3 * sizeof(double));
-        cm_status s = cm_rbf_solve(ctx, wc->rbf, 3, warp->values);
-        if (s >= 0) s = cm_rbf_evaluate(ctx, wc->rbf, wc->n_free, wc->free_xyz, warp->out);
-        if (s < 0) {
-            char msg[1024];
-            snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
-            return cm_error(ctx, s, "cm_warp_apply: component %zu: %s", k, msg);
-        }
-        for (size_t i = 0; i < wc->n_free; ++i)
-            memcpy(disp + 3 * wc->free_nodes[i], warp->out + 3 * i, 3 * sizeof(double));
-        cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components);
+    return warp->ops->apply(ctx, warp->state, disp, &warp->residual);
+}
+
+cm_warp_method cm_warp_get_method(const cm_warp *warp) { return warp->method; }
+
+double cm_warp_residual(const cm_warp *warp) { return warp ? warp->residual : 0; }
+
+cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
+                       const cm_warp_options *opt, double **sj, cm_warp_mesh_stats *stats)
+{
+    if (sj) *sj = NULL;
+    if (!mesh || !disp) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_mesh: NULL input");
+    cm_warp_mesh_stats st;
+    memset(&st, 0, sizeof st);
+    cm_mesh_boundary *b = NULL;
+    cm_warp *w = NULL;
+    size_t nn = mesh->n_nodes;
+    unsigned char *constrained = calloc(nn ? nn : 1, 1);
+    if (!constrained) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_mesh: out of memory");
+    cm_status s = cm_mesh_boundary_create(ctx, mesh, &b);
+    /* a boundary warning (non-manifold faces) is worth showing, and the warp goes on */
+    if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
+    if (s >= 0) {
+        if (listed) memcpy(constrained, listed, nn);
+        for (size_t i = 0; i < b->n_nodes; ++i)
+            constrained[b->nodes[i]] = 1;
+        st.boundary_nodes = b->n_nodes;
+        st.components = b->n_components;
+        for (size_t i = 0; i < nn; ++i)
+            st.constrained_nodes += constrained[i] != 0;
+        double t0 = cm_wtime();
+        s = cm_warp_create(ctx, mesh, b, constrained, opt, &w);
+        double t1 = cm_wtime();
+        if (s >= 0) s = cm_warp_apply(ctx, w, disp);
+        st.t_create = t1 - t0;
+        st.t_apply = cm_wtime() - t1;
+        st.residual = cm_warp_residual(w);
     }
+    cm_warp_destroy(&w);
+    cm_mesh_boundary_destroy(&b);
+    free(constrained);
+    double *field = NULL, *q = NULL;
+    if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &field);
+    if (s >= 0) {
+        for (size_t i = 0; i < 3 * nn; ++i)
+            mesh->xyz[i] += disp[i];
+        memcpy(field, disp, 3 * nn * sizeof *disp);
+        s = cm_mesh_add_field(ctx, mesh, "scaled_jacobian", CM_FIELD_CELL, 1, &q);
+    }
+    if (s >= 0) s = cm_mesh_quality(ctx, mesh, q);
+    if (s < 0) return s;
+    if (sj) *sj = q;
+    if (stats) *stats = st;
     return CM_OK;
 }

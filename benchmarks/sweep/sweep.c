@@ -40,9 +40,9 @@ static cm_surface_method method_surface(int m)
     return m == CM_SWEEP_PROJECT ? CM_SURFACE_PROJECT : CM_SURFACE_RBF;
 }
 
-static cm_rbf_kernel method_kernel(int m)
+static cm_warp_method method_kernel(int m)
 {
-    return m == CM_SWEEP_RBF_S_BIHARMONIC ? CM_RBF_BIHARMONIC : CM_RBF_TRIHARMONIC;
+    return m == CM_SWEEP_RBF_S_BIHARMONIC ? CM_WARP_RBF_BIHARMONIC : CM_WARP_RBF;
 }
 
 void cm_sweep_options_init(cm_sweep_options *opt)
@@ -243,7 +243,7 @@ static cm_status morph_step(cm_context *ctx, sweep *w, series *se, int k,
     if (!warp) {
         cm_warp_options wo;
         cm_warp_options_init(&wo);
-        wo.kernel = method_kernel(se->method);
+        wo.method = method_kernel(se->method);
         s = cm_warp_create(ctx, from, w->b, NULL, &wo, &own);
         if (s < 0) return s;
         warp = own;
@@ -273,11 +273,11 @@ static cm_status morph_step(cm_context *ctx, sweep *w, series *se, int k,
 
 static cm_status absolute_step(cm_context *ctx, sweep *w, series *se, int k, cm_sweep_row *row)
 {
-    int kern = method_kernel(se->method) == CM_RBF_BIHARMONIC;
+    int kern = method_kernel(se->method) == CM_WARP_RBF_BIHARMONIC;
     if (!w->warp[kern]) {
         cm_warp_options wo;
         cm_warp_options_init(&wo);
-        wo.kernel = method_kernel(se->method);
+        wo.method = method_kernel(se->method);
         double t0 = cm_wtime();
         cm_status s = cm_warp_create(ctx, w->mesh0, w->b, NULL, &wo, &w->warp[kern]);
         if (s < 0) return s;

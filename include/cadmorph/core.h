@@ -70,10 +70,22 @@ void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user);
 cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* Puts "<prefix>: " (printf-style) in front of the context message and returns code, for a
+ * caller that adds where an error happened: `return cm_error_prefix(ctx, s, "%s", path);`. */
+cm_status cm_error_prefix(cm_context *ctx, cm_status code, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
 void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
 void cm_progress(cm_context *ctx, const char *stage, double done, double total);
+
+/* Threads for a leaf loop of n items that is worth parallelising above min_per_thread items
+ * a thread: between 1 and the context's threads (0 there = all the machine has). */
+int cm_context_threads_for(const cm_context *ctx, size_t n, size_t min_per_thread);
+
+/* Length of the diagonal of a bounding box bb = {xmin, ymin, zmin, xmax, ymax, zmax}. */
+double cm_bbox_diagonal(const double bb[6]);
 
 /* Wall clock in seconds (monotonic), for stage timings in reports and benchmarks. */
 double cm_wtime(void);

@@ -1,12 +1,24 @@
-/* cadmorph morph engine: G, G' and a mesh M of G in, M' out (DESIGN.md's pipeline).
- * Conventions: see core.h.
+/* cadmorph morph engine: a mesh M of G follows G onto G' of the same topology (DESIGN.md's
+ * pipeline). The engine works on objects in memory:
+ *
+ *   cm_morpher_create  - classifies M's boundary nodes on G (vertex | edge | face) once;
+ *   cm_morpher_apply   - morphs onto any target G' of G's topology: the boundary by the
+ *                        surface morph (surface.h), the interior by a warp (warp.h) whose
+ *                        factorisation depends only on M, so it is made once per method and
+ *                        shared by every target (absolute morphs, studies);
+ *   cm_morpher_rebase  - a relative step: the morpher now starts from a morphed mesh on its
+ *                        geometry (classified again, warps refactorised on first use).
+ *
+ * cm_morph_run is the file-level wrapper behind `cadmorph morph`.
+ * Conventions: see core.h. Lifetimes: every cm_cad_model handed to the morpher (G at create
+ * or rebase, targets at apply) is borrowed and must outlive the morpher or the next rebase;
+ * meshes and coordinate arrays are copied. A morpher is used by one thread at a time.
  */
 #ifndef CADMORPH_MORPH_H
 #define CADMORPH_MORPH_H
 
 #include "cadmorph/cad.h"
 #include "cadmorph/mesh.h"
-#include "cadmorph/rbf.h"
 #include "cadmorph/surface.h"
 #include "cadmorph/warp.h"
 
@@ -14,33 +26,37 @@
 extern "C" {
 #endif
 
-/* ---- the morph pipeline: read G, G' and M, check that G and G' correspond, sample and
- * classify, morph the surface (surface.h), warp the interior per component (cm_warp), in
- * `steps` increments. Library target cm_morph (volume/morph_pipeline.c), apart from cm_volume
- * so that the warp and the mesher do not pull in the surface module. ---- */
-
 /* Samples on G beyond this are not worth their memory for the meshes cadmorph morphs; the
- * locator grows h instead and says so (a warning, never silent). Sweeps use it too. */
+ * locator grows h instead and says so (a warning, never silent). */
 #define CM_MORPH_MAX_SAMPLES ((size_t)4000000)
 
+/* A morph method: how the boundary reaches G' and how the interior follows. */
+typedef struct cm_morph_method {
+    cm_surface_method surface; /* default CM_SURFACE_RBF (RBF-S) */
+    cm_warp_options warp;      /* default CM_WARP_RBF (triharmonic) */
+} cm_morph_method;
+
+void cm_morph_method_init(cm_morph_method *m);
+
 typedef struct cm_morph_options {
-    cm_surface_method surface; /* default CM_SURFACE_RBF */
-    cm_rbf_kernel kernel;      /* volume warp: CM_RBF_TRIHARMONIC (default) or BIHARMONIC */
-    int steps;                 /* >= 1 (default 1): equal increments of the boundary motion */
-    const char *cad_unit;      /* target unit of both STEP files; NULL = "mm" */
+    cm_morph_method method;
+    int steps;            /* >= 1 (default 1): equal increments of the boundary motion; step 1
+                             uses the shared factorisation, later ones refactorise on the
+                             intermediate mesh */
+    const char *cad_unit; /* target unit of STEP files read by cm_morph_run; NULL = "mm" */
     /* Samples of each model for the locators: h is a quarter of the shortest boundary edge,
-     * raised (with a warning) if that needs more than max_samples; 0: 4,000,000. */
+     * raised (with a warning) if that needs more than max_samples; 0: CM_MORPH_MAX_SAMPLES. */
     size_t max_samples;
     cm_classify_options classify;
-    cm_surface_morph_options morph;
+    cm_surface_morph_options morph; /* its method field is replaced by method.surface */
 } cm_morph_options;
 
 void cm_morph_options_init(cm_morph_options *opt);
 
-/* One row of the report per step. Stage times in seconds; read, sample, classify and surface
- * are spent once and counted in step 1; volume_solve = warp assembly and factorisation,
- * evaluation = solve for the step's displacements, evaluation at the interior nodes and the
- * scaled Jacobian; write is left for the caller (who writes the mesh). */
+/* One row per step. Stage times in seconds; read, sample and classify are spent by the caller
+ * or by create and are filled in by cm_morph_run only; volume_solve = warp assembly and
+ * factorisation (0 when a shared factorisation was reused), evaluation = the warp's apply,
+ * the node update and the scaled Jacobian; write is left for the caller. */
 typedef struct cm_morph_step {
     int step;
     double min_sj, mean_sj;
@@ -48,15 +64,68 @@ typedef struct cm_morph_step {
     double max_dist; /* largest distance of the boundary nodes to G' after this step (by
                         projection through a locator on G'); before the last step the
                         boundary is a linear blend, so this is how far it still is */
-    double t_read, t_sample, t_classify, t_surface, t_volume_solve, t_evaluation, t_write;
+    size_t outside;  /* face nodes whose (u',v') left the trimmed face (cm_surface_morph_stats) */
+    double residual; /* the warp's miss at the constrained nodes (cm_warp_residual) */
+    double t_read, t_sample, t_classify, t_surface, t_volume_solve, t_evaluation, t_distance,
+        t_write;
 } cm_morph_step;
+
+typedef struct cm_morpher cm_morpher;
+
+/* What create (or the last rebase) found. */
+typedef struct cm_morpher_info {
+    size_t nodes, cells, boundary_nodes, components;
+    size_t counts[3];  /* boundary nodes on vertices, edges, faces */
+    double h;          /* sampling h used on G */
+    double class_dist; /* largest distance of a boundary node to its entity of G */
+    double diagonal;   /* bbox diagonal of G */
+    double t_sample, t_classify;
+} cm_morpher_info;
+
+/* g: the geometry M lies on; mesh: M (copied). Errors: CM_ERR_UNSUPPORTED for a mesh without
+ * volume cells, CM_ERR_MISMATCH when M is not a mesh of G (cm_surface_classify's message,
+ * prefixed), CM_ERR_FORMAT when every boundary edge has zero length. Returns CM_WARNING
+ * (after logging it) when the sampling hit its cap. opt may be NULL. */
+cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mesh *mesh,
+                            const cm_morph_options *opt, cm_morpher **morpher);
+void cm_morpher_destroy(cm_morpher **morpher);
+
+/* Morphs onto target with the options' method: out_xyz (#nodes x 3) receives the new
+ * coordinates (boundary nodes exactly where the surface morph sent them), rows (opt.steps
+ * rows, may be NULL) the quality and times. Errors: CM_ERR_MISMATCH when target does not
+ * correspond to G (up to 5 differences in the message); the warp's errors. Returns
+ * CM_WARNING when face nodes left their trimmed face (the result is complete). */
+cm_status cm_morpher_apply(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *target,
+                           double *out_xyz, cm_morph_step *rows);
+
+/* The same with another method; factorisations are kept per warp method, so a study that
+ * compares methods factorises each once. */
+cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *morpher,
+                                  const cm_cad_model *target, const cm_morph_method *method,
+                                  double *out_xyz, cm_morph_step *rows);
+
+/* Relative morphing: the morpher's mesh becomes xyz (#nodes x 3, e.g. the last apply's
+ * result), lying on g (e.g. that apply's target); the boundary is classified on g again and
+ * the warps are refactorised when next used. */
+cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *g,
+                            const double *xyz);
+
+const cm_morpher_info *cm_morpher_get_info(const cm_morpher *morpher);
+/* The mesh the morpher starts from (its coordinates change only by rebase). */
+const cm_mesh *cm_morpher_mesh(const cm_morpher *morpher);
+/* Per-cell scaled Jacobian (#cells) of the last apply's result; valid until the next call. */
+const double *cm_morpher_quality(const cm_morpher *morpher);
+/* Surface-morph statistics of the last apply. */
+const cm_surface_morph_stats *cm_morpher_surface_stats(const cm_morpher *morpher);
+
+/* ---- the file-level wrapper ---- */
 
 typedef struct cm_morph_result {
     cm_mesh *mesh; /* the morphed mesh, with per-node "displacement" (from M0) and
                       per-cell "scaled_jacobian" fields */
     double *sj;    /* #cells: the scaled_jacobian field's data (owned by mesh) */
     int n_steps;
-    cm_morph_step *steps; /* n_steps rows */
+    cm_morph_step *steps; /* n_steps rows; row 1 of a --via chain per geometry */
     size_t counts[3];     /* boundary nodes on vertices, edges, faces */
     cm_surface_morph_stats surface;
     double max_dist; /* largest distance of the final boundary nodes to G' */
@@ -64,16 +133,18 @@ typedef struct cm_morph_result {
     double h;        /* sampling h actually used on G */
 } cm_morph_result;
 
-/* Runs the pipeline. Errors: CM_ERR_MISMATCH when G and G' do not correspond (up to 5
- * differences in the message) or M is not a mesh of G (see cm_surface_classify); file
- * errors from the readers. Returns CM_WARNING (the first warning's message) when a stage
- * warned (nodes left a trimmed domain, sample cap reached) but the result is complete.
- * Warnings also go to the context's log (CM_LOG_WARNING) as they happen; those of the
- * sampling of G only once the mesh is known to lie on G (a mesh in the wrong unit makes the
- * sampling warn, and the real error is the mismatch). */
+/* Reads G (g0_path), G' (g1_path) and M, checks that they correspond, and morphs M onto G'.
+ * via: n_via intermediate geometries (may be 0): a relative morph G -> via[0] -> ... -> G',
+ * each step a rebase onto the previous result (opt.steps increments each). Errors:
+ * CM_ERR_MISMATCH when two geometries do not correspond or M is not a mesh of G; file errors
+ * from the readers. Returns CM_WARNING (the first warning's message) when a stage warned
+ * (nodes left a trimmed domain, sample cap reached) but the result is complete. Warnings
+ * also go to the context's log (CM_LOG_WARNING) as they happen; those of the sampling of G
+ * only once the mesh is known to lie on G (a mesh in the wrong unit makes the sampling warn,
+ * and the real error is the mismatch). */
 cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,
-                       const char *mesh_path, const cm_morph_options *opt,
-                       cm_morph_result **result);
+                       const char *mesh_path, const char *const *via, size_t n_via,
+                       const cm_morph_options *opt, cm_morph_result **result);
 void cm_morph_result_destroy(cm_morph_result **result);
 
 #ifdef __cplusplus

@@ -1,6 +1,15 @@
-/* cadmorph volume warps: the space warp that carries boundary motion into the interior of a
- * volume mesh, one interpolant per connected component (paper section 3), and the
+/* cadmorph volume warps: methods that carry a prescribed motion of some nodes (the boundary,
+ * and any pinned node) into the rest of a volume mesh, behind one interface, and the
  * displacement table of `cadmorph warp`. Conventions: see core.h.
+ *
+ * Every method has the same life cycle (DESIGN.md, "The warp interface"):
+ *   cm_warp_create  - everything that depends only on the mesh and on which nodes are
+ *                     constrained (assembly, factorisation), done once;
+ *   cm_warp_apply   - displacements at the constrained nodes in, at every node out; many
+ *                     calls on one warp share the factorisation (absolute studies);
+ *   cm_warp_destroy.
+ * A relative step creates a new warp on the moved mesh. Adding a method is one file in
+ * volume/ (or a space deformation in deform/) and one row in volume/warp.c's table.
  */
 #ifndef CADMORPH_WARP_H
 #define CADMORPH_WARP_H
@@ -12,24 +21,37 @@
 extern "C" {
 #endif
 
+typedef enum cm_warp_method {
+    CM_WARP_RBF = 0,            /* "rbf": triharmonic RBF, phi = r^3 + linear (the method) */
+    CM_WARP_RBF_BIHARMONIC = 1, /* "rbf-biharmonic": phi = r + linear (the paper's comparison) */
+    CM_WARP_N_METHODS
+} cm_warp_method;
+
+/* Short name of a method ("rbf", "rbf-biharmonic", ...), NULL out of range. */
+const char *cm_warp_method_name(cm_warp_method method);
+/* The method of a name, or -1 if unknown. */
+int cm_warp_method_from_name(const char *name);
+/* The method names joined by '|' ("rbf|rbf-biharmonic|..."), for usage lines. */
+const char *cm_warp_method_list(void);
+
 typedef struct cm_warp_options {
-    cm_rbf_kernel kernel; /* CM_RBF_TRIHARMONIC (default) or CM_RBF_BIHARMONIC */
+    cm_warp_method method; /* default CM_WARP_RBF */
 } cm_warp_options;
 
 void cm_warp_options_init(cm_warp_options *opt);
 
-/* A factorised warp: the centres are the constrained nodes of each component, so one warp
- * serves every displacement of the same constrained nodes (absolute sweeps). */
 typedef struct cm_warp cm_warp;
 
 /* constrained: #nodes flags, non-zero where the displacement is prescribed (the boundary
  * nodes, and any interior node a caller wants to pin). NULL = the boundary nodes of b.
- * Every component with unconstrained nodes must have constrained nodes that are not all
- * coplanar: otherwise the RBF's CM_ERR_NUMERIC, its message prefixed "component <k>".
- * A constrained node shared by components (touching at an edge or vertex) is a centre of
- * each; an unconstrained one follows the lowest-numbered component. Unconstrained nodes of
- * no volume cell are left alone (a CM_LOG_WARNING gives their count). A mesh without
- * volume cells is CM_ERR_UNSUPPORTED. mesh and b are borrowed: the warp keeps copies. */
+ * RBF methods: one interpolant per connected component of volume cells, centred at its
+ * constrained nodes; a component whose constrained nodes are all coplanar is the RBF's
+ * CM_ERR_NUMERIC, its message prefixed "component <k>". A constrained node shared by
+ * components (touching at an edge or vertex) is a centre of each; an unconstrained one
+ * follows the lowest-numbered component. Unconstrained nodes of no volume cell are left
+ * alone (a CM_LOG_WARNING gives their count). A mesh without volume cells is
+ * CM_ERR_UNSUPPORTED. mesh, b and constrained are borrowed for the call: the warp keeps
+ * what it needs. */
 cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                          const unsigned char *constrained, const cm_warp_options *opt,
                          cm_warp **warp);
@@ -37,9 +59,32 @@ void cm_warp_destroy(cm_warp **warp);
 
 /* disp: #nodes x 3. On input, read at constrained nodes only; on output, constrained nodes
  * keep their value and every other node of a volume cell gets the warp's displacement (other
- * entries are not written). Reuses the factorisation: one warp, many calls (not concurrently
- * on the same warp). */
+ * entries are not written). One warp, many calls (not concurrently on the same warp). */
 cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
+
+/* The method of a warp. */
+cm_warp_method cm_warp_get_method(const cm_warp *warp);
+
+/* Largest |displacement - prescribed| at the constrained nodes after the last apply: 0 for
+ * methods that interpolate exactly (RBF, FEMWARP); what approximating methods (DM-FFD, MLS)
+ * miss by. */
+double cm_warp_residual(const cm_warp *warp);
+
+/* ---- warping a whole mesh: what `cadmorph warp` does ---- */
+
+typedef struct cm_warp_mesh_stats {
+    size_t boundary_nodes, constrained_nodes, components;
+    double t_create, t_apply; /* seconds */
+    double residual;          /* cm_warp_residual */
+} cm_warp_mesh_stats;
+
+/* Moves mesh by disp (#nodes x 3; read at the boundary nodes and at listed nodes, the rest
+ * computed by the warp): the boundary nodes and the listed ones (listed: #nodes flags, may be
+ * NULL) are constrained. On return mesh->xyz is moved, and the mesh carries a per-node
+ * "displacement" and a per-cell "scaled_jacobian" field (sj, may be NULL: that field's data).
+ * disp is overwritten with the displacement of every node. stats may be NULL. */
+cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
+                       const cm_warp_options *opt, double **sj, cm_warp_mesh_stats *stats);
 
 /* Reads a displacement table (the D.csv of `cadmorph warp`): header `node,dx,dy,dz`, then one
  * row per listed node; node is the 0-based index in the mesh file's node order. Blank lines

@@ -15,10 +15,10 @@ static cm_morph_result *run(cm_context *ctx, const char *from, const char *to, c
     fx_mesh_path(m, sizeof m, mesh);
     cm_morph_options o;
     cm_morph_options_init(&o);
-    o.surface = method;
+    o.method.surface = method;
     o.steps = steps;
     cm_morph_result *r = NULL;
-    cm_status s = cm_morph_run(ctx, g0, g1, m, &o, &r);
+    cm_status s = cm_morph_run(ctx, g0, g1, m, NULL, 0, &o, &r);
     CHECK_MSG(s == CM_OK, "%s -> %s: %s", from, to, cm_context_message(ctx));
     if (s < 0) return NULL;
     CHECK(r && r->mesh && r->sj && r->n_steps == steps);
@@ -131,32 +131,32 @@ static void test_errors(cm_context *ctx)
     fx_step_path(g0, sizeof g0, "hole_a");
     fx_step_path(g1, sizeof g1, "holes2_a");
     fx_mesh_path(m, sizeof m, "hole_a");
-    CHECK(cm_morph_run(ctx, g0, g1, m, NULL, &r) == CM_ERR_MISMATCH && r == NULL);
+    CHECK(cm_morph_run(ctx, g0, g1, m, NULL, 0, NULL, &r) == CM_ERR_MISMATCH && r == NULL);
     CHECK_MSG(strstr(cm_context_message(ctx), "do not correspond: ") &&
                   strstr(cm_context_message(ctx), "faces: 7 in G, 8 in G'"),
               "%s", cm_context_message(ctx));
     fx_step_path(g1, sizeof g1, "hole_b");
     fx_mesh_path(m, sizeof m, "cyl_a");
-    CHECK(cm_morph_run(ctx, g0, g1, m, NULL, &r) == CM_ERR_MISMATCH && r == NULL);
+    CHECK(cm_morph_run(ctx, g0, g1, m, NULL, 0, NULL, &r) == CM_ERR_MISMATCH && r == NULL);
     CHECK_MSG(strstr(cm_context_message(ctx), "is not a mesh of"), "%s", cm_context_message(ctx));
     fx_mesh_path(m, sizeof m, "hole_a_metres");
-    CHECK(cm_morph_run(ctx, g0, g1, m, NULL, &r) == CM_ERR_MISMATCH && r == NULL);
+    CHECK(cm_morph_run(ctx, g0, g1, m, NULL, 0, NULL, &r) == CM_ERR_MISMATCH && r == NULL);
     CHECK_MSG(strstr(cm_context_message(ctx), "unit mismatch"), "%s", cm_context_message(ctx));
     /* the same mesh is fine once the CAD is read in metres */
     cm_morph_options o;
     cm_morph_options_init(&o);
     o.cad_unit = "m";
-    CHECK_MSG(cm_morph_run(ctx, g0, g1, m, &o, &r) == CM_OK && r, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_morph_run(ctx, g0, g1, m, NULL, 0, &o, &r) == CM_OK && r, "%s", cm_context_message(ctx));
     if (r) CHECK(r->steps[0].inverted == 0 && r->max_dist <= 1e-9 * r->diagonal);
     cm_morph_result_destroy(&r);
     o.steps = 0;
-    CHECK(cm_morph_run(ctx, g0, g1, m, &o, &r) == CM_ERR_ARGUMENT && r == NULL);
+    CHECK(cm_morph_run(ctx, g0, g1, m, NULL, 0, &o, &r) == CM_ERR_ARGUMENT && r == NULL);
 
     /* a sample cap below what h needs: h grows, the run says so and still ends on G' */
     fx_mesh_path(m, sizeof m, "hole_a");
     cm_morph_options_init(&o);
     o.max_samples = 3000;
-    CHECK(cm_morph_run(ctx, g0, g1, m, &o, &r) == CM_WARNING && r);
+    CHECK(cm_morph_run(ctx, g0, g1, m, NULL, 0, &o, &r) == CM_WARNING && r);
     CHECK_MSG(strstr(cm_context_message(ctx), "over the cap of 3000"), "%s",
               cm_context_message(ctx));
     if (r) {

@@ -76,7 +76,7 @@ static double affine_error(const cm_mesh *m, const double *d, const affine *f, s
     return err / range;
 }
 
-static void test_affine(int tets, cm_rbf_kernel kernel)
+static void test_affine(int tets, cm_warp_method kernel)
 {
     unsigned long long seed = 12345 + (unsigned)tets;
     cm_mesh *m = NULL;
@@ -97,8 +97,8 @@ static void test_affine(int tets, cm_rbf_kernel kernel)
     double *d = prescribe(m, mask, &f);
     cm_warp_options opt;
     cm_warp_options_init(&opt);
-    CHECK(opt.kernel == CM_RBF_TRIHARMONIC);
-    opt.kernel = kernel;
+    CHECK(opt.method == CM_WARP_RBF);
+    opt.method = kernel;
     cm_warp *w = NULL;
     s = cm_warp_create(ctx, m, b, NULL, &opt, &w); /* NULL: the boundary nodes */
     CHECK_MSG(s == CM_OK && w, "%s", cm_context_message(ctx));
@@ -108,7 +108,7 @@ static void test_affine(int tets, cm_rbf_kernel kernel)
         size_t n_nan = 0, exact = 0, n_interior = 0;
         double err = affine_error(m, d, &f, 0, m->n_nodes, &n_nan);
         CHECK(n_nan == 0);
-        CHECK_MSG(err <= 1e-10, "%s kernel %d: affine motion reproduced to %.3g relative",
+        CHECK_MSG(err <= 1e-10, "%s method %d: affine motion reproduced to %.3g relative",
                   tets ? "tet" : "hex", (int)kernel, err);
         for (size_t v = 0; v < m->n_nodes; ++v) {
             double e[3];
@@ -121,7 +121,7 @@ static void test_affine(int tets, cm_rbf_kernel kernel)
         CHECK(n_interior > 0);
         CHECK_MSG(exact == b->n_nodes, "%zu of %zu boundary nodes kept their value bit for bit",
                   exact, b->n_nodes);
-        printf("affine %s kernel %d: %zu nodes, %zu boundary, max rel error %.3g\n",
+        printf("affine %s method %d: %zu nodes, %zu boundary, max rel error %.3g\n",
                tets ? "tet" : "hex", (int)kernel, m->n_nodes, b->n_nodes, err);
         /* a second displacement on the same factorisation (absolute sweep) */
         affine g;
@@ -329,7 +329,7 @@ static void test_pinned_and_stray(void)
     cm_mesh_destroy(&m);
 }
 
-/* Errors: coplanar constraints name the component; a mesh without volume cells; bad kernel. */
+/* Errors: coplanar constraints name the component; a mesh without volume cells; unknown method. */
 static void test_errors(void)
 {
     unsigned long long seed = 5;
@@ -374,7 +374,7 @@ static void test_errors(void)
 
     cm_warp_options opt;
     cm_warp_options_init(&opt);
-    opt.kernel = CM_RBF_THIN_PLATE;
+    opt.method = (cm_warp_method)CM_WARP_N_METHODS;
     CHECK(cm_warp_create(ctx, m, b, NULL, &opt, &w) == CM_ERR_ARGUMENT && w == NULL);
     CHECK(cm_warp_create(ctx, m, NULL, NULL, NULL, &w) == CM_ERR_ARGUMENT);
     CHECK(cm_warp_apply(ctx, NULL, NULL) == CM_ERR_ARGUMENT);
@@ -406,9 +406,9 @@ int main(int argc, char **argv)
     (void)argv;
     cm_context_create(&ctx);
     cm_context_set_log(ctx, keep_warning, NULL);
-    test_affine(0, CM_RBF_TRIHARMONIC);
-    test_affine(1, CM_RBF_TRIHARMONIC);
-    test_affine(1, CM_RBF_BIHARMONIC);
+    test_affine(0, CM_WARP_RBF);
+    test_affine(1, CM_WARP_RBF);
+    test_affine(1, CM_WARP_RBF_BIHARMONIC);
     test_threads();
     test_two_components(0);
     test_two_components(1);

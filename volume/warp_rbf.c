@@ -1,0 +1,299 @@
+/* The RBF warp methods (paper section 3): one polyharmonic RBF per connected component of
+ * volume cells, centred at the component's constrained nodes, carries their displacement
+ * inside. Exact at the centres, so the residual is 0. */
+#include "warp_method.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* One component: the RBF is centred at `fixed`; `free_nodes` receive its values. */
+typedef struct warp_component {
+    cm_rbf *rbf; /* NULL when every node of the component is constrained */
+    size_t n_fixed;
+    int64_t *fixed; /* constrained nodes of the component, ascending */
+    size_t n_free;
+    int64_t *free_nodes; /* unconstrained nodes owned by the component, ascending */
+    double *free_xyz;    /* n_free x 3, copied: the mesh is only borrowed by create */
+} warp_component;
+
+typedef struct rbf_warp {
+    size_t n_nodes;
+    size_t n_components;
+    warp_component *comp;
+    double *values; /* scratch: max n_fixed x 3 */
+    double *out;    /* scratch: max n_free x 3 */
+} rbf_warp;
+
+static void rbf_destroy(void *state)
+{
+    rbf_warp *w = state;
+    if (!w) return;
+    for (size_t k = 0; w->comp && k < w->n_components; ++k) {
+        cm_rbf_destroy(&w->comp[k].rbf);
+        free(w->comp[k].fixed);
+        free(w->comp[k].free_nodes);
+        free(w->comp[k].free_xyz);
+    }
+    free(w->comp);
+    free(w->values);
+    free(w->out);
+    free(w);
+}
+
+/* Calls visit(node) for each node of cell c, possibly repeatedly (polyhedra list a node once
+ * per face); callers deduplicate. */
+typedef struct node_visitor {
+    int *stamp;    /* #nodes: last component that saw the node, + 1 */
+    int mark;      /* component + 1 */
+    int64_t *list; /* nodes seen for the first time in this component */
+    size_t n;
+} node_visitor;
+
+static void visit_cell(const cm_mesh *mesh, size_t c, node_visitor *v)
+{
+    const int64_t *conn = mesh->conn;
+    int64_t b = mesh->offset[c], e = mesh->offset[c + 1];
+    if (mesh->type[c] == CM_CELL_POLYHEDRON) {
+        /* face stream: nf, then per face its node count and nodes */
+        int64_t p = b + 1;
+        for (int64_t f = 0; f < conn[b] && p < e; ++f) {
+            int64_t n = conn[p++];
+            for (int64_t i = 0; i < n && p < e; ++i, ++p)
+                if (v->stamp[conn[p]] != v->mark) {
+                    v->stamp[conn[p]] = v->mark;
+                    v->list[v->n++] = conn[p];
+                }
+        }
+        return;
+    }
+    for (int64_t p = b; p < e; ++p)
+        if (v->stamp[conn[p]] != v->mark) {
+            v->stamp[conn[p]] = v->mark;
+            v->list[v->n++] = conn[p];
+        }
+}
+
+static int cmp_i64(const void *a, const void *b)
+{
+    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Splits the node list of component k into constrained centres and owned free nodes.
+ * owner: #nodes, the component that evaluates an unconstrained node (-1: none yet); a free
+ * node shared by two components (only possible with a caller's mask that leaves a boundary
+ * node free) goes to the first one, so that every node has exactly one displacement. */
+static cm_status split_component(cm_context *ctx, const cm_mesh *mesh,
+                                 const unsigned char *constrained, int k, const int64_t *list,
+                                 size_t n, int *owner, warp_component *wc, size_t *n_shared_free)
+{
+    size_t nf = 0, nu = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (constrained[list[i]])
+            ++nf;
+        else if (owner[list[i]] < 0)
+            ++nu;
+        else
+            ++*n_shared_free;
+    }
+    wc->fixed = malloc((nf ? nf : 1) * sizeof *wc->fixed);
+    wc->free_nodes = malloc((nu ? nu : 1) * sizeof *wc->free_nodes);
+    wc->free_xyz = malloc((nu ? nu : 1) * 3 * sizeof *wc->free_xyz);
+    if (!wc->fixed || !wc->free_nodes || !wc->free_xyz)
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+    for (size_t i = 0; i < n; ++i) {
+        int64_t v = list[i];
+        if (constrained[v]) {
+            wc->fixed[wc->n_fixed++] = v;
+        } else if (owner[v] < 0) {
+            owner[v] = k;
+            memcpy(wc->free_xyz + 3 * wc->n_free, mesh->xyz + 3 * v, 3 * sizeof(double));
+            wc->free_nodes[wc->n_free++] = v;
+        }
+    }
+    return CM_OK;
+}
+
+/* The RBF of component k; its errors (coplanar centres, failed factorisation) get the
+ * component number in front. */
+static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel, size_t k,
+                               warp_component *wc)
+{
+    if (wc->n_free == 0) return CM_OK; /* nothing to interpolate: every node is prescribed */
+    if (wc->n_fixed == 0)
+        return cm_error(ctx, CM_ERR_NUMERIC,
+                        "cm_warp_create: component %zu: no constrained node, %zu free nodes", k,
+                        wc->n_free);
+    double *centres = malloc(wc->n_fixed * 3 * sizeof *centres);
+    if (!centres) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+    for (size_t i = 0; i < wc->n_fixed; ++i)
+        memcpy(centres + 3 * i, mesh->xyz + 3 * wc->fixed[i], 3 * sizeof(double));
+    cm_status s = cm_rbf_create(ctx, kernel, 3, wc->n_fixed, centres, &wc->rbf);
+    free(centres);
+    if (s < 0) {
+        /* copy first: the message is rewritten from itself */
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
+        return cm_error(ctx, s, "cm_warp_create: component %zu (%zu constrained nodes): %s", k,
+                        wc->n_fixed, msg);
+    }
+    return CM_OK;
+}
+
+/* Nodes of volume cells grouped by component: cells are bucketed by component first so that
+ * one pass per component with a stamp array deduplicates its nodes. */
+static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
+                                  const unsigned char *constrained, cm_rbf_kernel kernel,
+                                  rbf_warp *w, size_t *n_shared_free)
+{
+    size_t nc = b->n_components, nn = mesh->n_nodes;
+    size_t *start = calloc(nc + 1, sizeof *start);
+    size_t *cells = malloc((mesh->n_cells ? mesh->n_cells : 1) * sizeof *cells);
+    int *stamp = calloc(nn ? nn : 1, sizeof *stamp);
+    int *owner = malloc((nn ? nn : 1) * sizeof *owner);
+    int64_t *list = malloc((nn ? nn : 1) * sizeof *list);
+    cm_status s = CM_OK;
+    if (!start || !cells || !stamp || !owner || !list) {
+        s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+        goto done;
+    }
+    for (size_t c = 0; c < mesh->n_cells; ++c) {
+        int k = b->cell_component[c];
+        if (k >= 0 && (size_t)k < nc) ++start[k + 1];
+    }
+    for (size_t k = 0; k < nc; ++k)
+        start[k + 1] += start[k];
+    {
+        size_t *fill = malloc((nc ? nc : 1) * sizeof *fill);
+        if (!fill) {
+            s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+            goto done;
+        }
+        memcpy(fill, start, nc * sizeof *fill);
+        for (size_t c = 0; c < mesh->n_cells; ++c) {
+            int k = b->cell_component[c];
+            if (k >= 0 && (size_t)k < nc) cells[fill[k]++] = c;
+        }
+        free(fill);
+    }
+    for (size_t v = 0; v < nn; ++v)
+        owner[v] = -1;
+    for (size_t k = 0; k < nc; ++k) {
+        node_visitor vis = {stamp, (int)k + 1, list, 0};
+        for (size_t i = start[k]; i < start[k + 1]; ++i)
+            visit_cell(mesh, cells[i], &vis);
+        /* ascending order: the centres, hence the result, do not depend on cell order */
+        qsort(list, vis.n, sizeof *list, cmp_i64);
+        s = split_component(ctx, mesh, constrained, (int)k, list, vis.n, owner, &w->comp[k],
+                            n_shared_free);
+        if (s < 0) goto done;
+        s = fit_component(ctx, mesh, kernel, k, &w->comp[k]);
+        if (s < 0) goto done;
+        cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc);
+    }
+    /* nodes of no volume cell and not constrained: nothing defines their motion */
+    {
+        size_t stray = 0;
+        for (size_t v = 0; v < nn; ++v)
+            if (!stamp[v] && !constrained[v]) ++stray;
+        if (stray)
+            cm_log(ctx, CM_LOG_WARNING,
+                   "cm_warp_create: %zu unconstrained nodes belong to no volume cell; they are "
+                   "left where they are",
+                   stray);
+    }
+done:
+    free(start);
+    free(cells);
+    free(stamp);
+    free(owner);
+    free(list);
+    return s;
+}
+
+static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
+                            const unsigned char *constrained, cm_rbf_kernel kernel, void **state)
+{
+    if (b->n_components > (size_t)(~0u >> 1))
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_warp_create: too many components");
+    rbf_warp *w = calloc(1, sizeof *w);
+    if (!w) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+    w->n_nodes = mesh->n_nodes;
+    w->n_components = b->n_components;
+    w->comp = calloc(b->n_components, sizeof *w->comp);
+    cm_status s = CM_OK;
+    if (!w->comp) {
+        s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+        goto fail;
+    }
+    size_t n_shared_free = 0;
+    s = build_components(ctx, mesh, b, constrained, kernel, w, &n_shared_free);
+    if (s < 0) goto fail;
+    if (n_shared_free)
+        cm_log(ctx, CM_LOG_WARNING,
+               "cm_warp_create: %zu unconstrained nodes are shared by several components; each "
+               "follows the first",
+               n_shared_free);
+
+    size_t max_fixed = 1, max_free = 1;
+    for (size_t k = 0; k < w->n_components; ++k) {
+        if (w->comp[k].n_fixed > max_fixed) max_fixed = w->comp[k].n_fixed;
+        if (w->comp[k].n_free > max_free) max_free = w->comp[k].n_free;
+    }
+    w->values = malloc(max_fixed * 3 * sizeof *w->values);
+    w->out = malloc(max_free * 3 * sizeof *w->out);
+    if (!w->values || !w->out) {
+        s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+        goto fail;
+    }
+    *state = w;
+    return CM_OK;
+fail:
+    rbf_destroy(w);
+    return s;
+}
+
+static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *residual)
+{
+    rbf_warp *warp = state;
+    *residual = 0;
+    for (size_t k = 0; k < warp->n_components; ++k) {
+        warp_component *wc = &warp->comp[k];
+        if (!wc->rbf) continue;
+        for (size_t i = 0; i < wc->n_fixed; ++i)
+            memcpy(warp->values + 3 * i, disp + 3 * wc->fixed[i], 3 * sizeof(double));
+        cm_status s = cm_rbf_solve(ctx, wc->rbf, 3, warp->values);
+        if (s >= 0) s = cm_rbf_evaluate(ctx, wc->rbf, wc->n_free, wc->free_xyz, warp->out);
+        if (s < 0) {
+            char msg[1024];
+            snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
+            return cm_error(ctx, s, "cm_warp_apply: component %zu: %s", k, msg);
+        }
+        for (size_t i = 0; i < wc->n_free; ++i)
+            memcpy(disp + 3 * wc->free_nodes[i], warp->out + 3 * i, 3 * sizeof(double));
+        cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components);
+    }
+    return CM_OK;
+}
+
+static cm_status triharmonic_create(cm_context *ctx, const cm_mesh *mesh,
+                                    const cm_mesh_boundary *b, const unsigned char *constrained,
+                                    const cm_warp_options *opt, void **state)
+{
+    (void)opt;
+    return rbf_create(ctx, mesh, b, constrained, CM_RBF_TRIHARMONIC, state);
+}
+
+static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
+                                   const cm_mesh_boundary *b, const unsigned char *constrained,
+                                   const cm_warp_options *opt, void **state)
+{
+    (void)opt;
+    return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, state);
+}
+
+const cm_warp_method_ops cm_warp_rbf_triharmonic = {"rbf", triharmonic_create, rbf_apply,
+                                                    rbf_destroy};
+const cm_warp_method_ops cm_warp_rbf_biharmonic = {"rbf-biharmonic", biharmonic_create,
+                                                   rbf_apply, rbf_destroy};
