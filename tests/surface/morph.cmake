@@ -84,3 +84,25 @@ cm_morph_cli(cli_morph_usage ${RUN} --exit 1 --stderr "--to is required" --
 cm_morph_cli(cli_morph_bad_surface ${RUN} --exit 1 --stderr "unknown surface method" --
   $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
   --mesh ${SW}/hole_a.msh -o ${SW}/x.vtu --surface nearest)
+
+# the warp method by name, and a relative morph through an intermediate geometry
+cm_morph_cli(cli_morph_method ${RUN} --exit 0 --stdout "${SUMMARY}" --
+  $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
+  --mesh ${SW}/hole_a.msh -o ${SW}/cli_method.vtu --method rbf-biharmonic)
+cm_morph_cli(cli_morph_bad_method ${RUN} --exit 1 --stderr "unknown method 'nearest' \\(rbf" --
+  $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
+  --mesh ${SW}/hole_a.msh -o ${SW}/x.vtu --method nearest)
+cm_morph_cli(cli_morph_via ${RUN} --exit 0 --stdout "${SUMMARY}" --
+  $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_a.step
+  --mesh ${SW}/hole_a.msh -o ${SW}/cli_via.vtu --relative --via ${SD}/hole_b.step
+  --steps 2 --report ${SW}/cli_via.csv)
+cm_morph_cli(cli_morph_via_report ${CHECK} report ${SW}/cli_via.csv 4)
+set_tests_properties(cli_morph_via_report PROPERTIES DEPENDS cli_morph_via)
+cm_morph_cli(cli_morph_via_topology ${RUN} --exit 2 --stderr-lines 1
+  --stderr "^cadmorph morph: .*hole_b.step and .*holes2_a.step do not correspond"
+  --absent ${SW}/cli_bad5.vtu --
+  $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
+  --mesh ${SW}/hole_a.msh -o ${SW}/cli_bad5.vtu --relative --via ${SD}/hole_b.step,${SD}/holes2_a.step)
+cm_morph_cli(cli_morph_via_alone ${RUN} --exit 1 --stderr "--via needs --relative" --
+  $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
+  --mesh ${SW}/hole_a.msh -o ${SW}/x.vtu --via ${SD}/hole_b.step)
