@@ -11,7 +11,8 @@
 static const char *const usage_line =
     "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] "
-    "[--report R.csv] [--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
+    "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
+    "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
 
 static void print_help(void)
 {
@@ -30,6 +31,15 @@ static void print_help(void)
         "  -o, --output M1      output mesh (must not be an input)\n"
         "  --steps K            split the boundary motion into K equal increments (default 1);\n"
         "                       each increment after the first refits the warp on the last mesh\n"
+        "  --steps auto         adaptive steps: the whole motion first, halved on failure and\n"
+        "                       refitted on the last valid mesh, doubled after easy steps,\n"
+        "                       until every cell keeps a scaled Jacobian above --min-sj\n"
+        "  --min-sj F           floor of --steps auto (default 0: no inverted cell)\n"
+        "  --min-step F         smallest adaptive step, a fraction of the motion (default 1/256)\n"
+        "  --keep-partial       when --steps auto finds no valid step, still write the last\n"
+        "                       valid mesh (and the report) before exiting 3\n"
+        "  --optimize           optimise the interior nodes after every step (boundary nodes\n"
+        "                       stay on G1): untangles and raises the worst cells\n"
         "  --relative --via L   morph relatively through the intermediate geometries of the\n"
         "                       comma-separated list L (same topology): G0 -> Ga -> ... -> G1,\n"
         "                       each leg from the previous result (K increments per leg)\n"
@@ -43,7 +53,8 @@ static void print_help(void)
         "  --threads N          threads (default: all)\n"
         "  --verbose            debug messages on stderr\n\n"
         "exit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
-        "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted.\n",
+        "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted or no\n"
+        "valid adaptive step (the message names the worst cells).\n",
         cm_warp_method_list());
 }
 
@@ -52,7 +63,7 @@ static void print_help(void)
 typedef struct morph_args {
     const char *from, *to, *mesh, *out, *report, *unit;
     cm_morph_options opt;
-    int fail_on_inverted, threads, verbose, relative;
+    int fail_on_inverted, threads, verbose, relative, keep_partial;
     char via_list[8192]; /* --via, split in place at the commas */
     const char *via[MORPH_MAX_VIA];
     size_t n_via;
@@ -134,6 +145,25 @@ static int parse_args(int argc, char **argv, morph_args *a)
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             int rc = parse_via(cmd, a, v);
             if (rc >= 0) return rc;
+        } else if (!strcmp(o, "--optimize")) {
+            a->opt.optimize = 1;
+        } else if (!strcmp(o, "--keep-partial")) {
+            a->keep_partial = 1;
+        } else if (!strcmp(o, "--min-sj") || !strcmp(o, "--min-step")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            char *end;
+            double x = strtod(v, &end);
+            int step = !strcmp(o, "--min-step");
+            if (*end || !(x >= -1 && x < 1) || (step && !(x > 0)))
+                return cli_usage(cmd, usage_line, "%s: expected a number in %s, got '%s'", o,
+                                 step ? "(0, 1)" : "[-1, 1)", v);
+            if (step)
+                a->opt.min_fraction = x;
+            else
+                a->opt.min_sj = x;
+        } else if (!strcmp(o, "--steps") && i + 1 < argc && !strcmp(argv[i + 1], "auto")) {
+            a->opt.steps = CM_MORPH_STEPS_AUTO;
+            ++i;
         } else if (!strcmp(o, "--steps") || !strcmp(o, "--threads")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             char *end;
@@ -153,6 +183,8 @@ static int parse_args(int argc, char **argv, morph_args *a)
     if (!a->to) return cli_usage(cmd, usage_line, "--to is required");
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
+    if (a->keep_partial && a->opt.steps != CM_MORPH_STEPS_AUTO)
+        return cli_usage(cmd, usage_line, "--keep-partial goes with --steps auto");
     if (a->n_via && !a->relative)
         return cli_usage(cmd, usage_line, "--via needs --relative (a morph through them)");
     if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
@@ -182,12 +214,23 @@ static cm_status write_report(cm_context *ctx, const char *path, const cm_morph_
     if (s < 0) return s;
     fprintf(out.f, "step,min_scaled_jacobian,mean_scaled_jacobian,inverted,max_distance_to_g1,"
                    "t_read,t_sample,t_classify,t_surface_morph,t_volume_solve,t_evaluation,"
-                   "t_write\n");
+                   "t_write,fraction,accepted,optimized_moves,note\n");
     for (int k = 0; k < r->n_steps; ++k) {
         const cm_morph_step *st = &r->steps[k];
-        fprintf(out.f, "%d,%.9g,%.9g,%zu,%.6g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f\n", st->step,
-                st->min_sj, st->mean_sj, st->inverted, st->max_dist, st->t_read, st->t_sample,
-                st->t_classify, st->t_surface, st->t_volume_solve, st->t_evaluation, st->t_write);
+        /* the note names cells and positions: quoted, with its own quotes doubled */
+        char note[2 * sizeof st->note + 3];
+        size_t n = 0;
+        note[n++] = '"';
+        for (const char *c = st->note; *c && n < sizeof note - 2; ++c) {
+            if (*c == '"') note[n++] = '"';
+            note[n++] = *c;
+        }
+        note[n++] = '"';
+        note[n] = 0;
+        fprintf(out.f, "%d,%.9g,%.9g,%zu,%.6g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.9g,%d,%zu,%s\n",
+                st->step, st->min_sj, st->mean_sj, st->inverted, st->max_dist, st->t_read,
+                st->t_sample, st->t_classify, st->t_surface, st->t_volume_solve, st->t_evaluation,
+                st->t_write, st->fraction, st->accepted, st->optimized_moves, note);
     }
     return cm_outfile_commit(ctx, &out);
 }
@@ -201,26 +244,32 @@ int cli_cmd_morph(int argc, char **argv)
     if (!ctx) return CLI_EXIT_INTERNAL;
     cm_morph_result *r = NULL;
     cm_status s = cm_morph_run(ctx, a.from, a.to, a.mesh, a.via, a.n_via, &a.opt, &r);
-    if (s < 0) {
+    if (s < 0 && !r) {
         rc = cli_fail(ctx, "morph", s);
         cm_context_destroy(&ctx);
         return rc;
     }
-    /* warnings were logged as they happened */
-    const cm_morph_step *last = &r->steps[r->n_steps - 1];
+    /* a rejected adaptive morph: the report, and with --keep-partial the last valid mesh */
+    int partial = s == CM_ERR_REJECTED;
+    if (partial) rc = cli_fail(ctx, "morph", s);
+    /* warnings were logged as they happened; the mesh is that of the last accepted step */
+    int k_last = r->n_steps - 1;
+    while (k_last > 0 && !r->steps[k_last].accepted)
+        --k_last;
+    const cm_morph_step *last = &r->steps[k_last];
     cm_log(ctx, CM_LOG_DEBUG,
            "morph: boundary nodes on vertices %zu, edges %zu, faces %zu; largest distance to "
            "G1 %.3g (%.3g x diagonal)",
            r->counts[0], r->counts[1], r->counts[2], r->max_dist,
            r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
-    rc = CLI_EXIT_OK;
-    if (a.fail_on_inverted && last->inverted > 0) {
+    if (!partial) rc = CLI_EXIT_OK;
+    if (!partial && a.fail_on_inverted && last->inverted > 0) {
         fprintf(stderr,
                 "cadmorph morph: %zu inverted cells (min scaled Jacobian %.6g); %s not written\n",
                 last->inverted, last->min_sj, a.out);
         rc = CLI_EXIT_REJECTED;
     }
-    if (rc == CLI_EXIT_OK) {
+    if (rc == CLI_EXIT_OK || (partial && a.keep_partial)) {
         double t = cm_wtime();
         s = cm_mesh_write(ctx, r->mesh, a.out, NULL);
         r->steps[r->n_steps - 1].t_write = cm_wtime() - t;

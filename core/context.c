@@ -35,6 +35,7 @@ const char *cm_status_name(cm_status s)
     case CM_ERR_NUMERIC: return "numerical error";
     case CM_ERR_CAD: return "CAD error";
     case CM_ERR_INTERNAL: return "internal error";
+    case CM_ERR_REJECTED: return "result rejected";
     }
     return "unknown status";
 }

@@ -38,10 +38,10 @@ static cm_status result_mesh(cm_context *ctx, const cm_morpher *mp, const double
     for (size_t i = 0; i < 3 * nn; ++i)
         disp[i] = xyz[i] - r->mesh->xyz[i];
     memcpy(r->mesh->xyz, xyz, 3 * nn * sizeof *xyz);
-    /* the scaled_jacobian field may have moved when the displacement field was added */
+    /* the scaled_jacobian field may have moved when the displacement field was added; it is
+     * measured again because the morpher's last trial may be a rejected adaptive step */
     r->sj = cm_mesh_find_field(r->mesh, "scaled_jacobian", CM_FIELD_CELL)->data;
-    memcpy(r->sj, cm_morpher_quality(mp), r->mesh->n_cells * sizeof *r->sj);
-    return CM_OK;
+    return cm_mesh_quality(ctx, r->mesh, r->sj);
 }
 
 cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,
@@ -54,22 +54,21 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
     cm_morph_options o;
     cm_morph_options_init(&o);
     if (opt) o = *opt;
-    if (o.steps < 1) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morph_run: steps must be >= 1");
+    if (o.steps < 1 && o.steps != CM_MORPH_STEPS_AUTO)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morph_run: steps must be >= 1 or auto");
     size_t n_geom = n_via + 2; /* G, the intermediates, G' */
     const char **path = malloc(n_geom * sizeof *path);
     cm_cad_model **g = calloc(n_geom, sizeof *g);
     cm_morph_result *r = calloc(1, sizeof *r);
-    cm_morph_step *rows = calloc((n_geom - 1) * (size_t)o.steps, sizeof *rows);
+    cm_morph_step *rows = NULL; /* every leg's rows, appended */
+    size_t n_rows = 0;
     cm_mesh *mesh = NULL;
     cm_morpher *mp = NULL;
     double *xyz = NULL;
     cm_status warned = CM_OK;
     char warning[1024] = "";
-    cm_status s = path && g && r && rows ? CM_OK
-                                         : cm_error(ctx, CM_ERR_NOMEM, "cm_morph_run: out of memory");
+    cm_status s = path && g && r ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_morph_run: out of memory");
     if (s >= 0) {
-        r->steps = rows;
-        r->n_steps = (int)(n_geom - 1) * o.steps;
         path[0] = g0_path;
         for (size_t i = 0; i < n_via; ++i)
             path[i + 1] = via[i];
@@ -105,7 +104,6 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
         if (!xyz) s = cm_error(ctx, CM_ERR_NOMEM, "cm_morph_run: out of memory");
     }
     for (size_t i = 1; i < n_geom && s >= 0; ++i) {
-        cm_morph_step *part = rows + (i - 1) * (size_t)o.steps;
         const cm_morpher_info *in = cm_morpher_get_info(mp);
         double t_sample = i == 1 ? in->t_sample : 0, t_classify = i == 1 ? in->t_classify : 0;
         if (i > 1) {
@@ -118,24 +116,49 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
             }
             note_warning(ctx, s, &warned, warning, sizeof warning);
         }
-        s = cm_morpher_apply(ctx, mp, g[i], xyz, part);
-        part->t_read = i == 1 ? t_read : 0;
-        part->t_sample += t_sample;
-        part->t_classify = t_classify;
-        for (int k = 0; k < o.steps; ++k)
-            part[k].step = (int)(i - 1) * o.steps + k + 1;
+        s = cm_morpher_apply(ctx, mp, g[i], xyz, NULL);
+        /* this leg's rows, numbered on from the last leg's, with the stages spent before */
+        size_t n_leg = 0;
+        const cm_morph_step *leg = cm_morpher_steps(mp, &n_leg);
+        cm_morph_step *grown = n_leg ? realloc(rows, (n_rows + n_leg) * sizeof *rows) : rows;
+        if (!grown) {
+            s = cm_error(ctx, CM_ERR_NOMEM, "cm_morph_run: out of memory");
+            break;
+        }
+        rows = grown;
+        for (size_t k = 0; k < n_leg; ++k) {
+            rows[n_rows + k] = leg[k];
+            rows[n_rows + k].step = (int)(n_rows + k + 1);
+        }
+        if (n_leg) {
+            rows[n_rows].t_read = i == 1 ? t_read : 0;
+            rows[n_rows].t_sample += t_sample;
+            rows[n_rows].t_classify = t_classify;
+        }
+        n_rows += n_leg;
         if (s < 0) {
             s = cm_error_prefix(ctx, s, "%s", mesh_path);
             break;
         }
         note_warning(ctx, s, &warned, warning, sizeof warning);
     }
+    cm_status failed = s;
+    /* a rejected adaptive morph hands back its last valid mesh */
+    if (s == CM_ERR_REJECTED && n_rows) s = CM_OK;
+    if (r) {
+        r->steps = rows;
+        r->n_steps = (int)n_rows;
+        rows = NULL;
+    }
     if (s >= 0) s = result_mesh(ctx, mp, xyz, r);
     if (s >= 0) {
         double bb[6];
         cm_cad_bbox(g[n_geom - 1], bb);
         r->diagonal = cm_bbox_diagonal(bb);
-        r->max_dist = rows[r->n_steps - 1].max_dist;
+        size_t last = n_rows - 1;
+        while (last > 0 && !r->steps[last].accepted)
+            --last;
+        r->max_dist = r->steps[last].max_dist;
         r->surface = *cm_morpher_surface_stats(mp);
     }
     cm_morpher_destroy(&mp);
@@ -145,12 +168,13 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
     free(g);
     free(path);
     free(xyz);
+    free(rows);
     if (s < 0) {
-        if (!r) free(rows);
         cm_morph_result_destroy(&r);
         return s;
     }
     *result = r;
+    if (failed < 0) return failed; /* CM_ERR_REJECTED with the partial result */
     if (warned == CM_WARNING) return cm_error(ctx, CM_WARNING, "%s", warning);
     return CM_OK;
 }

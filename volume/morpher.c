@@ -3,6 +3,7 @@
  * by a warp (section 3) whose factorisation depends only on M, kept per method. */
 #include "cadmorph/morph.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,6 +23,11 @@ struct cm_morpher {
     double *disp;  /* #nodes x 3 */
     double *bnew;  /* #boundary x 3: the surface morph's positions on the target */
     double *bxyz;  /* #boundary x 3: the positions of the current increment */
+    double *next;  /* #nodes x 3: the step being tried */
+    unsigned char *fixed; /* #nodes: the boundary nodes, which optimisation never moves */
+    double min_sj0;       /* M's minimum scaled Jacobian (keep_fraction) */
+    cm_morph_step *rows;  /* the last apply's steps */
+    size_t n_rows, cap_rows;
     cm_surface_morph_stats surface;
     cm_morpher_info info;
 };
@@ -37,6 +43,11 @@ void cm_morph_options_init(cm_morph_options *opt)
     memset(opt, 0, sizeof *opt);
     cm_morph_method_init(&opt->method);
     opt->steps = 1;
+    opt->min_sj = 0;
+    opt->keep_fraction = 0;
+    opt->min_fraction = 1.0 / 256;
+    opt->optimize = 0;
+    cm_optimize_options_init(&opt->optimize_options);
     cm_classify_options_init(&opt->classify);
     cm_surface_morph_options_init(&opt->morph);
 }
@@ -122,6 +133,9 @@ void cm_morpher_destroy(cm_morpher **morpher)
     free(mp->disp);
     free(mp->bnew);
     free(mp->bxyz);
+    free(mp->next);
+    free(mp->fixed);
+    free(mp->rows);
     free(mp);
     *morpher = NULL;
 }
@@ -140,9 +154,10 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
         cm_morph_options_init(&mp->opt);
     mp->g = g;
     held_warnings held = {0};
-    cm_status s = mp->opt.steps >= 1
+    cm_status s = mp->opt.steps >= 1 || mp->opt.steps == CM_MORPH_STEPS_AUTO
                       ? cm_mesh_copy(ctx, mesh, &mp->mesh)
-                      : cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_create: steps must be >= 1");
+                      : cm_error(ctx, CM_ERR_ARGUMENT,
+                                 "cm_morpher_create: steps must be >= 1 or auto");
     if (s >= 0) s = cm_mesh_boundary_create(ctx, mp->mesh, &mp->b);
     hold(ctx, &held, s);
     if (s >= 0 && mp->b->n_nodes == 0)
@@ -160,13 +175,21 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
         mp->disp = malloc(3 * (nn ? nn : 1) * sizeof *mp->disp);
         mp->bnew = malloc(3 * (nb ? nb : 1) * sizeof *mp->bnew);
         mp->bxyz = malloc(3 * (nb ? nb : 1) * sizeof *mp->bxyz);
-        if (!mp->disp || !mp->bnew || !mp->bxyz)
+        mp->next = malloc(3 * (nn ? nn : 1) * sizeof *mp->next);
+        mp->fixed = calloc(nn ? nn : 1, 1);
+        if (!mp->disp || !mp->bnew || !mp->bxyz || !mp->next || !mp->fixed)
             s = cm_error(ctx, CM_ERR_NOMEM, "cm_morpher_create: out of memory for %zu nodes", nn);
     }
     if (s < 0) {
         cm_morpher_destroy(&mp);
         return s;
     }
+    for (size_t i = 0; i < mp->b->n_nodes; ++i)
+        mp->fixed[mp->b->nodes[i]] = 1;
+    cm_quality_stats q0;
+    if (cm_mesh_quality(ctx, mp->work, mp->sj) >= 0 &&
+        cm_quality_summarize(ctx, mp->work, mp->sj, NULL, &q0) >= 0)
+        mp->min_sj0 = q0.min;
     mp->info.nodes = nn;
     mp->info.cells = cm_mesh_count_dim(mp->mesh, 3);
     mp->info.boundary_nodes = nb;
@@ -177,7 +200,7 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
 
 /* The locator of target (for distances), kept while the same target comes back. */
 static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
-                            cm_morph_step *first)
+                            double *t_sample)
 {
     if (target == mp->target && mp->target_loc) return CM_OK;
     cm_status s = target == mp->g ? CM_OK : cm_cad_compare(ctx, mp->g, target, 5);
@@ -189,7 +212,7 @@ static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
     if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
     if (s < 0) return s;
     mp->target = target;
-    if (first) first->t_sample += cm_wtime() - t0;
+    *t_sample = cm_wtime() - t0;
     return CM_OK;
 }
 
@@ -208,30 +231,50 @@ static cm_status shared_warp(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
     return CM_OK;
 }
 
-/* Increment k of n: the boundary at fraction k/n of its motion, the interior by the warp
- * made on the coordinates xyz (in: after increment k - 1, out: after k). */
-static cm_status increment(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo, int k,
-                           int n, double *xyz, cm_morph_step *row)
+/* A new row of the last apply (zeroed); NULL when out of memory. Rows move when the array
+ * grows: fill one before asking for the next. */
+static cm_morph_step *new_row(cm_context *ctx, cm_morpher *mp)
+{
+    if (mp->n_rows == mp->cap_rows) {
+        size_t cap = mp->cap_rows ? 2 * mp->cap_rows : 16;
+        cm_morph_step *p = realloc(mp->rows, cap * sizeof *p);
+        if (!p) {
+            cm_error(ctx, CM_ERR_NOMEM, "cm_morpher_apply: out of memory for step rows");
+            return NULL;
+        }
+        mp->rows = p;
+        mp->cap_rows = cap;
+    }
+    cm_morph_step *r = &mp->rows[mp->n_rows++];
+    memset(r, 0, sizeof *r);
+    r->step = (int)mp->n_rows;
+    return r;
+}
+
+/* The mesh at fraction f of the boundary motion: the boundary blended linearly from M's
+ * boundary to the surface morph's positions (exactly those at f = 1), the interior by the
+ * warp of the move from `from` (the shared factorisation when from is the start mesh, else
+ * one of its own on from), then optimised if asked; measured into row. */
+static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo, double f,
+                       int shared, const double *from, double *xyz, cm_morph_step *row)
 {
     const cm_surface_nodes *nd = mp->nodes;
     size_t nn = mp->mesh->n_nodes;
-    double frac = (double)k / n;
     memset(mp->disp, 0, 3 * nn * sizeof *mp->disp);
     for (size_t i = 0; i < nd->n; ++i)
         for (int c = 0; c < 3; ++c) {
-            double want = nd->xyz[3 * i + c] + frac * (mp->bnew[3 * i + c] - nd->xyz[3 * i + c]);
-            if (k == n) want = mp->bnew[3 * i + c];
+            double want = nd->xyz[3 * i + c] + f * (mp->bnew[3 * i + c] - nd->xyz[3 * i + c]);
+            if (f == 1.0) want = mp->bnew[3 * i + c];
             mp->bxyz[3 * i + c] = want;
-            mp->disp[3 * nd->node[i] + c] = want - xyz[3 * nd->node[i] + c];
+            mp->disp[3 * nd->node[i] + c] = want - from[3 * nd->node[i] + c];
         }
     cm_warp *w = NULL, *own = NULL;
     double t0 = cm_wtime();
     cm_status s;
-    if (k == 1) {
+    if (shared) {
         s = shared_warp(ctx, mp, wo, &w, &row->t_volume_solve);
     } else {
-        /* later increments start from the moved mesh: a warp of its own */
-        memcpy(mp->work->xyz, xyz, 3 * nn * sizeof *xyz);
+        memcpy(mp->work->xyz, from, 3 * nn * sizeof *from);
         s = cm_warp_create(ctx, mp->work, mp->b, NULL, wo, &own);
         w = own;
         row->t_volume_solve = cm_wtime() - t0;
@@ -242,11 +285,18 @@ static cm_status increment(cm_context *ctx, cm_morpher *mp, const cm_warp_option
     cm_warp_destroy(&own);
     if (s < 0) return s;
     for (size_t i = 0; i < 3 * nn; ++i)
-        xyz[i] += mp->disp[i];
+        xyz[i] = from[i] + mp->disp[i];
     /* boundary nodes exactly where they were sent (no round-off from the increments) */
     for (size_t i = 0; i < nd->n; ++i)
         memcpy(xyz + 3 * nd->node[i], mp->bxyz + 3 * i, 3 * sizeof(double));
     memcpy(mp->work->xyz, xyz, 3 * nn * sizeof *xyz);
+    if (mp->opt.optimize) {
+        cm_optimize_stats st;
+        s = cm_mesh_optimize(ctx, mp->work, mp->fixed, &mp->opt.optimize_options, &st);
+        if (s < 0) return s;
+        memcpy(xyz, mp->work->xyz, 3 * nn * sizeof *xyz);
+        row->optimized_moves = st.moves;
+    }
     cm_quality_stats all;
     s = cm_mesh_quality(ctx, mp->work, mp->sj);
     if (s >= 0) s = cm_quality_summarize(ctx, mp->work, mp->sj, NULL, &all);
@@ -256,29 +306,135 @@ static cm_status increment(cm_context *ctx, cm_morpher *mp, const cm_warp_option
         s = cm_surface_max_distance(ctx, mp->target_loc, mp->bxyz, nd->n, &row->max_dist, NULL);
     row->t_distance = cm_wtime() - t2;
     if (s < 0) return s;
-    row->step = k;
     row->min_sj = all.min;
     row->mean_sj = all.mean;
     row->inverted = all.inverted;
     row->cells = all.count;
     row->outside = mp->surface.outside;
+    row->fraction = f;
+    row->accepted = 1;
+    return CM_OK;
+}
+
+/* The worst volume cells of the last trial (up to 3): "cell <id> at (x, y, z) SJ <v>". */
+static void worst_cells(const cm_morpher *mp, char *out, size_t size)
+{
+    const cm_mesh *m = mp->work;
+    size_t best[3] = {0};
+    int n = 0;
+    for (size_t c = 0; c < m->n_cells; ++c) {
+        double q = mp->sj[c];
+        if (isnan(q) && cm_cell_type_info((cm_cell_type)m->type[c])->dim != 3) continue;
+        if (fabs(q) >= 1e29) q = -INFINITY; /* collapsed */
+        int pos = n;
+        while (pos > 0) {
+            double qb = mp->sj[best[pos - 1]];
+            if (fabs(qb) >= 1e29) qb = -INFINITY;
+            if (!(q < qb)) break;
+            --pos;
+        }
+        if (pos >= 3) continue;
+        for (int k = (n < 3 ? n : 2); k > pos; --k)
+            best[k] = best[k - 1];
+        best[pos] = c;
+        if (n < 3) ++n;
+    }
+    size_t len = 0;
+    out[0] = 0;
+    for (int k = 0; k < n && len < size; ++k) {
+        size_t c = best[k];
+        double x[3] = {0, 0, 0};
+        int64_t b = m->offset[c], e = m->offset[c + 1];
+        for (int64_t j = b; j < e; ++j)
+            for (int d = 0; d < 3; ++d)
+                x[d] += m->xyz[3 * m->conn[j] + d] / (double)(e - b);
+        int on_boundary = 1;
+        for (int64_t j = b; j < e; ++j)
+            on_boundary &= mp->fixed[m->conn[j]] != 0;
+        int w = snprintf(out + len, size - len, "%scell %zu at (%.4g, %.4g, %.4g) SJ %.3g%s",
+                         k ? "; " : "", c, x[0], x[1], x[2], mp->sj[c],
+                         on_boundary ? " (all its nodes on the boundary)" : "");
+        if (w < 0) break;
+        len += (size_t)w;
+    }
+}
+
+/* K equal increments (opt.steps >= 1). */
+static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
+                             double *xyz)
+{
+    int n = mp->opt.steps;
+    for (int k = 1; k <= n; ++k) {
+        cm_progress(ctx, "morph", k - 1, n);
+        cm_morph_step *row = new_row(ctx, mp);
+        if (!row) return CM_ERR_NOMEM;
+        cm_status s = trial(ctx, mp, wo, (double)k / n, k == 1, xyz, mp->next, row);
+        if (s < 0) return cm_error_prefix(ctx, s, "step %d of %d", k, n);
+        memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
+    }
+    cm_progress(ctx, "morph", n, n);
+    return CM_OK;
+}
+
+/* Adaptive steps (CM_MORPH_STEPS_AUTO), see cm_morph_options. */
+static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
+                            double *xyz)
+{
+    const cm_morph_options *o = &mp->opt;
+    double done = 0, step = 1, min_step = o->min_fraction > 0 ? o->min_fraction : 1.0 / 256;
+    int easy = 0;
+    while (done < 1) {
+        double f = done + step;
+        if (f > 1 - 1e-12) f = 1;
+        cm_progress(ctx, "morph", done, 1);
+        cm_morph_step *row = new_row(ctx, mp);
+        if (!row) return CM_ERR_NOMEM;
+        cm_status s = trial(ctx, mp, wo, f, done == 0, xyz, mp->next, row);
+        if (s < 0) return cm_error_prefix(ctx, s, "step to %.4g %%", 100 * f);
+        double floor = o->min_sj;
+        if (o->keep_fraction > 0 && step > min_step && o->keep_fraction * mp->min_sj0 > floor)
+            floor = o->keep_fraction * mp->min_sj0;
+        if (row->min_sj > floor) {
+            memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
+            done = f;
+            if (++easy >= 2) { /* two easy steps in a row: try a longer one */
+                step *= 2;
+                easy = 0;
+            }
+            continue;
+        }
+        row->accepted = 0;
+        int w = snprintf(row->note, sizeof row->note, "min SJ %.3g <= %.3g: ", row->min_sj, floor);
+        if (w > 0 && (size_t)w < sizeof row->note)
+            worst_cells(mp, row->note + w, sizeof row->note - (size_t)w);
+        easy = 0;
+        step /= 2;
+        if (step < min_step) {
+            char many[1024];
+            worst_cells(mp, many, sizeof many);
+            return cm_error(ctx, CM_ERR_REJECTED,
+                            "no valid step: from %.4g %% of the motion even a step of %.3g %% "
+                            "leaves %zu cells at or below scaled Jacobian %.3g (worst: %s)",
+                            100 * done, 100 * 2 * step, row->inverted > 0 ? row->inverted : 1,
+                            floor, many);
+        }
+    }
+    cm_progress(ctx, "morph", 1, 1);
     return CM_OK;
 }
 
 cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
                                   const cm_morph_method *method, double *out_xyz,
-                                  cm_morph_step *rows)
+                                  cm_morph_step *out_row)
 {
     if (!mp || !target || !method || !out_xyz)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_apply: NULL input");
     if ((int)method->warp.method < 0 || method->warp.method >= CM_WARP_N_METHODS)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_apply: unknown warp method %d",
                         (int)method->warp.method);
-    int n = mp->opt.steps;
-    cm_morph_step scratch;
-    if (rows)
-        memset(rows, 0, (size_t)n * sizeof *rows);
-    cm_status s = use_target(ctx, mp, target, rows);
+    mp->n_rows = 0;
+    double t_sample = 0;
+    cm_status s = use_target(ctx, mp, target, &t_sample);
     if (s < 0) return s;
     cm_surface_morph_options mo = mp->opt.morph;
     mo.method = method->surface;
@@ -286,27 +442,50 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     memset(&mp->surface, 0, sizeof mp->surface);
     s = cm_surface_morph(ctx, mp->g, target, mp->nodes, &mo, mp->bnew, &mp->surface);
     if (s < 0) return s;
-    cm_status warned = s;
-    if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
-    char warning[1024];
-    snprintf(warning, sizeof warning, "%s", s == CM_WARNING ? cm_context_message(ctx) : "");
-    if (rows) rows[0].t_surface = cm_wtime() - t0;
-    memcpy(out_xyz, mp->mesh->xyz, 3 * mp->mesh->n_nodes * sizeof *out_xyz);
-    for (int k = 1; k <= n; ++k) {
-        cm_progress(ctx, "morph", k - 1, n);
-        cm_morph_step *row = rows ? &rows[k - 1] : memset(&scratch, 0, sizeof scratch);
-        s = increment(ctx, mp, &method->warp, k, n, out_xyz, row);
-        if (s < 0) return cm_error_prefix(ctx, s, "step %d of %d", k, n);
+    double t_surface = cm_wtime() - t0;
+    char warning[1024] = "";
+    if (s == CM_WARNING) {
+        cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
+        snprintf(warning, sizeof warning, "%s", cm_context_message(ctx));
     }
-    cm_progress(ctx, "morph", n, n);
-    return warned == CM_WARNING ? cm_error(ctx, CM_WARNING, "%s", warning) : CM_OK;
+    memcpy(out_xyz, mp->mesh->xyz, 3 * mp->mesh->n_nodes * sizeof *out_xyz);
+    s = mp->opt.steps == CM_MORPH_STEPS_AUTO ? auto_steps(ctx, mp, &method->warp, out_xyz)
+                                             : fixed_steps(ctx, mp, &method->warp, out_xyz);
+    if (mp->n_rows) {
+        mp->rows[0].t_sample += t_sample;
+        mp->rows[0].t_surface += t_surface;
+    }
+    if (out_row && mp->n_rows) {
+        /* the last accepted row, with every row's stage times */
+        size_t last = mp->n_rows - 1;
+        while (last > 0 && !mp->rows[last].accepted)
+            --last;
+        *out_row = mp->rows[last];
+        out_row->t_sample = out_row->t_surface = out_row->t_volume_solve = 0;
+        out_row->t_evaluation = out_row->t_distance = 0;
+        for (size_t i = 0; i < mp->n_rows; ++i) {
+            out_row->t_sample += mp->rows[i].t_sample;
+            out_row->t_surface += mp->rows[i].t_surface;
+            out_row->t_volume_solve += mp->rows[i].t_volume_solve;
+            out_row->t_evaluation += mp->rows[i].t_evaluation;
+            out_row->t_distance += mp->rows[i].t_distance;
+        }
+    }
+    if (s < 0) return s;
+    return warning[0] ? cm_error(ctx, CM_WARNING, "%s", warning) : CM_OK;
 }
 
 cm_status cm_morpher_apply(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
-                           double *out_xyz, cm_morph_step *rows)
+                           double *out_xyz, cm_morph_step *out_row)
 {
     if (!mp) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_apply: NULL input");
-    return cm_morpher_apply_method(ctx, mp, target, &mp->opt.method, out_xyz, rows);
+    return cm_morpher_apply_method(ctx, mp, target, &mp->opt.method, out_xyz, out_row);
+}
+
+const cm_morph_step *cm_morpher_steps(const cm_morpher *mp, size_t *n)
+{
+    if (n) *n = mp ? mp->n_rows : 0;
+    return mp ? mp->rows : NULL;
 }
 
 cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *mp, const cm_cad_model *g,

@@ -32,7 +32,9 @@ typedef enum cm_status {
     CM_ERR_MISMATCH = -6,      /* inputs that do not belong together (CAD vs mesh, G vs G') */
     CM_ERR_NUMERIC = -7,       /* singular or indefinite system, non-finite values */
     CM_ERR_CAD = -8,           /* OpenCASCADE failed */
-    CM_ERR_INTERNAL = -9       /* a bug or an exception from a dependency */
+    CM_ERR_INTERNAL = -9,      /* a bug or an exception from a dependency */
+    CM_ERR_REJECTED = -10      /* a result refused by a quality guard (inverted cells that no
+                                  adaptive step avoids): exit code 3 in the CLI */
 } cm_status;
 
 /* Short fixed name of a status, e.g. "format error". */

@@ -19,6 +19,7 @@
 
 #include "cadmorph/cad.h"
 #include "cadmorph/mesh.h"
+#include "cadmorph/optimize.h"
 #include "cadmorph/surface.h"
 #include "cadmorph/warp.h"
 
@@ -38,11 +39,26 @@ typedef struct cm_morph_method {
 
 void cm_morph_method_init(cm_morph_method *m);
 
+/* steps = CM_MORPH_STEPS_AUTO: adaptive steps (see cm_morph_options). */
+#define CM_MORPH_STEPS_AUTO 0
+
 typedef struct cm_morph_options {
     cm_morph_method method;
-    int steps;            /* >= 1 (default 1): equal increments of the boundary motion; step 1
-                             uses the shared factorisation, later ones refactorise on the
-                             intermediate mesh */
+    /* >= 1 (default 1): equal increments of the boundary motion; increment 1 uses the shared
+     * factorisation, later ones refit the warp on the intermediate mesh.
+     * CM_MORPH_STEPS_AUTO: the largest steps that keep every cell's scaled Jacobian above
+     * min_sj (and, while steps can still shrink, above keep_fraction x M0's minimum): first
+     * the whole motion at once (the shared factorisation), on failure half the step, refit on
+     * the last accepted mesh; after two easy steps in a row the step doubles. Fails with
+     * CM_ERR_REJECTED, naming the worst cells, when no step down to min_fraction of the
+     * motion succeeds. */
+    int steps;
+    double min_sj;        /* auto: floor (default 0: no inversion) */
+    double keep_fraction; /* auto: 0 (default) = floor only */
+    double min_fraction;  /* auto: smallest step (default 1/256) */
+    int optimize;         /* 1: optimise the interior (optimize.h) after every increment,
+                             before it is judged; boundary nodes never move */
+    cm_optimize_options optimize_options;
     const char *cad_unit; /* target unit of STEP files read by cm_morph_run; NULL = "mm" */
     /* Samples of each model for the locators: h is a quarter of the shortest boundary edge,
      * raised (with a warning) if that needs more than max_samples; 0: CM_MORPH_MAX_SAMPLES. */
@@ -66,6 +82,10 @@ typedef struct cm_morph_step {
                         boundary is a linear blend, so this is how far it still is */
     size_t outside;  /* face nodes whose (u',v') left the trimmed face (cm_surface_morph_stats) */
     double residual; /* the warp's miss at the constrained nodes (cm_warp_residual) */
+    double fraction; /* of the boundary motion this row reaches (1 for the last) */
+    int accepted;    /* 0 for a rejected adaptive step (the next row retries a smaller one) */
+    size_t optimized_moves; /* node moves kept by the optimisation of this step */
+    char note[160];  /* why a step was rejected: worst cells with their scaled Jacobians */
     double t_read, t_sample, t_classify, t_surface, t_volume_solve, t_evaluation, t_distance,
         t_write;
 } cm_morph_step;
@@ -91,18 +111,25 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
 void cm_morpher_destroy(cm_morpher **morpher);
 
 /* Morphs onto target with the options' method: out_xyz (#nodes x 3) receives the new
- * coordinates (boundary nodes exactly where the surface morph sent them), rows (opt.steps
- * rows, may be NULL) the quality and times. Errors: CM_ERR_MISMATCH when target does not
- * correspond to G (up to 5 differences in the message); the warp's errors. Returns
- * CM_WARNING when face nodes left their trimmed face (the result is complete). */
+ * coordinates (boundary nodes exactly where the surface morph sent them), out_row (may be
+ * NULL) the last step's row with the times of all steps added up; every row (with rejected
+ * adaptive steps) is in cm_morpher_steps. Errors: CM_ERR_MISMATCH when target does not
+ * correspond to G (up to 5 differences in the message); the warp's errors; CM_ERR_REJECTED
+ * when adaptive steps found no valid step (out_xyz then holds the last accepted mesh, valid,
+ * and out_row its row). Returns CM_WARNING when face nodes left their trimmed face (the
+ * result is complete). */
 cm_status cm_morpher_apply(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *target,
-                           double *out_xyz, cm_morph_step *rows);
+                           double *out_xyz, cm_morph_step *out_row);
 
 /* The same with another method; factorisations are kept per warp method, so a study that
  * compares methods factorises each once. */
 cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *morpher,
                                   const cm_cad_model *target, const cm_morph_method *method,
-                                  double *out_xyz, cm_morph_step *rows);
+                                  double *out_xyz, cm_morph_step *out_row);
+
+/* The rows of the last apply, in order (accepted and rejected steps); *n their count. Valid
+ * until the next apply. */
+const cm_morph_step *cm_morpher_steps(const cm_morpher *morpher, size_t *n);
 
 /* Relative morphing: the morpher's mesh becomes xyz (#nodes x 3, e.g. the last apply's
  * result), lying on g (e.g. that apply's target); the boundary is classified on g again and
@@ -125,7 +152,7 @@ typedef struct cm_morph_result {
                       per-cell "scaled_jacobian" fields */
     double *sj;    /* #cells: the scaled_jacobian field's data (owned by mesh) */
     int n_steps;
-    cm_morph_step *steps; /* n_steps rows; row 1 of a --via chain per geometry */
+    cm_morph_step *steps; /* n_steps rows: each leg's rows (of a --via chain) in order */
     size_t counts[3];     /* boundary nodes on vertices, edges, faces */
     cm_surface_morph_stats surface;
     double max_dist; /* largest distance of the final boundary nodes to G' */
@@ -135,7 +162,10 @@ typedef struct cm_morph_result {
 
 /* Reads G (g0_path), G' (g1_path) and M, checks that they correspond, and morphs M onto G'.
  * via: n_via intermediate geometries (may be 0): a relative morph G -> via[0] -> ... -> G',
- * each step a rebase onto the previous result (opt.steps increments each). Errors:
+ * each step a rebase onto the previous result (opt.steps increments each). When adaptive
+ * steps find no valid step, the return is CM_ERR_REJECTED and, unlike every other error,
+ * *result is set: the last valid mesh and every row, rejected ones included (the caller
+ * decides whether to keep it). Errors:
  * CM_ERR_MISMATCH when two geometries do not correspond or M is not a mesh of G; file errors
  * from the readers. Returns CM_WARNING (the first warning's message) when a stage warned
  * (nodes left a trimmed domain, sample cap reached) but the result is complete. Warnings

@@ -57,22 +57,40 @@ def ongeom(m0_path, m1_path, step, rel):
 
 
 def report(path, k):
+    """k rows (an integer), or 'auto+N': any number with at least N accepted steps."""
     rows = list(csv.reader(open(path)))
     want = ["step", "min_scaled_jacobian", "mean_scaled_jacobian", "inverted",
             "max_distance_to_g1", "t_read", "t_sample", "t_classify", "t_surface_morph",
-            "t_volume_solve", "t_evaluation", "t_write"]
+            "t_volume_solve", "t_evaluation", "t_write", "fraction", "accepted",
+            "optimized_moves", "note"]
     if rows[0] != want:
         print("FAIL: header %s" % rows[0])
         return False
-    if len(rows) != k + 1 or [int(r[0]) for r in rows[1:]] != list(range(1, k + 1)):
-        print("FAIL: %d rows, expected steps 1..%d" % (len(rows) - 1, k))
+    n = len(rows) - 1
+    auto = k.startswith("auto+")
+    if (not auto and n != int(k)) or n < 1 or [int(r[0]) for r in rows[1:]] != list(range(1, n + 1)):
+        print("FAIL: %d rows, expected steps 1..%s" % (n, k))
         return False
     for r in rows[1:]:
-        v = [float(x) for x in r]
-        if not (0 < v[1] <= v[2] <= 1) or v[3] != 0 or min(v[5:]) < 0:
+        v = [float(x) for x in r[:15]]
+        accepted = v[13] == 1
+        if min(v[5:12]) < 0 or not (0 < v[12] <= 1):
             print("FAIL: row %s" % r)
             return False
-    if float(rows[-1][4]) > 1e-9 or float(rows[1][4]) <= float(rows[-1][4]):
+        if accepted and (not (0 < v[1] <= v[2] <= 1) or v[3] != 0):
+            print("FAIL: accepted row with inverted cells %s" % r)
+            return False
+        if not accepted and (v[1] > 0 or "SJ" not in r[15]):
+            print("FAIL: rejected row without inverted cells or note %s" % r)
+            return False
+    if auto and sum(float(r[13]) == 1 for r in rows[1:]) < int(k[5:]):
+        print("FAIL: fewer than %s accepted steps" % k[5:])
+        return False
+    last = rows[-1]
+    if float(last[13]) != 1 or float(last[12]) != 1:
+        print("FAIL: the last row is not an accepted full step: %s" % last)
+        return False
+    if float(last[4]) > 1e-9 or (float(rows[1][12]) < 1 and float(rows[1][4]) <= float(last[4])):
         print("FAIL: distance to G1 does not end at ~0: %s" % [r[4] for r in rows[1:]])
         return False
     return True
@@ -83,5 +101,5 @@ if __name__ == "__main__":
     if a[:1] == ["ongeom"] and len(a) == 5:
         sys.exit(0 if ongeom(a[1], a[2], a[3], float(a[4])) else 1)
     if a[:1] == ["report"] and len(a) == 3:
-        sys.exit(0 if report(a[1], int(a[2])) else 1)
+        sys.exit(0 if report(a[1], a[2]) else 1)
     sys.exit(__doc__)

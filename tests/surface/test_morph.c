@@ -149,7 +149,7 @@ static void test_errors(cm_context *ctx)
     CHECK_MSG(cm_morph_run(ctx, g0, g1, m, NULL, 0, &o, &r) == CM_OK && r, "%s", cm_context_message(ctx));
     if (r) CHECK(r->steps[0].inverted == 0 && r->max_dist <= 1e-9 * r->diagonal);
     cm_morph_result_destroy(&r);
-    o.steps = 0;
+    o.steps = -1;
     CHECK(cm_morph_run(ctx, g0, g1, m, NULL, 0, &o, &r) == CM_ERR_ARGUMENT && r == NULL);
 
     /* a sample cap below what h needs: h grows, the run says so and still ends on G' */

@@ -136,7 +136,7 @@ static void test_errors(cm_context *ctx)
               cm_context_message(ctx));
     cm_morph_options o;
     cm_morph_options_init(&o);
-    o.steps = 0;
+    o.steps = -1;
     CHECK(cm_morpher_create(ctx, g0, m0, &o, &mp) == CM_ERR_ARGUMENT && mp == NULL);
     free(xyz);
     cm_mesh_destroy(&m0);
