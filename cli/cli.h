@@ -56,5 +56,6 @@ int cli_cmd_mesh(int argc, char **argv);
 int cli_cmd_morph(int argc, char **argv);
 int cli_cmd_sweep(int argc, char **argv);
 int cli_cmd_demo(int argc, char **argv);
+int cli_cmd_optimize(int argc, char **argv);
 
 #endif

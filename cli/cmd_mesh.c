@@ -13,7 +13,7 @@
 
 static const char *const usage =
     "cadmorph mesh G.step -o MESH [--size H] [--quality Q] [--preserve-surface] "
-    "[--cad-unit U] [--threads N] [-v] [-h|--help]";
+    "[--no-optimize] [--cad-unit U] [--threads N] [-v] [-h|--help]";
 
 static int help(void)
 {
@@ -32,6 +32,8 @@ static int help(void)
            "  --preserve-surface  keep OpenCASCADE's surface triangulation as it is (TetGen -Y);\n"
            "                      by default TetGen refines it and its new boundary nodes are\n"
            "                      projected onto the CAD faces and edges\n"
+           "  --no-optimize       keep TetGen's interior nodes; by default they are optimised\n"
+           "                      to lift slivers (boundary nodes never move)\n"
            "  --cad-unit U        length unit of the coordinates (default mm)\n"
            "  --threads N         threads for the quality computation (default: all)\n"
            "  -v, --verbose       stage timings on stderr\n"
@@ -65,6 +67,8 @@ int cli_cmd_mesh(int argc, char **argv)
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) return help();
         if (!strcmp(a, "-v") || !strcmp(a, "--verbose")) {
             verbose = 1;
+        } else if (!strcmp(a, "--no-optimize")) {
+            opt.optimize = 0;
         } else if (!strcmp(a, "--preserve-surface")) {
             opt.preserve_surface = 1;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {

@@ -9,7 +9,7 @@
 #include <string.h>
 
 static const char *const usage_line =
-    "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] "
+    "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] [--optimize] "
     "[--threads N] [--verbose]";
 
 static void print_help(void)
@@ -30,6 +30,8 @@ static void print_help(void)
         "  -o, --output M1      output mesh (must not be an input)\n"
         "  --method M           interior warp: %s (default rbf: r^3)\n"
         "  --kernel K           triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)\n"
+        "  --optimize           then optimise the other nodes (untangle, raise the worst cells;\n"
+        "                       boundary and listed nodes stay where D.csv sends them)\n"
         "  --threads N          threads for evaluation and quality (default: all)\n"
         "  --verbose            debug messages on stderr\n\n"
         "exit codes: 0 done, 1 usage, 2 bad input (malformed file, degenerate boundary).\n",
@@ -39,7 +41,7 @@ static void print_help(void)
 typedef struct warp_args {
     const char *mesh, *csv, *out;
     cm_warp_method method;
-    int threads, verbose;
+    int threads, verbose, optimize;
 } warp_args;
 
 /* Returns -1 to go on, else the exit code. */
@@ -55,6 +57,8 @@ static int parse_args(int argc, char **argv, warp_args *a)
             return CLI_EXIT_OK;
         } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
             a->verbose = 1;
+        } else if (!strcmp(o, "--optimize")) {
+            a->optimize = 1;
         } else if (!strcmp(o, "--mesh")) {
             if (!(a->mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
         } else if (!strcmp(o, "--displacements")) {
@@ -118,7 +122,9 @@ int cli_cmd_warp(int argc, char **argv)
     opt.method = a.method;
     cm_warp_mesh_stats st;
     if (s >= 0) {
-        s = cm_warp_mesh(ctx, mesh, disp, listed, &opt, &sj, &st);
+        cm_optimize_options oo;
+        cm_optimize_options_init(&oo);
+        s = cm_warp_mesh(ctx, mesh, disp, listed, &opt, a.optimize ? &oo : NULL, &sj, &st);
         if (s < 0) s = cm_error_prefix(ctx, s, "%s", a.mesh);
     }
     if (s >= 0)

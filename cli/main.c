@@ -17,6 +17,7 @@ static const cli_command commands[] = {
     {"quality", cli_cmd_quality, "scaled Jacobian report of a mesh"},
     {"warp", cli_cmd_warp, "move interior nodes by an RBF warp of given boundary displacements"},
     {"mesh", cli_cmd_mesh, "tet mesh of a STEP solid (OpenCASCADE surface + TetGen)"},
+    {"optimize", cli_cmd_optimize, "move interior nodes to untangle and raise the worst cells"},
     {"info", cli_cmd_info, "topology summary of a STEP file, correspondence with another"},
 };
 

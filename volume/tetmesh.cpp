@@ -5,6 +5,7 @@
 // OpenCASCADE is reached only through cad's C API, which already maps Standard_Failure, so
 // no OpenCASCADE header is seen here (DESIGN: OpenCASCADE only in cad/).
 #include "cadmorph/kdtree.h"
+#include "cadmorph/optimize.h"
 #include "cadmorph/tetmesh.h"
 
 #include <tetgen.h>
@@ -315,6 +316,7 @@ extern "C" void cm_tetmesh_options_init(cm_tetmesh_options *opt)
     opt->size = 0;
     opt->quality = 1.4;
     opt->preserve_surface = 0;
+    opt->optimize = 1;
 }
 
 extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
@@ -327,7 +329,16 @@ extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *mode
     cm_tetmesh_options_init(&o);
     if (opt) o = *opt;
     try {
-        return build(ctx, model, o, mesh);
+        cm_status s = build(ctx, model, o, mesh);
+        /* TetGen's radius-edge bound leaves slivers: move the interior nodes to lift them */
+        if (s >= 0 && o.optimize) {
+            cm_status e = cm_mesh_optimize(ctx, *mesh, nullptr, nullptr, nullptr);
+            if (e < 0) {
+                cm_mesh_destroy(mesh);
+                return e;
+            }
+        }
+        return s;
     } catch (const std::bad_alloc &) {
         return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", fn);
     } catch (const std::exception &e) {

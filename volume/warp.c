@@ -112,7 +112,8 @@ cm_warp_method cm_warp_get_method(const cm_warp *warp) { return warp->method; }
 double cm_warp_residual(const cm_warp *warp) { return warp ? warp->residual : 0; }
 
 cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
-                       const cm_warp_options *opt, double **sj, cm_warp_mesh_stats *stats)
+                       const cm_warp_options *opt, const cm_optimize_options *optimize,
+                       double **sj, cm_warp_mesh_stats *stats)
 {
     if (sj) *sj = NULL;
     if (!mesh || !disp) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_mesh: NULL input");
@@ -144,12 +145,30 @@ cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsig
     }
     cm_warp_destroy(&w);
     cm_mesh_boundary_destroy(&b);
-    free(constrained);
     double *field = NULL, *q = NULL;
-    if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &field);
     if (s >= 0) {
         for (size_t i = 0; i < 3 * nn; ++i)
             mesh->xyz[i] += disp[i];
+    }
+    if (s >= 0 && optimize) {
+        double t0 = cm_wtime(), *before = malloc(3 * (nn ? nn : 1) * sizeof *before);
+        cm_optimize_stats os;
+        s = before ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_warp_mesh: out of memory");
+        if (s >= 0) {
+            memcpy(before, mesh->xyz, 3 * nn * sizeof *before);
+            s = cm_mesh_optimize(ctx, mesh, constrained, optimize, &os);
+        }
+        if (s >= 0) {
+            for (size_t i = 0; i < 3 * nn; ++i)
+                disp[i] += mesh->xyz[i] - before[i];
+            st.optimized_moves = os.moves;
+        }
+        free(before);
+        st.t_optimize = cm_wtime() - t0;
+    }
+    free(constrained);
+    if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &field);
+    if (s >= 0) {
         memcpy(field, disp, 3 * nn * sizeof *disp);
         s = cm_mesh_add_field(ctx, mesh, "scaled_jacobian", CM_FIELD_CELL, 1, &q);
     }

@@ -23,6 +23,9 @@ typedef struct cm_tetmesh_options {
      * planes, and TetGen adds no interior node that would encroach on a boundary triangle:
      * with 1, a model with large planar faces gets a coarse mesh whatever the size. */
     int preserve_surface;
+    /* 1 (default): the interior nodes are then optimised (optimize.h) to lift TetGen's
+     * slivers; boundary nodes stay where they are. */
+    int optimize;
 } cm_tetmesh_options;
 
 void cm_tetmesh_options_init(cm_tetmesh_options *opt);

@@ -15,6 +15,7 @@
 #define CADMORPH_WARP_H
 
 #include "cadmorph/mesh.h"
+#include "cadmorph/optimize.h"
 #include "cadmorph/rbf.h"
 
 #ifdef __cplusplus
@@ -74,17 +75,21 @@ double cm_warp_residual(const cm_warp *warp);
 
 typedef struct cm_warp_mesh_stats {
     size_t boundary_nodes, constrained_nodes, components;
-    double t_create, t_apply; /* seconds */
-    double residual;          /* cm_warp_residual */
+    double t_create, t_apply, t_optimize; /* seconds */
+    double residual;                      /* cm_warp_residual */
+    size_t optimized_moves;               /* node moves kept by the optimisation */
 } cm_warp_mesh_stats;
 
 /* Moves mesh by disp (#nodes x 3; read at the boundary nodes and at listed nodes, the rest
  * computed by the warp): the boundary nodes and the listed ones (listed: #nodes flags, may be
  * NULL) are constrained. On return mesh->xyz is moved, and the mesh carries a per-node
  * "displacement" and a per-cell "scaled_jacobian" field (sj, may be NULL: that field's data).
- * disp is overwritten with the displacement of every node. stats may be NULL. */
+ * disp is overwritten with the displacement of every node. optimize: NULL, or the options
+ * of an interior optimisation of the warped mesh (constrained nodes never move). stats may
+ * be NULL. */
 cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
-                       const cm_warp_options *opt, double **sj, cm_warp_mesh_stats *stats);
+                       const cm_warp_options *opt, const cm_optimize_options *optimize,
+                       double **sj, cm_warp_mesh_stats *stats);
 
 /* Reads a displacement table (the D.csv of `cadmorph warp`): header `node,dx,dy,dz`, then one
  * row per listed node; node is the 0-based index in the mesh file's node order. Blank lines
