@@ -414,9 +414,10 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
             worst_cells(mp, many, sizeof many);
             return cm_error(ctx, CM_ERR_REJECTED,
                             "no valid step: from %.4g %% of the motion even a step of %.3g %% "
-                            "leaves %zu cells at or below scaled Jacobian %.3g (worst: %s)",
+                            "leaves %zu cells at or below scaled Jacobian %.3g (worst: %s)%s",
                             100 * done, 100 * 2 * step, row->inverted > 0 ? row->inverted : 1,
-                            floor, many);
+                            floor, many,
+                            o->optimize ? "" : "; interior optimisation (--optimize) may lift them");
         }
     }
     cm_progress(ctx, "morph", 1, 1);
