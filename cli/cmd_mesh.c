@@ -13,7 +13,7 @@
 
 static const char *const usage =
     "cadmorph mesh G.step -o MESH [--size H] [--quality Q] [--preserve-surface] "
-    "[--no-optimize] [--cad-unit U] [--threads N] [-v] [-h|--help]";
+    "[--min-dihedral D] [--no-optimize] [--cad-unit U] [--threads N] [-v] [-h|--help]";
 
 static int help(void)
 {
@@ -32,6 +32,8 @@ static int help(void)
            "  --preserve-surface  keep OpenCASCADE's surface triangulation as it is (TetGen -Y);\n"
            "                      by default TetGen refines it and its new boundary nodes are\n"
            "                      projected onto the CAD faces and edges\n"
+           "  --min-dihedral D    lower bound on the tets' dihedral angles, degrees in [0, 20]\n"
+           "                      (default 12; 0: TetGen's own): fewer slivers, more tets\n"
            "  --no-optimize       keep TetGen's interior nodes; by default they are optimised\n"
            "                      to lift slivers (boundary nodes never move)\n"
            "  --cad-unit U        length unit of the coordinates (default mm)\n"
@@ -81,6 +83,12 @@ int cli_cmd_mesh(int argc, char **argv)
         } else if (!strcmp(a, "--quality")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
             if (parse_double(cmd, a, v, 1, &opt.quality)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(a, "--min-dihedral")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
+            char *end = NULL;
+            opt.min_dihedral = strtod(v, &end);
+            if (*end || !(opt.min_dihedral >= 0 && opt.min_dihedral <= 20))
+                return cli_usage(cmd, usage, "--min-dihedral needs degrees in [0, 20], got '%s'", v);
         } else if (!strcmp(a, "--threads")) {
             if (cli_threads_value(argc, argv, &i, cmd, usage, &threads)) return CLI_EXIT_USAGE;
         } else if (a[0] == '-' && a[1] != '\0') {

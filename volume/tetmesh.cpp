@@ -176,6 +176,10 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     if (!std::isfinite(h) || !std::isfinite(q) || q < 1.0)
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: size %g or quality %g out of range (quality >= 1)",
                         fn, h, q);
+    /* TetGen's refinement need not end for dihedral bounds much above 18 degrees */
+    if (!(o.min_dihedral >= 0 && o.min_dihedral <= 20))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: minimum dihedral angle %g out of [0, 20] degrees",
+                        fn, o.min_dihedral);
 
     const double t0 = cm_wtime();
     cad_guard surf;
@@ -215,7 +219,12 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     }
     const double vmax = h * h * h * std::sqrt(2.0) / 12.0;  // regular tet of edge h
     char sw[128];
-    std::snprintf(sw, sizeof sw, "pzq%.6ga%.6g%sQ", q, vmax, o.preserve_surface ? "Y" : "");
+    /* the dihedral bound (after the radius-edge ratio) is what removes most slivers: TetGen's
+     * -O optimisation levels changed no measured quality (benchmarks/RESULTS.md, issue 13) */
+    char dihedral[32] = "";
+    if (o.min_dihedral > 0) std::snprintf(dihedral, sizeof dihedral, "/%.6g", o.min_dihedral);
+    std::snprintf(sw, sizeof sw, "pzq%.6g%sa%.6g%sQ", q, dihedral, vmax,
+                  o.preserve_surface ? "Y" : "");
     try {
         tetrahedralize(sw, &in, &tv);
     } catch (int code) {
@@ -317,6 +326,7 @@ extern "C" void cm_tetmesh_options_init(cm_tetmesh_options *opt)
     opt->quality = 1.4;
     opt->preserve_surface = 0;
     opt->optimize = 1;
+    opt->min_dihedral = 12;
 }
 
 extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
