@@ -122,6 +122,46 @@ static void corner_s(const corner_table *tb, int k, const double *x, double *fro
     *det = det3(s);
 }
 
+/* Cost of corner k and its gradient with respect to the corner matrix A (3 x 3 column-major,
+ * dA = d(cost)/dA): with S = A W^-1, f = ||S||^2, s = det S = det A det W^-1,
+ *   cost = f / (3 h(s)^(2/3)),  d cost = df / (3 h^(2/3)) - 2 f h'(s) ds / (9 h^(5/3)),
+ *   df/dA = 2 S W^-T,  ds/dA = det W^-1 cof(A), cof(A) = [a2 x a3, a3 x a1, a1 x a2]. */
+static double corner_cost_grad(const corner_table *tb, int k, const double *x, double delta,
+                               double *dA)
+{
+    double a[9], sm[9];
+    corner_matrix(x, tb->c[k], a);
+    const double *w = tb->winv[k];
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i)
+            sm[3 * j + i] = a[i] * w[3 * j] + a[3 + i] * w[3 * j + 1] + a[6 + i] * w[3 * j + 2];
+    double f = 0;
+    for (int i = 0; i < 9; ++i)
+        f += sm[i] * sm[i];
+    const double dw = det3(w), sdet = det3(a) * dw;
+    const double root = delta > 0 ? sqrt(sdet * sdet + 4 * delta * delta) : 0;
+    const double hs = delta > 0 ? 0.5 * (sdet + root) : sdet;
+    if (!(hs > 0)) {
+        memset(dA, 0, 9 * sizeof *dA);
+        return INFINITY;
+    }
+    const double dh = delta > 0 ? 0.5 * (1 + sdet / root) : 1;
+    const double h23 = cbrt(hs * hs), c1 = 2.0 / (3.0 * h23), c2 = 2.0 * f * dh * dw / (9.0 * h23 * hs);
+    const double *a1 = a, *a2 = a + 3, *a3 = a + 6;
+    const double cof[9] = {a2[1] * a3[2] - a2[2] * a3[1], a2[2] * a3[0] - a2[0] * a3[2],
+                           a2[0] * a3[1] - a2[1] * a3[0], a3[1] * a1[2] - a3[2] * a1[1],
+                           a3[2] * a1[0] - a3[0] * a1[2], a3[0] * a1[1] - a3[1] * a1[0],
+                           a1[1] * a2[2] - a1[2] * a2[1], a1[2] * a2[0] - a1[0] * a2[2],
+                           a1[0] * a2[1] - a1[1] * a2[0]};
+    /* (S W^-T)_{i,j} = sum_l S_{i,l} W^-1_{j,l} */
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 3; ++i) {
+            double swt = sm[i] * w[j] + sm[3 + i] * w[3 + j] + sm[6 + i] * w[6 + j];
+            dA[3 * j + i] = c1 * swt - c2 * cof[3 * j + i];
+        }
+    return f / (3.0 * h23);
+}
+
 /* Inverse mean ratio with the regularised determinant h(s). */
 static double corner_cost(double frob, double det, double delta)
 {
@@ -216,6 +256,41 @@ static double node_cost(const optimizer *op, int64_t v, const double *p, double 
     return sum;
 }
 
+/* The local objective and its gradient g (3) with respect to the position p of node v. */
+static double node_cost_grad(const optimizer *op, int64_t v, const double *p, double delta,
+                             double *g)
+{
+    const cm_mesh *m = op->mesh;
+    double sum = 0;
+    g[0] = g[1] = g[2] = 0;
+    for (int64_t i = op->start[v]; i < op->start[v + 1]; ++i) {
+        size_t c = (size_t)op->cells[i];
+        double x[3 * MAX_CELL_NODES];
+        gather(m, c, x);
+        int local = -1;
+        for (int64_t j = m->offset[c]; j < m->offset[c + 1]; ++j)
+            if (m->conn[j] == v) {
+                local = (int)(j - m->offset[c]);
+                memcpy(x + 3 * local, p, 3 * sizeof(double));
+            }
+        const corner_table *tb = &tables[table_index(m->type[c])];
+        for (int k = 0; k < tb->n; ++k) {
+            const int *cn = tb->c[k];
+            if (cn[0] != local && cn[1] != local && cn[2] != local && cn[3] != local) continue;
+            double dA[9];
+            sum += corner_cost_grad(tb, k, x, delta, dA);
+            for (int j = 0; j < 3; ++j)
+                if (cn[j + 1] == local)
+                    for (int d = 0; d < 3; ++d)
+                        g[d] += dA[3 * j + d];
+            if (cn[0] == local)
+                for (int d = 0; d < 3; ++d)
+                    g[d] -= dA[d] + dA[3 + d] + dA[6 + d];
+        }
+    }
+    return sum;
+}
+
 /* delta of Escobar et al.: 0 when every corner around v is valid, else grows with the worst
  * (most negative) determinant, relative to the corners' typical size. */
 static double node_delta(const optimizer *op, int64_t v, double *length)
@@ -258,27 +333,19 @@ static int optimise_node(const optimizer *op, int64_t v)
     if (!isfinite(f)) return 0;
     const double hstep = 1e-4 * len;
     for (int it = 0; it < op->o->newton; ++it) {
-        double g[3], H[9], q[3];
+        /* analytic gradient; Hessian from forward differences of the gradient */
+        double g[3], H[9], q[3], gq[3];
+        node_cost_grad(op, v, p, delta, g);
         for (int i = 0; i < 3; ++i) {
             memcpy(q, p, sizeof q);
-            q[i] = p[i] + hstep;
-            double fp = node_cost(op, v, q, delta);
-            q[i] = p[i] - hstep;
-            double fm = node_cost(op, v, q, delta);
-            g[i] = (fp - fm) / (2 * hstep);
-            H[4 * i] = (fp - 2 * f + fm) / (hstep * hstep);
+            q[i] += hstep;
+            node_cost_grad(op, v, q, delta, gq);
+            for (int j = 0; j < 3; ++j)
+                H[3 * i + j] = (gq[j] - g[j]) / hstep;
         }
         for (int i = 0; i < 3; ++i)
-            for (int j = i + 1; j < 3; ++j) {
-                double e[4];
-                for (int s = 0; s < 4; ++s) {
-                    memcpy(q, p, sizeof q);
-                    q[i] += (s & 1 ? -hstep : hstep);
-                    q[j] += (s & 2 ? -hstep : hstep);
-                    e[s] = node_cost(op, v, q, delta);
-                }
-                H[3 * i + j] = H[3 * j + i] = (e[0] - e[1] - e[2] + e[3]) / (4 * hstep * hstep);
-            }
+            for (int j = i + 1; j < 3; ++j)
+                H[3 * i + j] = H[3 * j + i] = 0.5 * (H[3 * i + j] + H[3 * j + i]);
         if (!(isfinite(g[0]) && isfinite(g[1]) && isfinite(g[2]))) break;
         /* Newton direction if H is positive definite (Cholesky), else steepest descent
          * scaled to a tenth of the local length */
