@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define CM_MORPHER_MAX_WARPS 16
+
 struct cm_morpher {
     cm_morph_options opt;
     const cm_cad_model *g; /* borrowed: the geometry the start mesh lies on */
@@ -15,7 +17,13 @@ struct cm_morpher {
     cm_mesh_boundary *b;
     cm_cad_locator *loc; /* on g */
     cm_surface_nodes *nodes;
-    cm_warp *warp[CM_WARP_N_METHODS]; /* on mesh, made when first used */
+    /* warps on mesh, made when first used, one per set of warp options (a study may compare
+     * one method with several settings, e.g. lattice sizes) */
+    struct {
+        cm_warp_options opt;
+        cm_warp *warp;
+    } warps[CM_MORPHER_MAX_WARPS];
+    int n_warps;
     const cm_cad_model *target;       /* the last target (borrowed) and its locator */
     cm_cad_locator *target_loc;
     cm_mesh *work; /* a copy of mesh whose coordinates are the result being measured */
@@ -115,8 +123,9 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
 
 static void drop_warps(cm_morpher *mp)
 {
-    for (int m = 0; m < CM_WARP_N_METHODS; ++m)
-        cm_warp_destroy(&mp->warp[m]);
+    for (int i = 0; i < mp->n_warps; ++i)
+        cm_warp_destroy(&mp->warps[i].warp);
+    mp->n_warps = 0;
 }
 
 void cm_morpher_destroy(cm_morpher **morpher)
@@ -216,18 +225,29 @@ static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
     return CM_OK;
 }
 
-/* The warp of method on the start mesh, made on first use; *t: its factorisation time. */
+/* The warp with options wo on the start mesh, made on first use (options compared bytewise:
+ * cm_warp_options_init zeroes them first); *t: its factorisation time. */
 static cm_status shared_warp(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
                              cm_warp **warp, double *t)
 {
-    cm_warp **slot = &mp->warp[wo->method];
-    if (!*slot) {
-        double t0 = cm_wtime();
-        cm_status s = cm_warp_create(ctx, mp->mesh, mp->b, NULL, wo, slot);
-        if (s < 0) return s;
-        *t = cm_wtime() - t0;
+    for (int i = 0; i < mp->n_warps; ++i)
+        if (!memcmp(&mp->warps[i].opt, wo, sizeof *wo)) {
+            *warp = mp->warps[i].warp;
+            return CM_OK;
+        }
+    if (mp->n_warps == CM_MORPHER_MAX_WARPS) { /* keep the newest: drop the oldest */
+        cm_warp_destroy(&mp->warps[0].warp);
+        memmove(mp->warps, mp->warps + 1, (CM_MORPHER_MAX_WARPS - 1) * sizeof mp->warps[0]);
+        --mp->n_warps;
     }
-    *warp = *slot;
+    double t0 = cm_wtime();
+    cm_warp *w = NULL;
+    cm_status s = cm_warp_create(ctx, mp->mesh, mp->b, NULL, wo, &w);
+    if (s < 0) return s;
+    *t = cm_wtime() - t0;
+    mp->warps[mp->n_warps].opt = *wo;
+    mp->warps[mp->n_warps++].warp = w;
+    *warp = w;
     return CM_OK;
 }
 

@@ -121,8 +121,8 @@ void cm_morpher_destroy(cm_morpher **morpher);
 cm_status cm_morpher_apply(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *target,
                            double *out_xyz, cm_morph_step *out_row);
 
-/* The same with another method; factorisations are kept per warp method, so a study that
- * compares methods factorises each once. */
+/* The same with another method; factorisations are kept per set of warp options (up to 16,
+ * the oldest dropped beyond), so a study that compares methods factorises each once. */
 cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *morpher,
                                   const cm_cad_model *target, const cm_morph_method *method,
                                   double *out_xyz, cm_morph_step *out_row);
