@@ -1,0 +1,176 @@
+/* cadmorph deform: space deformations driven by control points or constrained points.
+ * FFD (free-form deformation) on a tensor-product lattice, uniform cubic B-splines (the
+ * paper shape-deformation-benchmarks-ffd-dmffd-rbf, section 2.1) or Bernstein polynomials
+ * of degree n-1 (PyGeM's FFD); DM-FFD (direct manipulation, section 2.2): the control
+ * displacements that carry given points to given targets in the least-norm / least-squares
+ * sense, through an SVD pseudo-inverse with clamped singular values. Conventions: core.h.
+ *
+ * The lattice maps local coordinates u in [0,1]^3 (the valid domain) to space. Its reference
+ * (undeformed) form is a parallelepiped x = origin + A u, A = [a0 a1 a2] (columns); control
+ * point p = (i, j, k), flat index p = (i n1 + j) n2 + k (C order of an n0 x n1 x n2 array,
+ * as PyGeM's mu arrays), sits at origin + A xi_p, xi the Greville abscissae of the basis:
+ *  - B-spline, uniform knots (default): t_j = (j - 3)/(n - 3), n - 3 spans on [0,1]; the
+ *    abscissae are evenly spaced and reach one spacing outside the domain on each side;
+ *  - B-spline, clamped knots: [0,0,0,0, 1/(n-3), ..., 1,1,1,1]; uneven abscissae at the ends;
+ *  - Bernstein: xi_i = i/(n - 1), evenly spaced over the box (PyGeM's lattice).
+ * With these positions the reference map is exactly affine (linear precision).
+ *
+ * Deformation in displacement form: d(x) = sum_p dc_p N_p(u(x)), so zero control
+ * displacements give d = 0 bitwise. Points whose u lies outside [0,1]^3 by more than 1e-12
+ * get d = 0 exactly and are counted; points within 1e-12 of a face are clamped onto it and
+ * deform (points on the bounding box move: not PyGeM's bug #272).
+ */
+#ifndef CADMORPH_DEFORM_H
+#define CADMORPH_DEFORM_H
+
+#include "cadmorph/core.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum cm_ffd_basis {
+    CM_FFD_BSPLINE = 0,  /* cubic B-splines (needs n >= 4 per axis): local support 4x4x4 */
+    CM_FFD_BERNSTEIN = 1 /* Bernstein of degree n - 1 (n >= 2): global support, PyGeM's */
+} cm_ffd_basis;
+
+typedef enum cm_ffd_knots {
+    CM_FFD_KNOTS_UNIFORM = 0, /* the paper's */
+    CM_FFD_KNOTS_CLAMPED = 1  /* open uniform; at n = 4 the cubic Bernstein basis */
+} cm_ffd_knots;
+
+typedef enum cm_ffd_local {
+    CM_FFD_LOCAL_AUTO = 0,   /* affine for the reference lattice, Newton for a moved one */
+    CM_FFD_LOCAL_AFFINE = 1, /* always u = A^-1 (x - origin) (ignores moved control points) */
+    CM_FFD_LOCAL_NEWTON = 2  /* always Newton from the affine guess (the paper's timing) */
+} cm_ffd_local;
+
+typedef struct cm_ffd_desc {
+    int n[3];           /* control points per axis */
+    cm_ffd_basis basis; /* default CM_FFD_BSPLINE */
+    cm_ffd_knots knots; /* B-spline only; default uniform */
+    double origin[3];   /* the domain corner u = 0 */
+    double axes[9];     /* row-major 3x3; column j is the domain edge a_j (u_j from 0 to 1) */
+} cm_ffd_desc;
+
+/* Defaults: 4x4x4 B-spline with uniform knots on the unit cube. */
+void cm_ffd_desc_init(cm_ffd_desc *desc);
+
+/* A PyGeM box: A = R diag(length), R = Rx Ry Rz of the angles in degrees (right-handed,
+ * applied to column vectors), as PyGeM's angles2matrix(z, y, x). axes: row-major 3x3. */
+void cm_ffd_box_axes(const double length[3], const double angle_deg[3], double axes[9]);
+
+/* A B-spline lattice (uniform knots) whose valid domain is the box bb = {xmin, ymin, zmin,
+ * xmax, ymax, zmax} grown by margin x its diagonal on every side, n control points per axis:
+ * the "DM-FFD-n lattice enclosing the mesh". */
+void cm_ffd_desc_enclosing(cm_ffd_desc *desc, const double bb[6], double margin, int n);
+
+typedef struct cm_ffd cm_ffd;
+
+/* CM_ERR_ARGUMENT for n below the basis' minimum, a singular or non-finite axis matrix, or
+ * more than 2^31 control points. */
+cm_status cm_ffd_create(cm_context *ctx, const cm_ffd_desc *desc, cm_ffd **ffd);
+void cm_ffd_destroy(cm_ffd **ffd);
+
+size_t cm_ffd_control_count(const cm_ffd *ffd);
+/* Reference (or, after cm_ffd_set_control_points, moved) control positions: #ctrl x 3. */
+void cm_ffd_control_points(const cm_ffd *ffd, double *xyz);
+/* A pre-deformed lattice: control positions xyz (#ctrl x 3; NULL restores the reference).
+ * Local coordinates then need Newton's method (CM_FFD_LOCAL_AUTO switches to it). */
+cm_status cm_ffd_set_control_points(cm_context *ctx, cm_ffd *ffd, const double *xyz);
+void cm_ffd_set_local(cm_ffd *ffd, cm_ffd_local mode);
+
+typedef struct cm_ffd_stats {
+    size_t inside, outside; /* points in / out of the lattice */
+    size_t failed;          /* Newton did not converge or met a singular Jacobian (folded) */
+    int max_iterations;     /* Newton steps of the worst point (0 on the affine path) */
+} cm_ffd_stats;
+
+/* Local coordinates of n points (x: n x 3) into u (n x 3) and inside (n flags: 1 inside, 0
+ * outside, 2 failed; may be NULL). Newton (moved lattice): damped steps from the affine
+ * guess, stops at |F| <= 1e-13 x lattice diagonal or |du| <= 1e-15, at most 30 steps.
+ * OpenMP over points. Returns CM_WARNING (message: how many) if any point failed. */
+cm_status cm_ffd_local_coords(cm_context *ctx, const cm_ffd *ffd, size_t n, const double *x,
+                              double *u, unsigned char *inside, cm_ffd_stats *stats);
+
+/* Tensor-product basis at local coordinates u in [0,1]^3: the non-zero N_p into idx/w
+ * (capacity: cm_ffd_support_size), returns their count. */
+size_t cm_ffd_support_size(const cm_ffd *ffd);
+size_t cm_ffd_basis_eval(const cm_ffd *ffd, const double u[3], int64_t *idx, double *w);
+
+/* FFD displacements: d (n x 3) = sum_p dc_p N_p(u(x_i)) for the points x (n x 3), dc:
+ * #ctrl x 3 control displacements. Outside points get 0, failed ones 0 as well (counted,
+ * CM_WARNING). stats may be NULL. */
+cm_status cm_ffd_deform(cm_context *ctx, const cm_ffd *ffd, const double *dc, size_t n,
+                        const double *x, double *d, cm_ffd_stats *stats);
+
+/* ---- DM-FFD ---- */
+
+typedef struct cm_dmffd_options {
+    double eps; /* singular values <= eps * sigma_max are clamped; default 1e-10 */
+    int floor;  /* 0: truncate (1/sigma -> 0, the default); 1: floor (1/max(sigma, tau)) */
+} cm_dmffd_options;
+
+void cm_dmffd_options_init(cm_dmffd_options *opt);
+
+typedef struct cm_dmffd_info {
+    size_t handles;         /* m */
+    size_t active;          /* control points in the support of some handle (SVD columns) */
+    size_t rank;            /* singular values kept (not clamped) */
+    size_t clamped;         /* singular values clamped */
+    double sigma_max, sigma_min;
+    double residual;        /* last solve: |Phi C - H|_inf / |H|_inf (0 if H = 0) */
+    double residual_abs;    /* last solve: |Phi C - H|_inf */
+    double max_control;     /* last solve: max |dc_p| (Euclidean) */
+} cm_dmffd_info;
+
+typedef struct cm_dmffd cm_dmffd;
+
+/* Phi (m handles x control points) at the handle positions (handles: m x 3) and its SVD
+ * (LAPACKE dgesdd, dgesvd if it does not converge) after dropping the columns that no handle
+ * touches. The lattice is borrowed and must outlive the DM-FFD. A handle outside the lattice
+ * (or failed in Newton) is CM_ERR_ARGUMENT naming it. */
+cm_status cm_dmffd_create(cm_context *ctx, const cm_ffd *ffd, size_t m, const double *handles,
+                          const cm_dmffd_options *opt, cm_dmffd **dm);
+void cm_dmffd_destroy(cm_dmffd **dm);
+
+/* C = Phi^+ H: h (m x 3) handle displacements in, dc (#ctrl x 3) control displacements out
+ * (exactly 0 for control points no handle touches). Least norm when under-determined, least
+ * squares when over-determined; the residual goes into the info. */
+cm_status cm_dmffd_solve(cm_context *ctx, cm_dmffd *dm, const double *h, double *dc);
+
+void cm_dmffd_get_info(const cm_dmffd *dm, cm_dmffd_info *info);
+
+/* Eqs. 9-10: B = M Phi^+ (k x m row-major, *b allocated, the caller frees) for the points x
+ * (k x 3), so that the displacements of x for any handle displacements H are B H. Points
+ * outside the lattice get zero rows. */
+cm_status cm_dmffd_precompute(cm_context *ctx, const cm_dmffd *dm, size_t k, const double *x,
+                              double **b);
+
+/* ---- PyGeM parameter files ---- */
+
+/* A PyGeM .prm file (configparser): [Box info] n control points, box length, box origin,
+ * rotation angle (degrees) per axis; [Parameters weights] parameter x|y|z lines "i j k mu".
+ * mu: n0 n1 n2 x 3 (index (i n1 + j) n2 + k), normalised by the box lengths in the box frame,
+ * as PyGeM: the physical displacement is R diag(length) mu. */
+typedef struct cm_ffd_prm {
+    int n[3];
+    double length[3], origin[3], angle[3];
+    double *mu;
+} cm_ffd_prm;
+
+/* Errors name path:line: CM_ERR_IO (missing file: unlike PyGeM, nothing is written),
+ * CM_ERR_FORMAT (missing key or section, a value that is not a number, an index out of
+ * range, fewer than 4 numbers on a weight line). */
+cm_status cm_ffd_prm_read(cm_context *ctx, const char *path, cm_ffd_prm *prm);
+void cm_ffd_prm_free(cm_ffd_prm *prm);
+
+/* The lattice of a .prm: the box as the domain (origin, R diag(length)), n per axis, the
+ * given basis (Bernstein: PyGeM's map; B-spline: uniform knots on the box as the domain).
+ * dc (may be NULL): #ctrl x 3 physical control displacements R diag(length) mu. */
+void cm_ffd_prm_desc(const cm_ffd_prm *prm, cm_ffd_basis basis, cm_ffd_desc *desc, double *dc);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
