@@ -9,6 +9,7 @@ packages=(
   libocct-data-exchange-dev libocct-ocaf-dev
   libflann-dev libtet1.5-dev liblapacke-dev libopenblas-dev zlib1g-dev
   gmsh python3-gmsh python3-numpy python3-scipy python3-vtk9 python3-meshio
+  python3-matplotlib  # imported by PyGeM, for tests/data/deform/make_pygem_fixture.py
 )
 
 missing=()

@@ -9,17 +9,17 @@
 
 /* xorshift64*: the same numbers on every machine */
 static uint64_t test_rng_state = 0x9E3779B97F4A7C15ull;
-static double urand(void)
+static inline double urand(void)
 {
     test_rng_state ^= test_rng_state >> 12;
     test_rng_state ^= test_rng_state << 25;
     test_rng_state ^= test_rng_state >> 27;
     return (double)((test_rng_state * 2685821657736338717ull) >> 11) * (1.0 / 9007199254740992.0);
 }
-static double urange(double a, double b) { return a + (b - a) * urand(); }
+static inline double urange(double a, double b) { return a + (b - a) * urand(); }
 
 /* A rotated, non-axis-aligned lattice: origin o, axes R diag(L) with R from angles. */
-static void rotated_desc(cm_ffd_desc *d, int n, cm_ffd_basis basis, cm_ffd_knots knots)
+static inline void rotated_desc(cm_ffd_desc *d, int n, cm_ffd_basis basis, cm_ffd_knots knots)
 {
     cm_ffd_desc_init(d);
     d->n[0] = d->n[1] = d->n[2] = n;
@@ -33,7 +33,7 @@ static void rotated_desc(cm_ffd_desc *d, int n, cm_ffd_basis basis, cm_ffd_knots
 }
 
 /* x = origin + A s */
-static void desc_point(const cm_ffd_desc *d, const double s[3], double x[3])
+static inline void desc_point(const cm_ffd_desc *d, const double s[3], double x[3])
 {
     for (int r = 0; r < 3; ++r)
         x[r] = d->origin[r] + d->axes[3 * r] * s[0] + d->axes[3 * r + 1] * s[1] +
@@ -41,7 +41,7 @@ static void desc_point(const cm_ffd_desc *d, const double s[3], double x[3])
 }
 
 /* x(u) = sum_p c_p N_p(u) from the public basis (ctrl: #ctrl x 3) */
-static void lattice_point(const cm_ffd *f, const double *ctrl, const double u[3], double x[3])
+static inline void lattice_point(const cm_ffd *f, const double *ctrl, const double u[3], double x[3])
 {
     size_t cap = cm_ffd_support_size(f);
     int64_t *idx = malloc(cap * sizeof *idx);
