@@ -10,7 +10,7 @@
 
 static const char *const usage_line =
     "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
-    "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] "
+    "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--lattice N] "
     "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
     "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
 
@@ -46,6 +46,10 @@ static void print_help(void)
         "  --surface S          rbf (parameter warp, default) or project (closest point)\n"
         "  --method M           interior warp: %s (default rbf)\n"
         "  --kernel K           triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)\n"
+        "  --lattice N          dmffd: control points per axis of the B-spline lattice on the\n"
+        "                       mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
+        "                       is least squares: the boundary keeps its motion exactly, the\n"
+        "                       interior follows a space map that misses it (residual)\n"
         "  --report R.csv       one row per step: quality, distance to G1, stage times\n"
         "  --fail-on-inverted   exit 3 without writing M1 if a cell is inverted\n"
         "  --cad-unit U         unit of the mesh coordinates: the STEP files are converted to\n"
@@ -132,6 +136,14 @@ static int parse_args(int argc, char **argv, morph_args *a)
                 a->opt.method.warp.method = CM_WARP_RBF_BIHARMONIC;
             else
                 return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
+        } else if (!strcmp(o, "--lattice")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            char *end;
+            long n = strtol(v, &end, 10);
+            if (end == v || *end || n < 4 || n > 200)
+                return cli_usage(cmd, usage_line,
+                                 "--lattice: expected 4..200 control points per axis, got '%s'", v);
+            a->opt.method.warp.lattice = (int)n;
         } else if (!strcmp(o, "--method")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             int m = cm_warp_method_from_name(v);

@@ -10,6 +10,7 @@
 static const cm_warp_method_ops *const methods[CM_WARP_N_METHODS] = {
     [CM_WARP_RBF] = &cm_warp_rbf_triharmonic,
     [CM_WARP_RBF_BIHARMONIC] = &cm_warp_rbf_biharmonic,
+    [CM_WARP_DMFFD] = &cm_warp_dmffd,
 };
 
 struct cm_warp {

@@ -19,5 +19,7 @@ typedef struct cm_warp_method_ops {
 /* The RBF methods (warp_rbf.c). */
 extern const cm_warp_method_ops cm_warp_rbf_triharmonic;
 extern const cm_warp_method_ops cm_warp_rbf_biharmonic;
+/* DM-FFD (warp_dmffd.c). */
+extern const cm_warp_method_ops cm_warp_dmffd;
 
 #endif

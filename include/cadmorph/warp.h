@@ -25,6 +25,8 @@ extern "C" {
 typedef enum cm_warp_method {
     CM_WARP_RBF = 0,            /* "rbf": triharmonic RBF, phi = r^3 + linear (the method) */
     CM_WARP_RBF_BIHARMONIC = 1, /* "rbf-biharmonic": phi = r + linear (the paper's comparison) */
+    CM_WARP_DMFFD,              /* "dmffd": DM-FFD on a cubic B-spline lattice around the mesh
+                                   (least squares: see cm_warp_residual) */
     CM_WARP_N_METHODS
 } cm_warp_method;
 
@@ -37,6 +39,11 @@ const char *cm_warp_method_list(void);
 
 typedef struct cm_warp_options {
     cm_warp_method method; /* default CM_WARP_RBF */
+    /* DM-FFD: control points per axis of the lattice whose domain is the mesh's bounding box
+     * (grown by 1e-3 of its diagonal): 5, 10, 15, 25 in the paper; 0 = 10 */
+    int lattice;
+    /* DM-FFD: singular values <= clamp x sigma_max are truncated; 0 = 1e-10 */
+    double clamp;
 } cm_warp_options;
 
 void cm_warp_options_init(cm_warp_options *opt);
