@@ -57,5 +57,6 @@ int cli_cmd_morph(int argc, char **argv);
 int cli_cmd_sweep(int argc, char **argv);
 int cli_cmd_demo(int argc, char **argv);
 int cli_cmd_optimize(int argc, char **argv);
+int cli_cmd_ffd(int argc, char **argv);
 
 #endif

@@ -16,6 +16,7 @@ static const cli_command commands[] = {
     {"demo", cli_cmd_demo, "the embedded example: bore model, tet mesh, 10-step absolute sweep"},
     {"quality", cli_cmd_quality, "scaled Jacobian report of a mesh"},
     {"warp", cli_cmd_warp, "move interior nodes by an RBF warp of given boundary displacements"},
+    {"ffd", cli_cmd_ffd, "free-form deformation of a mesh by a control lattice (PyGeM .prm accepted)"},
     {"mesh", cli_cmd_mesh, "tet mesh of a STEP solid (OpenCASCADE surface + TetGen)"},
     {"optimize", cli_cmd_optimize, "move interior nodes to untangle and raise the worst cells"},
     {"info", cli_cmd_info, "topology summary of a STEP file, correspondence with another"},

@@ -170,6 +170,14 @@ void cm_ffd_prm_free(cm_ffd_prm *prm);
  * dc (may be NULL): #ctrl x 3 physical control displacements R diag(length) mu. */
 void cm_ffd_prm_desc(const cm_ffd_prm *prm, cm_ffd_basis basis, cm_ffd_desc *desc, double *dc);
 
+/* The control-displacement table of `cadmorph ffd`: header `i,j,k,dx,dy,dz`, one row per
+ * moved control point (0-based lattice indices), physical displacements in the world frame.
+ * dc: #ctrl x 3 output (zeroed first); listed: #ctrl flags (may be NULL). Errors name
+ * path:line: CM_ERR_FORMAT (header, column count, number), CM_ERR_MISMATCH (index outside
+ * the n[0] x n[1] x n[2] lattice, a point listed twice). */
+cm_status cm_ffd_read_displacements(cm_context *ctx, const char *path, const int n[3],
+                                    double *dc, unsigned char *listed);
+
 #ifdef __cplusplus
 }
 #endif
