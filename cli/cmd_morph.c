@@ -10,7 +10,8 @@
 
 static const char *const usage_line =
     "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
-    "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--lattice N] "
+    "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] "
+    "[--lattice N [--clamp E]] "
     "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
     "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
 
@@ -50,6 +51,8 @@ static void print_help(void)
         "                       mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
         "                       is least squares: the boundary keeps its motion exactly, the\n"
         "                       interior follows a space map that misses it (residual)\n"
+        "  --clamp E            dmffd: singular values <= E x the largest are dropped\n"
+        "                       (default 1e-10; 1e-2 keeps coarse lattices usable)\n"
         "  --report R.csv       one row per step: quality, distance to G1, stage times\n"
         "  --fail-on-inverted   exit 3 without writing M1 if a cell is inverted\n"
         "  --cad-unit U         unit of the mesh coordinates: the STEP files are converted to\n"
@@ -136,6 +139,14 @@ static int parse_args(int argc, char **argv, morph_args *a)
                 a->opt.method.warp.method = CM_WARP_RBF_BIHARMONIC;
             else
                 return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
+        } else if (!strcmp(o, "--clamp")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            char *end;
+            double e = strtod(v, &end);
+            if (end == v || *end || !(e > 0 && e < 1))
+                return cli_usage(cmd, usage_line, "--clamp: expected a number in (0, 1), got '%s'",
+                                 v);
+            a->opt.method.warp.clamp = e;
         } else if (!strcmp(o, "--lattice")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             char *end;

@@ -9,7 +9,8 @@
 #include <string.h>
 
 static const char *const usage_line =
-    "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] [--lattice N] [--optimize] "
+    "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] "
+    "[--lattice N [--clamp E]] [--optimize] "
     "[--threads N] [--verbose]";
 
 static void print_help(void)
@@ -36,6 +37,8 @@ static void print_help(void)
         "                       mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
         "                       is least squares: the boundary keeps its motion exactly, the\n"
         "                       interior follows a space map that misses it (--verbose)\n"
+        "  --clamp E            dmffd: singular values <= E x the largest are dropped\n"
+        "                       (default 1e-10; 1e-2 keeps coarse lattices usable)\n"
         "  --threads N          threads for evaluation and quality (default: all)\n"
         "  --verbose            debug messages on stderr\n\n"
         "exit codes: 0 done, 1 usage, 2 bad input (malformed file, degenerate boundary).\n",
@@ -46,6 +49,7 @@ typedef struct warp_args {
     const char *mesh, *csv, *out;
     cm_warp_method method;
     int threads, verbose, optimize, lattice;
+    double clamp;
 } warp_args;
 
 /* Returns -1 to go on, else the exit code. */
@@ -77,6 +81,14 @@ static int parse_args(int argc, char **argv, warp_args *a)
                 a->method = CM_WARP_RBF_BIHARMONIC;
             else
                 return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
+        } else if (!strcmp(o, "--clamp")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            char *end;
+            double e = strtod(v, &end);
+            if (end == v || *end || !(e > 0 && e < 1))
+                return cli_usage(cmd, usage_line, "--clamp: expected a number in (0, 1), got '%s'",
+                                 v);
+            a->clamp = e;
         } else if (!strcmp(o, "--lattice")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             char *end;
@@ -133,6 +145,7 @@ int cli_cmd_warp(int argc, char **argv)
     cm_warp_options_init(&opt);
     opt.method = a.method;
     opt.lattice = a.lattice;
+    opt.clamp = a.clamp;
     cm_warp_mesh_stats st;
     if (s >= 0) {
         cm_optimize_options oo;

@@ -116,6 +116,10 @@ cm_status cm_ffd_create(cm_context *ctx, const cm_ffd_desc *desc, cm_ffd **ffd)
     if (!ffd) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_ffd_create: ffd is NULL");
     *ffd = NULL;
     if (!desc) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_ffd_create: desc is NULL");
+    if (desc->knots != CM_FFD_KNOTS_UNIFORM && desc->knots != CM_FFD_KNOTS_CLAMPED &&
+        desc->knots != CM_FFD_KNOTS_CUSTOM)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_ffd_create: unknown knot kind %d",
+                        (int)desc->knots);
     if (desc->basis != CM_FFD_BSPLINE && desc->basis != CM_FFD_BERNSTEIN)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_ffd_create: unknown basis %d",
                         (int)desc->basis);
@@ -175,6 +179,24 @@ cm_status cm_ffd_create(cm_context *ctx, const cm_ffd_desc *desc, cm_ffd **ffd)
             continue;
         }
         double *t = f->knot[a];
+        if (f->knots == CM_FFD_KNOTS_CUSTOM) {
+            const double *g = desc->knot[a];
+            int ok = g != NULL;
+            for (int j = 0; ok && j < n + 4; ++j)
+                ok = isfinite(g[j]) && (j == 0 || g[j] >= g[j - 1]) &&
+                     (j <= 3 || j > n || g[j] > g[j - 1]);
+            if (!ok || g[3] != 0 || g[n] != 1) {
+                cm_ffd_destroy(&f);
+                return cm_error(ctx, CM_ERR_ARGUMENT,
+                                "cm_ffd_create: axis %d: custom knots must be %d non-decreasing "
+                                "values with t_3 = 0, t_%d = 1 and no repeated knot inside",
+                                a, n + 4, n);
+            }
+            memcpy(t, g, (size_t)(n + 4) * sizeof *t);
+            for (int i = 0; i < n; ++i)
+                f->xi[a][i] = (t[i + 1] + t[i + 2] + t[i + 3]) / 3;
+            continue;
+        }
         for (int j = 0; j < n + 4; ++j) {
             double v = (double)(j - 3) / (n - 3);
             if (f->knots == CM_FFD_KNOTS_CLAMPED) v = j < 3 ? 0 : j > n ? 1 : v;
@@ -294,6 +316,19 @@ int cm_ffd_axis_basis(const cm_ffd *f, int a, double t, double *nv, double *dn, 
     /* span s with t_s <= t < t_{s+1}; t = 1 closes the last span (and only it) */
     double ts = floor(t * (n - 3));
     int s = ts < 0 ? 3 : ts >= n - 3 ? n - 1 : 3 + (int)ts;
+    if (f->knots == CM_FFD_KNOTS_CUSTOM) {
+        /* binary search for t_s <= t < t_{s+1} in [3, n-1]; t >= 1 closes the last span */
+        int lo = 3, hi = n - 1;
+        if (!(t < 1)) lo = n - 1;
+        while (lo < hi) {
+            int mid = (lo + hi + 1) / 2;
+            if (kn[mid] <= t)
+                lo = mid;
+            else
+                hi = mid - 1;
+        }
+        s = lo;
+    }
     *count = 4;
     if (f->knots == CM_FFD_KNOTS_UNIFORM) {
         /* the closed form of the uniform cubic (fewer roundings than Cox-de Boor) */

@@ -504,6 +504,173 @@ static void block_smooth(void)
     bench_surface_free(&s);
 }
 
+/* ---- block 4: adaptivity (Fig. 12) ---- */
+
+/* The target: a plane z = 0 on [0,1]^2 pushed into a steep bump 0.2 high (sigma ~0.055). */
+static double bump(double x, double y)
+{
+    return 0.2 * exp(-((x - 0.5) * (x - 0.5) + (y - 0.5) * (y - 0.5)) / 0.006);
+}
+
+/* Knot vector of n + 4 entries from the m + 1 domain knots g (0 = g_0 < ... < g_m = 1,
+ * m = n - 3 spans), extended by the end spans' widths. */
+static void full_knots(const double *g, int spans, double *t)
+{
+    double h0 = g[1] - g[0], h1 = g[spans] - g[spans - 1];
+    for (int j = 0; j < 3; ++j) {
+        t[j] = -(3 - j) * h0;
+        t[spans + 4 + j] = 1 + (j + 1) * h1;
+    }
+    for (int j = 0; j <= spans; ++j)
+        t[3 + j] = g[j];
+}
+
+static void block_adapt(void)
+{
+    const int side = 41;
+    const size_t nv = (size_t)side * side;
+    double *x = malloc(nv * 3 * sizeof *x), *hd = malloc(nv * 3 * sizeof *hd);
+    double *d = malloc(nv * 3 * sizeof *d);
+    for (int j = 0; j < side; ++j)
+        for (int i = 0; i < side; ++i) {
+            size_t v = (size_t)j * side + i;
+            x[3 * v] = (double)i / (side - 1);
+            x[3 * v + 1] = (double)j / (side - 1);
+            x[3 * v + 2] = 0;
+            hd[3 * v] = hd[3 * v + 1] = 0;
+            hd[3 * v + 2] = bump(x[3 * v], x[3 * v + 1]);
+        }
+    FILE *csv = out_csv("adapt.csv");
+    fprintf(csv, "method,dof,error_rel\n");
+    printf("block 4 (adaptivity): plane %dx%d vertices, all constraints, bump 0.2 high; "
+           "error = max |d - target| / 0.2 over the vertices\n",
+           side, side);
+    /* DM-FFD: domain knots in x and y, 4 control points in z; insert a knot in x and y at the
+     * middle of the spans holding the worst vertex, until DoF >= #constraints */
+    double gx[256] = {0, 1}, gy[256] = {0, 1};
+    int sx = 1, sy = 1;
+    const double eps = 1e-6;
+    for (int it = 0; it < 200; ++it) {
+        double tx[260], ty[260];
+        static const double tz[8] = {-3, -2, -1, 0, 1, 2, 3, 4};
+        full_knots(gx, sx, tx);
+        full_knots(gy, sy, ty);
+        cm_ffd_desc desc;
+        cm_ffd_desc_init(&desc);
+        desc.knots = CM_FFD_KNOTS_CUSTOM;
+        desc.n[0] = sx + 3;
+        desc.n[1] = sy + 3;
+        desc.n[2] = 4;
+        desc.knot[0] = tx;
+        desc.knot[1] = ty;
+        desc.knot[2] = tz;
+        desc.origin[0] = desc.origin[1] = -eps;
+        desc.origin[2] = -0.5;
+        desc.axes[0] = desc.axes[4] = 1 + 2 * eps;
+        desc.axes[8] = 1;
+        cm_ffd *f = NULL;
+        die(cm_ffd_create(ctx, &desc, &f), "lattice");
+        size_t nc = cm_ffd_control_count(f);
+        double *dc = malloc(nc * 3 * sizeof *dc);
+        cm_dmffd *dm = NULL;
+        die(cm_dmffd_create(ctx, f, nv, x, NULL, &dm), "dmffd");
+        die(cm_dmffd_solve(ctx, dm, hd, dc), "solve");
+        die(cm_ffd_deform(ctx, f, dc, nv, x, d, NULL), "deform");
+        cm_dmffd_info info;
+        cm_dmffd_get_info(dm, &info);
+        double err = 0;
+        size_t worst = 0;
+        for (size_t v = 0; v < nv; ++v) {
+            double e = fabs(d[3 * v + 2] - hd[3 * v + 2]);
+            if (e > err) {
+                err = e;
+                worst = v;
+            }
+        }
+        /* the plane sees the 4 z-layers only through one fixed combination: DoF = one layer */
+        size_t dof = (size_t)(sx + 3) * (sy + 3);
+        printf("DM-FFD  DoF %5zu (%d x %d x 4 control points, rank %zu)  error %.4e\n", dof,
+               sx + 3, sy + 3, info.rank, err / 0.2);
+        fprintf(csv, "dmffd,%zu,%.6e\n", dof, err / 0.2);
+        cm_dmffd_destroy(&dm);
+        free(dc);
+        cm_ffd_destroy(&f);
+        if (dof >= nv || sx >= 250 || sy >= 250) break;
+        /* refine: the spans (in x and in y) that hold the worst vertex */
+        double wx = (x[3 * worst] + eps) / (1 + 2 * eps), wy = (x[3 * worst + 1] + eps) / (1 + 2 * eps);
+        int kx = 0, ky = 0;
+        while (kx + 1 < sx && gx[kx + 1] <= wx)
+            ++kx;
+        while (ky + 1 < sy && gy[ky + 1] <= wy)
+            ++ky;
+        memmove(gx + kx + 2, gx + kx + 1, (size_t)(sx - kx) * sizeof *gx);
+        gx[kx + 1] = (gx[kx] + gx[kx + 2]) / 2;
+        ++sx;
+        memmove(gy + ky + 2, gy + ky + 1, (size_t)(sy - ky) * sizeof *gy);
+        gy[ky + 1] = (gy[ky] + gy[ky + 2]) / 2;
+        ++sy;
+    }
+    /* RBF, greedy (Schaback-Wendland): start from 3 corners, add the worst vertices (one at a
+     * time up to 100 centres, then 10 % more per round), refit from scratch. The vertices are
+     * coplanar, so the RBF is the 2D thin-plate spline (r^2 log r + linear) in (x, y): the 3D
+     * triharmonic one has no unisolvent polynomial block on a plane. */
+    unsigned char *is_c = calloc(nv, 1);
+    size_t *cent = malloc(nv * sizeof *cent), mc = 0;
+    size_t corners[3] = {0, (size_t)side - 1, nv - 1};
+    for (int i = 0; i < 3; ++i) {
+        cent[mc++] = corners[i];
+        is_c[corners[i]] = 1;
+    }
+    double *c2 = malloc(nv * 2 * sizeof *c2), *val = malloc(nv * sizeof *val);
+    double *p2 = malloc(nv * 2 * sizeof *p2), *out = malloc(nv * sizeof *out);
+    double *e = malloc(nv * sizeof *e);
+    for (size_t v = 0; v < nv; ++v) {
+        p2[2 * v] = x[3 * v];
+        p2[2 * v + 1] = x[3 * v + 1];
+    }
+    for (;;) {
+        for (size_t i = 0; i < mc; ++i) {
+            c2[2 * i] = p2[2 * cent[i]];
+            c2[2 * i + 1] = p2[2 * cent[i] + 1];
+            val[i] = hd[3 * cent[i] + 2];
+        }
+        cm_rbf *rbf = NULL;
+        die(cm_rbf_create(ctx, CM_RBF_THIN_PLATE, 2, mc, c2, &rbf), "rbf");
+        die(cm_rbf_solve(ctx, rbf, 1, val), "rbf");
+        die(cm_rbf_evaluate(ctx, rbf, nv, p2, out), "rbf");
+        cm_rbf_destroy(&rbf);
+        double err = 0;
+        for (size_t v = 0; v < nv; ++v) {
+            e[v] = is_c[v] ? -1 : fabs(out[v] - hd[3 * v + 2]);
+            err = fmax(err, fabs(out[v] - hd[3 * v + 2]));
+        }
+        printf("RBF     DoF %5zu  error %.4e\n", mc, err / 0.2);
+        fprintf(csv, "rbf,%zu,%.6e\n", mc, err / 0.2);
+        if (mc >= nv || err / 0.2 < 1e-9) break;
+        size_t add = mc < 100 ? 1 : mc / 10;
+        for (size_t a = 0; a < add && mc < nv; ++a) {
+            size_t best = 0;
+            for (size_t v = 1; v < nv; ++v)
+                if (e[v] > e[best]) best = v;
+            if (e[best] < 0) break;
+            cent[mc++] = best;
+            is_c[best] = 1;
+            e[best] = -1;
+        }
+    }
+    fclose(csv);
+    free(x);
+    free(hd);
+    free(d);
+    free(is_c);
+    free(cent);
+    free(c2);
+    free(val);
+    free(p2);
+    free(out);
+    free(e);
+}
+
 /* ---- block 6: volume morphing (Fig. 13-14) ---- */
 
 static cm_quality_stats quality_of(cm_mesh *m, const double *xyz)
@@ -546,12 +713,14 @@ static void block_volume(int argc, char **argv)
     bbox_of(nn, m0->xyz, bb);
     double diag = cm_bbox_diagonal(bb);
     char name[256];
-    snprintf(name, sizeof name, "volume_%s.csv", tag);
+    snprintf(name, sizeof name, "volume_%s%s%s.csv", tag, getenv("BENCH_EPS") ? "_eps" : "",
+             getenv("BENCH_EPS") ? getenv("BENCH_EPS") : "");
     FILE *csv = out_csv(name);
     fprintf(csv, "mesh,method,lattice,t,min_sj,inverted,min_sj_pure,inverted_pure,"
-                 "boundary_err_rel,residual_rel,t_create,t_apply\n");
+                 "boundary_err_rel,residual_rel,t_create,t_apply,max_dc\n");
+    setvbuf(stdout, NULL, _IOLBF, 0);
     printf("block 6 (volume): %s, %zu nodes, %zu boundary nodes, %zu cells; boundary error = "
-           "max |DM-FFD(b) - G(t) target| / diagonal %.4g\n",
+           "max |DM-FFD(b) - G(t) target| / the diagonal %.4g\n",
            tag, nn, m, m0->n_cells, diag);
     printf("%-9s %4s %12s %8s %12s %8s %12s %10s %9s\n", "method", "t", "min SJ", "inverted",
            "min SJ pure", "inv pure", "bnd err/diag", "residual", "create s");
@@ -559,15 +728,26 @@ static void block_volume(int argc, char **argv)
         cm_quality_stats q = quality_of(m0, target[i]);
         printf("%-9s %4.2f %12.5f %8zu %12s %8s %12s %10s %9s\n", "rbf-s", t[i], q.min,
                q.inverted, "-", "-", "0", "0", "-");
-        fprintf(csv, "%s,rbf-s,0,%g,%.6g,%zu,%.6g,%zu,0,0,0,0\n", tag, t[i], q.min, q.inverted,
+        fprintf(csv, "%s,rbf-s,0,%g,%.6g,%zu,%.6g,%zu,0,0,0,0,0\n", tag, t[i], q.min, q.inverted,
                 q.min, q.inverted);
     }
     double *h = malloc(m * 3 * sizeof *h), *hd = malloc(m * 3 * sizeof *hd);
     double *d = malloc(nn * 3 * sizeof *d), *xyz = malloc(nn * 3 * sizeof *xyz);
     for (size_t i = 0; i < m; ++i)
         memcpy(h + 3 * i, m0->xyz + 3 * b->nodes[i], 3 * sizeof *h);
-    int lats[4] = {5, 10, 15, 25};
-    for (int li = 0; li < 4; ++li) {
+    /* BENCH_LATTICES (e.g. "5,10") and BENCH_EPS (the clamping value) vary the defaults */
+    int lats[8] = {5, 10, 15, 25}, nl = 4;
+    const char *env = getenv("BENCH_LATTICES");
+    if (env) {
+        nl = 0;
+        for (const char *p = env; *p && nl < 8; p = strchr(p, ',') ? strchr(p, ',') + 1 : "")
+            lats[nl++] = atoi(p);
+    }
+    cm_dmffd_options dopt;
+    cm_dmffd_options_init(&dopt);
+    if (getenv("BENCH_EPS")) dopt.eps = atof(getenv("BENCH_EPS"));
+    printf("clamping eps %g\n", dopt.eps);
+    for (int li = 0; li < nl; ++li) {
         cm_ffd_desc desc;
         cm_ffd_desc_enclosing(&desc, bb, 1e-3, lats[li]); /* as volume/warp_dmffd.c */
         cm_ffd *f = NULL;
@@ -575,7 +755,7 @@ static void block_volume(int argc, char **argv)
         double *dc = malloc(cm_ffd_control_count(f) * 3 * sizeof *dc);
         cm_dmffd *dm = NULL;
         double t0 = cm_wtime();
-        cm_status st = cm_dmffd_create(ctx, f, m, h, NULL, &dm);
+        cm_status st = cm_dmffd_create(ctx, f, m, h, &dopt, &dm);
         double tc = cm_wtime() - t0;
         if (st < 0) {
             printf("dmffd-%-3d: %s\n", lats[li], cm_context_message(ctx));
@@ -611,11 +791,12 @@ static void block_volume(int argc, char **argv)
             cm_quality_stats qe = quality_of(m0, xyz);
             char meth[32];
             snprintf(meth, sizeof meth, "dmffd-%d", lats[li]);
-            printf("%-9s %4.2f %12.5f %8zu %12.5f %8zu %12.4e %10.3e %9.2f\n", meth, t[i], qe.min,
-                   qe.inverted, qp.min, qp.inverted, berr / diag, info.residual, tc);
-            fprintf(csv, "%s,dmffd,%d,%g,%.6g,%zu,%.6g,%zu,%.6e,%.6e,%.3f,%.3f\n", tag, lats[li],
-                    t[i], qe.min, qe.inverted, qp.min, qp.inverted, berr / diag, info.residual, tc,
-                    ta);
+            printf("%-9s %4.2f %12.5f %8zu %12.5f %8zu %12.4e %10.3e %9.2f  max|dc| %.3g\n", meth,
+                   t[i], qe.min, qe.inverted, qp.min, qp.inverted, berr / diag, info.residual, tc,
+                   info.max_control);
+            fprintf(csv, "%s,dmffd,%d,%g,%.6g,%zu,%.6g,%zu,%.6e,%.6e,%.3f,%.3f,%.6g\n", tag,
+                    lats[li], t[i], qe.min, qe.inverted, qp.min, qp.inverted, berr / diag,
+                    info.residual, tc, ta, info.max_control);
         }
         cm_dmffd_info info;
         cm_dmffd_get_info(dm, &info);
@@ -642,7 +823,7 @@ static void block_volume(int argc, char **argv)
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(stderr, "usage: bench_deform perf|precision|robust|smooth|all OUTDIR [threads]\n"
+        fprintf(stderr, "usage: bench_deform perf|precision|robust|smooth|adapt|all OUTDIR [threads]\n"
                         "       bench_deform volume OUTDIR TAG M0 T:MT ...\n");
         return 1;
     }
@@ -654,6 +835,7 @@ int main(int argc, char **argv)
     if (all || !strcmp(argv[1], "precision")) block_precision();
     if (all || !strcmp(argv[1], "robust")) block_robust();
     if (all || !strcmp(argv[1], "smooth")) block_smooth();
+    if (all || !strcmp(argv[1], "adapt")) block_adapt();
     if (!strcmp(argv[1], "volume")) {
         if (argc < 6) {
             fprintf(stderr, "usage: bench_deform volume OUTDIR TAG M0 T:MT...\n");

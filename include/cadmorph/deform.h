@@ -36,7 +36,8 @@ typedef enum cm_ffd_basis {
 
 typedef enum cm_ffd_knots {
     CM_FFD_KNOTS_UNIFORM = 0, /* the paper's */
-    CM_FFD_KNOTS_CLAMPED = 1  /* open uniform; at n = 4 the cubic Bernstein basis */
+    CM_FFD_KNOTS_CLAMPED = 1, /* open uniform; at n = 4 the cubic Bernstein basis */
+    CM_FFD_KNOTS_CUSTOM = 2   /* given per axis in cm_ffd_desc.knot (adaptive refinement) */
 } cm_ffd_knots;
 
 typedef enum cm_ffd_local {
@@ -51,6 +52,9 @@ typedef struct cm_ffd_desc {
     cm_ffd_knots knots; /* B-spline only; default uniform */
     double origin[3];   /* the domain corner u = 0 */
     double axes[9];     /* row-major 3x3; column j is the domain edge a_j (u_j from 0 to 1) */
+    /* CM_FFD_KNOTS_CUSTOM: n[a] + 4 knots per axis (copied by create), non-decreasing, with
+     * t_3 = 0, t_n = 1 and t_3 < t_4 < ... < t_n (no repeated knot inside the domain) */
+    const double *knot[3];
 } cm_ffd_desc;
 
 /* Defaults: 4x4x4 B-spline with uniform knots on the unit cube. */

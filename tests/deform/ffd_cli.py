@@ -8,6 +8,9 @@
 3. --displacements (physical units) and --basis bspline.
 4. Error paths: missing .prm (exit 2, nothing written there), unknown basis (exit 1),
    a B-spline lattice with 3 points per axis (exit 2), a bad CSV row (exit 2 with file:line).
+5. `cadmorph warp --method dmffd --lattice 5 --clamp 1e-2`: a valid mesh, the residual in the
+   debug line, constrained nodes at their motion; the default clamping gives a worse mesh;
+   --lattice 3 is a usage error.
 """
 import os
 import subprocess
@@ -117,4 +120,38 @@ write_prm(prm, n4, list(lo), list(L), [0.0, 0.0, 0.0], [np.zeros(n4)] * 3)
 rc, so, se = run("--mesh", mesh_path, "--lattice", prm, "--displacements", csv, "-o", out)
 check(rc == 2 and "ctrl.csv:66:" in se and len(se.strip().splitlines()) == 1,
       "bad csv row: exit %d, %s" % (rc, se.strip()))
+
+# 5. the DM-FFD interior warp through `cadmorph warp --method dmffd --lattice N`
+dcsv = os.path.join(WORK, "warp_disp.csv")
+face = np.where(np.abs(m.points[:, 0] - hi[0]) < 1e-9)[0]
+with open(dcsv, "w") as f:
+    f.write("node,dx,dy,dz\n")
+    for v in face:
+        f.write("%d,%r,0,0\n" % (v, 0.02 * L[0]))
+out = os.path.join(WORK, "warp_dmffd.vtu")
+def min_sj(text):
+    last = text.strip().splitlines()[-1]
+    return float(last.split()[0].split("=")[1]), int(last.split()[2].split("=")[1])
+
+
+# clamping 1e-2 keeps the coarse lattice's least-squares map tame (no inverted cell here);
+# the default 1e-10 keeps tiny singular values and does worse: the paper's Fig. 8 in a mesh
+p = subprocess.run([CM, "warp", "--mesh", mesh_path, "--displacements", dcsv, "-o", out,
+                    "--method", "dmffd", "--lattice", "5", "--clamp", "1e-2", "--verbose"],
+                   capture_output=True, text=True)
+check(p.returncode == 0 and min_sj(p.stdout)[1] == 0,
+      "warp --method dmffd --clamp 1e-2: exit %d, %s" % (p.returncode,
+                                                        p.stdout.strip().splitlines()[-1:]))
+check("residual at the constrained nodes" in p.stderr, "the residual is reported (--verbose)")
+if p.returncode == 0:
+    got = meshio.read(out).points
+    err = np.abs(got[face, 0] - m.points[face, 0] - 0.02 * L[0]).max()
+    check(err <= 1e-12, "constrained nodes keep their prescribed motion (%.3g)" % err)
+    q = subprocess.run([CM, "warp", "--mesh", mesh_path, "--displacements", dcsv, "-o", out,
+                        "--method", "dmffd", "--lattice", "5"], capture_output=True, text=True)
+    check(q.returncode == 0 and min_sj(q.stdout)[0] < min_sj(p.stdout)[0],
+          "default clamping 1e-10: min SJ %s < %s" % (min_sj(q.stdout)[0], min_sj(p.stdout)[0]))
+p = subprocess.run([CM, "warp", "--mesh", mesh_path, "--displacements", dcsv, "-o", out,
+                    "--method", "dmffd", "--lattice", "3"], capture_output=True, text=True)
+check(p.returncode == 1, "--lattice 3: exit %d" % p.returncode)
 sys.exit(1 if failures else 0)

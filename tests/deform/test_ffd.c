@@ -420,6 +420,54 @@ static void test_continuity(void)
     cm_ffd_destroy(&f);
 }
 
+/* Custom (refined, non-uniform) knots: partition of unity and linear precision still hold,
+ * so the reference map stays affine and local coordinates exact. */
+static void test_custom_knots(void)
+{
+    /* n = 7: interior knots 0, 0.1, 0.15, 0.5, 1 plus end extensions */
+    static const double kx[11] = {-0.3, -0.2, -0.1, 0, 0.1, 0.15, 0.5, 1, 1.5, 2, 2.5};
+    static const double ky[8] = {-3, -2, -1, 0, 1, 2, 3, 4}; /* n = 4: one span */
+    static const double kz[9] = {-0.6, -0.4, -0.2, 0, 0.2, 1, 1.8, 2.6, 3.4};
+    cm_ffd_desc d;
+    rotated_desc(&d, 4, CM_FFD_BSPLINE, CM_FFD_KNOTS_CUSTOM);
+    d.n[0] = 7;
+    d.n[2] = 5;
+    d.knot[0] = kx;
+    d.knot[1] = ky;
+    d.knot[2] = kz;
+    cm_ffd *f = NULL;
+    CHECK(cm_ffd_create(ctx, &d, &f) == CM_OK);
+    if (!f) return;
+    int64_t idx[64];
+    double w[64], worst = 0, lin = 0;
+    size_t nc = cm_ffd_control_count(f);
+    double *ctrl = malloc(nc * 3 * sizeof *ctrl);
+    cm_ffd_control_points(f, ctrl);
+    for (int i = 0; i < 20000; ++i) {
+        double u[3] = {urand(), urand(), urand()}, x[3], xr[3];
+        if (i < 3) u[i] = 1.0;
+        size_t q = cm_ffd_basis_eval(f, u, idx, w);
+        double s = 0;
+        for (size_t e = 0; e < q; ++e)
+            s += w[e];
+        worst = fmax(worst, fabs(s - 1));
+        lattice_point(f, ctrl, u, x);
+        desc_point(&d, u, xr);
+        for (int r = 0; r < 3; ++r)
+            lin = fmax(lin, fabs(x[r] - xr[r]));
+    }
+    printf("custom knots: max |sum - 1| = %.3g, |x(u) - (o + A u)| = %.3g\n", worst, lin);
+    CHECK(worst <= 4e-15);
+    CHECK(lin <= 1e-14);
+    free(ctrl);
+    cm_ffd_destroy(&f);
+    /* a repeated knot inside the domain is refused */
+    static const double bad[10] = {-3, -2, -1, 0, 0.5, 0.5, 1, 2, 3, 4};
+    d.n[0] = d.n[1] = d.n[2] = 6;
+    d.knot[0] = d.knot[1] = d.knot[2] = bad;
+    CHECK(cm_ffd_create(ctx, &d, &f) == CM_ERR_ARGUMENT);
+}
+
 static void test_errors(void)
 {
     cm_ffd_desc d;
@@ -444,6 +492,7 @@ int main(void)
     test_locality();
     test_faces_and_outside();
     test_continuity();
+    test_custom_knots();
     test_errors();
     cm_context_destroy(&ctx);
     return TEST_REPORT();
