@@ -100,11 +100,26 @@ if r:
     fig.tight_layout()
     fig.savefig(os.path.join(out, "deform_smooth.svg"))
 
+r = rows("adapt.csv")
+if r:
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for meth, lab in (("dmffd", "DM-FFD, x/y knot insertion at the worst vertex"),
+                      ("rbf", "RBF (2D thin plate), greedy at the worst vertex")):
+        pts = [(int(x["dof"]), float(x["error_rel"])) for x in r if x["method"] == meth]
+        ax.semilogy([p[0] for p in pts], [max(p[1], 1e-17) for p in pts], "-o", ms=2, label=lab)
+    ax.set_xlabel("degrees of freedom")
+    ax.set_ylabel("max |d - target| / bump height")
+    ax.set_title("Fig. 12 setting: plane 41 x 41, every vertex a constraint")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "deform_adapt.svg"))
+
 vol = []
-for name in ("volume_pipe_tet.csv", "volume_pipe_hex.csv"):
+for name in ("volume_pipe_tet.csv", "volume_pipe_hex.csv", "volume_pipe_tet_eps1e-2.csv",
+             "volume_pipe_hex_eps1e-2.csv"):
     x = rows(name)
     if x:
-        vol.append((name[7:-4], x))
+        vol.append((name[7:-4].replace("_eps", ", clamping "), x))
 if vol:
     fig, axes = plt.subplots(len(vol), 2, figsize=(11, 4 * len(vol)), squeeze=False)
     for row, (tag, r) in enumerate(vol):
