@@ -17,7 +17,7 @@ M=$B/benchmarks/models/cm_model
 here=$(dirname "$0")
 # run OUT cmd...: the command's stdout into OUT; prints "wall,cpu" seconds
 run() { out=$1; shift; /usr/bin/time -f "%e %U %S" -o "$O/time" "$@" > "$out" 2> "$out.err" || true
-        awk '{printf "%.2f,%.2f", $1, $2 + $3}' "$O/time"; }
+        tail -1 "$O/time" | awk '{printf "%.2f,%.2f", $1, $2 + $3}'; }
 summary() { tail -1 "$1" | sed 's/min_scaled_jacobian=\([^ ]*\) mean_scaled_jacobian=[^ ]* inverted=\([^ ]*\) cells=.*/\1,\2/'; }
 
 for m in bore pipe bracket; do
