@@ -2,6 +2,7 @@
 // TopExp::MapShapes) and the correspondence check of G and G' (paper section 4: "the topology
 // of G stays constant").
 #include "cad_internal.hxx"
+#include "step_scan.h"
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
@@ -32,7 +33,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <sstream>
 
 namespace cmcad {
 
@@ -287,14 +290,24 @@ cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_optio
     if (!occ)
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "%s: unknown length unit '%s' (mm, cm, m, km, in, ft, mi, um)", fn, o.unit);
-    FILE *f = fopen(path, "rb");
-    if (!f) return cm_error(ctx, CM_ERR_IO, "%s: %s", path, what_error(errno));
-    char head[64] = {0};
-    size_t got = fread(head, 1, sizeof head - 1, f);
-    fclose(f);
-    // OpenCASCADE's parser accepts some garbage silently; a STEP file starts with ISO-10303-21.
-    if (got < 12 || strncmp(head, "ISO-10303-21", 12) != 0)
-        return cm_error(ctx, CM_ERR_FORMAT, "%s: not a STEP file (no ISO-10303-21 header)", path);
+    // The bytes OpenCASCADE parses are the bytes we scanned: read once (cm_file_read refuses
+    // FIFOs and devices before opening them), scan, then hand OpenCASCADE a stream.
+    char *data = nullptr;
+    size_t size = 0;
+    cm_status st = cm_file_read(ctx, path, &data, &size);
+    if (st != CM_OK) return st;
+    st = cm_step_scan(ctx, path, data, size);
+    if (st != CM_OK) {
+        free(data);
+        return st;
+    }
+    std::string text;
+    st = cmcad::guard(ctx, fn, [&]() -> cm_status {
+        text.assign(data, size);
+        return CM_OK;
+    });
+    free(data);
+    if (st != CM_OK) return st;
 
     return cmcad::guard(ctx, fn, [&]() -> cm_status {
         silence_opencascade();
@@ -304,7 +317,8 @@ cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_optio
             STEPControl_Reader reader;
             Interface_Static::SetCVal("xstep.cascade.unit", occ);
             Interface_Static::SetIVal("read.step.product.mode", 1);
-            if (reader.ReadFile(path) != IFSelect_RetDone)
+            std::istringstream stream(std::move(text));
+            if (reader.ReadStream(path, stream) != IFSelect_RetDone)
                 return cm_error(ctx, CM_ERR_FORMAT, "%s: OpenCASCADE cannot parse this STEP file",
                                 path);
             TColStd_SequenceOfAsciiString lengths, angles, solid_angles;
@@ -319,6 +333,7 @@ cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_optio
             m->shape = reader.OneShape();
         }
         m->unit = o.unit;
+        m->path = path;
         if (m->shape.IsNull())
             return cm_error(ctx, CM_ERR_CAD, "%s: OpenCASCADE failed to transfer the shapes", path);
         index_topology(m.get());
@@ -377,6 +392,8 @@ const char *cm_cad_file_unit(const cm_cad_model *model)
 {
     return model ? model->file_unit.c_str() : "";
 }
+
+const char *cm_cad_path(const cm_cad_model *model) { return model ? model->path.c_str() : ""; }
 
 const char *cm_cad_unit(const cm_cad_model *model) { return model ? model->unit.c_str() : ""; }
 
