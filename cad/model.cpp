@@ -31,6 +31,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -559,7 +560,29 @@ cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_mo
                 add(line);
             }
         }
-        if (total == 0) return CM_OK;
+        if (total == 0) {
+            // Same topology but another scale: a file in mm against the same numbers declared
+            // in m morphs to a x1000 result. Orders of magnitude are an error, another unit
+            // name alone (converted to the same unit) a warning.
+            auto diag = [](const double *b) {
+                return std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
+                                 (b[5] - b[2]) * (b[5] - b[2]));
+            };
+            const double d1 = diag(g->bbox), d2 = diag(g2->bbox);
+            const double ratio = d1 > 0 && d2 > 0 ? std::max(d1 / d2, d2 / d1) : 1.0;
+            const bool units_differ = g->file_unit != g2->file_unit;
+            if (ratio >= 100)
+                return cm_error(ctx, CM_ERR_MISMATCH,
+                                "%s and %s: G and G' differ in size by %.3gx (bounding-box diagonals %g and %g "
+                                "%s; file units %s and %s): check the units of the STEP files",
+                                g->path.c_str(), g2->path.c_str(), ratio, d1, d2, g->unit.c_str(), g->file_unit.c_str(),
+                                g2->file_unit.c_str());
+            if (units_differ)
+                cm_log(ctx, CM_LOG_WARNING,
+                       "G is in %s, G' in %s (both read as %s): check that this is intended",
+                       g->file_unit.c_str(), g2->file_unit.c_str(), g->unit.c_str());
+            return CM_OK;
+        }
         std::string msg = "topology of G and G' differs (" + std::to_string(total) +
                           (total == 1 ? " difference): " : " differences): ");
         for (size_t i = 0; i < diff.size(); ++i) msg += (i ? "; " : "") + diff[i];
