@@ -4,8 +4,6 @@
 
 #include <errno.h>
 #include <fcntl.h>
-#include <signal.h>
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -106,19 +104,16 @@ cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out)
     memcpy(out->path, path, n + 1);
     memcpy(out->tmp, path, dir);
     memcpy(out->tmp + dir, pattern, sizeof pattern);
-    /* Registered before it exists so that no signal can fall between creation and
-     * registration (unlinking a name that does not exist yet is harmless). A signal inside
-     * mkstemp could still leave one; blocking signals for that one call closes the gap. */
-    sigset_t all, old;
-    sigfillset(&all);
-    pthread_sigmask(SIG_BLOCK, &all, &old);
+    /* Registered before it exists: a signal may reach any thread (OpenMP workers too) while
+     * mkstemp runs, and a handler that unlinks the template or a name mkstemp is still
+     * filling in does no harm. */
+    live_add(out->tmp);
     int fd = mkstemp(out->tmp);
     int err = errno;
-    if (fd >= 0) live_add(out->tmp);
-    pthread_sigmask(SIG_SETMASK, &old, NULL);
     if (fd < 0) {
         cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot create a temporary file beside it: %s",
                                path, strerror(err));
+        live_remove(out->tmp);
         free(out->tmp);
         out->tmp = NULL;
         cm_outfile_abort(out);
