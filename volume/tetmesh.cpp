@@ -238,6 +238,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     // triangles that intersect (what two touching solids or a bad triangulation give)
     // without that path.
     {
+        const double td = cm_wtime();
         tetgenio diag;
         char dsw[] = "pdQ";
         try {
@@ -265,6 +266,8 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
                             "CAD faces %s): TetGen cannot mesh it",
                             path, diag.numberoftrifaces, list.c_str());
         }
+        cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: no intersecting triangles (%.3f s)",
+               cm_wtime() - td);
     }
     char sw[128];
     /* the dihedral bound (after the radius-edge ratio) is what removes most slivers: TetGen's
