@@ -18,10 +18,15 @@ static const char *const si_names[] = {
     "COULOMB", "VOLT",   "FARAD",   "OHM",    "SIEMENS",        "WEBER",     "TESLA",
     "HENRY",   "DEGREE_CELSIUS", "LUMEN", "LUX", "BECQUEREL",   "GRAY",      "SIEVERT"};
 
+/* Enumerations are upper case in ISO 10303-21, but some writers do not care. */
 static int in_list(const char *s, size_t n, const char *const *list, size_t count)
 {
-    for (size_t i = 0; i < count; ++i)
-        if (strlen(list[i]) == n && !memcmp(list[i], s, n)) return 1;
+    for (size_t i = 0; i < count; ++i) {
+        if (strlen(list[i]) != n) continue;
+        size_t k = 0;
+        while (k < n && (s[k] >= 'a' && s[k] <= 'z' ? s[k] - 'a' + 'A' : s[k]) == list[i][k]) ++k;
+        if (k == n) return 1;
+    }
     return 0;
 }
 

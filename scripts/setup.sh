@@ -9,6 +9,7 @@ packages=(
   libocct-data-exchange-dev libocct-ocaf-dev
   libflann-dev libtet1.5-dev liblapacke-dev libopenblas-dev zlib1g-dev
   gmsh python3-gmsh python3-numpy python3-scipy python3-vtk9 python3-meshio
+  clang libclang-rt-14-dev  # make fuzz (libFuzzer); make check-asan uses gcc's sanitizers
 )
 
 missing=()
