@@ -11,4 +11,7 @@ foreach(_case IN LISTS _hostile_cases)
             ${CM_TEST_WORK}/hostile_cli/${_case} ${_case})
   set_tests_properties(cli_hostile_${_case} PROPERTIES LABELS "cli;hostile"
     PASS_REGULAR_EXPRESSION "\nok\n" FAIL_REGULAR_EXPRESSION "FAIL:")
+  if(CADMORPH_SANITIZE)
+    set_tests_properties(cli_hostile_${_case} PROPERTIES ENVIRONMENT "CM_MEM_FACTOR=4")
+  endif()
 endforeach()
