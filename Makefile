@@ -6,7 +6,7 @@ ifeq ($(CI),true)
 CMAKE_FLAGS += -DCADMORPH_WERROR=ON
 endif
 
-.PHONY: all setup build demo test bench clean
+.PHONY: all setup build demo test bench clean check-asan fuzz
 
 all: build
 
@@ -26,5 +26,22 @@ test: build
 bench: build
 	sh benchmarks/run_all.sh $(BUILD)
 
+# Unit and CLI tests with AddressSanitizer and UBSan in $(BUILD)-asan. LSan skips
+# OpenCASCADE's one-time statics (tests/lsan.supp).
+check-asan: setup
+	cmake -S . -B $(BUILD)-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCADMORPH_SANITIZE=ON
+	cmake --build $(BUILD)-asan -j $(JOBS)
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
+	ctest --test-dir $(BUILD)-asan -L 'unit|cli' -LE slow --output-on-failure -j $(JOBS)
+
+# libFuzzer drivers (clang) in $(BUILD)-fuzz, seed corpora in $(BUILD)-fuzz/corpus; run one with
+# e.g. $(BUILD)-fuzz/tests/fuzz/fuzz_vtu $(BUILD)-fuzz/corpus/vtu -max_total_time=300
+fuzz: setup
+	cmake -S . -B $(BUILD)-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCADMORPH_FUZZ=ON \
+	  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++
+	cmake --build $(BUILD)-fuzz -j $(JOBS) --target fuzz_msh fuzz_vtu fuzz_vtk fuzz_medit fuzz_dcsv fuzz_step_scan
+	sh tests/fuzz/seeds.sh $(CURDIR) $(BUILD)-fuzz/corpus
+
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) $(BUILD)-asan $(BUILD)-fuzz

@@ -29,6 +29,7 @@ struct cm_cad_model {
     TopTools_IndexedMapOfShape faces, edges, vertices;
     cm_cad_counts counts{};
     std::string file_unit, unit;
+    std::string path;  // as given to cm_cad_read, for messages
     double bbox[6]{};
     std::vector<cm_cad_face_info> face_info;
     std::vector<cm_cad_edge_info> edge_info;

@@ -2,6 +2,7 @@
 // TopExp::MapShapes) and the correspondence check of G and G' (paper section 4: "the topology
 // of G stays constant").
 #include "cad_internal.hxx"
+#include "step_scan.h"
 
 #include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
@@ -30,9 +31,12 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <sstream>
 
 namespace cmcad {
 
@@ -287,14 +291,24 @@ cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_optio
     if (!occ)
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "%s: unknown length unit '%s' (mm, cm, m, km, in, ft, mi, um)", fn, o.unit);
-    FILE *f = fopen(path, "rb");
-    if (!f) return cm_error(ctx, CM_ERR_IO, "%s: %s", path, what_error(errno));
-    char head[64] = {0};
-    size_t got = fread(head, 1, sizeof head - 1, f);
-    fclose(f);
-    // OpenCASCADE's parser accepts some garbage silently; a STEP file starts with ISO-10303-21.
-    if (got < 12 || strncmp(head, "ISO-10303-21", 12) != 0)
-        return cm_error(ctx, CM_ERR_FORMAT, "%s: not a STEP file (no ISO-10303-21 header)", path);
+    // The bytes OpenCASCADE parses are the bytes we scanned: read once (cm_file_read refuses
+    // FIFOs and devices before opening them), scan, then hand OpenCASCADE a stream.
+    char *data = nullptr;
+    size_t size = 0;
+    cm_status st = cm_file_read(ctx, path, &data, &size);
+    if (st != CM_OK) return st;
+    st = cm_step_scan(ctx, path, data, size);
+    if (st != CM_OK) {
+        free(data);
+        return st;
+    }
+    std::string text;
+    st = cmcad::guard(ctx, fn, [&]() -> cm_status {
+        text.assign(data, size);
+        return CM_OK;
+    });
+    free(data);
+    if (st != CM_OK) return st;
 
     return cmcad::guard(ctx, fn, [&]() -> cm_status {
         silence_opencascade();
@@ -304,7 +318,8 @@ cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_optio
             STEPControl_Reader reader;
             Interface_Static::SetCVal("xstep.cascade.unit", occ);
             Interface_Static::SetIVal("read.step.product.mode", 1);
-            if (reader.ReadFile(path) != IFSelect_RetDone)
+            std::istringstream stream(std::move(text));
+            if (reader.ReadStream(path, stream) != IFSelect_RetDone)
                 return cm_error(ctx, CM_ERR_FORMAT, "%s: OpenCASCADE cannot parse this STEP file",
                                 path);
             TColStd_SequenceOfAsciiString lengths, angles, solid_angles;
@@ -319,6 +334,7 @@ cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_optio
             m->shape = reader.OneShape();
         }
         m->unit = o.unit;
+        m->path = path;
         if (m->shape.IsNull())
             return cm_error(ctx, CM_ERR_CAD, "%s: OpenCASCADE failed to transfer the shapes", path);
         index_topology(m.get());
@@ -377,6 +393,8 @@ const char *cm_cad_file_unit(const cm_cad_model *model)
 {
     return model ? model->file_unit.c_str() : "";
 }
+
+const char *cm_cad_path(const cm_cad_model *model) { return model ? model->path.c_str() : ""; }
 
 const char *cm_cad_unit(const cm_cad_model *model) { return model ? model->unit.c_str() : ""; }
 
@@ -542,7 +560,29 @@ cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_mo
                 add(line);
             }
         }
-        if (total == 0) return CM_OK;
+        if (total == 0) {
+            // Same topology but another scale: a file in mm against the same numbers declared
+            // in m morphs to a x1000 result. Orders of magnitude are an error, another unit
+            // name alone (converted to the same unit) a warning.
+            auto diag = [](const double *b) {
+                return std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
+                                 (b[5] - b[2]) * (b[5] - b[2]));
+            };
+            const double d1 = diag(g->bbox), d2 = diag(g2->bbox);
+            const double ratio = d1 > 0 && d2 > 0 ? std::max(d1 / d2, d2 / d1) : 1.0;
+            const bool units_differ = g->file_unit != g2->file_unit;
+            if (ratio >= 100)
+                return cm_error(ctx, CM_ERR_MISMATCH,
+                                "%s and %s: G and G' differ in size by %.3gx (bounding-box diagonals %g and %g "
+                                "%s; file units %s and %s): check the units of the STEP files",
+                                g->path.c_str(), g2->path.c_str(), ratio, d1, d2, g->unit.c_str(), g->file_unit.c_str(),
+                                g2->file_unit.c_str());
+            if (units_differ)
+                cm_log(ctx, CM_LOG_WARNING,
+                       "G is in %s, G' in %s (both read as %s): check that this is intended",
+                       g->file_unit.c_str(), g2->file_unit.c_str(), g->unit.c_str());
+            return CM_OK;
+        }
         std::string msg = "topology of G and G' differs (" + std::to_string(total) +
                           (total == 1 ? " difference): " : " differences): ");
         for (size_t i = 0; i < diff.size(); ++i) msg += (i ? "; " : "") + diff[i];

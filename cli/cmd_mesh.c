@@ -13,7 +13,7 @@
 
 static const char *const usage =
     "cadmorph mesh G.step -o MESH [--size H] [--quality Q] [--preserve-surface] "
-    "[--min-dihedral D] [--no-optimize] [--cad-unit U] [--threads N] [-v] [-h|--help]";
+    "[--min-dihedral D] [--no-optimize] [--force] [--cad-unit U] [--threads N] [-v] [-h|--help]";
 
 static int help(void)
 {
@@ -36,12 +36,14 @@ static int help(void)
            "                      (default 12; 0: TetGen's own): fewer slivers, more tets\n"
            "  --no-optimize       keep TetGen's interior nodes; by default they are optimised\n"
            "                      to lift slivers (boundary nodes never move)\n"
+           "  --force             mesh even when the estimated tet count exceeds 1e7 (refused\n"
+           "                      otherwise, exit code 4, with the estimate)\n"
            "  --cad-unit U        length unit of the coordinates (default mm)\n"
            "  --threads N         threads for the quality computation (default: all)\n"
            "  -v, --verbose       stage timings on stderr\n"
            "  -h, --help          this text\n\n"
            "exit codes: 0 done, 1 usage, 2 bad input (unreadable STEP, no closed solid, TetGen\n"
-           "failure), 4 internal error.\n",
+           "failure, touching solids), 4 out of memory or beyond the tet limit, internal error.\n",
            usage);
     return CLI_EXIT_OK;
 }
@@ -73,6 +75,8 @@ int cli_cmd_mesh(int argc, char **argv)
             opt.optimize = 0;
         } else if (!strcmp(a, "--preserve-surface")) {
             opt.preserve_surface = 1;
+        } else if (!strcmp(a, "--force")) {
+            opt.max_tets = INFINITY;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!(out = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
         } else if (!strcmp(a, "--cad-unit")) {

@@ -88,6 +88,27 @@ void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user)
     ctx->progress_user = user;
 }
 
+/* A message is one line (the CLI prints it as "cadmorph <cmd>: <message>"), and parts of it
+ * come from files: control characters (newlines, escape sequences) become \n, \r, \t or
+ * \xHH, so that nothing a file holds can break the line or drive the terminal. */
+static void escape_controls(char *msg, size_t size)
+{
+    char out[CM_MESSAGE_MAX];
+    size_t k = 0;
+    for (const unsigned char *p = (const unsigned char *)msg; *p && k + 5 < sizeof out && k + 5 < size; ++p) {
+        if (*p >= 0x20 && *p != 0x7f) {
+            out[k++] = (char)*p;
+        } else if (*p == '\n' || *p == '\r' || *p == '\t') {
+            out[k++] = '\\';
+            out[k++] = *p == '\n' ? 'n' : *p == '\r' ? 'r' : 't';
+        } else {
+            k += (size_t)snprintf(out + k, 5, "\\x%02x", *p);
+        }
+    }
+    out[k] = '\0';
+    memcpy(msg, out, k + 1);
+}
+
 cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
 {
     if (ctx) {
@@ -95,6 +116,7 @@ cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
         va_start(ap, fmt);
         vsnprintf(ctx->message, sizeof ctx->message, fmt, ap);
         va_end(ap);
+        escape_controls(ctx->message, sizeof ctx->message);
     }
     return code;
 }
@@ -118,6 +140,7 @@ cm_status cm_error_prefix(cm_context *ctx, cm_status code, const char *fmt, ...)
     if (k > size - 1 - n) k = size - 1 - n; /* a long message loses its end, not its start */
     memcpy(ctx->message + n, old, k);
     ctx->message[n + k] = 0;
+    escape_controls(ctx->message, sizeof ctx->message);
     return code;
 }
 
@@ -144,6 +167,7 @@ void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(buf, sizeof buf, fmt, ap);
     va_end(ap);
+    escape_controls(buf, sizeof buf);
     ctx->log(ctx->log_user, level, buf);
 }
 

@@ -121,24 +121,37 @@ cm_status cm_mesh_resize_nodes(cm_context *ctx, cm_mesh *mesh, size_t n_nodes, i
     return CM_OK;
 }
 
+/* Capacity for at least `want`: half as much again as now, so that many small reservations
+ * (a .msh with one element block per entity) cost amortised linear time, not quadratic. */
+static size_t grown(size_t cap, size_t want)
+{
+    size_t g = cap + cap / 2;
+    if (g < 16) g = 16;
+    return g > want ? g : want;
+}
+
 cm_status cm_mesh_reserve_cells(cm_context *ctx, cm_mesh *mesh, size_t n_cells, size_t n_conn)
 {
     if (!mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_reserve_cells: mesh is NULL");
+    if (n_cells > SIZE_MAX / 2 - mesh->n_cells || n_conn > SIZE_MAX / 16 - (size_t)mesh->offset[mesh->n_cells])
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh: %zu cells with %zu nodes is too many", n_cells, n_conn);
     size_t want_cells = mesh->n_cells + n_cells;
     size_t want_conn = (size_t)mesh->offset[mesh->n_cells] + n_conn;
     if (want_cells > mesh->cap_cells) {
-        int ok = grow((void **)&mesh->type, want_cells, sizeof(uint8_t)) &&
-                 grow((void **)&mesh->offset, want_cells + 1, sizeof(int64_t)) &&
-                 grow((void **)&mesh->physical, want_cells, sizeof(int)) &&
-                 grow((void **)&mesh->entity, want_cells, sizeof(int)) &&
-                 (!mesh->cell_tag || grow((void **)&mesh->cell_tag, want_cells, sizeof(int64_t)));
+        const size_t cap = grown(mesh->cap_cells, want_cells);
+        int ok = grow((void **)&mesh->type, cap, sizeof(uint8_t)) &&
+                 grow((void **)&mesh->offset, cap + 1, sizeof(int64_t)) &&
+                 grow((void **)&mesh->physical, cap, sizeof(int)) &&
+                 grow((void **)&mesh->entity, cap, sizeof(int)) &&
+                 (!mesh->cell_tag || grow((void **)&mesh->cell_tag, cap, sizeof(int64_t)));
         if (!ok) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh: out of memory for %zu cells", want_cells);
-        mesh->cap_cells = want_cells;
+        mesh->cap_cells = cap;
     }
     if (want_conn > mesh->cap_conn) {
-        if (!grow((void **)&mesh->conn, want_conn, sizeof(int64_t)))
+        const size_t cap = grown(mesh->cap_conn, want_conn);
+        if (!grow((void **)&mesh->conn, cap, sizeof(int64_t)))
             return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh: out of memory for %zu cell nodes", want_conn);
-        mesh->cap_conn = want_conn;
+        mesh->cap_conn = cap;
     }
     return CM_OK;
 }
@@ -151,12 +164,15 @@ cm_status cm_mesh_add_cell(cm_context *ctx, cm_mesh *mesh, cm_cell_type type, co
     if ((unsigned)type >= CM_CELL_TYPE_COUNT)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_add_cell: unknown cell type %d", (int)type);
     size_t c = mesh->n_cells;
+    /* nodes may point into this mesh's own connectivity (copying a cell): growing conn would
+     * free it under us, so keep its position and find it again after the reallocation */
+    const int64_t *conn0 = mesh->conn;
+    const int inside = conn0 && nodes >= conn0 && nodes < conn0 + mesh->cap_conn;
+    const size_t at = inside ? (size_t)(nodes - conn0) : 0;
     if (c + 1 > mesh->cap_cells || (size_t)mesh->offset[c] + n > mesh->cap_conn) {
-        size_t more_cells = mesh->cap_cells > 16 ? mesh->cap_cells : 16;
-        size_t more_conn = mesh->cap_conn > 64 + n ? mesh->cap_conn : 64 + n;
-        cm_status s = cm_mesh_reserve_cells(ctx, mesh, c + 1 > mesh->cap_cells ? more_cells : 0,
-                                            more_conn);
+        cm_status s = cm_mesh_reserve_cells(ctx, mesh, 1, n);
         if (s != CM_OK) return s;
+        if (inside) nodes = mesh->conn + at;
     }
     if (tag != 0 && !mesh->cell_tag) {
         mesh->cell_tag = malloc(mesh->cap_cells * sizeof(int64_t));
@@ -164,7 +180,7 @@ cm_status cm_mesh_add_cell(cm_context *ctx, cm_mesh *mesh, cm_cell_type type, co
         for (size_t i = 0; i < c; ++i) mesh->cell_tag[i] = (int64_t)i + 1;
     }
     int64_t o = mesh->offset[c];
-    memcpy(mesh->conn + o, nodes, n * sizeof(int64_t));
+    memmove(mesh->conn + o, nodes, n * sizeof(int64_t));
     mesh->type[c] = (uint8_t)type;
     mesh->physical[c] = physical;
     mesh->entity[c] = entity;

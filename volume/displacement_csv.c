@@ -9,6 +9,8 @@
 #include <string.h>
 
 #define CSV_COLUMNS 4
+/* Larger displacements are no mesh motion; their squares would overflow (1e150^2 = 1e300) */
+#define CM_WARP_MAX_DISPLACEMENT 1e150
 
 /* One line split at commas, each field trimmed of spaces (not copied: pointers into data). */
 typedef struct csv_row {
@@ -99,6 +101,11 @@ static cm_status parse_row(cm_context *ctx, const char *path, long line, const c
         if (!isfinite(v[c - 1]))
             return cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: %s of node %lld is not finite (%s)", path,
                             line, names[c], id, buf);
+        /* the warp squares displacements (norms, the RBF solve): 1.7e308 overflows to inf
+         * there and LAPACK reports a bad argument, so refuse it here, at its line */
+        if (fabs(v[c - 1]) > CM_WARP_MAX_DISPLACEMENT)
+            return cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: %s of node %lld is %s, beyond any mesh (|d| <= %g)",
+                            path, line, names[c], id, buf, CM_WARP_MAX_DISPLACEMENT);
     }
     return CM_OK;
 }

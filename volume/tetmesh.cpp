@@ -166,6 +166,9 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     if (counts.solids == 0)
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: the model has no solid (%d faces)", fn,
                         counts.faces);
+    const char *path = cm_cad_path(model);
+    cm_status s = cm_cad_check_solids_apart(ctx, model);
+    if (s < 0) return s;
     double bb[6];
     cm_cad_bbox(model, bb);
     const double h = o.size > 0 ? o.size
@@ -180,13 +183,26 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     if (!(o.min_dihedral >= 0 && o.min_dihedral <= 20))
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: minimum dihedral angle %g out of [0, 20] degrees",
                         fn, o.min_dihedral);
+    const double vmax = h * h * h * std::sqrt(2.0) / 12.0;  // regular tet of edge h
+    // TetGen's tets average about a third of the volume bound (measured on the bore model,
+    // sizes 0.1-0.3: 2.4-2.9): estimate before the surface triangulation, which grows as
+    // 1/h^2 itself
+    double volume = 0;
+    if ((s = cm_cad_volume(ctx, model, &volume)) < 0) return s;
+    const double estimate = 3.0 * std::fabs(volume) / vmax;
+    const double max_tets = o.max_tets > 0 ? o.max_tets : CM_TETMESH_MAX_TETS;
+    if (!(estimate <= max_tets))
+        return cm_error(ctx, CM_ERR_NOMEM,
+                        "%s: size %g would make about %.2g tets (volume %g), more than the limit "
+                        "of %.3g: use a larger size or lift the limit (cadmorph mesh --force)",
+                        path, h, estimate, volume, max_tets);
 
     const double t0 = cm_wtime();
     cad_guard surf;
     cm_cad_triangulate_options topt;
     cm_cad_triangulate_options_init(&topt);
     topt.size = h;
-    cm_status s = cm_cad_triangulate(ctx, model, &topt, &surf.t);
+    s = cm_cad_triangulate(ctx, model, &topt, &surf.t);
     if (s < 0) return s;
     const cm_cad_triangulation &T = *surf.t;
     if (T.n_open_edges)
@@ -217,7 +233,42 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
         for (int k = 0; k < 3; ++k) f.polygonlist[0].vertexlist[k] = (int)T.tri[3 * t + k];
         in.facetmarkerlist[t] = T.tri_face[t] + 1;  // 0 would mean "no marker"
     }
-    const double vmax = h * h * h * std::sqrt(2.0) / 12.0;  // regular tet of edge h
+    // TetGen's error path frees its memory pools twice (terminatetetgen, then ~tetgenmesh)
+    // and crashes, so nothing may reach it that a check can find first: -d reports the
+    // triangles that intersect (what two touching solids or a bad triangulation give)
+    // without that path.
+    {
+        const double td = cm_wtime();
+        tetgenio diag;
+        char dsw[] = "pdQ";
+        try {
+            tetrahedralize(dsw, &in, &diag);
+        } catch (int code) {
+            return cm_error(ctx, code == 1 ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
+                            "%s: TetGen's intersection check failed with code %d (%s)", path,
+                            code, tetgen_reason(code));
+        }
+        if (diag.numberoftrifaces > 0) {
+            std::set<int> faces;
+            for (int t = 0; t < diag.numberoftrifaces && diag.trifacemarkerlist; ++t)
+                faces.insert(diag.trifacemarkerlist[t] - 1);
+            std::string list;
+            int shown = 0;
+            for (int f : faces) {
+                if (shown++ == 8) {
+                    list += ", ...";
+                    break;
+                }
+                list += (list.empty() ? "" : ", ") + std::to_string(f);
+            }
+            return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                            "%s: the surface triangulation intersects itself (%d triangles on "
+                            "CAD faces %s): TetGen cannot mesh it",
+                            path, diag.numberoftrifaces, list.c_str());
+        }
+        cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: no intersecting triangles (%.3f s)",
+               cm_wtime() - td);
+    }
     char sw[128];
     /* the dihedral bound (after the radius-edge ratio) is what removes most slivers: TetGen's
      * -O optimisation levels changed no measured quality (benchmarks/RESULTS.md, issue 13) */
@@ -327,6 +378,7 @@ extern "C" void cm_tetmesh_options_init(cm_tetmesh_options *opt)
     opt->preserve_surface = 0;
     opt->optimize = 1;
     opt->min_dihedral = 12;
+    opt->max_tets = 0;
 }
 
 extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,

@@ -94,6 +94,8 @@ cm_status cm_cad_edge_get_info(cm_context *ctx, const cm_cad_model *model, int e
                                cm_cad_edge_info *info);
 /* xyz: 3 doubles. */
 cm_status cm_cad_vertex_point(cm_context *ctx, const cm_cad_model *model, int vertex, double *xyz);
+/* The path the model was read from ("" if none), for messages. */
+const char *cm_cad_path(const cm_cad_model *model);
 /* Bounding box of the whole model: 6 doubles. */
 void cm_cad_bbox(const cm_cad_model *model, double *bbox);
 
@@ -108,6 +110,12 @@ cm_status cm_cad_face_wire(cm_context *ctx, const cm_cad_model *model, int face,
  * faces points into the model, n entries. */
 cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge,
                             const int **faces, int *n);
+
+/* Two solids of the model that touch, overlap or contain one another (closer than 1e-6 of the
+ * model's bounding-box diagonal): a mesher that fills every solid cannot take them (TetGen
+ * crashes on the shared or crossing faces). CM_OK when no two solids meet (or there is one);
+ * CM_ERR_UNSUPPORTED naming the first such pair (1-based, in TopExp order) otherwise. */
+cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model);
 
 /* G and G' correspond: counts, surface and curve types (a circle may become an ellipse),
  * edge -> vertices and face -> wires -> oriented edges all match. CM_OK if so; CM_ERR_MISMATCH with up to

@@ -98,8 +98,9 @@ double cm_wtime(void);
  * frees *data. CM_ERR_IO with the path and the reason on failure. */
 cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *size);
 
-/* Output through path + ".tmp.XXXXXX", renamed onto path by cm_outfile_commit, so that a
- * failed write never leaves a partial file. Write with fprintf/fwrite to f. */
+/* Output through a temporary "<dir of path>/.cm-XXXXXX", renamed onto path by
+ * cm_outfile_commit, so that a failed write never leaves a partial file. Write with
+ * fprintf/fwrite to f. */
 typedef struct cm_outfile {
     FILE *f;
     char *path;
@@ -111,6 +112,11 @@ cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out);
 cm_status cm_outfile_commit(cm_context *ctx, cm_outfile *out);
 /* Closes and removes the temporary file (after an error). Safe to call twice. */
 void cm_outfile_abort(cm_outfile *out);
+
+/* Unlinks the temporary files of every cm_outfile still open in this process. Only
+ * async-signal-safe calls: meant for a program's own SIGINT/SIGTERM/SIGHUP handler (the
+ * library installs no handlers). */
+void cm_outfile_unlink_all(void);
 
 /* True on a little-endian host (binary formats are written little-endian). */
 int cm_host_little_endian(void);

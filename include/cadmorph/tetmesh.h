@@ -29,15 +29,23 @@ typedef struct cm_tetmesh_options {
     /* 1 (default): the interior nodes are then optimised (optimize.h) to lift TetGen's
      * slivers; boundary nodes stay where they are. */
     int optimize;
+    /* Refused (CM_ERR_NOMEM, with the estimate) when the tets expected from the model's volume
+     * and `size` exceed this; <= 0: CM_TETMESH_MAX_TETS. INFINITY lifts the limit. */
+    double max_tets;
 } cm_tetmesh_options;
+
+/* Default bound on the estimated tet count: ~3 GB in TetGen and the mesh, minutes of work. */
+#define CM_TETMESH_MAX_TETS 1e7
 
 void cm_tetmesh_options_init(cm_tetmesh_options *opt);
 
 /* Tet mesh of the model's solids. The mesh holds the nodes, the tets (physical 1, entity 1,
  * group "solid") and the boundary triangles, outward, each with physical and entity tag
  * face + 1 of the CAD face it lies on (groups "face_<k>", k 0-based as in cad.h).
- * Errors: CM_ERR_UNSUPPORTED for a model without a solid or whose faces do not close
- * (message: number of open edges), CM_ERR_CAD for a surface triangulation failure,
+ * Errors: CM_ERR_UNSUPPORTED for a model without a solid, whose faces do not close
+ * (message: number of open edges), whose solids touch or overlap (cm_cad_check_solids_apart)
+ * or whose surface triangulation intersects itself (TetGen's -d check, run first because
+ * TetGen's own error path crashes), CM_ERR_NOMEM beyond max_tets, CM_ERR_CAD for a surface triangulation failure,
  * CM_ERR_NUMERIC with TetGen's code and its meaning when TetGen gives up (self-intersecting
  * or too close facets, tiny features), CM_ERR_NOMEM. TetGen itself may print a line on
  * stdout before it fails (it does so unconditionally). Not thread-safe on one model. */

@@ -338,6 +338,7 @@ static cm_status read_sections(cm_msh_reader *r)
                 return cm_msh_err(r, CM_ERR_UNSUPPORTED, 0, 0, "a second $Elements section");
             if (r->binary && r->version == 41) cm_msh_to_binary(r);
             s = r->version == 41 ? cm_msh_read_elements41(r) : cm_msh_read_elements22(r);
+            if (s == CM_OK) s = cm_msh_map_cells(r);
             r->have_elements = 1;
         } else if (word_is(tok, len, "$NodeData") || word_is(tok, len, "$ElementData")) {
             s = cm_msh_read_data(r, word_is(tok, len, "$NodeData") ? CM_FIELD_NODE : CM_FIELD_CELL);

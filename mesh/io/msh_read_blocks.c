@@ -393,7 +393,7 @@ cm_status cm_msh_read_elements22(cm_msh_reader *r)
 
 /* ---- $NodeData / $ElementData ---- */
 
-static cm_status map_cells(cm_msh_reader *r)
+cm_status cm_msh_map_cells(cm_msh_reader *r)
 {
     if (r->cells_mapped) return CM_OK;
     cm_mesh *m = r->m;
@@ -420,7 +420,7 @@ cm_status cm_msh_read_data(cm_msh_reader *r, cm_field_location where)
     const char *sec = where == CM_FIELD_NODE ? "$NodeData" : "$ElementData";
     if (!r->have_nodes || (where == CM_FIELD_CELL && !r->have_elements))
         return cm_msh_err(r, CM_ERR_FORMAT, 0, 0, "expected %s after $Nodes and $Elements", sec);
-    cm_status s = where == CM_FIELD_CELL ? map_cells(r) : CM_OK;
+    cm_status s = where == CM_FIELD_CELL ? cm_msh_map_cells(r) : CM_OK;
     int64_t nstr, nreal, nint, v;
     char *name = NULL;
     double x;

@@ -54,6 +54,9 @@ cm_status cm_msh_read_nodes41(cm_msh_reader *r);
 cm_status cm_msh_read_elements41(cm_msh_reader *r);
 cm_status cm_msh_read_nodes22(cm_msh_reader *r);
 cm_status cm_msh_read_elements22(cm_msh_reader *r);
+/* Maps element tags to cells (once); a tag used twice is a format error, whether or not
+ * $ElementData follows: our writers repeat the tags, and gmsh refuses such files. */
+cm_status cm_msh_map_cells(cm_msh_reader *r);
 cm_status cm_msh_read_data(cm_msh_reader *r, cm_field_location where);
 /* Builds r->nodes from the node tags read (after $Nodes). */
 cm_status cm_msh_map_nodes(cm_msh_reader *r);

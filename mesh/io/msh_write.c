@@ -10,6 +10,7 @@
 typedef struct writer {
     cm_context *ctx;
     const cm_mesh *m;
+    const char *path;
     FILE *f;
     int bin, v41;
     unsigned char buf[1 << 16]; /* binary staging, flushed to f */
@@ -130,13 +131,37 @@ static void write_format(writer *w)
     fprintf(w->f, "$EndMeshFormat\n");
 }
 
+/* ---- names ---- */
+
+/* gmsh quotes names and has no escape: a '"' or a line break in a name would end it early.
+ * Such names are written with '"' as '\'' and control characters as ' ', and a warning says
+ * so, so that every .msh we write is one our reader (and gmsh) accepts. */
+static void put_name(writer *w, const char *what, const char *name)
+{
+    int changed = 0;
+    fputc('"', w->f);
+    for (const unsigned char *p = (const unsigned char *)name; *p; ++p) {
+        int c = *p == '"' ? '\'' : *p < 0x20 || *p == 0x7f ? ' ' : *p;
+        changed |= c != *p;
+        fputc(c, w->f);
+    }
+    fputc('"', w->f);
+    if (changed)
+        cm_log(w->ctx, CM_LOG_WARNING, "%s: %s name '%s' holds a quote or control character: written with ' and spaces",
+               w->path, what, name);
+}
+
 static void write_groups(writer *w)
 {
     const cm_mesh *m = w->m;
     if (!m->n_groups) return;
     fprintf(w->f, "$PhysicalNames\n%zu\n", m->n_groups);
     for (size_t i = 0; i < m->n_groups; ++i)
-        fprintf(w->f, "%d %d \"%s\"\n", m->groups[i].dim, m->groups[i].tag, m->groups[i].name);
+    {
+        fprintf(w->f, "%d %d ", m->groups[i].dim, m->groups[i].tag);
+        put_name(w, "physical group", m->groups[i].name);
+        fputc('\n', w->f);
+    }
     fprintf(w->f, "$EndPhysicalNames\n");
 }
 
@@ -432,7 +457,9 @@ static void write_field(writer *w, const cm_field *f)
     int node = f->location == CM_FIELD_NODE;
     size_t n = node ? m->n_nodes : m->n_cells;
     const char *sec = node ? "NodeData" : "ElementData";
-    fprintf(w->f, "$%s\n1\n\"%s\"\n1\n0\n3\n0\n%d\n%zu\n", sec, f->name, f->components, n);
+    fprintf(w->f, "$%s\n1\n", sec);
+    put_name(w, "field", f->name);
+    fprintf(w->f, "\n1\n0\n3\n0\n%d\n%zu\n", f->components, n);
     for (size_t i = 0; i < n; ++i) {
         int64_t tag = node ? node_tag(m, i) : cell_tag(m, i);
         const double *d = f->data + i * (size_t)f->components;
@@ -464,10 +491,6 @@ cm_status cm_mesh_write_msh(cm_context *ctx, const cm_mesh *mesh, const char *pa
     int v41 = opt->msh_version == 41;
     cm_status s = check_mesh(ctx, mesh, path, v41);
     if (s != CM_OK) return s;
-    for (size_t i = 0; i < mesh->n_groups; ++i)
-        if (strchr(mesh->groups[i].name, '"') || strchr(mesh->groups[i].name, '\n'))
-            return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: physical group name '%s' holds a quote or newline",
-                            path, mesh->groups[i].name);
     writer *w = calloc(1, sizeof *w);
     ent *e = NULL;
     size_t n_ent = 0;
@@ -479,6 +502,7 @@ cm_status cm_mesh_write_msh(cm_context *ctx, const cm_mesh *mesh, const char *pa
     }
     w->ctx = ctx;
     w->m = mesh;
+    w->path = path;
     w->bin = opt->binary != 0;
     w->v41 = v41;
     if (v41) s = collect_entities(w, &e, &n_ent, node_ent);

@@ -25,14 +25,28 @@ cm_vtk_scalar cm_vtk_scalar_from_xml(const char *name)
 
 cm_vtk_scalar cm_vtk_scalar_from_legacy(const char *name, size_t len)
 {
+    /* every numeric name vtkDataReader knows: the C names, the fixed-width vtktype names
+     * (meshio writes vtktypeint32, vtktypefloat64, ...) and vtkIdType; like VTK, in any case */
     static const struct { const char *name; cm_vtk_scalar t; } names[] = {
-        {"char", CM_VTK_INT8},       {"signed_char", CM_VTK_INT8},   {"unsigned_char", CM_VTK_UINT8},
-        {"short", CM_VTK_INT16},     {"unsigned_short", CM_VTK_UINT16}, {"int", CM_VTK_INT32},
-        {"unsigned_int", CM_VTK_UINT32}, {"long", CM_VTK_INT64},     {"unsigned_long", CM_VTK_UINT64},
-        {"vtktypeint64", CM_VTK_INT64}, {"vtktypeuint64", CM_VTK_UINT64}, {"vtkIdType", CM_VTK_INT64},
-        {"float", CM_VTK_FLOAT32},   {"double", CM_VTK_FLOAT64}};
-    for (size_t i = 0; i < sizeof names / sizeof *names; ++i)
-        if (strlen(names[i].name) == len && !memcmp(names[i].name, name, len)) return names[i].t;
+        {"char", CM_VTK_INT8},           {"signed_char", CM_VTK_INT8},
+        {"unsigned_char", CM_VTK_UINT8}, {"short", CM_VTK_INT16},
+        {"unsigned_short", CM_VTK_UINT16}, {"int", CM_VTK_INT32},
+        {"unsigned_int", CM_VTK_UINT32}, {"long", CM_VTK_INT64},
+        {"unsigned_long", CM_VTK_UINT64}, {"long_long", CM_VTK_INT64},
+        {"unsigned_long_long", CM_VTK_UINT64}, {"vtkidtype", CM_VTK_INT64},
+        {"vtktypeint8", CM_VTK_INT8},    {"vtktypeuint8", CM_VTK_UINT8},
+        {"vtktypeint16", CM_VTK_INT16},  {"vtktypeuint16", CM_VTK_UINT16},
+        {"vtktypeint32", CM_VTK_INT32},  {"vtktypeuint32", CM_VTK_UINT32},
+        {"vtktypeint64", CM_VTK_INT64},  {"vtktypeuint64", CM_VTK_UINT64},
+        {"vtktypefloat32", CM_VTK_FLOAT32}, {"vtktypefloat64", CM_VTK_FLOAT64},
+        {"float", CM_VTK_FLOAT32},       {"double", CM_VTK_FLOAT64}};
+    for (size_t i = 0; i < sizeof names / sizeof *names; ++i) {
+        const char *n = names[i].name;
+        if (strlen(n) != len) continue;
+        size_t k = 0;
+        while (k < len && (name[k] >= 'A' && name[k] <= 'Z' ? name[k] - 'A' + 'a' : name[k]) == n[k]) ++k;
+        if (k == len) return names[i].t;
+    }
     return CM_VTK_SCALAR_COUNT;
 }
 

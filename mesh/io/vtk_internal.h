@@ -54,7 +54,11 @@ typedef struct cm_xml {
     int appended_elem;         /* element index of <AppendedData>, -1 if none */
 } cm_xml;
 
-/* Scans data; stops at the '_' that starts <AppendedData> (what follows is not XML). */
+/* Deepest element nesting accepted. */
+#define CM_XML_MAX_DEPTH 64
+
+/* Scans data; stops at the '_' that starts <AppendedData> (what follows is not XML). Elements
+ * nested deeper than CM_XML_MAX_DEPTH are a format error. */
 cm_status cm_xml_parse(cm_context *ctx, const char *path, const char *data, size_t size, cm_xml *x);
 void cm_xml_free(cm_xml *x);
 /* Attribute value or NULL. */
@@ -140,7 +144,10 @@ typedef struct cm_vtu_array {
     uint8_t *bytes;       /* host byte order, owned */
 } cm_vtu_array;
 
-cm_status cm_vtu_array_decode(const cm_vtu_decoder *d, int elem, cm_vtu_array *a);
+/* Decodes DataArray elem into a. An array that declares (binary header) or holds (ascii) more
+ * than max_values values (tuples x components; SIZE_MAX: no bound) is refused before it is
+ * allocated or inflated. */
+cm_status cm_vtu_array_decode(const cm_vtu_decoder *d, int elem, size_t max_values, cm_vtu_array *a);
 void cm_vtu_array_free(cm_vtu_array *a);
 
 #endif

@@ -39,9 +39,11 @@ static cm_status put_values(legacy_writer *w, cm_vtk_scalar as, const void *src,
     return CM_OK;
 }
 
-/* Legacy names cannot hold whitespace: VTK's own escape is %xx. */
+/* Legacy names cannot hold whitespace: VTK's own escape is %xx. An empty name would leave
+ * the line without one: it is written as %00, which reads back as "". */
 static void put_name(FILE *f, const char *s)
 {
+    if (!*s) fputs("%00", f);
     for (; *s; ++s) {
         unsigned char c = (unsigned char)*s;
         if (c <= ' ' || c == '%' || c >= 127) fprintf(f, "%%%02X", c);

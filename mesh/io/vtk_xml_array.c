@@ -54,13 +54,26 @@ static int read_header_int(source *s, int hdr64, uint64_t *v)
     return r;
 }
 
-static cm_status decode_binary(const cm_vtu_decoder *d, cm_vtu_array *a, source *s, size_t pos)
+/* A header that declares more values than the array may hold is refused before anything is
+ * allocated or inflated: a few MB of zlib data can claim gigabytes. */
+static cm_status too_many(const cm_vtu_decoder *d, const cm_vtu_array *a, size_t pos, uint64_t values,
+                          size_t max_values)
+{
+    char detail[96];
+    snprintf(detail, sizeof detail, "%llu values, more than the %zu expected", (unsigned long long)values,
+             max_values);
+    return fail(d, a, pos, "header declares ", detail);
+}
+
+static cm_status decode_binary(const cm_vtu_decoder *d, cm_vtu_array *a, source *s, size_t pos,
+                               size_t max_values)
 {
     const size_t w = cm_vtk_scalar_size(a->type);
     int r;
     if (!d->compressed) {
         uint64_t nbytes;
         if ((r = read_header_int(s, d->hdr64, &nbytes))) return src_fail(d, a, pos, r);
+        if (nbytes / w > max_values) return too_many(d, a, pos, nbytes / w, max_values);
         if (nbytes > src_avail(s)) return fail(d, a, pos, "data ends early (header claims more bytes than the file holds)", NULL);
         if (nbytes % w) return fail(d, a, pos, "byte count is not a multiple of the value size", NULL);
         a->bytes = malloc(nbytes ? nbytes : 1);
@@ -77,6 +90,10 @@ static cm_status decode_binary(const cm_vtu_decoder *d, cm_vtu_array *a, source 
     if (nb > src_avail(s) / hw) return fail(d, a, pos, "compression header: block count exceeds the data", NULL);
     if (nb > 0 && (bs == 0 || last > bs || bs > UINT64_MAX / nb))
         return fail(d, a, pos, "compression header: bad block sizes", NULL);
+    {
+        const uint64_t declared = nb == 0 ? 0 : (nb - 1) * bs + (last ? last : bs);
+        if (declared / w > max_values) return too_many(d, a, pos, declared / w, max_values);
+    }
     uint64_t *cs = malloc((nb ? nb : 1) * sizeof *cs);
     size_t *coff = malloc((nb + 1) * sizeof *coff);
     if (!cs || !coff) {
@@ -139,7 +156,8 @@ static cm_status decode_binary(const cm_vtu_decoder *d, cm_vtu_array *a, source 
 
 static int is_ws(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
 
-static cm_status decode_ascii(const cm_vtu_decoder *d, cm_vtu_array *a, size_t b, size_t e)
+static cm_status decode_ascii(const cm_vtu_decoder *d, cm_vtu_array *a, size_t b, size_t e,
+                              size_t max_values)
 {
     const char *t = d->x->data;
     size_t n = 0;
@@ -149,6 +167,9 @@ static cm_status decode_ascii(const cm_vtu_decoder *d, cm_vtu_array *a, size_t b
         ++n;
         while (p < e && !is_ws(t[p])) ++p;
     }
+    if (n > max_values)
+        return cm_error(d->ctx, CM_ERR_FORMAT, "%s:%ld: DataArray '%s': %zu values, more than the %zu expected",
+                        d->path, cm_xml_line(d->x, b), a->name ? a->name : "", n, max_values);
     /* Integers are kept as int64 (uint64 for UInt64), floats in their own width so that a
      * Float32 value reads as the same double VTK gets. */
     cm_vtk_scalar keep = cm_vtk_scalar_is_float(a->type) || a->type == CM_VTK_UINT64 ? a->type : CM_VTK_INT64;
@@ -185,7 +206,7 @@ static cm_status decode_ascii(const cm_vtu_decoder *d, cm_vtu_array *a, size_t b
     return CM_OK;
 }
 
-cm_status cm_vtu_array_decode(const cm_vtu_decoder *d, int elem, cm_vtu_array *a)
+cm_status cm_vtu_array_decode(const cm_vtu_decoder *d, int elem, size_t max_values, cm_vtu_array *a)
 {
     const cm_xml *x = d->x;
     memset(a, 0, sizeof *a);
@@ -210,7 +231,7 @@ cm_status cm_vtu_array_decode(const cm_vtu_decoder *d, int elem, cm_vtu_array *a
         a->components = (int)v;
     }
     const cm_xml_elem *el = &x->elem[elem];
-    if (!format || !strcmp(format, "ascii")) return decode_ascii(d, a, el->text_begin, el->text_end);
+    if (!format || !strcmp(format, "ascii")) return decode_ascii(d, a, el->text_begin, el->text_end, max_values);
     source s;
     memset(&s, 0, sizeof s);
     size_t pos;
@@ -244,7 +265,7 @@ cm_status cm_vtu_array_decode(const cm_vtu_decoder *d, int elem, cm_vtu_array *a
         return cm_error(d->ctx, CM_ERR_FORMAT, "%s:%ld: DataArray '%s': unknown format '%s'", d->path,
                         line, a->name ? a->name : "", format);
     }
-    return decode_binary(d, a, &s, pos);
+    return decode_binary(d, a, &s, pos, max_values);
 }
 
 void cm_vtu_array_free(cm_vtu_array *a)

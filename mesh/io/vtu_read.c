@@ -3,6 +3,7 @@
 #include "vtk_internal.h"
 #include "formats.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,18 +19,24 @@ static cm_status parse_count(vtu_reader *r, int piece, const char *name, size_t 
 {
     const char *v = cm_xml_get(&r->x, piece, name);
     char *end;
+    errno = 0;
     long long k = v ? strtoll(v, &end, 10) : -1;
-    if (!v || *end || k < 0)
+    if (!v || !*v || *end || k < 0 || errno)
         return cm_error(r->ctx, CM_ERR_FORMAT, "%s:%ld: <Piece> needs a non-negative %s", r->path,
                         cm_xml_line(&r->x, r->x.elem[piece].pos), name);
+    /* Every point and cell takes at least one byte of data, which zlib packs at most ~1032:1:
+     * a count beyond that cannot be in the file (and 3 x count must not wrap). */
+    if ((unsigned long long)k / 1100 > r->x.size)
+        return cm_error(r->ctx, CM_ERR_FORMAT, "%s:%ld: <Piece> %s=\"%lld\" is more than a file of %zu bytes can hold",
+                        r->path, cm_xml_line(&r->x, r->x.elem[piece].pos), name, k, r->x.size);
     *n = (size_t)k;
     return CM_OK;
 }
 
-/* Decodes a DataArray that must hold `want` values (SIZE_MAX: any count). */
-static cm_status decode(vtu_reader *r, int elem, size_t want, cm_vtu_array *a)
+/* Decodes a DataArray that must hold `want` values (SIZE_MAX: any count up to max). */
+static cm_status decode(vtu_reader *r, int elem, size_t want, size_t max, cm_vtu_array *a)
 {
-    cm_status s = cm_vtu_array_decode(&r->d, elem, a);
+    cm_status s = cm_vtu_array_decode(&r->d, elem, want != SIZE_MAX ? want : max, a);
     if (s == CM_ERR_UNSUPPORTED && a->unsupported_type) s = CM_ERR_FORMAT;
     if (s != CM_OK) return s;
     if (want != SIZE_MAX && a->count != want)
@@ -76,7 +83,7 @@ static cm_status read_points(vtu_reader *r, int piece, cm_mesh *mesh)
                         cm_xml_line(&r->x, r->x.elem[piece].pos));
     }
     cm_vtu_array a;
-    cm_status s = decode(r, arr, 3 * r->n_points, &a);
+    cm_status s = decode(r, arr, 3 * r->n_points, SIZE_MAX, &a);
     if (s == CM_OK && a.components != 3)
         s = cm_error(r->ctx, CM_ERR_FORMAT, "%s:%ld: points need NumberOfComponents=\"3\"", r->path,
                      cm_xml_line(&r->x, r->x.elem[arr].pos));
@@ -125,9 +132,18 @@ static cm_status read_cells(vtu_reader *r, int piece, cm_mesh *mesh)
     int64_t *off = NULL, *foff = NULL;
     cm_status s = CM_OK;
     const size_t want[5] = {SIZE_MAX, r->n_cells, r->n_cells, SIZE_MAX, r->n_cells};
-    for (int i = 0; i < 5 && s == CM_OK; ++i) {
+    /* the offsets first: their last values bound connectivity and faces, so that neither
+     * can be inflated past what the cells use */
+    static const int order[5] = {1, 2, 4, 0, 3};
+    size_t max[5] = {0, SIZE_MAX, SIZE_MAX, 0, SIZE_MAX};
+    for (int k = 0; k < 5 && s == CM_OK; ++k) {
+        const int i = order[k];
         if (el[i] < 0) continue;
-        s = decode(r, el[i], want[i], &a[i]);
+        if (i == 0 && r->n_cells > 0 && v[1][r->n_cells - 1] > 0) max[0] = (size_t)v[1][r->n_cells - 1];
+        if (i == 3)
+            for (size_t c = 0; c < r->n_cells; ++c)
+                if (v[4][c] > 0 && (size_t)v[4][c] > max[3]) max[3] = (size_t)v[4][c];
+        s = decode(r, el[i], want[i], max[i], &a[i]);
         if (s == CM_OK) s = to_int64(r, el[i], &a[i], &v[i]);
         count[i] = a[i].count;
         cm_vtu_array_free(&a[i]);
@@ -176,7 +192,10 @@ static cm_status read_data(vtu_reader *r, int piece, const char *section, cm_fie
         for (int e = cm_xml_child(x, sec, "DataArray", -1); e >= 0 && s == CM_OK;
              e = cm_xml_child(x, sec, "DataArray", e)) {
             cm_vtu_array a;
-            s = cm_vtu_array_decode(&r->d, e, &a);
+            /* components from the attribute: the bound is the expected count */
+            const char *nc = cm_xml_get(x, e, "NumberOfComponents");
+            const long ncomp = nc ? strtol(nc, NULL, 10) : 1;
+            s = cm_vtu_array_decode(&r->d, e, ncomp >= 1 && ncomp <= 1000 ? n * (size_t)ncomp : n, &a);
             if (s == CM_ERR_UNSUPPORTED && a.unsupported_type) {
                 /* String/Bit arrays carry no numbers for us: skip them. */
                 cm_context_clear(r->ctx);

@@ -99,6 +99,7 @@ cm_status cm_xml_parse(cm_context *ctx, const char *path, const char *data, size
     x->appended = SIZE_MAX;
     x->appended_elem = -1;
     int cur = -1; /* open element */
+    int depth = 0; /* of cur */
     size_t p = 0;
     cm_status s = CM_OK;
     while (p < size) {
@@ -139,6 +140,7 @@ cm_status cm_xml_parse(cm_context *ctx, const char *path, const char *data, size
             while (e < size && is_space(data[e])) ++e;
             if (e >= size || data[e] != '>') return syntax(ctx, path, x, p, "malformed closing tag");
             cur = o->parent;
+            --depth;
             p = e + 1;
             continue;
         }
@@ -146,6 +148,13 @@ cm_status cm_xml_parse(cm_context *ctx, const char *path, const char *data, size
         size_t b = p + 1, e = b;
         while (e < size && is_name_char(data[e])) ++e;
         if (e == b) return syntax(ctx, path, x, p, "expected an element name after '<'");
+        /* VTK files nest 5 or 6 deep; millions of unclosed elements are not a mesh, and each
+         * costs memory */
+        if (depth >= CM_XML_MAX_DEPTH) {
+            char msg[80];
+            snprintf(msg, sizeof msg, "elements nested deeper than %d", CM_XML_MAX_DEPTH);
+            return syntax(ctx, path, x, p, msg);
+        }
         if (!push_elem(x)) return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", path);
         int me = (int)x->n_elem - 1;
         cm_xml_elem *el = &x->elem[me];
@@ -202,6 +211,7 @@ cm_status cm_xml_parse(cm_context *ctx, const char *path, const char *data, size
         p = q;
         if (self_closing) continue;
         cur = me;
+        ++depth;
         if (el->name_len == 12 && !memcmp(el->name, "AppendedData", 12)) {
             /* Everything after the '_' is data (raw bytes or base64), not XML. */
             while (p < size && is_space(data[p])) ++p;

@@ -280,20 +280,31 @@ static void test_many_blocks(void)
     cm_mesh_destroy(&m);
 }
 
-/* A failed write leaves nothing; a good one leaves no temporary file. */
+/* A failed write leaves nothing; a good one leaves no temporary file (in a folder of its own:
+ * the temporaries have short generic names). */
 static void test_atomic_writes(const cm_mesh *ref)
 {
-    char p[2100];
+    char dir[2100], p[2200];
+    path_in(dir, sizeof dir, work_dir, "atomic");
+    mkdir(dir, 0777);
     path_in(p, sizeof p, work_dir, "no_such_dir/x.vtu");
     CHECK(cm_mesh_write(ctx, ref, p, NULL) == CM_ERR_IO);
-    DIR *d = opendir(work_dir);
+    path_in(p, sizeof p, dir, "ok.vtu");
+    CHECK(cm_mesh_write(ctx, ref, p, NULL) == CM_OK);
+    path_in(p, sizeof p, dir, "is_a_dir.vtu"); /* the rename fails: the temporary must go */
+    mkdir(p, 0777);
+    CHECK(cm_mesh_write(ctx, ref, p, NULL) == CM_ERR_IO);
+    DIR *d = opendir(dir);
     CHECK(d != NULL);
     struct dirent *e;
-    int tmp = 0;
-    while (d && (e = readdir(d)))
-        if (strstr(e->d_name, ".tmp.") && (strstr(e->d_name, "rt_") || strstr(e->d_name, "big_"))) ++tmp;
+    int tmp = 0, files = 0;
+    while (d && (e = readdir(d))) {
+        if (!strncmp(e->d_name, ".cm-", 4)) ++tmp; /* cm_outfile temporaries */
+        files += e->d_name[0] != '.';
+    }
     if (d) closedir(d);
     CHECK(tmp == 0);
+    CHECK(files == 2);
 }
 
 int main(int argc, char **argv)
