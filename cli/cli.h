@@ -17,8 +17,9 @@ enum {
 };
 
 /* A context whose log goes to stderr (debug lines only when verbose), whose progress is drawn
- * on stderr when stderr is a terminal, with `threads` threads (0: all). NULL, after a line
- * on stderr naming cmd, when out of memory. */
+ * on stderr when stderr is a terminal (during a study, stage "study": the variant count and
+ * an estimate of the time left), with `threads` threads (0: all). NULL, after a line on
+ * stderr naming cmd, when out of memory. */
 cm_context *cli_context_create(const char *cmd, int verbose, int threads);
 
 /* Prints "cadmorph <cmd>: <context message>" on one line to stderr, returns the exit code
@@ -28,6 +29,10 @@ int cli_fail(cm_context *ctx, const char *cmd, cm_status s);
 /* Prints "cadmorph <cmd>: <message>" and the usage hint to stderr; returns CLI_EXIT_USAGE. */
 int cli_usage(const char *cmd, const char *usage, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+
+/* mkdir -p: the output directory and any missing parents. 0, or CLI_EXIT_BAD_INPUT after a
+ * line on stderr naming cmd. */
+int cli_make_dir(const char *cmd, const char *dir);
 
 /* Non-zero if the two paths name the same file (an existing output that is an input). */
 int cli_same_file(const char *a, const char *b);
@@ -55,6 +60,7 @@ int cli_cmd_info(int argc, char **argv);
 int cli_cmd_mesh(int argc, char **argv);
 int cli_cmd_morph(int argc, char **argv);
 int cli_cmd_sweep(int argc, char **argv);
+int cli_cmd_study(int argc, char **argv);
 int cli_cmd_demo(int argc, char **argv);
 int cli_cmd_optimize(int argc, char **argv);
 int cli_cmd_ffd(int argc, char **argv);

@@ -3,17 +3,15 @@
  * and the meshes at 50 and 100 % in the output directory, a summary on stdout. */
 #include "cli.h"
 
-#include "sweep.h"
+#include "cadmorph/study.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 static const char *const usage_line =
     "cadmorph sweep bore|pipe|bracket --mesh tet|hex|FILE --mode absolute|relative|both "
-    "--steps N -o DIR [--size H] [--methods rbf-s,project,rbf-s-biharmonic] [--write-step] "
+    "--steps N -o DIR [--size H] [--methods LIST] [--write-step] "
     "[--threads N] [--verbose]";
 
 static void print_help(void)
@@ -31,7 +29,7 @@ static void print_help(void)
         "_100.vtu (the meshes at 50 and 100 %%, with 'scaled_jacobian' and 'displacement';\n"
         "for an odd N the middle one is the step just past 50 %%, named by its percent).\n\n"
         "options:\n"
-        "  MODEL              bore, pipe or bracket (benchmarks/models)\n"
+        "  MODEL              bore, pipe or bracket (the built-in models)\n"
         "  --mesh M           tet: TetGen mesh of G(0) at --size; hex: the O-grid hex mesh\n"
         "                     (bore, pipe); or a mesh file of G(0) (default tet)\n"
         "  --size H           tet edge length (default 0.2); hex: cells of about H (default\n"
@@ -39,7 +37,8 @@ static void print_help(void)
         "  --mode M           absolute, relative or both (default both)\n"
         "  --steps N          parameter steps (default 10)\n"
         "  -o, --output DIR   output directory (created if missing)\n"
-        "  --methods LIST     comma-separated subset (default all three)\n"
+        "  --methods LIST     comma-separated study methods (default the three above;\n"
+        "                     see 'cadmorph study --help')\n"
         "  --write-step       keep G(t) as DIR/G_<t>.step\n"
         "  --threads N        threads (default: all)\n"
         "  --verbose          debug messages on stderr\n\n"
@@ -47,23 +46,38 @@ static void print_help(void)
         "2 bad input, 4 internal error.\n");
 }
 
+enum { MAX_METHODS = 16 };
+
 typedef struct sweep_args {
     cm_sweep_options opt;
+    cm_study_method methods[MAX_METHODS];
     int threads, verbose;
 } sweep_args;
 
-static int parse_methods(const char *v, unsigned *methods)
+/* The list in the sweeps' table order (rbf-s, project, rbf-s-biharmonic, then the others as
+ * given), as the plot and summary have always shown them. */
+static int parse_methods(const char *v, sweep_args *a)
 {
-    char buf[256];
-    snprintf(buf, sizeof buf, "%s", v);
-    *methods = 0;
-    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
-         tok = strtok_r(NULL, ",", &save)) {
-        int m = cm_sweep_method_from_name(tok);
-        if (m < 0) return cli_usage("sweep", usage_line, "unknown method '%s'", tok);
-        *methods |= 1u << m;
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return cli_usage("sweep", usage_line, "out of memory");
+    size_t n = 0;
+    cm_status s = cm_study_methods_parse(ctx, v, a->methods, MAX_METHODS, &n);
+    if (s < 0) {
+        cli_usage("sweep", usage_line, "--methods: %s", cm_context_message(ctx));
+        cm_context_destroy(&ctx);
+        return CLI_EXIT_USAGE;
     }
-    if (!*methods) return cli_usage("sweep", usage_line, "--methods: empty list");
+    cm_context_destroy(&ctx);
+    for (size_t i = 1; i < n; ++i) /* insertion sort by slot: stable, n is tiny */
+        for (size_t j = i; j > 0 && cm_study_method_slot(&a->methods[j], MAX_METHODS) <
+                                        cm_study_method_slot(&a->methods[j - 1], MAX_METHODS);
+             --j) {
+            cm_study_method t = a->methods[j];
+            a->methods[j] = a->methods[j - 1];
+            a->methods[j - 1] = t;
+        }
+    a->opt.methods = a->methods;
+    a->opt.n_methods = n;
     return 0;
 }
 
@@ -92,16 +106,16 @@ static int parse_args(int argc, char **argv, sweep_args *a)
         } else if (!strcmp(o, "--mode")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             if (!strcmp(v, "absolute"))
-                a->opt.modes = CM_SWEEP_ABSOLUTE;
+                a->opt.modes = CM_STUDY_ABSOLUTE;
             else if (!strcmp(v, "relative"))
-                a->opt.modes = CM_SWEEP_RELATIVE;
+                a->opt.modes = CM_STUDY_RELATIVE;
             else if (!strcmp(v, "both"))
-                a->opt.modes = CM_SWEEP_ABSOLUTE | CM_SWEEP_RELATIVE;
+                a->opt.modes = CM_STUDY_BOTH;
             else
                 return cli_usage(cmd, usage_line, "unknown mode '%s'", v);
         } else if (!strcmp(o, "--methods")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (parse_methods(v, &a->opt.methods)) return CLI_EXIT_USAGE;
+            if (parse_methods(v, a)) return CLI_EXIT_USAGE;
         } else if (!strcmp(o, "--steps")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             long n = strtol(v, &end, 10);
@@ -136,59 +150,32 @@ static int parse_args(int argc, char **argv, sweep_args *a)
     return -1;
 }
 
-/* mkdir -p: the output directory and any missing parents. */
-static int make_dir(const char *dir)
-{
-    char path[4096];
-    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path) {
-        fprintf(stderr, "cadmorph sweep: output directory name too long\n");
-        return CLI_EXIT_BAD_INPUT;
-    }
-    for (char *p = path + 1;; ++p) {
-        if (*p != '/' && *p) continue;
-        char c = *p;
-        *p = 0;
-        struct stat st;
-        if (stat(path, &st) != 0) {
-            if (mkdir(path, 0777) != 0 && errno != EEXIST) {
-                fprintf(stderr, "cadmorph sweep: cannot create %s: %s\n", path, strerror(errno));
-                return CLI_EXIT_BAD_INPUT;
-            }
-        } else if (!S_ISDIR(st.st_mode)) {
-            fprintf(stderr, "cadmorph sweep: %s exists and is not a directory\n", path);
-            return CLI_EXIT_BAD_INPUT;
-        }
-        *p = c;
-        if (!c) return 0;
-    }
-}
-
 /* Per method and mode: the quality at 100 % and the first step with an inverted cell. */
-static void print_summary(const cm_sweep_result *r)
+static void print_summary(const cm_study_result *r)
 {
     printf("%s %s mesh: %zu nodes, %zu cells, %zu boundary nodes; M(0) min scaled Jacobian "
            "%.4g\n",
            r->model, r->mesh, r->nodes, r->cells, r->boundary_nodes, r->min_sj0);
     printf("%-18s %-9s %6s %10s %10s %9s %14s %12s\n", "method", "mode", "steps", "min_sj",
            "mean_sj", "inverted", "first_inverted", "max_dist/diag");
-    for (int mode = CM_SWEEP_ABSOLUTE; mode <= CM_SWEEP_RELATIVE; ++mode)
-        for (int m = 0; m < CM_SWEEP_N_METHODS; ++m) {
-            const cm_sweep_row *last = NULL;
+    for (int mode = CM_STUDY_ABSOLUTE; mode <= CM_STUDY_RELATIVE; ++mode)
+        for (size_t m = 0; m < r->n_methods; ++m) {
+            const cm_study_row *last = NULL;
             int first_inv = 0, n = 0;
             double worst = 0;
             for (size_t i = 0; i < r->n_rows; ++i) {
-                const cm_sweep_row *w = &r->rows[i];
-                if (w->mode != mode || w->method != m) continue;
+                const cm_study_row *w = &r->rows[i];
+                if (w->mode != mode || w->method != m || w->status < 0) continue;
                 last = w;
                 ++n;
-                if (w->inverted && !first_inv) first_inv = w->step;
+                if (w->inverted && !first_inv) first_inv = (int)w->variant + 1;
                 if (w->max_dist > worst) worst = w->max_dist;
             }
             if (!last) continue;
             char inv[32] = "-";
             if (first_inv) snprintf(inv, sizeof inv, "step %d", first_inv);
-            printf("%-18s %-9s %6d %10.4g %10.4g %9zu %14s %12.3g\n", cm_sweep_method_name(m),
-                   cm_sweep_mode_name(mode), n, last->min_sj, last->mean_sj, last->inverted, inv,
+            printf("%-18s %-9s %6d %10.4g %10.4g %9zu %14s %12.3g\n", r->methods[m].name,
+                   cm_study_mode_name(mode), n, last->min_sj, last->mean_sj, last->inverted, inv,
                    r->diagonal > 0 ? worst / r->diagonal : 0.0);
         }
 }
@@ -198,10 +185,10 @@ int cli_cmd_sweep(int argc, char **argv)
     sweep_args a;
     int rc = parse_args(argc, argv, &a);
     if (rc >= 0) return rc;
-    if ((rc = make_dir(a.opt.out_dir)) != 0) return rc;
+    if ((rc = cli_make_dir("sweep", a.opt.out_dir)) != 0) return rc;
     cm_context *ctx = cli_context_create("sweep", a.verbose, a.threads);
     if (!ctx) return CLI_EXIT_INTERNAL;
-    cm_sweep_result *r = NULL;
+    cm_study_result *r = NULL;
     cm_status s = cm_sweep_run(ctx, &a.opt, &r);
     if (s < 0) {
         rc = cli_fail(ctx, "sweep", s);
@@ -212,21 +199,21 @@ int cli_cmd_sweep(int argc, char **argv)
     size_t n = strlen(a.opt.out_dir) + 16;
     char *path = malloc(n);
     if (!path) {
-        cm_sweep_result_destroy(&r);
+        cm_study_result_destroy(&r);
         cm_context_destroy(&ctx);
         fprintf(stderr, "cadmorph sweep: out of memory\n");
         return CLI_EXIT_INTERNAL;
     }
     snprintf(path, n, "%s/sweep.csv", a.opt.out_dir);
-    s = cm_sweep_write_csv(ctx, r, path);
+    s = cm_study_write_csv(ctx, r, path, CM_STUDY_CSV_SWEEP);
     if (s >= 0) {
         snprintf(path, n, "%s/sweep.svg", a.opt.out_dir);
-        s = cm_sweep_write_svg(ctx, r, path);
+        s = cm_study_write_svg(ctx, r, path);
     }
     rc = s < 0 ? cli_fail(ctx, "sweep", s) : CLI_EXIT_OK;
     if (rc == CLI_EXIT_OK) print_summary(r);
     free(path);
-    cm_sweep_result_destroy(&r);
+    cm_study_result_destroy(&r);
     cm_context_destroy(&ctx);
     return rc;
 }

@@ -13,6 +13,10 @@ typedef struct cli_sink {
     int verbose;
     int tty;
     double last_draw;
+    /* a study (stage "study", done/total = variants) under way: its start, and whether the
+     * inner stages (a morph of each variant) should stay off the line */
+    int in_study;
+    double study_start, study_done, study_total;
 } cli_sink;
 
 static cli_sink sink;
@@ -25,16 +29,53 @@ static void log_to_stderr(void *user, cm_log_level level, const char *message)
     fprintf(stderr, "%s%s\n", level == CM_LOG_WARNING ? "warning: " : "", message);
 }
 
+/* "42 s", "3m05s", "2h10m" */
+static void format_duration(double sec, char *buf, size_t size)
+{
+    long s = (long)(sec + 0.5);
+    if (s < 60)
+        snprintf(buf, size, "%ld s", s);
+    else if (s < 3600)
+        snprintf(buf, size, "%ldm%02lds", s / 60, s % 60);
+    else
+        snprintf(buf, size, "%ldh%02ldm", s / 3600, (s % 3600) / 60);
+}
+
+/* "study 3/20 variants, about 1m20s left": the time left from the mean time per variant so
+ * far (variants of one study cost about the same). */
+static void draw_study(cli_sink *s, double now)
+{
+    char left[48] = "estimating the time left";
+    if (s->study_done > 0) {
+        char d[24];
+        format_duration((now - s->study_start) / s->study_done * (s->study_total - s->study_done),
+                        d, sizeof d);
+        snprintf(left, sizeof left, "about %s left", d);
+    }
+    fprintf(stderr, "\r\033[Kstudy %.0f/%.0f variants, %s", s->study_done, s->study_total, left);
+}
+
 static void progress_to_stderr(void *user, const char *stage, double done, double total)
 {
     cli_sink *s = user;
     if (!s->tty) return;
     double now = cm_wtime();
     int finished = done >= total;
+    if (!strcmp(stage, "study")) {
+        if (!s->in_study || done < s->study_done) s->study_start = now;
+        s->in_study = !finished;
+        s->study_done = done;
+        s->study_total = total;
+    } else if (s->in_study) {
+        if (now - s->last_draw < 1.0) return; /* the estimate moves with the variants */
+    }
     if (!finished && now - s->last_draw < 0.1) return;
     s->last_draw = now;
-    fprintf(stderr, "\r\033[K%s %5.1f%%", stage, total > 0 ? 100.0 * done / total : 100.0);
-    if (finished) fputs("\r\033[K", stderr);
+    if (s->in_study)
+        draw_study(s, now);
+    else
+        fprintf(stderr, "\r\033[K%s %5.1f%%", stage, total > 0 ? 100.0 * done / total : 100.0);
+    if (finished && !s->in_study) fputs("\r\033[K", stderr);
     fflush(stderr);
 }
 
@@ -71,6 +112,32 @@ int cli_usage(const char *cmd, const char *usage, const char *fmt, ...)
     va_end(ap);
     fprintf(stderr, "\nusage: %s\n", usage);
     return CLI_EXIT_USAGE;
+}
+
+int cli_make_dir(const char *cmd, const char *dir)
+{
+    char path[4096];
+    if (snprintf(path, sizeof path, "%s", dir) >= (int)sizeof path) {
+        fprintf(stderr, "cadmorph %s: output directory name too long\n", cmd);
+        return CLI_EXIT_BAD_INPUT;
+    }
+    for (char *p = path + 1;; ++p) {
+        if (*p != '/' && *p) continue;
+        char c = *p;
+        *p = 0;
+        struct stat st;
+        if (stat(path, &st) != 0) {
+            if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+                fprintf(stderr, "cadmorph %s: cannot create %s: %s\n", cmd, path, strerror(errno));
+                return CLI_EXIT_BAD_INPUT;
+            }
+        } else if (!S_ISDIR(st.st_mode)) {
+            fprintf(stderr, "cadmorph %s: %s exists and is not a directory\n", cmd, path);
+            return CLI_EXIT_BAD_INPUT;
+        }
+        *p = c;
+        if (!c) return 0;
+    }
 }
 
 int cli_same_file(const char *a, const char *b)

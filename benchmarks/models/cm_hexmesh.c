@@ -1,7 +1,7 @@
 /* `cm_hexmesh bore|pipe OUT.(vtu|msh|vtk|mesh) [scale]`: writes the structured O-grid hex mesh
  * of a benchmark model at t = 0 (scale multiplies the cell counts per direction, default 1:
  * about 34k nodes for the bore, 20k for the pipe) and prints its size and quality. */
-#include "hexmesh.h"
+#include "cadmorph/models.h"
 
 #include <stdio.h>
 #include <stdlib.h>

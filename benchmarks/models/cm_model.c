@@ -1,6 +1,6 @@
 /* `cm_model MODEL T OUT.step`: writes a benchmark model (bore, pipe, bracket) at parameter T
  * in [0, 1] as STEP. `cm_model MODEL T --signature` prints its topology signature and volume. */
-#include "models.h"
+#include "cadmorph/models.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -20,20 +20,18 @@ int main(int argc, char **argv)
         fprintf(stderr, "cm_model: T must be a number in [0, 1], got '%s'\n", argv[2]);
         return 1;
     }
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return 4;
+    cm_status s;
     if (!strcmp(argv[3], "--signature")) {
         static char buf[1 << 16];
         double vol = 0;
-        if (cm_model_signature(argv[1], t, buf, (int)sizeof buf, &vol) < 0) {
-            fprintf(stderr, "cm_model: %s\n", cm_model_error());
-            return 2;
-        }
-        printf("%svolume %.12g\n", buf, vol);
-        return 0;
+        s = cm_model_signature(ctx, argv[1], t, buf, sizeof buf, &vol);
+        if (s >= 0) printf("%svolume %.12g\n", buf, vol);
+    } else {
+        s = cm_model_write_step(ctx, argv[1], t, argv[3]);
     }
-    const int rc = cm_model_write_step(argv[1], t, argv[3]);
-    if (rc != 0) {
-        fprintf(stderr, "cm_model: %s\n", cm_model_error());
-        return rc == -1 ? 1 : 2;
-    }
-    return 0;
+    if (s < 0) fprintf(stderr, "cm_model: %s\n", cm_context_message(ctx));
+    cm_context_destroy(&ctx);
+    return s >= 0 ? 0 : s == CM_ERR_ARGUMENT ? 1 : 2;
 }

@@ -1,8 +1,7 @@
 /* O-grid hex meshes of the bore and pipe models at t = 0. Every node on the model's surface
  * is computed from the surface's own formula (circle, square side, torus section), so the
  * boundary is exact up to rounding; interior nodes blend linearly between the surfaces. */
-#include "hexmesh.h"
-#include "models.h"
+#include "cadmorph/models.h"
 
 #include <math.h>
 #include <stdlib.h>

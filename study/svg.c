@@ -1,7 +1,7 @@
-/* sweep.svg: min scaled Jacobian against percent of parameter change, one polyline per method
- * and mode (solid absolute, dashed relative), written by hand so that the benchmarks need no
- * plotting package. */
-#include "sweep.h"
+/* study.svg / sweep.svg: min scaled Jacobian against the variant (or percent of parameter
+ * change), one polyline per method and mode (solid absolute, dashed relative), written by hand
+ * so that cadmorph needs no plotting package. */
+#include "cadmorph/study.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -15,10 +15,24 @@
 #define PY0 60.0
 #define PY1 450.0
 
-static const char *const colours[CM_SWEEP_N_METHODS] = {"#1f77b4", "#d62728", "#2ca02c"};
+/* By cm_study_method_slot: the sweeps' three methods keep their colours. */
+static const char *const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e",
+                                      "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
+enum { N_COLOURS = sizeof colours / sizeof *colours };
 /* Curves of methods that agree lie on top of each other: the later ones are drawn thinner so
  * that the earlier stay visible. */
-static const double widths[CM_SWEEP_N_METHODS] = {4, 2.5, 1.5};
+static const double widths[] = {4, 2.5, 1.5};
+
+static const char *colour(const cm_study_result *r, size_t m)
+{
+    return colours[cm_study_method_slot(&r->methods[m], m) % N_COLOURS];
+}
+
+static double width(const cm_study_result *r, size_t m)
+{
+    int k = cm_study_method_slot(&r->methods[m], m);
+    return k < 3 ? widths[k] : 1.5;
+}
 
 /* Writes s with &, <, > and quotes escaped (model and mesh names come from the user). */
 static void xml_text(FILE *f, const char *s)
@@ -52,26 +66,28 @@ static double tick_step(double span)
 
 typedef struct frame {
     double ylo, yhi;
+    double xmax, xtick;
 } frame;
 
-static double px(double pct)
+static double px(const frame *fr, double x)
 {
-    return PX0 + (PX1 - PX0) * pct / 100;
+    return PX0 + (PX1 - PX0) * x / fr->xmax;
 }
 static double py(const frame *fr, double y)
 {
     return PY1 - (PY1 - PY0) * (y - fr->ylo) / (fr->yhi - fr->ylo);
 }
 
-static void axes(FILE *f, const frame *fr)
+static void axes(FILE *f, const frame *fr, const char *x_label)
 {
     fprintf(f, "<g font-family=\"sans-serif\" font-size=\"13\" fill=\"#222\">\n");
-    for (int x = 0; x <= 100; x += 10) {
+    for (int k = 0; k * fr->xtick <= fr->xmax * (1 + 1e-9); ++k) {
+        double x = k * fr->xtick;
         fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e4e4e4\"/>\n",
-                px(x), PY0, px(x), PY1);
+                px(fr, x), PY0, px(fr, x), PY1);
         fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#222\"/>\n",
-                px(x), PY1, px(x), PY1 + 5);
-        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%d</text>\n", px(x),
+                px(fr, x), PY1, px(fr, x), PY1 + 5);
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", px(fr, x),
                 PY1 + 20, x);
     }
     double step = tick_step(fr->yhi - fr->ylo);
@@ -88,8 +104,9 @@ static void axes(FILE *f, const frame *fr)
             "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" "
             "stroke=\"#222\"/>\n",
             PX0, PY0, PX1 - PX0, PY1 - PY0);
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">parameter change (%%)</text>\n",
-            (PX0 + PX1) / 2, PY1 + 45);
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", (PX0 + PX1) / 2, PY1 + 45);
+    xml_text(f, x_label);
+    fputs("</text>\n", f);
     fprintf(f,
             "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" "
             "transform=\"rotate(-90 %.1f %.1f)\">min scaled Jacobian</text>\n",
@@ -97,36 +114,73 @@ static void axes(FILE *f, const frame *fr)
     fprintf(f, "</g>\n");
 }
 
-/* The polyline of one method x mode, from M(0) at 0 % through its rows; returns 1 if drawn. */
-static int curve(FILE *f, const cm_sweep_result *r, const frame *fr, int mode, int method)
+static int complete(const cm_study_row *w, int mode, size_t method)
+{
+    return w->mode == mode && w->method == method && w->status >= 0;
+}
+
+/* The polyline of one method x mode, from M0 at 0 through its complete rows; returns 1 if
+ * drawn. */
+static int curve(FILE *f, const cm_study_result *r, const frame *fr, int mode, size_t method)
 {
     int n = 0;
     for (size_t i = 0; i < r->n_rows; ++i)
-        n += r->rows[i].mode == mode && r->rows[i].method == method;
+        n += complete(&r->rows[i], mode, method);
     if (n == 0) return 0;
     fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"%g\"%s points=\"%.2f,%.2f",
-            colours[method], widths[method],
-            mode == CM_SWEEP_RELATIVE ? " stroke-dasharray=\"7,4\"" : "", px(0),
+            colour(r, method), width(r, method),
+            mode == CM_STUDY_RELATIVE ? " stroke-dasharray=\"7,4\"" : "", px(fr, 0),
             py(fr, r->min_sj0));
     for (size_t i = 0; i < r->n_rows; ++i) {
-        const cm_sweep_row *w = &r->rows[i];
-        if (w->mode == mode && w->method == method)
-            fprintf(f, " %.2f,%.2f", px(100 * w->t), py(fr, w->min_sj));
+        const cm_study_row *w = &r->rows[i];
+        if (complete(w, mode, method))
+            fprintf(f, " %.2f,%.2f", px(fr, w->t * fr->xmax), py(fr, w->min_sj));
     }
     fprintf(f, "\"/>\n");
     for (size_t i = 0; i < r->n_rows; ++i) {
-        const cm_sweep_row *w = &r->rows[i];
-        if (w->mode == mode && w->method == method)
-            fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.5\" fill=\"%s\"/>\n", px(100 * w->t),
-                    py(fr, w->min_sj), colours[method]);
+        const cm_study_row *w = &r->rows[i];
+        if (complete(w, mode, method))
+            fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.5\" fill=\"%s\"/>\n",
+                    px(fr, w->t * fr->xmax), py(fr, w->min_sj), colour(r, method));
     }
     return 1;
 }
 
-cm_status cm_sweep_write_svg(cm_context *ctx, const cm_sweep_result *r, const char *path)
+/* A variant none of whose rows completed: a grey cross on the x axis. */
+static void failed_marks(FILE *f, const cm_study_result *r, const frame *fr)
 {
-    frame fr = {r->min_sj0, r->min_sj0};
     for (size_t i = 0; i < r->n_rows; ++i) {
+        const cm_study_row *w = &r->rows[i];
+        if (w->status >= 0) continue;
+        int any = 0;
+        for (size_t j = 0; j < r->n_rows && !any; ++j)
+            any = r->rows[j].variant == w->variant && r->rows[j].status >= 0;
+        int first = 1;
+        for (size_t j = 0; j < i && first; ++j)
+            first = r->rows[j].variant != w->variant;
+        if (any || !first) continue;
+        double x = px(fr, w->t * fr->xmax);
+        fprintf(f,
+                "<path d=\"M%.1f %.1f l8 8 m0 -8 l-8 8\" stroke=\"#888\" stroke-width=\"2\">"
+                "<title>",
+                x - 4, PY1 - 12);
+        xml_text(f, w->label);
+        fputs(": ", f);
+        xml_text(f, w->message);
+        fputs("</title></path>\n", f);
+    }
+}
+
+cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const char *path)
+{
+    if (!r || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_write_svg: NULL input");
+    frame fr = {r->min_sj0, r->min_sj0, r->x_max > 0 ? r->x_max : 1, r->x_tick};
+    if (!(fr.xtick > 0)) {
+        fr.xtick = tick_step(fr.xmax);
+        if (fr.xtick < 1 && fr.xmax >= 1) fr.xtick = 1; /* variants are counted */
+    }
+    for (size_t i = 0; i < r->n_rows; ++i) {
+        if (r->rows[i].status < 0) continue;
         if (r->rows[i].min_sj < fr.ylo) fr.ylo = r->rows[i].min_sj;
         if (r->rows[i].min_sj > fr.yhi) fr.yhi = r->rows[i].min_sj;
     }
@@ -155,21 +209,24 @@ cm_status cm_sweep_write_svg(cm_context *ctx, const cm_sweep_result *r, const ch
     xml_text(f, r->mesh);
     fprintf(f, " mesh (%zu nodes, %zu cells): min scaled Jacobian over the sweep</text>\n",
             r->nodes, r->cells);
-    axes(f, &fr);
+    axes(f, &fr, r->x_label);
+    failed_marks(f, r, &fr);
     int shown = 0;
-    for (int mode = CM_SWEEP_ABSOLUTE; mode <= CM_SWEEP_RELATIVE; ++mode)
-        for (int m = 0; m < CM_SWEEP_N_METHODS; ++m) {
+    for (int mode = CM_STUDY_ABSOLUTE; mode <= CM_STUDY_RELATIVE; ++mode)
+        for (size_t m = 0; m < r->n_methods; ++m) {
             if (!curve(f, r, &fr, mode, m)) continue;
             double y = PY0 + 10 + 24 * shown++;
             fprintf(f,
                     "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\" "
                     "stroke-width=\"%g\"%s/>\n",
-                    PX1 + 20, y, PX1 + 60, y, colours[m], widths[m],
-                    mode == CM_SWEEP_RELATIVE ? " stroke-dasharray=\"7,4\"" : "");
+                    PX1 + 20, y, PX1 + 60, y, colour(r, m), width(r, m),
+                    mode == CM_STUDY_RELATIVE ? " stroke-dasharray=\"7,4\"" : "");
             fprintf(f,
                     "<text x=\"%.1f\" y=\"%.1f\" font-family=\"sans-serif\" "
-                    "font-size=\"13\">%s, %s</text>\n",
-                    PX1 + 68, y + 4, cm_sweep_method_name(m), cm_sweep_mode_name(mode));
+                    "font-size=\"13\">",
+                    PX1 + 68, y + 4);
+            xml_text(f, r->methods[m].name);
+            fprintf(f, ", %s</text>\n", cm_study_mode_name(mode));
         }
     fprintf(f, "</svg>\n");
     return cm_outfile_commit(ctx, &out);

@@ -1,7 +1,8 @@
-// The benchmark models as OpenCASCADE solids and their STEP export. Each model is built by
+// The built-in models (models.h) as OpenCASCADE solids and their STEP export. Each model is built by
 // the same sequence of operations for every t, so that the boolean and sweep algorithms
 // produce the same topology in the same MapShapes order (checked by test_models).
-#include "models.h"
+#include "cadmorph/models.h"
+#include "cad_internal.hxx"
 
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepAlgoAPI_Fuse.hxx>
@@ -46,8 +47,6 @@
 #include <string>
 
 namespace {
-
-thread_local std::string last_error;
 
 const double deg = M_PI / 180.0;
 
@@ -150,13 +149,23 @@ TopoDS_Shape make_bracket(double t)
     return cut(cut(body, hole1, "bracket hole 1"), hole2, "bracket hole 2");
 }
 
+// CM_ERR_ARGUMENT for what the caller got wrong, before any OpenCASCADE work.
+cm_status check(cm_context *ctx, const char *fn, const char *model, double t)
+{
+    if (!model) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL model", fn);
+    if (!cm_model_known(model))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: unknown model '%s' (%s)", fn, model,
+                        cm_model_list());
+    if (!(t >= 0 && t <= 1))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: t must lie in [0, 1], got %g", fn, t);
+    return CM_OK;
+}
+
 TopoDS_Shape make(const char *model, double t)
 {
-    if (!(t >= 0 && t <= 1)) throw std::invalid_argument("t must lie in [0, 1]");
     if (!std::strcmp(model, "bore")) return make_bore(t);
     if (!std::strcmp(model, "pipe")) return make_pipe(t);
-    if (!std::strcmp(model, "bracket")) return make_bracket(t);
-    throw std::invalid_argument(std::string("unknown model '") + model + "' (bore, pipe, bracket)");
+    return make_bracket(t);
 }
 
 void quiet_occ()
@@ -165,45 +174,46 @@ void quiet_occ()
     Message::DefaultMessenger()->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
 }
 
-template <class F> int guard(F &&body)
-{
-    last_error.clear();
-    try {
-        return body();
-    } catch (const std::invalid_argument &e) {
-        last_error = e.what();
-        return -1;
-    } catch (const Standard_Failure &e) {
-        last_error = std::string("OpenCASCADE: ") + e.GetMessageString();
-    } catch (const std::exception &e) {
-        last_error = e.what();
-    } catch (...) {
-        last_error = "unknown exception";
-    }
-    return -2;
-}
-
 }  // namespace
 
-extern "C" int cm_model_write_step(const char *model, double t, const char *path)
+extern "C" cm_status cm_model_write_step(cm_context *ctx, const char *model, double t,
+                                         const char *path)
 {
-    return guard([&] {
-        TopoDS_Shape s = make(model, t);
+    static const char *fn = "cm_model_write_step";
+    cm_status st = check(ctx, fn, model, t);
+    if (st < 0) return st;
+    if (!path) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL path", fn);
+    return cmcad::guard(ctx, fn, [&]() -> cm_status {
+        TopoDS_Shape s;
+        try {
+            s = make(model, t);
+        } catch (const std::runtime_error &e) { // a boolean that did not give one solid
+            return cm_error(ctx, CM_ERR_CAD, "%s: %s at t = %g: %s", fn, model, t, e.what());
+        }
         quiet_occ();
         STEPControl_Writer writer;
         Interface_Static::SetCVal("write.step.unit", "MM");
         if (writer.Transfer(s, STEPControl_AsIs) != IFSelect_RetDone)
-            throw std::runtime_error("STEP transfer failed");
+            return cm_error(ctx, CM_ERR_CAD, "%s: %s at t = %g: STEP transfer failed", fn, model, t);
         if (writer.Write(path) != IFSelect_RetDone)
-            throw std::runtime_error(std::string("cannot write ") + path);
-        return 0;
+            return cm_error(ctx, CM_ERR_IO, "%s: cannot write %s", fn, path);
+        return CM_OK;
     });
 }
 
-extern "C" int cm_model_signature(const char *model, double t, char *buf, int size, double *volume)
+extern "C" cm_status cm_model_signature(cm_context *ctx, const char *model, double t, char *buf,
+                                        size_t size, double *volume)
 {
-    return guard([&] {
-        TopoDS_Shape s = make(model, t);
+    static const char *fn = "cm_model_signature";
+    cm_status st = check(ctx, fn, model, t);
+    if (st < 0) return st;
+    return cmcad::guard(ctx, fn, [&]() -> cm_status {
+        TopoDS_Shape s;
+        try {
+            s = make(model, t);
+        } catch (const std::runtime_error &e) {
+            return cm_error(ctx, CM_ERR_CAD, "%s: %s at t = %g: %s", fn, model, t, e.what());
+        }
         TopTools_IndexedMapOfShape solids, faces, edges, vertices;
         TopExp::MapShapes(s, TopAbs_SOLID, solids);
         TopExp::MapShapes(s, TopAbs_FACE, faces);
@@ -234,12 +244,7 @@ extern "C" int cm_model_signature(const char *model, double t, char *buf, int si
             BRepGProp::VolumeProperties(s, props);
             *volume = props.Mass();
         }
-        if (size > 0) {
-            std::snprintf(buf, (size_t)size, "%s", out.c_str());
-            return (int)(out.size() < (size_t)size ? out.size() : (size_t)size - 1);
-        }
-        return 0;
+        if (buf && size > 0) std::snprintf(buf, size, "%s", out.c_str());
+        return CM_OK;
     });
 }
-
-extern "C" const char *cm_model_error(void) { return last_error.c_str(); }

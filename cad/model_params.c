@@ -1,6 +1,8 @@
 /* Parameters of the benchmark models at t: linear interpolation between the values the issue
  * fixes for t = 0 and t = 1. Shared by the CAD models and the structured hex meshes. */
-#include "models.h"
+#include "cadmorph/models.h"
+
+#include <string.h>
 
 static double lerp(double a, double b, double t) { return a + (b - a) * t; }
 
@@ -29,3 +31,10 @@ void cm_model_bracket_at(double t, cm_model_bracket *p)
     p->hole1_x = lerp(3.0, 3.5, t);
     p->hole2_y = 3.0;
 }
+
+int cm_model_known(const char *name)
+{
+    return name && (!strcmp(name, "bore") || !strcmp(name, "pipe") || !strcmp(name, "bracket"));
+}
+
+const char *cm_model_list(void) { return "bore, pipe, bracket"; }

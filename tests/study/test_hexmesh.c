@@ -2,8 +2,7 @@
  * every node of the mesh boundary exactly on the model (analytic surfaces, 1e-12), the hex
  * volume close to the solid's (the faceted bore/pipe wall loses a little: 1e-2), and sizes
  * within the issue's 10k - 50k nodes. */
-#include "hexmesh.h"
-#include "models.h"
+#include "cadmorph/models.h"
 
 #include <math.h>
 #include <stdio.h>

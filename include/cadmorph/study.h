@@ -1,0 +1,220 @@
+/* cadmorph studies: a mesh M0 of G0 morphed onto every member of a family of geometries
+ * G(1..n) of G0's topology (DESIGN.md, study/), by several methods, absolutely and/or
+ * relatively, with quality, distance to G and stage times per variant; the CSV table and the
+ * SVG plot of the results. Conventions: see core.h.
+ *
+ *   absolute: one cm_morpher on M0 (one classification, one factorisation per warp method)
+ *             shared by every variant: cm_morpher_apply_method onto each G(i);
+ *   relative: G(i-1) -> G(i) step by step, one morpher per method re-based
+ *             (cm_morpher_rebase) on its previous result and that result's geometry.
+ * The family comes from a callback (cm_study_family: the built-in models of models.h use one
+ * through cm_sweep_run) or from a list of STEP files (cm_study_family_files). A variant that
+ * cannot be read or whose topology differs from G0 is a row with its error, not the end of
+ * the study. Progress: cm_progress stage "study", done/total = variants.
+ */
+#ifndef CADMORPH_STUDY_H
+#define CADMORPH_STUDY_H
+
+#include "cadmorph/morph.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+enum { CM_STUDY_ABSOLUTE = 1, CM_STUDY_RELATIVE = 2, CM_STUDY_BOTH = 3 };
+
+/* "absolute" / "relative" ("?" otherwise). */
+const char *cm_study_mode_name(int mode);
+
+/* ---- methods: a surface morph and a warp, named ----
+ * Names (one table in study/method.c; a new warp method of warp.h is a study method without
+ * changes here):
+ *   "rbf-s"              RBF-S surface morph + triharmonic RBF warp (the method)
+ *   "project"            closest-point surface + triharmonic RBF warp (baseline)
+ *   "rbf-s-biharmonic"   RBF-S + biharmonic RBF warp (the paper's comparison)
+ *   "<warp>"             closest-point surface + that warp: "rbf", "rbf-biharmonic", ...
+ *   "rbf-s-<warp>", "project-<warp>"   RBF-S / closest-point surface + that warp
+ * where <warp> is any name of cm_warp_method_name. A method keeps the name it was given
+ * (rows and files say "rbf" when asked for "rbf", although it is the same as "project"). */
+#define CM_STUDY_METHOD_NAME 48
+
+typedef struct cm_study_method {
+    char name[CM_STUDY_METHOD_NAME];
+    cm_morph_method method;
+} cm_study_method;
+
+/* CM_ERR_ARGUMENT (message lists the accepted forms) for an unknown name. */
+cm_status cm_study_method_parse(cm_context *ctx, const char *name, cm_study_method *out);
+/* A comma-separated list into out (cap entries); *n: how many. Empty entries, duplicates and
+ * more than cap methods are CM_ERR_ARGUMENT. */
+cm_status cm_study_methods_parse(cm_context *ctx, const char *list, cm_study_method *out,
+                                 size_t cap, size_t *n);
+/* The three methods the sweeps compare (rbf-s, project, rbf-s-biharmonic) into out (cap >= 3);
+ * returns how many were written. */
+size_t cm_study_default_methods(cm_study_method *out, size_t cap);
+/* A stable colour slot of a method for plots: its row in the named table (0, 1, 2), others
+ * from 3 on in the order given (k: the method's position in its study). */
+int cm_study_method_slot(const cm_study_method *m, size_t k);
+/* The accepted forms for usage and help text, e.g. "rbf-s, project, rbf-s-biharmonic, <warp>,
+ * rbf-s-<warp>, project-<warp> (<warp>: rbf|rbf-biharmonic)", into buf (size bytes). */
+void cm_study_method_help(char *buf, size_t size);
+
+/* ---- the family of geometries ---- */
+
+typedef struct cm_study_family {
+    size_t n; /* variants 0 .. n-1 (the morph targets; G0 is given separately) */
+    /* G of variant i into *g (the study destroys it). Any error becomes variant i's rows
+     * (its message with them); only CM_ERR_NOMEM ends the study. */
+    cm_status (*load)(cm_context *ctx, void *user, size_t i, cm_cad_model **g);
+    /* A short name of variant i for file names and the CSV (the STEP file's stem, "050"). */
+    void (*label)(void *user, size_t i, char *buf, size_t size);
+    /* Its parameter t in [0, 1] (CSV columns t, percent; the plot's x = t * x_max).
+     * NULL: (i + 1) / n. */
+    double (*param)(void *user, size_t i);
+    void (*destroy)(void *user); /* frees user; NULL if nothing to free */
+    void *user;
+    const char *x_label; /* the plot's x axis; NULL: "variant" */
+    double x_max;        /* the plot's x range [0, x_max]; 0: n */
+    double x_tick;       /* its tick spacing; 0: 1, 2 or 5 x 10^k for about 6 ticks */
+} cm_study_family;
+
+/* A family of STEP files: variant i is paths[i] read by cm_cad_read (opt may be NULL), its
+ * label the file name without directory and extension. paths are copied. */
+cm_status cm_study_family_files(cm_context *ctx, const char *const *paths, size_t n,
+                                const cm_cad_read_options *opt, cm_study_family *family);
+/* Calls family->destroy and clears *family. */
+void cm_study_family_release(cm_study_family *family);
+
+/* The variants of `cadmorph study --variants LIST`: LIST is a text file of STEP paths (one per
+ * line; blank lines and '#' comments skipped, surrounding blanks trimmed, a relative path is
+ * relative to the list file's directory) or, when it is not an existing file and contains
+ * '*', '?' or '[', a glob(3) pattern (matches sorted). Every path must name a readable file.
+ * Errors: CM_ERR_IO "LIST: cannot read: ..." or "LIST:<line>: <path>: No such file ...",
+ * CM_ERR_FORMAT "LIST: no STEP paths" for an empty list, CM_ERR_IO for a glob matching no
+ * file. *paths: *n strings, free with cm_study_paths_free. */
+cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n);
+void cm_study_paths_free(char ***paths, size_t n);
+
+/* ---- running a study ---- */
+
+enum {
+    CM_STUDY_WRITE_NONE = 0,
+    CM_STUDY_WRITE_ALL = 1,    /* every variant's mesh, per method and mode */
+    CM_STUDY_WRITE_FAILED = 2, /* the complete results with inverted cells */
+    CM_STUDY_WRITE_LISTED = 3  /* the variants flagged in write_listed */
+};
+
+typedef struct cm_study_options {
+    int modes;                     /* CM_STUDY_ABSOLUTE | CM_STUDY_RELATIVE (default both) */
+    const cm_study_method *methods; /* NULL: cm_study_default_methods */
+    size_t n_methods;
+    cm_morph_options morph; /* everything but the method (default cm_morph_options_init) */
+    int write_meshes;       /* CM_STUDY_WRITE_* (default NONE) */
+    const unsigned char *write_listed; /* #variants flags for CM_STUDY_WRITE_LISTED */
+    const char *out_dir;    /* meshes go to <out_dir>/<method>_<mode>_<label>.vtu, with
+                               per-cell scaled_jacobian and per-node displacement (from M0) */
+    const char *model;      /* names for the CSV columns model and mesh and the plot title */
+    const char *mesh;       /*   (NULL: "G0", "file") */
+} cm_study_options;
+
+void cm_study_options_init(cm_study_options *opt);
+
+/* One variant x method x mode. Times in seconds. status: CM_OK, CM_WARNING (complete, the
+ * message says what was odd: face nodes left their trimmed face) or the error that stopped
+ * this row (the quality fields are then 0). In absolute mode the classification of M0 and the
+ * factorisation of each warp happen once: t_classify is in each method's first row,
+ * t_volume_solve in the first row of each warp method. t_sample: reading G (or writing and
+ * reading it, for the models) and sampling it for the distance (once per variant and mode).
+ * t_evaluation includes the scaled Jacobian (t_quality stays 0: the morph engine measures
+ * both together). */
+typedef struct cm_study_row {
+    int mode;
+    size_t method;  /* index into the result's methods */
+    size_t variant; /* 0-based; the CSV's step is variant + 1 */
+    char label[64]; /* the family's label of the variant */
+    double t;
+    cm_status status;
+    char message[512];
+    double min_sj, mean_sj;
+    size_t inverted, cells;
+    double max_dist; /* largest distance of the boundary nodes to their G */
+    size_t outside;  /* face nodes whose (u',v') left the trimmed face */
+    double residual; /* the warp's miss at the constrained nodes */
+    double t_sample, t_classify, t_surface, t_volume_solve, t_evaluation, t_quality, t_distance,
+        t_write;
+} cm_study_row;
+
+typedef struct cm_study_result {
+    char model[64], mesh[64];
+    size_t nodes, cells, boundary_nodes;
+    double diagonal;          /* bbox diagonal of G0 */
+    double min_sj0, mean_sj0; /* quality of M0 (the curves start there) */
+    size_t inverted0;
+    int threads;
+    size_t n_methods;
+    cm_study_method *methods;
+    size_t n_variants;
+    char x_label[64];
+    double x_max, x_tick;
+    size_t n_rows, cap_rows;
+    cm_study_row *rows; /* variant-major: per variant, the absolute rows then the relative */
+    size_t n_failed;    /* rows with status < 0 */
+    double t_total;
+} cm_study_result;
+
+/* Morphs mesh (of g0; both borrowed for the call) onto every variant of family. Errors that
+ * end the study: M not a mesh of G0 and the other errors of cm_morpher_create, out of memory,
+ * a mesh that cannot be written. Returns CM_WARNING (message: the first failed row) when rows
+ * failed; their errors also go to the log as warnings. */
+cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *mesh,
+                       const cm_study_family *family, const cm_study_options *opt,
+                       cm_study_result **result);
+void cm_study_result_destroy(cm_study_result **result);
+
+/* ---- outputs ---- */
+
+enum {
+    CM_STUDY_CSV_FULL = 0, /* study.csv: every row, with columns variant, status, message */
+    CM_STUDY_CSV_SWEEP = 1 /* sweep.csv of issue 6: its columns only, complete rows only */
+};
+
+/* Header, then one row per cm_study_row (through a temporary file, renamed at the end).
+ * Columns: model,mesh,mode,method,step,t,percent,min_scaled_jacobian,mean_scaled_jacobian,
+ * inverted,cells,max_distance,max_distance_rel,outside,nodes,boundary_nodes,threads,t_sample,
+ * t_classify,t_surface,t_volume_solve,t_evaluation,t_quality,t_distance,t_write and, FULL,
+ * variant (label),status (cm_status_name),message (RFC 4180 quoting). */
+cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const char *path,
+                             int format);
+
+/* The plot: min scaled Jacobian against t * x_max, one polyline per method x mode (solid
+ * absolute, dashed relative) from M0 through its complete rows, axes, ticks, legend, title;
+ * failed variants are marked on the x axis. */
+cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const char *path);
+
+/* ---- sweeps of the built-in models (models.h): `cadmorph sweep` and `demo` ---- */
+
+typedef struct cm_sweep_options {
+    const char *model;   /* bore | pipe | bracket */
+    const char *mesh;    /* "tet", "hex" or the path of a mesh of G(0) */
+    double size;         /* tet: target edge (<= 0: 0.2); hex: cells of about this size
+                            (<= 0: 0.1; resolution scales as 0.1 / size) */
+    int modes;           /* CM_STUDY_ABSOLUTE | CM_STUDY_RELATIVE */
+    int steps;           /* N >= 1: G(k / N), k = 1 .. N */
+    const cm_study_method *methods; /* NULL: cm_study_default_methods */
+    size_t n_methods;
+    const char *out_dir; /* existing directory for G_<t>.step (removed unless write_step) and
+                            the meshes at 50 and 100 % (<method>_<mode>_<pct>.vtu) */
+    int write_step;      /* keep DIR/G_<t>.step */
+    int write_meshes;    /* write the meshes at 50 % and 100 % */
+} cm_sweep_options;
+
+void cm_sweep_options_init(cm_sweep_options *opt);
+
+/* Writes G(0) .. G(1) as STEP and reads them back (what a user's file goes through), meshes
+ * G(0) and runs the study. Errors as cm_study_run, and the meshers'. */
+cm_status cm_sweep_run(cm_context *ctx, const cm_sweep_options *opt, cm_study_result **result);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,194 @@
+/* Families of STEP files (study.h): the variant list of `cadmorph study` (a list file or a
+ * glob pattern) and the family that reads its files one at a time. */
+#include "cadmorph/study.h"
+
+#include <errno.h>
+#include <glob.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+void cm_study_paths_free(char ***paths, size_t n)
+{
+    if (!paths || !*paths) return;
+    for (size_t i = 0; i < n; ++i)
+        free((*paths)[i]);
+    free(*paths);
+    *paths = NULL;
+}
+
+typedef struct path_list {
+    char **v;
+    size_t n, cap;
+} path_list;
+
+static cm_status push(cm_context *ctx, path_list *l, const char *dir, size_t dir_len,
+                      const char *path, size_t len)
+{
+    if (l->n == l->cap) {
+        size_t cap = l->cap ? 2 * l->cap : 16;
+        char **v = realloc(l->v, cap * sizeof *v);
+        if (!v) return cm_error(ctx, CM_ERR_NOMEM, "cm_study_read_list: out of memory");
+        l->v = v;
+        l->cap = cap;
+    }
+    /* dir: the list file's directory with its trailing '/' (dir_len 0: none) */
+    size_t k = path[0] != '/' ? dir_len : 0;
+    char *p = malloc(k + len + 1);
+    if (!p) return cm_error(ctx, CM_ERR_NOMEM, "cm_study_read_list: out of memory");
+    if (k) memcpy(p, dir, k);
+    memcpy(p + k, path, len);
+    p[k + len] = 0;
+    l->v[l->n++] = p;
+    return CM_OK;
+}
+
+/* A readable regular file, else the reason. */
+static const char *unreadable(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return strerror(errno);
+    if (S_ISDIR(st.st_mode)) return "is a directory";
+    FILE *f = fopen(path, "rb");
+    if (!f) return strerror(errno);
+    fclose(f);
+    return NULL;
+}
+
+static cm_status read_file(cm_context *ctx, const char *list, path_list *l)
+{
+    FILE *f = fopen(list, "r");
+    if (!f) return cm_error(ctx, CM_ERR_IO, "%s: cannot read: %s", list, strerror(errno));
+    const char *slash = strrchr(list, '/');
+    size_t dir_len = slash ? (size_t)(slash - list) + 1 : 0;
+    char *line = NULL;
+    size_t size = 0;
+    long lineno = 0;
+    cm_status s = CM_OK;
+    while (s >= 0 && getline(&line, &size, f) >= 0) {
+        ++lineno;
+        char *hash = strchr(line, '#');
+        if (hash) *hash = 0;
+        char *b = line, *e = line + strlen(line);
+        while (*b == ' ' || *b == '\t') ++b;
+        while (e > b && (e[-1] == ' ' || e[-1] == '\t' || e[-1] == '\n' || e[-1] == '\r')) --e;
+        if (e == b) continue;
+        *e = 0;
+        s = push(ctx, l, list, dir_len, b, (size_t)(e - b));
+        if (s < 0) break;
+        const char *why = unreadable(l->v[l->n - 1]);
+        if (why)
+            s = cm_error(ctx, CM_ERR_IO, "%s:%ld: %s: %s", list, lineno, l->v[l->n - 1], why);
+    }
+    if (s >= 0 && ferror(f)) s = cm_error(ctx, CM_ERR_IO, "%s: read error", list);
+    free(line);
+    fclose(f);
+    if (s >= 0 && l->n == 0) s = cm_error(ctx, CM_ERR_FORMAT, "%s: no STEP paths", list);
+    return s;
+}
+
+static cm_status read_glob(cm_context *ctx, const char *pattern, path_list *l)
+{
+    glob_t g;
+    int rc = glob(pattern, 0, NULL, &g);
+    if (rc == GLOB_NOMATCH) return cm_error(ctx, CM_ERR_IO, "%s: no file matches", pattern);
+    if (rc == GLOB_NOSPACE) return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", pattern);
+    if (rc != 0) return cm_error(ctx, CM_ERR_IO, "%s: cannot expand the pattern", pattern);
+    cm_status s = CM_OK;
+    for (size_t i = 0; i < g.gl_pathc && s >= 0; ++i) {
+        s = push(ctx, l, NULL, 0, g.gl_pathv[i], strlen(g.gl_pathv[i]));
+        const char *why = s >= 0 ? unreadable(g.gl_pathv[i]) : NULL;
+        if (why) s = cm_error(ctx, CM_ERR_IO, "%s: %s: %s", pattern, g.gl_pathv[i], why);
+    }
+    globfree(&g);
+    return s;
+}
+
+cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n)
+{
+    if (paths) *paths = NULL;
+    if (n) *n = 0;
+    if (!list || !paths || !n) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_read_list: NULL input");
+    path_list l = {0};
+    struct stat st;
+    int is_file = stat(list, &st) == 0;
+    cm_status s = !is_file && strpbrk(list, "*?[") ? read_glob(ctx, list, &l)
+                                                     : read_file(ctx, list, &l);
+    if (s < 0) {
+        cm_study_paths_free(&l.v, l.n);
+        return s;
+    }
+    *paths = l.v;
+    *n = l.n;
+    return CM_OK;
+}
+
+/* ---- the family over the files ---- */
+
+typedef struct files {
+    char **paths;
+    size_t n;
+    cm_cad_read_options opt;
+    int has_opt;
+} files;
+
+static cm_status files_load(cm_context *ctx, void *user, size_t i, cm_cad_model **g)
+{
+    files *f = user;
+    cm_status s = cm_cad_read(ctx, f->paths[i], f->has_opt ? &f->opt : NULL, g);
+    return s < 0 ? cm_error_prefix(ctx, s, "%s", f->paths[i]) : s;
+}
+
+static void files_label(void *user, size_t i, char *buf, size_t size)
+{
+    const files *f = user;
+    const char *base = strrchr(f->paths[i], '/');
+    base = base ? base + 1 : f->paths[i];
+    const char *dot = strrchr(base, '.');
+    int len = dot && dot != base ? (int)(dot - base) : (int)strlen(base);
+    snprintf(buf, size, "%.*s", len, base);
+}
+
+static void files_destroy(void *user)
+{
+    files *f = user;
+    cm_study_paths_free(&f->paths, f->n);
+    free(f);
+}
+
+cm_status cm_study_family_files(cm_context *ctx, const char *const *paths, size_t n,
+                                const cm_cad_read_options *opt, cm_study_family *family)
+{
+    if (family) memset(family, 0, sizeof *family);
+    if (!paths || !family) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_family_files: NULL input");
+    files *f = calloc(1, sizeof *f);
+    if (f) f->paths = calloc(n ? n : 1, sizeof *f->paths);
+    if (!f || !f->paths) {
+        free(f);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_study_family_files: out of memory");
+    }
+    for (size_t i = 0; i < n; ++i) {
+        f->paths[i] = paths[i] ? strdup(paths[i]) : NULL;
+        f->n = i + 1;
+        if (!f->paths[i]) {
+            files_destroy(f);
+            return paths[i] ? cm_error(ctx, CM_ERR_NOMEM, "cm_study_family_files: out of memory")
+                            : cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_family_files: path %zu is NULL", i);
+        }
+    }
+    if (opt) f->opt = *opt, f->has_opt = 1;
+    family->n = n;
+    family->load = files_load;
+    family->label = files_label;
+    family->destroy = files_destroy;
+    family->user = f;
+    return CM_OK;
+}
+
+void cm_study_family_release(cm_study_family *family)
+{
+    if (!family) return;
+    if (family->destroy) family->destroy(family->user);
+    memset(family, 0, sizeof *family);
+}
