@@ -173,7 +173,7 @@ static cm_status run_variant(cm_context *ctx, study *w, size_t i, cm_cad_model *
     /* checked here, before any morpher sees g: a variant of another topology touches none */
     if (s >= 0) {
         s = cm_cad_compare(ctx, w->g0, g, 5);
-        if (s < 0) s = cm_error_prefix(ctx, s, "topology differs from G0");
+        if (s < 0) s = cm_error_prefix(ctx, s, "%s against G0", label);
     }
     double t_load = cm_wtime() - t0;
     if (s < 0) {
