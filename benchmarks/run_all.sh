@@ -13,3 +13,4 @@ echo "== RBF vs scipy";        sh "$root/benchmarks/bench_rbf.sh" "$build" 2
 echo "== CAD layer";           "$build/benchmarks/bench_cad" "$root/tests/data/cad/bore_a.step" 1e6 1e5 2
 echo "== models, tet meshes";  sh "$root/benchmarks/models/bench_models.sh" "$build" "$work/models"
 echo "== sweeps (20 steps, all models)"; sh "$root/benchmarks/sweep/run_sweeps.sh" "$build" "$work/sweeps" 2
+echo "== study: 20 bore variants vs one"; sh "$root/benchmarks/bench_study.sh" "$build" "$work/study" 2

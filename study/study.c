@@ -173,7 +173,7 @@ static cm_status run_variant(cm_context *ctx, study *w, size_t i, cm_cad_model *
     /* checked here, before any morpher sees g: a variant of another topology touches none */
     if (s >= 0) {
         s = cm_cad_compare(ctx, w->g0, g, 5);
-        if (s < 0) s = cm_error_prefix(ctx, s, "%s against G0", label);
+        if (s < 0) s = cm_error_prefix(ctx, s, "not a variant of G0");
     }
     double t_load = cm_wtime() - t0;
     if (s < 0) {
@@ -303,7 +303,14 @@ static cm_status setup(cm_context *ctx, study *w)
             se->method = m;
             if (mode == CM_STUDY_ABSOLUTE && w->abs) continue;
             cm_morpher **mp = mode == CM_STUDY_ABSOLUTE ? &w->abs : &se->mp;
-            s = cm_morpher_create(ctx, w->g0, w->mesh0, &o->morph, mp);
+            cm_morph_options mo = o->morph;
+            /* absolute: the targets are sampled only to measure the distance of the boundary
+             * to them, at 16 times fewer samples than the classification needs (the cost that
+             * would otherwise dominate a variant); relative: the fine sampling of a target is
+             * reused by the rebase onto it */
+            if (mode == CM_STUDY_ABSOLUTE && !(mo.target_h_scale > 0))
+                mo.target_h_scale = CM_STUDY_TARGET_H_SCALE;
+            s = cm_morpher_create(ctx, w->g0, w->mesh0, &mo, mp);
             if (s < 0) return cm_error_prefix(ctx, s, "M0 on G0");
             if (s == CM_WARNING && mode == CM_STUDY_ABSOLUTE)
                 cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
@@ -378,9 +385,9 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
     *result = r;
     for (size_t i = 0; i < r->n_rows; ++i)
         if (r->rows[i].status < 0)
-            return cm_error(ctx, CM_WARNING, "%zu of %zu rows failed; first: %s, %s, variant %zu: %s",
+            return cm_error(ctx, CM_WARNING, "%zu of %zu rows failed; first: %s, %s, variant %s: %s",
                             r->n_failed, r->n_rows, r->methods[r->rows[i].method].name,
-                            cm_study_mode_name(r->rows[i].mode), r->rows[i].variant + 1,
+                            cm_study_mode_name(r->rows[i].mode), r->rows[i].label,
                             r->rows[i].message);
     return CM_OK;
 }

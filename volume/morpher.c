@@ -81,11 +81,11 @@ static cm_status release(cm_context *ctx, const held_warnings *h)
 }
 
 static cm_status make_locator(cm_context *ctx, const cm_morpher *mp, const cm_cad_model *g,
-                              cm_cad_locator **loc)
+                              double scale, cm_cad_locator **loc)
 {
     cm_cad_sample_options so;
     cm_cad_sample_options_init(&so);
-    so.h = mp->info.h;
+    so.h = mp->info.h * (scale > 1 ? scale : 1);
     so.max_samples = mp->opt.max_samples ? mp->opt.max_samples : CM_MORPH_MAX_SAMPLES;
     return cm_cad_locator_create(ctx, g, &so, loc);
 }
@@ -96,7 +96,7 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
     double t0 = cm_wtime();
     cm_status s = CM_OK;
     if (!mp->loc) {
-        s = make_locator(ctx, mp, mp->g, &mp->loc);
+        s = make_locator(ctx, mp, mp->g, 1, &mp->loc);
         if (s < 0) return s;
         hold(ctx, held, s);
         mp->info.h = cm_cad_locator_h(mp->loc);
@@ -217,7 +217,7 @@ static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
     double t0 = cm_wtime();
     cm_cad_locator_destroy(&mp->target_loc);
     mp->target = NULL;
-    s = make_locator(ctx, mp, target, &mp->target_loc);
+    s = make_locator(ctx, mp, target, mp->opt.target_h_scale, &mp->target_loc);
     if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
     if (s < 0) return s;
     mp->target = target;
@@ -517,7 +517,8 @@ cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
         cm_status s = cm_cad_compare(ctx, mp->g, g, 5);
         if (s < 0) return cm_error_prefix(ctx, s, "the new base does not correspond to G");
         cm_cad_locator_destroy(&mp->loc);
-        if (g == mp->target) { /* the usual case: rebase onto the last target */
+        if (g == mp->target && !(mp->opt.target_h_scale > 1)) {
+            /* the usual case: rebase onto the last target, sampled at the classification h */
             mp->loc = mp->target_loc;
             mp->target_loc = NULL;
             mp->target = NULL;

@@ -63,6 +63,12 @@ typedef struct cm_morph_options {
     /* Samples of each model for the locators: h is a quarter of the shortest boundary edge,
      * raised (with a warning) if that needs more than max_samples; 0: CM_MORPH_MAX_SAMPLES. */
     size_t max_samples;
+    /* h of the locators on target geometries, which only measure max_dist (points that the
+     * surface morph put on the target), as a multiple of the classification h; values <= 1
+     * mean 1 (the default). Absolute studies raise it: sampling each target at the fine h
+     * would cost more than the morph itself. A rebase onto a target sampled coarser samples
+     * it again at the classification h. */
+    double target_h_scale;
     cm_classify_options classify;
     cm_surface_morph_options morph; /* its method field is replaced by method.surface */
 } cm_morph_options;

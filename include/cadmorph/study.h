@@ -23,6 +23,10 @@ extern "C" {
 
 enum { CM_STUDY_ABSOLUTE = 1, CM_STUDY_RELATIVE = 2, CM_STUDY_BOTH = 3 };
 
+/* Sampling of the absolute study's targets (cm_morph_options.target_h_scale): they are only
+ * sampled to measure the boundary's distance to them. */
+#define CM_STUDY_TARGET_H_SCALE 4.0
+
 /* "absolute" / "relative" ("?" otherwise). */
 const char *cm_study_mode_name(int mode);
 
@@ -108,7 +112,9 @@ typedef struct cm_study_options {
     int modes;                     /* CM_STUDY_ABSOLUTE | CM_STUDY_RELATIVE (default both) */
     const cm_study_method *methods; /* NULL: cm_study_default_methods */
     size_t n_methods;
-    cm_morph_options morph; /* everything but the method (default cm_morph_options_init) */
+    cm_morph_options morph; /* everything but the method (default cm_morph_options_init;
+                               its target_h_scale 0 means CM_STUDY_TARGET_H_SCALE for the
+                               absolute morpher, 1 for the relative ones) */
     int write_meshes;       /* CM_STUDY_WRITE_* (default NONE) */
     const unsigned char *write_listed; /* #variants flags for CM_STUDY_WRITE_LISTED */
     const char *out_dir;    /* meshes go to <out_dir>/<method>_<mode>_<label>.vtu, with
@@ -122,9 +128,11 @@ void cm_study_options_init(cm_study_options *opt);
 /* One variant x method x mode. Times in seconds. status: CM_OK, CM_WARNING (complete, the
  * message says what was odd: face nodes left their trimmed face) or the error that stopped
  * this row (the quality fields are then 0). In absolute mode the classification of M0 and the
- * factorisation of each warp happen once: t_classify is in each method's first row,
- * t_volume_solve in the first row of each warp method. t_sample: reading G (or writing and
- * reading it, for the models) and sampling it for the distance (once per variant and mode).
+ * factorisation of each warp happen once: t_classify (sampling G0 and classifying M0) is in
+ * each method's first row, t_volume_solve in the first row of each warp method; relative rows
+ * have the re-base onto the previous variant in t_classify. t_sample: reading G (writing and
+ * reading it, for the models) and checking it against G0, in every row of the variant, plus
+ * sampling G for the distance in the first row of each morpher that measures against it.
  * t_evaluation includes the scaled Jacobian (t_quality stays 0: the morph engine measures
  * both together). */
 typedef struct cm_study_row {

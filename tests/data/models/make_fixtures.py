@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Writes the STEP fixtures of the tet meshing tests through gmsh's OpenCASCADE kernel (an
-independent writer: cadmorph's own models come from benchmarks/models). Run with Debian's
+independent writer: cadmorph's own models come from cad/models.cpp). Run with Debian's
 /usr/bin/python3 from this directory:
   bore_0.step  the bore benchmark model at t = 0: block [-2,2] x [-2,2] x [0,2] minus a
                cylinder of radius 0.6 along z through its centre
