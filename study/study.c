@@ -49,7 +49,6 @@ typedef struct study {
     cm_cad_model *last, *base;
     cm_mesh *work; /* M0 with the output fields, coordinates of the row being written */
     double *sj, *dfield, *xyz;
-    cm_morph_step *steps;
     series *s;
     size_t n_series;
 } study;
@@ -105,35 +104,33 @@ static cm_status write_mesh(cm_context *ctx, study *w, const cm_morpher *mp, con
     return s;
 }
 
-/* One morph of series se onto g: the row's figures from the morph engine's steps. */
+/* One morph of series se onto g: the row's figures from the morph engine's (its steps added
+ * up, the quality of the last). */
 static cm_status morph(cm_context *ctx, study *w, series *se, cm_morpher *mp,
                        const cm_cad_model *g, const char *label, cm_study_row *row)
 {
     const cm_study_method *m = &w->r->methods[se->method];
-    int n = w->o->morph.steps;
-    cm_status s = cm_morpher_apply_method(ctx, mp, g, &m->method, w->xyz, w->steps);
-    for (int k = 0; k < n; ++k) {
-        const cm_morph_step *st = &w->steps[k];
-        row->t_sample += st->t_sample;
-        row->t_surface += st->t_surface;
-        row->t_volume_solve += st->t_volume_solve;
-        row->t_evaluation += st->t_evaluation;
-        row->t_distance += st->t_distance;
-        if (st->residual > row->residual) row->residual = st->residual;
-    }
+    cm_morph_step st;
+    memset(&st, 0, sizeof st);
+    cm_status s = cm_morpher_apply_method(ctx, mp, g, &m->method, w->xyz, &st);
+    row->t_sample += st.t_sample;
+    row->t_surface += st.t_surface;
+    row->t_volume_solve += st.t_volume_solve;
+    row->t_evaluation += st.t_evaluation;
+    row->t_distance += st.t_distance;
+    row->residual = st.residual;
     if (s < 0) {
         row_error(row, s, cm_context_message(ctx));
         return s;
     }
-    const cm_morph_step *last = &w->steps[n - 1];
     row->status = s;
-    if (s == CM_WARNING) row_error(row, s, cm_context_message(ctx)), row->status = CM_WARNING;
-    row->min_sj = last->min_sj;
-    row->mean_sj = last->mean_sj;
-    row->inverted = last->inverted;
-    row->cells = last->cells;
-    row->max_dist = last->max_dist;
-    row->outside = last->outside;
+    if (s == CM_WARNING) row_error(row, s, cm_context_message(ctx));
+    row->min_sj = st.min_sj;
+    row->mean_sj = st.mean_sj;
+    row->inverted = st.inverted;
+    row->cells = st.cells;
+    row->max_dist = st.max_dist;
+    row->outside = st.outside;
     if (wants_mesh(w, row)) {
         cm_status e = write_mesh(ctx, w, mp, label, row);
         if (e < 0) return e;
@@ -265,7 +262,6 @@ static void study_free(study *w)
     free(w->s);
     cm_mesh_destroy(&w->work);
     free(w->xyz);
-    free(w->steps);
     cm_cad_model *last = w->last, *base = w->base;
     w->last = w->base = NULL;
     if (last != base) cm_cad_destroy(&base);
@@ -292,9 +288,8 @@ static cm_status setup(cm_context *ctx, study *w)
     r->mean_sj0 = q0.mean;
     r->inverted0 = q0.inverted;
     w->xyz = malloc(3 * (nn ? nn : 1) * sizeof *w->xyz);
-    w->steps = calloc((size_t)o->morph.steps, sizeof *w->steps);
     w->s = calloc(2 * r->n_methods, sizeof *w->s);
-    if (!w->xyz || !w->steps || !w->s) return cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");
+    if (!w->xyz || !w->s) return cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");
     for (int mode = CM_STUDY_ABSOLUTE; mode <= CM_STUDY_RELATIVE; ++mode) {
         if (!(o->modes & mode)) continue;
         for (size_t m = 0; m < r->n_methods; ++m) {
@@ -328,7 +323,7 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
     if (result) *result = NULL;
     if (!g0 || !mesh || !family || !family->load || !family->label || !opt || !result)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_run: NULL input");
-    if (!(opt->modes & CM_STUDY_BOTH) || opt->morph.steps < 1 || (opt->methods && !opt->n_methods))
+    if (!(opt->modes & CM_STUDY_BOTH) || opt->morph.steps < 0 || (opt->methods && !opt->n_methods))
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_run: modes %d, steps %d, %zu methods",
                         opt->modes, opt->morph.steps, opt->n_methods);
     if (opt->write_meshes == CM_STUDY_WRITE_LISTED && !opt->write_listed)
