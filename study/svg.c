@@ -207,8 +207,9 @@ cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const ch
     xml_text(f, r->model);
     fputs(", ", f);
     xml_text(f, r->mesh);
-    fprintf(f, " mesh (%zu nodes, %zu cells): min scaled Jacobian over the sweep</text>\n",
-            r->nodes, r->cells);
+    /* a family counted in variants is a study; one in percent of a parameter a sweep */
+    fprintf(f, " mesh (%zu nodes, %zu cells): min scaled Jacobian over the %s</text>\n",
+            r->nodes, r->cells, strcmp(r->x_label, "variant") ? "sweep" : "study");
     axes(f, &fr, r->x_label);
     failed_marks(f, r, &fr);
     int shown = 0;
