@@ -25,6 +25,11 @@ extern "C" {
 typedef enum cm_warp_method {
     CM_WARP_RBF = 0,            /* "rbf": triharmonic RBF, phi = r^3 + linear (the method) */
     CM_WARP_RBF_BIHARMONIC = 1, /* "rbf-biharmonic": phi = r + linear (the paper's comparison) */
+    /* Staten et al. (IMR 2011)'s comparators, paper section 5: */
+    CM_WARP_FEMWARP = 2, /* "femwarp": linear finite-element Laplace warp (Baker 2001) */
+    CM_WARP_LBWARP = 3,  /* "lbwarp": log-barrier weighted Laplacian (Shontz, Vavasis 2003) */
+    CM_WARP_SIMPLEX = 4, /* "simplex": barycentrics in a Delaunay tet mesh of the constrained
+                            nodes (linear-simplex, a generalisation of BMSWEEP) */
     CM_WARP_N_METHODS
 } cm_warp_method;
 
@@ -71,6 +76,11 @@ cm_warp_method cm_warp_get_method(const cm_warp *warp);
  * miss by. */
 double cm_warp_residual(const cm_warp *warp);
 
+/* Nodes the method could not treat by its own rule and gave its documented fallback: LBWARP,
+ * nodes without positive log-barrier weights (outside the convex hull of their neighbours);
+ * simplex, nodes outside every Delaunay tet. 0 for the other methods. */
+size_t cm_warp_fallback_nodes(const cm_warp *warp);
+
 /* ---- warping a whole mesh: what `cadmorph warp` does ---- */
 
 typedef struct cm_warp_mesh_stats {
@@ -78,6 +88,7 @@ typedef struct cm_warp_mesh_stats {
     double t_create, t_apply, t_optimize; /* seconds */
     double residual;                      /* cm_warp_residual */
     size_t optimized_moves;               /* node moves kept by the optimisation */
+    size_t fallback_nodes;                /* cm_warp_fallback_nodes */
 } cm_warp_mesh_stats;
 
 /* Moves mesh by disp (#nodes x 3; read at the boundary nodes and at listed nodes, the rest
