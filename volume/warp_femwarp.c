@@ -278,7 +278,6 @@ static cm_status femwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_m
                                 const unsigned char *constrained, const cm_warp_options *opt,
                                 void **state)
 {
-    (void)b;
     (void)opt;
     for (size_t c = 0; c < mesh->n_cells; ++c) {
         if (!cm_warp_is_volume_cell(mesh, c)) continue;
@@ -292,7 +291,7 @@ static cm_status femwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_m
     }
     femwarp *w = calloc(1, sizeof *w);
     if (!w) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-    cm_status s = cm_warp_nodes_create(ctx, mesh, constrained, &w->nodes);
+    cm_status s = cm_warp_nodes_create(ctx, mesh, b, constrained, &w->nodes);
     if (s < 0) {
         free(w);
         return s;

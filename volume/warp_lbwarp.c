@@ -226,7 +226,6 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
                                const unsigned char *constrained, const cm_warp_options *opt,
                                void **state)
 {
-    (void)b;
     (void)opt;
     lbwarp *w = calloc(1, sizeof *w);
     if (!w) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
@@ -235,7 +234,7 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
     double *tx = NULL, *dxyz = NULL, *wt = NULL;
     void *symbolic = NULL;
     size_t max_len = 1, ii = 0, nt = 0, cap_t = 0, cap_ib = 0;
-    cm_status s = cm_warp_nodes_create(ctx, mesh, constrained, &w->nodes);
+    cm_status s = cm_warp_nodes_create(ctx, mesh, b, constrained, &w->nodes);
     if (s < 0) goto fail;
     const cm_warp_nodes *nd = w->nodes;
     size_t nf = nd->n_free;

@@ -46,7 +46,8 @@ cm_status cm_simplex_locate(cm_context *ctx, const double *pts, size_t n_pts, co
 
 /* The nodes of volume cells split into free (unconstrained) and fixed (constrained) ones,
  * each numbered in ascending node order. Unconstrained nodes of no volume cell are in
- * neither (a CM_LOG_WARNING gives their count, as for the RBF). */
+ * neither (a CM_LOG_WARNING gives their count, as for the RBF). A component of b with free
+ * nodes but no constrained node is CM_ERR_NUMERIC (nothing defines its motion). */
 typedef struct cm_warp_nodes {
     size_t n_nodes, n_free, n_fixed;
     int64_t *free_index;  /* #nodes: index among the free nodes, -1 for the others */
@@ -55,7 +56,7 @@ typedef struct cm_warp_nodes {
     int64_t *fixed_nodes; /* n_fixed node ids, ascending */
 } cm_warp_nodes;
 
-cm_status cm_warp_nodes_create(cm_context *ctx, const cm_mesh *mesh,
+cm_status cm_warp_nodes_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                                const unsigned char *constrained, cm_warp_nodes **nodes);
 void cm_warp_nodes_destroy(cm_warp_nodes **nodes);
 

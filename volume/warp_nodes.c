@@ -46,16 +46,18 @@ void cm_warp_nodes_destroy(cm_warp_nodes **nodes)
     *nodes = NULL;
 }
 
-cm_status cm_warp_nodes_create(cm_context *ctx, const cm_mesh *mesh,
+cm_status cm_warp_nodes_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                                const unsigned char *constrained, cm_warp_nodes **nodes)
 {
     *nodes = NULL;
-    size_t nn = mesh->n_nodes;
+    size_t nn = mesh->n_nodes, nc = b->n_components;
     cm_warp_nodes *w = calloc(1, sizeof *w);
     unsigned char *in_cell = calloc(nn ? nn : 1, 1);
+    /* per component: 1 has a free node, 2 has a constrained node */
+    unsigned char *comp = calloc(nc ? nc : 1, 1);
     int64_t *buf = NULL;
     size_t cap = 0;
-    if (!w || !in_cell) goto nomem;
+    if (!w || !in_cell || !comp) goto nomem;
     w->n_nodes = nn;
     for (size_t c = 0; c < mesh->n_cells; ++c) {
         if (!cm_warp_is_volume_cell(mesh, c)) continue;
@@ -66,9 +68,21 @@ cm_status cm_warp_nodes_create(cm_context *ctx, const cm_mesh *mesh,
             if (!(buf = malloc(cap * sizeof *buf))) goto nomem;
         }
         size_t k = cm_warp_cell_nodes(mesh, c, buf);
-        for (size_t i = 0; i < k; ++i)
+        int kc = b->cell_component[c];
+        for (size_t i = 0; i < k; ++i) {
             in_cell[buf[i]] = 1;
+            if (kc >= 0 && (size_t)kc < nc) comp[kc] |= constrained[buf[i]] ? 2 : 1;
+        }
     }
+    for (size_t k = 0; k < nc; ++k)
+        if (comp[k] == 1) {
+            free(in_cell);
+            free(comp);
+            free(buf);
+            cm_warp_nodes_destroy(&w);
+            return cm_error(ctx, CM_ERR_NUMERIC,
+                            "cm_warp_create: component %zu: no constrained node", k);
+        }
     size_t stray = 0;
     for (size_t v = 0; v < nn; ++v) {
         if (in_cell[v]) {
@@ -103,11 +117,13 @@ cm_status cm_warp_nodes_create(cm_context *ctx, const cm_mesh *mesh,
                "where they are",
                stray);
     free(in_cell);
+    free(comp);
     free(buf);
     *nodes = w;
     return CM_OK;
 nomem:
     free(in_cell);
+    free(comp);
     free(buf);
     cm_warp_nodes_destroy(&w);
     return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");

@@ -18,6 +18,7 @@ extern "C" {
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <new>
@@ -98,6 +99,35 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
         return cm_error(ctx, CM_ERR_NUMERIC, "%s: %zu constrained nodes, a tet needs 4", fn, n_pts);
     if (n_pts > (size_t)0x7fffffff)
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: too many constrained nodes for TetGen", fn);
+    // coplanar points: TetGen asserts (aborts) on a zero extent instead of throwing, so find
+    // four points spanning a tet first (farthest from a point, a line, then a plane)
+    {
+        auto dist2 = [&](size_t i, size_t j) {
+            double s2 = 0;
+            for (int k = 0; k < 3; ++k) s2 += (pts[3 * i + k] - pts[3 * j + k]) * (pts[3 * i + k] - pts[3 * j + k]);
+            return s2;
+        };
+        size_t a = 0, b = 0, c = 0;
+        for (size_t i = 1; i < n_pts; ++i)
+            if (dist2(0, i) > dist2(0, b)) b = i;
+        const double *pa = pts, *pb = pts + 3 * b, l2 = dist2(0, b);
+        double best = 0;
+        for (size_t i = 0; i < n_pts; ++i) {
+            const double *p = pts + 3 * i;
+            double u[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]},
+                   v[3] = {p[0] - pa[0], p[1] - pa[1], p[2] - pa[2]};
+            double w[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+            double a2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+            if (a2 > best) best = a2, c = i;
+        }
+        double vol = 0;
+        for (size_t i = 0; i < n_pts; ++i)
+            vol = std::max(vol, std::fabs(orient(pa, pb, pts + 3 * c, pts + 3 * i)));
+        (void)a;
+        if (!(l2 > 0) || !(vol > 1e-12 * l2 * std::sqrt(l2)))
+            return cm_error(ctx, CM_ERR_NUMERIC,
+                            "%s: the %zu constrained nodes are coplanar: no Delaunay tet", fn, n_pts);
+    }
     tetgenio in, out;
     in.firstnumber = 0;
     in.numberofpoints = (int)n_pts;
@@ -179,10 +209,10 @@ struct simplex_warp {
     ~simplex_warp() { cm_warp_nodes_destroy(&nodes); }
 };
 
-cm_status create(cm_context *ctx, const cm_mesh *mesh, const unsigned char *constrained,
-                 simplex_warp *w)
+cm_status create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
+                 const unsigned char *constrained, simplex_warp *w)
 {
-    cm_status s = cm_warp_nodes_create(ctx, mesh, constrained, &w->nodes);
+    cm_status s = cm_warp_nodes_create(ctx, mesh, b, constrained, &w->nodes);
     if (s < 0) return s;
     const cm_warp_nodes &n = *w->nodes;
     if (n.n_free == 0) return CM_OK;
@@ -232,13 +262,13 @@ size_t simplex_fallback_nodes(const void *state)
     return state ? static_cast<const simplex_warp *>(state)->n_outside : 0;
 }
 
-cm_status simplex_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *,
+cm_status simplex_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                          const unsigned char *constrained, const cm_warp_options *, void **state)
 {
     simplex_warp *w = nullptr;
     try {
         w = new simplex_warp;
-        cm_status s = create(ctx, mesh, constrained, w);
+        cm_status s = create(ctx, mesh, b, constrained, w);
         if (s < 0) {
             delete w;
             return s;
