@@ -191,7 +191,8 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
             // outside, or a walk that did not end (degenerate tets): search every tet
             t = best_tet(d, q, l);
             const double m = std::min(std::min(l[0], l[1]), std::min(l[2], l[3]));
-            if (outside || m < -inside_tol) ++*n_outside;
+            if (m < -inside_tol) ++*n_outside; // a walk can also end on a hull face by round-off
+            (void)outside;
         }
         for (int k = 0; k < 4; ++k) {
             corner[4 * i + k] = d.tet[4 * t + k];
