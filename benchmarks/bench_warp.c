@@ -1,6 +1,7 @@
 /* Warp methods side by side (issue 12): for one mesh, each method in a forked child (so that
  * each gets its own peak RSS) creates its warp on M0 (assembly + factorisation) and applies
  * it to the same smooth boundary motion `steps` times, as an absolute study does.
+ * BENCH_VERBOSE=1 in the environment shows the library's log (stage timings) on stderr.
  * usage: bench_warp MESH [steps=20] [threads=2] [methods=rbf,rbf-biharmonic,femwarp,lbwarp,simplex]
  * One line per method: key=value pairs (RESULTS.md, "Warp methods"). */
 #include "cadmorph/mesh.h"
@@ -27,12 +28,20 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+static void log_stderr(void *user, cm_log_level level, const char *message)
+{
+    (void)user;
+    (void)level;
+    fprintf(stderr, "  %s\n", message);
+}
+
 /* The child: everything for one method, one result line; returns the exit code. */
 static int run(const char *path, cm_warp_method method, int steps, int threads)
 {
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
     cm_context_set_threads(ctx, threads);
+    if (getenv("BENCH_VERBOSE")) cm_context_set_log(ctx, log_stderr, NULL);
     cm_mesh *m = NULL;
     cm_mesh_boundary *b = NULL;
     cm_warp *w = NULL;

@@ -18,7 +18,7 @@
  *
  * Solver: UMFPACK's sparse LU of I - W_II, factored once in create and reused by every apply
  * (absolute studies pay two triangular solves per step, as FEMWARP with CHOLMOD; the matrix
- * is not symmetric, so CHOLMOD does not apply). A preconditioned Krylov method (BiCGSTAB with
+ * is not symmetric, so CHOLMOD does not apply), with a METIS ordering. A preconditioned Krylov method (BiCGSTAB with
  * ILU) would need less memory on very large meshes but a tolerance and an iteration count per
  * step; at the sizes of the paper's benchmarks the direct factor is cheaper over a study. */
 #include "warp_method.h"
@@ -242,6 +242,7 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
         *state = w;
         return CM_OK;
     }
+    double t0 = cm_wtime(), t1 = 0, t2 = 0;
     if ((s = node_cells(ctx, mesh, &nc_start, &nc_cells, &max_len)) < 0) goto fail;
     stamp = malloc(mesh->n_nodes * sizeof *stamp);
     w->ib_start = malloc((nf + 1) * sizeof *w->ib_start);
@@ -312,6 +313,7 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
         w->ib_start[i + 1] = (int64_t)ii;
     }
     cm_progress(ctx, "lbwarp weights", 1, 1);
+    t1 = cm_wtime();
     if (w->n_fallback)
         cm_log(ctx, CM_LOG_WARNING,
                "cm_warp_create: lbwarp: %zu of %zu free nodes are not strictly inside the convex "
@@ -334,19 +336,25 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
     double control[UMFPACK_CONTROL], info[UMFPACK_INFO];
     umfpack_dl_defaults(control);
     control[UMFPACK_PRL] = 0; /* the library never prints */
+    /* METIS instead of the default AMD: on 3D meshes less than half the fill, and 5x faster
+     * (115k unknowns: LU nnz 89M against 207M, 18 s against 87 s; RESULTS.md) */
+    control[UMFPACK_ORDERING] = UMFPACK_ORDERING_METIS;
     st = umfpack_dl_symbolic((SuiteSparse_long)nf, (SuiteSparse_long)nf, w->ap, w->ai, w->ax,
                              &symbolic, control, info);
     if (st != UMFPACK_OK) {
         s = umfpack_failed(ctx, "symbolic analysis", (int)st);
         goto fail;
     }
+    t2 = cm_wtime();
     st = umfpack_dl_numeric(w->ap, w->ai, w->ax, symbolic, &w->numeric, control, info);
     if (st != UMFPACK_OK) {
         s = umfpack_failed(ctx, "factorisation", (int)st);
         goto fail;
     }
-    cm_log(ctx, CM_LOG_DEBUG, "lbwarp: %zu unknowns, %zu nonzeros, LU nnz %.0f", nf, nt,
-           info[UMFPACK_LNZ] + info[UMFPACK_UNZ]);
+    cm_log(ctx, CM_LOG_DEBUG,
+           "lbwarp: %zu unknowns, %zu nonzeros, LU nnz %.0f: weights %.3f s, ordering %.3f s, "
+           "factorisation %.3f s",
+           nf, nt, info[UMFPACK_LNZ] + info[UMFPACK_UNZ], t1 - t0, t2 - t1, cm_wtime() - t2);
     umfpack_dl_free_symbolic(&symbolic);
     free(nc_start);
     free(nc_cells);

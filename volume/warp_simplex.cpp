@@ -166,39 +166,47 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
     cm_kdtree_destroy(&tree);
     if (s < 0) return s;
 
-    const int64_t max_steps = (int64_t)(d.tet.size() / 4) + 16;
+    // a walk longer than this is cycling through near-flat tets: search every tet instead
+    const int64_t max_steps = std::min<int64_t>((int64_t)(d.tet.size() / 4) + 16, 100000);
+    size_t n_searched = 0;
     for (size_t i = 0; i < n_query; ++i) {
         const double *q = query + 3 * i;
         int64_t t = tet_of_point[near[i]] >= 0 ? tet_of_point[near[i]] : 0;
         double l[4];
-        bool found = false, outside = false;
+        bool found = false;
         for (int64_t step = 0; step < max_steps; ++step) {
             d.bary(t, q, l);
-            int k = 0;
-            for (int j = 1; j < 4; ++j)
-                if (l[j] < l[k]) k = j;
-            if (l[k] >= -inside_tol) {
+            // cross the face of the most negative coordinate that has a tet behind it; near
+            // the (often coplanar) boundary nodes, flat hull tets give a hull face a
+            // round-off negative coordinate although q is inside
+            int k = -1;
+            bool negative = false;
+            for (int j = 0; j < 4; ++j) {
+                if (!(l[j] >= -inside_tol)) negative = true;
+                if (!(l[j] >= -inside_tol) && d.nbr[4 * t + j] >= 0 && (k < 0 || l[j] < l[k])) k = j;
+            }
+            if (!negative) {
                 found = true;
                 break;
             }
-            if (d.nbr[4 * t + k] < 0) {
-                outside = true; // beyond a hull face, whose plane supports the convex hull
-                break;
-            }
+            if (k < 0) break; // only hull faces separate q from this tet: outside the hull
             t = d.nbr[4 * t + k];
         }
         if (!found) {
-            // outside, or a walk that did not end (degenerate tets): search every tet
+            // outside, or a walk that did not end: search every tet
+            ++n_searched;
             t = best_tet(d, q, l);
             const double m = std::min(std::min(l[0], l[1]), std::min(l[2], l[3]));
-            if (m < -inside_tol) ++*n_outside; // a walk can also end on a hull face by round-off
-            (void)outside;
+            if (m < -inside_tol) ++*n_outside;
         }
         for (int k = 0; k < 4; ++k) {
             corner[4 * i + k] = d.tet[4 * t + k];
             bary[4 * i + k] = l[k];
         }
     }
+    cm_log(ctx, CM_LOG_DEBUG, "simplex: %zu of %zu walks ended outside the hull or did not end; "
+           "every tet searched for them",
+           n_searched, n_query);
     return CM_OK;
 }
 
