@@ -3,9 +3,9 @@
 // the barycentric coordinates of the Delaunay tet that contains it, and after the boundary
 // moves the same combination of the moved corners. Affine motions are reproduced exactly;
 // a tet may span a concavity of the domain, which is the method's known weakness.
-// Location: a kD-tree gives the constrained node nearest to the query, a walk from one of its
-// tets crosses the face of the most negative coordinate until all are >= 0 (a visibility walk
-// terminates in a Delaunay mesh). A query beyond a hull face is outside every tet; it gets
+// Location: a kD-tree gives the constrained node nearest to the query, a stochastic visibility
+// walk from one of its tets crosses faces with the query on their far side until all
+// coordinates are >= 0. A query beyond a hull face is outside every tet; it gets
 // the tet with the largest smallest coordinate, used with its (partly negative) coordinates:
 // counted, logged (CM_LOG_DEBUG), cm_warp_fallback_nodes. Exceptions stop here (STYLE 8).
 #include "cadmorph/kdtree.h"
@@ -76,11 +76,13 @@ void build_neighbours(delaunay &d)
 }
 
 // The tet with the largest smallest coordinate (the containing one if there is one).
-int64_t best_tet(const delaunay &d, const double *q, double l[4])
+int64_t best_tet(const delaunay &d, const std::vector<unsigned char> &flat, const double *q,
+                 double l[4])
 {
     int64_t best = 0;
     double best_min = -1e300, lb[4];
     for (int64_t t = 0; t < (int64_t)(d.tet.size() / 4); ++t) {
+        if (flat[t]) continue;
         d.bary(t, q, lb);
         const double m = std::min(std::min(lb[0], lb[1]), std::min(lb[2], lb[3]));
         if (m > best_min) best_min = m, best = t, std::memcpy(l, lb, sizeof lb);
@@ -166,36 +168,65 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
     cm_kdtree_destroy(&tree);
     if (s < 0) return s;
 
-    // a walk longer than this is cycling through near-flat tets: search every tet instead
+    // TetGen's Delaunay tetrahedralisation of coplanar boundary nodes (planar faces, the
+    // O-grids' symmetry planes) contains flat tets, whose coordinates are noise (1e14): the
+    // walk never stops in one and leaves it through a random other face
+    std::vector<unsigned char> flat(d.tet.size() / 4);
+    for (size_t t = 0; t < flat.size(); ++t) {
+        const double *p[4];
+        double e2 = 0;
+        for (int k = 0; k < 4; ++k) p[k] = pts + 3 * d.tet[4 * t + k];
+        for (int a = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b) {
+                double s2 = 0;
+                for (int k = 0; k < 3; ++k) s2 += (p[a][k] - p[b][k]) * (p[a][k] - p[b][k]);
+                e2 = std::max(e2, s2);
+            }
+        flat[t] = std::fabs(orient(p[0], p[1], p[2], p[3])) <= 1e-10 * e2 * std::sqrt(e2);
+    }
+    // a stochastic visibility walk (it ends in a Delaunay mesh; Devillers, Pion, Teillaud
+    // 2002): cross a random face, other than the entry face, with q on its far side; walks
+    // longer than this are cycling and search every tet instead
     const int64_t max_steps = std::min<int64_t>((int64_t)(d.tet.size() / 4) + 16, 100000);
     size_t n_searched = 0;
+    unsigned long long rng = 0x9E3779B97F4A7C15ULL;
     for (size_t i = 0; i < n_query; ++i) {
         const double *q = query + 3 * i;
-        int64_t t = tet_of_point[near[i]] >= 0 ? tet_of_point[near[i]] : 0;
-        double l[4];
+        int64_t t = tet_of_point[near[i]] >= 0 ? tet_of_point[near[i]] : 0, from = -1;
+        double l[4] = {0, 0, 0, 0};
         bool found = false;
         for (int64_t step = 0; step < max_steps; ++step) {
-            d.bary(t, q, l);
-            // cross the face of the most negative coordinate that has a tet behind it; near
-            // the (often coplanar) boundary nodes, flat hull tets give a hull face a
-            // round-off negative coordinate although q is inside
-            int k = -1;
+            int cand[4], nc = 0;
             bool negative = false;
-            for (int j = 0; j < 4; ++j) {
-                if (!(l[j] >= -inside_tol)) negative = true;
-                if (!(l[j] >= -inside_tol) && d.nbr[4 * t + j] >= 0 && (k < 0 || l[j] < l[k])) k = j;
+            if (flat[t]) {
+                negative = true;
+                for (int j = 0; j < 4; ++j)
+                    if (d.nbr[4 * t + j] >= 0 && d.nbr[4 * t + j] != from) cand[nc++] = j;
+            } else {
+                d.bary(t, q, l);
+                for (int j = 0; j < 4; ++j)
+                    if (!(l[j] >= -inside_tol)) {
+                        negative = true;
+                        if (d.nbr[4 * t + j] >= 0 && d.nbr[4 * t + j] != from) cand[nc++] = j;
+                    }
             }
             if (!negative) {
                 found = true;
                 break;
             }
-            if (k < 0) break; // only hull faces separate q from this tet: outside the hull
-            t = d.nbr[4 * t + k];
+            if (nc == 0 && from >= 0) { // only the way back is open: take it
+                for (int j = 0; j < 4; ++j)
+                    if (d.nbr[4 * t + j] == from) cand[nc++] = j;
+            }
+            if (nc == 0) break; // only hull faces separate q from this tet: outside the hull
+            rng = rng * 6364136223846793005ULL + 1442695040888963407ULL;
+            from = t;
+            t = d.nbr[4 * t + cand[(rng >> 33) % (unsigned)nc]];
         }
         if (!found) {
             // outside, or a walk that did not end: search every tet
             ++n_searched;
-            t = best_tet(d, q, l);
+            t = best_tet(d, flat, q, l);
             const double m = std::min(std::min(l[0], l[1]), std::min(l[2], l[3]));
             if (m < -inside_tol) ++*n_outside;
         }
