@@ -30,6 +30,8 @@ typedef struct femwarp {
     int cc_started;
     cholmod_factor *L;
     cholmod_sparse *kib; /* n_dof x n_fixed */
+    /* kept between applies: CHOLMOD reuses them instead of allocating per step */
+    cholmod_dense *db, *rhs, *x, *y, *e;
 } femwarp;
 
 /* Growable triplets: (row, col, value). */
@@ -246,6 +248,11 @@ static void femwarp_destroy(void *state)
     if (!w) return;
     if (w->cc_started) {
         cholmod_l_free_factor(&w->L, &w->cc);
+        cholmod_l_free_dense(&w->db, &w->cc);
+        cholmod_l_free_dense(&w->rhs, &w->cc);
+        cholmod_l_free_dense(&w->x, &w->cc);
+        cholmod_l_free_dense(&w->y, &w->cc);
+        cholmod_l_free_dense(&w->e, &w->cc);
         cholmod_l_free_sparse(&w->kib, &w->cc);
         cholmod_l_finish(&w->cc);
     }
@@ -379,32 +386,26 @@ static cm_status femwarp_apply(cm_context *ctx, void *state, double *disp, doubl
     if (w->n_dof == 0) return CM_OK;
     const cm_warp_nodes *n = w->nodes;
     size_t nb = n->n_fixed ? n->n_fixed : 1;
-    cholmod_dense *db = cholmod_l_zeros(nb, 3, CHOLMOD_REAL, &w->cc);
-    cholmod_dense *rhs = cholmod_l_zeros(w->n_dof, 3, CHOLMOD_REAL, &w->cc);
-    cholmod_dense *x = NULL;
-    if (db && rhs) {
-        double *d = db->x;
+    if (!w->db) w->db = cholmod_l_zeros(nb, 3, CHOLMOD_REAL, &w->cc);
+    if (!w->rhs) w->rhs = cholmod_l_zeros(w->n_dof, 3, CHOLMOD_REAL, &w->cc);
+    int ok = w->db && w->rhs;
+    if (ok) {
+        double *d = w->db->x;
         for (size_t j = 0; j < n->n_fixed; ++j)
             for (int k = 0; k < 3; ++k)
                 d[j + k * nb] = disp[3 * n->fixed_nodes[j] + k];
         double minus_one[2] = {-1, 0}, zero[2] = {0, 0};
-        if (cholmod_l_sdmult(w->kib, 0, minus_one, zero, db, rhs, &w->cc))
-            x = cholmod_l_solve(CHOLMOD_A, w->L, rhs, &w->cc);
+        ok = cholmod_l_sdmult(w->kib, 0, minus_one, zero, w->db, w->rhs, &w->cc) &&
+             cholmod_l_solve2(CHOLMOD_A, w->L, w->rhs, NULL, &w->x, NULL, &w->y, &w->e, &w->cc);
     }
-    cm_status s = CM_OK;
-    if (!x) {
-        s = cm_error(ctx, w->cc.status == CHOLMOD_OUT_OF_MEMORY ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
-                     "cm_warp_apply: femwarp: CHOLMOD solve failed (status %d)", w->cc.status);
-    } else {
-        const double *xv = x->x;
-        for (size_t i = 0; i < n->n_free; ++i)
-            for (int k = 0; k < 3; ++k)
-                disp[3 * n->free_nodes[i] + k] = xv[i + k * w->n_dof];
-    }
-    cholmod_l_free_dense(&db, &w->cc);
-    cholmod_l_free_dense(&rhs, &w->cc);
-    cholmod_l_free_dense(&x, &w->cc);
-    return s;
+    if (!ok)
+        return cm_error(ctx, w->cc.status == CHOLMOD_OUT_OF_MEMORY ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
+                        "cm_warp_apply: femwarp: CHOLMOD solve failed (status %d)", w->cc.status);
+    const double *xv = w->x->x;
+    for (size_t i = 0; i < n->n_free; ++i)
+        for (int k = 0; k < 3; ++k)
+            disp[3 * n->free_nodes[i] + k] = xv[i + k * w->n_dof];
+    return CM_OK;
 }
 
 const cm_warp_method_ops cm_warp_femwarp = {"femwarp", femwarp_create, femwarp_apply,

@@ -10,13 +10,20 @@
                                 independently (numpy: P1 tets, Q1 hexes with 2x2x2 Gauss),
                                 solves K_II x = -K_IB d_B with scipy's spsolve and compares
                                 with the displacement field of cadmorph's OUT (<= 1e-10 rel.)
-  warp_staten.py affine WORK OUT...
-                                every node of each OUT moved by the affine field of affine.csv
+  warp_staten.py affine-csv MESH CSV
+                                writes CSV: the affine motion AFFINE of MESH's boundary nodes
+  warp_staten.py affine MESH OUT...
+                                every node of each OUT (cadmorph warp of MESH with that CSV)
+                                moved by AFFINE, to 1e-10 of the diagonal
 """
 import os
 import sys
 
 import numpy as np
+
+
+AFFINE = np.array([[0.02, -0.05, 0.01], [0.03, 0.04, -0.02], [-0.01, 0.02, 0.05]])
+SHIFT = np.array([0.1, -0.2, 0.05])
 
 
 def boundary_nodes(cells):
@@ -120,10 +127,7 @@ def setup(work):
         write_csv(os.path.join(out, name + "_D.csv"), nodes,
                   smooth_motion(mesh.points[nodes], 2.0))
         if name == "tets":
-            a = np.array([[0.02, -0.05, 0.01], [0.03, 0.04, -0.02], [-0.01, 0.02, 0.05]])
-            np.savetxt(os.path.join(out, "affine_matrix.txt"), a)
-            write_csv(os.path.join(out, "affine.csv"), nodes,
-                      mesh.points[nodes] @ a.T + [0.1, -0.2, 0.05])
+            affine_csv(os.path.join(out, "tets.msh"), os.path.join(out, "affine.csv"))
 
 
 def stiffness(points, cells, ndof, dof):
@@ -195,12 +199,17 @@ def femwarp(work, name, out):
         sys.exit("femwarp %s: cadmorph and scipy's spsolve differ" % name)
 
 
-def affine(work, outs):
+def affine_csv(mesh_path, csv):
     import meshio
-    d = os.path.join(work, "staten")
-    a = np.loadtxt(os.path.join(d, "affine_matrix.txt"))
-    m0 = meshio.read(os.path.join(d, "tets.msh"))
-    want = m0.points @ a.T + [0.1, -0.2, 0.05]
+    mesh = meshio.read(mesh_path)
+    nodes = boundary_nodes(volume_cells(mesh))
+    write_csv(csv, nodes, mesh.points[nodes] @ AFFINE.T + SHIFT)
+
+
+def affine(mesh_path, outs):
+    import meshio
+    m0 = meshio.read(mesh_path)
+    want = m0.points @ AFFINE.T + SHIFT
     size = np.linalg.norm(m0.points.max(axis=0) - m0.points.min(axis=0))
     for out in outs:
         got = meshio.read(out).point_data["displacement"]
@@ -215,6 +224,8 @@ def main(argv):
         setup(argv[1])
     elif len(argv) == 4 and argv[0] == "femwarp":
         femwarp(argv[1], argv[2], argv[3])
+    elif len(argv) == 3 and argv[0] == "affine-csv":
+        affine_csv(argv[1], argv[2])
     elif len(argv) >= 3 and argv[0] == "affine":
         affine(argv[1], argv[2:])
     else:
