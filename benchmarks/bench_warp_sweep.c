@@ -23,7 +23,10 @@ static int parse_method(const char *name, cm_morph_method *m)
         m->surface = CM_SURFACE_PROJECT;
         return 0;
     }
-    const char *warp = strncmp(name, "rbf-s-", 6) ? name : name + 6;
+    /* rbf-s-<kernel>: the surface morph with the RBF warp of that kernel */
+    char warp[64];
+    snprintf(warp, sizeof warp, "%s%s", strncmp(name, "rbf-s-", 6) ? "" : "rbf-",
+             strncmp(name, "rbf-s-", 6) ? name : name + 6);
     int w = cm_warp_method_from_name(warp);
     if (w < 0) return -1;
     m->warp.method = (cm_warp_method)w;
@@ -61,40 +64,54 @@ int main(int argc, char **argv)
         return 2;
     }
     double *xyz = malloc(3 * m0->n_nodes * sizeof *xyz);
-    int rc = 0;
-    for (char *tok = strtok(methods, ","); tok; tok = strtok(NULL, ",")) {
-        cm_morph_method method;
-        if (parse_method(tok, &method) < 0) {
+    int rc = 0, nm = 0;
+    const char *name[16];
+    cm_morph_method method[16];
+    for (char *tok = strtok(methods, ","); tok && nm < 16; tok = strtok(NULL, ",")) {
+        if (parse_method(tok, &method[nm]) < 0) {
             fprintf(stderr, "bench_warp_sweep: unknown method '%s'\n", tok);
             return 1;
         }
-        for (int rel = 0; rel < 2; ++rel) {
-            if (!strstr(modes, rel ? "relative" : "absolute")) continue;
-            cm_morpher *mp = NULL;
-            s = cm_morpher_create(ctx, g[0], m0, NULL, &mp);
-            for (int k = 1; k <= steps && s >= 0; ++k) {
+        name[nm++] = tok;
+    }
+    /* steps outer, methods inner: the morpher keeps the locator of the last target, so G(t)
+     * is sampled once per step for all methods (absolute); relative: one morpher per method */
+    for (int rel = 0; rel < 2; ++rel) {
+        if (!strstr(modes, rel ? "relative" : "absolute")) continue;
+        cm_morpher *mp[16] = {NULL};
+        int alive[16];
+        for (int i = 0; i < nm; ++i) {
+            alive[i] = (rel || i == 0) ? cm_morpher_create(ctx, g[0], m0, NULL, &mp[i]) >= 0 : 1;
+            if (!alive[i]) fprintf(stderr, "bench_warp_sweep: %s\n", cm_context_message(ctx));
+        }
+        for (int k = 1; k <= steps; ++k)
+            for (int i = 0; i < nm; ++i) {
+                cm_morpher *p = mp[rel ? i : 0];
+                if (!alive[i] || !p) continue;
                 cm_morph_step row;
                 memset(&row, 0, sizeof row);
-                s = cm_morpher_apply_method(ctx, mp, g[k], &method, xyz, &row);
-                if (s < 0) break;
-                printf("model=%s mesh=%s mode=%s method=%s step=%d t=%.2f min_sj=%.4f "
-                       "inverted=%zu cells=%zu surface_s=%.4f solve_s=%.4f evaluate_s=%.4f "
-                       "max_dist=%.3g\n",
-                       model, argv[2], rel ? "relative" : "absolute", tok, k, (double)k / steps,
-                       row.min_sj, row.inverted, row.cells, row.t_surface, row.t_volume_solve,
-                       row.t_evaluation, row.max_dist);
-                fflush(stdout);
-                if (rel) s = cm_morpher_rebase(ctx, mp, g[k], xyz);
+                s = cm_morpher_apply_method(ctx, p, g[k], &method[i], xyz, &row);
+                if (s >= 0) {
+                    printf("model=%s mesh=%s mode=%s method=%s step=%d t=%.2f min_sj=%.4f "
+                           "inverted=%zu cells=%zu surface_s=%.4f solve_s=%.4f evaluate_s=%.4f "
+                           "max_dist=%.3g\n",
+                           model, argv[2], rel ? "relative" : "absolute", name[i], k,
+                           (double)k / steps, row.min_sj, row.inverted, row.cells, row.t_surface,
+                           row.t_volume_solve, row.t_evaluation, row.max_dist);
+                    fflush(stdout);
+                    if (rel) s = cm_morpher_rebase(ctx, p, g[k], xyz);
+                }
+                if (s < 0) {
+                    /* a series can stop (a collapsed mesh makes the next warp singular) */
+                    printf("model=%s mesh=%s mode=%s method=%s step=%d stopped=\"%s\"\n", model,
+                           argv[2], rel ? "relative" : "absolute", name[i], k,
+                           cm_context_message(ctx));
+                    alive[i] = 0;
+                    rc = 3;
+                }
             }
-            if (s < 0) {
-                /* a relative series can stop (a collapsed mesh makes the next warp singular) */
-                printf("model=%s mesh=%s mode=%s method=%s stopped=\"%s\"\n", model, argv[2],
-                       rel ? "relative" : "absolute", tok, cm_context_message(ctx));
-                s = CM_OK;
-                rc = 3;
-            }
-            cm_morpher_destroy(&mp);
-        }
+        for (int i = 0; i < nm; ++i)
+            cm_morpher_destroy(&mp[i]);
     }
     free(xyz);
     for (int k = 0; k <= steps; ++k)

@@ -67,6 +67,9 @@ static void trip_free(triplets *t)
     free(t->i);
     free(t->j);
     free(t->x);
+    t->i = t->j = NULL;
+    t->x = NULL;
+    t->n = t->cap = 0;
 }
 
 /* 3x3 inverse of a (row-major); returns the determinant (0: a left untouched in inv). */
