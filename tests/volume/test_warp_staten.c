@@ -352,12 +352,44 @@ static void test_errors(void)
     cm_mesh_destroy(&m);
 }
 
+/* A tangled M0: one interior node dragged outside the block. LBWARP cannot give it positive
+ * weights, simplex finds it outside every Delaunay tet; both count it (cm_warp_fallback_nodes)
+ * and still move it (a finite displacement); the other nodes keep their weights. */
+static void test_fallbacks(void)
+{
+    cm_mesh *m = block_mesh(1, 0);
+    /* the interior node (3, 2, 2) of the 7 x 6 x 5 node grid */
+    int64_t v = 3 + 7 * (2 + 6 * 2);
+    m->xyz[3 * v + 2] = 5.0; /* the block ends at z = 1.2 */
+    cm_mesh_boundary *b = NULL;
+    cm_mesh_boundary_create(ctx, m, &b);
+    for (int k = 1; k < 3; ++k) {
+        cm_warp *w = NULL;
+        cm_warp_options opt = {staten[k]};
+        cm_status s = cm_warp_create(ctx, m, b, NULL, &opt, &w);
+        CHECK_MSG(s >= 0, "%s: %s", cm_warp_method_name(staten[k]), cm_context_message(ctx));
+        if (s < 0) continue;
+        size_t fb = cm_warp_fallback_nodes(w);
+        printf("tangled M0: %s: %zu fallback nodes\n", cm_warp_method_name(staten[k]), fb);
+        CHECK_MSG(fb >= 1 && fb <= 10, "%s: %zu", cm_warp_method_name(staten[k]), fb);
+        double *d = calloc(3 * m->n_nodes, sizeof *d);
+        for (size_t i = 0; i < b->n_nodes; ++i)
+            d[3 * b->nodes[i]] = 0.01;
+        CHECK(cm_warp_apply(ctx, w, d) == CM_OK && isfinite(d[3 * v]));
+        free(d);
+        cm_warp_destroy(&w);
+    }
+    cm_mesh_boundary_destroy(&b);
+    cm_mesh_destroy(&m);
+}
+
 int main(int argc, char **argv)
 {
     cm_context_create(&ctx);
     test_lbwarp_weights();
     test_simplex_locate();
     test_errors();
+    test_fallbacks();
     test_meshes(argc > 2 ? argv[2] : ".");
     cm_context_destroy(&ctx);
     return TEST_REPORT();
