@@ -94,7 +94,7 @@ static void check_zero(const cm_mesh *m0, cm_warp_method method, const char *wha
     cm_mesh *m = NULL;
     if (cm_mesh_copy(ctx, m0, &m) < 0) return;
     double *d = calloc(3 * m->n_nodes, sizeof *d);
-    cm_status s = cm_warp_mesh(ctx, m, d, NULL, &(cm_warp_options){method}, NULL, NULL);
+    cm_status s = cm_warp_mesh(ctx, m, d, NULL, &(cm_warp_options){method}, NULL, NULL, NULL);
     CHECK_MSG(s == CM_OK, "%s %s: %s", what, cm_warp_method_name(method), cm_context_message(ctx));
     CHECK_MSG(s == CM_OK && !memcmp(m->xyz, m0->xyz, 3 * m->n_nodes * sizeof *m->xyz),
               "%s %s: zero motion moved a node", what, cm_warp_method_name(method));
