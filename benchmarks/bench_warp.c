@@ -80,7 +80,8 @@ static int run(const char *path, cm_warp_method method, int steps, int threads)
     s = cm_warp_create(ctx, m, b, NULL, &opt, &w);
     double t_create = cm_wtime() - t0;
     if (s < 0) {
-        fprintf(stderr, "bench_warp: %s: %s\n", cm_warp_method_name(method), cm_context_message(ctx));
+        fprintf(stderr, "bench_warp: %s: %s\n", cm_warp_method_name(method),
+                cm_context_message(ctx));
         return 2;
     }
     double *t = malloc((size_t)steps * sizeof *t);

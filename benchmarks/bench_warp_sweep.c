@@ -36,7 +36,8 @@ static int parse_method(const char *name, cm_morph_method *m)
 int main(int argc, char **argv)
 {
     if (argc < 5) {
-        fprintf(stderr, "usage: bench_warp_sweep MODEL M0.msh STEPS WORK [methods] [threads] [modes]\n");
+        fprintf(stderr,
+                "usage: bench_warp_sweep MODEL M0.msh STEPS WORK [methods] [threads] [modes]\n");
         return 1;
     }
     const char *model = argv[1], *work = argv[4];

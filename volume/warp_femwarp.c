@@ -266,8 +266,8 @@ static void femwarp_destroy(void *state)
 static cholmod_sparse *to_sparse(triplets *t, size_t nrow, size_t ncol, int stype,
                                  cholmod_common *cc)
 {
-    cholmod_triplet *T = cholmod_l_allocate_triplet(nrow, ncol, t->n ? t->n : 1, stype,
-                                                    CHOLMOD_REAL, cc);
+    cholmod_triplet *T =
+        cholmod_l_allocate_triplet(nrow, ncol, t->n ? t->n : 1, stype, CHOLMOD_REAL, cc);
     if (!T) return NULL;
     memcpy(T->i, t->i, t->n * sizeof *t->i);
     memcpy(T->j, t->j, t->n * sizeof *t->j);

@@ -18,9 +18,10 @@
  *
  * Solver: UMFPACK's sparse LU of I - W_II, factored once in create and reused by every apply
  * (absolute studies pay two triangular solves per step, as FEMWARP with CHOLMOD; the matrix
- * is not symmetric, so CHOLMOD does not apply), with a METIS ordering. A preconditioned Krylov method (BiCGSTAB with
- * ILU) would need less memory on very large meshes but a tolerance and an iteration count per
- * step; at the sizes of the paper's benchmarks the direct factor is cheaper over a study. */
+ * is not symmetric, so CHOLMOD does not apply), with a METIS ordering. A preconditioned Krylov
+ * method (BiCGSTAB with ILU) would need less memory on very large meshes but a tolerance and an
+ * iteration count per step; at the sizes of the paper's benchmarks the direct factor is cheaper
+ * over a study. */
 #include "warp_method.h"
 
 #include <umfpack.h>
@@ -83,7 +84,8 @@ int cm_lbwarp_weights(const double *d, size_t n, double *w, double lambda[3], do
             break;
         }
         double l33 = sqrt(l33s);
-        double y1 = g[0] / l11, y2 = (g[1] - l21 * y1) / l22, y3 = (g[2] - l31 * y1 - l32 * y2) / l33;
+        double y1 = g[0] / l11, y2 = (g[1] - l21 * y1) / l22,
+               y3 = (g[2] - l31 * y1 - l32 * y2) / l33;
         double s3 = y3 / l33, s2 = (y2 - l32 * s3) / l22, s1 = (y1 - l21 * s2 - l31 * s3) / l11;
         double step[3] = {s1, s2, s3}, slope = g[0] * s1 + g[1] * s2 + g[2] * s3;
         /* backtracking: every n + lambda.e_j > 0 and sufficient increase of F */
@@ -93,7 +95,8 @@ int cm_lbwarp_weights(const double *d, size_t n, double *w, double lambda[3], do
             int feasible = 1;
             fnew = 0;
             for (size_t j = 0; j < n && feasible; ++j) {
-                double t = dn + (lt[0] * d[3 * j] + lt[1] * d[3 * j + 1] + lt[2] * d[3 * j + 2]) / h;
+                double t =
+                    dn + (lt[0] * d[3 * j] + lt[1] * d[3 * j + 1] + lt[2] * d[3 * j + 2]) / h;
                 if (t > 0)
                     fnew += log(t);
                 else
@@ -326,9 +329,9 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
     w->b = malloc(nf * sizeof *w->b);
     w->x = malloc(nf * sizeof *w->x);
     if (!w->ap || !w->ai || !w->ax || !w->b || !w->x) goto nomem;
-    SuiteSparse_long st = umfpack_dl_triplet_to_col((SuiteSparse_long)nf, (SuiteSparse_long)nf,
-                                                    (SuiteSparse_long)nt, ti, tj, tx, w->ap,
-                                                    w->ai, w->ax, NULL);
+    SuiteSparse_long st =
+        umfpack_dl_triplet_to_col((SuiteSparse_long)nf, (SuiteSparse_long)nf, (SuiteSparse_long)nt,
+                                  ti, tj, tx, w->ap, w->ai, w->ax, NULL);
     if (st != UMFPACK_OK) {
         s = umfpack_failed(ctx, "assembly", (int)st);
         goto fail;
@@ -406,11 +409,12 @@ static cm_status lbwarp_apply(cm_context *ctx, void *state, double *disp, double
                 s += w->ib_w[p] * disp[3 * w->ib_node[p] + k];
             w->b[i] = s;
         }
-        SuiteSparse_long st = umfpack_dl_solve(UMFPACK_A, w->ap, w->ai, w->ax, w->x, w->b,
-                                               w->numeric, control, info);
+        SuiteSparse_long st =
+            umfpack_dl_solve(UMFPACK_A, w->ap, w->ai, w->ax, w->x, w->b, w->numeric, control, info);
         if (st != UMFPACK_OK)
-            return cm_error(ctx, CM_ERR_NUMERIC, "cm_warp_apply: lbwarp: UMFPACK solve failed "
-                                                 "(status %ld)",
+            return cm_error(ctx, CM_ERR_NUMERIC,
+                            "cm_warp_apply: lbwarp: UMFPACK solve failed "
+                            "(status %ld)",
                             (long)st);
         for (size_t i = 0; i < nf; ++i)
             disp[3 * nd->free_nodes[i] + k] = w->x[i];

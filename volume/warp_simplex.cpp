@@ -24,7 +24,8 @@ extern "C" {
 #include <new>
 #include <vector>
 
-namespace {
+namespace
+{
 
 double orient(const double *a, const double *b, const double *c, const double *d)
 {
@@ -43,7 +44,8 @@ struct delaunay {
     void bary(int64_t t, const double *q, double l[4]) const
     {
         const double *p[4];
-        for (int k = 0; k < 4; ++k) p[k] = xyz + 3 * tet[4 * t + k];
+        for (int k = 0; k < 4; ++k)
+            p[k] = xyz + 3 * tet[4 * t + k];
         const double v = orient(p[0], p[1], p[2], p[3]);
         l[0] = orient(q, p[1], p[2], p[3]) / v;
         l[1] = orient(p[0], q, p[2], p[3]) / v;
@@ -106,7 +108,8 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
     {
         auto dist2 = [&](size_t i, size_t j) {
             double s2 = 0;
-            for (int k = 0; k < 3; ++k) s2 += (pts[3 * i + k] - pts[3 * j + k]) * (pts[3 * i + k] - pts[3 * j + k]);
+            for (int k = 0; k < 3; ++k)
+                s2 += (pts[3 * i + k] - pts[3 * j + k]) * (pts[3 * i + k] - pts[3 * j + k]);
             return s2;
         };
         size_t a = 0, b = 0, c = 0;
@@ -118,7 +121,8 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
             const double *p = pts + 3 * i;
             double u[3] = {pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]},
                    v[3] = {p[0] - pa[0], p[1] - pa[1], p[2] - pa[2]};
-            double w[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+            double w[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                           u[0] * v[1] - u[1] * v[0]};
             double a2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
             if (a2 > best) best = a2, c = i;
         }
@@ -128,7 +132,8 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
         (void)a;
         if (!(l2 > 0) || !(vol > 1e-12 * l2 * std::sqrt(l2)))
             return cm_error(ctx, CM_ERR_NUMERIC,
-                            "%s: the %zu constrained nodes are coplanar: no Delaunay tet", fn, n_pts);
+                            "%s: the %zu constrained nodes are coplanar: no Delaunay tet", fn,
+                            n_pts);
     }
     tetgenio in, out;
     in.firstnumber = 0;
@@ -144,8 +149,7 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
                         "constrained nodes?)",
                         fn, code);
     }
-    if (out.numberoftetrahedra <= 0 || out.numberofcorners != 4 ||
-        out.numberofpoints != (int)n_pts)
+    if (out.numberoftetrahedra <= 0 || out.numberofcorners != 4 || out.numberofpoints != (int)n_pts)
         return cm_error(ctx, CM_ERR_NUMERIC,
                         "%s: TetGen made %d tets on %d of %zu points (coplanar constrained nodes?)",
                         fn, out.numberoftetrahedra, out.numberofpoints, n_pts);
@@ -155,7 +159,8 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
     build_neighbours(d);
     std::vector<int64_t> tet_of_point(n_pts, -1);
     for (size_t t = 0; t < d.tet.size() / 4; ++t)
-        for (int k = 0; k < 4; ++k) tet_of_point[d.tet[4 * t + k]] = (int64_t)t;
+        for (int k = 0; k < 4; ++k)
+            tet_of_point[d.tet[4 * t + k]] = (int64_t)t;
     cm_log(ctx, CM_LOG_DEBUG, "simplex: Delaunay of %zu constrained nodes: %d tets", n_pts,
            out.numberoftetrahedra);
     if (n_query == 0) return CM_OK;
@@ -175,11 +180,13 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
     for (size_t t = 0; t < flat.size(); ++t) {
         const double *p[4];
         double e2 = 0;
-        for (int k = 0; k < 4; ++k) p[k] = pts + 3 * d.tet[4 * t + k];
+        for (int k = 0; k < 4; ++k)
+            p[k] = pts + 3 * d.tet[4 * t + k];
         for (int a = 0; a < 4; ++a)
             for (int b = a + 1; b < 4; ++b) {
                 double s2 = 0;
-                for (int k = 0; k < 3; ++k) s2 += (p[a][k] - p[b][k]) * (p[a][k] - p[b][k]);
+                for (int k = 0; k < 3; ++k)
+                    s2 += (p[a][k] - p[b][k]) * (p[a][k] - p[b][k]);
                 e2 = std::max(e2, s2);
             }
         flat[t] = std::fabs(orient(p[0], p[1], p[2], p[3])) <= 1e-10 * e2 * std::sqrt(e2);
@@ -235,7 +242,8 @@ cm_status locate(cm_context *ctx, const double *pts, size_t n_pts, const double 
             bary[4 * i + k] = l[k];
         }
     }
-    cm_log(ctx, CM_LOG_DEBUG, "simplex: %zu of %zu walks ended outside the hull or did not end; "
+    cm_log(ctx, CM_LOG_DEBUG,
+           "simplex: %zu of %zu walks ended outside the hull or did not end; "
            "every tet searched for them",
            n_searched, n_query);
     return CM_OK;
@@ -266,7 +274,8 @@ cm_status create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b
     s = locate(ctx, pts.data(), n.n_fixed, q.data(), n.n_free, w->corner.data(), w->bary.data(),
                &w->n_outside);
     if (s < 0) return s;
-    for (int64_t &c : w->corner) c = n.fixed_nodes[c]; // fixed index -> node id
+    for (int64_t &c : w->corner)
+        c = n.fixed_nodes[c]; // fixed index -> node id
     cm_log(ctx, CM_LOG_DEBUG,
            "simplex: %zu of %zu free nodes outside every Delaunay tet (extrapolated from the "
            "nearest)",
@@ -293,9 +302,13 @@ extern "C" cm_status cm_simplex_locate(cm_context *ctx, const double *pts, size_
     }
 }
 
-namespace {
+namespace
+{
 
-void simplex_destroy(void *state) { delete static_cast<simplex_warp *>(state); }
+void simplex_destroy(void *state)
+{
+    delete static_cast<simplex_warp *>(state);
+}
 
 size_t simplex_fallback_nodes(const void *state)
 {
@@ -340,7 +353,8 @@ cm_status simplex_apply(cm_context *, void *state, double *disp, double *residua
         double v[3] = {0, 0, 0};
         for (int k = 0; k < 4; ++k) {
             const double *dc = disp + 3 * w->corner[4 * i + k];
-            for (int j = 0; j < 3; ++j) v[j] += w->bary[4 * i + k] * dc[j];
+            for (int j = 0; j < 3; ++j)
+                v[j] += w->bary[4 * i + k] * dc[j];
         }
         std::memcpy(disp + 3 * n.free_nodes[i], v, sizeof v);
     }

@@ -135,8 +135,10 @@ static cm_mesh *block_mesh(int tets, int lshape)
             map[v] = (int64_t)v;
             if (v < first) continue;
             for (size_t u = 0; u < first; ++u)
-                if (fabs(m->xyz[3 * u] - m->xyz[3 * v]) + fabs(m->xyz[3 * u + 1] - m->xyz[3 * v + 1]) +
-                        fabs(m->xyz[3 * u + 2] - m->xyz[3 * v + 2]) < 1e-12) {
+                if (fabs(m->xyz[3 * u] - m->xyz[3 * v]) +
+                        fabs(m->xyz[3 * u + 1] - m->xyz[3 * v + 1]) +
+                        fabs(m->xyz[3 * u + 2] - m->xyz[3 * v + 2]) <
+                    1e-12) {
                     map[v] = (int64_t)u;
                     break;
                 }
@@ -240,12 +242,14 @@ static void test_lbwarp_weights(void)
                 for (int k = 0; k < 3; ++k)
                     rep[k] += w[j] * d[3 * j + k];
                 /* d/dw_j [sum log w - lambda.(sum w d) - mu (sum w - 1)], relative to 1/w_j */
-                double g = 1 / w[j] - mu - (lambda[0] * d[3 * j] + lambda[1] * d[3 * j + 1] +
-                                            lambda[2] * d[3 * j + 2]);
+                double g =
+                    1 / w[j] - mu -
+                    (lambda[0] * d[3 * j] + lambda[1] * d[3 * j + 1] + lambda[2] * d[3 * j + 2]);
                 worst_grad = fmax(worst_grad, fabs(g) * w[j]);
             }
             worst_sum = fmax(worst_sum, fabs(sum - 1));
-            worst_rep = fmax(worst_rep, sqrt(rep[0] * rep[0] + rep[1] * rep[1] + rep[2] * rep[2]) / h);
+            worst_rep =
+                fmax(worst_rep, sqrt(rep[0] * rep[0] + rep[1] * rep[1] + rep[2] * rep[2]) / h);
             ++checked;
         }
         printf("lbwarp weights (%s): %zu nodes, min w %.3g, |sum-1| %.3g, reproduction %.3g x "
