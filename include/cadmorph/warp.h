@@ -57,7 +57,11 @@ typedef struct cm_warp cm_warp;
  * follows the lowest-numbered component. Unconstrained nodes of no volume cell are left
  * alone (a CM_LOG_WARNING gives their count). A mesh without volume cells is
  * CM_ERR_UNSUPPORTED. mesh, b and constrained are borrowed for the call: the warp keeps
- * what it needs. */
+ * what it needs.
+ * FEMWARP, LBWARP, simplex: one system (one Delaunay mesh) for all components; a component
+ * with free nodes but no constrained node is CM_ERR_NUMERIC; FEMWARP takes linear cells only
+ * (tet4, hex8, wedge6, pyr5, polyhedra; others CM_ERR_UNSUPPORTED); simplex needs constrained
+ * nodes that are not all coplanar (CM_ERR_NUMERIC). */
 cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                          const unsigned char *constrained, const cm_warp_options *opt,
                          cm_warp **warp);
