@@ -14,3 +14,5 @@ echo "== CAD layer";           "$build/benchmarks/bench_cad" "$root/tests/data/c
 echo "== models, tet meshes";  sh "$root/benchmarks/models/bench_models.sh" "$build" "$work/models"
 echo "== sweeps (20 steps, all models)"; sh "$root/benchmarks/sweep/run_sweeps.sh" "$build" "$work/sweeps" 2
 echo "== study: 20 bore variants vs one"; sh "$root/benchmarks/bench_study.sh" "$build" "$work/study" 2
+echo "== warp methods side by side"; sh "$root/benchmarks/bench_warp.sh" "$build" "$work/warp" 2
+echo "== warp methods in the sweeps"; sh "$root/benchmarks/bench_warp_sweep.sh" "$build" "$work/wsweep" 2

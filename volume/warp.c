@@ -11,6 +11,9 @@ static const cm_warp_method_ops *const methods[CM_WARP_N_METHODS] = {
     [CM_WARP_RBF] = &cm_warp_rbf_triharmonic,
     [CM_WARP_RBF_BIHARMONIC] = &cm_warp_rbf_biharmonic,
     [CM_WARP_DMFFD] = &cm_warp_dmffd,
+    [CM_WARP_FEMWARP] = &cm_warp_femwarp,
+    [CM_WARP_LBWARP] = &cm_warp_lbwarp,
+    [CM_WARP_SIMPLEX] = &cm_warp_simplex,
 };
 
 struct cm_warp {
@@ -112,6 +115,11 @@ cm_warp_method cm_warp_get_method(const cm_warp *warp) { return warp->method; }
 
 double cm_warp_residual(const cm_warp *warp) { return warp ? warp->residual : 0; }
 
+size_t cm_warp_fallback_nodes(const cm_warp *warp)
+{
+    return warp && warp->ops->fallback_nodes ? warp->ops->fallback_nodes(warp->state) : 0;
+}
+
 cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
                        const cm_warp_options *opt, const cm_optimize_options *optimize,
                        double **sj, cm_warp_mesh_stats *stats)
@@ -143,6 +151,7 @@ cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsig
         st.t_create = t1 - t0;
         st.t_apply = cm_wtime() - t1;
         st.residual = cm_warp_residual(w);
+        st.fallback_nodes = cm_warp_fallback_nodes(w);
     }
     cm_warp_destroy(&w);
     cm_mesh_boundary_destroy(&b);

@@ -172,4 +172,5 @@ static cm_status dmffd_apply(cm_context *ctx, void *state, double *disp, double 
     return CM_OK;
 }
 
-const cm_warp_method_ops cm_warp_dmffd = {"dmffd", dmffd_create, dmffd_apply, dmffd_destroy};
+const cm_warp_method_ops cm_warp_dmffd = {"dmffd", dmffd_create, dmffd_apply, dmffd_destroy,
+                                          NULL};

@@ -25,6 +25,11 @@ extern "C" {
 typedef enum cm_warp_method {
     CM_WARP_RBF = 0,            /* "rbf": triharmonic RBF, phi = r^3 + linear (the method) */
     CM_WARP_RBF_BIHARMONIC = 1, /* "rbf-biharmonic": phi = r + linear (the paper's comparison) */
+    /* Staten et al. (IMR 2011)'s comparators, paper section 5: */
+    CM_WARP_FEMWARP = 2, /* "femwarp": linear finite-element Laplace warp (Baker 2001) */
+    CM_WARP_LBWARP = 3,  /* "lbwarp": log-barrier weighted Laplacian (Shontz, Vavasis 2003) */
+    CM_WARP_SIMPLEX = 4, /* "simplex": barycentrics in a Delaunay tet mesh of the constrained
+                            nodes (linear-simplex, a generalisation of BMSWEEP) */
     CM_WARP_DMFFD,              /* "dmffd": DM-FFD on a cubic B-spline lattice around the mesh
                                    (least squares: see cm_warp_residual) */
     CM_WARP_N_METHODS
@@ -59,7 +64,11 @@ typedef struct cm_warp cm_warp;
  * follows the lowest-numbered component. Unconstrained nodes of no volume cell are left
  * alone (a CM_LOG_WARNING gives their count). A mesh without volume cells is
  * CM_ERR_UNSUPPORTED. mesh, b and constrained are borrowed for the call: the warp keeps
- * what it needs. */
+ * what it needs.
+ * FEMWARP, LBWARP, simplex: one system (one Delaunay mesh) for all components; a component
+ * with free nodes but no constrained node is CM_ERR_NUMERIC; FEMWARP takes linear cells only
+ * (tet4, hex8, wedge6, pyr5, polyhedra; others CM_ERR_UNSUPPORTED); simplex needs constrained
+ * nodes that are not all coplanar (CM_ERR_NUMERIC). */
 cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                          const unsigned char *constrained, const cm_warp_options *opt,
                          cm_warp **warp);
@@ -78,6 +87,11 @@ cm_warp_method cm_warp_get_method(const cm_warp *warp);
  * miss by. */
 double cm_warp_residual(const cm_warp *warp);
 
+/* Nodes the method could not treat by its own rule and gave its documented fallback: LBWARP,
+ * nodes without positive log-barrier weights (outside the convex hull of their neighbours);
+ * simplex, nodes outside every Delaunay tet. 0 for the other methods. */
+size_t cm_warp_fallback_nodes(const cm_warp *warp);
+
 /* ---- warping a whole mesh: what `cadmorph warp` does ---- */
 
 typedef struct cm_warp_mesh_stats {
@@ -85,6 +99,7 @@ typedef struct cm_warp_mesh_stats {
     double t_create, t_apply, t_optimize; /* seconds */
     double residual;                      /* cm_warp_residual */
     size_t optimized_moves;               /* node moves kept by the optimisation */
+    size_t fallback_nodes;                /* cm_warp_fallback_nodes */
 } cm_warp_mesh_stats;
 
 /* Moves mesh by disp (#nodes x 3; read at the boundary nodes and at listed nodes, the rest

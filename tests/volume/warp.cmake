@@ -15,3 +15,13 @@ add_test(NAME warp_sphere_scipy
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/warp_sphere.py compare ${CM_TEST_WORK})
 set_tests_properties(warp_sphere_scipy PROPERTIES
   FIXTURES_REQUIRED "warp_sphere;warp_sphere_result" LABELS "unit")
+
+# Staten's comparators (FEMWARP, LBWARP, linear-simplex): gmsh writes a mixed mesh (tets,
+# hexes, wedges, pyramids) and the meshes of the scipy and CLI checks (tests/cli/
+# warp_methods.cmake); the C test checks affine reproduction, zero motion, the LBWARP weights
+# and the simplex location.
+add_test(NAME warp_staten_setup
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/warp_staten.py setup ${CM_TEST_WORK})
+set_tests_properties(warp_staten_setup PROPERTIES FIXTURES_SETUP warp_staten LABELS "unit;volume")
+cm_add_unit_test(test_warp_staten test_warp_staten.c LIBS cm_volume LABELS volume)
+set_tests_properties(test_warp_staten PROPERTIES FIXTURES_REQUIRED warp_staten)
