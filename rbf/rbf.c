@@ -281,16 +281,17 @@ static cm_status factor_projected(cm_context *ctx, cm_rbf *r, int threads)
     cm_rbf_assemble_projected(r->kernel, r->dim, m, r->c, k, v, z, r->sign, r->chol, threads);
     double t1 = cm_wtime();
 
-    blas_threads(threads);
-    cm_progress(ctx, "rbf factor", 0.0, 1.0);
-    info = LAPACKE_dpftrf_work(LAPACK_COL_MAJOR, 'N', 'L', (lapack_int)n2, r->chol);
-    cm_progress(ctx, "rbf factor", 1.0, 1.0);
+    int blas_n = 1;
+    st = cm_rbf_blas_threads(ctx, "cm_rbf_create", threads, &blas_n);
+    if (st != CM_OK) goto done;
+    /* dpftrf's arithmetic, panel by panel, so that progress moves (cholesky_blocked.c) */
+    info = cm_rbf_cholesky_rfp(ctx, (int)n2, r->chol, 0);
     double t2 = cm_wtime();
     blas_threads(1);
     cm_log(ctx, CM_LOG_DEBUG,
-           "cm_rbf_create: %zu centres, %d threads: memory %.3f s, projection + assembly %.3f s, "
-           "dpftrf %.3f s",
-           m, threads, ta, t1 - t0, t2 - t1);
+           "cm_rbf_create: %zu centres, %d threads (BLAS %d): memory %.3f s, projection + "
+           "assembly %.3f s, cholesky %.3f s",
+           m, threads, blas_n, ta, t1 - t0, t2 - t1);
     if (info > 0) {
         size_t a, b;
         double dist;
@@ -309,7 +310,7 @@ static cm_status factor_projected(cm_context *ctx, cm_rbf *r, int threads)
                           "(closer than about 1e-6 of the bounding box but not merged)",
                           n2, n2, kernel_name(r->kernel), (int)info);
     } else if (info < 0) {
-        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: dpftrf argument %d invalid",
+        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: Cholesky argument %d invalid",
                       (int)-info);
     }
 done:
@@ -348,7 +349,9 @@ cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m
     const int threads = cm_rbf_threads(ctx);
     const int saved_blas_threads = openblas_get_num_threads();
 
-    cm_status st = place_centres(ctx, r, centres);
+    /* before the first LAPACK call: OpenBLAS hangs, not fails, without its buffer */
+    cm_status st = cm_rbf_blas_threads(ctx, "cm_rbf_create", 1, NULL);
+    if (st == CM_OK) st = place_centres(ctx, r, centres);
     if (st == CM_OK && r->m < (size_t)r->k)
         st = cm_error(ctx, CM_ERR_NUMERIC,
                       "cm_rbf_create: only %zu distinct centres after merging duplicates; a "

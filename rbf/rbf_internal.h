@@ -53,4 +53,17 @@ void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const do
 long cm_rbf_merge_duplicates(int dim, size_t m_in, const double *c, double tol, size_t *rep,
                              size_t *first);
 
+/* Cholesky factorisation of the n x n SPD matrix in a (n(n+1)/2 doubles, RFP with TRANSR 'N',
+ * UPLO 'L', as dpftrf), in place, panel by panel of `block` columns (0: the default), with
+ * cm_progress(ctx, "rbf factor", done, total) after every panel (done in flops, monotonic).
+ * Returns dpftrf's info: 0, or i > 0 if the leading minor of order i is not positive definite.
+ * BLAS threads: as the caller set them (cm_rbf_blas_threads). */
+int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
+
+/* Sets OpenBLAS's thread count for the calls that follow to `want`, or fewer if the
+ * address-space limit cannot back their 128 MB buffers (blas.h, point 2); got (may be NULL)
+ * receives the count. CM_ERR_NOMEM, with a message starting with who, if not even the
+ * calling thread's buffer fits: OpenBLAS would spin forever trying to allocate it. */
+cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *got);
+
 #endif

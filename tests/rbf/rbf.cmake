@@ -8,3 +8,10 @@ set_tests_properties(test_rbf_scipy PROPERTIES FIXTURES_SETUP rbf_scipy_data)
 add_test(NAME rbf_scipy_check
          COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/rbf_scipy_check.py ${CM_TEST_WORK})
 set_tests_properties(rbf_scipy_check PROPERTIES LABELS "unit;rbf" FIXTURES_REQUIRED rbf_scipy_data)
+
+# the panel-by-panel RFP Cholesky against dpftrf (round-off), pivots, progress
+cm_add_unit_test(test_cholesky_blocked ${CMAKE_CURRENT_LIST_DIR}/test_cholesky_blocked.c
+  LIBS cm_rbf cm_lapack LABELS rbf)
+# the BLAS-core decision table (cpuid flags and core names in, decision out), cm_blas_info
+cm_add_unit_test(test_blas_core ${CMAKE_CURRENT_LIST_DIR}/test_blas_core.c
+  LIBS cm_rbf LABELS rbf)
