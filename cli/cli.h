@@ -39,7 +39,7 @@ int cli_same_file(const char *a, const char *b);
 
 /* Argument helpers: the value after an option, or NULL (and a usage message) if missing. */
 const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char *usage);
-/* The value of --threads (1..4096) into *threads: 0, or CLI_EXIT_USAGE after a usage message. */
+/* The value of --threads (1 .. 4 x the online cores) into *threads: 0, or CLI_EXIT_USAGE after a usage message. */
 int cli_threads_value(int argc, char **argv, int *i, const char *cmd, const char *usage,
                       int *threads);
 
@@ -52,6 +52,12 @@ void cli_print_quality_line(FILE *out, const cm_quality_stats *all);
  * overall stats. */
 cm_status cli_print_quality(cm_context *ctx, const cm_mesh *mesh, const double *sj, FILE *out,
                             cm_quality_stats *all);
+
+/* OpenBLAS set-up (cli/blas_reexec.c), first thing in main: may execute the program again
+ * with OPENBLAS_CORETYPE and OPENBLAS_NUM_THREADS set (blas.h); says so under --verbose. */
+void cli_blas_setup(int argc, char **argv);
+/* The BLAS lines of --version: library, core (and who chose it), threads. */
+void cli_blas_print_version(FILE *out);
 
 /* Subcommands: argv[0] is the subcommand name. */
 int cli_cmd_quality(int argc, char **argv);

@@ -21,6 +21,9 @@ typedef struct cli_sink {
 
 static cli_sink sink;
 
+/* --threads above this many per online core is refused. */
+#define CLI_THREADS_PER_CORE 4
+
 static void log_to_stderr(void *user, cm_log_level level, const char *message)
 {
     cli_sink *s = user;
@@ -155,8 +158,15 @@ int cli_threads_value(int argc, char **argv, int *i, const char *cmd, const char
     char *end = NULL;
     errno = 0;
     long t = strtol(v, &end, 10);
-    if (errno || end == v || *end || t < 1 || t > 4096)
+    if (errno || end == v || *end || t < 1)
         return cli_usage(cmd, usage, "--threads needs a positive integer, got '%s'", v);
+    /* libgomp aborts the process when it cannot create a thread (512 did on 2 cores); more
+     * than a few threads per core only costs, so refuse them here with a message */
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cores < 1) cores = 1;
+    if (t > CLI_THREADS_PER_CORE * cores)
+        return cli_usage(cmd, usage, "--threads %ld is more than %d per core (%ld cores: at most %ld)",
+                         t, CLI_THREADS_PER_CORE, cores, CLI_THREADS_PER_CORE * cores);
     *threads = (int)t;
     return 0;
 }

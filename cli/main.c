@@ -58,12 +58,14 @@ static void install_signal_handlers(void)
 
 int main(int argc, char **argv)
 {
+    cli_blas_setup(argc, argv);
     install_signal_handlers();
     if (argc < 2) return usage(stderr);
     if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "help"))
         return usage(stdout);
     if (!strcmp(argv[1], "--version")) {
         printf("cadmorph %s\n", CADMORPH_VERSION);
+        cli_blas_print_version(stdout);
         return 0;
     }
     for (size_t i = 0; i < sizeof commands / sizeof *commands; ++i)
