@@ -1,3 +1,7 @@
 # RBF core benchmark (run by benchmarks/bench_rbf.sh; not a test).
 add_executable(bench_rbf ${CMAKE_CURRENT_LIST_DIR}/bench_rbf.c)
 target_link_libraries(bench_rbf PRIVATE cm_rbf cm_core cm_lapack cm_warnings cm_posix)
+# dpftrf vs the panel-by-panel RFP Cholesky, side by side (benchmarks/RESULTS.md)
+add_executable(bench_cholesky ${CMAKE_CURRENT_LIST_DIR}/bench_cholesky.c)
+target_include_directories(bench_cholesky PRIVATE ${PROJECT_SOURCE_DIR})
+target_link_libraries(bench_cholesky PRIVATE cm_rbf cm_core cm_lapack cm_warnings cm_posix)

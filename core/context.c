@@ -8,7 +8,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <time.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #define CM_MESSAGE_MAX 2048
 
@@ -72,7 +76,38 @@ void cm_context_set_threads(cm_context *ctx, int threads)
     if (ctx) ctx->threads = threads > 0 ? threads : 0;
 }
 
-int cm_context_threads(const cm_context *ctx) { return ctx ? ctx->threads : 0; }
+/* Under an address-space limit (ulimit -v) libgomp aborts the process when it cannot create
+ * a thread, so the count is capped to what the free address space backs with room to spare:
+ * per thread its stack (RLIMIT_STACK) and a malloc arena (64 MB), for half of what is free. */
+static int address_space_cap(int threads)
+{
+    struct rlimit as, st;
+    if (getrlimit(RLIMIT_AS, &as) != 0 || as.rlim_cur == RLIM_INFINITY) return threads;
+    unsigned long pages = 0;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        if (fscanf(f, "%lu", &pages) != 1) pages = 0;
+        fclose(f);
+    }
+    double used = (double)pages * 4096.0, limit = (double)as.rlim_cur;
+    double stack = 8.0 * 1048576.0;
+    if (getrlimit(RLIMIT_STACK, &st) == 0 && st.rlim_cur != RLIM_INFINITY) stack = (double)st.rlim_cur;
+    double spare = limit > used ? 0.5 * (limit - used) : 0.0;
+    double fit = 1.0 + spare / (stack + 64.0 * 1048576.0);
+    if (threads <= 0) {
+#ifdef _OPENMP
+        threads = omp_get_max_threads();
+#else
+        threads = 1;
+#endif
+    }
+    return fit < (double)threads ? (int)fit : threads;
+}
+
+int cm_context_threads(const cm_context *ctx)
+{
+    return address_space_cap(ctx ? ctx->threads : 0);
+}
 
 void cm_context_set_log(cm_context *ctx, cm_log_fn fn, void *user)
 {

@@ -85,8 +85,12 @@ cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *g
     struct rlimit rl;
     int limited = getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY;
     int t = want;
+    /* one thread whose buffer OpenBLAS already holds needs nothing new */
     if (limited)
-        while (t >= 1 && !fits(need_for(t))) --t;
+        while (t > 1 || (t == 1 && !main_held)) {
+            if (fits(need_for(t))) break;
+            --t;
+        }
     if (t < 1) {
         size_t lim = limited ? (size_t)rl.rlim_cur : 0, used = mapped_bytes();
         pthread_mutex_unlock(&lock);

@@ -58,7 +58,9 @@ void cm_context_destroy(cm_context **ctx);
 const char *cm_context_message(const cm_context *ctx);
 void cm_context_clear(cm_context *ctx);
 
-/* Threads for OpenMP leaf loops and BLAS; 0 = all available (default). */
+/* Threads for OpenMP leaf loops and BLAS; 0 = all available (default). Under an address-space
+ * limit (ulimit -v) cm_context_threads returns no more than the free address space can give
+ * stacks to (libgomp aborts the process when it cannot create a thread). */
 void cm_context_set_threads(cm_context *ctx, int threads);
 int cm_context_threads(const cm_context *ctx);
 

@@ -1,0 +1,92 @@
+/* The dense factorisation alone: LAPACK's dpftrf against cadmorph's panel-by-panel RFP
+ * Cholesky (rbf/cholesky_blocked.c) on the same SPD matrix, alternating in one process, at
+ * the OpenBLAS core and thread count of this run; with the Cholesky bound n^3/3 at the best
+ * dgemm rate measured in the same process.
+ * usage: bench_cholesky THREADS REPS N...   (one line of key=value per n) */
+#include "rbf/rbf_internal.h"
+
+#include <cblas.h>
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A_ij = 1 / (1 + |i - j|) + n [i = j]: diagonally dominant, so SPD, and cheap to fill. */
+static void fill_rfp(int n, double *a)
+{
+    const int n2 = n / 2, n1 = n - n2;
+    const size_t ld = n % 2 ? (size_t)n : (size_t)n + 1;
+    double *t = a + (n % 2 ? 0 : 1), *u = a + (n % 2 ? (size_t)n : 0);
+    for (int j = 0; j < n; ++j)
+        for (int i = j; i < n; ++i) {
+            double v = 1.0 / (1.0 + (i - j)) + (i == j ? n : 0.0);
+            if (j < n1) t[(size_t)i + (size_t)j * ld] = v;
+            else u[(size_t)(j - n1) + (size_t)(i - n1) * ld] = v;
+        }
+}
+
+static double dgemm_rate(void)
+{
+    const int n = 2000;
+    double *a = malloc(sizeof(double) * n * n), *b = malloc(sizeof(double) * n * n);
+    double *c = malloc(sizeof(double) * n * n);
+    for (long i = 0; i < (long)n * n; ++i) a[i] = 1.0 / (1 + i % 7), b[i] = 0.5, c[i] = 0.0;
+    double best = 0.0;
+    for (int r = 0; r < 3; ++r) {
+        double t = cm_wtime();
+        cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, n, n, n, 1.0, a, n, b, n, 0.0, c, n);
+        best = fmax(best, 2.0 * n * (double)n * n / (cm_wtime() - t));
+    }
+    free(a), free(b), free(c);
+    return best;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 4) {
+        fprintf(stderr, "usage: %s THREADS REPS N...\n", argv[0]);
+        return 1;
+    }
+    const int threads = atoi(argv[1]), reps = atoi(argv[2]) > 0 ? atoi(argv[2]) : 1;
+    int got = 0;
+    if (cm_rbf_blas_threads(NULL, "bench_cholesky", threads > 0 ? threads : 2, &got) != CM_OK)
+        return 2;
+    for (int k = 3; k < argc; ++k) {
+        const int n = atoi(argv[k]);
+        const size_t len = (size_t)n * (n + 1) / 2;
+        double *a = malloc(len * sizeof *a), *b = malloc(len * sizeof *b);
+        if (!a || !b) return 2;
+        double rate = 0.0, best_ref = INFINITY, best_blk = INFINITY;
+        int info_ref = 0, info_blk = 0;
+        for (int r = 0; r < reps; ++r) {
+            rate = fmax(rate, dgemm_rate());
+            fill_rfp(n, a);
+            double t0 = cm_wtime();
+            info_ref = LAPACKE_dpftrf_work(LAPACK_COL_MAJOR, 'N', 'L', n, a);
+            double t1 = cm_wtime();
+            fill_rfp(n, b);
+            double t2 = cm_wtime();
+            info_blk = cm_rbf_cholesky_rfp(NULL, n, b, 0);
+            double t3 = cm_wtime();
+            best_ref = fmin(best_ref, t1 - t0);
+            best_blk = fmin(best_blk, t3 - t2);
+        }
+        rate = fmax(rate, dgemm_rate());
+        double diff = 0.0, big = 0.0;
+        for (size_t i = 0; i < len; ++i) {
+            diff = fmax(diff, fabs(a[i] - b[i]));
+            big = fmax(big, fabs(a[i]));
+        }
+        const double bound = (double)n * n * n / 3.0 / rate;
+        printf("n=%d core=%s blas_threads=%d reps=%d dgemm_gflops=%.1f bound_s=%.3f "
+               "dpftrf_s=%.3f dpftrf_over_bound=%.3f blocked_s=%.3f blocked_over_bound=%.3f "
+               "blocked_over_dpftrf=%.3f max_diff_rel=%.2g info=%d/%d\n",
+               n, openblas_get_corename(), got, reps, rate * 1e-9, bound, best_ref,
+               best_ref / bound, best_blk, best_blk / bound, best_blk / best_ref, diff / big,
+               info_ref, info_blk);
+        fflush(stdout);
+        free(a), free(b);
+    }
+    return 0;
+}
