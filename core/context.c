@@ -10,9 +10,6 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <time.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #define CM_MESSAGE_MAX 2048
 
@@ -94,13 +91,7 @@ static int address_space_cap(int threads)
     if (getrlimit(RLIMIT_STACK, &st) == 0 && st.rlim_cur != RLIM_INFINITY) stack = (double)st.rlim_cur;
     double spare = limit > used ? 0.5 * (limit - used) : 0.0;
     double fit = 1.0 + spare / (stack + 64.0 * 1048576.0);
-    if (threads <= 0) {
-#ifdef _OPENMP
-        threads = omp_get_max_threads();
-#else
-        threads = 1;
-#endif
-    }
+    if (threads <= 0) threads = omp_get_max_threads();
     return fit < (double)threads ? (int)fit : threads;
 }
 
