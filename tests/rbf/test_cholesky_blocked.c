@@ -98,6 +98,27 @@ static void check_pivot(int n, int bad, int block)
     free(full), free(ref), free(got);
 }
 
+/* The call site: cm_rbf_create reports the factorisation panel by panel. */
+static void check_create(void)
+{
+    const size_t m = 1500;
+    double *c = malloc(m * 3 * sizeof *c);
+    for (size_t i = 0; i < 3 * m; ++i) c[i] = urand();
+    cm_context *ctx = NULL;
+    cm_context_create(&ctx);
+    calls k = {0, 1, 1, 0.0, 0.0};
+    cm_context_set_progress(ctx, on_progress, &k);
+    cm_rbf *rbf = NULL;
+    CHECK(cm_rbf_create(ctx, CM_RBF_TRIHARMONIC, 3, m, c, &rbf) == CM_OK);
+    /* n = m - 4 = 1496: 3 + 3 panels of 256, plus the calls at 0 and at the end */
+    CHECK_MSG(k.count >= 7, "%d progress calls", k.count);
+    CHECK(k.monotonic && k.stage_ok);
+    CHECK_NEAR(k.last, k.total, 0.0);
+    cm_rbf_destroy(&rbf);
+    cm_context_destroy(&ctx);
+    free(c);
+}
+
 int main(void)
 {
     const int sizes[] = {1, 2, 3, 7, 16, 33, 64, 65, 100, 127, 128, 129, 301, 512, 513};
@@ -113,5 +134,6 @@ int main(void)
     check_pivot(201, 150, 16);  /* inside A22 */
     check_pivot(201, 200, 16);  /* last pivot */
     CHECK(cm_rbf_cholesky_rfp(NULL, 0, &(double){1.0}, 0) == 0);
+    check_create();
     return TEST_REPORT();
 }
