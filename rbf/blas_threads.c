@@ -9,6 +9,7 @@
 #if defined(__linux__) && !defined(_DEFAULT_SOURCE)
 #define _DEFAULT_SOURCE /* MAP_ANONYMOUS, MAP_NORESERVE */
 #endif
+#include "cadmorph/blas.h"
 #include "rbf_internal.h"
 
 #include <cblas.h>
@@ -111,4 +112,10 @@ cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *g
                who, t, want);
     if (got) *got = t;
     return CM_OK;
+}
+
+cm_status cm_blas_reserve(cm_context *ctx, const char *who)
+{
+    return cm_rbf_blas_threads(ctx, who ? who : "cm_blas_reserve", openblas_get_num_threads(),
+                               NULL);
 }

@@ -83,6 +83,12 @@ typedef struct cm_blas_summary {
 /* Fills out for this process. ctx (may be NULL) gives the thread count. */
 void cm_blas_info(const cm_context *ctx, cm_blas_summary *out);
 
+/* For code that calls BLAS or LAPACK itself (cm_rbf_create does this already): call first.
+ * Checks that the address space can back OpenBLAS's buffers for its current thread count,
+ * lowers the count if only fewer fit, and returns CM_ERR_NOMEM (message starting with who)
+ * if not even the calling thread's buffer fits, where OpenBLAS would spin forever. */
+cm_status cm_blas_reserve(cm_context *ctx, const char *who);
+
 #ifdef __cplusplus
 }
 #endif

@@ -5,6 +5,9 @@
 
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 static const cm_blas_cpu spr = {1, 1, 1, 1, 1, 1, 1, 1};   /* Sapphire Rapids, Zen 4/5 */
 static const cm_blas_cpu hsw = {1, 1, 0, 0, 0, 0, 1, 0};   /* Haswell .. Zen 3 */
@@ -109,8 +112,36 @@ static void info(void)
     cm_context_destroy(&ctx);
 }
 
+/* Under an address-space limit that leaves no room for OpenBLAS's 128 MB buffer,
+ * cm_blas_reserve fails with CM_ERR_NOMEM (OpenBLAS itself would spin); with room it passes.
+ * In a child process: the limit must not reach the rest of the tests. */
+static int reserve_under(size_t extra_mb)
+{
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        FILE *f = fopen("/proc/self/statm", "r");
+        unsigned long pages = 0;
+        if (!f || fscanf(f, "%lu", &pages) != 1) _exit(3);
+        fclose(f);
+        struct rlimit rl;
+        rl.rlim_cur = rl.rlim_max = (rlim_t)pages * 4096u + (rlim_t)extra_mb * 1048576u;
+        if (setrlimit(RLIMIT_AS, &rl) != 0) _exit(3);
+        cm_context *ctx = NULL;
+        if (cm_context_create(&ctx) != CM_OK) _exit(3);
+        cm_status st = cm_blas_reserve(ctx, "test");
+        if (st == CM_ERR_NOMEM && strstr(cm_context_message(ctx), "test: out of memory")) _exit(1);
+        _exit(st == CM_OK ? 0 : 2);
+    }
+    int status = 0;
+    if (pid < 0 || waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
+    return WEXITSTATUS(status);
+}
+
 int main(void)
 {
+    CHECK(reserve_under(40) == 1);  /* no room: a clean CM_ERR_NOMEM */
+    CHECK(reserve_under(600) == 0); /* room for the buffers of a few threads */
     decisions();
     detection();
     info();
