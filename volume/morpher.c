@@ -24,7 +24,10 @@ struct cm_morpher {
         cm_warp *warp;
     } warps[CM_MORPHER_MAX_WARPS];
     int n_warps;
-    const cm_cad_model *target;       /* the last target (borrowed) and its locator */
+    const cm_cad_model *target; /* the last target (borrowed), its bounding box (so that another
+                                   model read at the same address is not taken for it) and
+                                   its locator */
+    double target_bb[6];
     cm_cad_locator *target_loc;
     cm_mesh *work; /* a copy of mesh whose coordinates are the result being measured */
     double *sj;    /* work's scaled_jacobian field */
@@ -207,11 +210,21 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
     return release(ctx, &held);
 }
 
+/* Whether target is the last target (same address and the same bounding box: a model read
+ * again at a freed one's address is another model). */
+static int is_last_target(const cm_morpher *mp, const cm_cad_model *target)
+{
+    if (target != mp->target || !mp->target_loc) return 0;
+    double bb[6];
+    cm_cad_bbox(target, bb);
+    return !memcmp(bb, mp->target_bb, sizeof bb);
+}
+
 /* The locator of target (for distances), kept while the same target comes back. */
 static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
                             double *t_sample)
 {
-    if (target == mp->target && mp->target_loc) return CM_OK;
+    if (is_last_target(mp, target)) return CM_OK;
     cm_status s = target == mp->g ? CM_OK : cm_cad_compare(ctx, mp->g, target, 5);
     if (s < 0) return cm_error_prefix(ctx, s, "the target does not correspond to G");
     double t0 = cm_wtime();
@@ -221,6 +234,7 @@ static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
     if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
     if (s < 0) return s;
     mp->target = target;
+    cm_cad_bbox(target, mp->target_bb);
     *t_sample = cm_wtime() - t0;
     return CM_OK;
 }
@@ -517,7 +531,7 @@ cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
         cm_status s = cm_cad_compare(ctx, mp->g, g, 5);
         if (s < 0) return cm_error_prefix(ctx, s, "the new base does not correspond to G");
         cm_cad_locator_destroy(&mp->loc);
-        if (g == mp->target && !(mp->opt.target_h_scale > 1)) {
+        if (is_last_target(mp, g) && !(mp->opt.target_h_scale > 1)) {
             /* the usual case: rebase onto the last target, sampled at the classification h */
             mp->loc = mp->target_loc;
             mp->target_loc = NULL;
