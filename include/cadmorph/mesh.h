@@ -142,6 +142,59 @@ CM_API cm_status cm_mesh_validate(cm_context *ctx, const cm_mesh *mesh, const ch
 /* Number of cells of dimension dim. */
 CM_API size_t cm_mesh_count_dim(const cm_mesh *mesh, int dim);
 
+/* ---- the face stream of a polyhedron ----
+ * One walk for every reader of CM_CELL_POLYHEDRON's stream (nf, n0, ids of face 0, n1, ...):
+ *
+ *   for (cm_polyhedron_face f = cm_polyhedron_begin(stream, len); cm_polyhedron_more(&f);
+ *        cm_polyhedron_next(&f))
+ *       ... f.n node ids at f.nodes (face f.face of f.n_faces) ...
+ *
+ * stream = mesh->conn + mesh->offset[c], len = its entry count, or -1 for a stream already
+ * checked (cm_mesh_validate, which the readers run). A face with a negative count or one that
+ * runs past len ends the walk with f.bad set; after a complete walk f.at is one past the last
+ * face (so f.at < stream + len means trailing entries). */
+typedef struct cm_polyhedron_face {
+    int64_t face;         /* this face: 0 .. n_faces - 1 */
+    int64_t n_faces;      /* the stream's face count (0 if negative) */
+    int64_t n;            /* node count of this face */
+    const int64_t *nodes; /* its n node ids */
+    const int64_t *at;    /* this face's entry (its count) in the stream */
+    const int64_t *end;   /* one past the stream, NULL for an unbounded walk */
+    int bad;              /* stopped at a malformed face (f.face is that face) */
+} cm_polyhedron_face;
+
+static inline void cm_polyhedron_load(cm_polyhedron_face *f)
+{
+    if (f->face >= f->n_faces) return;
+    if ((f->end && f->at >= f->end) || f->at[0] < 0 || (f->end && f->at[0] >= f->end - f->at)) {
+        f->bad = 1;
+        return;
+    }
+    f->n = f->at[0];
+    f->nodes = f->at + 1;
+}
+
+static inline cm_polyhedron_face cm_polyhedron_begin(const int64_t *stream, int64_t len)
+{
+    cm_polyhedron_face f = {0, 0, 0, stream + 1, stream + 1, len >= 0 ? stream + len : NULL, 0};
+    f.n_faces = len != 0 && stream[0] > 0 ? stream[0] : 0;
+    cm_polyhedron_load(&f);
+    return f;
+}
+
+static inline int cm_polyhedron_more(const cm_polyhedron_face *f)
+{
+    return !f->bad && f->face < f->n_faces;
+}
+
+static inline void cm_polyhedron_next(cm_polyhedron_face *f)
+{
+    f->at += 1 + f->n;
+    ++f->face;
+    f->n = 0;
+    cm_polyhedron_load(f);
+}
+
 /* ---- files ----
  * Formats by extension: .msh (gmsh 2.2 / 4.1, ASCII / binary little-endian), .vtu (VTK XML),
  * .vtk (legacy UNSTRUCTURED_GRID, ASCII / binary), .mesh (Medit ASCII).
