@@ -2,12 +2,34 @@
  *
  * Conventions of the whole library (every public header follows them):
  *  - Names: cm_<module>_<verb> for functions, cm_<noun> for types, CM_ for macros/enums.
- *  - Every fallible call returns cm_status: CM_OK (0), an error (< 0) or a warning (> 0).
- *    The message of the last error or warning is in the context: cm_context_message().
- *  - Parameter order: context, inputs, outputs. Inputs are borrowed for the call.
- *  - Arrays: row-major, 0-based; documented with their shape, e.g. "xyz: #V x 3 double".
+ *    Functions of the API carry CM_API (export.h); nothing else is exported by libcadmorph.so.
+ *  - Parameter order: context, inputs, outputs. Arrays: row-major, 0-based; documented with
+ *    their shape, e.g. "xyz: #V x 3 double".
+ *  - Return values: every fallible call returns cm_status: CM_OK (0), an error (< 0) or a
+ *    warning (> 0: the result is complete, the message says what was odd). Test `s < 0` for
+ *    failure. The message of the last error or warning is in the context
+ *    (cm_context_message) until the next one; calls that succeed leave it alone. Functions
+ *    that cannot fail return their value directly (counts, names, pointers into objects).
  *  - Ownership: cm_X_create(ctx, ..., &out) allocates, cm_X_destroy(&p) frees, accepts NULL
  *    and sets the pointer to NULL. On failure nothing leaks and outputs are NULL.
+ *  - Pointer lifetimes: inputs are borrowed for the call and may be freed when it returns,
+ *    unless the header says an object keeps them (the morpher keeps its cm_cad_model
+ *    pointers: morph.h). Pointers a function returns into an object (names, arrays, info
+ *    structs) stay valid until the object is destroyed or, where the header says so, until
+ *    the next call on it; the caller never frees them. Strings returned without an object
+ *    (cm_status_name, cm_version) are static.
+ *  - Thread-safety: a context, and every object created with it, is used by one thread at a
+ *    time; separate contexts and objects may be used from separate threads at once. Read-only
+ *    objects (const parameters: models, locators, fitted RBFs, meshes) may be shared between
+ *    threads. Internally calls run OpenMP leaf loops sized by cm_context_set_threads; the
+ *    results do not depend on the thread count beyond round-off.
+ *  - Process-wide effects (the only ones): the RBF factorisation sets OpenBLAS's thread
+ *    count (openblas_set_num_threads) for its large calls and restores the caller's value
+ *    before it returns; two RBF calls in different threads at once may see each other's
+ *    setting (speed only, not results). The first STEP read or write removes the printers of
+ *    OpenCASCADE's default messenger (so the library never writes to stdout) and sets
+ *    OpenCASCADE's translator parameters (Interface_Static: units, schema) under a lock;
+ *    a program that uses OpenCASCADE itself sees both.
  *  - The library never prints, exits or aborts; the log callback decides what a user sees.
  */
 #ifndef CADMORPH_CORE_H
