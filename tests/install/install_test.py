@@ -19,6 +19,7 @@ import re
 import shutil
 import subprocess
 import sys
+import time
 
 ok = True
 
@@ -30,8 +31,9 @@ def fail(msg):
 
 
 def run(cmd, env=None, expect=0):
-    print("$ " + " ".join(cmd), flush=True)
+    t = time.monotonic()
     r = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    print("$ %s  [%.1f s]" % (" ".join(cmd), time.monotonic() - t), flush=True)
     if r.returncode != expect:
         fail("exit code %d, expected %d\n--- stdout\n%s--- stderr\n%s" %
              (r.returncode, expect, r.stdout, r.stderr))
@@ -43,9 +45,9 @@ def declared_functions(include_dir):
     names = set()
     for h in glob.glob(os.path.join(include_dir, "cadmorph", "*.h")):
         text = open(h).read()
-        names |= set(re.findall(r"^CM_API\b[^;{(]*?\b(cm_\w+)\s*\(", text, re.MULTILINE))
+        names |= set(re.findall(r"^CM_API\b[^;{(\n]*?\b(cm_\w+)\s*\(", text, re.MULTILINE))
         # a declaration at file scope without CM_API would be hidden in the shared library
-        for m in re.finditer(r"^(?!CM_API|typedef|static|#|\s|/|\*)[^;(]*?\b(cm_\w+)\s*\(",
+        for m in re.finditer(r"^(?!CM_API|typedef|static|#|\s|/|\*)[^;(\n]*?\b(cm_\w+)\s*\(",
                              text, re.MULTILINE):
             fail("%s: %s is declared without CM_API" % (os.path.basename(h), m.group(1)))
     return names
