@@ -28,11 +28,11 @@ static int print_help(void);
 static const char *const kernel_names[] = {"triharmonic", "biharmonic", NULL};
 static const int kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};
 
-static int parse_method(const cli_option *o, const char *v, void *dest)
+static int parse_method(const cli_parser *p, const cli_option *o, const char *v, void *dest)
 {
     int m = cm_warp_method_from_name(v);
     if (m < 0)
-        return cli_usage("warp", usage_line, "unknown method '%s' (%s)", v, cm_warp_method_list());
+        return cli_usage(p->cmd, p->usage, "unknown method '%s' (%s)", v, cm_warp_method_list());
     (void)o;
     *(cm_warp_method *)dest = (cm_warp_method)m;
     return 0;

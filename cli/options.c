@@ -12,7 +12,8 @@ static int takes_value(const cli_option *o)
 {
     switch (o->kind) {
     case CLI_FLAG:
-    case CLI_HELP: return 0;
+    case CLI_HELP:
+    case CLI_NOTE: return 0;
     case CLI_CUSTOM: return o->takes_value;
     default: return 1;
     }
@@ -59,8 +60,9 @@ static int set_value(const cli_parser *p, const cli_option *o, const char *opt, 
                 return 0;
             }
         return bad_value(p, o, opt, v);
-    case CLI_CUSTOM: return o->parse(o, v, o->dest);
+    case CLI_CUSTOM: return o->parse(p, o, v, o->dest);
     case CLI_HELP: return p->help();
+    case CLI_NOTE: break;
     }
     return CLI_EXIT_INTERNAL;
 }
@@ -72,7 +74,9 @@ int cli_parse(cli_parser *p, int argc, char **argv)
         const char *a = argv[i];
         const cli_option *o = p->options;
         if (a[0] == '-' && a[1] != '\0')
-            while (o->name && strcmp(a, o->name) && !(o->alias && !strcmp(a, o->alias))) ++o;
+            while (o->name && (o->kind == CLI_NOTE || (strcmp(a, o->name) &&
+                                                      !(o->alias && !strcmp(a, o->alias)))))
+                ++o;
         if (a[0] == '-' && a[1] != '\0' && !o->name)
             return cli_usage(p->cmd, p->usage, p->unknown, a);
         if (a[0] != '-' || a[1] == '\0') { /* a positional argument ("-" is one too) */

@@ -15,14 +15,18 @@ typedef enum cli_kind {
     CLI_ENUM,    /* int *dest = values[k] for the value names[k] */
     CLI_THREADS, /* int *dest, 1..4096 */
     CLI_CUSTOM,  /* parse(value, dest) decides */
-    CLI_HELP     /* prints the command's help, exit 0 */
+    CLI_HELP,    /* prints the command's help, exit 0 */
+    CLI_NOTE     /* a line of the help only (another form of an option), never parsed */
 } cli_kind;
 
 typedef struct cli_option cli_option;
+typedef struct cli_parser cli_parser;
 
 /* What a CLI_CUSTOM option does with its value (NULL for an option without value, see
- * takes_value): 0 done, or the exit code after a usage message (cli_usage). */
-typedef int (*cli_parse_fn)(const cli_option *o, const char *value, void *dest);
+ * takes_value): 0 done, or the exit code after a usage message (cli_usage with p's cmd and
+ * usage). */
+typedef int (*cli_parse_fn)(const cli_parser *p, const cli_option *o, const char *value,
+                            void *dest);
 
 struct cli_option {
     const char *name;  /* "--size" */
@@ -47,7 +51,7 @@ struct cli_option {
 
 /* A command's parser: its options (ended by an entry with name NULL), its positional
  * arguments (up to max_pos into pos), and its messages. */
-typedef struct cli_parser {
+struct cli_parser {
     const char *cmd;   /* "mesh" */
     const char *usage; /* the usage line */
     const cli_option *options;
@@ -57,7 +61,7 @@ typedef struct cli_parser {
     int max_pos;
     const char *extra;        /* format of one %s for a positional beyond max_pos */
     int n_pos;                /* out: how many were given */
-} cli_parser;
+};
 
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
  * --help, CLI_EXIT_USAGE after a message on stderr. */
