@@ -22,7 +22,7 @@ static const cli_option options[] = {
     {.name = "--help", .alias = "-h", .kind = CLI_HELP},
     {.name = "--compare", .kind = CLI_STRING, .dest = &other, .label = "--compare G2.step",
      .help = "check that G2 corresponds to G (same counts, surface and curve\n"
-             "                      types, face-edge-vertex incidence); lists the first differences"},
+             "types, face-edge-vertex incidence); lists the first differences"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &opt.unit, .label = "--cad-unit U",
      .help = "length unit of the coordinates (default mm): mm cm m km in ft mi um"},
     {.name = "--faces", .kind = CLI_FLAG, .dest = &faces, .label = "--faces",

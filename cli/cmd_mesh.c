@@ -32,18 +32,18 @@ static const cli_option options[] = {
     {.name = "--preserve-surface", .kind = CLI_FLAG, .dest = &preserve_surface,
      .label = "--preserve-surface",
      .help = "keep OpenCASCADE's surface triangulation as it is (TetGen -Y);\n"
-             "                      by default TetGen refines it and its new boundary nodes are\n"
-             "                      projected onto the CAD faces and edges"},
+             "by default TetGen refines it and its new boundary nodes are\n"
+             "projected onto the CAD faces and edges"},
     {.name = "--min-dihedral", .kind = CLI_DOUBLE, .dest = &opt.min_dihedral, .lo = 0, .hi = 20,
      .bad = "%s needs degrees in [0, 20], got '%s'", .label = "--min-dihedral D",
      .help = "lower bound on the tets' dihedral angles, degrees in [0, 20]\n"
-             "                      (default 12; 0: TetGen's own): fewer slivers, more tets"},
+             "(default 12; 0: TetGen's own): fewer slivers, more tets"},
     {.name = "--no-optimize", .kind = CLI_FLAG, .dest = &no_optimize, .label = "--no-optimize",
      .help = "keep TetGen's interior nodes; by default they are optimised\n"
-             "                      to lift slivers (boundary nodes never move)"},
+             "to lift slivers (boundary nodes never move)"},
     {.name = "--force", .kind = CLI_FLAG, .dest = &force, .label = "--force",
      .help = "mesh even when the estimated tet count exceeds 1e7 (refused\n"
-             "                      otherwise, exit code 4, with the estimate)"},
+             "otherwise, exit code 4, with the estimate)"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &unit, .label = "--cad-unit U",
      .help = "length unit of the coordinates (default mm)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",

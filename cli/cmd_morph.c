@@ -66,20 +66,9 @@ static int parse_steps(const cli_parser *p, const cli_option *o, const char *v, 
     return 0;
 }
 
-static int parse_method(const cli_parser *p, const cli_option *o, const char *v, void *dest)
-{
-    int m = cm_warp_method_from_name(v);
-    if (m < 0)
-        return cli_usage(p->cmd, p->usage, "unknown method '%s' (%s)", v, cm_warp_method_list());
-    (void)o;
-    *(cm_warp_method *)dest = (cm_warp_method)m;
-    return 0;
-}
 
 static const char *const surface_names[] = {"rbf", "project", NULL};
 static const int surface_methods[] = {CM_SURFACE_RBF, CM_SURFACE_PROJECT};
-static const char *const kernel_names[] = {"triharmonic", "biharmonic", NULL};
-static const int kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};
 
 static int print_help(void);
 
@@ -96,11 +85,11 @@ static const cli_option options[] = {
     {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_steps,
      .dest = &args.opt.steps, .label = "--steps K",
      .help = "split the boundary motion into K equal increments (default 1);\n"
-             "                       each increment after the first refits the warp on the last mesh"},
+             "each increment after the first refits the warp on the last mesh"},
     {.name = "--steps", .kind = CLI_NOTE, .label = "--steps auto",
      .help = "adaptive steps: the whole motion first, halved on failure and\n"
-             "                       refitted on the last valid mesh, doubled after easy steps,\n"
-             "                       until every cell keeps a scaled Jacobian above --min-sj"},
+             "refitted on the last valid mesh, doubled after easy steps,\n"
+             "until every cell keeps a scaled Jacobian above --min-sj"},
     {.name = "--min-sj", .kind = CLI_DOUBLE, .dest = &args.opt.min_sj, .lo = -1, .hi = 1,
      .open = 2, .bad = "%s: expected a number in [-1, 1), got '%s'", .label = "--min-sj F",
      .help = "floor of --steps auto (default 0: no inverted cell)"},
@@ -110,43 +99,44 @@ static const cli_option options[] = {
     {.name = "--keep-partial", .kind = CLI_FLAG, .dest = &args.keep_partial,
      .label = "--keep-partial",
      .help = "when --steps auto finds no valid step, still write the last\n"
-             "                       valid mesh (and the report) before exiting 3"},
+             "valid mesh (and the report) before exiting 3"},
     {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.opt.optimize, .label = "--optimize",
      .help = "optimise the interior nodes after every step (boundary nodes\n"
-             "                       stay on G1): untangles and raises the worst cells"},
+             "stay on G1): untangles and raises the worst cells"},
     {.name = "--relative", .kind = CLI_FLAG, .dest = &args.relative},
     {.name = "--via", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_via, .dest = &args,
      .label = "--relative --via L",
      .help = "morph relatively through the intermediate geometries of the\n"
-             "                       comma-separated list L (same topology): G0 -> Ga -> ... -> G1,\n"
-             "                       each leg from the previous result (K increments per leg)"},
+             "comma-separated list L (same topology): G0 -> Ga -> ... -> G1,\n"
+             "each leg from the previous result (K increments per leg)"},
     {.name = "--surface", .kind = CLI_ENUM, .dest = &args.opt.method.surface,
      .names = surface_names, .values = surface_methods, .bad = "%.0sunknown surface method '%s'",
      .label = "--surface S", .help = "rbf (parameter warp, default) or project (closest point)"},
-    {.name = "--method", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_method,
+    {.name = "--method", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_warp_method,
      .dest = &args.opt.method.warp.method, .label = "--method M",
      .help = "interior warp: %s (default rbf)", .help_arg = cm_warp_method_list},
     {.name = "--kernel", .kind = CLI_ENUM, .dest = &args.opt.method.warp.method,
-     .names = kernel_names, .values = kernel_methods, .bad = "%.0sunknown kernel '%s'",
-     .label = "--kernel K", .help = "triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)"},
+     .names = cli_kernel_names, .values = cli_kernel_methods, .bad = "%.0sunknown kernel '%s'",
+     .label = "--kernel K",
+     .help = "triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)"},
     {.name = "--lattice", .kind = CLI_INT, .dest = &args.opt.method.warp.lattice, .lo = 4,
      .hi = 200, .bad = "%s: expected 4..200 control points per axis, got '%s'",
      .label = "--lattice N",
      .help = "dmffd: control points per axis of the B-spline lattice on the\n"
-             "                       mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
-             "                       is least squares: the boundary keeps its motion exactly, the\n"
-             "                       interior follows a space map that misses it (residual)"},
+             "mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
+             "is least squares: the boundary keeps its motion exactly, the\n"
+             "interior follows a space map that misses it (residual)"},
     {.name = "--clamp", .kind = CLI_DOUBLE, .dest = &args.opt.method.warp.clamp, .lo = 0,
      .hi = 1, .open = 3, .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--clamp E",
      .help = "dmffd: singular values <= E x the largest are dropped\n"
-             "                       (default 1e-10; 1e-2 keeps coarse lattices usable)"},
+             "(default 1e-10; 1e-2 keeps coarse lattices usable)"},
     {.name = "--report", .kind = CLI_STRING, .dest = &args.report, .label = "--report R.csv",
      .help = "one row per step: quality, distance to G1, stage times"},
     {.name = "--fail-on-inverted", .kind = CLI_FLAG, .dest = &args.fail_on_inverted,
      .label = "--fail-on-inverted", .help = "exit 3 without writing M1 if a cell is inverted"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &args.unit, .label = "--cad-unit U",
      .help = "unit of the mesh coordinates: the STEP files are converted to\n"
-             "                       it (mm default; cm m in ft um ...)"},
+             "it (mm default; cm m in ft um ...)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads,
      .bad = "%s: expected a positive integer, got '%s'", .label = "--threads N",
      .help = "threads (default: all)"},

@@ -25,7 +25,7 @@ static const cli_option options[] = {
     {.name = "--target-sj", .kind = CLI_DOUBLE, .dest = &opt.target_sj, .lo = -1, .hi = 1,
      .open = 1, .bad = "%s: expected a number in (-1, 1]%.0s", .label = "--target-sj F",
      .help = "work on the cells below this scaled Jacobian and their\n"
-             "                       neighbours (default 0.3)"},
+             "neighbours (default 0.3)"},
     {.name = "--sweeps", .kind = CLI_INT, .dest = &opt.sweeps, .lo = 1, .hi = 1000,
      .bad = "%s: expected 1..1000, got '%s'", .label = "--sweeps N",
      .help = "passes over those nodes (default 6)"},

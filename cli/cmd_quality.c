@@ -14,7 +14,7 @@ static int threads;
 static const cli_option options[] = {
     {.name = "--csv", .kind = CLI_STRING, .dest = &csv, .label = "--csv OUT.csv",
      .help = "write cell,type,scaled_jacobian for every volume cell (cell: 0-based\n"
-             "                  index among all elements of the file)"},
+             "index among all elements of the file)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",
      .help = "threads for the computation (default: all)"},
     {.name = "--help", .alias = "-h", .kind = CLI_HELP, .label = "-h, --help", .help = "this text"},

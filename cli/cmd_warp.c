@@ -25,18 +25,7 @@ static warp_args args;
 
 static int print_help(void);
 
-static const char *const kernel_names[] = {"triharmonic", "biharmonic", NULL};
-static const int kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};
 
-static int parse_method(const cli_parser *p, const cli_option *o, const char *v, void *dest)
-{
-    int m = cm_warp_method_from_name(v);
-    if (m < 0)
-        return cli_usage(p->cmd, p->usage, "unknown method '%s' (%s)", v, cm_warp_method_list());
-    (void)o;
-    *(cm_warp_method *)dest = (cm_warp_method)m;
-    return 0;
-}
 
 static const cli_option options[] = {
     {.name = "--help", .alias = "-h", .kind = CLI_HELP},
@@ -46,25 +35,25 @@ static const cli_option options[] = {
      .label = "--displacements D", .help = "displacement table (CSV)"},
     {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
      .label = "-o, --output M1", .help = "output mesh (must not be an input)"},
-    {.name = "--method", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_method,
+    {.name = "--method", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_warp_method,
      .dest = &args.method, .label = "--method M",
      .help = "interior warp: %s (default rbf: r^3)", .help_arg = cm_warp_method_list},
-    {.name = "--kernel", .kind = CLI_ENUM, .dest = &args.method, .names = kernel_names,
-     .values = kernel_methods, .bad = "%.0sunknown kernel '%s'", .label = "--kernel K",
+    {.name = "--kernel", .kind = CLI_ENUM, .dest = &args.method, .names = cli_kernel_names,
+     .values = cli_kernel_methods, .bad = "%.0sunknown kernel '%s'", .label = "--kernel K",
      .help = "triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)"},
     {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.optimize, .label = "--optimize",
      .help = "then optimise the other nodes (untangle, raise the worst cells;\n"
-             "                       boundary and listed nodes stay where D.csv sends them)"},
+             "boundary and listed nodes stay where D.csv sends them)"},
     {.name = "--lattice", .kind = CLI_INT, .dest = &args.lattice, .lo = 4, .hi = 200,
      .bad = "%s: expected 4..200 control points per axis, got '%s'", .label = "--lattice N",
      .help = "dmffd: control points per axis of the B-spline lattice on the\n"
-             "                       mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
-             "                       is least squares: the boundary keeps its motion exactly, the\n"
-             "                       interior follows a space map that misses it (--verbose)"},
+             "mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
+             "is least squares: the boundary keeps its motion exactly, the\n"
+             "interior follows a space map that misses it (--verbose)"},
     {.name = "--clamp", .kind = CLI_DOUBLE, .dest = &args.clamp, .lo = 0, .hi = 1, .open = 3,
      .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--clamp E",
      .help = "dmffd: singular values <= E x the largest are dropped\n"
-             "                       (default 1e-10; 1e-2 keeps coarse lattices usable)"},
+             "(default 1e-10; 1e-2 keeps coarse lattices usable)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
      .help = "threads for evaluation and quality (default: all)"},
     {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,

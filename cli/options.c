@@ -3,6 +3,8 @@
 
 #include "cli.h"
 
+#include "cadmorph/warp.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -13,9 +15,12 @@ static int takes_value(const cli_option *o)
     switch (o->kind) {
     case CLI_FLAG:
     case CLI_HELP:
-    case CLI_NOTE: return 0;
-    case CLI_CUSTOM: return o->takes_value;
-    default: return 1;
+    case CLI_NOTE:
+        return 0;
+    case CLI_CUSTOM:
+        return o->takes_value;
+    default:
+        return 1;
     }
 }
 
@@ -28,11 +33,16 @@ static int set_value(const cli_parser *p, const cli_option *o, const char *opt, 
 {
     char *end = NULL;
     switch (o->kind) {
-    case CLI_FLAG: *(int *)o->dest = 1; return 0;
-    case CLI_STRING: *(const char **)o->dest = v; return 0;
+    case CLI_FLAG:
+        *(int *)o->dest = 1;
+        return 0;
+    case CLI_STRING:
+        *(const char **)o->dest = v;
+        return 0;
     case CLI_THREADS:
     case CLI_INT: {
-        const double lo = o->kind == CLI_THREADS ? 1 : o->lo, hi = o->kind == CLI_THREADS ? 4096 : o->hi;
+        const double lo = o->kind == CLI_THREADS ? 1 : o->lo,
+                     hi = o->kind == CLI_THREADS ? 4096 : o->hi;
         errno = 0;
         const long n = strtol(v, &end, 10);
         if (errno || end == v || *end || n < lo || n > hi) {
@@ -60,9 +70,12 @@ static int set_value(const cli_parser *p, const cli_option *o, const char *opt, 
                 return 0;
             }
         return bad_value(p, o, opt, v);
-    case CLI_CUSTOM: return o->parse(p, o, v, o->dest);
-    case CLI_HELP: return p->help();
-    case CLI_NOTE: break;
+    case CLI_CUSTOM:
+        return o->parse(p, o, v, o->dest);
+    case CLI_HELP:
+        return p->help();
+    case CLI_NOTE:
+        break;
     }
     return CLI_EXIT_INTERNAL;
 }
@@ -74,8 +87,8 @@ int cli_parse(cli_parser *p, int argc, char **argv)
         const char *a = argv[i];
         const cli_option *o = p->options;
         if (a[0] == '-' && a[1] != '\0')
-            while (o->name && (o->kind == CLI_NOTE || (strcmp(a, o->name) &&
-                                                      !(o->alias && !strcmp(a, o->alias)))))
+            while (o->name && (o->kind == CLI_NOTE ||
+                               (strcmp(a, o->name) && !(o->alias && !strcmp(a, o->alias)))))
                 ++o;
         if (a[0] == '-' && a[1] != '\0' && !o->name)
             return cli_usage(p->cmd, p->usage, p->unknown, a);
@@ -88,8 +101,7 @@ int cli_parse(cli_parser *p, int argc, char **argv)
         if (o->kind == CLI_HELP) return p->help();
         const char *v = NULL;
         if (takes_value(o)) {
-            if (i + 1 >= argc)
-                return cli_usage(p->cmd, p->usage, "option %s needs a value", a);
+            if (i + 1 >= argc) return cli_usage(p->cmd, p->usage, "option %s needs a value", a);
             v = argv[++i];
         }
         const int rc = set_value(p, o, a, v);
@@ -102,8 +114,27 @@ void cli_print_options(FILE *out, const cli_option *options, int width)
 {
     for (const cli_option *o = options; o->name; ++o) {
         if (!o->label) continue;
+        char text[2048];
+        snprintf(text, sizeof text, o->help, o->help_arg ? o->help_arg() : "");
         fprintf(out, "  %-*s", width, o->label);
-        fprintf(out, o->help, o->help_arg ? o->help_arg() : "");
+        for (const char *c = text; *c; ++c) /* continuation lines start under the column */
+            if (*c == '\n')
+                fprintf(out, "\n%*s", width + 2, "");
+            else
+                fputc(*c, out);
         fputc('\n', out);
     }
 }
+
+int cli_parse_warp_method(const cli_parser *p, const cli_option *o, const char *v, void *dest)
+{
+    (void)o;
+    const int m = cm_warp_method_from_name(v);
+    if (m < 0)
+        return cli_usage(p->cmd, p->usage, "unknown method '%s' (%s)", v, cm_warp_method_list());
+    *(cm_warp_method *)dest = (cm_warp_method)m;
+    return 0;
+}
+
+const char *const cli_kernel_names[] = {"triharmonic", "biharmonic", NULL};
+const int cli_kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};

@@ -34,8 +34,9 @@ struct cli_option {
     cli_kind kind;
     void *dest;
     const char *label; /* left column of the help ("--size H"); NULL: not in the help */
-    const char *help;  /* right column, printf format of one %s (help_arg); continuation
-                          lines are written out, indented, in the string */
+    /* right column: printf format of one %s (help_arg); a newline in it starts a continuation
+     * line under the column */
+    const char *help;
     const char *(*help_arg)(void); /* the %s of help (e.g. the list of warp methods), or NULL */
     /* CLI_INT: min, max; CLI_DOUBLE: lo, hi (NAN: no bound), open: bit 1 lo open, bit 2 hi
      * open */
@@ -45,8 +46,8 @@ struct cli_option {
     const char *bad;
     const char *const *names; /* CLI_ENUM: NULL-terminated names and their values */
     const int *values;
-    cli_parse_fn parse;       /* CLI_CUSTOM */
-    int takes_value;          /* CLI_CUSTOM: 1 if it reads a value */
+    cli_parse_fn parse; /* CLI_CUSTOM */
+    int takes_value;    /* CLI_CUSTOM: 1 if it reads a value */
 };
 
 /* A command's parser: its options (ended by an entry with name NULL), its positional
@@ -55,20 +56,26 @@ struct cli_parser {
     const char *cmd;   /* "mesh" */
     const char *usage; /* the usage line */
     const cli_option *options;
-    int (*help)(void);        /* prints the help; its return value is the exit code */
-    const char *unknown;      /* "unknown option '%s'" or "unknown argument '%s'" */
-    const char **pos;         /* positional arguments; max_pos 0: none accepted */
+    int (*help)(void);   /* prints the help; its return value is the exit code */
+    const char *unknown; /* "unknown option '%s'" or "unknown argument '%s'" */
+    const char **pos;    /* positional arguments; max_pos 0: none accepted */
     int max_pos;
-    const char *extra;        /* format of one %s for a positional beyond max_pos */
-    int n_pos;                /* out: how many were given */
+    const char *extra; /* format of one %s for a positional beyond max_pos */
+    int n_pos;         /* out: how many were given */
 };
+
+/* Values shared by several commands: --method M of the warp method table (dest: a
+ * cm_warp_method), and --kernel triharmonic|biharmonic (a CLI_ENUM onto the same field). */
+int cli_parse_warp_method(const cli_parser *p, const cli_option *o, const char *value, void *dest);
+extern const char *const cli_kernel_names[];
+extern const int cli_kernel_methods[];
 
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
  * --help, CLI_EXIT_USAGE after a message on stderr. */
 int cli_parse(cli_parser *p, int argc, char **argv);
 
-/* The options block of a help text: one "  <label>  <help>" line per labelled option, the
- * label column width wide. */
+/* The options block of a help text: "  <label><help>" per labelled option, the label
+ * column width wide, continuation lines indented to the help column. */
 void cli_print_options(FILE *out, const cli_option *options, int width);
 
 #endif
