@@ -23,10 +23,10 @@
  *    objects (const parameters: models, locators, fitted RBFs, meshes) may be shared between
  *    threads. Internally calls run OpenMP leaf loops sized by cm_context_set_threads; the
  *    results do not depend on the thread count beyond round-off.
- *  - Process-wide effects (the only ones): the RBF factorisation sets OpenBLAS's thread
- *    count (openblas_set_num_threads) for its large calls and restores the caller's value
- *    before it returns; two RBF calls in different threads at once may see each other's
- *    setting (speed only, not results). The first STEP read or write removes the printers of
+ *  - Process-wide effects (the only ones): the RBF factorisation and DM-FFD's SVD set
+ *    OpenBLAS's thread count (openblas_set_num_threads) for their large calls and restore the
+ *    caller's value before they return; two such calls in different threads at once may see
+ *    each other's setting (speed only, not results). The first STEP read or write removes the printers of
  *    OpenCASCADE's default messenger (so the library never writes to stdout) and sets
  *    OpenCASCADE's translator parameters (Interface_Static: units, schema) under a lock;
  *    a program that uses OpenCASCADE itself sees both.
