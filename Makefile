@@ -6,7 +6,7 @@ ifeq ($(CI),true)
 CMAKE_FLAGS += -DCADMORPH_WERROR=ON
 endif
 
-.PHONY: all setup build demo test bench clean check-asan fuzz
+.PHONY: all setup build demo test test-all bench clean check-asan fuzz
 
 all: build
 
@@ -20,8 +20,12 @@ build: setup
 demo: build
 	$(BUILD)/cli/cadmorph demo -o $(BUILD)/demo
 
+# every label but slow (tests over ~20 s); test-all runs them too
 test: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -LE slow
+
+test-all: build
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
 bench: build
 	sh benchmarks/run_all.sh $(BUILD)

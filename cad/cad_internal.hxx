@@ -94,8 +94,6 @@ struct region_error {
     }
 };
 
-int threads(const cm_context *ctx);
-
 cm_status check_face(cm_context *ctx, const cm_cad_model *m, int face, const char *fn);
 cm_status check_edge(cm_context *ctx, const cm_cad_model *m, int edge, const char *fn);
 

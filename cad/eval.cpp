@@ -43,7 +43,7 @@ cm_status parallel_over(cm_context *ctx, const char *fn, const cm_cad_model *m, 
 {
     return cmcad::guard(ctx, fn, [&]() -> cm_status {
         cmcad::region_error err;
-#pragma omp parallel num_threads(cmcad::threads(ctx)) if (n > 256)
+#pragma omp parallel num_threads(cm_context_threads_for(ctx, n, 256)) if (n > 256)
         {
             cmcad::adaptors a(m);
 #pragma omp for schedule(static)

@@ -5,7 +5,7 @@
 #include <flann/flann.h>
 #include <limits.h>
 #include <math.h>
-#include <omp.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -27,8 +27,7 @@ static struct FLANNParameters kdtree_params(const cm_context *ctx)
     p.eps = 0.0f;
     p.leaf_max_size = 10;
     p.log_level = FLANN_LOG_NONE; /* the library never prints */
-    int threads = cm_context_threads(ctx);
-    p.cores = threads > 0 ? threads : omp_get_max_threads();
+    p.cores = cm_context_threads_for(ctx, SIZE_MAX, 1); /* set per search below */
     p.random_seed = 1;
     return p;
 }
@@ -98,8 +97,7 @@ cm_status cm_kdtree_nearest(cm_context *ctx, const cm_kdtree *tree, const double
     }
     /* FLANN's signature takes non-const pointers but does not write the data or the params. */
     struct FLANNParameters p = tree->params;
-    int threads = cm_context_threads(ctx);
-    p.cores = threads > 0 ? threads : omp_get_max_threads();
+    p.cores = cm_context_threads_for(ctx, m, 1);
     cm_status st = CM_OK;
     for (size_t q0 = 0; q0 < m; q0 += block) {
         size_t nq = m - q0 < block ? m - q0 : block;

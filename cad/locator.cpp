@@ -104,9 +104,7 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
 {
     const char *fn = "cm_cad_locator_create";
     const cm_cad_model *m = L->model;
-    const double *bb = m->bbox;
-    double diag = std::sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) + (bb[4] - bb[1]) * (bb[4] - bb[1]) +
-                            (bb[5] - bb[2]) * (bb[5] - bb[2]));
+    double diag = cm_bbox_diagonal(m->bbox);
     double h = o.h > 0 ? o.h : diag / 200;
     size_t cap = o.max_samples ? o.max_samples : default_cap;
     double clock0 = cm_wtime();
@@ -134,7 +132,7 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     std::vector<char> keep(ncand, 0);
     cmcad::region_error err;
     cm_progress(ctx, "sample", 0, (double)rows.size());
-#pragma omp parallel num_threads(cmcad::threads(ctx)) if (ncand > 4096)
+#pragma omp parallel num_threads(cm_context_threads_for(ctx, ncand, 4096)) if (ncand > 4096)
     {
         cmcad::adaptors ta(m);
         const int nt = omp_get_num_threads();
@@ -305,7 +303,7 @@ cm_status cm_cad_locate_faces(cm_context *ctx, const cm_cad_locator *L, const do
         if (st != CM_OK) return st;
         cmcad::region_error err;
         const double h = L->h;
-#pragma omp parallel num_threads(cmcad::threads(ctx)) if (n > 64)
+#pragma omp parallel num_threads(cm_context_threads_for(ctx, n, 64)) if (n > 64)
         {
             cmcad::adaptors a(L->model);
 #pragma omp for schedule(static)
@@ -381,7 +379,7 @@ cm_status cm_cad_locate_edges(cm_context *ctx, const cm_cad_locator *L, const do
         if (st != CM_OK) return st;
         cmcad::region_error err;
         const double h = L->h;
-#pragma omp parallel num_threads(cmcad::threads(ctx)) if (n > 64)
+#pragma omp parallel num_threads(cm_context_threads_for(ctx, n, 64)) if (n > 64)
         {
             cmcad::adaptors a(L->model);
 #pragma omp for schedule(static)

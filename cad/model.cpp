@@ -28,7 +28,6 @@
 #include <TopoDS_Vertex.hxx>
 #include <TopoDS_Wire.hxx>
 
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -39,12 +38,6 @@
 #include <sstream>
 
 namespace cmcad {
-
-int threads(const cm_context *ctx)
-{
-    int t = cm_context_threads(ctx);
-    return t > 0 ? t : omp_get_max_threads();
-}
 
 cm_status check_face(cm_context *ctx, const cm_cad_model *m, int face, const char *fn)
 {

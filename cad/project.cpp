@@ -296,7 +296,7 @@ cm_status cm_cad_project_face(cm_context *ctx, const cm_cad_model *model, int fa
     if (n && !xyz) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: xyz is NULL", fn);
     return cmcad::guard(ctx, fn, [&]() -> cm_status {
         cmcad::region_error err;
-#pragma omp parallel num_threads(cmcad::threads(ctx)) if (n > 64)
+#pragma omp parallel num_threads(cm_context_threads_for(ctx, n, 64)) if (n > 64)
         {
             cmcad::adaptors a(model);
 #pragma omp for schedule(static)
@@ -333,7 +333,7 @@ cm_status cm_cad_project_edge(cm_context *ctx, const cm_cad_model *model, int ed
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: edge %d is degenerate (a point)", fn, edge);
     return cmcad::guard(ctx, fn, [&]() -> cm_status {
         cmcad::region_error err;
-#pragma omp parallel num_threads(cmcad::threads(ctx)) if (n > 64)
+#pragma omp parallel num_threads(cm_context_threads_for(ctx, n, 64)) if (n > 64)
         {
             cmcad::adaptors a(model);
 #pragma omp for schedule(static)

@@ -107,10 +107,7 @@ extern "C" cm_status cm_cad_triangulate(cm_context *ctx, const cm_cad_model *mod
         cm_cad_triangulate_options o;
         cm_cad_triangulate_options_init(&o);
         if (opt) o = *opt;
-        const double *bb = model->bbox;
-        const double diag = std::sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) +
-                                      (bb[4] - bb[1]) * (bb[4] - bb[1]) +
-                                      (bb[5] - bb[2]) * (bb[5] - bb[2]));
+        const double diag = cm_bbox_diagonal(model->bbox);
         const double h = o.size > 0 ? o.size : diag / 20;
         const double lin = o.linear_deflection > 0 ? o.linear_deflection : h / 10;
         const double ang = o.angular_deflection > 0 ? o.angular_deflection : 0.3;

@@ -2,6 +2,7 @@
  * and, with --compare, the verdict on whether a second file corresponds to it (same topology
  * in the same order, DESIGN.md: G and G'). */
 #include "cli.h"
+#include "options.h"
 
 #include "cadmorph/cad.h"
 
@@ -11,19 +12,35 @@
 static const char *const usage_line =
     "cadmorph info G.step [--compare G2.step] [--cad-unit mm|cm|m|in|ft|...] [--faces] [--edges]";
 
-static void print_help(void)
+static const char *other;
+static cm_cad_read_options opt;
+static int faces, edges;
+
+static int print_help(void);
+
+static const cli_option options[] = {
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP},
+    {.name = "--compare", .kind = CLI_STRING, .dest = &other, .label = "--compare G2.step",
+     .help = "check that G2 corresponds to G (same counts, surface and curve\n"
+             "types, face-edge-vertex incidence); lists the first differences"},
+    {.name = "--cad-unit", .kind = CLI_STRING, .dest = &opt.unit, .label = "--cad-unit U",
+     .help = "length unit of the coordinates (default mm): mm cm m km in ft mi um"},
+    {.name = "--faces", .kind = CLI_FLAG, .dest = &faces, .label = "--faces",
+     .help = "one line per face (type, area, wires, parameter range)"},
+    {.name = "--edges", .kind = CLI_FLAG, .dest = &edges, .label = "--edges",
+     .help = "one line per edge (type, length, vertices)"},
+    {0}};
+
+static int print_help(void)
 {
     printf("usage: %s\n\n", usage_line);
     printf("Prints the topology of the STEP model G: counts, length units, bounding box, faces by\n"
            "surface type and edges by curve type. Faces, edges and vertices are numbered from 0\n"
            "in OpenCASCADE's order, the order cadmorph uses everywhere.\n\n"
-           "options:\n"
-           "  --compare G2.step   check that G2 corresponds to G (same counts, surface and curve\n"
-           "                      types, face-edge-vertex incidence); lists the first differences\n"
-           "  --cad-unit U        length unit of the coordinates (default mm): mm cm m km in ft mi um\n"
-           "  --faces             one line per face (type, area, wires, parameter range)\n"
-           "  --edges             one line per edge (type, length, vertices)\n\n"
-           "exit codes: 0 done (and G2 corresponds), 1 usage, 2 bad input or G2 differs.\n");
+           "options:\n");
+    cli_print_options(stdout, options, 20);
+    printf("\nexit codes: 0 done (and G2 corresponds), 1 usage, 2 bad input or G2 differs.\n");
+    return CLI_EXIT_OK;
 }
 
 static void print_model(const char *path, const cm_cad_model *m, int faces, int edges)
@@ -92,31 +109,13 @@ static void print_model(const char *path, const cm_cad_model *m, int faces, int 
 int cli_cmd_info(int argc, char **argv)
 {
     static const char *cmd = "info";
-    const char *path = NULL, *other = NULL;
-    cm_cad_read_options opt;
+    const char *path = NULL;
     cm_cad_read_options_init(&opt);
-    int faces = 0, edges = 0;
-    for (int i = 1; i < argc; ++i) {
-        const char *o = argv[i];
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            print_help();
-            return CLI_EXIT_OK;
-        } else if (!strcmp(o, "--compare")) {
-            if (!(other = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--cad-unit")) {
-            if (!(opt.unit = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--faces")) {
-            faces = 1;
-        } else if (!strcmp(o, "--edges")) {
-            edges = 1;
-        } else if (o[0] == '-' && o[1]) {
-            return cli_usage(cmd, usage_line, "unknown option '%s'", o);
-        } else if (!path) {
-            path = o;
-        } else {
-            return cli_usage(cmd, usage_line, "one STEP file expected, got '%s' too", o);
-        }
-    }
+    cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
+                    .unknown = "unknown option '%s'", .pos = &path, .max_pos = 1,
+                    .extra = "one STEP file expected, got '%s' too"};
+    const int parsed = cli_parse(&p, argc, argv);
+    if (parsed >= 0) return parsed;
     if (!path) return cli_usage(cmd, usage_line, "no STEP file given");
 
     cm_context *ctx = cli_context_create("info", 0, 0);

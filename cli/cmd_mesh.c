@@ -2,6 +2,7 @@
  * solid (OpenCASCADE surface triangulation, TetGen volume), written with its quality field,
  * then the node/cell counts and the quality report. */
 #include "cli.h"
+#include "options.h"
 
 #include "cadmorph/cad.h"
 #include "cadmorph/tetmesh.h"
@@ -15,6 +16,43 @@ static const char *const usage =
     "cadmorph mesh G.step -o MESH [--size H] [--quality Q] [--preserve-surface] "
     "[--min-dihedral D] [--no-optimize] [--force] [--cad-unit U] [--threads N] [-v] [-h|--help]";
 
+static const char *out, *unit;
+static cm_tetmesh_options opt;
+static int threads, verbose, preserve_surface, no_optimize, force;
+
+static const cli_option options[] = {
+    {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &out, .label = "-o MESH",
+     .help = "output mesh (required)"},
+    {.name = "--size", .kind = CLI_DOUBLE, .dest = &opt.size, .lo = 0, .hi = NAN, .open = 1,
+     .bad = "%s needs a number > 0, got '%s'", .label = "--size H",
+     .help = "target edge length in model units (default: bbox diagonal / 20)"},
+    {.name = "--quality", .kind = CLI_DOUBLE, .dest = &opt.quality, .lo = 1, .hi = NAN,
+     .bad = "%s needs a number >= 1, got '%s'", .label = "--quality Q",
+     .help = "bound on the tets' radius-edge ratio, >= 1 (default 1.4)"},
+    {.name = "--preserve-surface", .kind = CLI_FLAG, .dest = &preserve_surface,
+     .label = "--preserve-surface",
+     .help = "keep OpenCASCADE's surface triangulation as it is (TetGen -Y);\n"
+             "by default TetGen refines it and its new boundary nodes are\n"
+             "projected onto the CAD faces and edges"},
+    {.name = "--min-dihedral", .kind = CLI_DOUBLE, .dest = &opt.min_dihedral, .lo = 0, .hi = 20,
+     .bad = "%s needs degrees in [0, 20], got '%s'", .label = "--min-dihedral D",
+     .help = "lower bound on the tets' dihedral angles, degrees in [0, 20]\n"
+             "(default 12; 0: TetGen's own): fewer slivers, more tets"},
+    {.name = "--no-optimize", .kind = CLI_FLAG, .dest = &no_optimize, .label = "--no-optimize",
+     .help = "keep TetGen's interior nodes; by default they are optimised\n"
+             "to lift slivers (boundary nodes never move)"},
+    {.name = "--force", .kind = CLI_FLAG, .dest = &force, .label = "--force",
+     .help = "mesh even when the estimated tet count exceeds 1e7 (refused\n"
+             "otherwise, exit code 4, with the estimate)"},
+    {.name = "--cad-unit", .kind = CLI_STRING, .dest = &unit, .label = "--cad-unit U",
+     .help = "length unit of the coordinates (default mm)"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",
+     .help = "threads for the quality computation (default: all)"},
+    {.name = "-v", .alias = "--verbose", .kind = CLI_FLAG, .dest = &verbose,
+     .label = "-v, --verbose", .help = "stage timings on stderr"},
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP, .label = "-h, --help", .help = "this text"},
+    {0}};
+
 static int help(void)
 {
     printf("usage: %s\n\n"
@@ -25,84 +63,26 @@ static int help(void)
            "'cadmorph info'), and the cell field scaled_jacobian. Prints the counts, then the\n"
            "quality report ending with\n"
            "  min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k> cells=<n>\n\n"
-           "options:\n"
-           "  -o MESH             output mesh (required)\n"
-           "  --size H            target edge length in model units (default: bbox diagonal / 20)\n"
-           "  --quality Q         bound on the tets' radius-edge ratio, >= 1 (default 1.4)\n"
-           "  --preserve-surface  keep OpenCASCADE's surface triangulation as it is (TetGen -Y);\n"
-           "                      by default TetGen refines it and its new boundary nodes are\n"
-           "                      projected onto the CAD faces and edges\n"
-           "  --min-dihedral D    lower bound on the tets' dihedral angles, degrees in [0, 20]\n"
-           "                      (default 12; 0: TetGen's own): fewer slivers, more tets\n"
-           "  --no-optimize       keep TetGen's interior nodes; by default they are optimised\n"
-           "                      to lift slivers (boundary nodes never move)\n"
-           "  --force             mesh even when the estimated tet count exceeds 1e7 (refused\n"
-           "                      otherwise, exit code 4, with the estimate)\n"
-           "  --cad-unit U        length unit of the coordinates (default mm)\n"
-           "  --threads N         threads for the quality computation (default: all)\n"
-           "  -v, --verbose       stage timings on stderr\n"
-           "  -h, --help          this text\n\n"
-           "exit codes: 0 done, 1 usage, 2 bad input (unreadable STEP, no closed solid, TetGen\n"
-           "failure, touching solids), 4 out of memory or beyond the tet limit, internal error.\n",
+           "options:\n",
            usage);
+    cli_print_options(stdout, options, 20);
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable STEP, no closed solid, TetGen\n"
+           "failure, touching solids), 4 out of memory or beyond the tet limit, internal error.\n");
     return CLI_EXIT_OK;
-}
-
-static int parse_double(const char *cmd, const char *opt, const char *v, double lo, double *out)
-{
-    char *end = NULL;
-    errno = 0;
-    const double x = strtod(v, &end);
-    if (errno || *end || !isfinite(x) || !(x >= lo) || (lo == 0 && x == 0))
-        return cli_usage(cmd, usage, "%s needs a number %s %g, got '%s'", opt, lo == 0 ? ">" : ">=",
-                         lo, v);
-    *out = x;
-    return 0;
 }
 
 int cli_cmd_mesh(int argc, char **argv)
 {
-    const char *cmd = "mesh", *in = NULL, *out = NULL, *unit = NULL;
-    cm_tetmesh_options opt;
+    const char *cmd = "mesh", *in = NULL;
     cm_tetmesh_options_init(&opt);
-    int threads = 0, verbose = 0;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *v = NULL;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) return help();
-        if (!strcmp(a, "-v") || !strcmp(a, "--verbose")) {
-            verbose = 1;
-        } else if (!strcmp(a, "--no-optimize")) {
-            opt.optimize = 0;
-        } else if (!strcmp(a, "--preserve-surface")) {
-            opt.preserve_surface = 1;
-        } else if (!strcmp(a, "--force")) {
-            opt.max_tets = INFINITY;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            if (!(out = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(a, "--cad-unit")) {
-            if (!(unit = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(a, "--size")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
-            if (parse_double(cmd, a, v, 0, &opt.size)) return CLI_EXIT_USAGE;
-        } else if (!strcmp(a, "--quality")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
-            if (parse_double(cmd, a, v, 1, &opt.quality)) return CLI_EXIT_USAGE;
-        } else if (!strcmp(a, "--min-dihedral")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
-            char *end = NULL;
-            opt.min_dihedral = strtod(v, &end);
-            if (*end || !(opt.min_dihedral >= 0 && opt.min_dihedral <= 20))
-                return cli_usage(cmd, usage, "--min-dihedral needs degrees in [0, 20], got '%s'", v);
-        } else if (!strcmp(a, "--threads")) {
-            if (cli_threads_value(argc, argv, &i, cmd, usage, &threads)) return CLI_EXIT_USAGE;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage(cmd, usage, "unknown option '%s'", a);
-        } else if (in) {
-            return cli_usage(cmd, usage, "unexpected argument '%s'", a);
-        } else {
-            in = a;
-        }
-    }
+    cli_parser p = {.cmd = cmd, .usage = usage, .options = options, .help = help,
+                    .unknown = "unknown option '%s'", .pos = &in, .max_pos = 1,
+                    .extra = "unexpected argument '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    if (parsed >= 0) return parsed;
+    if (preserve_surface) opt.preserve_surface = 1;
+    if (no_optimize) opt.optimize = 0;
+    if (force) opt.max_tets = INFINITY;
     if (!in) return cli_usage(cmd, usage, "missing G.step");
     if (!out) return cli_usage(cmd, usage, "missing -o MESH");
     if (cm_mesh_format_from_path(out) == CM_FORMAT_UNKNOWN)

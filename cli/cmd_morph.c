@@ -1,6 +1,7 @@
 /* `cadmorph morph`: morphs a volume mesh of G onto G' (surface morph on the CAD, then the
  * RBF warp of the interior), writes it, reports its quality and, on request, a CSV of stages. */
 #include "cli.h"
+#include "options.h"
 
 #include "cadmorph/morph.h"
 
@@ -15,56 +16,6 @@ static const char *const usage_line =
     "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
     "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
 
-static void print_help(void)
-{
-    printf("usage: %s\n\n", usage_line);
-    printf(
-        "Moves the volume mesh M0 of the CAD model G0 onto G1 (same topology, other dimensions):\n"
-        "boundary nodes on CAD vertices go to the matching vertex, nodes on edges keep their\n"
-        "arc length, nodes on faces are moved in the face's (u,v) by a 2D thin-plate RBF fitted\n"
-        "on the face boundaries; the interior follows by an RBF space warp per component.\n"
-        "Writes M1 (.msh .vtu .vtk .mesh) with per-node 'displacement' and per-cell\n"
-        "'scaled_jacobian', then prints the quality summary line.\n\n"
-        "options:\n"
-        "  --from G0.step       the geometry M0 was meshed from\n"
-        "  --to G1.step         the edited geometry (same topology)\n"
-        "  --mesh M0            input volume mesh\n"
-        "  -o, --output M1      output mesh (must not be an input)\n"
-        "  --steps K            split the boundary motion into K equal increments (default 1);\n"
-        "                       each increment after the first refits the warp on the last mesh\n"
-        "  --steps auto         adaptive steps: the whole motion first, halved on failure and\n"
-        "                       refitted on the last valid mesh, doubled after easy steps,\n"
-        "                       until every cell keeps a scaled Jacobian above --min-sj\n"
-        "  --min-sj F           floor of --steps auto (default 0: no inverted cell)\n"
-        "  --min-step F         smallest adaptive step, a fraction of the motion (default 1/256)\n"
-        "  --keep-partial       when --steps auto finds no valid step, still write the last\n"
-        "                       valid mesh (and the report) before exiting 3\n"
-        "  --optimize           optimise the interior nodes after every step (boundary nodes\n"
-        "                       stay on G1): untangles and raises the worst cells\n"
-        "  --relative --via L   morph relatively through the intermediate geometries of the\n"
-        "                       comma-separated list L (same topology): G0 -> Ga -> ... -> G1,\n"
-        "                       each leg from the previous result (K increments per leg)\n"
-        "  --surface S          rbf (parameter warp, default) or project (closest point)\n"
-        "  --method M           interior warp: %s (default rbf)\n"
-        "  --kernel K           triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)\n"
-        "  --lattice N          dmffd: control points per axis of the B-spline lattice on the\n"
-        "                       mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
-        "                       is least squares: the boundary keeps its motion exactly, the\n"
-        "                       interior follows a space map that misses it (residual)\n"
-        "  --clamp E            dmffd: singular values <= E x the largest are dropped\n"
-        "                       (default 1e-10; 1e-2 keeps coarse lattices usable)\n"
-        "  --report R.csv       one row per step: quality, distance to G1, stage times\n"
-        "  --fail-on-inverted   exit 3 without writing M1 if a cell is inverted\n"
-        "  --cad-unit U         unit of the mesh coordinates: the STEP files are converted to\n"
-        "                       it (mm default; cm m in ft um ...)\n"
-        "  --threads N          threads (default: all)\n"
-        "  --verbose            debug messages on stderr\n\n"
-        "exit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
-        "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted or no\n"
-        "valid adaptive step (the message names the worst cells).\n",
-        cm_warp_method_list());
-}
-
 #define MORPH_MAX_VIA 256
 
 typedef struct morph_args {
@@ -76,132 +27,154 @@ typedef struct morph_args {
     size_t n_via;
 } morph_args;
 
-/* Splits --via's value at commas into a->via. */
-static int parse_via(const char *cmd, morph_args *a, const char *v)
+static morph_args args;
+
+/* Splits --via's value at commas into args.via. */
+static int parse_via(const cli_parser *p, const cli_option *o, const char *v, void *dest)
 {
+    morph_args *a = dest;
+    (void)o;
     if (strlen(v) >= sizeof a->via_list)
-        return cli_usage(cmd, usage_line, "--via: list longer than %zu characters",
+        return cli_usage(p->cmd, p->usage, "--via: list longer than %zu characters",
                          sizeof a->via_list - 1);
     snprintf(a->via_list, sizeof a->via_list, "%s", v);
     a->n_via = 0;
-    for (char *p = a->via_list; p;) {
-        char *comma = strchr(p, ',');
+    for (char *q = a->via_list; q;) {
+        char *comma = strchr(q, ',');
         if (comma) *comma = 0;
-        if (!*p) return cli_usage(cmd, usage_line, "--via: empty path in '%s'", v);
+        if (!*q) return cli_usage(p->cmd, p->usage, "--via: empty path in '%s'", v);
         if (a->n_via == MORPH_MAX_VIA)
-            return cli_usage(cmd, usage_line, "--via: more than %d geometries", MORPH_MAX_VIA);
-        a->via[a->n_via++] = p;
-        p = comma ? comma + 1 : NULL;
+            return cli_usage(p->cmd, p->usage, "--via: more than %d geometries", MORPH_MAX_VIA);
+        a->via[a->n_via++] = q;
+        q = comma ? comma + 1 : NULL;
     }
-    return -1;
+    return 0;
+}
+
+/* --steps K (1..4096) or --steps auto */
+static int parse_steps(const cli_parser *p, const cli_option *o, const char *v, void *dest)
+{
+    if (!strcmp(v, "auto")) {
+        *(int *)dest = CM_MORPH_STEPS_AUTO;
+        return 0;
+    }
+    char *end;
+    long n = strtol(v, &end, 10);
+    if (*end || n < 1 || n > 4096)
+        return cli_usage(p->cmd, p->usage, "%s: expected a positive integer, got '%s'", o->name, v);
+    *(int *)dest = (int)n;
+    return 0;
+}
+
+
+static const char *const surface_names[] = {"rbf", "project", NULL};
+static const int surface_methods[] = {CM_SURFACE_RBF, CM_SURFACE_PROJECT};
+
+static int print_help(void);
+
+static const cli_option options[] = {
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP},
+    {.name = "--from", .kind = CLI_STRING, .dest = &args.from, .label = "--from G0.step",
+     .help = "the geometry M0 was meshed from"},
+    {.name = "--to", .kind = CLI_STRING, .dest = &args.to, .label = "--to G1.step",
+     .help = "the edited geometry (same topology)"},
+    {.name = "--mesh", .kind = CLI_STRING, .dest = &args.mesh, .label = "--mesh M0",
+     .help = "input volume mesh"},
+    {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
+     .label = "-o, --output M1", .help = "output mesh (must not be an input)"},
+    {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_steps,
+     .dest = &args.opt.steps, .label = "--steps K",
+     .help = "split the boundary motion into K equal increments (default 1);\n"
+             "each increment after the first refits the warp on the last mesh"},
+    {.name = "--steps", .kind = CLI_NOTE, .label = "--steps auto",
+     .help = "adaptive steps: the whole motion first, halved on failure and\n"
+             "refitted on the last valid mesh, doubled after easy steps,\n"
+             "until every cell keeps a scaled Jacobian above --min-sj"},
+    {.name = "--min-sj", .kind = CLI_DOUBLE, .dest = &args.opt.min_sj, .lo = -1, .hi = 1,
+     .open = 2, .bad = "%s: expected a number in [-1, 1), got '%s'", .label = "--min-sj F",
+     .help = "floor of --steps auto (default 0: no inverted cell)"},
+    {.name = "--min-step", .kind = CLI_DOUBLE, .dest = &args.opt.min_fraction, .lo = 0, .hi = 1,
+     .open = 3, .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--min-step F",
+     .help = "smallest adaptive step, a fraction of the motion (default 1/256)"},
+    {.name = "--keep-partial", .kind = CLI_FLAG, .dest = &args.keep_partial,
+     .label = "--keep-partial",
+     .help = "when --steps auto finds no valid step, still write the last\n"
+             "valid mesh (and the report) before exiting 3"},
+    {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.opt.optimize, .label = "--optimize",
+     .help = "optimise the interior nodes after every step (boundary nodes\n"
+             "stay on G1): untangles and raises the worst cells"},
+    {.name = "--relative", .kind = CLI_FLAG, .dest = &args.relative},
+    {.name = "--via", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_via, .dest = &args,
+     .label = "--relative --via L",
+     .help = "morph relatively through the intermediate geometries of the\n"
+             "comma-separated list L (same topology): G0 -> Ga -> ... -> G1,\n"
+             "each leg from the previous result (K increments per leg)"},
+    {.name = "--surface", .kind = CLI_ENUM, .dest = &args.opt.method.surface,
+     .names = surface_names, .values = surface_methods, .bad = "%.0sunknown surface method '%s'",
+     .label = "--surface S", .help = "rbf (parameter warp, default) or project (closest point)"},
+    {.name = "--method", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_warp_method,
+     .dest = &args.opt.method.warp.method, .label = "--method M",
+     .help = "interior warp: %s (default rbf)", .help_arg = cm_warp_method_list},
+    {.name = "--kernel", .kind = CLI_ENUM, .dest = &args.opt.method.warp.method,
+     .names = cli_kernel_names, .values = cli_kernel_methods, .bad = "%.0sunknown kernel '%s'",
+     .label = "--kernel K",
+     .help = "triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)"},
+    {.name = "--lattice", .kind = CLI_INT, .dest = &args.opt.method.warp.lattice, .lo = 4,
+     .hi = 200, .bad = "%s: expected 4..200 control points per axis, got '%s'",
+     .label = "--lattice N",
+     .help = "dmffd: control points per axis of the B-spline lattice on the\n"
+             "mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
+             "is least squares: the boundary keeps its motion exactly, the\n"
+             "interior follows a space map that misses it (residual)"},
+    {.name = "--clamp", .kind = CLI_DOUBLE, .dest = &args.opt.method.warp.clamp, .lo = 0,
+     .hi = 1, .open = 3, .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--clamp E",
+     .help = "dmffd: singular values <= E x the largest are dropped\n"
+             "(default 1e-10; 1e-2 keeps coarse lattices usable)"},
+    {.name = "--report", .kind = CLI_STRING, .dest = &args.report, .label = "--report R.csv",
+     .help = "one row per step: quality, distance to G1, stage times"},
+    {.name = "--fail-on-inverted", .kind = CLI_FLAG, .dest = &args.fail_on_inverted,
+     .label = "--fail-on-inverted", .help = "exit 3 without writing M1 if a cell is inverted"},
+    {.name = "--cad-unit", .kind = CLI_STRING, .dest = &args.unit, .label = "--cad-unit U",
+     .help = "unit of the mesh coordinates: the STEP files are converted to\n"
+             "it (mm default; cm m in ft um ...)"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads,
+     .bad = "%s: expected a positive integer, got '%s'", .label = "--threads N",
+     .help = "threads (default: all)"},
+    {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
+     .label = "--verbose", .help = "debug messages on stderr"},
+    {0}};
+
+static int print_help(void)
+{
+    printf("usage: %s\n\n", usage_line);
+    printf(
+        "Moves the volume mesh M0 of the CAD model G0 onto G1 (same topology, other dimensions):\n"
+        "boundary nodes on CAD vertices go to the matching vertex, nodes on edges keep their\n"
+        "arc length, nodes on faces are moved in the face's (u,v) by a 2D thin-plate RBF fitted\n"
+        "on the face boundaries; the interior follows by an RBF space warp per component.\n"
+        "Writes M1 (.msh .vtu .vtk .mesh) with per-node 'displacement' and per-cell\n"
+        "'scaled_jacobian', then prints the quality summary line.\n\n"
+        "options:\n");
+    cli_print_options(stdout, options, 21);
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
+           "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted or no\n"
+           "valid adaptive step (the message names the worst cells).\n");
+    return CLI_EXIT_OK;
 }
 
 static int parse_args(int argc, char **argv, morph_args *a)
 {
     static const char *cmd = "morph";
-    memset(a, 0, sizeof *a);
-    cm_morph_options_init(&a->opt);
-    for (int i = 1; i < argc; ++i) {
-        const char *o = argv[i], *v;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            print_help();
-            return CLI_EXIT_OK;
-        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
-            a->verbose = 1;
-        } else if (!strcmp(o, "--fail-on-inverted")) {
-            a->fail_on_inverted = 1;
-        } else if (!strcmp(o, "--from")) {
-            if (!(a->from = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--to")) {
-            if (!(a->to = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--mesh")) {
-            if (!(a->mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(a->out = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--report")) {
-            if (!(a->report = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--cad-unit")) {
-            if (!(a->unit = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            a->opt.cad_unit = a->unit;
-        } else if (!strcmp(o, "--surface")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (!strcmp(v, "rbf"))
-                a->opt.method.surface = CM_SURFACE_RBF;
-            else if (!strcmp(v, "project"))
-                a->opt.method.surface = CM_SURFACE_PROJECT;
-            else
-                return cli_usage(cmd, usage_line, "unknown surface method '%s'", v);
-        } else if (!strcmp(o, "--kernel")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (!strcmp(v, "triharmonic"))
-                a->opt.method.warp.method = CM_WARP_RBF;
-            else if (!strcmp(v, "biharmonic"))
-                a->opt.method.warp.method = CM_WARP_RBF_BIHARMONIC;
-            else
-                return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
-        } else if (!strcmp(o, "--clamp")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            double e = strtod(v, &end);
-            if (end == v || *end || !(e > 0 && e < 1))
-                return cli_usage(cmd, usage_line, "--clamp: expected a number in (0, 1), got '%s'",
-                                 v);
-            a->opt.method.warp.clamp = e;
-        } else if (!strcmp(o, "--lattice")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            long n = strtol(v, &end, 10);
-            if (end == v || *end || n < 4 || n > 200)
-                return cli_usage(cmd, usage_line,
-                                 "--lattice: expected 4..200 control points per axis, got '%s'", v);
-            a->opt.method.warp.lattice = (int)n;
-        } else if (!strcmp(o, "--method")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            int m = cm_warp_method_from_name(v);
-            if (m < 0)
-                return cli_usage(cmd, usage_line, "unknown method '%s' (%s)", v,
-                                 cm_warp_method_list());
-            a->opt.method.warp.method = (cm_warp_method)m;
-        } else if (!strcmp(o, "--relative")) {
-            a->relative = 1;
-        } else if (!strcmp(o, "--via")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            int rc = parse_via(cmd, a, v);
-            if (rc >= 0) return rc;
-        } else if (!strcmp(o, "--optimize")) {
-            a->opt.optimize = 1;
-        } else if (!strcmp(o, "--keep-partial")) {
-            a->keep_partial = 1;
-        } else if (!strcmp(o, "--min-sj") || !strcmp(o, "--min-step")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            double x = strtod(v, &end);
-            int step = !strcmp(o, "--min-step");
-            if (*end || !(x >= -1 && x < 1) || (step && !(x > 0)))
-                return cli_usage(cmd, usage_line, "%s: expected a number in %s, got '%s'", o,
-                                 step ? "(0, 1)" : "[-1, 1)", v);
-            if (step)
-                a->opt.min_fraction = x;
-            else
-                a->opt.min_sj = x;
-        } else if (!strcmp(o, "--steps") && i + 1 < argc && !strcmp(argv[i + 1], "auto")) {
-            a->opt.steps = CM_MORPH_STEPS_AUTO;
-            ++i;
-        } else if (!strcmp(o, "--steps") || !strcmp(o, "--threads")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            long n = strtol(v, &end, 10);
-            if (*end || n < 1 || n > 4096)
-                return cli_usage(cmd, usage_line, "%s: expected a positive integer, got '%s'", o,
-                                 v);
-            if (!strcmp(o, "--steps"))
-                a->opt.steps = (int)n;
-            else
-                a->threads = (int)n;
-        } else {
-            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
-        }
-    }
+    memset(&args, 0, sizeof args);
+    cm_morph_options_init(&args.opt);
+    cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
+                    .unknown = "unknown argument '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    if (args.unit) args.opt.cad_unit = args.unit;
+    *a = args;
+    for (size_t k = 0; k < a->n_via; ++k) /* into a's own copy of the list */
+        a->via[k] = a->via_list + (args.via[k] - args.via_list);
+    if (parsed >= 0) return parsed;
     if (!a->from) return cli_usage(cmd, usage_line, "--from is required");
     if (!a->to) return cli_usage(cmd, usage_line, "--to is required");
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");

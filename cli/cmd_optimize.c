@@ -1,6 +1,7 @@
 /* `cadmorph optimize MESH -o OUT`: interior node optimisation of any volume mesh (boundary
  * nodes never move): untangles inverted cells and raises the worst ones (optimize.h). */
 #include "cli.h"
+#include "options.h"
 
 #include "cadmorph/optimize.h"
 
@@ -11,7 +12,30 @@
 static const char *const usage_line =
     "cadmorph optimize MESH -o OUT [--target-sj F] [--sweeps N] [--threads N] [--verbose]";
 
-static void print_help(void)
+static const char *out;
+static int threads, verbose;
+static cm_optimize_options opt;
+
+static int print_help(void);
+
+static const cli_option options[] = {
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP},
+    {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &out,
+     .label = "-o, --output OUT", .help = "output mesh (must not be the input)"},
+    {.name = "--target-sj", .kind = CLI_DOUBLE, .dest = &opt.target_sj, .lo = -1, .hi = 1,
+     .open = 1, .bad = "%s: expected a number in (-1, 1]%.0s", .label = "--target-sj F",
+     .help = "work on the cells below this scaled Jacobian and their\n"
+             "neighbours (default 0.3)"},
+    {.name = "--sweeps", .kind = CLI_INT, .dest = &opt.sweeps, .lo = 1, .hi = 1000,
+     .bad = "%s: expected 1..1000, got '%s'", .label = "--sweeps N",
+     .help = "passes over those nodes (default 6)"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",
+     .help = "threads (default: all); the result does not depend on it"},
+    {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &verbose, .label = "--verbose",
+     .help = "debug messages on stderr"},
+    {0}};
+
+static int print_help(void)
 {
     printf("usage: %s\n\n", usage_line);
     printf("Moves the interior nodes of the volume mesh MESH to untangle inverted cells and raise\n"
@@ -21,56 +45,22 @@ static void print_help(void)
            "than linear tets, hexes, wedges and pyramids, never move. Writes OUT (.msh .vtu .vtk\n"
            ".mesh) with per-cell 'scaled_jacobian' and per-node 'displacement', prints the\n"
            "quality before and after and ends with the summary line of the result.\n\n"
-           "options:\n"
-           "  -o, --output OUT     output mesh (must not be the input)\n"
-           "  --target-sj F        work on the cells below this scaled Jacobian and their\n"
-           "                       neighbours (default 0.3)\n"
-           "  --sweeps N           passes over those nodes (default 6)\n"
-           "  --threads N          threads (default: all); the result does not depend on it\n"
-           "  --verbose            debug messages on stderr\n\n"
-           "exit codes: 0 done, 1 usage, 2 bad input, 3 inverted cells remain.\n");
+           "options:\n");
+    cli_print_options(stdout, options, 21);
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input, 3 inverted cells remain.\n");
+    return CLI_EXIT_OK;
 }
 
 int cli_cmd_optimize(int argc, char **argv)
 {
     static const char *cmd = "optimize";
-    const char *in = NULL, *out = NULL;
-    int threads = 0, verbose = 0;
-    cm_optimize_options opt;
+    const char *in = NULL;
     cm_optimize_options_init(&opt);
-    for (int i = 1; i < argc; ++i) {
-        const char *o = argv[i], *v;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            print_help();
-            return CLI_EXIT_OK;
-        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
-            verbose = 1;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(out = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--target-sj")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            opt.target_sj = strtod(v, &end);
-            if (*end || !(opt.target_sj > -1 && opt.target_sj <= 1))
-                return cli_usage(cmd, usage_line, "--target-sj: expected a number in (-1, 1]");
-        } else if (!strcmp(o, "--sweeps")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            long n = strtol(v, &end, 10);
-            if (*end || n < 1 || n > 1000)
-                return cli_usage(cmd, usage_line, "--sweeps: expected 1..1000, got '%s'", v);
-            opt.sweeps = (int)n;
-        } else if (!strcmp(o, "--threads")) {
-            if (cli_threads_value(argc, argv, &i, cmd, usage_line, &threads))
-                return CLI_EXIT_USAGE;
-        } else if (o[0] == '-' && o[1]) {
-            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
-        } else if (in) {
-            return cli_usage(cmd, usage_line, "unexpected argument '%s'", o);
-        } else {
-            in = o;
-        }
-    }
+    cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
+                    .unknown = "unknown argument '%s'", .pos = &in, .max_pos = 1,
+                    .extra = "unexpected argument '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    if (parsed >= 0) return parsed;
     if (!in) return cli_usage(cmd, usage_line, "missing MESH");
     if (!out) return cli_usage(cmd, usage_line, "-o is required");
     if (cm_mesh_format_from_path(out) == CM_FORMAT_UNKNOWN)

@@ -1,12 +1,24 @@
 /* `cadmorph quality MESH [--csv OUT.csv] [--threads N]`: Verdict scaled Jacobian of every
  * volume cell, a per-type table and the summary line; optionally one CSV row per volume cell. */
 #include "cli.h"
-
+#include "options.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 static const char *const usage = "cadmorph quality MESH [--csv OUT.csv] [--threads N] [-h|--help]";
+
+static const char *csv;
+static int threads;
+
+static const cli_option options[] = {
+    {.name = "--csv", .kind = CLI_STRING, .dest = &csv, .label = "--csv OUT.csv",
+     .help = "write cell,type,scaled_jacobian for every volume cell (cell: 0-based\n"
+             "index among all elements of the file)"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",
+     .help = "threads for the computation (default: all)"},
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP, .label = "-h, --help", .help = "this text"},
+    {0}};
 
 static int help(void)
 {
@@ -15,12 +27,9 @@ static int help(void)
            "MESH (.msh, .vtu, .vtk, .mesh). Prints one row per cell type - cells, minimum, mean,\n"
            "1st percentile, inverted (scaled Jacobian <= 0) - and ends with the line\n"
            "  min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k> cells=<n>\n\n"
-           "options:\n"
-           "  --csv OUT.csv   write cell,type,scaled_jacobian for every volume cell (cell: 0-based\n"
-           "                  index among all elements of the file)\n"
-           "  --threads N     threads for the computation (default: all)\n"
-           "  -h, --help      this text\n",
+           "options:\n",
            usage);
+    cli_print_options(stdout, options, 16);
     return CLI_EXIT_OK;
 }
 
@@ -40,23 +49,12 @@ static cm_status write_csv(cm_context *ctx, const cm_mesh *mesh, const double *s
 
 int cli_cmd_quality(int argc, char **argv)
 {
-    const char *cmd = "quality", *mesh_path = NULL, *csv = NULL;
-    int threads = 0;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) return help();
-        if (!strcmp(a, "--csv")) {
-            if (!(csv = cli_value(argc, argv, &i, cmd, usage))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(a, "--threads")) {
-            if (cli_threads_value(argc, argv, &i, cmd, usage, &threads)) return CLI_EXIT_USAGE;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage(cmd, usage, "unknown option '%s'", a);
-        } else if (mesh_path) {
-            return cli_usage(cmd, usage, "unexpected argument '%s'", a);
-        } else {
-            mesh_path = a;
-        }
-    }
+    const char *cmd = "quality", *mesh_path = NULL;
+    cli_parser p = {.cmd = cmd, .usage = usage, .options = options, .help = help,
+                    .unknown = "unknown option '%s'", .pos = &mesh_path, .max_pos = 1,
+                    .extra = "unexpected argument '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    if (parsed >= 0) return parsed;
     if (!mesh_path) return cli_usage(cmd, usage, "missing MESH");
     if (csv && cli_same_file(csv, mesh_path))
         return cli_usage(cmd, usage, "--csv %s is the input mesh; refusing to overwrite it", csv);

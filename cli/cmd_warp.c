@@ -1,6 +1,7 @@
 /* `cadmorph warp`: moves the interior nodes of a volume mesh by the RBF warp of boundary
  * displacements given in a CSV table, writes the moved mesh and reports its quality. */
 #include "cli.h"
+#include "options.h"
 
 #include "cadmorph/warp.h"
 
@@ -13,7 +14,53 @@ static const char *const usage_line =
     "[--lattice N [--clamp E]] [--optimize] "
     "[--threads N] [--verbose]";
 
-static void print_help(void)
+typedef struct warp_args {
+    const char *mesh, *csv, *out;
+    cm_warp_method method;
+    int threads, verbose, optimize, lattice;
+    double clamp;
+} warp_args;
+
+static warp_args args;
+
+static int print_help(void);
+
+
+
+static const cli_option options[] = {
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP},
+    {.name = "--mesh", .kind = CLI_STRING, .dest = &args.mesh, .label = "--mesh M0",
+     .help = "input volume mesh"},
+    {.name = "--displacements", .kind = CLI_STRING, .dest = &args.csv,
+     .label = "--displacements D", .help = "displacement table (CSV)"},
+    {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
+     .label = "-o, --output M1", .help = "output mesh (must not be an input)"},
+    {.name = "--method", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_warp_method,
+     .dest = &args.method, .label = "--method M",
+     .help = "interior warp: %s (default rbf: r^3)", .help_arg = cm_warp_method_list},
+    {.name = "--kernel", .kind = CLI_ENUM, .dest = &args.method, .names = cli_kernel_names,
+     .values = cli_kernel_methods, .bad = "%.0sunknown kernel '%s'", .label = "--kernel K",
+     .help = "triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)"},
+    {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.optimize, .label = "--optimize",
+     .help = "then optimise the other nodes (untangle, raise the worst cells;\n"
+             "boundary and listed nodes stay where D.csv sends them)"},
+    {.name = "--lattice", .kind = CLI_INT, .dest = &args.lattice, .lo = 4, .hi = 200,
+     .bad = "%s: expected 4..200 control points per axis, got '%s'", .label = "--lattice N",
+     .help = "dmffd: control points per axis of the B-spline lattice on the\n"
+             "mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
+             "is least squares: the boundary keeps its motion exactly, the\n"
+             "interior follows a space map that misses it (--verbose)"},
+    {.name = "--clamp", .kind = CLI_DOUBLE, .dest = &args.clamp, .lo = 0, .hi = 1, .open = 3,
+     .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--clamp E",
+     .help = "dmffd: singular values <= E x the largest are dropped\n"
+             "(default 1e-10; 1e-2 keeps coarse lattices usable)"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
+     .help = "threads for evaluation and quality (default: all)"},
+    {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
+     .label = "--verbose", .help = "debug messages on stderr"},
+    {0}};
+
+static int print_help(void)
 {
     printf("usage: %s\n\n", usage_line);
     printf(
@@ -25,92 +72,23 @@ static void print_help(void)
         "D.csv: header node,dx,dy,dz; node is the 0-based index of the node in M0's file order.\n"
         "  Boundary nodes that are not listed stay where they are;\n"
         "  listed interior nodes are pinned to their displacement.\n\n"
-        "options:\n"
-        "  --mesh M0            input volume mesh\n"
-        "  --displacements D    displacement table (CSV)\n"
-        "  -o, --output M1      output mesh (must not be an input)\n"
-        "  --method M           interior warp: %s (default rbf: r^3)\n"
-        "  --kernel K           triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)\n"
-        "  --optimize           then optimise the other nodes (untangle, raise the worst cells;\n"
-        "                       boundary and listed nodes stay where D.csv sends them)\n"
-        "  --lattice N          dmffd: control points per axis of the B-spline lattice on the\n"
-        "                       mesh's bounding box (paper: 5 10 15 25; default 10); DM-FFD\n"
-        "                       is least squares: the boundary keeps its motion exactly, the\n"
-        "                       interior follows a space map that misses it (--verbose)\n"
-        "  --clamp E            dmffd: singular values <= E x the largest are dropped\n"
-        "                       (default 1e-10; 1e-2 keeps coarse lattices usable)\n"
-        "  --threads N          threads for evaluation and quality (default: all)\n"
-        "  --verbose            debug messages on stderr\n\n"
-        "exit codes: 0 done, 1 usage, 2 bad input (malformed file, degenerate boundary).\n",
-        cm_warp_method_list());
+        "options:\n");
+    cli_print_options(stdout, options, 21);
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed file, degenerate boundary).\n");
+    return CLI_EXIT_OK;
 }
-
-typedef struct warp_args {
-    const char *mesh, *csv, *out;
-    cm_warp_method method;
-    int threads, verbose, optimize, lattice;
-    double clamp;
-} warp_args;
 
 /* Returns -1 to go on, else the exit code. */
 static int parse_args(int argc, char **argv, warp_args *a)
 {
     static const char *cmd = "warp";
-    memset(a, 0, sizeof *a);
-    a->method = CM_WARP_RBF;
-    for (int i = 1; i < argc; ++i) {
-        const char *o = argv[i], *v;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            print_help();
-            return CLI_EXIT_OK;
-        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
-            a->verbose = 1;
-        } else if (!strcmp(o, "--optimize")) {
-            a->optimize = 1;
-        } else if (!strcmp(o, "--mesh")) {
-            if (!(a->mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--displacements")) {
-            if (!(a->csv = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(a->out = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--kernel")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (!strcmp(v, "triharmonic"))
-                a->method = CM_WARP_RBF;
-            else if (!strcmp(v, "biharmonic"))
-                a->method = CM_WARP_RBF_BIHARMONIC;
-            else
-                return cli_usage(cmd, usage_line, "unknown kernel '%s'", v);
-        } else if (!strcmp(o, "--clamp")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            double e = strtod(v, &end);
-            if (end == v || *end || !(e > 0 && e < 1))
-                return cli_usage(cmd, usage_line, "--clamp: expected a number in (0, 1), got '%s'",
-                                 v);
-            a->clamp = e;
-        } else if (!strcmp(o, "--lattice")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            long n = strtol(v, &end, 10);
-            if (end == v || *end || n < 4 || n > 200)
-                return cli_usage(cmd, usage_line,
-                                 "--lattice: expected 4..200 control points per axis, got '%s'", v);
-            a->lattice = (int)n;
-        } else if (!strcmp(o, "--method")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            int m = cm_warp_method_from_name(v);
-            if (m < 0)
-                return cli_usage(cmd, usage_line, "unknown method '%s' (%s)", v,
-                                 cm_warp_method_list());
-            a->method = (cm_warp_method)m;
-        } else if (!strcmp(o, "--threads")) {
-            if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
-                return CLI_EXIT_USAGE;
-        } else {
-            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
-        }
-    }
+    memset(&args, 0, sizeof args);
+    args.method = CM_WARP_RBF;
+    cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
+                    .unknown = "unknown argument '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    *a = args;
+    if (parsed >= 0) return parsed;
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->csv) return cli_usage(cmd, usage_line, "--displacements is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");

@@ -1,6 +1,8 @@
 /* The cadmorph program: picks the subcommand; each lives in its own cmd_<name>.c. */
 #include "cli.h"
 
+#include "cadmorph/version.h"
+
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
@@ -64,7 +66,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "help"))
         return usage(stdout);
     if (!strcmp(argv[1], "--version")) {
-        printf("cadmorph %s\n", CADMORPH_VERSION);
+        printf("cadmorph %s\n", cm_version());
         cli_blas_print_version(stdout);
         return 0;
     }

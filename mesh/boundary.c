@@ -141,14 +141,12 @@ static int cell_node_set(const cm_mesh *mesh, size_t c, int64_t *out, int cap)
     const int64_t len = mesh->offset[c + 1] - mesh->offset[c];
     int n = 0;
     if (mesh->type[c] == CM_CELL_POLYHEDRON) {
-        const int64_t *s = conn + 1;
-        for (int64_t f = 0; f < conn[0]; ++f) {
-            for (int64_t i = 0; i < s[0]; ++i) {
+        for (cm_polyhedron_face f = cm_polyhedron_begin(conn, len); cm_polyhedron_more(&f);
+             cm_polyhedron_next(&f))
+            for (int64_t i = 0; i < f.n; ++i) {
                 if (n >= cap) return -1;
-                out[n++] = s[1 + i];
+                out[n++] = f.nodes[i];
             }
-            s += 1 + s[0];
-        }
     } else {
         if (len > cap) return -1;
         for (int64_t i = 0; i < len; ++i) out[n++] = conn[i];
@@ -490,8 +488,7 @@ cm_status cm_mesh_boundary_create(cm_context *ctx, const cm_mesh *mesh, cm_mesh_
     if (!mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_boundary_create: mesh is NULL");
     cm_mesh_boundary *b = calloc(1, sizeof *b);
     if (!b) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_boundary_create: out of memory");
-    int threads = cm_context_threads(ctx);
-    if (threads <= 0) threads = omp_get_max_threads();
+    int threads = cm_context_threads_for(ctx, mesh->n_cells, 1);
 
     faces_of_types ft;
     faces_init(&ft);

@@ -107,13 +107,13 @@ int cm_cell_face_nodes(const cm_mesh *mesh, size_t c, int f, int64_t *nodes, int
     const cm_cell_type type = (cm_cell_type)mesh->type[c];
     const int64_t *conn = mesh->conn + mesh->offset[c];
     if (type == CM_CELL_POLYHEDRON) {
-        const int64_t *s = conn + 1;
-        if (f < 0 || f >= conn[0]) return -1;
-        for (int g = 0; g < f; ++g) s += 1 + s[0];
-        const int64_t n = s[0];
-        if (n > cap || n < 0) return -1;
-        for (int64_t i = 0; i < n; ++i) nodes[i] = s[1 + i];
-        return (int)n;
+        cm_polyhedron_face p = cm_polyhedron_begin(conn, mesh->offset[c + 1] - mesh->offset[c]);
+        if (f < 0 || f >= p.n_faces) return -1;
+        while (cm_polyhedron_more(&p) && p.face < f)
+            cm_polyhedron_next(&p);
+        if (!cm_polyhedron_more(&p) || p.n > cap) return -1;
+        for (int64_t i = 0; i < p.n; ++i) nodes[i] = p.nodes[i];
+        return (int)p.n;
     }
     const cm_cell_info *info = cm_cell_type_info(type);
     const cm_face_table *t = info ? faces_of(info->linear) : NULL;

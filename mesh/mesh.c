@@ -321,22 +321,20 @@ static cm_status check_polyhedron(cm_context *ctx, const cm_mesh *mesh, size_t c
     int64_t len = mesh->offset[c + 1] - mesh->offset[c];
     if (len < 1 || s[0] < 4)
         return cm_error(ctx, CM_ERR_FORMAT, "%s: polyhedron cell %zu: needs at least 4 faces", what, c);
-    int64_t pos = 1;
-    for (int64_t f = 0; f < s[0]; ++f) {
-        if (pos >= len || s[pos] < 3 || pos + 1 + s[pos] > len)
-            return cm_error(ctx, CM_ERR_FORMAT,
-                            "%s: polyhedron cell %zu: face %lld: face stream is inconsistent", what,
-                            c, (long long)f);
-        for (int64_t k = 1; k <= s[pos]; ++k)
-            if (s[pos + k] < 0 || (size_t)s[pos + k] >= mesh->n_nodes)
+    cm_polyhedron_face f = cm_polyhedron_begin(s, len);
+    for (; cm_polyhedron_more(&f) && f.n >= 3; cm_polyhedron_next(&f))
+        for (int64_t k = 0; k < f.n; ++k)
+            if (f.nodes[k] < 0 || (size_t)f.nodes[k] >= mesh->n_nodes)
                 return cm_error(ctx, CM_ERR_FORMAT,
                                 "%s: polyhedron cell %zu: node index %lld out of range [0, %zu)",
-                                what, c, (long long)s[pos + k], mesh->n_nodes);
-        pos += 1 + s[pos];
-    }
-    if (pos != len)
+                                what, c, (long long)f.nodes[k], mesh->n_nodes);
+    if (f.face < f.n_faces)
+        return cm_error(ctx, CM_ERR_FORMAT,
+                        "%s: polyhedron cell %zu: face %lld: face stream is inconsistent", what, c,
+                        (long long)f.face);
+    if (f.at != s + len)
         return cm_error(ctx, CM_ERR_FORMAT, "%s: polyhedron cell %zu: %lld trailing entries", what, c,
-                        (long long)(len - pos));
+                        (long long)(s + len - f.at));
     return CM_OK;
 }
 

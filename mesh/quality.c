@@ -9,7 +9,6 @@
 #include "cadmorph/mesh.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -190,43 +189,35 @@ double cm_quality_polyhedron(const double *mesh_xyz, const int64_t *face_stream)
     /* cell centre: mean of distinct nodes (a node appears in several faces) */
     double cc[3] = {0, 0, 0};
     size_t n_distinct = 0;
-    const int64_t *s = face_stream + 1;
-    const int64_t *first = s;
-    for (int64_t f = 0; f < nf; ++f) {
-        const int64_t n = *s++;
-        for (int64_t i = 0; i < n; ++i) {
-            const int64_t v = s[i];
+    for (cm_polyhedron_face f = cm_polyhedron_begin(face_stream, -1); cm_polyhedron_more(&f);
+         cm_polyhedron_next(&f))
+        for (int64_t i = 0; i < f.n; ++i) {
+            const int64_t v = f.nodes[i];
             int seen = 0;
             /* earlier occurrences: scan the stream before this entry (cells are small) */
-            const int64_t *t = first;
-            for (int64_t g = 0; g <= f && !seen; ++g) {
-                const int64_t m = *t++;
-                const int64_t upto = (g == f) ? i : m;
+            for (cm_polyhedron_face g = cm_polyhedron_begin(face_stream, -1);
+                 !seen && cm_polyhedron_more(&g) && g.face <= f.face; cm_polyhedron_next(&g)) {
+                const int64_t upto = (g.face == f.face) ? i : g.n;
                 for (int64_t j = 0; j < upto; ++j)
-                    if (t[j] == v) {
+                    if (g.nodes[j] == v) {
                         seen = 1;
                         break;
                     }
-                t += m;
             }
             if (!seen) {
                 for (int d = 0; d < 3; ++d) cc[d] += mesh_xyz[3 * v + d];
                 ++n_distinct;
             }
         }
-        s += n;
-    }
     if (n_distinct == 0) return NAN;
     for (int d = 0; d < 3; ++d) cc[d] /= (double)n_distinct;
 
     double qmin = NAN;
-    s = face_stream + 1;
-    for (int64_t f = 0; f < nf; ++f) {
-        const int64_t n = *s++;
-        if (n < 3) {
-            s += n < 0 ? 0 : n;
-            continue;
-        }
+    for (cm_polyhedron_face f = cm_polyhedron_begin(face_stream, -1); cm_polyhedron_more(&f);
+         cm_polyhedron_next(&f)) {
+        const int64_t n = f.n;
+        const int64_t *s = f.nodes;
+        if (n < 3) continue;
         double fc[3] = {0, 0, 0};
         for (int64_t i = 0; i < n; ++i)
             for (int d = 0; d < 3; ++d) fc[d] += mesh_xyz[3 * s[i] + d];
@@ -237,7 +228,6 @@ double cm_quality_polyhedron(const double *mesh_xyz, const int64_t *face_stream)
             const double q = tet_sj(a, fc, b, cc);
             if (isnan(qmin) || q < qmin) qmin = q;
         }
-        s += n;
     }
     return qmin;
 }
@@ -246,8 +236,7 @@ cm_status cm_mesh_quality(cm_context *ctx, const cm_mesh *mesh, double *sj)
 {
     if (!mesh || !sj) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_quality: mesh or sj is NULL");
     const size_t n = mesh->n_cells;
-    int threads = cm_context_threads(ctx);
-    if (threads <= 0) threads = omp_get_max_threads();
+    const int threads = cm_context_threads_for(ctx, n, CM_QUALITY_PARALLEL_MIN);
     const long long nn = (long long)n;
 #pragma omp parallel for schedule(static) num_threads(threads) if (n > CM_QUALITY_PARALLEL_MIN)
     for (long long c = 0; c < nn; ++c) {

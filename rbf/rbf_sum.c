@@ -8,9 +8,6 @@
 #include <stdint.h>
 #include <string.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #define NB 16      /* points held in registers while streaming the centres */
 #define PB 128     /* points per parallel work item (a multiple of NB) */
@@ -165,13 +162,8 @@ static block_fn pick_block(void)
 
 int cm_rbf_threads(const cm_context *ctx)
 {
-    int t = cm_context_threads(ctx);
-#ifdef _OPENMP
-    if (t <= 0) t = omp_get_max_threads();
-#else
-    t = 1;
-#endif
-    return t > 0 ? t : 1;
+    /* the dense kernels have work for every thread the context allows */
+    return cm_context_threads_for(ctx, SIZE_MAX, 1);
 }
 
 void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,

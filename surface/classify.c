@@ -92,12 +92,6 @@ static cm_surface_nodes *nodes_alloc(size_t n)
     return s;
 }
 
-static double diag6(const double *bb)
-{
-    double dx = bb[3] - bb[0], dy = bb[4] - bb[1], dz = bb[5] - bb[2];
-    return sqrt(dx * dx + dy * dy + dz * dz);
-}
-
 /* Millimetres per unit of the names cm_cad_read_options.unit accepts. */
 static const struct {
     const char *name;
@@ -119,7 +113,7 @@ static void unit_hint(const cm_surface_nodes *s, const cm_cad_model *g, char *ou
         }
     cm_cad_bbox(g, cb);
     out[0] = 0;
-    double dm = diag6(bb), dg = diag6(cb), model_mm = 0;
+    double dm = cm_bbox_diagonal(bb), dg = cm_bbox_diagonal(cb), model_mm = 0;
     if (!(dm > 0) || !(dg > 0)) return;
     const size_t nu = sizeof units / sizeof *units;
     for (size_t i = 0; i < nu; ++i)
@@ -213,7 +207,7 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
     }
     double cb[6];
     cm_cad_bbox(g, cb);
-    double diag = diag6(cb);
+    double diag = cm_bbox_diagonal(cb);
     st = cm_surface_edge_lengths(ctx, mesh, b, s->h, NULL);
     if (st < 0) goto done;
     for (size_t i = 0; i < n; ++i) {

@@ -38,9 +38,7 @@ static cm_status samples_per_edge(cm_context *ctx, const cm_cad_model *g, const 
     if (!(spacing > 0)) {
         double bb[6];
         cm_cad_bbox(g, bb);
-        spacing = sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) + (bb[4] - bb[1]) * (bb[4] - bb[1]) +
-                       (bb[5] - bb[2]) * (bb[5] - bb[2])) /
-                  100;
+        spacing = cm_bbox_diagonal(bb) / 100;
     }
     cm_cad_counts c;
     cm_cad_get_counts(g, &c);
@@ -112,11 +110,7 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
         r = cm_rbf_create(ctx, CM_RBF_THIN_PLATE, 2, ba->n, ba->uv, &rbf);
         if (r >= 0) r = cm_rbf_solve(ctx, rbf, 2, values);
         if (r >= 0) r = cm_rbf_evaluate(ctx, rbf, k, uv, d);
-        if (r < 0) {
-            char msg[1024];
-            snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
-            r = cm_error(ctx, r, "face %d: parameter warp: %s", f, msg);
-        }
+        if (r < 0) r = cm_error_prefix(ctx, r, "face %d: parameter warp", f);
     }
     if (r >= 0) {
         for (size_t j = 0; j < 2 * k; ++j)

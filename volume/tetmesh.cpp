@@ -171,10 +171,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     if (s < 0) return s;
     double bb[6];
     cm_cad_bbox(model, bb);
-    const double h = o.size > 0 ? o.size
-                                : std::sqrt((bb[3] - bb[0]) * (bb[3] - bb[0]) +
-                                            (bb[4] - bb[1]) * (bb[4] - bb[1]) +
-                                            (bb[5] - bb[2]) * (bb[5] - bb[2])) / 20;
+    const double h = o.size > 0 ? o.size : cm_bbox_diagonal(bb) / 20;
     const double q = o.quality > 0 ? o.quality : 1.4;
     if (!std::isfinite(h) || !std::isfinite(q) || q < 1.0)
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: size %g or quality %g out of range (quality >= 1)",

@@ -55,16 +55,13 @@ static void visit_cell(const cm_mesh *mesh, size_t c, node_visitor *v)
     const int64_t *conn = mesh->conn;
     int64_t b = mesh->offset[c], e = mesh->offset[c + 1];
     if (mesh->type[c] == CM_CELL_POLYHEDRON) {
-        /* face stream: nf, then per face its node count and nodes */
-        int64_t p = b + 1;
-        for (int64_t f = 0; f < conn[b] && p < e; ++f) {
-            int64_t n = conn[p++];
-            for (int64_t i = 0; i < n && p < e; ++i, ++p)
-                if (v->stamp[conn[p]] != v->mark) {
-                    v->stamp[conn[p]] = v->mark;
-                    v->list[v->n++] = conn[p];
+        for (cm_polyhedron_face f = cm_polyhedron_begin(conn + b, e - b); cm_polyhedron_more(&f);
+             cm_polyhedron_next(&f))
+            for (int64_t i = 0; i < f.n; ++i)
+                if (v->stamp[f.nodes[i]] != v->mark) {
+                    v->stamp[f.nodes[i]] = v->mark;
+                    v->list[v->n++] = f.nodes[i];
                 }
-        }
         return;
     }
     for (int64_t p = b; p < e; ++p)
@@ -131,13 +128,9 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
         memcpy(centres + 3 * i, mesh->xyz + 3 * wc->fixed[i], 3 * sizeof(double));
     cm_status s = cm_rbf_create(ctx, kernel, 3, wc->n_fixed, centres, &wc->rbf);
     free(centres);
-    if (s < 0) {
-        /* copy first: the message is rewritten from itself */
-        char msg[1024];
-        snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
-        return cm_error(ctx, s, "cm_warp_create: component %zu (%zu constrained nodes): %s", k,
-                        wc->n_fixed, msg);
-    }
+    if (s < 0)
+        return cm_error_prefix(ctx, s, "cm_warp_create: component %zu (%zu constrained nodes)", k,
+                               wc->n_fixed);
     return CM_OK;
 }
 
@@ -265,11 +258,7 @@ static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *r
             memcpy(warp->values + 3 * i, disp + 3 * wc->fixed[i], 3 * sizeof(double));
         cm_status s = cm_rbf_solve(ctx, wc->rbf, 3, warp->values);
         if (s >= 0) s = cm_rbf_evaluate(ctx, wc->rbf, wc->n_free, wc->free_xyz, warp->out);
-        if (s < 0) {
-            char msg[1024];
-            snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
-            return cm_error(ctx, s, "cm_warp_apply: component %zu: %s", k, msg);
-        }
+        if (s < 0) return cm_error_prefix(ctx, s, "cm_warp_apply: component %zu", k);
         for (size_t i = 0; i < wc->n_free; ++i)
             memcpy(disp + 3 * wc->free_nodes[i], warp->out + 3 * i, 3 * sizeof(double));
         cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components);

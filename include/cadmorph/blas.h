@@ -55,17 +55,17 @@ typedef enum cm_blas_action {
     CM_BLAS_USE_SKYLAKEX = 2  /* AVX-512 F/BW/DQ/VL available, OpenBLAS chose weaker kernels */
 } cm_blas_action;
 
-void cm_blas_cpu_detect(cm_blas_cpu *cpu);
+CM_API void cm_blas_cpu_detect(cm_blas_cpu *cpu);
 
 /* The decision, a pure function: given the CPU, the name of the core OpenBLAS runs
  * (openblas_get_corename(), compared without case) and whether the user set
  * OPENBLAS_CORETYPE, which core to ask for. KEEP when the user set the variable, when the
  * name is not one of OpenBLAS's x86 cores (another architecture, or a core newer than this
  * table), and when the chosen core is already as strong as the CPU allows. */
-cm_blas_action cm_blas_decide(const cm_blas_cpu *cpu, const char *core, int coretype_set);
+CM_API cm_blas_action cm_blas_decide(const cm_blas_cpu *cpu, const char *core, int coretype_set);
 
 /* OPENBLAS_CORETYPE value for an action ("SkylakeX", "Haswell"), NULL for KEEP. */
-const char *cm_blas_action_core(cm_blas_action action);
+CM_API const char *cm_blas_action_core(cm_blas_action action);
 
 typedef struct cm_blas_summary {
     char config[160];  /* openblas_get_config(), e.g. "OpenBLAS 0.3.21 DYNAMIC_ARCH ..." */
@@ -81,13 +81,13 @@ typedef struct cm_blas_summary {
 } cm_blas_summary;
 
 /* Fills out for this process. ctx (may be NULL) gives the thread count. */
-void cm_blas_info(const cm_context *ctx, cm_blas_summary *out);
+CM_API void cm_blas_info(const cm_context *ctx, cm_blas_summary *out);
 
 /* For code that calls BLAS or LAPACK itself (cm_rbf_create does this already): call first.
  * Checks that the address space can back OpenBLAS's buffers for its current thread count,
  * lowers the count if only fewer fit, and returns CM_ERR_NOMEM (message starting with who)
  * if not even the calling thread's buffer fits, where OpenBLAS would spin forever. */
-cm_status cm_blas_reserve(cm_context *ctx, const char *who);
+CM_API cm_status cm_blas_reserve(cm_context *ctx, const char *who);
 
 #ifdef __cplusplus
 }

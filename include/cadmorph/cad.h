@@ -27,21 +27,21 @@ typedef struct cm_cad_read_options {
     const char *unit;
 } cm_cad_read_options;
 
-void cm_cad_read_options_init(cm_cad_read_options *opt);
+CM_API void cm_cad_read_options_init(cm_cad_read_options *opt);
 
 /* Reads a STEP file (all roots transferred into one compound). Errors: CM_ERR_IO (missing,
  * unreadable), CM_ERR_FORMAT (not STEP, no face in it), CM_ERR_CAD (transfer failed).
  * opt may be NULL for defaults. */
-cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_options *opt,
+CM_API cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_options *opt,
                       cm_cad_model **model);
 /* Writes the model as STEP (AP214) in the model's target unit, via a temporary file. */
-cm_status cm_cad_write(cm_context *ctx, const cm_cad_model *model, const char *path);
-void cm_cad_destroy(cm_cad_model **model);
+CM_API cm_status cm_cad_write(cm_context *ctx, const cm_cad_model *model, const char *path);
+CM_API void cm_cad_destroy(cm_cad_model **model);
 
 /* The length unit named in the file ("millimetre", "metre", "inch", ... as the file says;
  * "" if none) and the target unit of the coordinates ("mm", ...). Owned by the model. */
-const char *cm_cad_file_unit(const cm_cad_model *model);
-const char *cm_cad_unit(const cm_cad_model *model);
+CM_API const char *cm_cad_file_unit(const cm_cad_model *model);
+CM_API const char *cm_cad_unit(const cm_cad_model *model);
 
 /* ---- topology ---- */
 
@@ -49,7 +49,7 @@ typedef struct cm_cad_counts {
     int solids, shells, faces, wires, edges, vertices;
 } cm_cad_counts;
 
-void cm_cad_get_counts(const cm_cad_model *model, cm_cad_counts *counts);
+CM_API void cm_cad_get_counts(const cm_cad_model *model, cm_cad_counts *counts);
 
 /* Surface and curve types follow OpenCASCADE's GeomAbs enumerations. */
 typedef enum cm_cad_surface_type {
@@ -64,8 +64,8 @@ typedef enum cm_cad_curve_type {
 } cm_cad_curve_type;
 
 /* "plane", "cylinder", ..., "line", "circle", ... */
-const char *cm_cad_surface_type_name(cm_cad_surface_type type);
-const char *cm_cad_curve_type_name(cm_cad_curve_type type);
+CM_API const char *cm_cad_surface_type_name(cm_cad_surface_type type);
+CM_API const char *cm_cad_curve_type_name(cm_cad_curve_type type);
 
 typedef struct cm_cad_face_info {
     cm_cad_surface_type type;
@@ -88,60 +88,60 @@ typedef struct cm_cad_edge_info {
     double bbox[6];
 } cm_cad_edge_info;
 
-cm_status cm_cad_face_get_info(cm_context *ctx, const cm_cad_model *model, int face,
+CM_API cm_status cm_cad_face_get_info(cm_context *ctx, const cm_cad_model *model, int face,
                                cm_cad_face_info *info);
-cm_status cm_cad_edge_get_info(cm_context *ctx, const cm_cad_model *model, int edge,
+CM_API cm_status cm_cad_edge_get_info(cm_context *ctx, const cm_cad_model *model, int edge,
                                cm_cad_edge_info *info);
 /* xyz: 3 doubles. */
-cm_status cm_cad_vertex_point(cm_context *ctx, const cm_cad_model *model, int vertex, double *xyz);
+CM_API cm_status cm_cad_vertex_point(cm_context *ctx, const cm_cad_model *model, int vertex, double *xyz);
 /* The path the model was read from ("" if none), for messages. */
-const char *cm_cad_path(const cm_cad_model *model);
+CM_API const char *cm_cad_path(const cm_cad_model *model);
 /* Bounding box of the whole model: 6 doubles. */
-void cm_cad_bbox(const cm_cad_model *model, double *bbox);
+CM_API void cm_cad_bbox(const cm_cad_model *model, double *bbox);
 
 /* Oriented edges of wire w of a face, in the wire's order. edges/reversed point into the
  * model (valid until it is destroyed): n entries, edge indices and 1 where the edge runs
  * against its own direction in this face. A seam edge of a periodic face appears twice,
  * once each way. */
-cm_status cm_cad_face_wire(cm_context *ctx, const cm_cad_model *model, int face, int wire,
+CM_API cm_status cm_cad_face_wire(cm_context *ctx, const cm_cad_model *model, int face, int wire,
                            const int **edges, const int **reversed, int *n);
 
 /* Faces adjacent to an edge (1 for a free edge, 2 for a manifold edge, 1 for a seam):
  * faces points into the model, n entries. */
-cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge,
+CM_API cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge,
                             const int **faces, int *n);
 
 /* Two solids of the model that touch, overlap or contain one another (closer than 1e-6 of the
  * model's bounding-box diagonal): a mesher that fills every solid cannot take them (TetGen
  * crashes on the shared or crossing faces). CM_OK when no two solids meet (or there is one);
  * CM_ERR_UNSUPPORTED naming the first such pair (1-based, in TopExp order) otherwise. */
-cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model);
+CM_API cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model);
 
 /* G and G' correspond: counts, surface and curve types (a circle may become an ellipse),
  * edge -> vertices and face -> wires -> oriented edges all match. CM_OK if so; CM_ERR_MISMATCH with up to
  * max_report differences in the message ("face 12: plane in G, cylinder in G'") if not. */
-cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+CM_API cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
                          int max_report);
 
 /* ---- evaluation (arrays; OpenMP with one adaptor per thread) ---- */
 
 /* uv: n x 2; xyz: n x 3 output; normal: n x 3 unit normals oriented as the face (outward for
  * the faces of a solid), may be NULL. */
-cm_status cm_cad_face_eval(cm_context *ctx, const cm_cad_model *model, int face, const double *uv,
+CM_API cm_status cm_cad_face_eval(cm_context *ctx, const cm_cad_model *model, int face, const double *uv,
                            size_t n, double *xyz, double *normal);
 /* t: n; xyz: n x 3 output. */
-cm_status cm_cad_edge_eval(cm_context *ctx, const cm_cad_model *model, int edge, const double *t,
+CM_API cm_status cm_cad_edge_eval(cm_context *ctx, const cm_cad_model *model, int edge, const double *t,
                            size_t n, double *xyz);
 /* Trimming: inside[i] = 1 if uv[i] (n x 2) lies in the face's trimmed domain or on its
  * boundary, 0 outside. Periodic parameters are taken modulo the period. */
-cm_status cm_cad_face_inside(cm_context *ctx, const cm_cad_model *model, int face,
+CM_API cm_status cm_cad_face_inside(cm_context *ctx, const cm_cad_model *model, int face,
                              const double *uv, size_t n, int *inside);
 
 /* Arc length: s = length(t_first .. t) / length(edge) and its inverse (GCPnts_AbscissaPoint).
  * Degenerate edges map linearly between t and s. t, s: n entries. */
-cm_status cm_cad_edge_t_to_s(cm_context *ctx, const cm_cad_model *model, int edge, const double *t,
+CM_API cm_status cm_cad_edge_t_to_s(cm_context *ctx, const cm_cad_model *model, int edge, const double *t,
                              size_t n, double *s);
-cm_status cm_cad_edge_s_to_t(cm_context *ctx, const cm_cad_model *model, int edge, const double *s,
+CM_API cm_status cm_cad_edge_s_to_t(cm_context *ctx, const cm_cad_model *model, int edge, const double *s,
                              size_t n, double *t);
 
 /* ---- face boundaries in parameter space ---- */
@@ -162,9 +162,9 @@ typedef struct cm_cad_boundary {
 
 /* per_edge: #edges counts (indexed by edge; at least 1 each), or NULL to use `count` for
  * every edge. */
-cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model, int face,
+CM_API cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model, int face,
                                const int *per_edge, int count, cm_cad_boundary **boundary);
-void cm_cad_boundary_destroy(cm_cad_boundary **boundary);
+CM_API void cm_cad_boundary_destroy(cm_cad_boundary **boundary);
 
 /* ---- projection ---- */
 
@@ -172,11 +172,11 @@ void cm_cad_boundary_destroy(cm_cad_boundary **boundary);
  * surface, kept inside the trimmed domain (a foot point outside the trimming is replaced by
  * the nearest point on the face's boundary edges). xyz: n x 3. Outputs uv: n x 2, dist: n,
  * foot: n x 3; each may be NULL. */
-cm_status cm_cad_project_face(cm_context *ctx, const cm_cad_model *model, int face,
+CM_API cm_status cm_cad_project_face(cm_context *ctx, const cm_cad_model *model, int face,
                               const double *xyz, size_t n, const double *uv0, double *uv,
                               double *dist, double *foot);
 /* Onto one edge (global search on the curve, then Newton): t, dist: n. */
-cm_status cm_cad_project_edge(cm_context *ctx, const cm_cad_model *model, int edge,
+CM_API cm_status cm_cad_project_edge(cm_context *ctx, const cm_cad_model *model, int edge,
                               const double *xyz, size_t n, double *t, double *dist);
 
 /* Dense samples of the trimmed faces plus a kD-tree on them, for projections of many points. */
@@ -190,19 +190,19 @@ typedef struct cm_cad_sample_options {
                             create call returns CM_WARNING saying so. */
 } cm_cad_sample_options;
 
-void cm_cad_sample_options_init(cm_cad_sample_options *opt);
+CM_API void cm_cad_sample_options_init(cm_cad_sample_options *opt);
 
 /* Samples every face inside its trimmed domain on a grid whose step adapts to the surface
  * metric (3D spacing close to h) plus points on every edge (each with the uv of its pcurve in
  * each adjacent face), then builds the kD-trees. The model must outlive the locator. */
-cm_status cm_cad_locator_create(cm_context *ctx, const cm_cad_model *model,
+CM_API cm_status cm_cad_locator_create(cm_context *ctx, const cm_cad_model *model,
                                 const cm_cad_sample_options *opt, cm_cad_locator **locator);
-void cm_cad_locator_destroy(cm_cad_locator **locator);
+CM_API void cm_cad_locator_destroy(cm_cad_locator **locator);
 
 /* The samples: n, and borrowed arrays xyz (n x 3), face (n), uv (n x 2); h actually used. */
-size_t cm_cad_locator_samples(const cm_cad_locator *locator, const double **xyz,
+CM_API size_t cm_cad_locator_samples(const cm_cad_locator *locator, const double **xyz,
                               const int **face, const double **uv);
-double cm_cad_locator_h(const cm_cad_locator *locator);
+CM_API double cm_cad_locator_h(const cm_cad_locator *locator);
 
 /* Nearest face of each point (paper section 4): the nearest sample is the start value of a
  * Newton projection onto its face; the faces of the next nearest samples (up to 4 samples,
@@ -210,14 +210,14 @@ double cm_cad_locator_h(const cm_cad_locator *locator);
  * stays in the trimmed domain (outside it, the nearest point of the face's boundary edges is
  * taken). Periodic u, v are returned in the face's range. face: n (0-based), uv: n x 2,
  * dist: n, foot: n x 3; each output may be NULL. */
-cm_status cm_cad_locate_faces(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
+CM_API cm_status cm_cad_locate_faces(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
                               size_t n, int *face, double *uv, double *dist, double *foot);
 /* Nearest edge of each point (a kD-tree on edge samples, then Newton on the curves of the
  * nearest samples' edges): edge (0-based), t, dist: n. s follows from cm_cad_edge_t_to_s. */
-cm_status cm_cad_locate_edges(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
+CM_API cm_status cm_cad_locate_edges(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
                               size_t n, int *edge, double *t, double *dist);
 /* Nearest vertex of each point: vertex, dist: n. */
-cm_status cm_cad_locate_vertices(cm_context *ctx, const cm_cad_locator *locator,
+CM_API cm_status cm_cad_locate_vertices(cm_context *ctx, const cm_cad_locator *locator,
                                  const double *xyz, size_t n, int *vertex, double *dist);
 
 /* ---- surface triangulation (for tet meshing) and volume ---- */
@@ -231,7 +231,7 @@ typedef struct cm_cad_triangulate_options {
     double min_size;    /* BRepMesh's smallest edge (MinSize); <= 0: size / 4 */
 } cm_cad_triangulate_options;
 
-void cm_cad_triangulate_options_init(cm_cad_triangulate_options *opt);
+CM_API void cm_cad_triangulate_options_init(cm_cad_triangulate_options *opt);
 
 /* One node per CAD vertex, per interior point of an edge's discretisation (shared by the
  * faces on both sides) and per interior point of a face: the triangulation is watertight
@@ -255,12 +255,12 @@ typedef struct cm_cad_triangulation {
  * shape by an earlier call is discarded first, so do not call it concurrently on the same
  * model). Errors: CM_ERR_UNSUPPORTED for a model without faces, CM_ERR_CAD when BRepMesh
  * fails or leaves a face without triangles (message names the face). */
-cm_status cm_cad_triangulate(cm_context *ctx, const cm_cad_model *model,
+CM_API cm_status cm_cad_triangulate(cm_context *ctx, const cm_cad_model *model,
                              const cm_cad_triangulate_options *opt, cm_cad_triangulation **out);
-void cm_cad_triangulation_destroy(cm_cad_triangulation **t);
+CM_API void cm_cad_triangulation_destroy(cm_cad_triangulation **t);
 
 /* Total volume of the model's solids (BRepGProp); CM_ERR_UNSUPPORTED if it has no solid. */
-cm_status cm_cad_volume(cm_context *ctx, const cm_cad_model *model, double *volume);
+CM_API cm_status cm_cad_volume(cm_context *ctx, const cm_cad_model *model, double *volume);
 
 #ifdef __cplusplus
 }

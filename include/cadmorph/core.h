@@ -2,16 +2,40 @@
  *
  * Conventions of the whole library (every public header follows them):
  *  - Names: cm_<module>_<verb> for functions, cm_<noun> for types, CM_ for macros/enums.
- *  - Every fallible call returns cm_status: CM_OK (0), an error (< 0) or a warning (> 0).
- *    The message of the last error or warning is in the context: cm_context_message().
- *  - Parameter order: context, inputs, outputs. Inputs are borrowed for the call.
- *  - Arrays: row-major, 0-based; documented with their shape, e.g. "xyz: #V x 3 double".
+ *    Functions of the API carry CM_API (export.h); nothing else is exported by libcadmorph.so.
+ *  - Parameter order: context, inputs, outputs. Arrays: row-major, 0-based; documented with
+ *    their shape, e.g. "xyz: #V x 3 double".
+ *  - Return values: every fallible call returns cm_status: CM_OK (0), an error (< 0) or a
+ *    warning (> 0: the result is complete, the message says what was odd). Test `s < 0` for
+ *    failure. The message of the last error or warning is in the context
+ *    (cm_context_message) until the next one; calls that succeed leave it alone. Functions
+ *    that cannot fail return their value directly (counts, names, pointers into objects).
  *  - Ownership: cm_X_create(ctx, ..., &out) allocates, cm_X_destroy(&p) frees, accepts NULL
  *    and sets the pointer to NULL. On failure nothing leaks and outputs are NULL.
+ *  - Pointer lifetimes: inputs are borrowed for the call and may be freed when it returns,
+ *    unless the header says an object keeps them (the morpher keeps its cm_cad_model
+ *    pointers: morph.h). Pointers a function returns into an object (names, arrays, info
+ *    structs) stay valid until the object is destroyed or, where the header says so, until
+ *    the next call on it; the caller never frees them. Strings returned without an object
+ *    (cm_status_name, cm_version) are static.
+ *  - Thread-safety: a context, and every object created with it, is used by one thread at a
+ *    time; separate contexts and objects may be used from separate threads at once. Read-only
+ *    objects (const parameters: models, locators, fitted RBFs, meshes) may be shared between
+ *    threads. Internally calls run OpenMP leaf loops sized by cm_context_set_threads; the
+ *    results do not depend on the thread count beyond round-off.
+ *  - Process-wide effects (the only ones): the RBF factorisation and DM-FFD's SVD set
+ *    OpenBLAS's thread count (openblas_set_num_threads) for their large calls and restore the
+ *    caller's value before they return; two such calls in different threads at once may see
+ *    each other's setting (speed only, not results). The first STEP read or write removes the printers of
+ *    OpenCASCADE's default messenger (so the library never writes to stdout) and sets
+ *    OpenCASCADE's translator parameters (Interface_Static: units, schema) under a lock;
+ *    a program that uses OpenCASCADE itself sees both.
  *  - The library never prints, exits or aborts; the log callback decides what a user sees.
  */
 #ifndef CADMORPH_CORE_H
 #define CADMORPH_CORE_H
+
+#include "cadmorph/export.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -38,10 +62,10 @@ typedef enum cm_status {
 } cm_status;
 
 /* Short fixed name of a status, e.g. "format error". */
-const char *cm_status_name(cm_status s);
+CM_API const char *cm_status_name(cm_status s);
 
 /* True for errors that mean "the input is bad" (exit code 2 in the CLI). */
-int cm_status_is_input_error(cm_status s);
+CM_API int cm_status_is_input_error(cm_status s);
 
 typedef enum cm_log_level { CM_LOG_DEBUG = 0, CM_LOG_INFO = 1, CM_LOG_WARNING = 2 } cm_log_level;
 
@@ -51,54 +75,54 @@ typedef void (*cm_progress_fn)(void *user, const char *stage, double done, doubl
 
 typedef struct cm_context cm_context;
 
-cm_status cm_context_create(cm_context **ctx);
-void cm_context_destroy(cm_context **ctx);
+CM_API cm_status cm_context_create(cm_context **ctx);
+CM_API void cm_context_destroy(cm_context **ctx);
 
 /* Message of the last error or warning set on this context ("" if none). */
-const char *cm_context_message(const cm_context *ctx);
-void cm_context_clear(cm_context *ctx);
+CM_API const char *cm_context_message(const cm_context *ctx);
+CM_API void cm_context_clear(cm_context *ctx);
 
 /* Threads for OpenMP leaf loops and BLAS; 0 = all available (default). Under an address-space
  * limit (ulimit -v) cm_context_threads returns no more than the free address space can give
  * stacks to (libgomp aborts the process when it cannot create a thread). */
-void cm_context_set_threads(cm_context *ctx, int threads);
-int cm_context_threads(const cm_context *ctx);
+CM_API void cm_context_set_threads(cm_context *ctx, int threads);
+CM_API int cm_context_threads(const cm_context *ctx);
 
-void cm_context_set_log(cm_context *ctx, cm_log_fn fn, void *user);
-void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user);
+CM_API void cm_context_set_log(cm_context *ctx, cm_log_fn fn, void *user);
+CM_API void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user);
 
 /* ---- for module code ---- */
 
 /* Sets the context message (printf-style) and returns code, so that errors read
  * `return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: expected ...", ...);` */
-cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
+CM_API cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
 /* Puts "<prefix>: " (printf-style) in front of the context message and returns code, for a
  * caller that adds where an error happened: `return cm_error_prefix(ctx, s, "%s", path);`. */
-cm_status cm_error_prefix(cm_context *ctx, cm_status code, const char *fmt, ...)
+CM_API cm_status cm_error_prefix(cm_context *ctx, cm_status code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
+CM_API void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-void cm_progress(cm_context *ctx, const char *stage, double done, double total);
+CM_API void cm_progress(cm_context *ctx, const char *stage, double done, double total);
 
 /* Threads for a leaf loop of n items that is worth parallelising above min_per_thread items
  * a thread: between 1 and the context's threads (0 there = all the machine has). */
-int cm_context_threads_for(const cm_context *ctx, size_t n, size_t min_per_thread);
+CM_API int cm_context_threads_for(const cm_context *ctx, size_t n, size_t min_per_thread);
 
 /* Length of the diagonal of a bounding box bb = {xmin, ymin, zmin, xmax, ymax, zmax}. */
-double cm_bbox_diagonal(const double bb[6]);
+CM_API double cm_bbox_diagonal(const double bb[6]);
 
 /* Wall clock in seconds (monotonic), for stage timings in reports and benchmarks. */
-double cm_wtime(void);
+CM_API double cm_wtime(void);
 
 /* ---- files ---- */
 
 /* Reads a whole regular file into *data (NUL-terminated; *size excludes the NUL). The caller
  * frees *data. CM_ERR_IO with the path and the reason on failure. */
-cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *size);
+CM_API cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *size);
 
 /* Output through a temporary "<dir of path>/.cm-XXXXXX", renamed onto path by
  * cm_outfile_commit, so that a failed write never leaves a partial file. Write with
@@ -109,19 +133,19 @@ typedef struct cm_outfile {
     char *tmp;
 } cm_outfile;
 
-cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out);
+CM_API cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out);
 /* Flushes, closes and renames; on any error removes the temporary file. */
-cm_status cm_outfile_commit(cm_context *ctx, cm_outfile *out);
+CM_API cm_status cm_outfile_commit(cm_context *ctx, cm_outfile *out);
 /* Closes and removes the temporary file (after an error). Safe to call twice. */
-void cm_outfile_abort(cm_outfile *out);
+CM_API void cm_outfile_abort(cm_outfile *out);
 
 /* Unlinks the temporary files of every cm_outfile still open in this process. Only
  * async-signal-safe calls: meant for a program's own SIGINT/SIGTERM/SIGHUP handler (the
  * library installs no handlers). */
-void cm_outfile_unlink_all(void);
+CM_API void cm_outfile_unlink_all(void);
 
 /* True on a little-endian host (binary formats are written little-endian). */
-int cm_host_little_endian(void);
+CM_API int cm_host_little_endian(void);
 
 #ifdef __cplusplus
 }

@@ -58,31 +58,31 @@ typedef struct cm_ffd_desc {
 } cm_ffd_desc;
 
 /* Defaults: 4x4x4 B-spline with uniform knots on the unit cube. */
-void cm_ffd_desc_init(cm_ffd_desc *desc);
+CM_API void cm_ffd_desc_init(cm_ffd_desc *desc);
 
 /* A PyGeM box: A = R diag(length), R = Rx Ry Rz of the angles in degrees (right-handed,
  * applied to column vectors), as PyGeM's angles2matrix(z, y, x). axes: row-major 3x3. */
-void cm_ffd_box_axes(const double length[3], const double angle_deg[3], double axes[9]);
+CM_API void cm_ffd_box_axes(const double length[3], const double angle_deg[3], double axes[9]);
 
 /* A B-spline lattice (uniform knots) whose valid domain is the box bb = {xmin, ymin, zmin,
  * xmax, ymax, zmax} grown by margin x its diagonal on every side, n control points per axis:
  * the "DM-FFD-n lattice enclosing the mesh". */
-void cm_ffd_desc_enclosing(cm_ffd_desc *desc, const double bb[6], double margin, int n);
+CM_API void cm_ffd_desc_enclosing(cm_ffd_desc *desc, const double bb[6], double margin, int n);
 
 typedef struct cm_ffd cm_ffd;
 
 /* CM_ERR_ARGUMENT for n below the basis' minimum, a singular or non-finite axis matrix, or
  * more than 2^31 control points. */
-cm_status cm_ffd_create(cm_context *ctx, const cm_ffd_desc *desc, cm_ffd **ffd);
-void cm_ffd_destroy(cm_ffd **ffd);
+CM_API cm_status cm_ffd_create(cm_context *ctx, const cm_ffd_desc *desc, cm_ffd **ffd);
+CM_API void cm_ffd_destroy(cm_ffd **ffd);
 
-size_t cm_ffd_control_count(const cm_ffd *ffd);
+CM_API size_t cm_ffd_control_count(const cm_ffd *ffd);
 /* Reference (or, after cm_ffd_set_control_points, moved) control positions: #ctrl x 3. */
-void cm_ffd_control_points(const cm_ffd *ffd, double *xyz);
+CM_API void cm_ffd_control_points(const cm_ffd *ffd, double *xyz);
 /* A pre-deformed lattice: control positions xyz (#ctrl x 3; NULL restores the reference).
  * Local coordinates then need Newton's method (CM_FFD_LOCAL_AUTO switches to it). */
-cm_status cm_ffd_set_control_points(cm_context *ctx, cm_ffd *ffd, const double *xyz);
-void cm_ffd_set_local(cm_ffd *ffd, cm_ffd_local mode);
+CM_API cm_status cm_ffd_set_control_points(cm_context *ctx, cm_ffd *ffd, const double *xyz);
+CM_API void cm_ffd_set_local(cm_ffd *ffd, cm_ffd_local mode);
 
 typedef struct cm_ffd_stats {
     size_t inside, outside; /* points in / out of the lattice */
@@ -94,18 +94,18 @@ typedef struct cm_ffd_stats {
  * outside, 2 failed; may be NULL). Newton (moved lattice): damped steps from the affine
  * guess, stops at |F| <= 1e-13 x lattice diagonal or |du| <= 1e-15, at most 30 steps.
  * OpenMP over points. Returns CM_WARNING (message: how many) if any point failed. */
-cm_status cm_ffd_local_coords(cm_context *ctx, const cm_ffd *ffd, size_t n, const double *x,
+CM_API cm_status cm_ffd_local_coords(cm_context *ctx, const cm_ffd *ffd, size_t n, const double *x,
                               double *u, unsigned char *inside, cm_ffd_stats *stats);
 
 /* Tensor-product basis at local coordinates u in [0,1]^3: the non-zero N_p into idx/w
  * (capacity: cm_ffd_support_size), returns their count. */
-size_t cm_ffd_support_size(const cm_ffd *ffd);
-size_t cm_ffd_basis_eval(const cm_ffd *ffd, const double u[3], int64_t *idx, double *w);
+CM_API size_t cm_ffd_support_size(const cm_ffd *ffd);
+CM_API size_t cm_ffd_basis_eval(const cm_ffd *ffd, const double u[3], int64_t *idx, double *w);
 
 /* FFD displacements: d (n x 3) = sum_p dc_p N_p(u(x_i)) for the points x (n x 3), dc:
  * #ctrl x 3 control displacements. Outside points get 0, failed ones 0 as well (counted,
  * CM_WARNING). stats may be NULL. */
-cm_status cm_ffd_deform(cm_context *ctx, const cm_ffd *ffd, const double *dc, size_t n,
+CM_API cm_status cm_ffd_deform(cm_context *ctx, const cm_ffd *ffd, const double *dc, size_t n,
                         const double *x, double *d, cm_ffd_stats *stats);
 
 /* ---- DM-FFD ---- */
@@ -115,7 +115,7 @@ typedef struct cm_dmffd_options {
     int floor;  /* 0: truncate (1/sigma -> 0, the default); 1: floor (1/max(sigma, tau)) */
 } cm_dmffd_options;
 
-void cm_dmffd_options_init(cm_dmffd_options *opt);
+CM_API void cm_dmffd_options_init(cm_dmffd_options *opt);
 
 typedef struct cm_dmffd_info {
     size_t handles;         /* m */
@@ -134,21 +134,21 @@ typedef struct cm_dmffd cm_dmffd;
  * (LAPACKE dgesdd, dgesvd if it does not converge) after dropping the columns that no handle
  * touches. The lattice is borrowed and must outlive the DM-FFD. A handle outside the lattice
  * (or failed in Newton) is CM_ERR_ARGUMENT naming it. */
-cm_status cm_dmffd_create(cm_context *ctx, const cm_ffd *ffd, size_t m, const double *handles,
+CM_API cm_status cm_dmffd_create(cm_context *ctx, const cm_ffd *ffd, size_t m, const double *handles,
                           const cm_dmffd_options *opt, cm_dmffd **dm);
-void cm_dmffd_destroy(cm_dmffd **dm);
+CM_API void cm_dmffd_destroy(cm_dmffd **dm);
 
 /* C = Phi^+ H: h (m x 3) handle displacements in, dc (#ctrl x 3) control displacements out
  * (exactly 0 for control points no handle touches). Least norm when under-determined, least
  * squares when over-determined; the residual goes into the info. */
-cm_status cm_dmffd_solve(cm_context *ctx, cm_dmffd *dm, const double *h, double *dc);
+CM_API cm_status cm_dmffd_solve(cm_context *ctx, cm_dmffd *dm, const double *h, double *dc);
 
-void cm_dmffd_get_info(const cm_dmffd *dm, cm_dmffd_info *info);
+CM_API void cm_dmffd_get_info(const cm_dmffd *dm, cm_dmffd_info *info);
 
 /* Eqs. 9-10: B = M Phi^+ (k x m row-major, *b allocated, the caller frees) for the points x
  * (k x 3), so that the displacements of x for any handle displacements H are B H. Points
  * outside the lattice get zero rows. */
-cm_status cm_dmffd_precompute(cm_context *ctx, const cm_dmffd *dm, size_t k, const double *x,
+CM_API cm_status cm_dmffd_precompute(cm_context *ctx, const cm_dmffd *dm, size_t k, const double *x,
                               double **b);
 
 /* ---- PyGeM parameter files ---- */
@@ -166,20 +166,20 @@ typedef struct cm_ffd_prm {
 /* Errors name path:line: CM_ERR_IO (missing file: unlike PyGeM, nothing is written),
  * CM_ERR_FORMAT (missing key or section, a value that is not a number, an index out of
  * range, fewer than 4 numbers on a weight line). */
-cm_status cm_ffd_prm_read(cm_context *ctx, const char *path, cm_ffd_prm *prm);
-void cm_ffd_prm_free(cm_ffd_prm *prm);
+CM_API cm_status cm_ffd_prm_read(cm_context *ctx, const char *path, cm_ffd_prm *prm);
+CM_API void cm_ffd_prm_free(cm_ffd_prm *prm);
 
 /* The lattice of a .prm: the box as the domain (origin, R diag(length)), n per axis, the
  * given basis (Bernstein: PyGeM's map; B-spline: uniform knots on the box as the domain).
  * dc (may be NULL): #ctrl x 3 physical control displacements R diag(length) mu. */
-void cm_ffd_prm_desc(const cm_ffd_prm *prm, cm_ffd_basis basis, cm_ffd_desc *desc, double *dc);
+CM_API void cm_ffd_prm_desc(const cm_ffd_prm *prm, cm_ffd_basis basis, cm_ffd_desc *desc, double *dc);
 
 /* The control-displacement table of `cadmorph ffd`: header `i,j,k,dx,dy,dz`, one row per
  * moved control point (0-based lattice indices), physical displacements in the world frame.
  * dc: #ctrl x 3 output (zeroed first); listed: #ctrl flags (may be NULL). Errors name
  * path:line: CM_ERR_FORMAT (header, column count, number), CM_ERR_MISMATCH (index outside
  * the n[0] x n[1] x n[2] lattice, a point listed twice). */
-cm_status cm_ffd_read_displacements(cm_context *ctx, const char *path, const int n[3],
+CM_API cm_status cm_ffd_read_displacements(cm_context *ctx, const char *path, const int n[3],
                                     double *dc, unsigned char *listed);
 
 #ifdef __cplusplus

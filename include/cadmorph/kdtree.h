@@ -13,17 +13,17 @@ typedef struct cm_kdtree cm_kdtree;
 
 /* Builds the tree on n points. xyz: n x 3 double (copied; the tree does not keep it).
  * n must be at least 1 and below 2^31 (FLANN indexes with int). */
-cm_status cm_kdtree_create(cm_context *ctx, const double *xyz, size_t n, cm_kdtree **tree);
-void cm_kdtree_destroy(cm_kdtree **tree);
+CM_API cm_status cm_kdtree_create(cm_context *ctx, const double *xyz, size_t n, cm_kdtree **tree);
+CM_API void cm_kdtree_destroy(cm_kdtree **tree);
 
 /* Number of points in the tree. */
-size_t cm_kdtree_size(const cm_kdtree *tree);
+CM_API size_t cm_kdtree_size(const cm_kdtree *tree);
 
 /* The k nearest points of each of the m queries, nearest first (exact).
  * query: m x 3 double; index: m x k, 0-based; dist2: m x k squared distances (may be NULL).
  * k must be between 1 and the tree size. Uses the context's threads. */
-cm_status cm_kdtree_nearest(cm_context *ctx, const cm_kdtree *tree, const double *query, size_t m,
-                            int k, int64_t *index, double *dist2);
+CM_API cm_status cm_kdtree_nearest(cm_context *ctx, const cm_kdtree *tree, const double *query,
+                                   size_t m, int k, int64_t *index, double *dist2);
 
 #ifdef __cplusplus
 }

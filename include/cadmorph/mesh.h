@@ -49,10 +49,10 @@ typedef struct cm_cell_info {
 } cm_cell_info;
 
 /* Table entry of a type; NULL for an out-of-range value. */
-const cm_cell_info *cm_cell_type_info(cm_cell_type type);
+CM_API const cm_cell_info *cm_cell_type_info(cm_cell_type type);
 /* Type from VTK / gmsh id; returns CM_CELL_TYPE_COUNT for ids cadmorph does not know. */
-cm_cell_type cm_cell_type_from_vtk(int vtk_id);
-cm_cell_type cm_cell_type_from_gmsh(int gmsh_id);
+CM_API cm_cell_type cm_cell_type_from_vtk(int vtk_id);
+CM_API cm_cell_type cm_cell_type_from_gmsh(int gmsh_id);
 
 typedef enum cm_field_location { CM_FIELD_NODE = 0, CM_FIELD_CELL = 1 } cm_field_location;
 
@@ -107,35 +107,93 @@ typedef struct cm_mesh {
     size_t cap_nodes, cap_cells, cap_conn;
 } cm_mesh;
 
-cm_status cm_mesh_create(cm_context *ctx, cm_mesh **mesh);
-void cm_mesh_destroy(cm_mesh **mesh);
+CM_API cm_status cm_mesh_create(cm_context *ctx, cm_mesh **mesh);
+CM_API void cm_mesh_destroy(cm_mesh **mesh);
 
 /* Sets the node count; xyz is (re)allocated and left uninitialised beyond the old count.
  * with_tags: also allocate node_tag (left for the caller to fill). */
-cm_status cm_mesh_resize_nodes(cm_context *ctx, cm_mesh *mesh, size_t n_nodes, int with_tags);
+CM_API cm_status cm_mesh_resize_nodes(cm_context *ctx, cm_mesh *mesh, size_t n_nodes,
+                                      int with_tags);
 /* Reserves room for more cells and connectivity entries (optional: add_cell grows). */
-cm_status cm_mesh_reserve_cells(cm_context *ctx, cm_mesh *mesh, size_t n_cells, size_t n_conn);
+CM_API cm_status cm_mesh_reserve_cells(cm_context *ctx, cm_mesh *mesh, size_t n_cells,
+                                       size_t n_conn);
 /* Appends a cell. nodes: n entries, 0-based, VTK order (polyhedra: the face stream).
  * tag: the file's element id or 0 to use index + 1. */
-cm_status cm_mesh_add_cell(cm_context *ctx, cm_mesh *mesh, cm_cell_type type, const int64_t *nodes,
-                           size_t n, int physical, int entity, int64_t tag);
+CM_API cm_status cm_mesh_add_cell(cm_context *ctx, cm_mesh *mesh, cm_cell_type type,
+                                  const int64_t *nodes, size_t n, int physical, int entity,
+                                  int64_t tag);
 /* Adds (or replaces) a field; *data points to its zeroed array, owned by the mesh. */
-cm_status cm_mesh_add_field(cm_context *ctx, cm_mesh *mesh, const char *name,
-                            cm_field_location location, int components, double **data);
-cm_field *cm_mesh_find_field(const cm_mesh *mesh, const char *name, cm_field_location location);
-cm_status cm_mesh_add_group(cm_context *ctx, cm_mesh *mesh, int dim, int tag, const char *name);
+CM_API cm_status cm_mesh_add_field(cm_context *ctx, cm_mesh *mesh, const char *name,
+                                   cm_field_location location, int components, double **data);
+CM_API cm_field *cm_mesh_find_field(const cm_mesh *mesh, const char *name,
+                                    cm_field_location location);
+CM_API cm_status cm_mesh_add_group(cm_context *ctx, cm_mesh *mesh, int dim, int tag,
+                                   const char *name);
 /* Appends an entity; the arrays are copied. */
-cm_status cm_mesh_add_entity(cm_context *ctx, cm_mesh *mesh, const cm_mesh_entity *entity);
+CM_API cm_status cm_mesh_add_entity(cm_context *ctx, cm_mesh *mesh, const cm_mesh_entity *entity);
 
 /* Deep copy. */
-cm_status cm_mesh_copy(cm_context *ctx, const cm_mesh *mesh, cm_mesh **copy);
+CM_API cm_status cm_mesh_copy(cm_context *ctx, const cm_mesh *mesh, cm_mesh **copy);
 
 /* Node indices in range, node counts match types, coordinates finite, polyhedron streams
  * consistent. what: a name for messages (usually the file path). */
-cm_status cm_mesh_validate(cm_context *ctx, const cm_mesh *mesh, const char *what);
+CM_API cm_status cm_mesh_validate(cm_context *ctx, const cm_mesh *mesh, const char *what);
 
 /* Number of cells of dimension dim. */
-size_t cm_mesh_count_dim(const cm_mesh *mesh, int dim);
+CM_API size_t cm_mesh_count_dim(const cm_mesh *mesh, int dim);
+
+/* ---- the face stream of a polyhedron ----
+ * One walk for every reader of CM_CELL_POLYHEDRON's stream (nf, n0, ids of face 0, n1, ...):
+ *
+ *   for (cm_polyhedron_face f = cm_polyhedron_begin(stream, len); cm_polyhedron_more(&f);
+ *        cm_polyhedron_next(&f))
+ *       ... f.n node ids at f.nodes (face f.face of f.n_faces) ...
+ *
+ * stream = mesh->conn + mesh->offset[c], len = its entry count, or -1 for a stream already
+ * checked (cm_mesh_validate, which the readers run). A face with a negative count or one that
+ * runs past len ends the walk with f.bad set; after a complete walk f.at is one past the last
+ * face (so f.at < stream + len means trailing entries). */
+typedef struct cm_polyhedron_face {
+    int64_t face;         /* this face: 0 .. n_faces - 1 */
+    int64_t n_faces;      /* the stream's face count (0 if negative) */
+    int64_t n;            /* node count of this face */
+    const int64_t *nodes; /* its n node ids */
+    const int64_t *at;    /* this face's entry (its count) in the stream */
+    const int64_t *end;   /* one past the stream, NULL for an unbounded walk */
+    int bad;              /* stopped at a malformed face (f.face is that face) */
+} cm_polyhedron_face;
+
+static inline void cm_polyhedron_load(cm_polyhedron_face *f)
+{
+    if (f->face >= f->n_faces) return;
+    if ((f->end && f->at >= f->end) || f->at[0] < 0 || (f->end && f->at[0] >= f->end - f->at)) {
+        f->bad = 1;
+        return;
+    }
+    f->n = f->at[0];
+    f->nodes = f->at + 1;
+}
+
+static inline cm_polyhedron_face cm_polyhedron_begin(const int64_t *stream, int64_t len)
+{
+    cm_polyhedron_face f = {0, 0, 0, stream + 1, stream + 1, len >= 0 ? stream + len : NULL, 0};
+    f.n_faces = len != 0 && stream[0] > 0 ? stream[0] : 0;
+    cm_polyhedron_load(&f);
+    return f;
+}
+
+static inline int cm_polyhedron_more(const cm_polyhedron_face *f)
+{
+    return !f->bad && f->face < f->n_faces;
+}
+
+static inline void cm_polyhedron_next(cm_polyhedron_face *f)
+{
+    f->at += 1 + f->n;
+    ++f->face;
+    f->n = 0;
+    cm_polyhedron_load(f);
+}
 
 /* ---- files ----
  * Formats by extension: .msh (gmsh 2.2 / 4.1, ASCII / binary little-endian), .vtu (VTK XML),
@@ -152,7 +210,7 @@ typedef enum cm_mesh_format {
     CM_FORMAT_MEDIT
 } cm_mesh_format;
 
-cm_mesh_format cm_mesh_format_from_path(const char *path);
+CM_API cm_mesh_format cm_mesh_format_from_path(const char *path);
 
 typedef struct cm_mesh_write_options {
     int msh_version; /* 22 or 41 (default 41) */
@@ -161,12 +219,12 @@ typedef struct cm_mesh_write_options {
     int appended;    /* vtu: appended raw data section */
 } cm_mesh_write_options;
 
-void cm_mesh_write_options_init(cm_mesh_write_options *opt);
+CM_API void cm_mesh_write_options_init(cm_mesh_write_options *opt);
 
-cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh);
+CM_API cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh);
 /* opt may be NULL for defaults. */
-cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
-                        const cm_mesh_write_options *opt);
+CM_API cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                               const cm_mesh_write_options *opt);
 
 /* ---- boundary and components (volume cells only: dim 3) ---- */
 
@@ -184,22 +242,23 @@ typedef struct cm_mesh_boundary {
 } cm_mesh_boundary;
 
 /* Returns CM_WARNING (with counts in the message) for non-manifold faces or duplicates. */
-cm_status cm_mesh_boundary_create(cm_context *ctx, const cm_mesh *mesh, cm_mesh_boundary **b);
-void cm_mesh_boundary_destroy(cm_mesh_boundary **b);
+CM_API cm_status cm_mesh_boundary_create(cm_context *ctx, const cm_mesh *mesh,
+                                         cm_mesh_boundary **b);
+CM_API void cm_mesh_boundary_destroy(cm_mesh_boundary **b);
 
 /* ---- quality: Verdict's scaled Jacobian ---- */
 
 /* Scaled Jacobian of one cell from its corner coordinates (VTK order, corners x 3).
  * Types: tet, hex, wedge, pyramid (higher-order types use their corners).
  * Returns NaN for types without a definition (use cm_quality_polyhedron for polyhedra). */
-double cm_quality_scaled_jacobian(cm_cell_type type, const double *xyz);
+CM_API double cm_quality_scaled_jacobian(cm_cell_type type, const double *xyz);
 
 /* Polyhedron: decomposed into tets (cell centre, face centre, edge) - minimum of their
  * scaled Jacobians. face_stream as in CM_CELL_POLYHEDRON; coordinates from mesh xyz. */
-double cm_quality_polyhedron(const double *mesh_xyz, const int64_t *face_stream);
+CM_API double cm_quality_polyhedron(const double *mesh_xyz, const int64_t *face_stream);
 
 /* sj: #cells output; NaN for cells of dimension < 3. OpenMP over cells. */
-cm_status cm_mesh_quality(cm_context *ctx, const cm_mesh *mesh, double *sj);
+CM_API cm_status cm_mesh_quality(cm_context *ctx, const cm_mesh *mesh, double *sj);
 
 typedef struct cm_quality_stats {
     size_t count;
@@ -210,8 +269,8 @@ typedef struct cm_quality_stats {
 
 /* Stats over volume cells: per_type[CM_CELL_TYPE_COUNT] (by linear type) and all. Either
  * output may be NULL. sj as from cm_mesh_quality. */
-cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const double *sj,
-                               cm_quality_stats *per_type, cm_quality_stats *all);
+CM_API cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const double *sj,
+                                      cm_quality_stats *per_type, cm_quality_stats *all);
 
 #ifdef __cplusplus
 }

@@ -48,27 +48,27 @@ typedef struct cm_model_bracket {
 } cm_model_bracket;
 
 /* Parameters at t (linear interpolation between the values at t = 0 and t = 1). */
-void cm_model_bore_at(double t, cm_model_bore *p);
-void cm_model_pipe_at(double t, cm_model_pipe *p);
-void cm_model_bracket_at(double t, cm_model_bracket *p);
+CM_API void cm_model_bore_at(double t, cm_model_bore *p);
+CM_API void cm_model_pipe_at(double t, cm_model_pipe *p);
+CM_API void cm_model_bracket_at(double t, cm_model_bracket *p);
 
 /* Non-zero if name is a built-in model ("bore", "pipe", "bracket"). */
-int cm_model_known(const char *name);
+CM_API int cm_model_known(const char *name);
 /* The model names joined by ", " ("bore, pipe, bracket"), for messages. */
-const char *cm_model_list(void);
+CM_API const char *cm_model_list(void);
 
 /* Writes model at t as STEP (AP214, mm). Errors: CM_ERR_ARGUMENT for an unknown model or t
  * outside [0, 1], CM_ERR_IO when path cannot be written, CM_ERR_CAD when OpenCASCADE fails.
  * Process-wide effect: removes the stdout printer of OpenCASCADE's default messenger (as
  * cm_cad_read does). */
-cm_status cm_model_write_step(cm_context *ctx, const char *model, double t, const char *path);
+CM_API cm_status cm_model_write_step(cm_context *ctx, const char *model, double t, const char *path);
 
 /* Topology signature of model at t, for checking that G(t) keeps its topology: counts
  * (solids, faces, edges, vertices) and, in MapShapes order, each face's surface type and
  * each edge's curve type and vertex indices, written as text into buf (size bytes, truncated
  * to size - 1). Also the solid's volume (BRepGProp) in *volume if not NULL. Errors as
  * cm_model_write_step. */
-cm_status cm_model_signature(cm_context *ctx, const char *model, double t, char *buf,
+CM_API cm_status cm_model_signature(cm_context *ctx, const char *model, double t, char *buf,
                              size_t size, double *volume);
 
 /* ---- structured hex meshes of G(0) (study/hexmesh.c) ----
@@ -78,12 +78,12 @@ cm_status cm_model_signature(cm_context *ctx, const char *model, double t, char 
  * section, n_theta cells around (a multiple of 8: the square's corners are nodes), n_r
  * across (graded towards the bore by `grading` per cell, 1 = uniform), n_z along z.
  * Hexes (physical 1) only; their boundary is the bore's surface. */
-cm_status cm_hexmesh_bore(cm_context *ctx, int n_theta, int n_r, int n_z, double grading,
+CM_API cm_status cm_hexmesh_bore(cm_context *ctx, int n_theta, int n_r, int n_z, double grading,
                           cm_mesh **mesh);
 
 /* pipe: a butterfly O-grid of the disc (central square of n x n cells, a ring of n_ring cells
  * outside each of its sides) swept along the centreline with cells of about `step` length. */
-cm_status cm_hexmesh_pipe(cm_context *ctx, int n, int n_ring, double step, cm_mesh **mesh);
+CM_API cm_status cm_hexmesh_pipe(cm_context *ctx, int n, int n_ring, double step, cm_mesh **mesh);
 
 #ifdef __cplusplus
 }

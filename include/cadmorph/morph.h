@@ -37,7 +37,7 @@ typedef struct cm_morph_method {
     cm_warp_options warp;      /* default CM_WARP_RBF (triharmonic) */
 } cm_morph_method;
 
-void cm_morph_method_init(cm_morph_method *m);
+CM_API void cm_morph_method_init(cm_morph_method *m);
 
 /* steps = CM_MORPH_STEPS_AUTO: adaptive steps (see cm_morph_options). */
 #define CM_MORPH_STEPS_AUTO 0
@@ -73,7 +73,7 @@ typedef struct cm_morph_options {
     cm_surface_morph_options morph; /* its method field is replaced by method.surface */
 } cm_morph_options;
 
-void cm_morph_options_init(cm_morph_options *opt);
+CM_API void cm_morph_options_init(cm_morph_options *opt);
 
 /* One row per step. Stage times in seconds; read, sample and classify are spent by the caller
  * or by create and are filled in by cm_morph_run only; volume_solve = warp assembly and
@@ -112,9 +112,9 @@ typedef struct cm_morpher_info {
  * volume cells, CM_ERR_MISMATCH when M is not a mesh of G (cm_surface_classify's message,
  * prefixed), CM_ERR_FORMAT when every boundary edge has zero length. Returns CM_WARNING
  * (after logging it) when the sampling hit its cap. opt may be NULL. */
-cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mesh *mesh,
+CM_API cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mesh *mesh,
                             const cm_morph_options *opt, cm_morpher **morpher);
-void cm_morpher_destroy(cm_morpher **morpher);
+CM_API void cm_morpher_destroy(cm_morpher **morpher);
 
 /* Morphs onto target with the options' method: out_xyz (#nodes x 3) receives the new
  * coordinates (boundary nodes exactly where the surface morph sent them), out_row (may be
@@ -124,32 +124,32 @@ void cm_morpher_destroy(cm_morpher **morpher);
  * when adaptive steps found no valid step (out_xyz then holds the last accepted mesh, valid,
  * and out_row its row). Returns CM_WARNING when face nodes left their trimmed face (the
  * result is complete). */
-cm_status cm_morpher_apply(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *target,
+CM_API cm_status cm_morpher_apply(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *target,
                            double *out_xyz, cm_morph_step *out_row);
 
 /* The same with another method; factorisations are kept per set of warp options (up to 16,
  * the oldest dropped beyond), so a study that compares methods factorises each once. */
-cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *morpher,
+CM_API cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *morpher,
                                   const cm_cad_model *target, const cm_morph_method *method,
                                   double *out_xyz, cm_morph_step *out_row);
 
 /* The rows of the last apply, in order (accepted and rejected steps); *n their count. Valid
  * until the next apply. */
-const cm_morph_step *cm_morpher_steps(const cm_morpher *morpher, size_t *n);
+CM_API const cm_morph_step *cm_morpher_steps(const cm_morpher *morpher, size_t *n);
 
 /* Relative morphing: the morpher's mesh becomes xyz (#nodes x 3, e.g. the last apply's
  * result), lying on g (e.g. that apply's target); the boundary is classified on g again and
  * the warps are refactorised when next used. */
-cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *g,
+CM_API cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *g,
                             const double *xyz);
 
-const cm_morpher_info *cm_morpher_get_info(const cm_morpher *morpher);
+CM_API const cm_morpher_info *cm_morpher_get_info(const cm_morpher *morpher);
 /* The mesh the morpher starts from (its coordinates change only by rebase). */
-const cm_mesh *cm_morpher_mesh(const cm_morpher *morpher);
+CM_API const cm_mesh *cm_morpher_mesh(const cm_morpher *morpher);
 /* Per-cell scaled Jacobian (#cells) of the last apply's result; valid until the next call. */
-const double *cm_morpher_quality(const cm_morpher *morpher);
+CM_API const double *cm_morpher_quality(const cm_morpher *morpher);
 /* Surface-morph statistics of the last apply. */
-const cm_surface_morph_stats *cm_morpher_surface_stats(const cm_morpher *morpher);
+CM_API const cm_surface_morph_stats *cm_morpher_surface_stats(const cm_morpher *morpher);
 
 /* ---- the file-level wrapper ---- */
 
@@ -178,10 +178,10 @@ typedef struct cm_morph_result {
  * also go to the context's log (CM_LOG_WARNING) as they happen; those of the sampling of G
  * only once the mesh is known to lie on G (a mesh in the wrong unit makes the sampling warn,
  * and the real error is the mismatch). */
-cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,
+CM_API cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,
                        const char *mesh_path, const char *const *via, size_t n_via,
                        const cm_morph_options *opt, cm_morph_result **result);
-void cm_morph_result_destroy(cm_morph_result **result);
+CM_API void cm_morph_result_destroy(cm_morph_result **result);
 
 #ifdef __cplusplus
 }

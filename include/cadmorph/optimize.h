@@ -27,7 +27,7 @@ typedef struct cm_optimize_options {
     int newton;       /* Newton iterations per node and pass (default 4) */
 } cm_optimize_options;
 
-void cm_optimize_options_init(cm_optimize_options *opt);
+CM_API void cm_optimize_options_init(cm_optimize_options *opt);
 
 typedef struct cm_optimize_stats {
     double min_sj_before, min_sj_after;
@@ -41,13 +41,13 @@ typedef struct cm_optimize_stats {
  * boundary nodes. Nodes of cells other than tet4, hex8, wedge6 and pyr5 (higher order,
  * polyhedra) are never moved either. stats and opt may be NULL. Errors: CM_ERR_NOMEM,
  * CM_ERR_UNSUPPORTED for a mesh without volume cells. */
-cm_status cm_mesh_optimize(cm_context *ctx, cm_mesh *mesh, const unsigned char *fixed,
+CM_API cm_status cm_mesh_optimize(cm_context *ctx, cm_mesh *mesh, const unsigned char *fixed,
                            const cm_optimize_options *opt, cm_optimize_stats *stats);
 
 /* The corner measure of one linear cell (tet4, hex8, wedge6, pyr5; xyz: its nodes x 3):
  * the mean of the inverse mean ratios of its corners with delta = 0, 1 for the ideal cell,
  * +inf when a corner is inverted or flat. NAN for other types. For tests and reports. */
-double cm_optimize_cell_measure(cm_cell_type type, const double *xyz);
+CM_API double cm_optimize_cell_measure(cm_cell_type type, const double *xyz);
 
 #ifdef __cplusplus
 }

@@ -28,23 +28,23 @@ typedef struct cm_rbf cm_rbf;
  * 1e-12 x the bounding-box diagonal are merged (their values must then agree, see solve).
  * Errors: CM_ERR_NUMERIC if the centres leave the polynomial block singular (all coplanar
  * in 3D, collinear in 2D) or the factorisation fails (the message has the pivot). */
-cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
-                        const double *centres, cm_rbf **rbf);
-void cm_rbf_destroy(cm_rbf **rbf);
+CM_API cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
+                               const double *centres, cm_rbf **rbf);
+CM_API void cm_rbf_destroy(cm_rbf **rbf);
 
 /* Solves for values at the m centres given to create (values: m x ncomp row-major) and keeps
  * the weights in rbf, replacing earlier ones. Merged duplicate centres whose values differ
  * by more than 1e-8 of the largest value are an error naming both indices (smaller
  * differences are round-off, e.g. of projections that put two nodes on one point). */
-cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values);
+CM_API cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values);
 
 /* Evaluates the current interpolant at n points (points: n x dim) into out (n x ncomp).
  * OpenMP-parallel over points; no n x m matrix is formed. */
-cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const double *points,
-                          double *out);
+CM_API cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const double *points,
+                                 double *out);
 
 /* Centres after merging duplicates. */
-size_t cm_rbf_centre_count(const cm_rbf *rbf);
+CM_API size_t cm_rbf_centre_count(const cm_rbf *rbf);
 
 #ifdef __cplusplus
 }

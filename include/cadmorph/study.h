@@ -28,7 +28,7 @@ enum { CM_STUDY_ABSOLUTE = 1, CM_STUDY_RELATIVE = 2, CM_STUDY_BOTH = 3 };
 #define CM_STUDY_TARGET_H_SCALE 4.0
 
 /* "absolute" / "relative" ("?" otherwise). */
-const char *cm_study_mode_name(int mode);
+CM_API const char *cm_study_mode_name(int mode);
 
 /* ---- methods: a surface morph and a warp, named ----
  * Names (one table in study/method.c; a new warp method of warp.h is a study method without
@@ -48,20 +48,20 @@ typedef struct cm_study_method {
 } cm_study_method;
 
 /* CM_ERR_ARGUMENT (message lists the accepted forms) for an unknown name. */
-cm_status cm_study_method_parse(cm_context *ctx, const char *name, cm_study_method *out);
+CM_API cm_status cm_study_method_parse(cm_context *ctx, const char *name, cm_study_method *out);
 /* A comma-separated list into out (cap entries); *n: how many. Empty entries, duplicates and
  * more than cap methods are CM_ERR_ARGUMENT. */
-cm_status cm_study_methods_parse(cm_context *ctx, const char *list, cm_study_method *out,
+CM_API cm_status cm_study_methods_parse(cm_context *ctx, const char *list, cm_study_method *out,
                                  size_t cap, size_t *n);
 /* The three methods the sweeps compare (rbf-s, project, rbf-s-biharmonic) into out (cap >= 3);
  * returns how many were written. */
-size_t cm_study_default_methods(cm_study_method *out, size_t cap);
+CM_API size_t cm_study_default_methods(cm_study_method *out, size_t cap);
 /* A stable colour slot of a method for plots: its row in the named table (0, 1, 2), others
  * from 3 on in the order given (k: the method's position in its study). */
-int cm_study_method_slot(const cm_study_method *m, size_t k);
+CM_API int cm_study_method_slot(const cm_study_method *m, size_t k);
 /* The accepted forms for usage and help text, e.g. "rbf-s, project, rbf-s-biharmonic, <warp>,
  * rbf-s-<warp>, project-<warp> (<warp>: rbf|rbf-biharmonic)", into buf (size bytes). */
-void cm_study_method_help(char *buf, size_t size);
+CM_API void cm_study_method_help(char *buf, size_t size);
 
 /* ---- the family of geometries ---- */
 
@@ -84,10 +84,10 @@ typedef struct cm_study_family {
 
 /* A family of STEP files: variant i is paths[i] read by cm_cad_read (opt may be NULL), its
  * label the file name without directory and extension. paths are copied. */
-cm_status cm_study_family_files(cm_context *ctx, const char *const *paths, size_t n,
+CM_API cm_status cm_study_family_files(cm_context *ctx, const char *const *paths, size_t n,
                                 const cm_cad_read_options *opt, cm_study_family *family);
 /* Calls family->destroy and clears *family. */
-void cm_study_family_release(cm_study_family *family);
+CM_API void cm_study_family_release(cm_study_family *family);
 
 /* The variants of `cadmorph study --variants LIST`: LIST is a text file of STEP paths (one per
  * line; blank lines and '#' comments skipped, surrounding blanks trimmed, a relative path is
@@ -96,8 +96,8 @@ void cm_study_family_release(cm_study_family *family);
  * Errors: CM_ERR_IO "LIST: cannot read: ..." or "LIST:<line>: <path>: No such file ...",
  * CM_ERR_FORMAT "LIST: no STEP paths" for an empty list, CM_ERR_IO for a glob matching no
  * file. *paths: *n strings, free with cm_study_paths_free. */
-cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n);
-void cm_study_paths_free(char ***paths, size_t n);
+CM_API cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n);
+CM_API void cm_study_paths_free(char ***paths, size_t n);
 
 /* ---- running a study ---- */
 
@@ -123,7 +123,7 @@ typedef struct cm_study_options {
     const char *mesh;       /*   (NULL: "G0", "file") */
 } cm_study_options;
 
-void cm_study_options_init(cm_study_options *opt);
+CM_API void cm_study_options_init(cm_study_options *opt);
 
 /* One variant x method x mode. Times in seconds. status: CM_OK, CM_WARNING (complete, the
  * message says what was odd: face nodes left their trimmed face) or the error that stopped
@@ -174,10 +174,10 @@ typedef struct cm_study_result {
  * end the study: M not a mesh of G0 and the other errors of cm_morpher_create, out of memory,
  * a mesh that cannot be written. Returns CM_WARNING (message: the first failed row) when rows
  * failed; their errors also go to the log as warnings. */
-cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *mesh,
+CM_API cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *mesh,
                        const cm_study_family *family, const cm_study_options *opt,
                        cm_study_result **result);
-void cm_study_result_destroy(cm_study_result **result);
+CM_API void cm_study_result_destroy(cm_study_result **result);
 
 /* ---- outputs ---- */
 
@@ -191,13 +191,13 @@ enum {
  * inverted,cells,max_distance,max_distance_rel,outside,nodes,boundary_nodes,threads,t_sample,
  * t_classify,t_surface,t_volume_solve,t_evaluation,t_quality,t_distance,t_write and, FULL,
  * variant (label),status (cm_status_name),message (RFC 4180 quoting). */
-cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const char *path,
+CM_API cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const char *path,
                              int format);
 
 /* The plot: min scaled Jacobian against t * x_max, one polyline per method x mode (solid
  * absolute, dashed relative) from M0 through its complete rows, axes, ticks, legend, title;
  * failed variants are marked on the x axis. */
-cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const char *path);
+CM_API cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const char *path);
 
 /* ---- sweeps of the built-in models (models.h): `cadmorph sweep` and `demo` ---- */
 
@@ -216,11 +216,11 @@ typedef struct cm_sweep_options {
     int write_meshes;    /* write the meshes at 50 % and 100 % */
 } cm_sweep_options;
 
-void cm_sweep_options_init(cm_sweep_options *opt);
+CM_API void cm_sweep_options_init(cm_sweep_options *opt);
 
 /* Writes G(0) .. G(1) as STEP and reads them back (what a user's file goes through), meshes
  * G(0) and runs the study. Errors as cm_study_run, and the meshers'. */
-cm_status cm_sweep_run(cm_context *ctx, const cm_sweep_options *opt, cm_study_result **result);
+CM_API cm_status cm_sweep_run(cm_context *ctx, const cm_sweep_options *opt, cm_study_result **result);
 
 #ifdef __cplusplus
 }

@@ -31,7 +31,7 @@ typedef struct cm_classify_options {
     double rel_tol, abs_tol;
 } cm_classify_options;
 
-void cm_classify_options_init(cm_classify_options *opt);
+CM_API void cm_classify_options_init(cm_classify_options *opt);
 
 /* The boundary nodes of a mesh, each on one entity of G. Arrays owned by the struct. */
 typedef struct cm_surface_nodes {
@@ -50,8 +50,8 @@ typedef struct cm_surface_nodes {
 /* Shortest boundary-face edge at each boundary node: h_node (b->n_nodes, in the order of
  * b->nodes), and the shortest over all, *h_min (either may be NULL). Edges of zero length
  * are ignored (a node with only such edges gets the global minimum). */
-cm_status cm_surface_edge_lengths(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
-                                  double *h_node, double *h_min);
+CM_API cm_status cm_surface_edge_lengths(cm_context *ctx, const cm_mesh *mesh,
+                                         const cm_mesh_boundary *b, double *h_node, double *h_min);
 
 /* Classifies the boundary nodes of b: vertex if within tolerance of a CAD vertex, else edge
  * if within tolerance of an edge (t from the projection, s its arc length), else face (u,v).
@@ -59,10 +59,11 @@ cm_status cm_surface_edge_lengths(cm_context *ctx, const cm_mesh *mesh, const cm
  * than the tolerance from every face is CM_ERR_MISMATCH; the message gives their count, the
  * worst distance and node, and suggests a unit mismatch when the mesh and model sizes differ
  * by a unit factor (10, 100, 1000, 25.4, 304.8). opt may be NULL for defaults. */
-cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_cad_locator *locator,
-                              const cm_mesh *mesh, const cm_mesh_boundary *b,
-                              const cm_classify_options *opt, cm_surface_nodes **nodes);
-void cm_surface_nodes_destroy(cm_surface_nodes **nodes);
+CM_API cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g,
+                                     const cm_cad_locator *locator, const cm_mesh *mesh,
+                                     const cm_mesh_boundary *b, const cm_classify_options *opt,
+                                     cm_surface_nodes **nodes);
+CM_API void cm_surface_nodes_destroy(cm_surface_nodes **nodes);
 
 /* ---- morph ---- */
 
@@ -80,7 +81,7 @@ typedef struct cm_surface_morph_options {
     int min_per_edge, max_per_edge;
 } cm_surface_morph_options;
 
-void cm_surface_morph_options_init(cm_surface_morph_options *opt);
+CM_API void cm_surface_morph_options_init(cm_surface_morph_options *opt);
 
 typedef struct cm_surface_morph_stats {
     size_t faces_warped;        /* faces with nodes, one 2D RBF each (RBF method) */
@@ -95,14 +96,16 @@ typedef struct cm_surface_morph_stats {
  * xyz: nodes->n x 3 output, the new positions in the order of nodes->node. Returns
  * CM_WARNING (message with count and worst node) when face nodes left their trimmed domain.
  * opt and stats may be NULL. */
-cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
-                           const cm_surface_nodes *nodes, const cm_surface_morph_options *opt,
-                           double *xyz, cm_surface_morph_stats *stats);
+CM_API cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+                                  const cm_surface_nodes *nodes,
+                                  const cm_surface_morph_options *opt, double *xyz,
+                                  cm_surface_morph_stats *stats);
 
 /* Distance of points (n x 3) to the model of the locator: the largest, and the index of the
  * point where it occurs (either may be NULL). */
-cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *locator, const double *xyz,
-                                  size_t n, double *max_dist, size_t *worst);
+CM_API cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *locator,
+                                         const double *xyz, size_t n, double *max_dist,
+                                         size_t *worst);
 
 #ifdef __cplusplus
 }

@@ -37,7 +37,7 @@ typedef struct cm_tetmesh_options {
 /* Default bound on the estimated tet count: ~3 GB in TetGen and the mesh, minutes of work. */
 #define CM_TETMESH_MAX_TETS 1e7
 
-void cm_tetmesh_options_init(cm_tetmesh_options *opt);
+CM_API void cm_tetmesh_options_init(cm_tetmesh_options *opt);
 
 /* Tet mesh of the model's solids. The mesh holds the nodes, the tets (physical 1, entity 1,
  * group "solid") and the boundary triangles, outward, each with physical and entity tag
@@ -49,7 +49,7 @@ void cm_tetmesh_options_init(cm_tetmesh_options *opt);
  * CM_ERR_NUMERIC with TetGen's code and its meaning when TetGen gives up (self-intersecting
  * or too close facets, tiny features), CM_ERR_NOMEM. TetGen itself may print a line on
  * stdout before it fails (it does so unconditionally). Not thread-safe on one model. */
-cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
+CM_API cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
                             const cm_tetmesh_options *opt, cm_mesh **mesh);
 
 #ifdef __cplusplus

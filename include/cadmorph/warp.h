@@ -36,11 +36,11 @@ typedef enum cm_warp_method {
 } cm_warp_method;
 
 /* Short name of a method ("rbf", "rbf-biharmonic", ...), NULL out of range. */
-const char *cm_warp_method_name(cm_warp_method method);
+CM_API const char *cm_warp_method_name(cm_warp_method method);
 /* The method of a name, or -1 if unknown. */
-int cm_warp_method_from_name(const char *name);
+CM_API int cm_warp_method_from_name(const char *name);
 /* The method names joined by '|' ("rbf|rbf-biharmonic|..."), for usage lines. */
-const char *cm_warp_method_list(void);
+CM_API const char *cm_warp_method_list(void);
 
 typedef struct cm_warp_options {
     cm_warp_method method; /* default CM_WARP_RBF */
@@ -51,7 +51,7 @@ typedef struct cm_warp_options {
     double clamp;
 } cm_warp_options;
 
-void cm_warp_options_init(cm_warp_options *opt);
+CM_API void cm_warp_options_init(cm_warp_options *opt);
 
 typedef struct cm_warp cm_warp;
 
@@ -69,28 +69,28 @@ typedef struct cm_warp cm_warp;
  * with free nodes but no constrained node is CM_ERR_NUMERIC; FEMWARP takes linear cells only
  * (tet4, hex8, wedge6, pyr5, polyhedra; others CM_ERR_UNSUPPORTED); simplex needs constrained
  * nodes that are not all coplanar (CM_ERR_NUMERIC). */
-cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
+CM_API cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                          const unsigned char *constrained, const cm_warp_options *opt,
                          cm_warp **warp);
-void cm_warp_destroy(cm_warp **warp);
+CM_API void cm_warp_destroy(cm_warp **warp);
 
 /* disp: #nodes x 3. On input, read at constrained nodes only; on output, constrained nodes
  * keep their value and every other node of a volume cell gets the warp's displacement (other
  * entries are not written). One warp, many calls (not concurrently on the same warp). */
-cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
+CM_API cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
 
 /* The method of a warp. */
-cm_warp_method cm_warp_get_method(const cm_warp *warp);
+CM_API cm_warp_method cm_warp_get_method(const cm_warp *warp);
 
 /* Largest |displacement - prescribed| at the constrained nodes after the last apply: 0 for
  * methods that interpolate exactly (RBF, FEMWARP); what approximating methods (DM-FFD, MLS)
  * miss by. */
-double cm_warp_residual(const cm_warp *warp);
+CM_API double cm_warp_residual(const cm_warp *warp);
 
 /* Nodes the method could not treat by its own rule and gave its documented fallback: LBWARP,
  * nodes without positive log-barrier weights (outside the convex hull of their neighbours);
  * simplex, nodes outside every Delaunay tet. 0 for the other methods. */
-size_t cm_warp_fallback_nodes(const cm_warp *warp);
+CM_API size_t cm_warp_fallback_nodes(const cm_warp *warp);
 
 /* ---- warping a whole mesh: what `cadmorph warp` does ---- */
 
@@ -109,7 +109,7 @@ typedef struct cm_warp_mesh_stats {
  * disp is overwritten with the displacement of every node. optimize: NULL, or the options
  * of an interior optimisation of the warped mesh (constrained nodes never move). stats may
  * be NULL. */
-cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
+CM_API cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
                        const cm_warp_options *opt, const cm_optimize_options *optimize,
                        double **sj, cm_warp_mesh_stats *stats);
 
@@ -120,7 +120,7 @@ cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsig
  * 1 for listed nodes (may be NULL). n_nodes: the mesh's node count.
  * Errors name path:line: CM_ERR_FORMAT for a wrong header, column count, non-numeric or
  * non-finite value, CM_ERR_MISMATCH for a node index out of range or listed twice. */
-cm_status cm_warp_read_displacements(cm_context *ctx, const char *path, size_t n_nodes,
+CM_API cm_status cm_warp_read_displacements(cm_context *ctx, const char *path, size_t n_nodes,
                                      double *disp, unsigned char *listed);
 
 #ifdef __cplusplus

@@ -118,17 +118,14 @@ size_t cm_vtk_to_int64(cm_vtk_scalar t, const void *src, size_t n, int64_t *dst)
 size_t cm_vtk_polyhedron_points(const int64_t *stream, int64_t *ids)
 {
     size_t n = 0;
-    int64_t nf = stream[0], pos = 1;
-    for (int64_t f = 0; f < nf; ++f) {
-        int64_t m = stream[pos];
-        for (int64_t k = 1; k <= m; ++k) {
-            int64_t id = stream[pos + k];
+    for (cm_polyhedron_face f = cm_polyhedron_begin(stream, -1); cm_polyhedron_more(&f);
+         cm_polyhedron_next(&f))
+        for (int64_t k = 0; k < f.n; ++k) {
+            int64_t id = f.nodes[k];
             size_t j = 0;
             while (j < n && ids[j] != id) ++j;
             if (j == n) ids[n++] = id;
         }
-        pos += 1 + m;
-    }
     return n;
 }
 

@@ -3,7 +3,6 @@
 #include "vtk_internal.h"
 
 #include <errno.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 #include <zlib.h>
@@ -129,8 +128,7 @@ static cm_status decode_binary(const cm_vtu_decoder *d, cm_vtu_array *a, source 
     if (st == CM_OK) {
         long bad = -1;
         const long n_blocks = (long)nb;
-        int threads = cm_context_threads(d->ctx);
-        if (threads <= 0) threads = omp_get_max_threads();
+        const int threads = cm_context_threads_for(d->ctx, nb, 1);
 #pragma omp parallel for schedule(static) num_threads(threads) if (n_blocks > 8)
         for (long i = 0; i < n_blocks; ++i) {
             uLongf want = (uLongf)(i == n_blocks - 1 && last ? last : bs);

@@ -3,7 +3,6 @@
 #include "vtk_internal.h"
 #include "formats.h"
 
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 #include <zlib.h>
@@ -52,8 +51,7 @@ static cm_status encode(vtu_writer *w, const void *src, size_t nbytes, payload *
     }
     int bad = 0;
     const long n_blocks = (long)nb;
-    int threads = cm_context_threads(w->ctx);
-    if (threads <= 0) threads = omp_get_max_threads();
+    const int threads = cm_context_threads_for(w->ctx, nb, 1);
 #pragma omp parallel for schedule(static) num_threads(threads) if (n_blocks > 8) reduction(| : bad)
     for (long i = 0; i < n_blocks; ++i) {
         size_t b = (size_t)i * BLOCK;

@@ -14,11 +14,14 @@ foreach(t model project sample boundary)
   set_tests_properties(test_cad_${t} PROPERTIES FIXTURES_REQUIRED cad_shapes)
 endforeach()
 
-# cadmorph info: exit codes and one-line messages on real files.
-set(CM_EXPECT ${CMAKE_CURRENT_LIST_DIR}/expect_exit.cmake)
+# cadmorph info: exit codes and one-line messages on real files (bad input: one stderr line).
 function(cm_cad_cli name code regex)
-  add_test(NAME ${name} COMMAND ${CMAKE_COMMAND} -DEXE=$<TARGET_FILE:cadmorph> "-DARGS=${ARGN}"
-           -DCODE=${code} "-DREGEX=${regex}" -P ${CM_EXPECT})
+  set(lines)
+  if(code EQUAL 2)
+    set(lines --stderr-lines 1)
+  endif()
+  add_test(NAME ${name} COMMAND ${CM_RUN_CLI} --exit ${code} --output "${regex}" ${lines} --
+           $<TARGET_FILE:cadmorph> ${ARGN})
   set_tests_properties(${name} PROPERTIES LABELS "cad;cli" FIXTURES_REQUIRED cad_shapes)
 endfunction()
 set(D ${CM_TEST_DATA}/cad)

@@ -86,7 +86,7 @@ static void run(cm_context *ctx, const char *work, const char *name)
     if (!m || !p.n) return;
     double bb[6];
     cm_cad_bbox(m, bb);
-    const double L = sqrt(sq(bb[3] - bb[0]) + sq(bb[4] - bb[1]) + sq(bb[5] - bb[2]));
+    const double L = cm_bbox_diagonal(bb);
     const double tol = 1e-10 * L;
 
     cm_cad_sample_options so;

@@ -1,16 +1,13 @@
 /* cm_kdtree: the nearest point of random queries equals a brute-force scan (exact search),
  * k-nearest come sorted, and argument errors are reported, not crashed on. */
 #include "cadmorph/kdtree.h"
+#include "test_rng.h"
 #include "test_util.h"
 
 #include <stdint.h>
 #include <stdlib.h>
 
-static double rnd(uint64_t *s)
-{
-    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
-    return (double)(*s >> 11) / 9007199254740992.0;
-}
+static double rnd(uint64_t *s) { return test_rng_uniform(s); }
 
 int main(void)
 {

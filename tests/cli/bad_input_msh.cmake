@@ -1,16 +1,5 @@
 # `cadmorph quality` on broken gmsh files (tests/data/msh/bad, from generate_bad.py there) must
 # exit with 2 and name the file with its line (ASCII) or byte offset (binary).
-# Included from tests/cli/CMakeLists.txt it registers the tests; run with -P it is the check.
-if(CMAKE_SCRIPT_MODE_FILE)
-  execute_process(COMMAND ${CLI} quality ${FILE} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 2)
-    message(FATAL_ERROR "exit code ${rc}, expected 2\nstdout: ${out}\nstderr: ${err}")
-  endif()
-  if(NOT err MATCHES "${REGEX}")
-    message(FATAL_ERROR "stderr does not match '${REGEX}':\n${err}")
-  endif()
-  return()
-endif()
 
 set(_msh_bad
   "truncated|truncated\\.msh:18: expected"
@@ -31,7 +20,7 @@ foreach(_case IN LISTS _msh_bad)
   list(GET _parts 0 _name)
   list(GET _parts 1 _regex)
   add_test(NAME cli_bad_msh_${_name}
-    COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:cadmorph> -DFILE=${CM_TEST_DATA}/msh/bad/${_name}.msh
-            "-DREGEX=${_regex}" -P ${CMAKE_CURRENT_LIST_FILE})
+    COMMAND ${CM_RUN_CLI} --exit 2 --stderr "${_regex}" --
+            $<TARGET_FILE:cadmorph> quality ${CM_TEST_DATA}/msh/bad/${_name}.msh)
   set_tests_properties(cli_bad_msh_${_name} PROPERTIES LABELS "cli")
 endforeach()

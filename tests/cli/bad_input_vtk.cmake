@@ -1,34 +1,7 @@
 # `cadmorph quality <broken .vtu/.vtk/.mesh>` (tests/data/vtk/bad, made by
 # tests/data/vtk/generate.py from real VTK/meshio files): exit code 2 and exactly one stderr
-# line that names the file and where (path:LINE or "byte offset N") and what is wrong.
-#
-# Run with -P this file is its own checker:
-#   cmake -DCADMORPH=... -DINPUT=... -DWHERE=line|offset|none -DWHAT=regex -P bad_input_vtk.cmake
-if(CMAKE_SCRIPT_MODE_FILE)
-  execute_process(COMMAND ${CADMORPH} quality ${INPUT}
-    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 2)
-    message(FATAL_ERROR "exit code ${rc}, expected 2; stderr: ${err}")
-  endif()
-  string(REGEX MATCHALL "\n" newlines "${err}")
-  list(LENGTH newlines n)
-  if(NOT n EQUAL 1 OR NOT err MATCHES "\n$")
-    message(FATAL_ERROR "expected exactly one stderr line, got: ${err}")
-  endif()
-  string(FIND "${err}" "${INPUT}" at)
-  if(at LESS 0)
-    message(FATAL_ERROR "stderr does not name ${INPUT}: ${err}")
-  endif()
-  if(WHERE STREQUAL "line" AND NOT err MATCHES ":[1-9][0-9]*: ")
-    message(FATAL_ERROR "stderr has no line number: ${err}")
-  elseif(WHERE STREQUAL "offset" AND NOT err MATCHES "byte offset [0-9]+")
-    message(FATAL_ERROR "stderr has no byte offset: ${err}")
-  endif()
-  if(NOT err MATCHES "${WHAT}")
-    message(FATAL_ERROR "stderr does not match '${WHAT}': ${err}")
-  endif()
-  return()
-endif()
+# line (ending in a newline) that names the file and where (path:LINE or "byte offset N") and
+# what is wrong.
 
 set(VTK_BAD ${CM_TEST_DATA}/vtk/bad)
 # name; file; where; what the message says
@@ -58,8 +31,15 @@ foreach(c IN LISTS VTK_BAD_CASES)
   list(GET f 1 file)
   list(GET f 2 where)
   list(GET f 3 what)
+  set(where_rx)
+  if(where STREQUAL "line")
+    set(where_rx --stderr ":[1-9][0-9]*: ")
+  elseif(where STREQUAL "offset")
+    set(where_rx --stderr "byte offset [0-9]+")
+  endif()
   add_test(NAME cli_bad_input_vtk_${name}
-    COMMAND ${CMAKE_COMMAND} -DCADMORPH=$<TARGET_FILE:cadmorph> -DINPUT=${VTK_BAD}/${file}
-            -DWHERE=${where} -DWHAT=${what} -P ${CMAKE_CURRENT_LIST_FILE})
+    COMMAND ${CM_RUN_CLI} --exit 2 --stderr-lines 1 --stderr "\n\\Z"
+            --stderr-has ${VTK_BAD}/${file} ${where_rx} --stderr "${what}" --
+            $<TARGET_FILE:cadmorph> quality ${VTK_BAD}/${file})
   set_tests_properties(cli_bad_input_vtk_${name} PROPERTIES LABELS "unit;cli")
 endforeach()

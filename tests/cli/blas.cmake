@@ -2,7 +2,7 @@
 # --version names the BLAS, its core and threads; the re-exec with OPENBLAS_CORETYPE (on
 # machines where OpenBLAS chooses well, CADMORPH_TEST_BLAS_PICKED pretends it did not); the
 # user's OPENBLAS_CORETYPE stands; ulimit -v never hangs (item 5); --threads is capped (item 7).
-set(BRUN ${CM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/volume/run_cli.py)
+set(BRUN ${CM_RUN_CLI})
 set(BW ${CM_TEST_WORK}/warp)
 add_test(NAME cli_version_blas COMMAND ${CMAKE_COMMAND} -E env --unset=OPENBLAS_CORETYPE
   ${BRUN} --exit 0

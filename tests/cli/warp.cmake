@@ -3,7 +3,6 @@
 # paths (exit 2 with file:line, one stderr line) and the refusal to overwrite an input.
 set(W ${CM_TEST_WORK}/warp)
 set(WD ${CM_TEST_DATA}/warp)
-set(RUN ${CM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/volume/run_cli.py)
 set(SUMMARY "^min_scaled_jacobian=[-+0-9.e]+ mean_scaled_jacobian=[-+0-9.e]+ inverted=0 cells=[1-9][0-9]*\n?\\Z")
 
 function(cm_warp_cli_test name)
@@ -12,13 +11,13 @@ function(cm_warp_cli_test name)
 endfunction()
 
 # the three input formats, different output formats; the summary line ends stdout
-cm_warp_cli_test(cli_warp_msh ${RUN} --exit 0 --stdout "${SUMMARY}" --
+cm_warp_cli_test(cli_warp_msh ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
   $<TARGET_FILE:cadmorph> warp --mesh ${W}/sphere.msh --displacements ${W}/sphere_disp.csv
   -o ${W}/cli_from_msh.vtu)
-cm_warp_cli_test(cli_warp_vtu ${RUN} --exit 0 --stdout "${SUMMARY}" --
+cm_warp_cli_test(cli_warp_vtu ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
   $<TARGET_FILE:cadmorph> warp --mesh ${W}/sphere.vtu --displacements ${W}/sphere_disp.csv
   -o ${W}/cli_from_vtu.msh --threads 1)
-cm_warp_cli_test(cli_warp_medit ${RUN} --exit 0 --stdout "${SUMMARY}" --
+cm_warp_cli_test(cli_warp_medit ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
   $<TARGET_FILE:cadmorph> warp --mesh ${W}/sphere.mesh --displacements ${W}/sphere_disp.csv
   -o ${W}/cli_from_medit.vtk --kernel biharmonic)
 # the written mesh: nodes moved by its displacement field, sphere nodes exactly as listed
@@ -33,26 +32,26 @@ foreach(case header:1 columns:3 number:2 node:4 range:3 duplicate:4 nan:2 inf:3)
   string(REPLACE ":" ";" parts ${case})
   list(GET parts 0 what)
   list(GET parts 1 line)
-  cm_warp_cli_test(cli_warp_bad_${what} ${RUN} --exit 2 --stderr-lines 1
+  cm_warp_cli_test(cli_warp_bad_${what} ${CM_RUN_CLI} --exit 2 --stderr-lines 1
     --stderr "^cadmorph warp: .*bad_${what}\\.csv:${line}: " --absent ${W}/cli_bad_${what}.vtu --
     $<TARGET_FILE:cadmorph> warp --mesh ${W}/sphere.msh --displacements ${WD}/bad_${what}.csv
     -o ${W}/cli_bad_${what}.vtu)
 endforeach()
 # a component whose boundary is flat: exit 2, the component named
-cm_warp_cli_test(cli_warp_flat ${RUN} --exit 2 --stderr-lines 1
+cm_warp_cli_test(cli_warp_flat ${CM_RUN_CLI} --exit 2 --stderr-lines 1
   --stderr "^cadmorph warp: .*flat\\.vtk: .*component 0" --
   $<TARGET_FILE:cadmorph> warp --mesh ${WD}/flat.vtk --displacements ${WD}/none.csv
   -o ${W}/cli_flat.vtu)
 # output equal to the input: usage error, the input untouched
-cm_warp_cli_test(cli_warp_same_file ${RUN} --exit 1 --stderr "is an input"
+cm_warp_cli_test(cli_warp_same_file ${CM_RUN_CLI} --exit 1 --stderr "is an input"
   --unchanged ${W}/sphere.vtu --
   $<TARGET_FILE:cadmorph> warp --mesh ${W}/sphere.vtu --displacements ${W}/sphere_disp.csv
   -o ${W}/../warp/sphere.vtu)
-cm_warp_cli_test(cli_warp_help ${RUN} --exit 0
+cm_warp_cli_test(cli_warp_help ${CM_RUN_CLI} --exit 0
   --stdout "listed interior nodes are pinned to their displacement" --
   $<TARGET_FILE:cadmorph> warp --help)
-cm_warp_cli_test(cli_warp_usage ${RUN} --exit 1 --stderr "--displacements is required" --
+cm_warp_cli_test(cli_warp_usage ${CM_RUN_CLI} --exit 1 --stderr "--displacements is required" --
   $<TARGET_FILE:cadmorph> warp --mesh ${W}/sphere.msh -o ${W}/cli_usage.vtu)
-cm_warp_cli_test(cli_warp_kernel ${RUN} --exit 1 --stderr "unknown kernel" --
+cm_warp_cli_test(cli_warp_kernel ${CM_RUN_CLI} --exit 1 --stderr "unknown kernel" --
   $<TARGET_FILE:cadmorph> warp --mesh ${W}/sphere.msh --displacements ${W}/sphere_disp.csv
   -o ${W}/cli_kernel.vtu --kernel gaussian)

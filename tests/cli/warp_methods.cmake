@@ -3,7 +3,7 @@
 # on graded hexes; FEMWARP's result equals scipy's spsolve of an independently assembled
 # K_II x = -K_IB d_B; an affine D.csv is reproduced at every node by every method.
 set(SW ${CM_TEST_WORK}/staten)
-set(RUN ${CM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/volume/run_cli.py)
+set(RUN ${CM_RUN_CLI})
 set(CHK ${CM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/volume/warp_staten.py)
 set(SUMMARY "^min_scaled_jacobian=[-+0-9.e]+ mean_scaled_jacobian=[-+0-9.e]+ inverted=0 cells=[1-9][0-9]*\n?\\Z")
 

@@ -4,7 +4,7 @@
  * boundary but let the interior sag (least norm), bad lattice sizes are refused. */
 #include "test_util.h"
 
-#include "../volume/warp_meshes.h"
+#include "test_mesh.h"
 #include "cadmorph/warp.h"
 
 #include <math.h>
@@ -16,7 +16,7 @@ static void test_dmffd_warp(void)
 {
     cm_mesh *m = NULL;
     CHECK(cm_mesh_create(ctx, &m) == CM_OK);
-    unsigned long long seed = 7;
+    uint64_t seed = 7;
     test_block blk = {8, 6, 5, {0, 0, 0}, {0.25, 0.25, 0.2}, 1, 0.2};
     CHECK(test_add_block(ctx, m, &blk, &seed) == 0);
     cm_mesh_boundary *b = NULL;

@@ -2,6 +2,7 @@
  * blocks split into tets (and tet10), disjoint blocks, duplicates and non-manifold faces,
  * single higher-order cells, wedge, pyramid and polyhedron. */
 #include "cadmorph/mesh.h"
+#include "test_mesh.h"
 #include "test_util.h"
 
 #define _USE_MATH_DEFINES
@@ -14,69 +15,16 @@
 
 static cm_context *ctx;
 
-static int64_t grid_node(int n, int i, int j, int k) { return ((int64_t)k * (n + 1) + j) * (n + 1) + i; }
-
-/* Nodes of an n x n x n block of unit cubes at offset x0 appended to m; returns the first. */
-static int64_t add_grid_nodes(cm_mesh *m, int n, double x0)
+/* An n x n x n block of unit cubes at offset x0 (hexes, or 6 Kuhn tets each) appended to m. */
+static void add_block(cm_mesh *m, int n, double x0, int tets)
 {
-    const size_t first = m->n_nodes, count = (size_t)(n + 1) * (n + 1) * (n + 1);
-    CHECK(cm_mesh_resize_nodes(ctx, m, first + count, 0) == CM_OK);
-    for (int k = 0; k <= n; ++k)
-        for (int j = 0; j <= n; ++j)
-            for (int i = 0; i <= n; ++i) {
-                double *p = m->xyz + 3 * (first + (size_t)grid_node(n, i, j, k));
-                p[0] = x0 + i;
-                p[1] = j;
-                p[2] = k;
-            }
-    return (int64_t)first;
+    const test_block blk = {n, n, n, {x0, 0, 0}, {1, 1, 1}, tets, 0.0};
+    uint64_t seed = 1; /* no jitter: unused */
+    CHECK(test_add_block(ctx, m, &blk, &seed) >= 0);
 }
 
-static void hex_nodes(int n, int64_t base, int i, int j, int k, int64_t h[8])
-{
-    h[0] = base + grid_node(n, i, j, k);
-    h[1] = base + grid_node(n, i + 1, j, k);
-    h[2] = base + grid_node(n, i + 1, j + 1, k);
-    h[3] = base + grid_node(n, i, j + 1, k);
-    for (int a = 0; a < 4; ++a) h[a + 4] = h[a] + (int64_t)(n + 1) * (n + 1);
-}
-
-static void add_hex_block(cm_mesh *m, int n, double x0)
-{
-    const int64_t base = add_grid_nodes(m, n, x0);
-    for (int k = 0; k < n; ++k)
-        for (int j = 0; j < n; ++j)
-            for (int i = 0; i < n; ++i) {
-                int64_t h[8];
-                hex_nodes(n, base, i, j, k, h);
-                CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_HEX8, h, 8, 0, 0, 0) == CM_OK);
-            }
-}
-
-/* Kuhn split of every cube into 6 tets around the diagonal 0-6: conforming on the grid. */
-static void add_tet_block(cm_mesh *m, int n)
-{
-    static const int kuhn[6][4] = {{0, 1, 2, 6}, {0, 2, 3, 6}, {0, 3, 7, 6},
-                                   {0, 7, 4, 6}, {0, 4, 5, 6}, {0, 5, 1, 6}};
-    const int64_t base = add_grid_nodes(m, n, 0);
-    for (int k = 0; k < n; ++k)
-        for (int j = 0; j < n; ++j)
-            for (int i = 0; i < n; ++i) {
-                int64_t h[8];
-                hex_nodes(n, base, i, j, k, h);
-                for (int t = 0; t < 6; ++t) {
-                    int64_t tet[4] = {h[kuhn[t][0]], h[kuhn[t][1]], h[kuhn[t][2]], h[kuhn[t][3]]};
-                    double x[12];
-                    for (int a = 0; a < 4; ++a) memcpy(x + 3 * a, m->xyz + 3 * tet[a], 3 * sizeof(double));
-                    if (cm_quality_scaled_jacobian(CM_CELL_TET4, x) < 0) { /* orient positively */
-                        int64_t s = tet[1];
-                        tet[1] = tet[2];
-                        tet[2] = s;
-                    }
-                    CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_TET4, tet, 4, 0, 0, 0) == CM_OK);
-                }
-            }
-}
+static void add_hex_block(cm_mesh *m, int n, double x0) { add_block(m, n, x0, 0); }
+static void add_tet_block(cm_mesh *m, int n) { add_block(m, n, 0, 1); }
 
 static void cell_centroid(const cm_mesh *m, size_t c, double cc[3])
 {
@@ -358,14 +306,20 @@ static void test_polyhedra(void)
 {
     cm_mesh *m = NULL;
     CHECK(cm_mesh_create(ctx, &m) == CM_OK);
-    add_grid_nodes(m, 2, 0);
+    cm_mesh *hexes = NULL; /* two unit cubes side by side, their hexes made polyhedra */
+    CHECK(cm_mesh_create(ctx, &hexes) == CM_OK);
+    const test_block blk = {2, 1, 1, {0, 0, 0}, {1, 1, 1}, 0, 0.0};
+    uint64_t seed = 1;
+    CHECK(test_add_block(ctx, hexes, &blk, &seed) == 0);
+    CHECK(cm_mesh_resize_nodes(ctx, m, hexes->n_nodes, 0) == CM_OK);
+    memcpy(m->xyz, hexes->xyz, 3 * hexes->n_nodes * sizeof(double));
     for (int i = 0; i < 2; ++i) {
-        int64_t h[8];
-        hex_nodes(2, 0, i, 0, 0, h);
+        const int64_t *h = hexes->conn + hexes->offset[i];
         const int64_t s[] = {6, 4, h[0], h[4], h[7], h[3], 4, h[1], h[2], h[6], h[5], 4, h[0], h[1], h[5], h[4],
                              4, h[3], h[7], h[6], h[2], 4, h[0], h[3], h[2], h[1], 4, h[4], h[5], h[6], h[7]};
         CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_POLYHEDRON, s, sizeof s / sizeof *s, 0, 0, 0) == CM_OK);
     }
+    cm_mesh_destroy(&hexes);
     cm_mesh_boundary *b = NULL;
     CHECK(cm_mesh_boundary_create(ctx, m, &b) == CM_OK);
     if (b) {

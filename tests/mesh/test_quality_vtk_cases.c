@@ -2,6 +2,7 @@
  * Jacobian to WORK/quality_vtk_cases.txt; check_quality_vtk.py recomputes them with VTK's
  * vtkMeshQuality (Verdict) and fails on any difference above 1e-9. */
 #include "cadmorph/mesh.h"
+#include "test_rng.h"
 #include "test_util.h"
 
 #include <stdint.h>
@@ -10,13 +11,7 @@
 
 static uint64_t rng_state = 0x2545F4914F6CDD1Dull;
 
-static double uniform(void) /* xorshift64*: reproducible on every platform */
-{
-    rng_state ^= rng_state >> 12;
-    rng_state ^= rng_state << 25;
-    rng_state ^= rng_state >> 27;
-    return (double)((rng_state * 0x2545F4914F6CDD1Dull) >> 11) * (1.0 / 9007199254740992.0);
-}
+static double uniform(void) { return test_rng_uniform(&rng_state); }
 
 static double noise(double a) { return a * (2.0 * uniform() - 1.0); }
 

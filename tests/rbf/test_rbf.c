@@ -1,20 +1,15 @@
 /* Tests of the RBF core: linear precision, interpolation, several right-hand sides, thread
  * independence, duplicate merging, and the refusals (coplanar/collinear, too few centres). */
 #include "cadmorph/rbf.h"
+#include "test_rng.h"
 #include "test_util.h"
 
 #include <stdlib.h>
 #include <string.h>
 
-static unsigned long long rng_state = 88172645463325252ULL;
+static uint64_t rng_state = 88172645463325252ULL;
 
-static double urand(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); }
 
 /* Centres in an off-centre, anisotropic box, so that the unit-box map matters. */
 static void random_points(int dim, size_t n, double *x)

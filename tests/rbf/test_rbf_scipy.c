@@ -3,21 +3,16 @@
  * usage: test_rbf_scipy DATA_DIR WORK_DIR -> WORK_DIR/rbf_scipy/<case>_{centres,values,
  * points,result}.txt */
 #include "cadmorph/rbf.h"
+#include "test_rng.h"
 #include "test_util.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
-static unsigned long long rng_state = 0x2545F4914F6CDD1DULL;
+static uint64_t rng_state = 0x2545F4914F6CDD1DULL;
 
-static double urand(void)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return (double)(rng_state >> 11) * (1.0 / 9007199254740992.0);
-}
+static double urand(void) { return test_rng_uniform(&rng_state); }
 
 static int write_txt(const char *dir, const char *cs, const char *what, size_t rows, int cols,
                      const double *a)

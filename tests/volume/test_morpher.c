@@ -3,7 +3,7 @@
  * shared factorisation gives what a fresh one gives, morphing a mesh onto the geometry it
  * lies on changes nothing, and a target of another topology is refused. */
 #include "cadmorph/morph.h"
-#include "surface/surface_fixture.h"
+#include "surface_fixture.h"
 
 static int same_bits(const double *a, const double *b, size_t n)
 {

@@ -4,7 +4,7 @@
  * the minimum scaled Jacobian, and gives the same coordinates with 1 and 2 threads. */
 #include "cadmorph/optimize.h"
 #include "test_util.h"
-#include "warp_meshes.h"
+#include "test_mesh.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -46,7 +46,7 @@ static cm_mesh *tangled_block(cm_context *ctx, int tets, size_t *pushed)
     cm_mesh *m = NULL;
     cm_mesh_create(ctx, &m);
     test_block blk = {6, 5, 4, {0, 0, 0}, {1.0, 1.2, 0.9}, tets, 0.15};
-    unsigned long long seed = 12345;
+    uint64_t seed = 12345;
     CHECK(test_add_block(ctx, m, &blk, &seed) == 0);
     /* interior node (i,j,k) = i + 7 (j + 6 k): push three of them by most of a cell */
     const int64_t nodes[3] = {2 + 7 * (2 + 6 * 2), 4 + 7 * (3 + 6 * 1), 3 + 7 * (1 + 6 * 3)};

@@ -5,6 +5,7 @@
  * volume equals the tets'); tet volume = BRepGProp volume = 4*4*2 - pi*0.6^2*2 (1e-2 rel.);
  * more nodes for a smaller size; also with the surface kept as OpenCASCADE made it. And a STEP without a solid is refused. */
 #include "cadmorph/tetmesh.h"
+#include "test_mesh.h"
 #include "test_util.h"
 
 #include <stdlib.h>
@@ -13,15 +14,6 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-static double tet_volume(const double *a, const double *b, const double *c, const double *d)
-{
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-            u[2] * (v[0] * w[1] - v[1] * w[0])) / 6.0;
-}
 
 /* distance of p from the bore's boundary: box faces (within the face) or the cylinder */
 static double bore_distance(const double *p)
@@ -64,11 +56,11 @@ static size_t mesh_and_check(cm_context *ctx, const cm_cad_model *model, double 
         const int64_t *n = m->conn + m->offset[c];
         if (m->type[c] == CM_CELL_TET4) {
             ++n_tet;
-            vol += tet_volume(&m->xyz[3 * n[0]], &m->xyz[3 * n[1]], &m->xyz[3 * n[2]], &m->xyz[3 * n[3]]);
+            vol += test_tet_volume(&m->xyz[3 * n[0]], &m->xyz[3 * n[1]], &m->xyz[3 * n[2]], &m->xyz[3 * n[3]]);
         } else if (m->type[c] == CM_CELL_TRI3) {
             ++n_tri;
             /* outward triangles: the cones from any point sum to the enclosed volume */
-            div_vol += tet_volume(origin, &m->xyz[3 * n[0]], &m->xyz[3 * n[1]], &m->xyz[3 * n[2]]);
+            div_vol += test_tet_volume(origin, &m->xyz[3 * n[0]], &m->xyz[3 * n[1]], &m->xyz[3 * n[2]]);
             for (int k = 0; k < 3; ++k) on_boundary[n[k]] = 1;
             if (m->entity[c] < 1 || m->entity[c] > 7) ++bad_tags;
         }

@@ -3,7 +3,7 @@
  * change the result, degenerate and empty inputs are errors. Meshes are built in code. */
 #include "cadmorph/warp.h"
 #include "test_util.h"
-#include "warp_meshes.h"
+#include "test_mesh.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -24,7 +24,7 @@ typedef struct affine {
     double t[3];
 } affine;
 
-static void random_affine(unsigned long long *seed, double scale, affine *f)
+static void random_affine(uint64_t *seed, double scale, affine *f)
 {
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j)
@@ -78,7 +78,7 @@ static double affine_error(const cm_mesh *m, const double *d, const affine *f, s
 
 static void test_affine(int tets, cm_warp_method kernel)
 {
-    unsigned long long seed = 12345 + (unsigned)tets;
+    uint64_t seed = 12345 + (unsigned)tets;
     cm_mesh *m = NULL;
     cm_mesh_create(ctx, &m);
     test_block blk = {7, 5, 4, {-0.3, 0.2, 1.0}, {0.25, 0.3, 0.2}, tets, tets ? 0.2 : 0.0};
@@ -143,7 +143,7 @@ static void test_affine(int tets, cm_warp_method kernel)
 /* Smooth non-affine boundary motion: 1 thread vs 2 threads. */
 static void test_threads(void)
 {
-    unsigned long long seed = 99;
+    uint64_t seed = 99;
     cm_mesh *m = NULL;
     cm_mesh_create(ctx, &m);
     test_block blk = {8, 7, 6, {0, 0, 0}, {0.125, 0.15, 0.2}, 1, 0.2};
@@ -191,7 +191,7 @@ static void test_threads(void)
  * node with the first (components meet at a vertex); the maps agree there. */
 static void test_two_components(int touching)
 {
-    unsigned long long seed = 777 + (unsigned)touching;
+    uint64_t seed = 777 + (unsigned)touching;
     cm_mesh *m = NULL;
     cm_mesh_create(ctx, &m);
     test_block b1 = {4, 4, 4, {0, 0, 0}, {0.25, 0.25, 0.25}, 1, 0.15};
@@ -274,7 +274,7 @@ static void test_two_components(int touching)
  * of no volume cell (here: of a stray line element) is left alone. */
 static void test_pinned_and_stray(void)
 {
-    unsigned long long seed = 4242;
+    uint64_t seed = 4242;
     cm_mesh *m = NULL;
     cm_mesh_create(ctx, &m);
     test_block blk = {6, 6, 6, {0, 0, 0}, {1.0 / 6, 1.0 / 6, 1.0 / 6}, 1, 0.1};
@@ -332,7 +332,7 @@ static void test_pinned_and_stray(void)
 /* Errors: coplanar constraints name the component; a mesh without volume cells; unknown method. */
 static void test_errors(void)
 {
-    unsigned long long seed = 5;
+    uint64_t seed = 5;
     cm_mesh *m = NULL;
     cm_mesh_create(ctx, &m);
     test_block b1 = {3, 3, 3, {0, 0, 0}, {1, 1, 1}, 0, 0};

@@ -7,7 +7,7 @@
 #include "cadmorph/warp.h"
 #include "test_util.h"
 #include "volume/warp_method.h"
-#include "warp_meshes.h"
+#include "test_mesh.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -46,7 +46,7 @@ static double affine_error(cm_mesh *m, cm_warp_method method, size_t *fallback)
     opt.method = method;
     double err = INFINITY;
     if (cm_mesh_boundary_create(ctx, m, &b) < 0) return err;
-    unsigned long long seed = 7;
+    uint64_t seed = 7;
     double a[12];
     for (int i = 0; i < 12; ++i)
         a[i] = 0.1 * test_rand(&seed);
@@ -124,7 +124,7 @@ static cm_mesh *block_mesh(int tets, int lshape)
 {
     cm_mesh *m = NULL;
     cm_mesh_create(ctx, &m);
-    unsigned long long seed = 42;
+    uint64_t seed = 42;
     test_block b = {6, 5, 4, {0, 0, 0}, {0.2, 0.25, 0.3}, tets, 0.25};
     test_add_block(ctx, m, &b, &seed);
     if (lshape) {
@@ -279,7 +279,7 @@ static void test_lbwarp_weights(void)
 static void test_simplex_locate(void)
 {
     enum { NP = 300, NQ = 200, NOUT = 7 };
-    unsigned long long seed = 3;
+    uint64_t seed = 3;
     double pts[3 * NP], q[3 * (NQ + NOUT)], bary[4 * (NQ + NOUT)];
     int64_t corner[4 * (NQ + NOUT)];
     /* the 8 corners of the unit cube, then random points inside */

@@ -1,19 +1,17 @@
-/* Meshes built in code for the warp tests: structured hex blocks and Kuhn-split tet blocks
- * (conforming, with jittered interior nodes), appended to a mesh so blocks can be combined. */
-#ifndef CADMORPH_TEST_WARP_MESHES_H
-#define CADMORPH_TEST_WARP_MESHES_H
+/* Meshes built in code for the tests: the one block mesher (structured hex blocks and
+ * Kuhn-split tet blocks, conforming, with jittered interior nodes, appended to a mesh so
+ * blocks can be combined) and the one signed tet volume. */
+#ifndef CADMORPH_TEST_MESH_H
+#define CADMORPH_TEST_MESH_H
 
 #include "cadmorph/mesh.h"
+#include "test_rng.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 /* Deterministic uniform [-1, 1) (tests must not depend on libc's rand). */
-static double test_rand(unsigned long long *state)
-{
-    *state = *state * 6364136223846793005ULL + 1442695040888963407ULL;
-    return (double)(*state >> 11) / 4503599627370496.0 - 1.0;
-}
+static inline double test_rand(uint64_t *state) { return test_rng_range(state, -1.0, 1.0); }
 
 typedef struct test_block {
     int nx, ny, nz; /* cells per direction */
@@ -22,19 +20,28 @@ typedef struct test_block {
     double jitter; /* interior nodes moved by up to jitter x h (random) */
 } test_block;
 
-static double tet_volume6(const double *xyz, const int64_t *t)
+/* Signed volume of tet (a, b, c, d), positive when d is on the side of (a, b, c) that the
+ * right-hand rule points to (VTK's positive tet). */
+static inline double test_tet_volume(const double *a, const double *b, const double *c,
+                                     const double *d)
 {
-    const double *a = xyz + 3 * t[0], *b = xyz + 3 * t[1], *c = xyz + 3 * t[2], *d = xyz + 3 * t[3];
     double u[3], v[3], w[3];
     for (int i = 0; i < 3; ++i)
         u[i] = b[i] - a[i], v[i] = c[i] - a[i], w[i] = d[i] - a[i];
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0]);
+    return (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+            u[2] * (v[0] * w[1] - v[1] * w[0])) /
+           6.0;
+}
+
+/* The same for tet t (4 node indices into xyz, #nodes x 3). */
+static inline double test_tet_volume_at(const double *xyz, const int64_t *t)
+{
+    return test_tet_volume(xyz + 3 * t[0], xyz + 3 * t[1], xyz + 3 * t[2], xyz + 3 * t[3]);
 }
 
 /* Appends the block's nodes and cells; returns the index of its first node (or -1). */
-static int64_t test_add_block(cm_context *ctx, cm_mesh *m, const test_block *b,
-                              unsigned long long *seed)
+static inline int64_t test_add_block(cm_context *ctx, cm_mesh *m, const test_block *b,
+                                     uint64_t *seed)
 {
     size_t first = m->n_nodes;
     size_t n = (size_t)(b->nx + 1) * (b->ny + 1) * (b->nz + 1);
@@ -81,7 +88,7 @@ static int64_t test_add_block(cm_context *ctx, cm_mesh *m, const test_block *b,
                         c[perm[p][s]] = 1;
                         t[s + 1] = NODE(i + c[0], j + c[1], k + c[2]);
                     }
-                    if (tet_volume6(m->xyz, t) < 0) {
+                    if (test_tet_volume_at(m->xyz, t) < 0) {
                         int64_t x = t[2];
                         t[2] = t[3];
                         t[3] = x;

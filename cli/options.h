@@ -1,0 +1,81 @@
+/* One option parser for every subcommand: a table of options (name, alias, kind, where the
+ * value goes, help text) instead of a strcmp chain per command. The messages are those the
+ * commands printed before (tests check them): "option X needs a value", "unknown option 'X'",
+ * and each option's own message for a bad value. */
+#ifndef CADMORPH_CLI_OPTIONS_H
+#define CADMORPH_CLI_OPTIONS_H
+
+#include <stdio.h>
+
+typedef enum cli_kind {
+    CLI_FLAG,    /* int *dest = 1 */
+    CLI_STRING,  /* const char **dest = the value */
+    CLI_INT,     /* int *dest, min..max */
+    CLI_DOUBLE,  /* double *dest, in the range of lo, hi, open */
+    CLI_ENUM,    /* int *dest = values[k] for the value names[k] */
+    CLI_THREADS, /* int *dest, 1..4096 */
+    CLI_CUSTOM,  /* parse(value, dest) decides */
+    CLI_HELP,    /* prints the command's help, exit 0 */
+    CLI_NOTE     /* a line of the help only (another form of an option), never parsed */
+} cli_kind;
+
+typedef struct cli_option cli_option;
+typedef struct cli_parser cli_parser;
+
+/* What a CLI_CUSTOM option does with its value (NULL for an option without value, see
+ * takes_value): 0 done, or the exit code after a usage message (cli_usage with p's cmd and
+ * usage). */
+typedef int (*cli_parse_fn)(const cli_parser *p, const cli_option *o, const char *value,
+                            void *dest);
+
+struct cli_option {
+    const char *name;  /* "--size" */
+    const char *alias; /* "-o", or NULL */
+    cli_kind kind;
+    void *dest;
+    const char *label; /* left column of the help ("--size H"); NULL: not in the help */
+    /* right column: printf format of one %s (help_arg); a newline in it starts a continuation
+     * line under the column */
+    const char *help;
+    const char *(*help_arg)(void); /* the %s of help (e.g. the list of warp methods), or NULL */
+    /* CLI_INT: min, max; CLI_DOUBLE: lo, hi (NAN: no bound), open: bit 1 lo open, bit 2 hi
+     * open */
+    double lo, hi;
+    int open;
+    /* bad value: printf format of two %s, the option name and the value (%.0s skips one) */
+    const char *bad;
+    const char *const *names; /* CLI_ENUM: NULL-terminated names and their values */
+    const int *values;
+    cli_parse_fn parse; /* CLI_CUSTOM */
+    int takes_value;    /* CLI_CUSTOM: 1 if it reads a value */
+};
+
+/* A command's parser: its options (ended by an entry with name NULL), its positional
+ * arguments (up to max_pos into pos), and its messages. */
+struct cli_parser {
+    const char *cmd;   /* "mesh" */
+    const char *usage; /* the usage line */
+    const cli_option *options;
+    int (*help)(void);   /* prints the help; its return value is the exit code */
+    const char *unknown; /* "unknown option '%s'" or "unknown argument '%s'" */
+    const char **pos;    /* positional arguments; max_pos 0: none accepted */
+    int max_pos;
+    const char *extra; /* format of one %s for a positional beyond max_pos */
+    int n_pos;         /* out: how many were given */
+};
+
+/* Values shared by several commands: --method M of the warp method table (dest: a
+ * cm_warp_method), and --kernel triharmonic|biharmonic (a CLI_ENUM onto the same field). */
+int cli_parse_warp_method(const cli_parser *p, const cli_option *o, const char *value, void *dest);
+extern const char *const cli_kernel_names[];
+extern const int cli_kernel_methods[];
+
+/* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
+ * --help, CLI_EXIT_USAGE after a message on stderr. */
+int cli_parse(cli_parser *p, int argc, char **argv);
+
+/* The options block of a help text: "  <label><help>" per labelled option, the label
+ * column width wide, continuation lines indented to the help column. */
+void cli_print_options(FILE *out, const cli_option *options, int width);
+
+#endif

@@ -1,0 +1,149 @@
+#!/usr/bin/python3
+"""The installed package as a user sees it: `cmake --install` into a fresh prefix, then the
+programs of examples/ configured and built against that prefix three ways - find_package
+(cadmorph::cadmorph, shared), find_package (cadmorph::cadmorph_static) and pkg-config - plus
+one direct `cc ... $(pkg-config --static --libs cadmorph)` link of libcadmorph.a, and every
+build run on the plate-with-a-hole STEP fixtures (tests/data/surface) and gmsh's mesh of it
+(fixture surface_meshes).
+
+  install_test.py --cmake CMAKE --build BUILD_DIR --examples SRC_DIR --data TESTS_DATA
+                  --mesh HOLE_A_MESH --work DIR
+
+Also checked: the exported symbols of libcadmorph.so are exactly the functions the installed
+headers declare (CM_API), and `cadmorph --version`, cadmorph.pc and the config version agree.
+"""
+import argparse
+import glob
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+ok = True
+
+
+def fail(msg):
+    global ok
+    print("FAIL: " + msg)
+    ok = False
+
+
+def run(cmd, env=None, expect=0):
+    t = time.monotonic()
+    r = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    print("$ %s  [%.1f s]" % (" ".join(cmd), time.monotonic() - t), flush=True)
+    if r.returncode != expect:
+        fail("exit code %d, expected %d\n--- stdout\n%s--- stderr\n%s" %
+             (r.returncode, expect, r.stdout, r.stderr))
+    return r
+
+
+def declared_functions(include_dir):
+    """cm_ functions declared with CM_API in the installed headers."""
+    names = set()
+    for h in glob.glob(os.path.join(include_dir, "cadmorph", "*.h")):
+        text = open(h).read()
+        names |= set(re.findall(r"^CM_API\b[^;{(\n]*?\b(cm_\w+)\s*\(", text, re.MULTILINE))
+        # a declaration at file scope without CM_API would be hidden in the shared library
+        for m in re.finditer(r"^(?!CM_API|typedef|static|#|\s|/|\*)[^;(\n]*?\b(cm_\w+)\s*\(",
+                             text, re.MULTILINE):
+            fail("%s: %s is declared without CM_API" % (os.path.basename(h), m.group(1)))
+    return names
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    for a in ("cmake", "build", "examples", "data", "mesh", "work"):
+        ap.add_argument("--" + a, required=True)
+    a = ap.parse_args()
+    prefix = os.path.join(a.work, "prefix")
+    shutil.rmtree(a.work, ignore_errors=True)
+    os.makedirs(a.work)
+
+    run([a.cmake, "--install", a.build, "--prefix", prefix])
+    libdir = os.path.dirname(glob.glob(os.path.join(prefix, "lib*", "**", "libcadmorph.so"),
+                                       recursive=True)[0])
+    for f in ("libcadmorph.a", "pkgconfig/cadmorph.pc", "cmake/cadmorph/cadmorphConfig.cmake",
+              "cmake/cadmorph/cadmorphConfigVersion.cmake"):
+        if not os.path.exists(os.path.join(libdir, f)):
+            fail("not installed: " + f)
+    if not ok:
+        return 1
+
+    # the API: exported = declared
+    exported = set(run(["nm", "-D", "--defined-only", os.path.join(libdir, "libcadmorph.so")])
+                   .stdout.split()[2::3])
+    declared = declared_functions(os.path.join(prefix, "include"))
+    if declared - exported:
+        fail("declared but not exported: " + ", ".join(sorted(declared - exported)))
+    if exported - declared:
+        fail("exported but not in a header: " + ", ".join(sorted(exported - declared)))
+    print("%d functions declared and exported" % len(declared))
+
+    # versions agree
+    env = dict(os.environ, PKG_CONFIG_PATH=os.path.join(libdir, "pkgconfig"))
+    version = run([os.path.join(prefix, "bin", "cadmorph"), "--version"]).stdout.strip()
+    pc = run(["pkg-config", "--modversion", "cadmorph"], env=env).stdout.strip()
+    if version != "cadmorph " + pc or not re.fullmatch(r"\d+\.\d+\.\d+", pc):
+        fail("cadmorph --version says %r, cadmorph.pc %r" % (version, pc))
+
+    # the plate with a hole, its edit, one of another topology, a rigid motion of it
+    g0, g1, other, rigid = (os.path.join(a.data, "surface", k + ".step")
+                            for k in ("hole_a", "hole_b", "holes2_a", "hole_rigid"))
+    m0 = a.mesh
+
+    builds = {
+        "config": ["-DCMAKE_PREFIX_PATH=" + prefix],
+        "config_static": ["-DCMAKE_PREFIX_PATH=" + prefix, "-DCADMORPH_EXAMPLES_STATIC=ON"],
+        "pkgconfig": ["-DCADMORPH_EXAMPLES_PKGCONFIG=ON"],
+    }
+    bins = {}
+    for name, args in builds.items():
+        b = os.path.join(a.work, "examples_" + name)
+        r = run([a.cmake, "-S", a.examples, "-B", b, "-DCMAKE_BUILD_TYPE=Release"] + args, env=env)
+        if r.returncode == 0:
+            run([a.cmake, "--build", b], env=env)
+        bins[name] = b
+    # libcadmorph.a by hand from the .pc's private libraries
+    b = os.path.join(a.work, "examples_pkgconfig_static")
+    os.makedirs(b)
+    cflags = run(["pkg-config", "--cflags", "cadmorph"], env=env).stdout.split()
+    libs = run(["pkg-config", "--static", "--libs", "cadmorph"], env=env).stdout.split()
+    libs = [os.path.join(libdir, "libcadmorph.a") if x == "-lcadmorph" else x for x in libs]
+    for ex in ("morph_mesh", "morph_family"):
+        run(["cc", "-std=c11", "-Wall", "-Werror"] + cflags +
+            [os.path.join(a.examples, ex + ".c"), "-o", os.path.join(b, ex)] + libs)
+    bins["pkgconfig_static"] = b
+    if not ok:
+        return 1
+
+    for name, b in bins.items():
+        linked = run(["ldd", os.path.join(b, "morph_mesh")]).stdout
+        shared = "libcadmorph.so" in linked
+        if shared != (name in ("config", "pkgconfig")):
+            fail("%s: libcadmorph.so %s" % (name, "linked" if shared else "not linked"))
+        out = os.path.join(a.work, name + "_m1.vtu")
+        r = run([os.path.join(b, "morph_mesh"), g0, g1, m0, out])
+        m = re.search(r"(\d+) inverted, boundary (\S+) from G1 \(diagonal (\S+)\)", r.stdout)
+        if not m or int(m.group(1)) != 0 or float(m.group(2)) > 1e-9 * float(m.group(3)):
+            fail("%s: morph_mesh: %r" % (name, r.stdout))
+        if not os.path.exists(out):
+            fail("%s: %s not written" % (name, out))
+        # the family: G1, a target of another topology (its row says so, exit 2), a rigid motion
+        d = os.path.join(a.work, name + "_family")
+        os.makedirs(d)
+        r = run([os.path.join(b, "morph_family"), g0, m0, d, g1, other, rigid], expect=2)
+        rows = r.stdout.splitlines()
+        dist = [re.search(r" 0 inverted, boundary (\S+) from it", row) for row in rows]
+        if len(rows) != 3 or "does not correspond" not in rows[1] or \
+                any(not dist[i] or float(dist[i].group(1)) > 1e-9 for i in (0, 2)):
+            fail("%s: morph_family: %r" % (name, r.stdout))
+        if sorted(os.listdir(d)) != ["variant_1.vtu", "variant_3.vtu"]:
+            fail("%s: morph_family wrote %s" % (name, sorted(os.listdir(d))))
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
