@@ -64,9 +64,15 @@ static double tick_step(double span)
     return (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10) * p;
 }
 
+/* A collapsing method (min SJ down to -1) would squeeze the curves that matter into a few
+ * pixels at the top: the y axis stops here, and lower values are drawn on it as downward
+ * triangles (their value in a tooltip; the CSV has them all). */
+#define SVG_Y_CLIP (-0.2)
+
 typedef struct frame {
     double ylo, yhi;
     double xmax, xtick;
+    int clipped; /* some value lies below ylo = SVG_Y_CLIP */
 } frame;
 
 static double px(const frame *fr, double x)
@@ -75,6 +81,7 @@ static double px(const frame *fr, double x)
 }
 static double py(const frame *fr, double y)
 {
+    if (y < fr->ylo) y = fr->ylo; /* clipped: on the axis */
     return PY1 - (PY1 - PY0) * (y - fr->ylo) / (fr->yhi - fr->ylo);
 }
 
@@ -104,6 +111,16 @@ static void axes(FILE *f, const frame *fr, const char *x_label)
             "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" "
             "stroke=\"#222\"/>\n",
             PX0, PY0, PX1 - PX0, PY1 - PY0);
+    if (fr->clipped) {
+        fprintf(f,
+                "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#c00\" "
+                "stroke-width=\"2\" stroke-dasharray=\"4,3\"/>\n",
+                PX0, PY1, PX1, PY1);
+        fprintf(f,
+                "<text x=\"%.1f\" y=\"%.1f\" fill=\"#c00\" font-size=\"12\">axis clipped at "
+                "%g: values below it drawn on it as &#9660; (exact values in the CSV)</text>\n",
+                PX0 + 6, PY1 - 6, SVG_Y_CLIP);
+    }
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", (PX0 + PX1) / 2, PY1 + 45);
     xml_text(f, x_label);
     fputs("</text>\n", f);
@@ -139,9 +156,16 @@ static int curve(FILE *f, const cm_study_result *r, const frame *fr, int mode, s
     fprintf(f, "\"/>\n");
     for (size_t i = 0; i < r->n_rows; ++i) {
         const cm_study_row *w = &r->rows[i];
-        if (complete(w, mode, method))
-            fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.5\" fill=\"%s\"/>\n",
-                    px(fr, w->t * fr->xmax), py(fr, w->min_sj), colour(r, method));
+        if (!complete(w, mode, method)) continue;
+        double x = px(fr, w->t * fr->xmax), y = py(fr, w->min_sj);
+        if (w->min_sj < fr->ylo)
+            fprintf(f,
+                    "<path d=\"M%.2f %.2f l5 0 l-5 8 l-5 -8 z\" fill=\"%s\"><title>%.4g"
+                    "</title></path>\n",
+                    x, y - 4, colour(r, method), w->min_sj);
+        else
+            fprintf(f, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.5\" fill=\"%s\"/>\n", x, y,
+                    colour(r, method));
     }
     return 1;
 }
@@ -174,7 +198,7 @@ static void failed_marks(FILE *f, const cm_study_result *r, const frame *fr)
 cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const char *path)
 {
     if (!r || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_write_svg: NULL input");
-    frame fr = {r->min_sj0, r->min_sj0, r->x_max > 0 ? r->x_max : 1, r->x_tick};
+    frame fr = {r->min_sj0, r->min_sj0, r->x_max > 0 ? r->x_max : 1, r->x_tick, 0};
     if (!(fr.xtick > 0)) {
         fr.xtick = tick_step(fr.xmax);
         if (fr.xtick < 1 && fr.xmax >= 1) fr.xtick = 1; /* variants are counted */
@@ -188,6 +212,7 @@ cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const ch
     /* round outwards to tenths; keep a visible span */
     fr.ylo = floor(fr.ylo * 10 - 1e-9) / 10;
     fr.yhi = ceil(fr.yhi * 10 + 1e-9) / 10;
+    if (fr.ylo < SVG_Y_CLIP) fr.ylo = SVG_Y_CLIP, fr.clipped = 1;
     if (fr.yhi - fr.ylo < 0.1) fr.yhi = fr.ylo + 0.1;
 
     cm_outfile out;
