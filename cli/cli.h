@@ -42,6 +42,8 @@ const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char
 /* The value of --threads (1 .. 4 x the online cores) into *threads: 0, or CLI_EXIT_USAGE after a usage message. */
 int cli_threads_value(int argc, char **argv, int *i, const char *cmd, const char *usage,
                       int *threads);
+/* The check behind it on the value v alone (also used by the option table). */
+int cli_threads_parse(const char *cmd, const char *usage, const char *v, int *threads);
 
 /* Quality report shared by quality, warp and morph. The line every mesh-producing command
  * ends with (DESIGN.md): "min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k>

@@ -12,7 +12,7 @@
 static const char *const usage_line =
     "cadmorph study --from G0.step --mesh M0 --variants LIST -o DIR "
     "[--mode absolute|relative|both] [--methods LIST] [--write-meshes none|all|failed] "
-    "[--cad-unit U] [--threads N] [--verbose]";
+    "[--steps K|auto] [--optimize] [--cad-unit U] [--threads N] [--verbose]";
 
 static void print_help(void)
 {
@@ -40,6 +40,10 @@ static void print_help(void)
         "  --mode M              absolute, relative or both (default absolute)\n"
         "  --methods LIST        comma-separated (default rbf-s): %s\n"
         "  --write-meshes W      none, all (default) or failed (results with inverted cells)\n"
+        "  --steps K|auto        increments of each morph (default 1), or adaptive steps as\n"
+        "                        in morph --steps auto (a variant without a valid step is a row\n"
+        "                        with its error)\n"
+        "  --optimize            interior optimisation after each morph step\n"
         "  --cad-unit U          unit of the mesh coordinates (mm default; cm m in ft um ...)\n"
         "  --threads N           threads (default: all)\n"
         "  --verbose             debug messages on stderr\n\n"
@@ -54,7 +58,7 @@ enum { MAX_METHODS = 16 };
 
 typedef struct study_args {
     const char *from, *mesh, *variants, *out, *unit;
-    int modes, write_meshes, threads, verbose;
+    int modes, write_meshes, threads, verbose, steps, optimize;
     cm_study_method methods[MAX_METHODS];
     size_t n_methods;
 } study_args;
@@ -65,6 +69,7 @@ static int parse_args(int argc, char **argv, study_args *a)
     memset(a, 0, sizeof *a);
     a->modes = CM_STUDY_ABSOLUTE;
     a->write_meshes = CM_STUDY_WRITE_ALL;
+    a->steps = 1;
     const char *methods = "rbf-s";
     for (int i = 1; i < argc; ++i) {
         const char *o = argv[i], *v;
@@ -96,6 +101,18 @@ static int parse_args(int argc, char **argv, study_args *a)
                 return cli_usage(cmd, usage_line, "unknown mode '%s'", v);
         } else if (!strcmp(o, "--methods")) {
             if (!(methods = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--optimize")) {
+            a->optimize = 1;
+        } else if (!strcmp(o, "--steps")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            char *end;
+            long n = strtol(v, &end, 10);
+            if (!strcmp(v, "auto"))
+                a->steps = CM_MORPH_STEPS_AUTO;
+            else if (end == v || *end || n < 1 || n > 1000)
+                return cli_usage(cmd, usage_line, "--steps: expected 1..1000 or auto, got '%s'", v);
+            else
+                a->steps = (int)n;
         } else if (!strcmp(o, "--write-meshes")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             if (!strcmp(v, "none"))
@@ -177,6 +194,8 @@ static int run(cm_context *ctx, const study_args *a)
             so.model = base ? base + 1 : a->from;
             so.mesh = mbase ? mbase + 1 : a->mesh;
             if (a->unit) so.morph.cad_unit = a->unit;
+            so.morph.steps = a->steps;
+            so.morph.optimize = a->optimize;
             s = cm_study_run(ctx, g0, mesh, &fam, &so, &r);
             if (s < 0) s = cm_error_prefix(ctx, s, "%s, %s", a->from, a->mesh);
         }

@@ -11,7 +11,7 @@
 
 static const char *const usage_line =
     "cadmorph sweep bore|pipe|bracket --mesh tet|hex|FILE --mode absolute|relative|both "
-    "--steps N -o DIR [--size H] [--methods LIST] [--write-step] "
+    "--steps N -o DIR [--size H] [--methods LIST] [--adaptive] [--optimize] [--write-step] "
     "[--threads N] [--verbose]";
 
 static void print_help(void)
@@ -36,6 +36,8 @@ static void print_help(void)
         "                     0.1)\n"
         "  --mode M           absolute, relative or both (default both)\n"
         "  --steps N          parameter steps (default 10)\n"
+        "  --adaptive         each morph with adaptive steps (as morph --steps auto)\n"
+        "  --optimize         each morph with interior optimisation (as morph --optimize)\n"
         "  -o, --output DIR   output directory (created if missing)\n"
         "  --methods LIST     comma-separated study methods (default the three above;\n"
         "                     see 'cadmorph study --help')\n"
@@ -116,6 +118,10 @@ static int parse_args(int argc, char **argv, sweep_args *a)
         } else if (!strcmp(o, "--methods")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             if (parse_methods(v, a)) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--adaptive")) {
+            a->opt.adaptive = 1;
+        } else if (!strcmp(o, "--optimize")) {
+            a->opt.optimize = 1;
         } else if (!strcmp(o, "--steps")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             long n = strtol(v, &end, 10);

@@ -155,6 +155,11 @@ int cli_threads_value(int argc, char **argv, int *i, const char *cmd, const char
 {
     const char *v = cli_value(argc, argv, i, cmd, usage);
     if (!v) return CLI_EXIT_USAGE;
+    return cli_threads_parse(cmd, usage, v, threads);
+}
+
+int cli_threads_parse(const char *cmd, const char *usage, const char *v, int *threads)
+{
     char *end = NULL;
     errno = 0;
     long t = strtol(v, &end, 10);

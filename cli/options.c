@@ -40,16 +40,11 @@ static int set_value(const cli_parser *p, const cli_option *o, const char *opt, 
         *(const char **)o->dest = v;
         return 0;
     case CLI_THREADS:
+        return cli_threads_parse(p->cmd, p->usage, v, (int *)o->dest) ? CLI_EXIT_USAGE : 0;
     case CLI_INT: {
-        const double lo = o->kind == CLI_THREADS ? 1 : o->lo,
-                     hi = o->kind == CLI_THREADS ? 4096 : o->hi;
         errno = 0;
         const long n = strtol(v, &end, 10);
-        if (errno || end == v || *end || n < lo || n > hi) {
-            if (o->kind == CLI_THREADS && !o->bad)
-                return cli_usage(p->cmd, p->usage, "%s needs a positive integer, got '%s'", opt, v);
-            return bad_value(p, o, opt, v);
-        }
+        if (errno || end == v || *end || n < o->lo || n > o->hi) return bad_value(p, o, opt, v);
         *(int *)o->dest = (int)n;
         return 0;
     }

@@ -115,6 +115,8 @@ cm_status cm_sweep_run(cm_context *ctx, const cm_sweep_options *opt, cm_study_re
         so.modes = opt->modes;
         so.methods = opt->methods;
         so.n_methods = opt->n_methods;
+        if (opt->adaptive) so.morph.steps = CM_MORPH_STEPS_AUTO;
+        so.morph.optimize = opt->optimize;
         so.out_dir = opt->out_dir;
         so.model = opt->model;
         so.mesh = kind;

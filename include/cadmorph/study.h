@@ -214,6 +214,8 @@ typedef struct cm_sweep_options {
                             the meshes at 50 and 100 % (<method>_<mode>_<pct>.vtu) */
     int write_step;      /* keep DIR/G_<t>.step */
     int write_meshes;    /* write the meshes at 50 % and 100 % */
+    int adaptive;        /* each morph with adaptive steps (CM_MORPH_STEPS_AUTO, floor 0) */
+    int optimize;        /* each morph with interior optimisation (cm_morph_options.optimize) */
 } cm_sweep_options;
 
 CM_API void cm_sweep_options_init(cm_sweep_options *opt);

@@ -84,7 +84,8 @@ def main():
 
     # versions agree
     env = dict(os.environ, PKG_CONFIG_PATH=os.path.join(libdir, "pkgconfig"))
-    version = run([os.path.join(prefix, "bin", "cadmorph"), "--version"]).stdout.strip()
+    # the first line; the BLAS and its core follow
+    version = run([os.path.join(prefix, "bin", "cadmorph"), "--version"]).stdout.strip().split("\n")[0]
     pc = run(["pkg-config", "--modversion", "cadmorph"], env=env).stdout.strip()
     if version != "cadmorph " + pc or not re.fullmatch(r"\d+\.\d+\.\d+", pc):
         fail("cadmorph --version says %r, cadmorph.pc %r" % (version, pc))
