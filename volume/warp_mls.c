@@ -1,5 +1,5 @@
 /* The MLS warp method (deform/, mls.h): one constrained MLS space deformation over the whole
- * mesh, every component at once, with the default stretch and bend weights. Approximate: the
+ * mesh, every component at once, with the default stretch and bend weights and gamma_f = 1e5. Approximate: the
  * constrained nodes keep their prescribed displacement and the apply reports how far the
  * field missed them. */
 #include "warp_method.h"
@@ -16,6 +16,8 @@ static cm_status mls_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
     (void)opt;
     cm_mls_options o;
     cm_mls_options_init(&o);
+    /* a warp must meet the boundary closely: a stiffer penalty than the handle default */
+    o.fix = 1e5;
     cm_mls *m = NULL;
     cm_status s = cm_mls_create(ctx, mesh, constrained, &o, &m);
     if (s < 0) return cm_error_prefix(ctx, s, "cm_warp_create");

@@ -94,7 +94,7 @@ static void test_basis(cm_context *ctx, int flat)
         if (!flat) worst_dpu = fmax(worst_dpu, fabs(ls) * 1e-2);
         if (flat) continue;
         /* central differences where the support set does not change within +-h */
-        double h = 1e-5, g_scale = 0, l_fd[64] = {0}, gmax = 0;
+        double h = 1e-6, g_scale = 0, l_fd[64] = {0}, gmax = 0;
         int same = cnt <= 64;
         double gfd[3 * 64];
         for (int d = 0; d < 3 && same; ++d) {
@@ -106,7 +106,7 @@ static void test_basis(cm_context *ctx, int flat)
             same &= cnt2 == cnt && !memcmp(idx, idx2, cnt * sizeof *idx);
             for (size_t q = 0; q < cnt && same; ++q)
                 gfd[3 * q + d] = (fp[q] - fm[q]) / (2 * h);
-            double hl = 1e-4;
+            double hl = 1e-5; /* below this, round-off dominates */
             xp[d] = p[d] + hl, xm[d] = p[d] - hl;
             cm_mls_basis_eval(ctx, b, xp, mx, &cnt2, idx2, fp, NULL, NULL);
             same &= cnt2 == cnt && !memcmp(idx, idx2, cnt * sizeof *idx);
@@ -253,7 +253,7 @@ static void test_two_components(cm_context *ctx)
         else
             eb = fmax(eb, e);
     }
-    CHECK_MSG(ea <= 1e-8 && eb <= 1e-8, "two components: moved %g, fixed %g", ea, eb);
+    CHECK_MSG(ea <= 1e-6 && eb <= 1e-6, "two components: moved %g, fixed %g", ea, eb);
     printf("two components: %.2e %.2e\n", ea, eb);
     cm_mls_destroy(&mls);
 
@@ -278,7 +278,7 @@ static void test_two_components(cm_context *ctx)
     for (size_t i = 0; i < 3 * n; ++i)
         inner = fmax(inner, fabs(d[i] - pre[i]));
     CHECK_MSG(keep == 0, "boundary kept: %g", keep);
-    CHECK_MSG(r > 0 && r < 0.02 && inner < 0.02, "warp residual %g, interior off affine %g", r,
+    CHECK_MSG(r > 0 && r < 2e-3 && inner < 2e-3, "warp residual %g, interior off affine %g", r,
               inner);
     printf("warp mls: residual %.3e, interior vs affine %.3e\n", r, inner);
     cm_warp_destroy(&w);
@@ -322,6 +322,7 @@ static void test_plate(cm_context *ctx)
         o.stretch = e ? 1 : 0;
         o.bend = e ? 0 : 1;
         o.keep_constrained = 0;
+        o.fix = 1e5; /* bending a plate needs a stiffer penalty than the default */
         cm_mls *mls = NULL;
         CHECK(cm_mls_create(ctx, m, con, &o, &mls) == CM_OK);
         double res = -1;
