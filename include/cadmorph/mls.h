@@ -88,6 +88,15 @@ void cm_mls_get_stats(const cm_mls *mls, cm_mls_stats *stats);
 /* The samples (k x 3). */
 const double *cm_mls_samples(const cm_mls *mls, size_t *k);
 
+/* ---- surfaces ---- */
+
+/* Mean curvature H_i = |lap x_i| / 2 of the 2D cells of mesh (cotangent Laplace-Beltrami,
+ * barycentric areas; quads and polygons fanned into triangles): H #nodes output, 0 at
+ * boundary vertices and vertices of no face. boundary: #nodes output flags of vertices on an
+ * edge used by one face (may be NULL). */
+cm_status cm_mls_mean_curvature(cm_context *ctx, const cm_mesh *mesh, double *H,
+                                unsigned char *boundary);
+
 #ifdef __cplusplus
 }
 #endif
