@@ -251,6 +251,7 @@ int cli_cmd_deform(int argc, char **argv)
         nh += con[i] != 0;
         nf += fixed[i] != 0;
         if (fixed[i]) con[i] = 1, disp[3 * i] = disp[3 * i + 1] = disp[3 * i + 2] = 0;
+        else if (con[i]) con[i] = 2; /* the MLS weighs handle and fixed groups apart */
     }
     if (s >= 0 && nh == 0) s = cm_error(ctx, CM_ERR_ARGUMENT, "%s: no handle node", a.handles);
     double residual = 0, t0 = cm_wtime();

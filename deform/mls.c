@@ -19,7 +19,7 @@ struct cm_mls {
     size_t n_con;
     int64_t *con; /* constrained nodes, ascending */
     unsigned char *is_con;
-    double wf; /* fix weight per constraint */
+    double *wf; /* #constrained: fix weight of each (gamma_f / size of its group) */
     int keep_constrained;
     cholmod_common cc;
     cholmod_factor *factor;
@@ -53,6 +53,7 @@ void cm_mls_destroy(cm_mls **mls)
     free(m->val);
     free(m->con);
     free(m->is_con);
+    free(m->wf);
     free(m->coef);
     if (m->factor) cholmod_free_factor(&m->factor, &m->cc);
     cholmod_finish(&m->cc);
@@ -240,19 +241,19 @@ static cm_status factor_system(cm_context *ctx, cm_mls *m, size_t N, const doubl
             cp[++col] = (int)e;
         }
     }
-    double f = sqrt(m->wf);
     for (size_t i = 0; i < m->n_con; ++i) {
         int64_t v = m->con[i];
+        double f = sqrt(m->wf[i]);
         for (int64_t p = m->row[v]; p < m->row[v + 1]; ++p)
             ri[e] = m->col[p], vx[e++] = f * m->val[p];
         cp[++col] = (int)e;
     }
     /* a tiny ridge: samples that no cubature point or constraint sees get 0, not a pivot
-     * failure; 1e-12 of the mean diagonal changes nothing measurable elsewhere */
+     * failure; 1e-14 of the mean diagonal changes nothing measurable elsewhere */
     double diag = 0;
     for (size_t i = 0; i < e; ++i)
         diag += vx[i] * vx[i];
-    double beta[2] = {1e-12 * diag / (double)m->k, 0};
+    double beta[2] = {1e-14 * diag / (double)m->k, 0};
     m->factor = cholmod_analyze(bt, &m->cc);
     if (m->factor) cholmod_factorize_p(bt, beta, NULL, 0, m->factor, &m->cc);
     cholmod_free_sparse(&bt, &m->cc);
@@ -339,21 +340,32 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
         goto done;
     }
     double t2 = cm_wtime();
-    double bb[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i < n; ++i)
-        for (int a = 0; a < 3; ++a) {
-            bb[a] = fmin(bb[a], mesh->xyz[3 * i + a]);
-            bb[3 + a] = fmax(bb[3 + a], mesh->xyz[3 * i + a]);
-        }
-    double L = cm_bbox_diagonal(bb), V = 0;
+    /* the length that makes the three terms comparable: the mean support radius, i.e. the
+     * resolution of the subspace (the bounding box would let bending swamp the constraints
+     * of any feature smaller than the model) */
+    double L = 0, V = 0;
+    const double *radius = cm_mls_basis_radii(m->basis);
+    for (size_t j = 0; j < k; ++j)
+        L += radius[j] / (double)k;
     for (size_t i = 0; i < N; ++i)
         V += qv[i];
     if (!(L > 0) || !(V > 0)) {
-        s = cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mls_create: degenerate mesh (diagonal %g, measure %g)",
+        s = cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mls_create: degenerate mesh (radius %g, measure %g)",
                      L, V);
         goto done;
     }
-    m->wf = o.fix / (double)m->n_con;
+    {
+        size_t group[256] = {0};
+        for (size_t i = 0; i < m->n_con; ++i)
+            ++group[constrained[m->con[i]]];
+        m->wf = malloc(m->n_con * sizeof *m->wf);
+        if (!m->wf) {
+            s = cm_error(ctx, CM_ERR_NOMEM, "cm_mls_create: out of memory");
+            goto done;
+        }
+        for (size_t i = 0; i < m->n_con; ++i)
+            m->wf[i] = o.fix / (double)group[constrained[m->con[i]]];
+    }
     s = factor_system(ctx, m, N, qv, qrow, qcol, qgrad, qlap, o.stretch * L * L / V,
                       o.bend * L * L * L * L / V);
     if (s < 0) goto done;
@@ -391,7 +403,7 @@ cm_status cm_mls_apply(cm_context *ctx, cm_mls *m, double *disp, double *residua
         int64_t v = m->con[i];
         for (int64_t p = m->row[v]; p < m->row[v + 1]; ++p)
             for (int d = 0; d < 3; ++d)
-                bx[d * k + (size_t)m->col[p]] += m->wf * m->val[p] * disp[3 * v + d];
+                bx[d * k + (size_t)m->col[p]] += m->wf[i] * m->val[p] * disp[3 * v + d];
     }
     cholmod_dense *x = cholmod_solve(CHOLMOD_A, m->factor, b, &m->cc);
     cholmod_free_dense(&b, &m->cc);

@@ -64,10 +64,12 @@ typedef struct cm_mls cm_mls;
 
 /* Samples the mesh (its 2D cells for a surface mesh; its volume cells and their boundary
  * faces for a volume mesh), builds the shape functions at every node and at the cubature
- * points, assembles and factors eq. 14. constrained: #nodes flags (H and F), at least one.
+ * points, assembles and factors eq. 14. constrained: #nodes, 0 for a free node, else the
+ * node's constraint group (1..255, e.g. 1 fixed region F, 2 handle H); at least one node.
  * The energies are normalised so that the weights do not depend on the mesh's size: the
- * stretch term by L^2 / V, the bend term by L^4 / V (L the bounding-box diagonal, V the
- * total cubature volume), the fix term by 1 / #constrained. mesh is borrowed. */
+ * stretch term by L^2 / V, the bend term by L^4 / V (L the mean support radius: the
+ * subspace's resolution; V the total cubature volume), the fix term of each node by 1 / the size of its group (so a small
+ * handle weighs as much as a large fixed region). mesh is borrowed. */
 cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned char *constrained,
                         const cm_mls_options *opt, cm_mls **mls);
 void cm_mls_destroy(cm_mls **mls);

@@ -253,7 +253,7 @@ static void test_two_components(cm_context *ctx)
         else
             eb = fmax(eb, e);
     }
-    CHECK_MSG(ea <= 1e-6 && eb <= 1e-6, "two components: moved %g, fixed %g", ea, eb);
+    CHECK_MSG(ea <= 1e-9 && eb <= 1e-9, "two components: moved %g, fixed %g", ea, eb);
     printf("two components: %.2e %.2e\n", ea, eb);
     cm_mls_destroy(&mls);
 
@@ -322,7 +322,6 @@ static void test_plate(cm_context *ctx)
         o.stretch = e ? 1 : 0;
         o.bend = e ? 0 : 1;
         o.keep_constrained = 0;
-        o.fix = 1e5; /* bending a plate needs a stiffer penalty than the default */
         cm_mls *mls = NULL;
         CHECK(cm_mls_create(ctx, m, con, &o, &mls) == CM_OK);
         double res = -1;
@@ -336,7 +335,7 @@ static void test_plate(cm_context *ctx)
             if (x < 1e-9) rim = fmax(rim, fabs(d[3 * i + 2]));
         }
         CHECK(finite);
-        CHECK_MSG(centre > 0.09 && rim < 0.01 && res < 0.02, "%s: centre %g rim %g residual %g",
+        CHECK_MSG(centre > 0.095 && rim < 5e-3 && res < 5e-3, "%s: centre %g rim %g residual %g",
                   e ? "stretch" : "bend", centre, rim, res);
         printf("plate %s: centre %.4f rim %.2e residual %.2e\n", e ? "stretch" : "bend", centre,
                rim, res);
