@@ -209,7 +209,8 @@ cm_status mls_farthest(cm_context *ctx, const double *xyz, size_t n, size_t k, u
         dmin[i] = DBL_MAX;
     uint64_t rng = seed * 0x2545F4914F6CDD1Dull + 7;
     size_t cur = (size_t)(rng_next(&rng) % n);
-    int nt = cm_context_threads_for(ctx, n, 20000);
+    /* one parallel region per pick: only worth its barrier for large dense sets */
+    int nt = cm_context_threads_for(ctx, n, 250000);
     for (size_t j = 0; j < k; ++j) {
         const double *c = xyz + 3 * cur;
         memcpy(out + 3 * j, c, 3 * sizeof *out);
