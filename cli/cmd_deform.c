@@ -15,7 +15,7 @@
 
 static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
-    "[--method rbf|mls] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
+    "[--method rbf|mls|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
     "[--exact-constraints] [--threads N] [--verbose]";
 
 static void print_help(void)
@@ -35,10 +35,12 @@ static void print_help(void)
         "  --fixed F.csv             the fixed region\n"
         "  --fix-unlisted-boundary   fix every boundary node not in H.csv (volume: the\n"
         "                            boundary surface; surface: its border edges)\n"
-        "  --method M                rbf (triharmonic, exact at H and F) or mls (constrained\n"
-        "                            MLS, approximate; default mls)\n"
-        "  --stretch GS, --bend GB   MLS energy weights (default 1, 1)\n"
-        "  --fix GF                  MLS constraint weight (default 1000)\n"
+        "  --method M                rbf (triharmonic, exact at H and F), mls (constrained\n"
+        "                            MLS, approximate; default) or shell (surfaces: the\n"
+        "                            mesh-based shell of the paper's eq. 10, the ground truth;\n"
+        "                            weights per unit area, not normalised)\n"
+        "  --stretch GS, --bend GB   MLS / shell energy weights (default 1, 1)\n"
+        "  --fix GF                  MLS / shell constraint weight (default 1000)\n"
         "  --samples K               MLS samples (default 2%% of the nodes, at least 500)\n"
         "  --exact-constraints       MLS: H and F nodes get their prescribed value instead of\n"
         "                            the field's\n"
@@ -50,7 +52,7 @@ static void print_help(void)
 
 typedef struct deform_args {
     const char *mesh, *handles, *fixed, *out;
-    int fix_boundary, mls, exact, threads, verbose;
+    int fix_boundary, mls, shell, exact, threads, verbose;
     double stretch, bend, fix;
     size_t samples;
 } deform_args;
@@ -96,8 +98,10 @@ static int parse_args(int argc, char **argv, deform_args *a)
                 a->mls = 0;
             else if (!strcmp(v, "mls"))
                 a->mls = 1;
+            else if (!strcmp(v, "shell"))
+                a->mls = 0, a->shell = 1;
             else
-                return cli_usage(cmd, usage_line, "unknown method '%s' (rbf|mls)", v);
+                return cli_usage(cmd, usage_line, "unknown method '%s' (rbf|mls|shell)", v);
         } else if (!strcmp(o, "--stretch") || !strcmp(o, "--bend") || !strcmp(o, "--fix")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             double *dst = o[2] == 's' ? &a->stretch : o[2] == 'b' ? &a->bend : &a->fix;
@@ -121,7 +125,7 @@ static int parse_args(int argc, char **argv, deform_args *a)
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
     if (a->fixed && a->fix_boundary)
         return cli_usage(cmd, usage_line, "--fixed and --fix-unlisted-boundary exclude each other");
-    if (a->mls && (a->fix <= 0 || a->stretch + a->bend <= 0))
+    if ((a->mls || a->shell) && (a->fix <= 0 || a->stretch + a->bend <= 0))
         return cli_usage(cmd, usage_line, "--fix must be > 0 and --stretch + --bend > 0");
     if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
         return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
@@ -255,7 +259,10 @@ int cli_cmd_deform(int argc, char **argv)
     }
     if (s >= 0 && nh == 0) s = cm_error(ctx, CM_ERR_ARGUMENT, "%s: no handle node", a.handles);
     double residual = 0, t0 = cm_wtime();
-    if (s >= 0 && !a.mls) s = deform_rbf(ctx, mesh, con, disp);
+    if (s >= 0 && a.shell && volume)
+        s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: --method shell deforms surface meshes only", a.mesh);
+    if (s >= 0 && a.shell) s = cm_mls_shell(ctx, mesh, con, a.stretch, a.bend, a.fix, disp);
+    if (s >= 0 && !a.mls && !a.shell) s = deform_rbf(ctx, mesh, con, disp);
     if (s >= 0 && a.mls) {
         cm_mls_options o;
         cm_mls_options_init(&o);
@@ -299,7 +306,7 @@ int cli_cmd_deform(int argc, char **argv)
             if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
             if (s >= 0) {
                 printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                       a.mls ? "mls" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                       a.mls ? "mls" : a.shell ? "shell" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
                 printf("mean_curvature (interior vertices): before min=%.6g mean=%.6g max=%.6g; "
                        "after min=%.6g mean=%.6g max=%.6g\n",
                        h_before[0], h_before[1], h_before[2], cnt ? mn : 0,
@@ -313,7 +320,7 @@ int cli_cmd_deform(int argc, char **argv)
         if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
         if (s >= 0) {
             printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                   a.mls ? "mls" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                   a.mls ? "mls" : a.shell ? "shell" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
             s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
         }
     }

@@ -99,6 +99,16 @@ const double *cm_mls_samples(const cm_mls *mls, size_t *k);
 cm_status cm_mls_mean_curvature(cm_context *ctx, const cm_mesh *mesh, double *H,
                                 unsigned char *boundary);
 
+/* The mesh-based shell of section 3 (eq. 10), the ground truth of the MLS subspace: the
+ * piecewise-linear displacement of the 2D cells minimising
+ *   stretch sum_t A_t |grad d|^2 + bend sum_i A_i |lap d_i|^2
+ *   + fix sum_{constrained} A_i |d_i - disp_i|^2
+ * (cotangent operators, barycentric areas A_i; weights as in the paper, not normalised).
+ * disp: #nodes x 3, read at the constrained nodes, written at every node. Every connected
+ * part of the surface needs a constrained node (else CM_ERR_NUMERIC). */
+cm_status cm_mls_shell(cm_context *ctx, const cm_mesh *mesh, const unsigned char *constrained,
+                       double stretch, double bend, double fix, double *disp);
+
 #ifdef __cplusplus
 }
 #endif

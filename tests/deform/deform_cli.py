@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """`cadmorph deform` end to end: a quad plate (surface) and a hex box (volume) written here,
-MLS and RBF, the mean_curvature field and summary, the quality line, and the error paths.
+MLS and RBF, the mean_curvature field and summary, the quality line, the shell of eq. 10
+against scipy (1e-10), and the error paths.
 usage: deform_cli.py CADMORPH DATA_DIR WORK_DIR"""
 import os, re, subprocess, sys
 import numpy as np
@@ -47,6 +48,40 @@ if rc == 0:
     check(np.abs(d[0]).max() < 5e-3, "plate: corner fixed %s" % d[0])
     res = float(re.search(r"residual (\S+)", out).group(1))
     check(0 < res < 5e-3, "plate: residual %g" % res)
+
+# the shell of eq. 10 (--method shell) against an independent scipy solve of the same system
+import scipy.sparse as sp, scipy.sparse.linalg as spl
+pz = pts.copy()
+pz[:, 2] = 0.05 * np.sin(3 * pz[:, 0]) * np.cos(2 * pz[:, 1])  # not flat: a general surface
+meshio.write("wavy.vtk", meshio.Mesh(pz, [("quad", np.array(quads))]), binary=False)
+gs, gb, gf = 0.5, 1.0, 1e4
+rc, out, err = run("--mesh", "wavy.vtk", "--handles", "plate_H.csv", "--fix-unlisted-boundary",
+                   "--method", "shell", "--stretch", str(gs), "--bend", str(gb), "--fix", str(gf),
+                   "-o", "wavy_shell.vtu")
+check(rc == 0, "shell: exit %d %s" % (rc, err))
+if rc == 0:
+    tri = np.array([[q[0], q[f], q[f + 1]] for q in quads for f in (1, 2)])
+    N = len(pz)
+    K = sp.lil_matrix((N, N)); A = np.zeros(N)
+    for t in tri:
+        P = pz[t]
+        nrm = np.cross(P[1] - P[0], P[2] - P[0]); a = np.linalg.norm(nrm) / 2; u = nrm / (2 * a)
+        g = [np.cross(u, P[(q + 2) % 3] - P[(q + 1) % 3]) / (2 * a) for q in range(3)]
+        for i in range(3):
+            A[t[i]] += a / 3
+            for j in range(3):
+                K[t[i], t[j]] += a * g[i] @ g[j]
+    K = K.tocsr()
+    bnd = (np.min(pz[:, :2], axis=1) < 1e-9) | (np.max(pz[:, :2], axis=1) > 1 - 1e-9)
+    con = bnd.copy(); con[centre] = True
+    dbar = np.zeros((N, 3)); dbar[centre, 2] = 0.1
+    F = sp.diags(np.where(con, A, 0))
+    S = gs * K + gb * K @ sp.diags(1 / A) @ K + gf * F
+    ref = spl.spsolve(S.tocsc(), gf * (F @ dbar))
+    d = meshio.read("wavy_shell.vtu").point_data["displacement"]
+    err_rel = np.abs(d - ref).max() / np.abs(ref).max()
+    check(err_rel < 1e-10, "shell vs scipy: %g" % err_rel)
+    print("shell vs scipy: relative %.2e" % err_rel)
 
 # hex box 6^3 cells; handle: the face x = 1 moved by 0.1 in x, the rest of the boundary fixed
 k = 7
