@@ -27,17 +27,17 @@ typedef struct cm_mls_basis cm_mls_basis;
 /* centres: k x 3 sample positions (k >= 4). points: n_points x 3; each sample's support radius
  * is chosen so that every point is covered by at least `cover` samples (the paper's s = 5).
  * The arrays are copied. */
-cm_status cm_mls_basis_create(cm_context *ctx, size_t k, const double *centres, size_t n_points,
+CM_API cm_status cm_mls_basis_create(cm_context *ctx, size_t k, const double *centres, size_t n_points,
                               const double *points, int cover, cm_mls_basis **basis);
-void cm_mls_basis_destroy(cm_mls_basis **basis);
+CM_API void cm_mls_basis_destroy(cm_mls_basis **basis);
 /* An upper bound on the samples covering any point: the room cm_mls_basis_eval needs. */
-size_t cm_mls_basis_max_support(const cm_mls_basis *basis);
+CM_API size_t cm_mls_basis_max_support(const cm_mls_basis *basis);
 /* Support radii: k entries. */
-const double *cm_mls_basis_radii(const cm_mls_basis *basis);
+CM_API const double *cm_mls_basis_radii(const cm_mls_basis *basis);
 /* The shape functions at x: *count samples idx (ascending), phi, grad (count x 3, may be
  * NULL), lap (count, may be NULL). max: room in the arrays, at least
  * cm_mls_basis_max_support. A point no support covers gets *count = 0. */
-cm_status cm_mls_basis_eval(cm_context *ctx, const cm_mls_basis *basis, const double x[3],
+CM_API cm_status cm_mls_basis_eval(cm_context *ctx, const cm_mls_basis *basis, const double x[3],
                             size_t max, size_t *count, int32_t *idx, double *phi, double *grad,
                             double *lap);
 
@@ -58,7 +58,7 @@ typedef struct cm_mls_options {
     uint64_t seed;         /* random sampling (1) */
 } cm_mls_options;
 
-void cm_mls_options_init(cm_mls_options *opt);
+CM_API void cm_mls_options_init(cm_mls_options *opt);
 
 typedef struct cm_mls cm_mls;
 
@@ -70,14 +70,14 @@ typedef struct cm_mls cm_mls;
  * stretch term by L^2 / V, the bend term by L^4 / V (L the mean support radius: the
  * subspace's resolution; V the total cubature volume), the fix term of each node by 1 / the size of its group (so a small
  * handle weighs as much as a large fixed region). mesh is borrowed. */
-cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned char *constrained,
+CM_API cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned char *constrained,
                         const cm_mls_options *opt, cm_mls **mls);
-void cm_mls_destroy(cm_mls **mls);
+CM_API void cm_mls_destroy(cm_mls **mls);
 
 /* disp: #nodes x 3, read at the constrained nodes, written at every node (constrained ones
  * as keep_constrained says). residual: the largest |d(x_i) - prescribed_i| over constrained
  * nodes (may be NULL). One factorisation, any number of calls (not concurrently). */
-cm_status cm_mls_apply(cm_context *ctx, cm_mls *mls, double *disp, double *residual);
+CM_API cm_status cm_mls_apply(cm_context *ctx, cm_mls *mls, double *disp, double *residual);
 
 typedef struct cm_mls_stats {
     size_t samples, surface_samples, cubature, constrained;
@@ -86,9 +86,9 @@ typedef struct cm_mls_stats {
     double t_sample, t_basis, t_factor, t_apply; /* seconds (t_apply: the last call) */
 } cm_mls_stats;
 
-void cm_mls_get_stats(const cm_mls *mls, cm_mls_stats *stats);
+CM_API void cm_mls_get_stats(const cm_mls *mls, cm_mls_stats *stats);
 /* The samples (k x 3). */
-const double *cm_mls_samples(const cm_mls *mls, size_t *k);
+CM_API const double *cm_mls_samples(const cm_mls *mls, size_t *k);
 
 /* ---- surfaces ---- */
 
@@ -96,7 +96,7 @@ const double *cm_mls_samples(const cm_mls *mls, size_t *k);
  * barycentric areas; quads and polygons fanned into triangles): H #nodes output, 0 at
  * boundary vertices and vertices of no face. boundary: #nodes output flags of vertices on an
  * edge used by one face (may be NULL). */
-cm_status cm_mls_mean_curvature(cm_context *ctx, const cm_mesh *mesh, double *H,
+CM_API cm_status cm_mls_mean_curvature(cm_context *ctx, const cm_mesh *mesh, double *H,
                                 unsigned char *boundary);
 
 /* The mesh-based shell of section 3 (eq. 10), the ground truth of the MLS subspace: the
@@ -106,7 +106,7 @@ cm_status cm_mls_mean_curvature(cm_context *ctx, const cm_mesh *mesh, double *H,
  * (cotangent operators, barycentric areas A_i; weights as in the paper, not normalised).
  * disp: #nodes x 3, read at the constrained nodes, written at every node. Every connected
  * part of the surface needs a constrained node (else CM_ERR_NUMERIC). */
-cm_status cm_mls_shell(cm_context *ctx, const cm_mesh *mesh, const unsigned char *constrained,
+CM_API cm_status cm_mls_shell(cm_context *ctx, const cm_mesh *mesh, const unsigned char *constrained,
                        double stretch, double bend, double fix, double *disp);
 
 #ifdef __cplusplus
