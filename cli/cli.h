@@ -64,6 +64,7 @@ void cli_blas_print_version(FILE *out);
 /* Subcommands: argv[0] is the subcommand name. */
 int cli_cmd_quality(int argc, char **argv);
 int cli_cmd_warp(int argc, char **argv);
+int cli_cmd_deform(int argc, char **argv);
 int cli_cmd_info(int argc, char **argv);
 int cli_cmd_mesh(int argc, char **argv);
 int cli_cmd_morph(int argc, char **argv);

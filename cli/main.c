@@ -19,6 +19,7 @@ static const cli_command commands[] = {
     {"sweep", cli_cmd_sweep, "Staten-style study: morph a benchmark model over its parameter change"},
     {"demo", cli_cmd_demo, "the embedded example: bore model, tet mesh, 10-step absolute sweep"},
     {"quality", cli_cmd_quality, "scaled Jacobian report of a mesh"},
+    {"deform", cli_cmd_deform, "handle-based deformation of a surface or volume mesh (RBF, MLS, shell)"},
     {"warp", cli_cmd_warp, "move interior nodes by an RBF warp of given boundary displacements"},
     {"ffd", cli_cmd_ffd, "free-form deformation of a mesh by a control lattice (PyGeM .prm accepted)"},
     {"mesh", cli_cmd_mesh, "tet mesh of a STEP solid (OpenCASCADE surface + TetGen)"},

@@ -14,6 +14,7 @@ static const cm_warp_method_ops *const methods[CM_WARP_N_METHODS] = {
     [CM_WARP_FEMWARP] = &cm_warp_femwarp,
     [CM_WARP_LBWARP] = &cm_warp_lbwarp,
     [CM_WARP_SIMPLEX] = &cm_warp_simplex,
+    [CM_WARP_MLS] = &cm_warp_mls,
 };
 
 struct cm_warp {

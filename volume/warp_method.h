@@ -29,6 +29,8 @@ extern const cm_warp_method_ops cm_warp_dmffd;
 extern const cm_warp_method_ops cm_warp_femwarp;
 extern const cm_warp_method_ops cm_warp_lbwarp;
 extern const cm_warp_method_ops cm_warp_simplex;
+/* The MLS space deformation (warp_mls.c over deform/mls.h). */
+extern const cm_warp_method_ops cm_warp_mls;
 
 /* LBWARP's log-barrier weights of one node (warp_lbwarp.c): d, n x 3, the offsets x_j - x_i
  * of its neighbours; w, n outputs; lambda, mu the Lagrange multipliers of the reproduction

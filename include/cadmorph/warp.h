@@ -32,6 +32,7 @@ typedef enum cm_warp_method {
                             nodes (linear-simplex, a generalisation of BMSWEEP) */
     CM_WARP_DMFFD,              /* "dmffd": DM-FFD on a cubic B-spline lattice around the mesh
                                    (least squares: see cm_warp_residual) */
+    CM_WARP_MLS,                /* "mls": constrained MLS space deformation (mls.h), approximate */
     CM_WARP_N_METHODS
 } cm_warp_method;
 

@@ -1,0 +1,333 @@
+/* `cadmorph deform`: handle-based deformation of a surface or volume mesh (the handle
+ * metaphor of the MLS paper, section 3): handle nodes H move as given, fixed nodes F stay,
+ * the rest follows a space deformation (triharmonic RBF or constrained MLS). */
+#include "cli.h"
+
+#include "cadmorph/mls.h"
+#include "cadmorph/rbf.h"
+#include "cadmorph/warp.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const usage_line =
+    "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
+    "[--method rbf|mls|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
+    "[--exact-constraints] [--threads N] [--verbose]";
+
+static void print_help(void)
+{
+    printf("usage: %s\n\n", usage_line);
+    printf(
+        "Deforms the mesh M (a surface mesh of triangles/quads, or a volume mesh; .msh .vtu\n"
+        ".vtk .mesh) by moving the handle nodes of H.csv, keeping the fixed nodes in place and\n"
+        "letting every other node follow a space deformation. Writes M' with a per-node\n"
+        "'displacement' field; surfaces also get 'mean_curvature' (H = |lap x|/2, cotangent\n"
+        "Laplacian) and a mean-curvature summary, volume meshes the quality summary line.\n\n"
+        "H.csv: header node,dx,dy,dz (0-based node index in M's file order).\n"
+        "F.csv: header node, then one node index per line.\n\n"
+        "options:\n"
+        "  --mesh M                  input mesh\n"
+        "  --handles H.csv           the handle region and its displacement\n"
+        "  --fixed F.csv             the fixed region\n"
+        "  --fix-unlisted-boundary   fix every boundary node not in H.csv (volume: the\n"
+        "                            boundary surface; surface: its border edges)\n"
+        "  --method M                rbf (triharmonic, exact at H and F), mls (constrained\n"
+        "                            MLS, approximate; default) or shell (surfaces: the\n"
+        "                            mesh-based shell of the paper's eq. 10, the ground truth;\n"
+        "                            weights per unit area, not normalised)\n"
+        "  --stretch GS, --bend GB   MLS / shell energy weights (default 1, 1)\n"
+        "  --fix GF                  MLS / shell constraint weight (default 1000)\n"
+        "  --samples K               MLS samples (default 2%% of the nodes, at least 500)\n"
+        "  --exact-constraints       MLS: H and F nodes get their prescribed value instead of\n"
+        "                            the field's\n"
+        "  -o, --output M'           output mesh (must not be an input)\n"
+        "  --threads N               threads (default: all)\n"
+        "  --verbose                 timings and debug messages on stderr\n\n"
+        "exit codes: 0 done, 1 usage, 2 bad input.\n");
+}
+
+typedef struct deform_args {
+    const char *mesh, *handles, *fixed, *out;
+    int fix_boundary, mls, shell, exact, threads, verbose;
+    double stretch, bend, fix;
+    size_t samples;
+} deform_args;
+
+static int number(const char *v, double *out)
+{
+    char *end;
+    errno = 0;
+    double d = strtod(v, &end);
+    if (errno || *end || end == v || !isfinite(d) || d < 0) return -1;
+    *out = d;
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, deform_args *a)
+{
+    static const char *cmd = "deform";
+    memset(a, 0, sizeof *a);
+    a->mls = 1;
+    a->stretch = 1, a->bend = 1, a->fix = 1000;
+    for (int i = 1; i < argc; ++i) {
+        const char *o = argv[i], *v;
+        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
+            print_help();
+            return CLI_EXIT_OK;
+        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
+            a->verbose = 1;
+        } else if (!strcmp(o, "--fix-unlisted-boundary")) {
+            a->fix_boundary = 1;
+        } else if (!strcmp(o, "--exact-constraints")) {
+            a->exact = 1;
+        } else if (!strcmp(o, "--mesh")) {
+            if (!(a->mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--handles")) {
+            if (!(a->handles = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--fixed")) {
+            if (!(a->fixed = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
+            if (!(a->out = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+        } else if (!strcmp(o, "--method")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            if (!strcmp(v, "rbf"))
+                a->mls = 0;
+            else if (!strcmp(v, "mls"))
+                a->mls = 1;
+            else if (!strcmp(v, "shell"))
+                a->mls = 0, a->shell = 1;
+            else
+                return cli_usage(cmd, usage_line, "unknown method '%s' (rbf|mls|shell)", v);
+        } else if (!strcmp(o, "--stretch") || !strcmp(o, "--bend") || !strcmp(o, "--fix")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            double *dst = o[2] == 's' ? &a->stretch : o[2] == 'b' ? &a->bend : &a->fix;
+            if (number(v, dst))
+                return cli_usage(cmd, usage_line, "%s: '%s' is not a number >= 0", o, v);
+        } else if (!strcmp(o, "--samples")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            double d;
+            if (number(v, &d) || d < 4 || d > 1e8 || d != floor(d))
+                return cli_usage(cmd, usage_line, "--samples: '%s' is not an integer >= 4", v);
+            a->samples = (size_t)d;
+        } else if (!strcmp(o, "--threads")) {
+            if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
+                return CLI_EXIT_USAGE;
+        } else {
+            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
+        }
+    }
+    if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
+    if (!a->handles) return cli_usage(cmd, usage_line, "--handles is required");
+    if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
+    if (a->fixed && a->fix_boundary)
+        return cli_usage(cmd, usage_line, "--fixed and --fix-unlisted-boundary exclude each other");
+    if ((a->mls || a->shell) && (a->fix <= 0 || a->stretch + a->bend <= 0))
+        return cli_usage(cmd, usage_line, "--fix must be > 0 and --stretch + --bend > 0");
+    if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
+        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
+                         a->out);
+    if (cli_same_file(a->out, a->mesh) || cli_same_file(a->out, a->handles) ||
+        (a->fixed && cli_same_file(a->out, a->fixed)))
+        return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
+                         a->out);
+    return -1;
+}
+
+/* F.csv: header `node`, one 0-based index per line; blank lines and CRLF accepted. */
+static cm_status read_fixed(cm_context *ctx, const char *path, size_t n, unsigned char *fixed)
+{
+    char *data = NULL;
+    size_t size = 0;
+    cm_status s = cm_file_read(ctx, path, &data, &size);
+    if (s < 0) return s;
+    char *p = data;
+    long line = 0;
+    int header = 0;
+    while (p && *p) {
+        char *e = strchr(p, '\n');
+        if (e) *e = 0;
+        ++line;
+        size_t len = strlen(p);
+        while (len && (p[len - 1] == '\r' || p[len - 1] == ' ')) p[--len] = 0;
+        if (len) {
+            if (!header) {
+                if (strcmp(p, "node")) {
+                    s = cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: expected the header 'node'", path, line);
+                    break;
+                }
+                header = 1;
+            } else {
+                char *end;
+                errno = 0;
+                long long v = strtoll(p, &end, 10);
+                if (errno || *end || end == p) {
+                    s = cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: '%s' is not a node index", path, line, p);
+                    break;
+                }
+                if (v < 0 || (unsigned long long)v >= n) {
+                    s = cm_error(ctx, CM_ERR_MISMATCH, "%s:%ld: node %lld out of range (%zu nodes)",
+                                 path, line, v, n);
+                    break;
+                }
+                fixed[v] = 1;
+            }
+        }
+        p = e ? e + 1 : NULL;
+    }
+    if (s >= 0 && !header) s = cm_error(ctx, CM_ERR_FORMAT, "%s: empty (expected the header 'node')", path);
+    free(data);
+    return s;
+}
+
+/* Triharmonic RBF through the constrained nodes, evaluated at the others. */
+static cm_status deform_rbf(cm_context *ctx, const cm_mesh *m, const unsigned char *con, double *disp)
+{
+    size_t n = m->n_nodes, nc = 0;
+    for (size_t i = 0; i < n; ++i)
+        nc += con[i] != 0;
+    double *c = malloc((nc ? nc : 1) * 3 * sizeof *c), *v = malloc((nc ? nc : 1) * 3 * sizeof *v);
+    double *f = malloc(((n - nc) ? n - nc : 1) * 3 * sizeof *f), *out = malloc(((n - nc) ? n - nc : 1) * 3 * sizeof *out);
+    cm_rbf *rbf = NULL;
+    cm_status s = c && v && f && out ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+    for (size_t i = 0, a = 0, b = 0; s >= 0 && i < n; ++i)
+        if (con[i]) {
+            memcpy(c + 3 * a, m->xyz + 3 * i, 3 * sizeof *c);
+            memcpy(v + 3 * a++, disp + 3 * i, 3 * sizeof *v);
+        } else {
+            memcpy(f + 3 * b++, m->xyz + 3 * i, 3 * sizeof *f);
+        }
+    if (s >= 0) s = cm_rbf_create(ctx, CM_RBF_TRIHARMONIC, 3, nc, c, &rbf);
+    if (s >= 0) s = cm_rbf_solve(ctx, rbf, 3, v);
+    if (s >= 0 && n > nc) s = cm_rbf_evaluate(ctx, rbf, n - nc, f, out);
+    for (size_t i = 0, b = 0; s >= 0 && i < n; ++i)
+        if (!con[i]) memcpy(disp + 3 * i, out + 3 * b++, 3 * sizeof *disp);
+    cm_rbf_destroy(&rbf);
+    free(c), free(v), free(f), free(out);
+    return s;
+}
+
+int cli_cmd_deform(int argc, char **argv)
+{
+    deform_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc >= 0) return rc;
+    cm_context *ctx = cli_context_create("deform", a.verbose, a.threads);
+    if (!ctx) return CLI_EXIT_INTERNAL;
+    cm_mesh *mesh = NULL;
+    cm_mesh_boundary *b = NULL;
+    double *disp = NULL, *H = NULL, *field = NULL, *sj = NULL;
+    unsigned char *con = NULL, *fixed = NULL, *border = NULL;
+    cm_status s = cm_mesh_read(ctx, a.mesh, &mesh);
+    size_t n = s >= 0 ? mesh->n_nodes : 0;
+    int volume = s >= 0 && cm_mesh_count_dim(mesh, 3) > 0;
+    if (s >= 0 && !volume && cm_mesh_count_dim(mesh, 2) == 0)
+        s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: neither faces nor volume cells", a.mesh);
+    if (s >= 0) {
+        disp = malloc((n ? n : 1) * 3 * sizeof *disp);
+        con = calloc(n ? n : 1, 1);
+        fixed = calloc(n ? n : 1, 1);
+        border = calloc(n ? n : 1, 1);
+        H = malloc((n ? n : 1) * sizeof *H);
+        if (!disp || !con || !fixed || !border || !H) s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+    }
+    if (s >= 0) s = cm_warp_read_displacements(ctx, a.handles, n, disp, con);
+    if (s >= 0 && a.fixed) s = read_fixed(ctx, a.fixed, n, fixed);
+    if (s >= 0 && !volume) s = cm_mls_mean_curvature(ctx, mesh, H, border);
+    if (s >= 0 && volume && a.fix_boundary) {
+        s = cm_mesh_boundary_create(ctx, mesh, &b);
+        if (s >= 0) {
+            s = CM_OK;
+            for (size_t i = 0; i < b->n_nodes; ++i)
+                border[b->nodes[i]] = 1;
+        }
+    }
+    size_t nh = 0, nf = 0;
+    for (size_t i = 0; s >= 0 && i < n; ++i) {
+        if (con[i] && fixed[i]) {
+            s = cm_error(ctx, CM_ERR_MISMATCH, "node %zu is both a handle and fixed", i);
+            break;
+        }
+        if (a.fix_boundary && border[i] && !con[i]) fixed[i] = 1;
+        nh += con[i] != 0;
+        nf += fixed[i] != 0;
+        if (fixed[i]) con[i] = 1, disp[3 * i] = disp[3 * i + 1] = disp[3 * i + 2] = 0;
+        else if (con[i]) con[i] = 2; /* the MLS weighs handle and fixed groups apart */
+    }
+    if (s >= 0 && nh == 0) s = cm_error(ctx, CM_ERR_ARGUMENT, "%s: no handle node", a.handles);
+    double residual = 0, t0 = cm_wtime();
+    if (s >= 0 && a.shell && volume)
+        s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: --method shell deforms surface meshes only", a.mesh);
+    if (s >= 0 && a.shell) s = cm_mls_shell(ctx, mesh, con, a.stretch, a.bend, a.fix, disp);
+    if (s >= 0 && !a.mls && !a.shell) s = deform_rbf(ctx, mesh, con, disp);
+    if (s >= 0 && a.mls) {
+        cm_mls_options o;
+        cm_mls_options_init(&o);
+        o.stretch = a.stretch, o.bend = a.bend, o.fix = a.fix, o.samples = a.samples;
+        o.keep_constrained = a.exact;
+        cm_mls *mls = NULL;
+        s = cm_mls_create(ctx, mesh, con, &o, &mls);
+        if (s >= 0) s = cm_mls_apply(ctx, mls, disp, &residual);
+        cm_mls_stats st;
+        cm_mls_get_stats(mls, &st);
+        if (s >= 0)
+            cm_log(ctx, CM_LOG_DEBUG,
+                   "deform mls: %zu samples (%zu surface), %zu cubature points, %zu constrained; "
+                   "sample %.3f s, basis %.3f s, factor %.3f s (%zu entries), apply %.3f s",
+                   st.samples, st.surface_samples, st.cubature, st.constrained, st.t_sample,
+                   st.t_basis, st.t_factor, st.factor_nonzeros, st.t_apply);
+        cm_mls_destroy(&mls);
+    }
+    double t1 = cm_wtime();
+    if (s >= 0) {
+        for (size_t i = 0; i < 3 * n; ++i)
+            mesh->xyz[i] += disp[i];
+        s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &field);
+        if (s >= 0) memcpy(field, disp, n * 3 * sizeof *field);
+    }
+    double h_before[3] = {0, 0, 0}; /* min, mean, max over interior vertices */
+    if (s >= 0 && !volume) {
+        for (int pass = 0; pass < 2 && s >= 0; ++pass) {
+            if (pass == 1) s = cm_mls_mean_curvature(ctx, mesh, H, border);
+            double mn = INFINITY, mx = 0, sum = 0;
+            size_t cnt = 0;
+            for (size_t i = 0; s >= 0 && i < n; ++i)
+                if (!border[i]) mn = fmin(mn, H[i]), mx = fmax(mx, H[i]), sum += H[i], ++cnt;
+            if (pass == 0) {
+                h_before[0] = cnt ? mn : 0, h_before[1] = cnt ? sum / (double)cnt : 0, h_before[2] = mx;
+                /* H of the input was computed before the move */
+                continue;
+            }
+            if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "mean_curvature", CM_FIELD_NODE, 1, &field);
+            if (s >= 0) memcpy(field, H, n * sizeof *field);
+            if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
+            if (s >= 0) {
+                printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
+                       a.mls ? "mls" : a.shell ? "shell" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                printf("mean_curvature (interior vertices): before min=%.6g mean=%.6g max=%.6g; "
+                       "after min=%.6g mean=%.6g max=%.6g\n",
+                       h_before[0], h_before[1], h_before[2], cnt ? mn : 0,
+                       cnt ? sum / (double)cnt : 0, mx);
+            }
+        }
+    }
+    if (s >= 0 && volume) {
+        s = cm_mesh_add_field(ctx, mesh, "scaled_jacobian", CM_FIELD_CELL, 1, &sj);
+        if (s >= 0) s = cm_mesh_quality(ctx, mesh, sj);
+        if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
+        if (s >= 0) {
+            printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
+                   a.mls ? "mls" : a.shell ? "shell" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+            s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
+        }
+    }
+    rc = s < 0 ? cli_fail(ctx, "deform", s) : CLI_EXIT_OK;
+    free(disp), free(con), free(fixed), free(border), free(H);
+    cm_mesh_boundary_destroy(&b);
+    cm_mesh_destroy(&mesh);
+    cm_context_destroy(&ctx);
+    return rc;
+}

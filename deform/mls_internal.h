@@ -1,0 +1,66 @@
+/* Private pieces of the MLS space deformation (mls.h): a uniform grid over points for
+ * nearest-sample queries, the support grid of the shape functions, and the sampling. */
+#ifndef CADMORPH_DEFORM_MLS_INTERNAL_H
+#define CADMORPH_DEFORM_MLS_INTERNAL_H
+
+#include "cadmorph/mls.h"
+
+#include <stdint.h>
+
+/* Points bucketed by a uniform grid (cells of size h over their bounding box). */
+typedef struct mls_grid {
+    double lo[3], h;
+    int n[3];
+    int32_t *start; /* #cells + 1 */
+    int32_t *items; /* point indices, ascending within a cell */
+    const double *xyz;
+    size_t n_points;
+} mls_grid;
+
+/* target: points per cell (about). */
+cm_status mls_grid_build(cm_context *ctx, mls_grid *g, size_t n, const double *xyz,
+                         double target);
+void mls_grid_free(mls_grid *g);
+/* The s nearest points of x (fewer if the grid has fewer): idx and dist ascending by
+ * distance; returns the count. */
+int mls_grid_nearest(const mls_grid *g, const double x[3], int s, int32_t *idx, double *dist);
+
+/* The shape functions: samples with a support radius each, and a grid whose cells list every
+ * sample whose support box overlaps them (ascending). */
+struct cm_mls_basis {
+    size_t k;
+    double *c;     /* k x 3 */
+    double *sigma; /* k */
+    double lo[3], h;
+    int n[3];
+    int32_t *start, *items;
+    int max_list; /* longest cell list: an upper bound on the samples covering a point */
+};
+
+/* Shape functions at x into caller scratch of max_list entries; grad/lap may be NULL.
+ * Returns the count (0: no sample covers x). */
+int mls_basis_eval(const cm_mls_basis *b, const double x[3], int32_t *idx, double *phi,
+                   double *grad, double *lap);
+
+/* Samples of a mesh (section 4-5): dense random points on its surface (2D cells, or the
+ * boundary faces of a volume mesh) and in its volume cells. */
+typedef struct mls_dense {
+    size_t n_s, n_v;      /* surface, volume points */
+    double *xyz;          /* (n_s + n_v) x 3: surface points first */
+    double area, volume;  /* total measures */
+} mls_dense;
+
+cm_status mls_dense_create(cm_context *ctx, const cm_mesh *mesh, size_t n_surface,
+                           size_t n_volume, uint64_t seed, mls_dense *d);
+void mls_dense_free(mls_dense *d);
+
+/* k points out of dense points [first, first + n): farthest-point subset (from a seeded
+ * random start) into out (k x 3). */
+cm_status mls_farthest(cm_context *ctx, const double *xyz, size_t n, size_t k, uint64_t seed,
+                       double *out);
+/* Lloyd relaxation of k centres over n weighted points (weight[i], NULL = 1); mass: k output
+ * (sum of the weights of the points closest to each centre, may be NULL). */
+cm_status mls_lloyd(cm_context *ctx, const double *xyz, const double *weight, size_t n,
+                    int iterations, size_t k, double *centres, double *mass);
+
+#endif
