@@ -106,10 +106,9 @@ static void ensure_tables(void)
     }
 }
 
-/* ||S||_F^2 and det S of S = A W^-1 for corner k. */
-static void corner_s(const corner_table *tb, int k, const double *x, double *frob, double *det)
+/* A (corner matrix) and S = A W^-1 of corner k; returns ||S||_F^2. */
+static double corner_as(const corner_table *tb, int k, const double *x, double *a, double *s)
 {
-    double a[9], s[9];
     corner_matrix(x, tb->c[k], a);
     const double *w = tb->winv[k];
     for (int j = 0; j < 3; ++j)
@@ -118,7 +117,14 @@ static void corner_s(const corner_table *tb, int k, const double *x, double *fro
     double f = 0;
     for (int i = 0; i < 9; ++i)
         f += s[i] * s[i];
-    *frob = f;
+    return f;
+}
+
+/* ||S||_F^2 and det S of S = A W^-1 for corner k. */
+static void corner_s(const corner_table *tb, int k, const double *x, double *frob, double *det)
+{
+    double a[9], s[9];
+    *frob = corner_as(tb, k, x, a, s);
     *det = det3(s);
 }
 
@@ -130,14 +136,8 @@ static double corner_cost_grad(const corner_table *tb, int k, const double *x, d
                                double *dA)
 {
     double a[9], sm[9];
-    corner_matrix(x, tb->c[k], a);
+    const double f = corner_as(tb, k, x, a, sm);
     const double *w = tb->winv[k];
-    for (int j = 0; j < 3; ++j)
-        for (int i = 0; i < 3; ++i)
-            sm[3 * j + i] = a[i] * w[3 * j] + a[3 + i] * w[3 * j + 1] + a[6 + i] * w[3 * j + 2];
-    double f = 0;
-    for (int i = 0; i < 9; ++i)
-        f += sm[i] * sm[i];
     const double dw = det3(w), sdet = det3(a) * dw;
     const double root = delta > 0 ? sqrt(sdet * sdet + 4 * delta * delta) : 0;
     const double hs = delta > 0 ? 0.5 * (sdet + root) : sdet;
