@@ -85,6 +85,7 @@ void cm_rbf_destroy(cm_rbf **rbf)
     free(r->chol);
     free(r->w);
     free(r->q);
+    cm_rbf_iterative_destroy(&r->iter);
     free(r);
     *rbf = NULL;
 }
@@ -323,6 +324,13 @@ done:
 cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
                         const double *centres, cm_rbf **rbf)
 {
+    return cm_rbf_create_opt(ctx, kernel, dim, m, centres, NULL, rbf);
+}
+
+cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
+                            const double *centres, const cm_rbf_options *opt, cm_rbf **rbf)
+{
+    const double t_start = cm_wtime();
     if (!rbf) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: rbf is NULL");
     *rbf = NULL;
     if (kernel != CM_RBF_TRIHARMONIC && kernel != CM_RBF_BIHARMONIC &&
@@ -346,6 +354,8 @@ cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m
     r->k = dim + 1;
     r->m_in = m;
     r->sign = kernel == CM_RBF_BIHARMONIC ? -1.0 : 1.0;
+    if (opt) r->opt = *opt;
+    else cm_rbf_options_init(&r->opt);
     const int threads = cm_rbf_threads(ctx);
     const int saved_blas_threads = openblas_get_num_threads();
 
@@ -358,7 +368,17 @@ cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m
                       "linear polynomial in %d dimensions needs at least %d",
                       r->m, dim, dim + 1);
     if (st == CM_OK) st = factor_polynomial(ctx, r);
-    if (st == CM_OK) st = factor_projected(ctx, r, threads);
+    cm_rbf_solver solver = r->opt.solver;
+    if (solver == CM_RBF_SOLVER_AUTO)
+        solver = cm_rbf_auto_dense(kernel, r->m) ? CM_RBF_SOLVER_DENSE : CM_RBF_SOLVER_ITERATIVE;
+    r->stats.solver = solver;
+    r->stats.centres = r->m;
+    if (st == CM_OK)
+        st = solver == CM_RBF_SOLVER_ITERATIVE ? cm_rbf_iterative_setup(ctx, r, threads)
+                                               : factor_projected(ctx, r, threads);
+    if (st == CM_OK && solver == CM_RBF_SOLVER_DENSE)
+        r->stats.memory_bytes = (r->m - (size_t)r->k) * (r->m - (size_t)r->k + 1) / 2 * 8;
+    r->stats.setup_seconds = cm_wtime() - t_start;
     openblas_set_num_threads(saved_blas_threads);
     if (st != CM_OK) {
         cm_rbf_destroy(&r);
@@ -506,13 +526,15 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
         }
     const int saved_blas_threads = openblas_get_num_threads();
     blas_threads(1);
-    st = solve_pass(ctx, rbf, nc, f, w, q, aw, g, threads);
+    const double t_start = cm_wtime();
+    st = rbf->iter ? cm_rbf_iterative_solve(ctx, rbf, nc, f, w, q, threads)
+                   : solve_pass(ctx, rbf, nc, f, w, q, aw, g, threads);
     /* Iterative refinement with the same factorisation: the cubic kernel's system is badly
      * conditioned for dense centres, and one or two cheap O(m^2) passes recover digits the
      * O(m^3) factorisation lost. Skipped when the first residual is already tiny. */
     double prev = INFINITY, first = -1.0, e = 0.0;
     int steps = 0;
-    for (; st == CM_OK; ++steps) {
+    for (; st == CM_OK && !rbf->iter; ++steps) {
         e = residual(rbf, nc, f, aw, q, res) / (fmaxabs > 0.0 ? fmaxabs : 1.0);
         if (first < 0.0) first = e;
         if (e <= CM_RBF_REFINE_TOL || !(e < 0.5 * prev) || steps == CM_RBF_REFINE_STEPS) break;
@@ -525,12 +547,17 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
         }
         for (size_t i = 0; i < k * nc; ++i) q[i] += dq[i];
     }
-    if (st == CM_OK)
+    rbf->stats.solve_seconds = cm_wtime() - t_start;
+    if (st == CM_OK && !rbf->iter) {
+        rbf->stats.residual = e;
+        rbf->stats.iterations = steps;
+    }
+    if (st == CM_OK && !rbf->iter)
         cm_log(ctx, CM_LOG_DEBUG,
                "cm_rbf_solve: relative residual at the centres %.2g, after %d refinement "
                "steps %.2g",
                first, steps, e);
-    if (st == CM_OK) {
+    if (st >= CM_OK) { /* a warning keeps the weights: the message says how good they are */
         free(rbf->w);
         free(rbf->q);
         rbf->w = w;

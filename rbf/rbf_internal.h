@@ -10,6 +10,8 @@
 /* Below this many point-centre pairs a loop runs on one thread: forking costs more. */
 #define CM_RBF_PARALLEL_MIN_PAIRS 200000.0
 
+typedef struct cm_rbf_iter cm_rbf_iter;
+
 struct cm_rbf {
     cm_rbf_kernel kernel;
     int dim;          /* 2 or 3 */
@@ -28,6 +30,9 @@ struct cm_rbf {
     int ncomp;        /* components of the current weights, 0 before the first solve */
     double *w;        /* ncomp x m, SoA: kernel weights */
     double *q;        /* ncomp x k: polynomial coefficients in unit-box coordinates */
+    cm_rbf_options opt;
+    cm_rbf_stats stats;
+    cm_rbf_iter *iter; /* iterative solver state, NULL for dense (then chol is set) */
 };
 
 /* Threads for a leaf loop: the context's count, or all that OpenMP offers for 0. */
@@ -65,5 +70,30 @@ int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
  * receives the count. CM_ERR_NOMEM, with a message starting with who, if not even the
  * calling thread's buffer fits: OpenBLAS would spin forever trying to allocate it. */
 cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *got);
+/* ---- iterative solver (rbf_iterative.c, rbf_schwarz.c) ---- */
+
+/* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */
+int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m);
+
+/* Builds r->iter (preconditioner) for the centres in r (placed, P factored). */
+cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads);
+/* f: nc x m SoA (merged centres) -> w (nc x m SoA), q (nc x k); fills r->stats. */
+cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
+                                 double *w, double *q, int threads);
+void cm_rbf_iterative_destroy(cm_rbf_iter **it);
+
+typedef struct cm_rbf_schwarz cm_rbf_schwarz;
+
+/* Two-level restricted additive Schwarz for the r^3 system on the centres of r. */
+cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
+                                cm_rbf_schwarz **pc);
+void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc);
+/* out = M in for nc (1..4) vectors, nc x m SoA each: coarse solve, coarse residual, then
+ * the restricted local solves. out is not projected onto the null space of P'. */
+void cm_rbf_schwarz_apply(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc, const double *in,
+                          double *out, int threads);
+size_t cm_rbf_schwarz_bytes(const cm_rbf_schwarz *pc);
+int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc);
+int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc);
 
 #endif

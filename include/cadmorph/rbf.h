@@ -23,13 +23,80 @@ typedef enum cm_rbf_kernel {
 
 typedef struct cm_rbf cm_rbf;
 
+/* How the system is solved. DENSE: null-space projected Cholesky of the m x m system,
+ * O(m^2) memory and O(m^3) time, any kernel, m <= 60000. ITERATIVE (triharmonic only):
+ * FGMRES in the null space of the polynomial block, right-preconditioned by a two-level
+ * restricted additive Schwarz method (kD-tree leaves grown by an overlap, each solved by
+ * the dense projected Cholesky of its own r^3 system; a coarse space of farthest-point
+ * centres solved exactly), with direct-summation matvecs: O(m * local_size) memory and
+ * O(m^2) time per iteration. AUTO: dense below a size set by a measured cost model (time
+ * and memory, see rbf_iterative.c), iterative above; dense for kernels other than r^3. */
+typedef enum cm_rbf_solver {
+    CM_RBF_SOLVER_AUTO = 0,
+    CM_RBF_SOLVER_DENSE = 1,
+    CM_RBF_SOLVER_ITERATIVE = 2
+} cm_rbf_solver;
+
+/* Options of cm_rbf_create_opt; cm_rbf_options_init fills the defaults (in brackets).
+ * Fields other than solver matter only for the iterative solver. */
+typedef struct cm_rbf_options {
+    cm_rbf_solver solver; /* [AUTO] */
+    double tolerance;     /* [1e-10] stop when max_i |f_i - s(c_i)| <= tolerance * max |f|,
+                           * or at the attainable floor if that is higher (see stats) */
+    int max_iterations;   /* [300] Krylov iterations per component, over all restarts */
+    int restart;          /* [40] FGMRES restart length */
+    int leaf_size;        /* [256] kD-tree leaf size: leaves hold leaf_size/2..leaf_size
+                           * centres and are the disjoint cores of the subdomains */
+    int local_size;       /* [1400] centres per overlapping subdomain (the leaf plus the
+                           * centres nearest to its box): the overlap is the knob that
+                           * matters on thin walls */
+    int coarse_size;      /* [2000] farthest-point centres of the coarse space, 0: none */
+    int local_float;      /* [1] store the local inverse rows in float (half the memory;
+                           * the preconditioner need not be exact, the residual is) */
+} cm_rbf_options;
+
+CM_API void cm_rbf_options_init(cm_rbf_options *opt);
+
+/* Figures of the last create and solve (cm_rbf_stats). */
+typedef struct cm_rbf_stats {
+    cm_rbf_solver solver;  /* the one used: DENSE or ITERATIVE */
+    size_t centres;        /* after merging duplicates */
+    int subdomains;        /* iterative: Schwarz subdomains; 0 for dense */
+    int coarse_size;       /* iterative: coarse centres */
+    double setup_seconds;  /* create: factorisation or preconditioner set-up */
+    double solve_seconds;  /* last solve */
+    size_t memory_bytes;   /* factor or preconditioner + Krylov storage of the last solve */
+    int iterations;        /* last solve: Krylov iterations (largest over components);
+                            * dense: refinement steps */
+    int matvecs;           /* last solve: direct-summation products with the m x m matrix
+                            * (one per iteration and restart, all components together) */
+    double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| (exactness at the
+                            * centres, computed by direct summation after the solve) */
+    double floor;          /* iterative: the rounding error of the direct sums, as a
+                            * relative residual: eps max_i sum_j |w_j| phi(|c_i - c_j|) / max|f|
+                            * (computed when a restart finds the tolerance not yet met) */
+    int floor_limited;     /* 1 if the solve stagnated above the tolerance but within 10x
+                            * the floor: the attainable accuracy, not a failure */
+} cm_rbf_stats;
+
+CM_API void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats);
+
 /* Fits the system for m centres (centres: m x dim row-major; dim 3 for the triharmonic and
  * biharmonic kernels, 2 for thin plate) and keeps its factorisation. Centres closer than
  * 1e-12 x the bounding-box diagonal are merged (their values must then agree, see solve).
  * Errors: CM_ERR_NUMERIC if the centres leave the polynomial block singular (all coplanar
- * in 3D, collinear in 2D) or the factorisation fails (the message has the pivot). */
+ * in 3D, collinear in 2D) or the factorisation fails (the message has the pivot).
+ * Uses the AUTO solver (see cm_rbf_solver). */
 CM_API cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
-                               const double *centres, cm_rbf **rbf);
+                        const double *centres, cm_rbf **rbf);
+/* cm_rbf_create with options (NULL: the defaults). With the iterative solver, create builds
+ * the preconditioner (the costly step, reused by every solve on these centres); a solve
+ * that stops above the tolerance because it stagnates returns CM_WARNING (weights kept,
+ * the message and stats have the residual); one that stops at the attainable floor
+ * returns CM_OK with stats.floor_limited = 1. CM_ERR_UNSUPPORTED for ITERATIVE with a
+ * kernel other than r^3. */
+CM_API cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
+                            const double *centres, const cm_rbf_options *opt, cm_rbf **rbf);
 CM_API void cm_rbf_destroy(cm_rbf **rbf);
 
 /* Solves for values at the m centres given to create (values: m x ncomp row-major) and keeps
@@ -39,9 +106,9 @@ CM_API void cm_rbf_destroy(cm_rbf **rbf);
 CM_API cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values);
 
 /* Evaluates the current interpolant at n points (points: n x dim) into out (n x ncomp).
- * OpenMP-parallel over points; no n x m matrix is formed. */
+ * OpenMP-parallel over points; no n x m matrix is formed. Same for both solvers. */
 CM_API cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const double *points,
-                                 double *out);
+                          double *out);
 
 /* Centres after merging duplicates. */
 CM_API size_t cm_rbf_centre_count(const cm_rbf *rbf);

@@ -15,3 +15,5 @@ cm_add_unit_test(test_cholesky_blocked ${CMAKE_CURRENT_LIST_DIR}/test_cholesky_b
 # the BLAS-core decision table (cpuid flags and core names in, decision out), cm_blas_info
 cm_add_unit_test(test_blas_core ${CMAKE_CURRENT_LIST_DIR}/test_blas_core.c
   LIBS cm_rbf LABELS rbf)
+# iterative solver vs dense on a box-with-bore boundary set, affine data, two bodies, threads
+cm_add_unit_test(test_rbf_iterative ${CMAKE_CURRENT_LIST_DIR}/test_rbf_iterative.c LIBS cm_rbf LABELS rbf)

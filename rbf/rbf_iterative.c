@@ -1,0 +1,415 @@
+/* Iterative solver for the r^3 + linear RBF system: restarted FGMRES in the null space of
+ * the polynomial block, right-preconditioned by two-level restricted Schwarz
+ * (rbf_schwarz.c), with direct-summation matvecs (rbf_sum.c).
+ *
+ * Why the null space: with Pi = I - Q1 Q1' (Q1 an orthonormal basis of the polynomials at
+ * the centres), the weights are the solution of Pi A w = Pi f with Pi w = w, and Pi A Pi is
+ * SPD there. Every Krylov vector is kept in range(Pi), so the polynomial coefficients never
+ * enter the iteration; they follow at the end from R q = Q1'(f - A w), and Pi(f - A w) is
+ * then exactly the residual at the centres, f - A w - P q. Why FGMRES rather than CG: the
+ * restricted Schwarz preconditioner is not symmetric (and is stored in float), so CG's
+ * short recurrence does not hold; GMRES needs one matvec per iteration like CG, and the
+ * iteration counts here are small, so the extra orthogonalisation is cheap. The components
+ * of the data run in lock step, so one kernel-sum pass serves up to four of them. */
+#include "rbf_internal.h"
+
+#include <cblas.h>
+#include <float.h>
+#include <lapacke.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* The rounding error of one direct sum A w is at most about eps sum_j |w_j phi_ij|; the
+ * error of a whole solve, observed, stays within this factor of that estimate. */
+#define CM_RBF_FLOOR_SLACK 10.0
+
+struct cm_rbf_iter {
+    cm_rbf_schwarz *pc;
+    double *q1; /* m x k col-major, orthonormal basis of the polynomials at the centres */
+};
+
+void cm_rbf_options_init(cm_rbf_options *opt)
+{
+    if (!opt) return;
+    memset(opt, 0, sizeof *opt);
+    opt->solver = CM_RBF_SOLVER_AUTO;
+    opt->tolerance = 1e-10;
+    opt->max_iterations = 300;
+    opt->restart = 40;
+    opt->leaf_size = 256;
+    opt->local_size = 1400;
+    opt->coarse_size = 2000;
+    opt->local_float = 1;
+}
+
+void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
+{
+    if (!stats) return;
+    if (!rbf) {
+        memset(stats, 0, sizeof *stats);
+        return;
+    }
+    *stats = rbf->stats;
+}
+
+/* Cost model for AUTO, from benchmarks/bench_rbf_iterative (RESULTS.md, this machine kind):
+ * the dense fit grows as m^3 and its factor takes 4 m^2 bytes, the iterative one as
+ * (iterations) m^2 plus a set-up linear in m; they cross near m = CM_RBF_AUTO_DENSE_MAX.
+ * The dense path is also refused when its factor would take more than half the memory. */
+#define CM_RBF_AUTO_DENSE_MAX 8000
+
+int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
+{
+    if (kernel != CM_RBF_TRIHARMONIC) return 1;
+    if (m > CM_RBF_AUTO_DENSE_MAX) return 0;
+    long pages = sysconf(_SC_PHYS_PAGES), psize = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && psize > 0 && 4.0 * (double)m * (double)m > 0.5 * (double)pages * (double)psize)
+        return 0;
+    return 1;
+}
+
+void cm_rbf_iterative_destroy(cm_rbf_iter **it)
+{
+    if (!it || !*it) return;
+    cm_rbf_schwarz_destroy(&(*it)->pc);
+    free((*it)->q1);
+    free(*it);
+    *it = NULL;
+}
+
+cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
+{
+    const size_t m = r->m, k = (size_t)r->k;
+    const cm_rbf_options *o = &r->opt;
+    if (r->kernel != CM_RBF_TRIHARMONIC || r->dim != 3)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "cm_rbf_create: the iterative solver handles the 3D r^3 kernel only");
+    if (!(o->tolerance > 0.0) || o->max_iterations < 1 || o->restart < 2 || o->leaf_size < 8 ||
+        o->local_size < o->leaf_size || o->coarse_size < 0)
+        return cm_error(ctx, CM_ERR_ARGUMENT,
+                        "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
+                        "restart %d, leaf_size %d, local_size %d, coarse_size %d)",
+                        o->tolerance, o->max_iterations, o->restart, o->leaf_size,
+                        o->local_size, o->coarse_size);
+    cm_rbf_iter *it = calloc(1, sizeof *it);
+    if (!it) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+    it->q1 = malloc(m * k * sizeof *it->q1);
+    if (!it->q1) {
+        free(it);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+    }
+    memcpy(it->q1, r->qr, m * k * sizeof *it->q1);
+    lapack_int info = LAPACKE_dorgqr(LAPACK_COL_MAJOR, (lapack_int)m, (lapack_int)k,
+                                     (lapack_int)k, it->q1, (lapack_int)m, r->tau);
+    cm_status st = info == 0 ? CM_OK
+                             : cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: dorgqr failed (info %d)",
+                                        (int)info);
+    if (st == CM_OK) st = cm_rbf_schwarz_create(ctx, r, threads, &it->pc);
+    if (st != CM_OK) {
+        cm_rbf_iterative_destroy(&it);
+        return st;
+    }
+    r->iter = it;
+    r->stats.subdomains = cm_rbf_schwarz_subdomains(it->pc);
+    r->stats.coarse_size = cm_rbf_schwarz_coarse(it->pc);
+    r->stats.memory_bytes = cm_rbf_schwarz_bytes(it->pc) + m * k * sizeof(double);
+    return CM_OK;
+}
+
+/* v -= Q1 (Q1' v), twice (the second pass removes what round-off left of the first). */
+static void project(const double *q1, size_t m, int k, double *v)
+{
+    for (int pass = 0; pass < 2; ++pass)
+        for (int a = 0; a < k; ++a) {
+            const double *qa = q1 + (size_t)a * m;
+            double s = cblas_ddot((int)m, qa, 1, v, 1);
+            cblas_daxpy((int)m, -s, qa, 1, v, 1);
+        }
+}
+
+/* Lock-step state of up to four components. */
+typedef struct krylov {
+    size_t m;
+    int R;          /* restart length */
+    int g;          /* components */
+    double *v[4];   /* (R+1) x m each */
+    double *z[4];   /* R x m each */
+    double *h[4];   /* (R+1) x R col-major */
+    double cs[4][64], sn[4][64], gv[4][65];
+    double *soa, *rowm, *aux; /* g x m scratch */
+} krylov;
+
+/* out_c = A in_c for the components in list (n of them, in: pointers to m-vectors). */
+static void matvec(const cm_rbf *r, krylov *kr, int n, double *const *in, double *const *out,
+                   int threads)
+{
+    const size_t m = kr->m;
+    for (int c = 0; c < n; ++c) memcpy(kr->soa + (size_t)c * m, in[c], m * sizeof(double));
+    cm_rbf_kernel_sum(r->kernel, 3, m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
+    for (int c = 0; c < n; ++c)
+        for (size_t i = 0; i < m; ++i) out[c][i] = kr->rowm[i * (size_t)n + (size_t)c];
+}
+
+static void precondition(const cm_rbf *r, krylov *kr, int n, double *const *in,
+                         double *const *out, int threads)
+{
+    const size_t m = kr->m;
+    for (int c = 0; c < n; ++c) memcpy(kr->soa + (size_t)c * m, in[c], m * sizeof(double));
+    cm_rbf_schwarz_apply(r->iter->pc, r, n, kr->soa, kr->aux, threads);
+    for (int c = 0; c < n; ++c) {
+        memcpy(out[c], kr->aux + (size_t)c * m, m * sizeof(double));
+        project(r->iter->q1, m, r->k, out[c]);
+    }
+}
+
+static double norm_inf(size_t m, const double *v)
+{
+    double s = 0.0;
+    for (size_t i = 0; i < m; ++i) s = fmax(s, fabs(v[i]));
+    return s;
+}
+
+/* Solves components [c0, c0 + g) of f (nc x m SoA) into w. it/stop/floor per component. */
+static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
+                             double *w, double *aw, int *iters, int *matvecs, double *floor_rel,
+                             int *status, int threads)
+{
+    const size_t m = kr->m;
+    const int g = kr->g, R = kr->R;
+    const cm_rbf_options *o = &r->opt;
+    double fnorm[4], prev[4], res[4], target[4], est[4] = {0, 0, 0, 0};
+    double *res_v[4], *ax[4];
+    int state[4]; /* 0 running, 1 converged, 2 floor, 3 stagnated, 4 max iterations */
+    for (int c = 0; c < g; ++c) {
+        fnorm[c] = norm_inf(m, f + (size_t)c * m);
+        prev[c] = INFINITY;
+        iters[c] = 0;
+        floor_rel[c] = 0.0;
+        state[c] = 0;
+        res_v[c] = kr->v[c]; /* the residual is built in V_0 */
+        ax[c] = aw + (size_t)c * m;
+        memset(w + (size_t)c * m, 0, m * sizeof(double));
+        memset(ax[c], 0, m * sizeof(double));
+    }
+    for (int cycle = 0;; ++cycle) {
+        /* true residual Pi(f - A w) of every running component */
+        double *in[4], *out[4];
+        int list[4], n = 0;
+        for (int c = 0; c < g; ++c)
+            if (state[c] == 0) {
+                list[n] = c;
+                in[n] = w + (size_t)c * m;
+                out[n] = ax[c];
+                ++n;
+            }
+        if (n == 0) break;
+        if (cycle > 0) {
+            matvec(r, kr, n, in, out, threads);
+            ++*matvecs;
+        }
+        int nfl = 0, fl[4];
+        double *absw[4], *afl[4];
+        for (int u = 0; u < n; ++u) {
+            int c = list[u];
+            double *rv = res_v[c];
+            for (size_t i = 0; i < m; ++i) rv[i] = f[(size_t)c * m + i] - ax[c][i];
+            project(r->iter->q1, m, r->k, rv);
+            res[c] = fnorm[c] > 0.0 ? norm_inf(m, rv) / fnorm[c] : 0.0;
+            if (res[c] <= o->tolerance) state[c] = 1;
+            else if (cycle > 0) {
+                fl[nfl] = c;
+                ++nfl;
+            }
+        }
+        /* the attainable floor: the rounding error of the sums A w themselves */
+        if (nfl > 0) {
+            for (int u = 0; u < nfl; ++u) {
+                int c = fl[u];
+                absw[u] = kr->z[c]; /* Z is free between cycles */
+                afl[u] = kr->z[c] + m;
+                for (size_t i = 0; i < m; ++i) absw[u][i] = fabs(w[(size_t)c * m + i]);
+            }
+            matvec(r, kr, nfl, absw, afl, threads);
+            ++*matvecs;
+            for (int u = 0; u < nfl; ++u) {
+                int c = fl[u];
+                floor_rel[c] = DBL_EPSILON * norm_inf(m, afl[u]) / fnorm[c];
+                /* a cycle that does not halve the residual has stagnated: at the floor if
+                 * within CM_RBF_FLOOR_SLACK of it, else a failure to converge */
+                if (res[c] > 0.5 * prev[c])
+                    state[c] = res[c] <= CM_RBF_FLOOR_SLACK * floor_rel[c] ? 2 : 3;
+                else if (iters[c] >= o->max_iterations)
+                    state[c] = res[c] <= CM_RBF_FLOOR_SLACK * floor_rel[c] ? 2 : 4;
+            }
+        }
+        for (int u = 0; u < n; ++u) {
+            int c = list[u];
+            cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: component %d, cycle %d: %d iterations, "
+                   "residual %.3g (floor %.3g), 2-norm %.3g (GMRES estimate %.3g)", c, cycle,
+                   iters[c], res[c], floor_rel[c], cblas_dnrm2((int)m, res_v[c], 1) / fnorm[c],
+                   est[c] / fnorm[c]);
+            prev[c] = res[c];
+        }
+        /* the inner loop stops on the 2-norm that GMRES minimises: aim for the max-norm
+         * target through the ratio of the two norms at the restart */
+        int act[4], na = 0;
+        for (int c = 0; c < g; ++c) {
+            if (state[c] != 0) continue;
+            double *v0 = kr->v[c];
+            double r2 = cblas_dnrm2((int)m, v0, 1), rinf = norm_inf(m, v0);
+            target[c] = 0.5 * o->tolerance * fnorm[c] * (r2 / rinf);
+            cblas_dscal((int)m, 1.0 / r2, v0, 1);
+            memset(kr->gv[c], 0, sizeof kr->gv[c]);
+            kr->gv[c][0] = r2;
+            act[na++] = c;
+        }
+        int jn[4] = {0, 0, 0, 0};
+        for (int j = 0; j < R && na > 0; ++j) {
+            double *vi[4], *zo[4], *wo[4];
+            for (int u = 0; u < na; ++u) {
+                int c = act[u];
+                vi[u] = kr->v[c] + (size_t)j * m;
+                zo[u] = kr->z[c] + (size_t)j * m;
+                wo[u] = kr->v[c] + (size_t)(j + 1) * m;
+            }
+            precondition(r, kr, na, vi, zo, threads);
+            matvec(r, kr, na, zo, wo, threads);
+            ++*matvecs;
+            int keep = 0;
+            for (int u = 0; u < na; ++u) {
+                int c = act[u];
+                double *wv = wo[u], *h = kr->h[c] + (size_t)j * (size_t)(R + 1);
+                project(r->iter->q1, m, r->k, wv);
+                for (int pass = 0; pass < 2; ++pass) /* classical Gram-Schmidt, twice */
+                    for (int i = 0; i <= j; ++i) {
+                        const double *vv = kr->v[c] + (size_t)i * m;
+                        double s = cblas_ddot((int)m, vv, 1, wv, 1);
+                        h[i] = (pass ? h[i] : 0.0) + s;
+                        cblas_daxpy((int)m, -s, vv, 1, wv, 1);
+                    }
+                double hn = cblas_dnrm2((int)m, wv, 1);
+                h[j + 1] = hn;
+                if (hn > 0.0) cblas_dscal((int)m, 1.0 / hn, wv, 1);
+                for (int i = 0; i < j; ++i) { /* earlier rotations */
+                    double t = kr->cs[c][i] * h[i] + kr->sn[c][i] * h[i + 1];
+                    h[i + 1] = -kr->sn[c][i] * h[i] + kr->cs[c][i] * h[i + 1];
+                    h[i] = t;
+                }
+                double d = hypot(h[j], h[j + 1]);
+                double cs = d > 0.0 ? h[j] / d : 1.0, sn = d > 0.0 ? h[j + 1] / d : 0.0;
+                kr->cs[c][j] = cs;
+                kr->sn[c][j] = sn;
+                h[j] = d;
+                h[j + 1] = 0.0;
+                kr->gv[c][j + 1] = -sn * kr->gv[c][j];
+                kr->gv[c][j] *= cs;
+                jn[c] = j + 1;
+                est[c] = fabs(kr->gv[c][j + 1]);
+                ++iters[c];
+                int done = fabs(kr->gv[c][j + 1]) <= target[c] || hn == 0.0 ||
+                           iters[c] >= o->max_iterations;
+                if (!done) act[keep++] = c;
+            }
+            na = keep;
+        }
+        /* w += Z y, H y = g (upper triangular after the rotations) */
+        for (int c = 0; c < g; ++c) {
+            if (jn[c] == 0) continue;
+            double y[64];
+            for (int i = jn[c] - 1; i >= 0; --i) {
+                double s = kr->gv[c][i];
+                for (int l = i + 1; l < jn[c]; ++l) s -= kr->h[c][(size_t)l * (size_t)(R + 1) + (size_t)i] * y[l];
+                y[i] = s / kr->h[c][(size_t)i * (size_t)(R + 1) + (size_t)i];
+            }
+            for (int i = 0; i < jn[c]; ++i)
+                cblas_daxpy((int)m, y[i], kr->z[c] + (size_t)i * m, 1, w + (size_t)c * m, 1);
+        }
+    }
+    for (int c = 0; c < g; ++c) status[c] = state[c];
+    return CM_OK;
+}
+
+cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
+                                 double *w, double *q, int threads)
+{
+    const size_t m = r->m, k = (size_t)r->k;
+    const cm_rbf_options *o = &r->opt;
+    const int R = o->restart < 63 ? o->restart : 63;
+    const int gmax = nc < 4 ? (int)nc : 4;
+    krylov kr;
+    memset(&kr, 0, sizeof kr);
+    kr.m = m;
+    kr.R = R;
+    int ok = 1;
+    for (int c = 0; c < gmax; ++c) {
+        kr.v[c] = malloc((size_t)(R + 1) * m * sizeof(double));
+        kr.z[c] = malloc((size_t)R * m * sizeof(double));
+        kr.h[c] = calloc((size_t)(R + 1) * (size_t)R, sizeof(double));
+        ok = ok && kr.v[c] && kr.z[c] && kr.h[c];
+    }
+    kr.soa = malloc((size_t)gmax * m * sizeof(double));
+    kr.rowm = malloc((size_t)gmax * m * sizeof(double));
+    kr.aux = malloc((size_t)gmax * m * sizeof(double));
+    double *aw = malloc(nc * m * sizeof *aw);
+    cm_status st = CM_OK;
+    if (!ok || !kr.soa || !kr.rowm || !kr.aux || !aw) {
+        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_solve: out of memory for the Krylov basis "
+                      "(%.3g GB)", (double)(2 * R + 1) * (double)m * gmax * 8e-9);
+        goto done;
+    }
+    int maxit = 0, mv = 0, floor_hit = 0, stagnated = 0, maxed = 0;
+    double floor_max = 0.0;
+    for (size_t c0 = 0; c0 < nc; c0 += 4) {
+        kr.g = nc - c0 < 4 ? (int)(nc - c0) : 4;
+        int iters[4], status[4];
+        double fl[4];
+        solve_group(ctx, r, &kr, f + c0 * m, w + c0 * m, aw + c0 * m, iters, &mv, fl, status,
+                    threads);
+        for (int c = 0; c < kr.g; ++c) {
+            if (iters[c] > maxit) maxit = iters[c];
+            if (fl[c] > floor_max) floor_max = fl[c];
+            floor_hit |= status[c] == 2;
+            stagnated |= status[c] == 3;
+            maxed |= status[c] == 4;
+        }
+    }
+    /* polynomial: R q = Q1'(f - A w); then the residual at the centres, exactly */
+    double worst = 0.0;
+    for (size_t c = 0; c < nc; ++c) {
+        const double *fc = f + c * m, *ac = aw + c * m;
+        double *qc = q + c * k, t[4];
+        double *g = kr.soa;
+        for (size_t i = 0; i < m; ++i) g[i] = fc[i] - ac[i];
+        for (size_t a = 0; a < k; ++a) t[a] = cblas_ddot((int)m, r->iter->q1 + a * m, 1, g, 1);
+        for (int i = (int)k - 1; i >= 0; --i) {
+            double s = t[i];
+            for (size_t j = (size_t)i + 1; j < k; ++j) s -= r->qr[j * m + (size_t)i] * qc[j];
+            qc[i] = s / r->qr[(size_t)i * m + (size_t)i];
+        }
+        double fn = norm_inf(m, fc), e = 0.0;
+        for (size_t i = 0; i < m; ++i) {
+            double p = qc[0] + qc[1] * r->c[i] + qc[2] * r->c[m + i] + qc[3] * r->c[2 * m + i];
+            e = fmax(e, fabs(g[i] - p));
+        }
+        worst = fmax(worst, fn > 0.0 ? e / fn : 0.0);
+    }
+    r->stats.iterations = maxit;
+    r->stats.matvecs = mv;
+    r->stats.residual = worst;
+    r->stats.floor = floor_max;
+    r->stats.floor_limited = floor_hit && worst > o->tolerance;
+    r->stats.memory_bytes = cm_rbf_schwarz_bytes(r->iter->pc) + m * k * sizeof(double) +
+                            (size_t)gmax * (size_t)(2 * R + 4) * m * sizeof(double);
+    if (worst > o->tolerance && !r->stats.floor_limited)
+        st = cm_error(ctx, CM_WARNING,
+                      "cm_rbf_solve: the iterative solver %s after %d iterations at a relative "
+                      "residual of %.3g (tolerance %.3g, attainable floor %.3g)",
+                      stagnated ? "stagnated" : maxed ? "reached max_iterations" : "stopped",
+                      maxit, worst, o->tolerance, floor_max);
+done:
+    for (int c = 0; c < 4; ++c) free(kr.v[c]), free(kr.z[c]), free(kr.h[c]);
+    free(kr.soa), free(kr.rowm), free(kr.aux), free(aw);
+    return st;
+}

@@ -1,0 +1,291 @@
+/* Tests of the iterative RBF solver (FGMRES + two-level restricted Schwarz): agreement with
+ * the dense solver on a box-with-bore boundary set, affine data, two bodies far apart,
+ * thread-count independence, the solver choice and the option checks. */
+#include "cadmorph/rbf.h"
+#include "test_util.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Boundary nodes of a box [0,a] x [0,b] x [0,c] with a bore of radius rad along z through
+ * (xc, yc), spaced about h, shifted by off: the kind of set a tet mesh of bore_a.step has
+ * (flat faces, a curved face, sharp edges). Returns the count written into x (n x 3). */
+static size_t box_with_bore(double a, double b, double c, double xc, double yc, double rad,
+                            double h, const double *off, double *x)
+{
+    size_t n = 0;
+    const int na = (int)(a / h + 0.5), nb = (int)(b / h + 0.5), nz = (int)(c / h + 0.5);
+#define PUT(px, py, pz)                                                                         \
+    do {                                                                                       \
+        if (x) {                                                                               \
+            x[3 * n] = (px) + off[0];                                                          \
+            x[3 * n + 1] = (py) + off[1];                                                      \
+            x[3 * n + 2] = (pz) + off[2];                                                      \
+        }                                                                                      \
+        ++n;                                                                                   \
+    } while (0)
+    for (int i = 0; i <= na; ++i)
+        for (int j = 0; j <= nb; ++j) {
+            double px = a * i / na, py = b * j / nb;
+            if (hypot(px - xc, py - yc) < rad + 0.3 * h) continue; /* the hole */
+            PUT(px, py, 0.0);
+            PUT(px, py, c);
+        }
+    for (int k = 1; k < nz; ++k) {
+        double pz = c * k / nz;
+        for (int i = 0; i <= na; ++i) {
+            PUT(a * i / na, 0.0, pz);
+            PUT(a * i / na, b, pz);
+        }
+        for (int j = 1; j < nb; ++j) {
+            PUT(0.0, b * j / nb, pz);
+            PUT(a, b * j / nb, pz);
+        }
+    }
+    const int nt = (int)(6.283185307179586 * rad / h + 0.5);
+    for (int k = 0; k <= nz; ++k)
+        for (int t = 0; t < nt; ++t) {
+            double th = 6.283185307179586 * (t + 0.5 * (k % 2)) / nt;
+            PUT(xc + rad * cos(th), yc + rad * sin(th), c * k / nz);
+        }
+#undef PUT
+    return n;
+}
+
+/* A displacement like the bore's edit: the bore face moves radially, the rest follows
+ * smoothly, plus a global bend. */
+static void bore_motion(size_t n, const double *x, double xc, double yc, double *d)
+{
+    for (size_t i = 0; i < n; ++i) {
+        double dx = x[3 * i] - xc, dy = x[3 * i + 1] - yc, r = hypot(dx, dy) + 1e-12;
+        double s = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
+        d[3 * i] = s * dx / r + 0.01 * sin(x[3 * i + 2]);
+        d[3 * i + 1] = s * dy / r;
+        d[3 * i + 2] = 0.02 * x[3 * i] * x[3 * i] / 16.0;
+    }
+}
+
+static double range_of(size_t n, const double *v)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        lo = fmin(lo, v[i]);
+        hi = fmax(hi, v[i]);
+    }
+    return hi - lo;
+}
+
+static double max_diff(size_t n, const double *a, const double *b)
+{
+    double v = 0.0;
+    for (size_t i = 0; i < n; ++i) v = fmax(v, fabs(a[i] - b[i]));
+    return v;
+}
+
+/* Fits values on x with the given solver and evaluates at p (np points). */
+static cm_status fit_eval(cm_context *ctx, cm_rbf_solver solver, size_t m, const double *x,
+                          const double *val, size_t np, const double *p, double *out,
+                          cm_rbf_stats *stats)
+{
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = solver;
+    cm_rbf *r = NULL;
+    cm_status st = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r);
+    if (st == CM_OK) st = cm_rbf_solve(ctx, r, 3, val);
+    if (st == CM_OK) st = cm_rbf_evaluate(ctx, r, np, p, out);
+    if (r) cm_rbf_get_stats(r, stats);
+    cm_rbf_destroy(&r);
+    return st;
+}
+
+/* Evaluation points: the centres and points inside the box. */
+static double *eval_points(size_t m, const double *x, size_t nin, size_t *np)
+{
+    double *p = malloc((m + nin) * 3 * sizeof *p);
+    memcpy(p, x, m * 3 * sizeof *p);
+    for (size_t i = 0; i < nin; ++i) {
+        double t = (double)i / (double)nin;
+        p[3 * (m + i)] = 0.1 + 3.8 * t;
+        p[3 * (m + i) + 1] = 0.1 + 0.3 * fmod(7.0 * t, 1.0);
+        p[3 * (m + i) + 2] = 0.1 + 0.8 * fmod(13.0 * t, 1.0);
+    }
+    *np = m + nin;
+    return p;
+}
+
+/* The box-with-bore set at m ~ 5k: iterative vs dense at the centres and inside, then the
+ * iterative fit again on one thread. */
+static void test_against_dense(cm_context *ctx)
+{
+    const double off[3] = {10.0, -3.0, 2.0};
+    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, NULL);
+    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, x);
+    double *xl = malloc(m * 3 * sizeof *xl);
+    for (size_t i = 0; i < m; ++i)
+        for (int e = 0; e < 3; ++e) xl[3 * i + e] = x[3 * i + e] - off[e];
+    bore_motion(m, xl, 2.0, 1.0, d);
+    free(xl);
+    size_t np;
+    double *p = eval_points(m, x, 2000, &np);
+    for (size_t i = m; i < np; ++i)
+        for (int e = 0; e < 3; ++e) p[3 * i + e] += off[e];
+    double *sd = malloc(np * 3 * sizeof *sd), *si = malloc(np * 3 * sizeof *si);
+    double *s1 = malloc(np * 3 * sizeof *s1);
+    cm_rbf_stats std, sti, st1;
+    cm_status a = fit_eval(ctx, CM_RBF_SOLVER_DENSE, m, x, d, np, p, sd, &std);
+    cm_status b = fit_eval(ctx, CM_RBF_SOLVER_ITERATIVE, m, x, d, np, p, si, &sti);
+    CHECK_MSG(a == CM_OK && b == CM_OK, "dense %d iterative %d: %s", a, b, cm_context_message(ctx));
+    double range = fmax(range_of(m * 3, d), 1e-300);
+    double diff = max_diff(np * 3, sd, si) / range;
+    double tol = fmax(1e-9, 3.0 * std.residual);
+    printf("box with bore: m = %zu, iterative %d iterations, %d subdomains, coarse %d, "
+           "residual %.3g (dense %.3g), floor %.3g, |iterative - dense| = %.3g of the range\n",
+           m, sti.iterations, sti.subdomains, sti.coarse_size, sti.residual, std.residual,
+           sti.floor, diff);
+    CHECK(m > 4000 && m < 7000);
+    CHECK(std.solver == CM_RBF_SOLVER_DENSE && sti.solver == CM_RBF_SOLVER_ITERATIVE);
+    CHECK_MSG(diff <= tol, "%.3g > %.3g", diff, tol);
+    CHECK_MSG(sti.residual <= fmax(1e-10, sti.floor), "%.3g", sti.residual);
+    /* exactness at the centres, measured here independently of the solver's own figure */
+    CHECK_MSG(max_diff(m * 3, si, d) / range <= 1e-9, "%.3g", max_diff(m * 3, si, d) / range);
+    CHECK_MSG(sti.iterations >= 1 && sti.iterations <= 25, "%d iterations", sti.iterations);
+    CHECK(sti.subdomains > 10 && sti.memory_bytes > 0 && sti.matvecs >= sti.iterations);
+
+    /* one thread: same result within the tolerance */
+    cm_context_set_threads(ctx, 1);
+    cm_status c = fit_eval(ctx, CM_RBF_SOLVER_ITERATIVE, m, x, d, np, p, s1, &st1);
+    cm_context_set_threads(ctx, 2);
+    double dt = max_diff(np * 3, s1, si) / range;
+    printf("threads 1 vs 2: %.3g of the range (%d vs %d iterations)\n", dt, st1.iterations,
+           sti.iterations);
+    CHECK(c == CM_OK);
+    CHECK_MSG(dt <= 1e-9, "%.3g", dt);
+    free(x), free(d), free(p), free(sd), free(si), free(s1);
+}
+
+/* Affine data lie in the polynomial space: the weights are zero and the fit is exact. */
+static void test_affine(cm_context *ctx)
+{
+    const double off[3] = {0.0, 0.0, 0.0};
+    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.11, off, NULL);
+    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.11, off, x);
+    size_t np;
+    double *p = eval_points(m, x, 500, &np);
+    double *ref = malloc(np * 3 * sizeof *ref), *out = malloc(np * 3 * sizeof *out);
+    for (size_t i = 0; i < np; ++i)
+        for (int e = 0; e < 3; ++e) {
+            const double *y = p + 3 * i;
+            double v = 0.3 * e - 1.0 + (1.0 + e) * y[0] - 0.5 * y[1] + 2.0 * e * y[2];
+            ref[3 * i + e] = v;
+            if (i < m) d[3 * i + e] = v;
+        }
+    cm_rbf_stats st;
+    cm_status s = fit_eval(ctx, CM_RBF_SOLVER_ITERATIVE, m, x, d, np, p, out, &st);
+    double err = max_diff(np * 3, out, ref) / range_of(np * 3, ref);
+    printf("affine: m = %zu, error %.3g, %d iterations\n", m, err, st.iterations);
+    CHECK(s == CM_OK);
+    CHECK_MSG(err <= 1e-13, "%.3g", err);
+    free(x), free(d), free(p), free(ref), free(out);
+}
+
+/* Two parts far apart (10 part sizes): the coarse space and the subdomains must not couple
+ * them wrongly, and the null space is that of the whole set. */
+static void test_two_bodies(cm_context *ctx)
+{
+    const double off0[3] = {0.0, 0.0, 0.0};
+    double sep = getenv("XS") ? atof(getenv("XS")) : 1.0;
+    const double off1[3] = {40.0 * sep, 15.0 * sep, -8.0 * sep};
+    size_t m0 = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.1, off0, NULL);
+    size_t m1 = box_with_bore(3.0, 1.5, 1.0, 1.5, 0.75, 0.3, 0.1, off1, NULL);
+    size_t m = m0 + m1;
+    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.1, off0, x);
+    box_with_bore(3.0, 1.5, 1.0, 1.5, 0.75, 0.3, 0.1, off1, x + 3 * m0);
+    bore_motion(m0, x, 2.0, 1.0, d);
+    for (size_t i = m0; i < m; ++i) { /* the second part moves rigidly, a little rotated */
+        d[3 * i] = 0.2 - 0.01 * (x[3 * i + 1] - off1[1]);
+        d[3 * i + 1] = 0.01 * (x[3 * i] - off1[0]);
+        d[3 * i + 2] = 0.05;
+    }
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    if (getenv("XD")) o.local_float = 0;
+    if (getenv("XL")) o.local_size = atoi(getenv("XL"));
+    if (getenv("XC")) o.coarse_size = atoi(getenv("XC"));
+    cm_rbf *r = NULL;
+    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r);
+    if (s == CM_OK) s = cm_rbf_solve(ctx, r, 3, d);
+    cm_rbf_stats st;
+    cm_rbf_get_stats(r, &st);
+    double *out = malloc(m * 3 * sizeof *out);
+    if (s == CM_OK) s = cm_rbf_evaluate(ctx, r, m, x, out);
+    double err = s == CM_OK ? max_diff(m * 3, out, d) / range_of(m * 3, d) : 1.0;
+    /* the dense solver on the same set: how far the system itself lets a solve go */
+    double *dn = malloc(m * 3 * sizeof *dn);
+    cm_rbf_stats sd;
+    cm_status s2 = fit_eval(ctx, CM_RBF_SOLVER_DENSE, m, x, d, m, x, dn, &sd);
+    double agree = max_diff(m * 3, out, dn) / range_of(m * 3, d);
+    printf("two bodies: m = %zu, %d iterations, residual %.3g (floor %.3g, at floor %d; dense "
+           "%.3g), error at the centres %.3g, vs dense %.3g\n",
+           m, st.iterations, st.residual, st.floor, st.floor_limited, sd.residual, err, agree);
+    CHECK_MSG(s == CM_OK && s2 == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(err <= fmax(1e-9, 3.0 * sd.residual), "%.3g", err);
+    free(dn);
+    CHECK_MSG(st.iterations <= 40, "%d iterations", st.iterations);
+    cm_rbf_destroy(&r);
+    free(x), free(d), free(out);
+}
+
+/* AUTO: dense for small sets and other kernels; the iterative solver refuses other kernels
+ * and bad options. */
+static void test_choice(cm_context *ctx)
+{
+    const double off[3] = {0.0, 0.0, 0.0};
+    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.2, off, NULL);
+    double *x = malloc(m * 3 * sizeof *x);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.2, off, x);
+    cm_rbf *r = NULL;
+    cm_rbf_stats st;
+    CHECK(cm_rbf_create(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &r) == CM_OK);
+    cm_rbf_get_stats(r, &st);
+    CHECK(st.solver == CM_RBF_SOLVER_DENSE && st.centres == m);
+    cm_rbf_destroy(&r);
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_BIHARMONIC, 3, m, x, &o, &r) == CM_ERR_UNSUPPORTED);
+    CHECK(r == NULL);
+    o.tolerance = 0.0;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.local_size = 8; /* smaller than the leaves */
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    free(x);
+}
+
+/* CM_TEST_VERBOSE=1 shows the solver's debug log (iterations per restart cycle). */
+static void log_stderr(void *user, cm_log_level level, const char *message)
+{
+    (void)user;
+    (void)level;
+    fprintf(stderr, "%s\n", message);
+}
+
+int main(void)
+{
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return 1;
+    if (getenv("CM_TEST_VERBOSE")) cm_context_set_log(ctx, log_stderr, NULL);
+    cm_context_set_threads(ctx, 2);
+    test_against_dense(ctx);
+    test_affine(ctx);
+    test_two_bodies(ctx);
+    test_choice(ctx);
+    cm_context_destroy(&ctx);
+    return TEST_REPORT();
+}
