@@ -45,6 +45,11 @@ void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                        const double *w, int nc, size_t n, const double *p, size_t ldp,
                        double *out, size_t ldo, int threads);
 
+/* cm_rbf_kernel_sum for r^3 in 3D with compensated (double-double) accumulation: error about
+ * eps |result| instead of eps sum_j |w_j phi_ij| (rbf_sum_acc.c says why). */
+void cm_rbf_kernel_sum_acc(size_t m, const double *c, const double *w, int nc, size_t n,
+                           const double *p, size_t ldp, double *out, size_t ldo, int threads);
+
 /* Lower triangle of B = sign * (A - V Z' - Z V') restricted to rows/columns k..m-1, into
  * rfp (n = m - k; n(n+1)/2 doubles, LAPACK rectangular full packed, TRANSR 'N', UPLO 'L').
  * A_ij = phi(|c_i - c_j|); v and z: m x k col-major. */

@@ -147,7 +147,10 @@ static void matvec(const cm_rbf *r, krylov *kr, int n, double *const *in, double
 {
     const size_t m = kr->m;
     for (int c = 0; c < n; ++c) memcpy(kr->soa + (size_t)c * m, in[c], m * sizeof(double));
+    if (getenv("XPLAIN"))
     cm_rbf_kernel_sum(r->kernel, 3, m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
+    else
+    cm_rbf_kernel_sum_acc(m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
     for (int c = 0; c < n; ++c)
         for (size_t i = 0; i < m; ++i) out[c][i] = kr->rowm[i * (size_t)n + (size_t)c];
 }

@@ -520,14 +520,14 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
     const size_t m = r->m, ncs = p->nc;
     memset(out, 0, (size_t)nc * m * sizeof *out);
     const double *res = in;
-    double *r1 = NULL;
+    double *r1 = NULL, *rc = NULL, *ac = NULL;
     if (ncs > 0) {
-        double *rc = calloc(2 * ncs * (size_t)nc, sizeof *rc);
-        double *ac = malloc(m * (size_t)nc * sizeof *ac);
+        rc = calloc(2 * ncs * (size_t)nc, sizeof *rc);
+        ac = malloc(m * (size_t)nc * sizeof *ac);
         r1 = malloc(m * (size_t)nc * sizeof *r1);
         if (!rc || !ac || !r1) { /* no coarse correction: still a valid preconditioner */
             free(rc), free(ac), free(r1);
-            r1 = NULL;
+            r1 = rc = ac = NULL;
         } else {
             double *wc = rc + ncs * (size_t)nc;
             for (int c = 0; c < nc; ++c)
@@ -544,8 +544,6 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
                 for (size_t i = 0; i < m; ++i)
                     r1[(size_t)c * m + i] = in[(size_t)c * m + i] - ac[i * (size_t)nc + (size_t)c];
             res = r1;
-            free(rc);
-            free(ac);
         }
     }
     /* leaves are disjoint, so the scatter into out needs no synchronisation */
@@ -578,4 +576,6 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
         free(loc);
     }
     free(r1);
+    free(rc);
+    free(ac);
 }

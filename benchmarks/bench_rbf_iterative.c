@@ -1,0 +1,153 @@
+/* Iterative vs dense RBF solver on real boundary node sets (bench_rbf_iterative_data.py
+ * writes them from `cadmorph morph` output): set-up, solve, evaluation at the interior
+ * nodes, iterations, peak memory, and agreement with the dense solver in the same run.
+ * usage: bench_rbf_iterative PREFIX [--dense] [--no-iterative] [--threads N] [--leaf N]
+ *        [--local N] [--coarse N] [--double] [--tol T] [--restart N] [--eval N] [--verbose]
+ * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
+#include "cadmorph/rbf.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+static double *read_raw(const char *prefix, const char *ext, size_t *n)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s.%s", prefix, ext);
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long bytes = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    double *x = malloc((size_t)bytes + 8);
+    size_t got = x ? fread(x, 1, (size_t)bytes, f) : 0;
+    fclose(f);
+    if (got != (size_t)bytes) {
+        free(x);
+        return NULL;
+    }
+    *n = (size_t)bytes / (3 * sizeof(double));
+    return x;
+}
+
+static double peak_rss_mb(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_maxrss / 1024.0;
+}
+
+static void log_stderr(void *user, cm_log_level level, const char *message)
+{
+    (void)user;
+    (void)level;
+    fprintf(stderr, "%s\n", message);
+}
+
+typedef struct run {
+    cm_rbf_stats st;
+    double eval_s;
+    cm_status status;
+    double *out; /* (m + ne) x 3: at the centres, then the interior sample */
+} run;
+
+static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
+                const double *v, size_t ne, const double *p, run *r)
+{
+    cm_rbf *rbf = NULL;
+    r->out = malloc((m + ne) * 3 * sizeof *r->out);
+    r->status = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &rbf);
+    if (r->status >= 0) r->status = cm_rbf_solve(ctx, rbf, 3, v);
+    if (r->status >= 0) {
+        double t0 = cm_wtime();
+        r->status = cm_rbf_evaluate(ctx, rbf, ne, p, r->out + m * 3);
+        r->eval_s = cm_wtime() - t0;
+        if (r->status >= 0) r->status = cm_rbf_evaluate(ctx, rbf, m, x, r->out);
+    }
+    if (r->status < 0) fprintf(stderr, "error: %s\n", cm_context_message(ctx));
+    cm_rbf_get_stats(rbf, &r->st);
+    cm_rbf_destroy(&rbf);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: bench_rbf_iterative PREFIX [options], see the source\n");
+        return 1;
+    }
+    const char *prefix = argv[1];
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    int dense = 0, iterative = 1, threads = 0, verbose = 0;
+    long neval = -1;
+    for (int i = 2; i < argc; ++i) {
+        const char *a = argv[i], *b = i + 1 < argc ? argv[i + 1] : "0";
+        if (!strcmp(a, "--dense")) dense = 1;
+        else if (!strcmp(a, "--no-iterative")) iterative = 0;
+        else if (!strcmp(a, "--double")) o.local_float = 0;
+        else if (!strcmp(a, "--verbose")) verbose = 1;
+        else if (!strcmp(a, "--threads")) threads = atoi(b), ++i;
+        else if (!strcmp(a, "--leaf")) o.leaf_size = atoi(b), ++i;
+        else if (!strcmp(a, "--local")) o.local_size = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse")) o.coarse_size = atoi(b), ++i;
+        else if (!strcmp(a, "--restart")) o.restart = atoi(b), ++i;
+        else if (!strcmp(a, "--tol")) o.tolerance = atof(b), ++i;
+        else if (!strcmp(a, "--eval")) neval = atol(b), ++i;
+        else {
+            fprintf(stderr, "unknown option %s\n", a);
+            return 1;
+        }
+    }
+    size_t m = 0, mv = 0, ni = 0;
+    double *x = read_raw(prefix, "centres", &m), *v = read_raw(prefix, "values", &mv);
+    double *p = read_raw(prefix, "interior", &ni);
+    if (!x || !v || mv != m) {
+        fprintf(stderr, "cannot read %s.centres / .values\n", prefix);
+        return 1;
+    }
+    size_t ne = neval >= 0 && (size_t)neval < ni ? (size_t)neval : ni;
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return 1;
+    cm_context_set_threads(ctx, threads);
+    if (verbose) cm_context_set_log(ctx, log_stderr, NULL);
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < 3 * m; ++i) lo = fmin(lo, v[i]), hi = fmax(hi, v[i]);
+    const double range = hi - lo;
+
+    run it = {0}, dn = {0};
+    printf("set=%s m=%zu interior=%zu", prefix, m, ne);
+    if (iterative) {
+        o.solver = CM_RBF_SOLVER_ITERATIVE;
+        fit(ctx, &o, m, x, v, ne, p, &it);
+        double exact = 0.0;
+        for (size_t i = 0; i < 3 * m; ++i) exact = fmax(exact, fabs(it.out[i] - v[i]));
+        printf(" it_status=%d leaf=%d local=%d coarse=%d subdomains=%d it_setup_s=%.2f "
+               "it_solve_s=%.2f it_eval_s=%.2f iterations=%d matvecs=%d it_residual=%.3g "
+               "it_floor=%.3g at_floor=%d it_exact=%.3g it_mem_mb=%.1f it_rss_mb=%.0f",
+               it.status, o.leaf_size, o.local_size, it.st.coarse_size, it.st.subdomains,
+               it.st.setup_seconds, it.st.solve_seconds, it.eval_s, it.st.iterations,
+               it.st.matvecs, it.st.residual, it.st.floor, it.st.floor_limited, exact / range,
+               (double)it.st.memory_bytes / 1e6, peak_rss_mb());
+    }
+    if (dense) {
+        o.solver = CM_RBF_SOLVER_DENSE;
+        fit(ctx, &o, m, x, v, ne, p, &dn);
+        printf(" dense_status=%d dense_setup_s=%.2f dense_solve_s=%.2f dense_eval_s=%.2f "
+               "dense_residual=%.3g dense_rss_mb=%.0f",
+               dn.status, dn.st.setup_seconds, dn.st.solve_seconds, dn.eval_s, dn.st.residual,
+               peak_rss_mb());
+        if (iterative && it.status >= 0 && dn.status >= 0) {
+            double d = 0.0;
+            for (size_t i = 0; i < 3 * (m + ne); ++i) d = fmax(d, fabs(it.out[i] - dn.out[i]));
+            double ti = it.st.setup_seconds + it.st.solve_seconds;
+            double td = dn.st.setup_seconds + dn.st.solve_seconds;
+            printf(" agreement=%.3g speedup=%.2f", d / range, td / ti);
+        }
+    }
+    printf(" range=%.6g\n", range);
+    free(it.out), free(dn.out), free(x), free(v), free(p);
+    cm_context_destroy(&ctx);
+    return 0;
+}
