@@ -2,7 +2,8 @@
  * writes them from `cadmorph morph` output): set-up, solve, evaluation at the interior
  * nodes, iterations, peak memory, and agreement with the dense solver in the same run.
  * usage: bench_rbf_iterative PREFIX [--dense] [--no-iterative] [--threads N] [--leaf N]
- *        [--local N] [--coarse N] [--double] [--tol T] [--restart N] [--eval N] [--verbose]
+ *        [--local N] [--coarse N] [--float] [--tol T] [--maxit N] [--restart N] [--eval N]
+ *        [--verbose]
  * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
 #include "cadmorph/rbf.h"
 
@@ -39,6 +40,16 @@ static double peak_rss_mb(void)
     return (double)ru.ru_maxrss / 1024.0;
 }
 
+/* CPU seconds of the process (user + system): on a shared machine the figure that the
+ * other jobs disturb least. */
+static double cpu_s(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
 static void log_stderr(void *user, cm_log_level level, const char *message)
 {
     (void)user;
@@ -49,6 +60,8 @@ static void log_stderr(void *user, cm_log_level level, const char *message)
 typedef struct run {
     cm_rbf_stats st;
     double eval_s;
+    double fit_cpu_s; /* create + solve */
+    double eval_cpu_s;
     cm_status status;
     double *out; /* (m + ne) x 3: at the centres, then the interior sample */
 } run;
@@ -58,12 +71,16 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
 {
     cm_rbf *rbf = NULL;
     r->out = malloc((m + ne) * 3 * sizeof *r->out);
+    double c0 = cpu_s();
     r->status = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &rbf);
     if (r->status >= 0) r->status = cm_rbf_solve(ctx, rbf, 3, v);
+    r->fit_cpu_s = cpu_s() - c0;
     if (r->status >= 0) {
         double t0 = cm_wtime();
+        c0 = cpu_s();
         r->status = cm_rbf_evaluate(ctx, rbf, ne, p, r->out + m * 3);
         r->eval_s = cm_wtime() - t0;
+        r->eval_cpu_s = cpu_s() - c0;
         if (r->status >= 0) r->status = cm_rbf_evaluate(ctx, rbf, m, x, r->out);
     }
     if (r->status < 0) fprintf(stderr, "error: %s\n", cm_context_message(ctx));
@@ -86,7 +103,7 @@ int main(int argc, char **argv)
         const char *a = argv[i], *b = i + 1 < argc ? argv[i + 1] : "0";
         if (!strcmp(a, "--dense")) dense = 1;
         else if (!strcmp(a, "--no-iterative")) iterative = 0;
-        else if (!strcmp(a, "--double")) o.local_float = 0;
+        else if (!strcmp(a, "--float")) o.local_float = 1;
         else if (!strcmp(a, "--verbose")) verbose = 1;
         else if (!strcmp(a, "--threads")) threads = atoi(b), ++i;
         else if (!strcmp(a, "--leaf")) o.leaf_size = atoi(b), ++i;
@@ -94,6 +111,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--coarse")) o.coarse_size = atoi(b), ++i;
         else if (!strcmp(a, "--restart")) o.restart = atoi(b), ++i;
         else if (!strcmp(a, "--tol")) o.tolerance = atof(b), ++i;
+        else if (!strcmp(a, "--maxit")) o.max_iterations = atoi(b), ++i;
         else if (!strcmp(a, "--eval")) neval = atol(b), ++i;
         else {
             fprintf(stderr, "unknown option %s\n", a);
@@ -125,25 +143,27 @@ int main(int argc, char **argv)
         for (size_t i = 0; i < 3 * m; ++i) exact = fmax(exact, fabs(it.out[i] - v[i]));
         printf(" it_status=%d leaf=%d local=%d coarse=%d subdomains=%d it_setup_s=%.2f "
                "it_solve_s=%.2f it_eval_s=%.2f iterations=%d matvecs=%d it_residual=%.3g "
-               "it_floor=%.3g at_floor=%d it_exact=%.3g it_mem_mb=%.1f it_rss_mb=%.0f",
+               "it_floor=%.3g at_floor=%d it_exact=%.3g it_mem_mb=%.1f it_rss_mb=%.0f "
+               "it_fit_cpu_s=%.1f it_eval_cpu_s=%.1f",
                it.status, o.leaf_size, o.local_size, it.st.coarse_size, it.st.subdomains,
                it.st.setup_seconds, it.st.solve_seconds, it.eval_s, it.st.iterations,
                it.st.matvecs, it.st.residual, it.st.floor, it.st.floor_limited, exact / range,
-               (double)it.st.memory_bytes / 1e6, peak_rss_mb());
+               (double)it.st.memory_bytes / 1e6, peak_rss_mb(), it.fit_cpu_s, it.eval_cpu_s);
     }
     if (dense) {
         o.solver = CM_RBF_SOLVER_DENSE;
         fit(ctx, &o, m, x, v, ne, p, &dn);
         printf(" dense_status=%d dense_setup_s=%.2f dense_solve_s=%.2f dense_eval_s=%.2f "
-               "dense_residual=%.3g dense_rss_mb=%.0f",
+               "dense_residual=%.3g dense_rss_mb=%.0f dense_fit_cpu_s=%.1f",
                dn.status, dn.st.setup_seconds, dn.st.solve_seconds, dn.eval_s, dn.st.residual,
-               peak_rss_mb());
+               peak_rss_mb(), dn.fit_cpu_s);
         if (iterative && it.status >= 0 && dn.status >= 0) {
             double d = 0.0;
             for (size_t i = 0; i < 3 * (m + ne); ++i) d = fmax(d, fabs(it.out[i] - dn.out[i]));
             double ti = it.st.setup_seconds + it.st.solve_seconds;
             double td = dn.st.setup_seconds + dn.st.solve_seconds;
-            printf(" agreement=%.3g speedup=%.2f", d / range, td / ti);
+            printf(" agreement=%.3g speedup=%.2f cpu_speedup=%.2f", d / range, td / ti,
+                   dn.fit_cpu_s / it.fit_cpu_s);
         }
     }
     printf(" range=%.6g\n", range);

@@ -41,7 +41,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->leaf_size = 256;
     opt->local_size = 1400;
     opt->coarse_size = 2000;
-    opt->local_float = 1;
+    opt->local_float = 0;
 }
 
 void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
@@ -147,9 +147,6 @@ static void matvec(const cm_rbf *r, krylov *kr, int n, double *const *in, double
 {
     const size_t m = kr->m;
     for (int c = 0; c < n; ++c) memcpy(kr->soa + (size_t)c * m, in[c], m * sizeof(double));
-    if (getenv("XPLAIN"))
-    cm_rbf_kernel_sum(r->kernel, 3, m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
-    else
     cm_rbf_kernel_sum_acc(m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
     for (int c = 0; c < n; ++c)
         for (size_t i = 0; i < m; ++i) out[c][i] = kr->rowm[i * (size_t)n + (size_t)c];
@@ -176,8 +173,8 @@ static double norm_inf(size_t m, const double *v)
 
 /* Solves components [c0, c0 + g) of f (nc x m SoA) into w. it/stop/floor per component. */
 static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
-                             double *w, double *aw, int *iters, int *matvecs, double *floor_rel,
-                             int *status, int threads)
+                             double fmax_all, double *w, double *aw, int *iters, int *matvecs,
+                             double *floor_rel, int *status, int threads)
 {
     const size_t m = kr->m;
     const int g = kr->g, R = kr->R;
@@ -186,7 +183,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
     double *res_v[4], *ax[4];
     int state[4]; /* 0 running, 1 converged, 2 floor, 3 stagnated, 4 max iterations */
     for (int c = 0; c < g; ++c) {
-        fnorm[c] = norm_inf(m, f + (size_t)c * m);
+        fnorm[c] = fmax_all; /* relative to all the data, as the dense solver's residual */
         prev[c] = INFINITY;
         iters[c] = 0;
         floor_rel[c] = 0.0;
@@ -362,14 +359,15 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                       "(%.3g GB)", (double)(2 * R + 1) * (double)m * gmax * 8e-9);
         goto done;
     }
+    const double fmax_all = norm_inf(nc * m, f);
     int maxit = 0, mv = 0, floor_hit = 0, stagnated = 0, maxed = 0;
     double floor_max = 0.0;
     for (size_t c0 = 0; c0 < nc; c0 += 4) {
         kr.g = nc - c0 < 4 ? (int)(nc - c0) : 4;
         int iters[4], status[4];
         double fl[4];
-        solve_group(ctx, r, &kr, f + c0 * m, w + c0 * m, aw + c0 * m, iters, &mv, fl, status,
-                    threads);
+        solve_group(ctx, r, &kr, f + c0 * m, fmax_all, w + c0 * m, aw + c0 * m, iters, &mv, fl,
+                    status, threads);
         for (int c = 0; c < kr.g; ++c) {
             if (iters[c] > maxit) maxit = iters[c];
             if (fl[c] > floor_max) floor_max = fl[c];
@@ -391,7 +389,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             for (size_t j = (size_t)i + 1; j < k; ++j) s -= r->qr[j * m + (size_t)i] * qc[j];
             qc[i] = s / r->qr[(size_t)i * m + (size_t)i];
         }
-        double fn = norm_inf(m, fc), e = 0.0;
+        double fn = fmax_all, e = 0.0;
         for (size_t i = 0; i < m; ++i) {
             double p = qc[0] + qc[1] * r->c[i] + qc[2] * r->c[m + i] + qc[3] * r->c[2 * m + i];
             e = fmax(e, fabs(g[i] - p));
