@@ -54,19 +54,26 @@ void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
     *stats = rbf->stats;
 }
 
-/* Cost model for AUTO, from benchmarks/bench_rbf_iterative (RESULTS.md, this machine kind):
- * the dense fit grows as m^3 and its factor takes 4 m^2 bytes, the iterative one as
- * (iterations) m^2 plus a set-up linear in m; they cross near m = CM_RBF_AUTO_DENSE_MAX.
- * The dense path is also refused when its factor would take more than half the memory. */
-#define CM_RBF_AUTO_DENSE_MAX 8000
+/* Cost model for AUTO, CPU seconds measured by benchmarks/bench_rbf_iterative on this
+ * machine kind (RESULTS.md, bore m = 9,960: dense 7.8 s, iterative 4.8 s, 7 iterations; 2
+ * threads, OpenBLAS Haswell kernels): dense ~ a m^3 (dpftrf), iterative ~ b m (local
+ * factorisations: m / 190 subdomains of 1400 centres) + c m^2 (about 8 compensated matvecs
+ * of 3 components). They cross near m = 7,500. Dense is also refused when its factor
+ * (4 m^2 bytes) would take more than half the physical memory. A faster BLAS core makes
+ * the dense path relatively cheaper: the crossover then moves up, by the cube root of the
+ * speed-up. */
+#define CM_RBF_COST_DENSE_M3 7.9e-12
+#define CM_RBF_COST_ITER_M 3.5e-4
+#define CM_RBF_COST_ITER_M2 1.3e-8
 
 int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
 {
     if (kernel != CM_RBF_TRIHARMONIC) return 1;
-    if (m > CM_RBF_AUTO_DENSE_MAX) return 0;
-    long pages = sysconf(_SC_PHYS_PAGES), psize = sysconf(_SC_PAGESIZE);
-    if (pages > 0 && psize > 0 && 4.0 * (double)m * (double)m > 0.5 * (double)pages * (double)psize)
+    const double x = (double)m;
+    if (CM_RBF_COST_DENSE_M3 * x * x * x > CM_RBF_COST_ITER_M * x + CM_RBF_COST_ITER_M2 * x * x)
         return 0;
+    long pages = sysconf(_SC_PHYS_PAGES), psize = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && psize > 0 && 4.0 * x * x > 0.5 * (double)pages * (double)psize) return 0;
     return 1;
 }
 

@@ -3,8 +3,9 @@
  *
  *   d(x) = sum_j w_j phi(|x - c_j|) + q_0 + q_1 x_1 + ... + q_dim x_dim,  sum_j w_j p(c_j) = 0
  *
- * The factorisation depends only on the centres: create once, then solve for any number of
- * right-hand sides (an absolute sweep changes only the values). Conventions: see core.h.
+ * The factorisation (dense) or preconditioner (iterative) depends only on the centres:
+ * create once, then solve for any number of right-hand sides (an absolute sweep changes only
+ * the values). Conventions: see core.h.
  */
 #ifndef CADMORPH_RBF_H
 #define CADMORPH_RBF_H
@@ -23,14 +24,21 @@ typedef enum cm_rbf_kernel {
 
 typedef struct cm_rbf cm_rbf;
 
-/* How the system is solved. DENSE: null-space projected Cholesky of the m x m system,
- * O(m^2) memory and O(m^3) time, any kernel, m <= 60000. ITERATIVE (triharmonic only):
- * FGMRES in the null space of the polynomial block, right-preconditioned by a two-level
- * restricted additive Schwarz method (kD-tree leaves grown by an overlap, each solved by
- * the dense projected Cholesky of its own r^3 system; a coarse space of farthest-point
- * centres solved exactly), with direct-summation matvecs: O(m * local_size) memory and
- * O(m^2) time per iteration. AUTO: dense below a size set by a measured cost model (time
- * and memory, see rbf_iterative.c), iterative above; dense for kernels other than r^3. */
+/* How the system is solved.
+ * DENSE: null-space projected Cholesky of the m x m system: 4 m^2 bytes, O(m^3) time, any
+ *   kernel, m <= 60000.
+ * ITERATIVE (3D r^3 only): restarted FGMRES in the null space of the polynomial block,
+ *   right-preconditioned by two-level restricted additive Schwarz: kD-tree leaves of
+ *   leaf_size/2..leaf_size centres, each grown to local_size centres and solved by the
+ *   projected Cholesky of its own r^3 system, after a coarse solve on coarse_size
+ *   farthest-point centres. Matvecs are direct sums with compensated accumulation (the
+ *   preconditioned vectors cancel too much for plain sums; rbf_sum_acc.c). Memory about
+ *   8 m local_size bytes (local_float: 4) plus the Krylov basis, 16 m restart bytes per
+ *   component; time O(m local_size^2) to set up, O(m^2) per iteration.
+ * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
+ *   crossover near 7,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
+ *   iterative above; dense for the other kernels.
+ * The interpolant is evaluated the same way for both (cm_rbf_evaluate). */
 typedef enum cm_rbf_solver {
     CM_RBF_SOLVER_AUTO = 0,
     CM_RBF_SOLVER_DENSE = 1,
@@ -73,11 +81,14 @@ typedef struct cm_rbf_stats {
                             * dense: refinement steps */
     int matvecs;           /* last solve: direct-summation products with the m x m matrix
                             * (one per iteration and restart, all components together) */
-    double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| (exactness at the
-                            * centres, computed by direct summation after the solve) */
-    double floor;          /* iterative: the rounding error of the direct sums, as a
-                            * relative residual: eps max_i sum_j |w_j| phi(|c_i - c_j|) / max|f|
-                            * (computed when a restart finds the tolerance not yet met) */
+    double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| over all components
+                            * (exactness at the centres, by direct summation after the solve;
+                            * iterative: with compensated sums) */
+    double floor;          /* iterative: eps max_i sum_j |w_j| phi(|c_i - c_j|) / max |f|, the
+                            * rounding error of plain direct sums of these weights, so also
+                            * about how exactly cm_rbf_evaluate reproduces the data at the
+                            * centres (computed when a restart finds the tolerance not met,
+                            * else 0) */
     int floor_limited;     /* 1 if the solve stagnated above the tolerance but within 10x
                             * the floor: the attainable accuracy, not a failure */
 } cm_rbf_stats;
