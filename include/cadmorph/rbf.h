@@ -85,10 +85,10 @@ typedef struct cm_rbf_stats {
                             * (exactness at the centres, by direct summation after the solve;
                             * iterative: with compensated sums) */
     double floor;          /* iterative: eps max_i sum_j |w_j| phi(|c_i - c_j|) / max |f|, the
-                            * rounding error of plain direct sums of these weights, so also
-                            * about how exactly cm_rbf_evaluate reproduces the data at the
-                            * centres (computed when a restart finds the tolerance not met,
-                            * else 0) */
+                            * rounding error of plain direct sums of these weights, so about
+                            * how exactly cm_rbf_evaluate reproduces the data at the centres
+                            * (for either solver: the weights are the same; on the bracket
+                            * and on two bodies far apart it is 1e-9 .. 1e-8) */
     int floor_limited;     /* 1 if the solve stagnated above the tolerance but within 10x
                             * the floor: the attainable accuracy, not a failure */
 } cm_rbf_stats;
