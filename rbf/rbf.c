@@ -587,7 +587,10 @@ cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const do
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < dim; ++d)
             p[(size_t)d * n + i] = (points[i * (size_t)dim + (size_t)d] - rbf->shift[d]) * rbf->scale;
-    kernel_sum_all(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx));
+    if (rbf->iter) /* compensated sums: see cm_rbf_iterative_evaluate */
+        cm_rbf_iterative_evaluate(rbf, n, p, out, cm_rbf_threads(ctx));
+    else
+        kernel_sum_all(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx));
     for (size_t i = 0; i < n; ++i) {
         for (int c = 0; c < ncomp; ++c) {
             const double *qc = rbf->q + (size_t)c * (size_t)k;

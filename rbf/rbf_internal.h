@@ -86,6 +86,9 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads);
 cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
                                  double *w, double *q, int threads);
 void cm_rbf_iterative_destroy(cm_rbf_iter **it);
+/* out (n x ncomp) = sum_j w_j phi(|p_i - c_j|) by compensated sums; p: 3 x n SoA. */
+void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
+                               int threads);
 
 typedef struct cm_rbf_schwarz cm_rbf_schwarz;
 

@@ -233,11 +233,12 @@ static void test_two_bodies(cm_context *ctx)
            agree);
     CHECK_MSG(s == CM_OK && s2 == CM_OK, "%s", cm_context_message(ctx));
     CHECK_MSG(st.residual <= 1e-10 && !st.floor_limited, "%.3g", st.residual);
-    /* The residual above is the solver's, by compensated sums. Evaluation by plain sums
-     * errs by more at the centres, for the dense weights too (both about 5e-9 here): far
-     * apart, the parts need sum |w| = 3e6 x max |d|, and eps times that is the floor. */
-    CHECK_MSG(err <= fmax(1e-9, 3.0 * derr), "%.3g vs dense %.3g", err, derr);
-    CHECK_MSG(err <= 10.0 * st.floor, "%.3g vs floor %.3g", err, st.floor);
+    /* Far apart, the parts need sum |w| = 3e6 x max |d|: plain sums, as the dense path
+     * evaluates, reproduce the data at the centres only to about eps times that (5.7e-9
+     * measured, the floor in the stats); the iterative path evaluates with compensated sums
+     * and is exact to its residual. */
+    CHECK_MSG(err <= 1e-9, "%.3g (dense %.3g)", err, derr);
+    CHECK_MSG(st.floor > 1e-10 && derr <= 10.0 * st.floor, "floor %.3g, dense %.3g", st.floor, derr);
     CHECK_MSG(agree <= fmax(1e-9, 3.0 * derr), "%.3g", agree);
     free(dn);
     CHECK_MSG(st.iterations <= 40, "%d iterations", st.iterations);
