@@ -240,7 +240,16 @@ static void test_two_bodies(cm_context *ctx)
     CHECK_MSG(err <= 1e-9, "%.3g (dense %.3g)", err, derr);
     CHECK_MSG(st.floor > 1e-10 && derr <= 10.0 * st.floor, "floor %.3g, dense %.3g", st.floor, derr);
     CHECK_MSG(agree <= fmax(1e-9, 3.0 * derr), "%.3g", agree);
-    free(dn);
+
+    /* a second right-hand side on the same preconditioner (an absolute study): 2 d + affine */
+    double *d2 = malloc(m * 3 * sizeof *d2), *out2 = malloc(m * 3 * sizeof *out2);
+    for (size_t i = 0; i < m * 3; ++i) d2[i] = 2.0 * d[i] + 0.1 + 0.01 * x[i];
+    cm_status s3 = cm_rbf_solve(ctx, r, 3, d2);
+    if (s3 == CM_OK) s3 = cm_rbf_evaluate(ctx, r, m, x, out2);
+    double err2 = s3 == CM_OK ? max_diff(m * 3, out2, d2) / range_of(m * 3, d2) : 1.0;
+    printf("two bodies, second right-hand side: error at the centres %.3g\n", err2);
+    CHECK_MSG(s3 == CM_OK && err2 <= 1e-9, "%.3g", err2);
+    free(d2), free(out2), free(dn);
     CHECK_MSG(st.iterations <= 40, "%d iterations", st.iterations);
     cm_rbf_destroy(&r);
     free(x), free(d), free(out);
