@@ -78,10 +78,12 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
     if (r->status >= 0) {
         double t0 = cm_wtime();
         c0 = cpu_s();
+        cm_status solved = r->status; /* keep a solve's warning (stagnation, max_iterations) */
         r->status = cm_rbf_evaluate(ctx, rbf, ne, p, r->out + m * 3);
         r->eval_s = cm_wtime() - t0;
         r->eval_cpu_s = cpu_s() - c0;
         if (r->status >= 0) r->status = cm_rbf_evaluate(ctx, rbf, m, x, r->out);
+        if (r->status == CM_OK) r->status = solved;
     }
     if (r->status < 0) fprintf(stderr, "error: %s\n", cm_context_message(ctx));
     cm_rbf_get_stats(rbf, &r->st);
