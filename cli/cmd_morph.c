@@ -11,7 +11,7 @@
 
 static const char *const usage_line =
     "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
-    "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] "
+    "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] "
     "[--lattice N [--clamp E]] "
     "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
     "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
@@ -119,6 +119,11 @@ static const cli_option options[] = {
      .names = cli_kernel_names, .values = cli_kernel_methods, .bad = "%.0sunknown kernel '%s'",
      .label = "--kernel K",
      .help = "triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)"},
+    {.name = "--solver", .kind = CLI_ENUM, .dest = &args.opt.method.warp.solver, .names = cli_solver_names,
+     .values = cli_solver_values, .bad = "%.0sunknown solver '%s' (auto, dense, iterative)",
+     .label = "--solver S",
+     .help = "RBF warps: auto (default: dense below ~7,500 boundary nodes,\n"
+             "iterative above), dense or iterative (FGMRES + Schwarz)"},
     {.name = "--lattice", .kind = CLI_INT, .dest = &args.opt.method.warp.lattice, .lo = 4,
      .hi = 200, .bad = "%s: expected 4..200 control points per axis, got '%s'",
      .label = "--lattice N",

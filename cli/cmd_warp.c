@@ -11,13 +11,13 @@
 
 static const char *const usage_line =
     "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] "
-    "[--lattice N [--clamp E]] [--optimize] "
+    "[--solver S] [--lattice N [--clamp E]] [--optimize] "
     "[--threads N] [--verbose]";
 
 typedef struct warp_args {
     const char *mesh, *csv, *out;
     cm_warp_method method;
-    int threads, verbose, optimize, lattice;
+    int threads, verbose, optimize, lattice, solver;
     double clamp;
 } warp_args;
 
@@ -44,6 +44,11 @@ static const cli_option options[] = {
     {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.optimize, .label = "--optimize",
      .help = "then optimise the other nodes (untangle, raise the worst cells;\n"
              "boundary and listed nodes stay where D.csv sends them)"},
+    {.name = "--solver", .kind = CLI_ENUM, .dest = &args.solver, .names = cli_solver_names,
+     .values = cli_solver_values, .bad = "%.0sunknown solver '%s' (auto, dense, iterative)",
+     .label = "--solver S",
+     .help = "RBF warps: auto (default: dense below ~7,500 boundary nodes,\n"
+             "iterative above), dense or iterative (FGMRES + Schwarz)"},
     {.name = "--lattice", .kind = CLI_INT, .dest = &args.lattice, .lo = 4, .hi = 200,
      .bad = "%s: expected 4..200 control points per axis, got '%s'", .label = "--lattice N",
      .help = "dmffd: control points per axis of the B-spline lattice on the\n"
@@ -123,6 +128,7 @@ int cli_cmd_warp(int argc, char **argv)
     cm_warp_options_init(&opt);
     opt.method = a.method;
     opt.lattice = a.lattice;
+    opt.solver = (cm_rbf_solver)a.solver;
     opt.clamp = a.clamp;
     cm_warp_mesh_stats st;
     if (s >= 0) {

@@ -132,4 +132,6 @@ int cli_parse_warp_method(const cli_parser *p, const cli_option *o, const char *
 }
 
 const char *const cli_kernel_names[] = {"triharmonic", "biharmonic", NULL};
+const char *const cli_solver_names[] = {"auto", "dense", "iterative", NULL};
+const int cli_solver_values[] = {CM_RBF_SOLVER_AUTO, CM_RBF_SOLVER_DENSE, CM_RBF_SOLVER_ITERATIVE};
 const int cli_kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};

@@ -68,6 +68,9 @@ struct cli_parser {
  * cm_warp_method), and --kernel triharmonic|biharmonic (a CLI_ENUM onto the same field). */
 int cli_parse_warp_method(const cli_parser *p, const cli_option *o, const char *value, void *dest);
 extern const char *const cli_kernel_names[];
+/* --solver of the RBF warps: auto, dense, iterative (cm_rbf_solver). */
+extern const char *const cli_solver_names[];
+extern const int cli_solver_values[];
 extern const int cli_kernel_methods[];
 
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after

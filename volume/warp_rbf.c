@@ -114,7 +114,8 @@ static cm_status split_component(cm_context *ctx, const cm_mesh *mesh,
 
 /* The RBF of component k; its errors (coplanar centres, failed factorisation) get the
  * component number in front. */
-static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel, size_t k,
+static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel,
+                               cm_rbf_solver solver, size_t k,
                                warp_component *wc)
 {
     if (wc->n_free == 0) return CM_OK; /* nothing to interpolate: every node is prescribed */
@@ -126,7 +127,10 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
     if (!centres) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
     for (size_t i = 0; i < wc->n_fixed; ++i)
         memcpy(centres + 3 * i, mesh->xyz + 3 * wc->fixed[i], 3 * sizeof(double));
-    cm_status s = cm_rbf_create(ctx, kernel, 3, wc->n_fixed, centres, &wc->rbf);
+    cm_rbf_options ro;
+    cm_rbf_options_init(&ro);
+    ro.solver = solver;
+    cm_status s = cm_rbf_create_opt(ctx, kernel, 3, wc->n_fixed, centres, &ro, &wc->rbf);
     free(centres);
     if (s < 0)
         return cm_error_prefix(ctx, s, "cm_warp_create: component %zu (%zu constrained nodes)", k,
@@ -138,6 +142,7 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
  * one pass per component with a stamp array deduplicates its nodes. */
 static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                                   const unsigned char *constrained, cm_rbf_kernel kernel,
+                                  cm_rbf_solver solver,
                                   rbf_warp *w, size_t *n_shared_free)
 {
     size_t nc = b->n_components, nn = mesh->n_nodes;
@@ -181,7 +186,7 @@ static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm
         s = split_component(ctx, mesh, constrained, (int)k, list, vis.n, owner, &w->comp[k],
                             n_shared_free);
         if (s < 0) goto done;
-        s = fit_component(ctx, mesh, kernel, k, &w->comp[k]);
+        s = fit_component(ctx, mesh, kernel, solver, k, &w->comp[k]);
         if (s < 0) goto done;
         cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc);
     }
@@ -206,7 +211,8 @@ done:
 }
 
 static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
-                            const unsigned char *constrained, cm_rbf_kernel kernel, void **state)
+                            const unsigned char *constrained, cm_rbf_kernel kernel,
+                            cm_rbf_solver solver, void **state)
 {
     if (b->n_components > (size_t)(~0u >> 1))
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_warp_create: too many components");
@@ -221,7 +227,7 @@ static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
         goto fail;
     }
     size_t n_shared_free = 0;
-    s = build_components(ctx, mesh, b, constrained, kernel, w, &n_shared_free);
+    s = build_components(ctx, mesh, b, constrained, kernel, solver, w, &n_shared_free);
     if (s < 0) goto fail;
     if (n_shared_free)
         cm_log(ctx, CM_LOG_WARNING,
@@ -270,16 +276,14 @@ static cm_status triharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                     const cm_mesh_boundary *b, const unsigned char *constrained,
                                     const cm_warp_options *opt, void **state)
 {
-    (void)opt;
-    return rbf_create(ctx, mesh, b, constrained, CM_RBF_TRIHARMONIC, state);
+    return rbf_create(ctx, mesh, b, constrained, CM_RBF_TRIHARMONIC, opt->solver, state);
 }
 
 static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                    const cm_mesh_boundary *b, const unsigned char *constrained,
                                    const cm_warp_options *opt, void **state)
 {
-    (void)opt;
-    return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, state);
+    return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, opt->solver, state);
 }
 
 const cm_warp_method_ops cm_warp_rbf_triharmonic = {"rbf", triharmonic_create, rbf_apply,

@@ -105,3 +105,14 @@ cm_morph_cli(cli_morph_via_topology ${CM_RUN_CLI} --exit 2 --stderr-lines 1
 cm_morph_cli(cli_morph_via_alone ${CM_RUN_CLI} --exit 1 --stderr "--via needs --relative" --
   $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
   --mesh ${SW}/hole_a.msh -o ${SW}/x.vtu --via ${SD}/hole_b.step)
+
+# the RBF solver by name: the iterative solver's morph passes the same checks as the dense one
+cm_morph_cli(cli_morph_solver_iterative ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
+  $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
+  --mesh ${SW}/hole_a.msh -o ${SW}/cli_solver.vtu --solver iterative)
+cm_morph_cli(cli_morph_solver_on_g1 ${CHECK} ongeom ${SW}/hole_a.msh ${SW}/cli_solver.vtu
+  ${SD}/hole_b.step 1e-9)
+set_tests_properties(cli_morph_solver_on_g1 PROPERTIES DEPENDS cli_morph_solver_iterative)
+cm_morph_cli(cli_morph_bad_solver ${CM_RUN_CLI} --exit 1 --stderr "unknown solver 'fast'" --
+  $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
+  --mesh ${SW}/hole_a.msh -o ${SW}/x.vtu --solver fast)
