@@ -7,6 +7,8 @@
  * hidden. */
 #include "ffd_internal.h"
 
+#include "cadmorph/blas.h"
+
 #include <cblas.h>
 #include <lapacke.h>
 #include <math.h>
@@ -84,6 +86,9 @@ static cm_status build_rows(cm_context *ctx, cm_dmffd *d, const double *handles)
 
 static cm_status svd(cm_context *ctx, cm_dmffd *d, const cm_dmffd_options *opt)
 {
+    /* under an address-space limit OpenBLAS would spin in its buffer allocation (blas.h) */
+    cm_status st = cm_blas_reserve(ctx, "cm_dmffd_create");
+    if (st < 0) return st;
     size_t m = d->m, n = d->n_act, r = m < n ? m : n;
     d->r = r;
     double *phi = calloc(m * n + 1, sizeof *phi);
