@@ -3,8 +3,9 @@
  * the rest follows a space deformation (triharmonic RBF or constrained MLS). */
 #include "cli.h"
 
+#include "cadmorph/deform.h"
+
 #include "cadmorph/mls.h"
-#include "cadmorph/rbf.h"
 #include "cadmorph/warp.h"
 
 #include <errno.h>
@@ -183,33 +184,6 @@ static cm_status read_fixed(cm_context *ctx, const char *path, size_t n, unsigne
     return s;
 }
 
-/* Triharmonic RBF through the constrained nodes, evaluated at the others. */
-static cm_status deform_rbf(cm_context *ctx, const cm_mesh *m, const unsigned char *con, double *disp)
-{
-    size_t n = m->n_nodes, nc = 0;
-    for (size_t i = 0; i < n; ++i)
-        nc += con[i] != 0;
-    double *c = malloc((nc ? nc : 1) * 3 * sizeof *c), *v = malloc((nc ? nc : 1) * 3 * sizeof *v);
-    double *f = malloc(((n - nc) ? n - nc : 1) * 3 * sizeof *f), *out = malloc(((n - nc) ? n - nc : 1) * 3 * sizeof *out);
-    cm_rbf *rbf = NULL;
-    cm_status s = c && v && f && out ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "out of memory");
-    for (size_t i = 0, a = 0, b = 0; s >= 0 && i < n; ++i)
-        if (con[i]) {
-            memcpy(c + 3 * a, m->xyz + 3 * i, 3 * sizeof *c);
-            memcpy(v + 3 * a++, disp + 3 * i, 3 * sizeof *v);
-        } else {
-            memcpy(f + 3 * b++, m->xyz + 3 * i, 3 * sizeof *f);
-        }
-    if (s >= 0) s = cm_rbf_create(ctx, CM_RBF_TRIHARMONIC, 3, nc, c, &rbf);
-    if (s >= 0) s = cm_rbf_solve(ctx, rbf, 3, v);
-    if (s >= 0 && n > nc) s = cm_rbf_evaluate(ctx, rbf, n - nc, f, out);
-    for (size_t i = 0, b = 0; s >= 0 && i < n; ++i)
-        if (!con[i]) memcpy(disp + 3 * i, out + 3 * b++, 3 * sizeof *disp);
-    cm_rbf_destroy(&rbf);
-    free(c), free(v), free(f), free(out);
-    return s;
-}
-
 int cli_cmd_deform(int argc, char **argv)
 {
     deform_args a;
@@ -262,7 +236,7 @@ int cli_cmd_deform(int argc, char **argv)
     if (s >= 0 && a.shell && volume)
         s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: --method shell deforms surface meshes only", a.mesh);
     if (s >= 0 && a.shell) s = cm_mls_shell(ctx, mesh, con, a.stretch, a.bend, a.fix, disp);
-    if (s >= 0 && !a.mls && !a.shell) s = deform_rbf(ctx, mesh, con, disp);
+    if (s >= 0 && !a.mls && !a.shell) s = cm_deform_rbf(ctx, mesh->n_nodes, mesh->xyz, con, disp);
     if (s >= 0 && a.mls) {
         cm_mls_options o;
         cm_mls_options_init(&o);

@@ -182,6 +182,14 @@ CM_API void cm_ffd_prm_desc(const cm_ffd_prm *prm, cm_ffd_basis basis, cm_ffd_de
 CM_API cm_status cm_ffd_read_displacements(cm_context *ctx, const char *path, const int n[3],
                                     double *dc, unsigned char *listed);
 
+/* ---- the RBF space deformation (handles) ----
+ * disp: n x 3; read at the constrained points (constrained: n flags), written at the others
+ * by one triharmonic RBF (r^3 + linear, rbf.h) through the constrained points xyz (n x 3).
+ * Needs no cells: surface and volume meshes alike. Errors: the RBF's (coplanar constrained
+ * points are CM_ERR_NUMERIC). */
+CM_API cm_status cm_deform_rbf(cm_context *ctx, size_t n, const double *xyz,
+                               const unsigned char *constrained, double *disp);
+
 #ifdef __cplusplus
 }
 #endif
