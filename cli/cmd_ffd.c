@@ -2,6 +2,7 @@
  * a PyGeM parameter file (.prm), writes the mesh and reports how many nodes the lattice held
  * and the quality of the volume cells. */
 #include "cli.h"
+#include "options.h"
 
 #include "cadmorph/deform.h"
 
@@ -13,7 +14,46 @@ static const char *const usage_line =
     "cadmorph ffd --mesh M --lattice L.prm [--displacements C.csv] [--basis bspline|bernstein] "
     "-o M1 [--threads N] [--verbose]";
 
-static void print_help(void)
+typedef struct ffd_args {
+    const char *mesh, *lattice, *csv, *out;
+    int basis; /* cm_ffd_basis */
+    int threads, verbose;
+} ffd_args;
+
+static ffd_args args;
+
+static int print_help(void);
+
+static const char *const basis_names[] = {"bernstein", "bspline", NULL};
+static const int basis_values[] = {CM_FFD_BERNSTEIN, CM_FFD_BSPLINE};
+
+static const cli_option options[] = {
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP},
+    {.name = "--mesh", .kind = CLI_STRING, .dest = &args.mesh, .label = "--mesh M",
+     .help = "input mesh (any cells: volume or surface)"},
+    {.name = "--lattice", .kind = CLI_STRING, .dest = &args.lattice, .label = "--lattice L.prm",
+     .help = "the lattice and, unless --displacements is given, its weights"},
+    {.name = "--displacements", .kind = CLI_STRING, .dest = &args.csv,
+     .label = "--displacements C",
+     .help = "control displacements instead of the .prm weights: CSV with\n"
+             "header i,j,k,dx,dy,dz, physical units in the world frame (not\n"
+             "normalised); points not listed stay"},
+    {.name = "--basis", .kind = CLI_ENUM, .dest = &args.basis, .names = basis_names,
+     .values = basis_values, .bad = "%.0sunknown basis '%s' (bspline|bernstein)",
+     .label = "--basis B",
+     .help = "bernstein (default for .prm: PyGeM's Bernstein polynomials of\n"
+             "degree n-1, global support) or bspline (uniform cubic B-splines\n"
+             "on the box as their valid domain, the paper's; n >= 4 per axis;\n"
+             "the control points then reach one spacing outside the box)"},
+    {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
+     .label = "-o, --output M1", .help = "output mesh (must not be an input)"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
+     .help = "threads (default: all)"},
+    {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
+     .label = "--verbose", .help = "debug messages on stderr"},
+    {0}};
+
+static int print_help(void)
 {
     printf("usage: %s\n\n", usage_line);
     printf(
@@ -36,65 +76,24 @@ static void print_help(void)
         "  - displacement form: zero weights leave every node bit for bit where it was (PyGeM's\n"
         "    two least-squares affine fits move them by ~1e-15);\n"
         "  - a missing .prm file is an error (PyGeM writes a default one there).\n\n"
-        "options:\n"
-        "  --mesh M             input mesh (any cells: volume or surface)\n"
-        "  --lattice L.prm      the lattice and, unless --displacements is given, its weights\n"
-        "  --displacements C    control displacements instead of the .prm weights: CSV with\n"
-        "                       header i,j,k,dx,dy,dz, physical units in the world frame (not\n"
-        "                       normalised); points not listed stay\n"
-        "  --basis B            bernstein (default for .prm: PyGeM's Bernstein polynomials of\n"
-        "                       degree n-1, global support) or bspline (uniform cubic B-splines\n"
-        "                       on the box as their valid domain, the paper's; n >= 4 per axis;\n"
-        "                       the control points then reach one spacing outside the box)\n"
-        "  -o, --output M1      output mesh (must not be an input)\n"
-        "  --threads N          threads (default: all)\n"
-        "  --verbose            debug messages on stderr\n\n"
-        "exit codes: 0 done, 1 usage, 2 bad input (malformed .prm or CSV, a lattice that is not\n"
-        "invertible).\n");
+        "options:\n");
+    cli_print_options(stdout, options, 21);
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed .prm or CSV, a lattice that is not\n"
+           "invertible).\n");
+    return CLI_EXIT_OK;
 }
-
-typedef struct ffd_args {
-    const char *mesh, *lattice, *csv, *out;
-    cm_ffd_basis basis;
-    int threads, verbose;
-} ffd_args;
 
 /* Returns -1 to go on, else the exit code. */
 static int parse_args(int argc, char **argv, ffd_args *a)
 {
     static const char *cmd = "ffd";
-    memset(a, 0, sizeof *a);
-    a->basis = CM_FFD_BERNSTEIN;
-    for (int i = 1; i < argc; ++i) {
-        const char *o = argv[i], *v;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            print_help();
-            return CLI_EXIT_OK;
-        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
-            a->verbose = 1;
-        } else if (!strcmp(o, "--mesh")) {
-            if (!(a->mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--lattice")) {
-            if (!(a->lattice = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--displacements")) {
-            if (!(a->csv = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(a->out = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--basis")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (!strcmp(v, "bernstein"))
-                a->basis = CM_FFD_BERNSTEIN;
-            else if (!strcmp(v, "bspline"))
-                a->basis = CM_FFD_BSPLINE;
-            else
-                return cli_usage(cmd, usage_line, "unknown basis '%s' (bspline|bernstein)", v);
-        } else if (!strcmp(o, "--threads")) {
-            if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
-                return CLI_EXIT_USAGE;
-        } else {
-            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
-        }
-    }
+    memset(&args, 0, sizeof args);
+    args.basis = CM_FFD_BERNSTEIN;
+    cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
+                    .unknown = "unknown argument '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    *a = args;
+    if (parsed >= 0) return parsed;
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->lattice) return cli_usage(cmd, usage_line, "--lattice is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
