@@ -3,4 +3,5 @@
 # of the library cm_mls, whose private CHOLMOD factor the alternation updates.
 target_sources(cm_mls PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/shape_fit.c  # plane, circle, cylinder, similar/rigid projections
+  ${CMAKE_CURRENT_LIST_DIR}/shapeup.c    # the alternation, eq. 17, sparse C of section 6.1
 )
