@@ -4,4 +4,5 @@
 target_sources(cm_mls PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/shape_fit.c  # plane, circle, cylinder, similar/rigid projections
   ${CMAKE_CURRENT_LIST_DIR}/shapeup.c    # the alternation, eq. 17, sparse C of section 6.1
+  ${CMAKE_CURRENT_LIST_DIR}/ransac.c     # primitive detection (section 6.3), ransac.h
 )
