@@ -135,7 +135,7 @@ static int parse_args(int argc, char **argv, deform_args *a)
         return cli_usage(cmd, usage_line, "--fixed and --fix-unlisted-boundary exclude each other");
     if ((a->mls || a->shell) && (a->fix <= 0 || a->stretch + a->bend <= 0))
         return cli_usage(cmd, usage_line, "--fix must be > 0 and --stretch + --bend > 0");
-    if (a->cons.n && !a->mls)
+    if (cli_constraints_any(&a->cons) && !a->mls)
         return cli_usage(cmd, usage_line, "--constraint needs --method mls");
     if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
         return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
@@ -255,11 +255,11 @@ int cli_cmd_deform(int argc, char **argv)
         cm_shape_set sets[CLI_MAX_CONSTRAINTS];
         s = cli_constraints_resolve(ctx, mesh, &a.cons, sets);
         if (s >= 0) s = cm_mls_create(ctx, mesh, con, &o, &mls);
-        if (s >= 0 && a.cons.n)
+        if (s >= 0 && cli_constraints_any(&a.cons))
             s = cli_constraints_run(ctx, mls, mesh, &a.cons, sets, disp, &residual);
         else if (s >= 0)
             s = cm_mls_apply(ctx, mls, disp, &residual);
-        cli_constraints_free(a.cons.n, sets);
+        cli_constraints_free(&a.cons, sets);
         cm_mls_stats st;
         cm_mls_get_stats(mls, &st);
         if (s >= 0)

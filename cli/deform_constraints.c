@@ -34,7 +34,15 @@ void cli_constraints_help(void)
         "  --constraint-tolerance T  stop when no constrained node moves more than T x the\n"
         "                            bounding-box diagonal in one alternation (default 1e-9)\n"
         "  --dense-constraints       mean-centred C (dense per set) instead of subtracting one\n"
-        "                            point (section 6.1, the default)\n");
+        "                            point (section 6.1, the default)\n"
+        "  --constraint-snap         after the alternation, put the constrained nodes on their\n"
+        "                            projections (the shapes then hold to rounding)\n"
+        "  --constraints-from-cad G  volume meshes: constraints from the STEP model G of the\n"
+        "                            mesh: the nodes of each planar face (with its edges and\n"
+        "                            vertices) a plane set, of each cylindrical face a cylinder\n"
+        "                            set, of each circular edge a circle set\n"
+        "  --cad-constraints LIST    which of them: plane, cylinder, circle, face:N, edge:N\n"
+        "                            (0-based ids as `cadmorph info` lists; default all types)\n");
 }
 
 static int parse_number(const char *v, double *out)
@@ -54,6 +62,18 @@ int cli_constraints_option(int argc, char **argv, int *i, const char *cmd, const
     double d;
     if (!strcmp(o, "--dense-constraints")) {
         c->opt.sparse = 0;
+        return 1;
+    }
+    if (!strcmp(o, "--constraint-snap")) {
+        c->opt.snap = 1;
+        return 1;
+    }
+    if (!strcmp(o, "--constraints-from-cad") || !strcmp(o, "--cad-constraints")) {
+        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
+        if (o[2] == 'c' && o[3] == 'o')
+            c->cad = v;
+        else
+            c->cad_filter = v;
         return 1;
     }
     if (!strcmp(o, "--constraint")) {
@@ -224,11 +244,16 @@ static cm_status mesh_set(cm_context *ctx, const cm_mesh *m, const char *set, un
                     set, used ? have : "none");
 }
 
-cm_status cli_constraints_resolve(cm_context *ctx, const cm_mesh *mesh, const cli_constraints *c,
+int cli_constraints_any(const cli_constraints *c)
+{
+    return c->n > 0 || c->cad != NULL;
+}
+
+cm_status cli_constraints_resolve(cm_context *ctx, const cm_mesh *mesh, cli_constraints *c,
                                   cm_shape_set *sets)
 {
     size_t n = mesh->n_nodes;
-    memset(sets, 0, (size_t)c->n * sizeof *sets);
+    memset(sets, 0, CLI_MAX_CONSTRAINTS * sizeof *sets);
     unsigned char *mark = malloc(n ? n : 1);
     if (!mark) return cm_error(ctx, CM_ERR_NOMEM, "out of memory");
     cm_status s = CM_OK;
@@ -257,19 +282,24 @@ cm_status cli_constraints_resolve(cm_context *ctx, const cm_mesh *mesh, const cl
         if (k == 0) s = cm_error(ctx, CM_ERR_MISMATCH, "constraint set '%s': no node", c->set[t]);
     }
     free(mark);
-    if (s < 0) cli_constraints_free(c->n, sets);
+    if (s >= 0 && c->cad) s = cli_cad_constraints(ctx, mesh, c, sets);
+    if (s >= 0 && c->cad && c->n == 0)
+        s = cm_error(ctx, CM_ERR_MISMATCH, "%s: no plane, cylinder or circle to constrain (filter %s)",
+                     c->cad, c->cad_filter ? c->cad_filter : "all");
     return s;
 }
 
-void cli_constraints_free(int n, cm_shape_set *sets)
+void cli_constraints_free(cli_constraints *c, cm_shape_set *sets)
 {
-    for (int t = 0; t < n; ++t) {
+    for (int t = 0; t < CLI_MAX_CONSTRAINTS; ++t) {
         free((void *)sets[t].nodes);
         sets[t].nodes = NULL;
+        free(c->owned[t]);
+        c->owned[t] = NULL;
     }
 }
 
-cm_status cli_constraints_run(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh,
+cm_status cli_constraints_run(cm_context *ctx, cm_mls *mls, cm_mesh *mesh,
                               const cli_constraints *c, const cm_shape_set *sets, double *disp,
                               double *fix_residual)
 {
@@ -285,6 +315,19 @@ cm_status cli_constraints_run(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh,
     cm_shapeup_report rep;
     s = cm_shapeup_apply(ctx, su, disp, r0, r1, &rep);
     cm_shapeup_destroy(&su);
+    /* which set each node is in (the last one listed), for ParaView and the tests */
+    double *field = NULL;
+    if (s >= 0) {
+        cm_status fs = cm_mesh_add_field(ctx, mesh, "constraint_set", CM_FIELD_NODE, 1, &field);
+        if (fs < 0) s = fs;
+    }
+    if (field) {
+        for (size_t i = 0; i < mesh->n_nodes; ++i)
+            field[i] = -1;
+        for (int t = 0; t < c->n; ++t)
+            for (size_t i = 0; i < sets[t].n; ++i)
+                field[sets[t].nodes[i]] = t;
+    }
     if (s >= 0) {
         double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
         for (size_t i = 0; i < mesh->n_nodes; ++i)
@@ -302,6 +345,9 @@ cm_status cli_constraints_run(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh,
                rep.iterations, rep.converged ? "converged" : "NOT converged", rep.last_move,
                c->opt.sparse ? "sparse" : "mean-centred", rep.c_nonzeros, rep.factor_nonzeros,
                rep.t_factor, rep.t_iterate);
+        if (c->opt.snap)
+            printf("snap: constrained nodes moved onto their projections by at most %.6g\n",
+                   rep.snap_move);
         if (s > 0) {
             /* the cap was hit: a result, with the warning on stderr */
             fprintf(stderr, "cadmorph deform: warning: %s\n", cm_context_message(ctx));

@@ -64,6 +64,7 @@ void cm_shapeup_options_init(cm_shapeup_options *opt)
     opt->max_iterations = 10000;
     opt->tolerance = 1e-9;
     opt->sparse = 1;
+    opt->snap = 0;
 }
 
 void cm_shapeup_destroy(cm_shapeup **su)
@@ -512,7 +513,21 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
         }
         memcpy(disp + 3 * i, d, sizeof d);
     }
+    double smove = 0;
+    if (s->opt.snap)
+        for (size_t i = 0; i < s->n_tot; ++i) {
+            int64_t node = s->nodes[i];
+            if (v->is_con[node] && v->keep_constrained) continue; /* prescribed stays */
+            double e = 0;
+            for (int a = 0; a < 3; ++a) {
+                double target = p[3 * i + a] - s->ref[3 * i + a];
+                e += (target - disp[3 * node + a]) * (target - disp[3 * node + a]);
+                disp[3 * node + a] = target;
+            }
+            smove = fmax(smove, sqrt(e));
+        }
     if (rep) {
+        rep->snap_move = smove;
         rep->iterations = it;
         rep->converged = converged;
         rep->last_move = move;

@@ -69,6 +69,9 @@ typedef struct cm_shapeup_options {
                            diagonal in one alternation (1e-9) */
     int sparse;         /* 1: section 6.1, subtract one point of each set (sparse C);
                            0: mean-centring (dense n_t x n_t blocks) */
+    int snap;           /* 1: after the alternation, the set nodes take their projections
+                           (the constraints then hold to rounding; a node of several sets
+                           takes the last one's); 0: the field everywhere (default) */
 } cm_shapeup_options;
 
 CM_API void cm_shapeup_options_init(cm_shapeup_options *opt);
@@ -88,6 +91,7 @@ typedef struct cm_shapeup_report {
     int converged;       /* 1 if the tolerance was met before the cap */
     double last_move;    /* largest move of a set node in the last alternation */
     double fix_residual; /* largest miss at the MLS constrained nodes */
+    double snap_move;    /* snap: the largest move of a set node onto its projection */
     size_t c_nonzeros;   /* entries of C */
     size_t update_nonzeros; /* entries of Phi^T C^T (the columns of the factor update) */
     size_t factor_nonzeros; /* entries of the constrained factor */
