@@ -35,6 +35,8 @@ void cli_constraints_help(void)
         "                            bounding-box diagonal in one alternation (default 1e-9)\n"
         "  --dense-constraints       mean-centred C (dense per set) instead of subtracting one\n"
         "                            point (section 6.1, the default)\n"
+        "  --constraint-anderson M   Anderson acceleration over the last M iterates (1..64;\n"
+        "                            default off: the paper's plain alternation)\n"
         "  --constraint-snap         after the alternation, put the constrained nodes on their\n"
         "                            projections (the shapes then hold to rounding)\n"
         "  --constraints-from-cad G  volume meshes: constraints from the STEP model G of the\n"
@@ -99,6 +101,15 @@ int cli_constraints_option(int argc, char **argv, int *i, const char *cmd, const
         }
         c->type[c->n] = t;
         c->set[c->n++] = colon + 1;
+        return 1;
+    }
+    if (!strcmp(o, "--constraint-anderson")) {
+        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
+        if (parse_number(v, &d) || d < 1 || d > 64 || d != floor(d)) {
+            cli_usage(cmd, usage, "%s: '%s' is not an integer in 1..64", o, v);
+            return -1;
+        }
+        c->opt.anderson = (int)d;
         return 1;
     }
     if (!strcmp(o, "--constraint-weight") || !strcmp(o, "--constraint-tolerance") ||

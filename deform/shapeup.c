@@ -65,6 +65,7 @@ void cm_shapeup_options_init(cm_shapeup_options *opt)
     opt->tolerance = 1e-9;
     opt->sparse = 1;
     opt->snap = 0;
+    opt->anderson = 0;
 }
 
 void cm_shapeup_destroy(cm_shapeup **su)
@@ -228,11 +229,12 @@ cm_status cm_shapeup_create(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh, s
                       who, mesh->n_nodes, s->v.n_nodes);
         goto done;
     }
-    if (!(s->opt.weight > 0) || s->opt.max_iterations < 0 || !(s->opt.tolerance >= 0)) {
+    if (!(s->opt.weight > 0) || s->opt.max_iterations < 0 || !(s->opt.tolerance >= 0) ||
+        s->opt.anderson < 0 || s->opt.anderson > 64) {
         st = cm_error(ctx, CM_ERR_ARGUMENT,
-                      "%s: weight %g, iterations %d, tolerance %g: need weight > 0, iterations >= 0, "
-                      "tolerance >= 0",
-                      who, s->opt.weight, s->opt.max_iterations, s->opt.tolerance);
+                      "%s: weight %g, iterations %d, tolerance %g, anderson %d: need weight > 0, "
+                      "iterations >= 0, tolerance >= 0, 0 <= anderson <= 64",
+                      who, s->opt.weight, s->opt.max_iterations, s->opt.tolerance, s->opt.anderson);
         goto done;
     }
     s->xyz = mesh->xyz;
@@ -335,6 +337,123 @@ done:
     return st;
 }
 
+/* Anderson acceleration of the fixed-point map w -> G(w) = one alternation (Walker and Ni
+ * 2011; for Shape-Up-like local/global solvers: Peng et al. 2018): the next iterate combines
+ * the last m images so that the linearised residual G(w) - w is least; the history restarts
+ * whenever the residual grows (the plain alternation's step is then taken). */
+typedef struct anderson {
+    size_t n;
+    int m, count, head, have_prev;
+    double *wp, *f, *g, *fprev, *gprev; /* n each */
+    double *df, *dg;                    /* m x n rings */
+    double fprev_norm;
+} anderson;
+
+static anderson *anderson_create(size_t n, int m)
+{
+    anderson *a = calloc(1, sizeof *a);
+    if (!a) return NULL;
+    a->n = n, a->m = m;
+    a->wp = malloc(n * sizeof *a->wp), a->f = malloc(n * sizeof *a->f), a->g = malloc(n * sizeof *a->g);
+    a->fprev = malloc(n * sizeof *a->fprev), a->gprev = malloc(n * sizeof *a->gprev);
+    a->df = malloc((size_t)m * n * sizeof *a->df), a->dg = malloc((size_t)m * n * sizeof *a->dg);
+    if (!a->wp || !a->f || !a->g || !a->fprev || !a->gprev || !a->df || !a->dg) {
+        free(a->wp), free(a->f), free(a->g), free(a->fprev), free(a->gprev), free(a->df), free(a->dg);
+        free(a);
+        return NULL;
+    }
+    return a;
+}
+
+static void anderson_destroy(anderson *a)
+{
+    if (!a) return;
+    free(a->wp), free(a->f), free(a->g), free(a->fprev), free(a->gprev), free(a->df), free(a->dg);
+    free(a);
+}
+
+/* w: in G(wp), out the accelerated iterate */
+static void anderson_step(anderson *a, double *w)
+{
+    size_t n = a->n;
+    double fn = 0;
+    for (size_t i = 0; i < n; ++i)
+        a->g[i] = w[i], a->f[i] = w[i] - a->wp[i], fn += a->f[i] * a->f[i];
+    fn = sqrt(fn);
+    if (a->have_prev && fn > a->fprev_norm) {
+        a->count = 0; /* the residual grew: restart, plain step */
+    } else if (a->have_prev) {
+        double *df = a->df + (size_t)a->head * n, *dg = a->dg + (size_t)a->head * n;
+        for (size_t i = 0; i < n; ++i)
+            df[i] = a->f[i] - a->fprev[i], dg[i] = a->g[i] - a->gprev[i];
+        a->head = (a->head + 1) % a->m;
+        if (a->count < a->m) ++a->count;
+        /* theta = argmin |f - dF theta|, by the m x m normal equations with a small ridge */
+        int c = a->count;
+        double ata[64 * 64], atb[64], tr = 0;
+        for (int i = 0; i < c; ++i) {
+            const double *di = a->df + (size_t)i * n;
+            double sb = 0;
+            for (size_t q = 0; q < n; ++q)
+                sb += di[q] * a->f[q];
+            atb[i] = sb;
+            for (int j = 0; j <= i; ++j) {
+                const double *dj = a->df + (size_t)j * n;
+                double sa = 0;
+                for (size_t q = 0; q < n; ++q)
+                    sa += di[q] * dj[q];
+                ata[i * c + j] = ata[j * c + i] = sa;
+            }
+            tr += ata[i * c + i];
+        }
+        for (int i = 0; i < c; ++i)
+            ata[i * c + i] += 1e-10 * tr / c + 1e-300;
+        /* Cholesky */
+        int ok = 1;
+        for (int j = 0; j < c && ok; ++j) {
+            double d = ata[j * c + j];
+            for (int l = 0; l < j; ++l)
+                d -= ata[j * c + l] * ata[j * c + l];
+            if (!(d > 0)) {
+                ok = 0;
+                break;
+            }
+            ata[j * c + j] = sqrt(d);
+            for (int i = j + 1; i < c; ++i) {
+                double e = ata[i * c + j];
+                for (int l = 0; l < j; ++l)
+                    e -= ata[i * c + l] * ata[j * c + l];
+                ata[i * c + j] = e / ata[j * c + j];
+            }
+        }
+        if (ok) {
+            for (int i = 0; i < c; ++i) {
+                double e = atb[i];
+                for (int l = 0; l < i; ++l)
+                    e -= ata[i * c + l] * atb[l];
+                atb[i] = e / ata[i * c + i];
+            }
+            for (int i = c - 1; i >= 0; --i) {
+                double e = atb[i];
+                for (int l = i + 1; l < c; ++l)
+                    e -= ata[l * c + i] * atb[l];
+                atb[i] = e / ata[i * c + i];
+            }
+            for (int i = 0; i < c; ++i) {
+                const double *gi = a->dg + (size_t)i * n;
+                for (size_t q = 0; q < n; ++q)
+                    w[q] -= atb[i] * gi[q];
+            }
+        } else {
+            a->count = 0;
+        }
+    }
+    memcpy(a->fprev, a->f, n * sizeof *a->f);
+    memcpy(a->gprev, a->g, n * sizeof *a->g);
+    a->fprev_norm = fn;
+    a->have_prev = 1;
+}
+
 /* positions of the set nodes under the coefficients w (k x 3, row-major) */
 static void set_positions(const cm_shapeup *s, const double *w, double *y)
 {
@@ -416,7 +535,8 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
     double *w = malloc(k * 3 * sizeof *w), *y = malloc(nt * 3 * sizeof *y);
     double *y2 = malloc(nt * 3 * sizeof *y2), *p = malloc(nt * 3 * sizeof *p);
     double *res = malloc((s->n_sets ? s->n_sets : 1) * sizeof *res);
-    if (!bfix || !b || !w || !y || !y2 || !p || !res) {
+    anderson *aa = s->opt.anderson > 0 ? anderson_create(3 * k, s->opt.anderson) : NULL;
+    if (!bfix || !b || !w || !y || !y2 || !p || !res || (s->opt.anderson > 0 && !aa)) {
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_shapeup_apply: out of memory");
         goto done;
     }
@@ -476,8 +596,10 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
                         bx[a * k + (size_t)v->col[q]] -= v->val[q] * zs[a];
             }
         }
+        if (aa) memcpy(aa->wp, w, 3 * k * sizeof *w);
         st = solve(ctx, s, s->factor, b, w);
         if (st < 0) goto done;
+        if (aa) anderson_step(aa, w);
         set_positions(s, w, y2);
         move = 0;
         for (size_t i = 0; i < s->n_tot; ++i) {
@@ -547,5 +669,6 @@ done:
     if (bfix) cholmod_free_dense(&bfix, &s->cc);
     if (b) cholmod_free_dense(&b, &s->cc);
     free(w), free(y), free(y2), free(p), free(res);
+    anderson_destroy(aa);
     return st;
 }

@@ -69,6 +69,8 @@ typedef struct cm_shapeup_options {
                            diagonal in one alternation (1e-9) */
     int sparse;         /* 1: section 6.1, subtract one point of each set (sparse C);
                            0: mean-centring (dense n_t x n_t blocks) */
+    int anderson;       /* > 0: Anderson acceleration with this many past iterates (at most 64;
+                           0: the plain alternation, default) */
     int snap;           /* 1: after the alternation, the set nodes take their projections
                            (the constraints then hold to rounding; a node of several sets
                            takes the last one's); 0: the field everywhere (default) */

@@ -179,7 +179,11 @@ static void test_shear(cm_context *ctx)
     size_t cnnz[2] = {0, 0};
     /* gamma_c = 10 (the paper's) trades the constraints against bending; 1000 nearly
      * enforces them, in more alternations */
-    for (int pass = 0; pass < 4; ++pass) {
+    /* passes 4, 5: gamma_c = 1000 with Anderson acceleration: the same fixed point in fewer
+     * alternations */
+    double plain_r1[2][2] = {{0, 0}, {0, 0}};
+    int plain_it[2] = {0, 0};
+    for (int pass = 0; pass < 6; ++pass) {
         int sparse = pass & 1;
         double gamma = pass < 2 ? 10 : 1000, fplane = pass < 2 ? 0.5 : 0.05, frigid = pass < 2 ? 0.9 : 0.25;
         cm_shapeup_options so;
@@ -188,6 +192,7 @@ static void test_shear(cm_context *ctx)
         so.tolerance = 1e-10;
         so.max_iterations = 30000;
         so.weight = gamma;
+        so.anderson = pass >= 4 ? 5 : 0;
         cm_shapeup *su = NULL;
         CHECK(cm_shapeup_create(ctx, mls, m, 2, sets, &so, &su) == CM_OK);
         double *d1 = malloc(n * 3 * sizeof *d1), r0[2], r1[2];
@@ -204,10 +209,20 @@ static void test_shear(cm_context *ctx)
         CHECK_MSG(rep.fix_residual < 10 * res + 1e-3, "fix residual %g (unconstrained %g)",
                   rep.fix_residual, res);
         cnnz[sparse] = rep.c_nonzeros;
-        printf("gamma_c %g, sparse %d: plane %.3g -> %.3g, rigid %.3g -> %.3g, %d iterations, C nnz %zu, "
+        printf("gamma_c %g, anderson %d, sparse %d: plane %.3g -> %.3g, rigid %.3g -> %.3g, %d iterations, C nnz %zu, "
                "update nnz %zu, factor nnz %zu, update %.3f s, iterations %.3f s\n",
-               gamma, sparse, r0[0], r1[0], r0[1], r1[1], rep.iterations, rep.c_nonzeros,
+               gamma, so.anderson, sparse, r0[0], r1[0], r0[1], r1[1], rep.iterations, rep.c_nonzeros,
                rep.update_nonzeros, rep.factor_nonzeros, rep.t_factor, rep.t_iterate);
+        if (pass >= 2 && pass < 4)
+            plain_r1[sparse][0] = r1[0], plain_r1[sparse][1] = r1[1], plain_it[sparse] = rep.iterations;
+        if (pass >= 4) {
+            CHECK_MSG(fabs(r1[0] - plain_r1[sparse][0]) < 1e-3 * plain_r1[sparse][0] + 1e-7 &&
+                          fabs(r1[1] - plain_r1[sparse][1]) < 1e-3 * plain_r1[sparse][1] + 1e-7,
+                      "anderson: residuals %g %g vs plain %g %g", r1[0], r1[1], plain_r1[sparse][0],
+                      plain_r1[sparse][1]);
+            CHECK_MSG(rep.iterations * 3 < plain_it[sparse], "anderson: %d iterations vs plain %d",
+                      rep.iterations, plain_it[sparse]);
+        }
         if (pass >= 2) {
             free(d1);
             cm_shapeup_destroy(&su);
