@@ -115,11 +115,10 @@ static int parse_args(int argc, char **argv, detect_args *a)
     if (parsed >= 0) return parsed;
     if (p.n_pos < 1 || !a->mesh) return cli_usage(cmd, usage_line, "MESH is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
-    if (a->faces && cm_mesh_format_from_path(a->faces) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
-                         a->faces);
-    if (cli_same_file(a->out, a->mesh) || (a->faces && cli_same_file(a->faces, a->mesh)))
-        return cli_usage(cmd, usage_line, "output is an input: refusing to overwrite it");
+    const char *inputs[] = {a->mesh};
+    if (a->faces && cli_check_mesh_output(cmd, usage_line, a->faces, inputs, 1)) return CLI_EXIT_USAGE;
+    if (cli_same_file(a->out, a->mesh))
+        return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it", a->out);
     return -1;
 }
 

@@ -4,7 +4,8 @@ feature line, cylinder, rigid), each deformed by `cadmorph deform --method mls` 
 with the constraint (bending only: gamma_s = 0, gamma_b = 1, gamma_c = 10, the paper's).
 Writes OUT/fig6.csv (residual before/after, iterations, times) and OUT/fig6.svg (original,
 without, with; constrained nodes in red).
-usage: fig6.py CADMORPH OUT [extra deform options...]"""
+usage: fig6.py CADMORPH OUT [extra deform options...]
+Also gamma_c = 1000 (nearly hard constraints), plain and with Anderson acceleration (m = 5)."""
 import csv, os, re, subprocess, sys
 import numpy as np
 import meshio
@@ -97,7 +98,10 @@ for r, (name, p, q, fixed, handle, disp, cset) in enumerate(cases):
     res = {}
     for tag, opts in (("free", []), ("con", ["--constraint", "%s:%s_set.csv" % (name, name)]),
                       ("con1000", ["--constraint", "%s:%s_set.csv" % (name, name),
-                                   "--constraint-weight", "1000", "--constraint-iterations", "50000"])):
+                                   "--constraint-weight", "1000", "--constraint-iterations", "50000"]),
+                      ("aa1000", ["--constraint", "%s:%s_set.csv" % (name, name),
+                                  "--constraint-weight", "1000", "--constraint-iterations", "50000",
+                                  "--constraint-anderson", "5"])):
         cmd = [cad, *common, *opts, "-o", "%s_%s.vtu" % (name, tag)]
         pr = subprocess.run(cmd, capture_output=True, text=True)
         if pr.returncode:
@@ -106,6 +110,10 @@ for r, (name, p, q, fixed, handle, disp, cset) in enumerate(cases):
     o3 = res["con1000"][0]
     m3 = re.search(r"residual before (\S+) after (\S+) \((\S+) of the diagonal", o3)
     it3 = re.search(r"shape-up: (\d+) iterations, (\S+) ", o3)
+    o4 = res["aa1000"][0]
+    m4 = re.search(r"residual before (\S+) after (\S+) \((\S+) of the diagonal", o4)
+    it4 = re.search(r"shape-up: (\d+) iterations, (\S+) .* iterations (\S+) s", o4)
+    it3t = re.search(r"shape-up: .* iterations (\S+) s", o3)
     o = res["con"][0]
     m = re.search(r"residual before (\S+) after (\S+) \((\S+) of the diagonal", o)
     it = re.search(r"shape-up: (\d+) iterations, (\S+) .* update (\S+) s, iterations (\S+) s", o)
@@ -117,7 +125,9 @@ for r, (name, p, q, fixed, handle, disp, cset) in enumerate(cases):
                  "iterations": it.group(1), "converged": it.group(2), "update_s": it.group(3),
                  "iterate_s": it.group(4), "total_s": t.group(1), "handle_residual": t.group(2),
                  "after_gc1000": m3.group(2), "iterations_gc1000": it3.group(1),
-                 "converged_gc1000": it3.group(2)})
+                 "converged_gc1000": it3.group(2), "iterate_s_gc1000": it3t.group(1),
+                 "after_gc1000_anderson5": m4.group(2), "iterations_gc1000_anderson5": it4.group(1),
+                 "converged_gc1000_anderson5": it4.group(2), "iterate_s_gc1000_anderson5": it4.group(3)})
     for c, (title, d) in enumerate((("original", 0 * p), ("without constraint", res["free"][1]),
                                      ("with %s constraint" % name, res["con"][1]))):
         ax = fig.add_subplot(5, 3, 3 * r + c + 1, projection="3d")
