@@ -86,7 +86,7 @@ cases.append(("rigid", p, q, np.where((p[:, 0] < 0.08) | (p[:, 0] > 0.92))[0],
               np.where(abs(p[:, 0] - 0.5) < 0.04)[0], lambda v: (0, 0, 0.3), block))
 
 rows = []
-fig = plt.figure(figsize=(12, 17))
+plot_only = os.environ.get("FIG6_PLOT_ONLY")
 for r, (name, p, q, fixed, handle, disp, cset) in enumerate(cases):
     used = np.unique(q)
     meshio.write("%s.vtk" % name, meshio.Mesh(p, [("quad", q)]), binary=False)
@@ -96,6 +96,8 @@ for r, (name, p, q, fixed, handle, disp, cset) in enumerate(cases):
     common = ["deform", "--mesh", "%s.vtk" % name, "--handles", "%s_H.csv" % name, "--fixed",
               "%s_F.csv" % name, "--method", "mls", "--stretch", "0", "--bend", "1", *extra]
     res = {}
+    if plot_only:
+        continue
     for tag, opts in (("free", []), ("con", ["--constraint", "%s:%s_set.csv" % (name, name)]),
                       ("con1000", ["--constraint", "%s:%s_set.csv" % (name, name),
                                    "--constraint-weight", "1000", "--constraint-iterations", "50000"]),
@@ -128,20 +130,37 @@ for r, (name, p, q, fixed, handle, disp, cset) in enumerate(cases):
                  "converged_gc1000": it3.group(2), "iterate_s_gc1000": it3t.group(1),
                  "after_gc1000_anderson5": m4.group(2), "iterations_gc1000_anderson5": it4.group(1),
                  "converged_gc1000_anderson5": it4.group(2), "iterate_s_gc1000_anderson5": it4.group(3)})
-    for c, (title, d) in enumerate((("original", 0 * p), ("without constraint", res["free"][1]),
-                                     ("with %s constraint" % name, res["con"][1]))):
+
+# the picture: original, without, with (gamma_c = 10); constrained nodes red
+from mpl_toolkits.mplot3d.art3d import Line3DCollection  # noqa: E402
+
+fig = plt.figure(figsize=(12, 17))
+for r, (name, p, q, fixed, handle, disp, cset) in enumerate(cases):
+    used = np.unique(q)
+    dfree = meshio.read("%s_free.vtu" % name).point_data["displacement"]
+    dcon = meshio.read("%s_con.vtu" % name).point_data["displacement"]
+    edges = np.unique(np.sort(np.vstack([q[:, [0, 1]], q[:, [1, 2]], q[:, [2, 3]], q[:, [3, 0]]]), 1), axis=0)
+    for c, (title, d) in enumerate((("original", 0 * p), ("without constraint", dfree),
+                                     ("with %s constraint" % name, dcon))):
         ax = fig.add_subplot(5, 3, 3 * r + c + 1, projection="3d")
         y = p + d
-        for quad in q[:: max(1, len(q) // 900)]:
-            loop = list(quad) + [quad[0]]
-            ax.plot(y[loop, 0], y[loop, 1], y[loop, 2], color="0.6", lw=0.3)
-        ax.scatter(*y[cset].T, s=3, color="red")
+        lc = Line3DCollection(y[edges], colors="0.55", linewidths=0.25)
+        ax.add_collection3d(lc)
+        ax.scatter(*y[cset].T, s=3, color="red", depthshade=False)
+        allp = np.vstack([p[used], (p + dfree)[used], (p + dcon)[used]])
+        lo, hi = allp.min(0) - 0.02, allp.max(0) + 0.02
+        ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
         ax.set_title("%s: %s" % (name, title), fontsize=9)
-        ax.set_box_aspect(np.ptp(p[used], 0) + 1e-3 + [0, 0, 0.3 if name != "cylinder" else 0])
+        ax.set_box_aspect(np.maximum(hi - lo, 0.3))
         ax.set_axis_off()
-        ax.view_init(elev=25 if name != "circle" else 90, azim=-60 if name != "circle" else -90)
+        ax.view_init(elev=25 if name != "circle" else 89, azim=-60 if name != "circle" else -90)
+        ax.set_rasterized(True)
 fig.tight_layout()
-fig.savefig("fig6.svg")
+fig.savefig("fig6.svg", dpi=80)
+if os.environ.get("FIG6_PNG"):
+    fig.savefig("fig6.png", dpi=60)
+if plot_only:
+    sys.exit(0)
 with open("fig6.csv", "w") as f:
     w = csv.DictWriter(f, fieldnames=list(rows[0]))
     w.writeheader()
