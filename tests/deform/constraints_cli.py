@@ -118,7 +118,7 @@ check(rc == 0, "unconstrained: exit %d %s" % (rc, err))
 d0 = meshio.read("free.vtu").point_data["displacement"] if rc == 0 else None
 
 rc, out, err = run(*base, "--constraint", "cylinder:bore", "--constraint", "plane:top",
-                   "--constraint-weight", "100", "-o", "con.vtu")
+                   "--constraint-weight", "100", "--constraint-anderson", "5", "-o", "con.vtu")
 check(rc == 0, "constrained: exit %d %s" % (rc, err))
 if rc == 0 and d0 is not None:
     d1 = meshio.read("con.vtu").point_data["displacement"]
@@ -137,7 +137,7 @@ if rc == 0 and d0 is not None:
 
 # the same set as a node-list file, and the dense formulation: the same bore, converging
 rc, out, err = run(*base, "--constraint", "cylinder:bore_nodes.csv", "--dense-constraints",
-                   "--constraint-weight", "100", "-o", "con_file.vtu")
+                   "--constraint-weight", "100", "--constraint-anderson", "5", "-o", "con_file.vtu")
 check(rc == 0 and "mean-centred" in out, "node file, dense: exit %d %s %s" % (rc, out, err))
 if rc == 0 and d0 is not None:
     d2 = meshio.read("con_file.vtu").point_data["displacement"]
@@ -161,6 +161,8 @@ check(rc == 2 and "no such file, physical group or field" in err and "bore" in e
 rc, out, err = run(*base, "--method", "rbf", "--constraint", "plane:top", "-o", "x.vtu")
 check(rc == 1 and "--method mls" in err, "rbf: %d %s" % (rc, err))
 check(not os.path.exists("x.vtu"), "no output after a failure")
+rc, out, err = run(*base, "--constraint", "plane:top", "--constraint-anderson", "0", "-o", "x.vtu")
+check(rc == 1 and "1..64" in err, "anderson 0: %d %s" % (rc, err))
 rc, out, err = run("--help")
 check(rc == 0 and "--constraint TYPE:SET" in out, "help")
 
