@@ -734,6 +734,47 @@ cm_status cm_ransac_detect(cm_context *ctx, size_t n_nodes, const double *xyz, s
         if (best < tau && p_tau > o.probability) break;
     }
     r->candidates = draws;
+    /* Boundary refinement: a face on the border of its primitive moves to a neighbouring
+     * primitive it fits better (the border rows of a blend tangent to an earlier-extracted
+     * plane belong to the blend); unassigned faces join a compatible neighbour. Then the
+     * counts, areas and rms are those of the final faces. */
+    for (int pass = 0; pass < 10; ++pass) {
+        size_t changed = 0;
+        for (size_t f = 0; f < n_faces; ++f) {
+            if (!(s.area[f] > 0)) continue;
+            int32_t cur = r->face_primitive[f], best = cur;
+            double nv[3], bd = INFINITY;
+            if (cur >= 0) {
+                cand kc = {r->primitives[cur].type, {0}, 0};
+                memcpy(kc.p, r->primitives[cur].p, sizeof kc.p);
+                bd = prim_distance(&kc, s.c + 3 * f, nv);
+            }
+            for (int64_t a = s.adj_off[f]; a < s.adj_off[f + 1]; ++a) {
+                int32_t q = r->face_primitive[s.adj[a]];
+                if (q < 0 || q == best) continue;
+                cand kq = {r->primitives[q].type, {0}, 0};
+                memcpy(kq.p, r->primitives[q].p, sizeof kq.p);
+                double d = prim_distance(&kq, s.c + 3 * f, nv);
+                if (d < bd && compatible(&s, &kq, f)) bd = d, best = q;
+            }
+            if (best != cur) r->face_primitive[f] = best, ++changed;
+        }
+        if (!changed) break;
+    }
+    for (size_t i = 0; i < r->n_primitives; ++i)
+        r->primitives[i].n_faces = 0, r->primitives[i].area = 0, r->primitives[i].rms = 0;
+    for (size_t f = 0; f < n_faces; ++f) {
+        int32_t q = r->face_primitive[f];
+        if (q < 0) continue;
+        cm_primitive *pr = r->primitives + q;
+        cand kq = {pr->type, {0}, 0};
+        memcpy(kq.p, pr->p, sizeof kq.p);
+        double nv[3], d = prim_distance(&kq, s.c + 3 * f, nv);
+        ++pr->n_faces, pr->area += s.area[f], pr->rms += d * d;
+    }
+    for (size_t i = 0; i < r->n_primitives; ++i)
+        if (r->primitives[i].n_faces)
+            r->primitives[i].rms = sqrt(r->primitives[i].rms / (double)r->primitives[i].n_faces);
 nodes:
     /* the vertices of each primitive's faces */
     {

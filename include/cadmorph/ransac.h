@@ -3,7 +3,8 @@
  * on face barycentres and face normals (not vertex normals: at a sharp edge those belong to
  * no primitive, the paper's Figure 7), planes, cylinders, spheres and cones, each candidate
  * refined by a forward search (grow through face neighbours compatible with the refitted
- * primitive, refit, repeat). A primitive is assigned to every vertex of its faces, so a
+ * primitive, refit, repeat); at the end a face on a primitive's border moves to a
+ * neighbouring primitive it fits closer (tangent blends). A primitive is assigned to every vertex of its faces, so a
  * vertex may belong to several. Conventions: see core.h. */
 #ifndef CADMORPH_RANSAC_H
 #define CADMORPH_RANSAC_H
