@@ -113,6 +113,15 @@ if rc == 0:
     prims = compare("sphere_cone", types2, "sc_faces.vtu", "sc.csv")
     sph = [p for p in prims if p["type"] == "sphere"]
     check(sph and abs(float(sph[0]["p3"]) - 0.5) < 0.005, "sphere radius")
+    # the cone (refitted by Levenberg-Marquardt): radius 0.5 -> 0.15 over 0.8, so half-angle
+    # atan(0.35 / 0.8) and apex at z = -0.4 + 0.8 * 0.5 / 0.35 on the axis x = 2, y = 0
+    cone = [p for p in prims if p["type"] == "cone"]
+    if cone:
+        c = cone[0]
+        apex = np.array([float(c["p0"]), float(c["p1"]), float(c["p2"])])
+        check(abs(float(c["p6"]) - np.arctan(0.35 / 0.8)) < 0.003, "cone half-angle %s" % c["p6"])
+        check(np.linalg.norm(apex - [2, 0, -0.4 + 0.8 * 0.5 / 0.35]) < 0.01, "cone apex %s" % apex)
+        check(float(c["rms"]) < 1e-3, "cone rms %s" % c["rms"])
 
 # a volume mesh: its boundary faces
 build("block_tet", block, 0.12, dim=3)
