@@ -108,7 +108,7 @@ cm_status cli_cad_constraints(cm_context *ctx, const cm_mesh *mesh, cli_constrai
     cm_cad_locator *loc = NULL;
     cm_mesh_boundary *b = NULL;
     cm_surface_nodes *sn = NULL;
-    unsigned char *on_vertex = NULL, *mark = NULL;
+    unsigned char *mark = NULL;
     int *node_kind_entity = NULL;
     size_t n = mesh->n_nodes;
     s = cm_cad_read(ctx, c->cad, NULL, &g);
@@ -212,7 +212,7 @@ cm_status cli_cad_constraints(cm_context *ctx, const cm_mesh *mesh, cli_constrai
             s = cm_error(ctx, CM_ERR_MISMATCH, "--cad-constraints: edge %d of a model of %d edges",
                          flt.edges[i], cnt.edges);
 done:
-    free(on_vertex), free(mark), free(node_kind_entity);
+    free(mark), free(node_kind_entity);
     cm_surface_nodes_destroy(&sn);
     cm_mesh_boundary_destroy(&b);
     cm_cad_locator_destroy(&loc);

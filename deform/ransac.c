@@ -502,11 +502,7 @@ static void prefer_simple(cm_context *ctx, rs *s, cand *k, size_t m, const int32
     alt[na] = *k, alt[na++].type = CM_PRIMITIVE_PLANE;
     if (k->type == CM_PRIMITIVE_CONE) {
         alt[na] = *k, alt[na].type = CM_PRIMITIVE_CYLINDER;
-        /* axis through the faces' mean, radius of the mean distance */
-        double mean[3] = {0, 0, 0};
-        for (size_t i = 0; i < m; ++i)
-            for (int a = 0; a < 3; ++a)
-                mean[a] += s->c[3 * list[i] + a] / (double)m;
+        /* the start: the cone's axis (through its apex), the mean distance from it */
         memcpy(alt[na].p, k->p, 3 * sizeof(double));
         double r = 0;
         for (size_t i = 0; i < m; ++i) {
@@ -516,7 +512,6 @@ static void prefer_simple(cm_context *ctx, rs *s, cand *k, size_t m, const int32
             r += prim_distance(&c0, s->c + 3 * list[i], nrm) / (double)m;
         }
         alt[na].p[6] = r;
-        (void)mean;
         ++na;
     }
     for (int i = 0; i < na; ++i) {
