@@ -29,7 +29,7 @@ struct cm_shapeup {
     cm_shapeup_options opt;
     cholmod_common cc;
     cholmod_factor *factor;
-    size_t c_nnz, u_nnz, l_nnz;
+    size_t c_nnz, u_nnz, l_nnz, l0_nnz;
     double t_factor;
 };
 
@@ -66,6 +66,7 @@ void cm_shapeup_options_init(cm_shapeup_options *opt)
     opt->sparse = 1;
     opt->snap = 0;
     opt->anderson = 0;
+    opt->reorder = 1;
 }
 
 void cm_shapeup_destroy(cm_shapeup **su)
@@ -206,6 +207,78 @@ done:
     return st;
 }
 
+static int cmp_pair(const void *a, const void *b)
+{
+    const int64_t *x = a, *y = b;
+    return (x[0] > y[0]) - (x[0] < y[0]);
+}
+
+/* The constrained matrix A + U U^T factored afresh, with a fill-reducing ordering of its own:
+ * A = P^T L L^T P from the MLS factor (its rows, which the MLS object does not keep, are not
+ * needed), so CHOLMOD factors F F^T with F = [P^T L, U] (U in the original ordering). */
+static cm_status refactor(cm_context *ctx, cm_shapeup *s, cholmod_factor *f0, cholmod_sparse *u)
+{
+    cholmod_common *cc = &s->cc;
+    size_t k = s->v.k;
+    cholmod_factor *lc = cholmod_copy_factor(f0, cc);
+    cholmod_sparse *ls = NULL, *f = NULL;
+    int64_t *pair = NULL;
+    cm_status st = CM_OK;
+    if (!lc || !cholmod_change_factor(CHOLMOD_REAL, 1, 0, 1, 1, lc, cc) ||
+        !(ls = cholmod_factor_to_sparse(lc, cc))) {
+        st = cm_error(ctx, cc->status == CHOLMOD_OUT_OF_MEMORY ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
+                      "cm_shapeup_create: the MLS factor as a matrix (CHOLMOD status %d)", cc->status);
+        goto done;
+    }
+    const int *perm = f0->Perm, *lp = ls->p, *li = ls->i, *up = u->p, *ui = u->i;
+    const double *lx = ls->x, *ux = u->x;
+    size_t nl = (size_t)lp[ls->ncol], nu = (size_t)up[u->ncol], ncol = ls->ncol + u->ncol;
+    s->l0_nnz = nl;
+    f = cholmod_allocate_sparse(k, ncol, nl + nu, 1, 1, 0, CHOLMOD_REAL, cc);
+    pair = malloc((k ? k : 1) * 2 * sizeof *pair);
+    if (!f || !pair) {
+        st = cm_error(ctx, CM_ERR_NOMEM, "cm_shapeup_create: out of memory (%zu entries)", nl + nu);
+        goto done;
+    }
+    int *fp = f->p, *fi = f->i;
+    double *fx = f->x;
+    size_t e = 0;
+    fp[0] = 0;
+    for (size_t j = 0; j < ls->ncol; ++j) {
+        /* the rows of P^T L: row i of L is row perm[i] of A's ordering; sorted per column */
+        size_t m = 0;
+        for (int q = lp[j]; q < lp[j + 1]; ++q) {
+            pair[2 * m] = perm ? perm[li[q]] : li[q];
+            memcpy(pair + 2 * m + 1, lx + q, sizeof(double));
+            ++m;
+        }
+        qsort(pair, m, 2 * sizeof *pair, cmp_pair);
+        for (size_t q = 0; q < m; ++q, ++e) {
+            fi[e] = (int)pair[2 * q];
+            memcpy(fx + e, pair + 2 * q + 1, sizeof(double));
+        }
+        fp[j + 1] = (int)e;
+    }
+    for (size_t j = 0; j < u->ncol; ++j) {
+        for (int q = up[j]; q < up[j + 1]; ++q, ++e)
+            fi[e] = ui[q], fx[e] = ux[q];
+        fp[ls->ncol + j + 1] = (int)e;
+    }
+    s->factor = cholmod_analyze(f, cc);
+    if (s->factor) cholmod_factorize(f, s->factor, cc);
+    if (!s->factor || cc->status != CHOLMOD_OK)
+        st = cm_error(ctx, cc->status == CHOLMOD_OUT_OF_MEMORY ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
+                      "cm_shapeup_create: CHOLMOD failed on the constrained %zu x %zu system "
+                      "(status %d)",
+                      k, k, cc->status);
+done:
+    free(pair);
+    if (f) cholmod_free_sparse(&f, cc);
+    if (ls) cholmod_free_sparse(&ls, cc);
+    if (lc) cholmod_free_factor(&lc, cc);
+    return st;
+}
+
 cm_status cm_shapeup_create(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh, size_t n_sets,
                             const cm_shape_set *sets, const cm_shapeup_options *opt, cm_shapeup **out)
 {
@@ -304,12 +377,18 @@ cm_status cm_shapeup_create(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh, s
     }
     double t0 = cm_wtime();
     cholmod_factor *f0 = s->v.factor;
-    s->factor = cholmod_copy_factor(f0, &s->cc);
-    if (!s->factor) {
-        st = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory (copy of the MLS factor)", who);
-        goto done;
+    if (s->n_tot && s->opt.reorder) {
+        st = build_update(ctx, s, NULL, &u);
+        if (st >= 0) st = refactor(ctx, s, f0, u);
+        if (st < 0) goto done;
+    } else {
+        s->factor = cholmod_copy_factor(f0, &s->cc);
+        if (!s->factor) {
+            st = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory (copy of the MLS factor)", who);
+            goto done;
+        }
     }
-    if (s->n_tot) {
+    if (s->n_tot && !s->opt.reorder) {
         st = build_update(ctx, s, s->factor->Perm, &u);
         if (st < 0) goto done;
         if (!cholmod_updown(1, u, s->factor, &s->cc) || s->cc.status != CHOLMOD_OK) {
@@ -321,7 +400,11 @@ cm_status cm_shapeup_create(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh, s
         }
     }
     s->t_factor = cm_wtime() - t0;
-    if (s->factor->is_super)
+    /* entries of L (CHOLMOD's count from the analysis; a supernodal xsize would count the
+     * supernodes' zeros too) */
+    if (s->n_tot && s->opt.reorder)
+        s->l_nnz = (size_t)s->cc.lnz;
+    else if (s->factor->is_super)
         s->l_nnz = s->factor->xsize;
     else {
         const int *nz = s->factor->nz;
@@ -657,6 +740,7 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
         rep->c_nonzeros = s->c_nnz;
         rep->update_nonzeros = s->u_nnz;
         rep->factor_nonzeros = s->l_nnz;
+        rep->mls_factor_nonzeros = s->l0_nnz;
         rep->t_factor = s->t_factor;
         rep->t_iterate = cm_wtime() - t0;
     }

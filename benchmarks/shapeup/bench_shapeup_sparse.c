@@ -1,7 +1,8 @@
 /* The two constraint formulations of section 6.1 side by side on a planarity constraint
  * covering a whole plate (the worst case of the mean-centred C): entries of C, of the factor
  * update Phi^T C^T and of the constrained factor, the update's time and the alternations'.
- * usage: bench_shapeup_sparse N K [dense]   (an N x N quad plate, K MLS samples) */
+ * usage: bench_shapeup_sparse N K [dense] [update]   (an N x N quad plate, K MLS samples;
+ * update: CHOLMOD's rank update of the MLS factor instead of a reordered factorisation) */
 #include "cadmorph/shapeup.h"
 
 #include <stdio.h>
@@ -20,7 +21,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: bench_shapeup_sparse N K [dense]\n");
         return 1;
     }
-    int n = atoi(argv[1]), dense = argc > 3 && !strcmp(argv[3], "dense");
+    int n = atoi(argv[1]), dense = 0, update = 0;
+    for (int i = 3; i < argc; ++i)
+        dense |= !strcmp(argv[i], "dense"), update |= !strcmp(argv[i], "update");
     size_t k = (size_t)atol(argv[2]);
     cm_context *ctx = NULL;
     cm_mesh *m = NULL;
@@ -66,6 +69,7 @@ int main(int argc, char **argv)
     cm_shapeup_options so;
     cm_shapeup_options_init(&so);
     so.sparse = !dense;
+    so.reorder = !update;
     so.max_iterations = 20000;
     cm_shapeup *su = NULL;
     double c2 = cpu();
@@ -79,12 +83,12 @@ int main(int argc, char **argv)
     cm_shapeup_report rep;
     s = cm_shapeup_apply(ctx, su, d, &r0, &r1, &rep);
     double c4 = cpu();
-    printf("formulation,nodes,samples,C_nnz,update_nnz,mls_factor_nnz,factor_nnz,mls_cpu_s,"
+    printf("formulation,factor,nodes,samples,C_nnz,update_nnz,mls_factor_nnz,factor_nnz,mls_cpu_s,"
            "update_cpu_s,iterations,converged,iterate_cpu_s,per_iteration_ms,residual_before,"
            "residual_after\n");
-    printf("%s,%zu,%zu,%zu,%zu,%zu,%zu,%.3f,%.3f,%d,%d,%.3f,%.3f,%.3g,%.3g\n",
-           dense ? "mean-centred" : "sparse", nn, st.samples, rep.c_nonzeros, rep.update_nonzeros,
-           st.factor_nonzeros, rep.factor_nonzeros, c1 - c0, c3 - c2, rep.iterations,
+    printf("%s,%s,%zu,%zu,%zu,%zu,%zu,%zu,%.3f,%.3f,%d,%d,%.3f,%.3f,%.3g,%.3g\n",
+           dense ? "mean-centred" : "sparse", update ? "rank-update" : "reordered", nn, st.samples, rep.c_nonzeros, rep.update_nonzeros,
+           rep.mls_factor_nonzeros ? rep.mls_factor_nonzeros : st.factor_nonzeros, rep.factor_nonzeros, c1 - c0, c3 - c2, rep.iterations,
            rep.converged, c4 - c3, 1e3 * (c4 - c3) / (rep.iterations ? rep.iterations : 1), r0, r1);
     cm_shapeup_destroy(&su);
     cm_mls_destroy(&mls);

@@ -69,6 +69,10 @@ typedef struct cm_shapeup_options {
                            diagonal in one alternation (1e-9) */
     int sparse;         /* 1: section 6.1, subtract one point of each set (sparse C);
                            0: mean-centring (dense n_t x n_t blocks) */
+    int reorder;        /* 1: factor MLS matrix + gamma_c Phi^T C^T C Phi afresh with its own
+                           fill-reducing ordering (default); 0: CHOLMOD's rank update of the MLS
+                           factor in the MLS ordering (cheaper for small sets, more fill for
+                           large ones) */
     int anderson;       /* > 0: Anderson acceleration with this many past iterates (at most 64;
                            0: the plain alternation, default) */
     int snap;           /* 1: after the alternation, the set nodes take their projections
@@ -80,8 +84,8 @@ CM_API void cm_shapeup_options_init(cm_shapeup_options *opt);
 
 typedef struct cm_shapeup cm_shapeup;
 
-/* Factors MLS normal equations + gamma_c Phi^T C^T C Phi once (a CHOLMOD update of the MLS
- * factor). mls and mesh (the one mls was built on) are borrowed and must outlive the
+/* Factors MLS normal equations + gamma_c Phi^T C^T C Phi once (from the MLS factor: see
+ * reorder). mls and mesh (the one mls was built on) are borrowed and must outlive the
  * object; sets are copied. A set needs at least 3 nodes (5 for a cylinder). */
 CM_API cm_status cm_shapeup_create(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh,
                                    size_t n_sets, const cm_shape_set *sets,
@@ -97,6 +101,7 @@ typedef struct cm_shapeup_report {
     size_t c_nonzeros;   /* entries of C */
     size_t update_nonzeros; /* entries of Phi^T C^T (the columns of the factor update) */
     size_t factor_nonzeros; /* entries of the constrained factor */
+    size_t mls_factor_nonzeros; /* entries of the MLS factor's L (reorder only; else 0) */
     double t_factor, t_iterate; /* seconds: the update at create, the last apply's loop */
 } cm_shapeup_report;
 
