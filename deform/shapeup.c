@@ -1,8 +1,9 @@
 /* Shape-Up in the MLS deformation (paper section 6, eq. 17; section 6.1's sparse C):
  * alternate the projections of every constraint set (local step) with the MLS normal
  * equations plus gamma_c Phi^T C^T C Phi (global step). The matrix is the same in every
- * iteration: the MLS factor is copied and updated once by CHOLMOD's rank-r update with the
- * columns sqrt(gamma_t) Phi^T c_r, one per row c_r of C; each iteration is one solve. */
+ * iteration, so it is factored once from the MLS factor and the columns sqrt(gamma_t) Phi^T c_r
+ * (one per row c_r of C): afresh with its own ordering, or by CHOLMOD's rank update of the MLS
+ * factor; each iteration is one solve. Optional Anderson acceleration of the alternation. */
 #include "mls_internal.h"
 
 #include "cadmorph/shapeup.h"
