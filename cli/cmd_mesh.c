@@ -14,11 +14,14 @@
 
 static const char *const usage =
     "cadmorph mesh G.step -o MESH [--size H] [--quality Q] [--preserve-surface] "
-    "[--min-dihedral D] [--no-optimize] [--force] [--cad-unit U] [--threads N] [-v] [-h|--help]";
+    "[--min-dihedral D] [--no-optimize] [--force] [--mesher tetgen|gmsh] [--time-limit S] "
+    "[--cad-unit U] [--threads N] [-v] [-h|--help]";
 
 static const char *out, *unit;
 static cm_tetmesh_options opt;
 static int threads, verbose, preserve_surface, no_optimize, force;
+static const char *const mesher_names[] = {"tetgen", "gmsh", NULL};
+static const int mesher_values[] = {CM_MESHER_TETGEN, CM_MESHER_GMSH};
 
 static const cli_option options[] = {
     {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &out, .label = "-o MESH",
@@ -44,6 +47,16 @@ static const cli_option options[] = {
     {.name = "--force", .kind = CLI_FLAG, .dest = &force, .label = "--force",
      .help = "mesh even when the estimated tet count exceeds 1e7 (refused\n"
              "otherwise, exit code 4, with the estimate)"},
+    {.name = "--mesher", .kind = CLI_ENUM, .dest = &opt.mesher, .names = mesher_names,
+     .values = mesher_values, .bad = "%.0sunknown mesher '%s' (tetgen|gmsh)",
+     .label = "--mesher M",
+     .help = "tetgen (default) or gmsh (gmsh's library meshes the same STEP\n"
+             "file; --size is its maximum element size, --quality,\n"
+             "--min-dihedral and --preserve-surface are TetGen's)"},
+    {.name = "--time-limit", .kind = CLI_DOUBLE, .dest = &opt.time_limit, .lo = 0, .hi = NAN,
+     .open = 1, .bad = "%s needs seconds > 0, got '%s'", .label = "--time-limit S",
+     .help = "seconds one mesher run may take (default 600); the mesher runs\n"
+             "in a child process, so its crash or hang is an error message"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &unit, .label = "--cad-unit U",
      .help = "length unit of the coordinates (default mm)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",
@@ -66,8 +79,9 @@ static int help(void)
            "options:\n",
            usage);
     cli_print_options(stdout, options, 20);
-    printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable STEP, no closed solid, TetGen\n"
-           "failure, touching solids), 4 out of memory or beyond the tet limit, internal error.\n");
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable STEP, no closed solid, touching\n"
+           "solids, the mesher failed, crashed or ran out of time: the message says what was\n"
+           "tried), 4 out of memory or beyond the tet limit, internal error.\n");
     return CLI_EXIT_OK;
 }
 

@@ -8,7 +8,7 @@
 #include "cadmorph/optimize.h"
 #include "cadmorph/tetmesh.h"
 
-#include <tetgen.h>
+#include "tetgen_run.h"
 
 #include <algorithm>
 #include <array>
@@ -23,22 +23,14 @@
 
 namespace {
 
-const char *tetgen_reason(int code)
-{
-    switch (code) {
-    case 1: return "out of memory";
-    case 2: return "internal error";
-    case 3: return "the surface intersects itself";
-    case 4: return "a very small input feature";
-    case 5: return "two very close input facets";
-    case 10: return "invalid input";
-    default: return "unknown error";
-    }
-}
-
 struct cad_guard {
     cm_cad_triangulation *t = nullptr;
     ~cad_guard() { cm_cad_triangulation_destroy(&t); }
+};
+
+struct tetgen_result {
+    cm_tetgen_result r = {};
+    ~tetgen_result() { cm_tetgen_result_free(&r); }
 };
 
 struct mesh_guard {
@@ -211,44 +203,28 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
            T.n_triangles, t1 - t0);
     cm_progress(ctx, "tetgen", 0, 1);
 
-    tetgenio in, tv;
-    in.firstnumber = 0;
-    in.numberofpoints = (int)T.n_nodes;
-    in.pointlist = new REAL[3 * T.n_nodes];
-    std::copy(T.xyz, T.xyz + 3 * T.n_nodes, in.pointlist);
-    in.numberoffacets = (int)T.n_triangles;
-    in.facetlist = new tetgenio::facet[T.n_triangles];
-    in.facetmarkerlist = new int[T.n_triangles];
-    for (size_t t = 0; t < T.n_triangles; ++t) {
-        tetgenio::facet &f = in.facetlist[t];
-        tetgenio::init(&f);
-        f.numberofpolygons = 1;
-        f.polygonlist = new tetgenio::polygon[1];
-        tetgenio::init(&f.polygonlist[0]);
-        f.polygonlist[0].numberofvertices = 3;
-        f.polygonlist[0].vertexlist = new int[3];
-        for (int k = 0; k < 3; ++k) f.polygonlist[0].vertexlist[k] = (int)T.tri[3 * t + k];
-        in.facetmarkerlist[t] = T.tri_face[t] + 1;  // 0 would mean "no marker"
-    }
-    // TetGen's error path frees its memory pools twice (terminatetetgen, then ~tetgenmesh)
-    // and crashes, so nothing may reach it that a check can find first: -d reports the
-    // triangles that intersect (what two touching solids or a bad triangulation give)
-    // without that path.
+    const cm_tetgen_plc plc = {T.n_nodes, T.n_triangles, T.xyz, T.tri, nullptr};
+    std::vector<int> marker(T.n_triangles);
+    for (size_t t = 0; t < T.n_triangles; ++t) marker[t] = T.tri_face[t] + 1;  // 0: no marker
+    cm_tetgen_plc in = plc;
+    in.marker = marker.data();
+    const double limit = o.time_limit > 0 ? o.time_limit : CM_TETMESH_TIME_LIMIT;
+    // TetGen's -d reports the triangles that intersect (what two touching solids or a bad
+    // triangulation give) in words a user can act on; TetGen's error path crashes (now in the
+    // child), which says less
     {
         const double td = cm_wtime();
-        tetgenio diag;
-        char dsw[] = "pdQ";
-        try {
-            tetrahedralize(dsw, &in, &diag);
-        } catch (int code) {
-            return cm_error(ctx, code == 1 ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
-                            "%s: TetGen's intersection check failed with code %d (%s)", path,
-                            code, tetgen_reason(code));
-        }
-        if (diag.numberoftrifaces > 0) {
+        tetgen_result diag;
+        int failure = 0;
+        s = cm_tetgen_run(ctx, path, &in, "pdQ", limit, &diag.r, &failure);
+        if (s < 0 && failure == 0) return s;
+        if (s < 0) {
+            // a crash or a timeout of the check itself: the meshing below says what happens
+            cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: %s", cm_context_message(ctx));
+            if (failure == 3) return s;
+        } else if (diag.r.n_trifaces > 0) {
             std::set<int> faces;
-            for (int t = 0; t < diag.numberoftrifaces && diag.trifacemarkerlist; ++t)
-                faces.insert(diag.trifacemarkerlist[t] - 1);
+            for (size_t t = 0; t < diag.r.n_trifaces; ++t) faces.insert(diag.r.trimarker[t] - 1);
             std::string list;
             int shown = 0;
             for (int f : faces) {
@@ -259,37 +235,118 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
                 list += (list.empty() ? "" : ", ") + std::to_string(f);
             }
             return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                            "%s: the surface triangulation intersects itself (%d triangles on "
+                            "%s: the surface triangulation intersects itself (%zu triangles on "
                             "CAD faces %s): TetGen cannot mesh it",
-                            path, diag.numberoftrifaces, list.c_str());
+                            path, diag.r.n_trifaces, list.c_str());
+        } else {
+            cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: no intersecting triangles (%.3f s)",
+                   cm_wtime() - td);
         }
-        cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: no intersecting triangles (%.3f s)",
-               cm_wtime() - td);
     }
-    char sw[128];
-    /* the dihedral bound (after the radius-edge ratio) is what removes most slivers: TetGen's
-     * -O optimisation levels changed no measured quality (benchmarks/RESULTS.md, issue 13) */
-    char dihedral[32] = "";
-    if (o.min_dihedral > 0) std::snprintf(dihedral, sizeof dihedral, "/%.6g", o.min_dihedral);
-    std::snprintf(sw, sizeof sw, "pzq%.6g%sa%.6g%sQ", q, dihedral, vmax,
-                  o.preserve_surface ? "Y" : "");
-    try {
-        tetrahedralize(sw, &in, &tv);
-    } catch (int code) {
-        return cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen failed with code %d (%s), switches %s",
-                        fn, code, tetgen_reason(code), sw);
-    }
-    if (tv.numberoftetrahedra <= 0 || tv.numberofcorners != 4)
-        return cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen made no linear tets (switches %s)", fn, sw);
 
-    const size_t nn = (size_t)tv.numberofpoints, nt = (size_t)tv.numberoftetrahedra,
-                 nb = (size_t)tv.numberoftrifaces;
-    std::vector<double> xyz(tv.pointlist, tv.pointlist + 3 * nn);
+    // What helps when TetGen crashes, asserts or gives up on a valid surface: keeping the
+    // surface (-Y: no Steiner points on it, where fillcavity's assertion was met), a looser
+    // quality bound (less refinement near degenerate spots), a surface moved off its exact
+    // cocircular and coplanar configurations (its nodes put back afterwards)
+    struct attempt {
+        const char *label;
+        bool keep_surface;
+        double q, dihedral;
+        bool perturb;
+    };
+    std::vector<attempt> attempts = {{"the switches asked for", o.preserve_surface != 0, q,
+                                      o.min_dihedral, false}};
+    if (!o.preserve_surface) attempts.push_back({"-Y (surface kept)", true, q, o.min_dihedral, false});
+    if (q < 2 || o.min_dihedral > 0)
+        attempts.push_back({"quality q2 without a dihedral bound", o.preserve_surface != 0,
+                            std::max(q, 2.0), 0, false});
+    attempts.push_back({"a surface perturbed by 1e-6 x size", o.preserve_surface != 0, q,
+                        o.min_dihedral, true});
+    tetgen_result tv;
+    std::string tried;
+    bool preserved = o.preserve_surface != 0;
+    char sw[128] = "";
+    std::vector<double> perturbed;
+    size_t chosen = attempts.size();
+    for (size_t a = 0; a < attempts.size(); ++a) {
+        const attempt &at = attempts[a];
+        /* the dihedral bound (after the radius-edge ratio) is what removes most slivers:
+         * TetGen's -O optimisation levels changed no measured quality (benchmarks/RESULTS.md,
+         * issue 13) */
+        char dihedral[32] = "";
+        if (at.dihedral > 0) std::snprintf(dihedral, sizeof dihedral, "/%.6g", at.dihedral);
+        std::snprintf(sw, sizeof sw, "pzq%.6g%sa%.6g%sQ", at.q, dihedral, vmax,
+                      at.keep_surface ? "Y" : "");
+        in.xyz = T.xyz;
+        if (at.perturb) {
+            // a fixed sequence: the same model gives the same mesh
+            perturbed.assign(T.xyz, T.xyz + 3 * T.n_nodes);
+            uint64_t state = 0x9e3779b97f4a7c15ULL;
+            for (double &x : perturbed) {
+                state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+                x += 1e-6 * h * ((double)(state >> 11) / 9007199254740992.0 - 0.5);
+            }
+            in.xyz = perturbed.data();
+        }
+        int failure = 0;
+        s = cm_tetgen_run(ctx, path, &in, sw, limit, &tv.r, &failure);
+        if (s >= 0 && (tv.r.n_tets == 0 || tv.r.corners != 4)) {
+            cm_tetgen_result_free(&tv.r);
+            s = cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen made no linear tets (switches %s)", path, sw);
+        }
+        if (s >= 0 && at.perturb) {
+            // the input nodes go back onto the CAD model: refused if that inverts a tet
+            size_t flipped = 0;
+            std::vector<double> back(tv.r.xyz, tv.r.xyz + 3 * tv.r.n_points);
+            std::copy(T.xyz, T.xyz + 3 * T.n_nodes, back.begin());
+            for (size_t t = 0; t < tv.r.n_tets; ++t) {
+                const int32_t *c = &tv.r.tet[4 * t];
+                const double before = orient(&tv.r.xyz[3 * c[0]], &tv.r.xyz[3 * c[1]],
+                                             &tv.r.xyz[3 * c[2]], &tv.r.xyz[3 * c[3]]);
+                const double after = orient(&back[3 * c[0]], &back[3 * c[1]], &back[3 * c[2]],
+                                            &back[3 * c[3]]);
+                if ((before > 0) != (after > 0) || after == 0) ++flipped;
+            }
+            if (flipped) {
+                cm_tetgen_result_free(&tv.r);
+                s = cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen meshed the perturbed surface, but "
+                             "putting its nodes back inverts %zu tets", path, flipped);
+            } else {
+                std::copy(back.begin(), back.end(), tv.r.xyz);
+            }
+        }
+        if (s >= 0) {
+            chosen = a;
+            preserved = at.keep_surface;
+            break;
+        }
+        std::string why = cm_context_message(ctx);
+        const std::string prefix = std::string(path) + ": ";
+        if (why.compare(0, prefix.size(), prefix) == 0) why.erase(0, prefix.size());
+        tried += std::string(tried.empty() ? "" : "; ") + at.label + ": " + why;
+        if (failure == 3) break;  // a hang is not retried: each would take the whole limit
+    }
+    if (chosen == attempts.size()) {
+        const bool hung = tried.find("did not finish") != std::string::npos;
+        return cm_error(ctx, s < 0 ? s : CM_ERR_NUMERIC, "%s: TetGen could not mesh it. Tried %s%s",
+                        path, tried.c_str(),
+                        hung ? " (nothing more: raise the time limit, --time-limit, or try "
+                               "--mesher gmsh)"
+                             : " (try --mesher gmsh)");
+    }
+    if (chosen > 0)
+        cm_log(ctx, CM_LOG_WARNING, "%s: TetGen meshed with %s (switches %s) after: %s", path,
+               attempts[chosen].label, sw, tried.c_str());
+
+    if (tv.r.trimarker == nullptr && tv.r.n_trifaces)
+        return cm_error(ctx, CM_ERR_INTERNAL, "%s: TetGen gave no face markers", fn);
+    const size_t nn = tv.r.n_points, nt = tv.r.n_tets, nb = tv.r.n_trifaces;
+    std::vector<double> xyz(tv.r.xyz, tv.r.xyz + 3 * nn);
     std::vector<int64_t> tri(nb * 3);
     std::vector<int> tri_face(nb);
     for (size_t t = 0; t < nb; ++t) {
-        for (int k = 0; k < 3; ++k) tri[3 * t + k] = tv.trifacelist[3 * t + k];
-        tri_face[t] = tv.trifacemarkerlist ? tv.trifacemarkerlist[t] - 1 : -1;
+        for (int k = 0; k < 3; ++k) tri[3 * t + k] = tv.r.triface[3 * t + k];
+        tri_face[t] = tv.r.trimarker[t] - 1;
         if (tri_face[t] < 0 || tri_face[t] >= counts.faces)
             return cm_error(ctx, CM_ERR_INTERNAL, "%s: boundary triangle %zu without a CAD face", fn, t);
     }
@@ -297,7 +354,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -%s: %zu nodes, %zu tets (%.3f s)", sw, nn, nt, t2 - t1);
     // TetGen keeps the input points first and in order; the others are its Steiner points
     size_t n_projected = 0;
-    if (!o.preserve_surface &&
+    if (!preserved &&
         (s = project_new_nodes(ctx, model, T, T.n_nodes, xyz, tri, tri_face, &n_projected)) < 0)
         return s;
     cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu new boundary nodes projected onto curved faces and edges (%.3f s)",
@@ -308,7 +365,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     std::vector<std::array<int64_t, 4>> tets(nt);
     for (size_t t = 0; t < nt; ++t) {
         std::array<int64_t, 4> &c = tets[t];
-        for (int k = 0; k < 4; ++k) c[k] = tv.tetrahedronlist[4 * t + k];
+        for (int k = 0; k < 4; ++k) c[k] = tv.r.tet[4 * t + k];
         if (orient(&xyz[3 * c[0]], &xyz[3 * c[1]], &xyz[3 * c[2]], &xyz[3 * c[3]]) < 0)
             std::swap(c[2], c[3]);
     }
@@ -376,6 +433,8 @@ extern "C" void cm_tetmesh_options_init(cm_tetmesh_options *opt)
     opt->optimize = 1;
     opt->min_dihedral = 12;
     opt->max_tets = 0;
+    opt->time_limit = 0;
+    opt->mesher = CM_MESHER_TETGEN;
 }
 
 extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
@@ -402,9 +461,6 @@ extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *mode
         return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", fn);
     } catch (const std::exception &e) {
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: %s", fn, e.what());
-    } catch (int code) {
-        return cm_error(ctx, code == 1 ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
-                        "%s: TetGen failed with code %d (%s)", fn, code, tetgen_reason(code));
     } catch (...) {
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: unknown exception", fn);
     }
