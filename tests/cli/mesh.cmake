@@ -35,6 +35,18 @@ add_test(NAME cli_mesh_missing_file COMMAND ${CM_RUN_CLI} --exit 2 --stderr-line
   $<TARGET_FILE:cadmorph> mesh ${MW}/does_not_exist.step -o ${MW}/x.vtu)
 add_test(NAME cli_mesh_not_step COMMAND ${CM_RUN_CLI} --exit 2 --stderr-lines 1 --
   $<TARGET_FILE:cadmorph> mesh ${MD}/make_fixtures.py -o ${MW}/x.vtu)
+# TetGen runs in a child process under a time limit: far below the work it is killed, the
+# command says so in one line and writes nothing (issue 18)
+add_test(NAME cli_mesh_time_limit COMMAND ${CM_RUN_CLI} --exit 2 --stderr-lines 1
+  --stderr "cadmorph mesh: [^\n]*bore_0.step: TetGen could not mesh it[^\n]*TetGen did not finish in 0.05 s[^\n]*--time-limit"
+  --absent ${MW}/time_limit.vtu --
+  $<TARGET_FILE:cadmorph> mesh ${MD}/bore_0.step -o ${MW}/time_limit.vtu --size 0.1 --time-limit 0.05)
+add_test(NAME cli_mesh_bad_time_limit COMMAND ${CM_RUN_CLI} --exit 1 --stderr "--time-limit needs seconds > 0" --
+  $<TARGET_FILE:cadmorph> mesh ${MD}/bore_0.step -o ${MW}/x.vtu --time-limit 0)
+add_test(NAME cli_mesh_bad_mesher COMMAND ${CM_RUN_CLI} --exit 1 --stderr "unknown mesher 'netgen'" --
+  $<TARGET_FILE:cadmorph> mesh ${MD}/bore_0.step -o ${MW}/x.vtu --mesher netgen)
+set_tests_properties(cli_mesh_time_limit cli_mesh_bad_time_limit cli_mesh_bad_mesher
+  PROPERTIES LABELS "unit;cli;cad")
 set_tests_properties(cli_mesh_bore_vtu cli_mesh_bore_msh cli_mesh_bore_vtk_gmsh cli_mesh_bore_medit cli_mesh_help
   cli_mesh_no_output cli_mesh_bad_size cli_mesh_bad_quality cli_mesh_output_is_input
   cli_mesh_no_solid cli_mesh_missing_file cli_mesh_not_step PROPERTIES LABELS "unit;cli;cad")
