@@ -2,7 +2,8 @@
  * TetGen 1.5.0 crashes on its own error path (terminatetetgen frees the pools, ~tetgenmesh
  * frees them again): a self-intersecting surface given to it without the -d check, as two
  * overlapping boxes are, reproduces that crash every time. It must come back as a status with
- * the signal, and the test process must go on: the same run with -d lists the intersecting
+ * the signal, and the test process must go on; so must its assertion (abort) on points
+ * without extent in one direction: the same run with -d lists the intersecting
  * triangles; a clean box meshes (volume 1); a time limit far below the work kills the child;
  * none of TetGen's printing and none of the parent's buffered output reaches stdout twice;
  * OpenMP's thread pool works before and after the forks. */
@@ -108,13 +109,24 @@ int main(int argc, char **argv)
     CHECK(r.xyz == NULL && r.n_tets == 0);
     fprintf(stderr, "two boxes without -d: %s\n", msg);
 
-    /* 3. -d names the intersecting triangles instead */
+    /* 3. points with no extent in x: Debian's TetGen asserts in exactinit (assertions are on in
+     * its build) and aborts; the assertion it printed ends the message */
+    const double flat[12] = {0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1};
+    cm_tetgen_plc plane = {4, 0, flat, NULL, NULL};
+    s = cm_tetgen_run(ctx, "flat", &plane, "Q", 0, &r, &failure);
+    msg = cm_context_message(ctx);
+    CHECK_MSG(s == CM_ERR_NUMERIC && failure >= 1, "status %d failure %d: %s", (int)s, failure, msg);
+    if (failure == 2)
+        CHECK_MSG(strstr(msg, "TetGen aborted (signal 6") && strstr(msg, "Assertion"), "message: %s", msg);
+    fprintf(stderr, "flat points: %s\n", msg);
+
+    /* 4. -d names the intersecting triangles instead */
     s = cm_tetgen_run(ctx, "two boxes -d", &two, "pdQ", 0, &r, &failure);
     CHECK_MSG(s == CM_OK, "-d: %s", cm_context_message(ctx));
     CHECK(r.n_trifaces > 0);
     cm_tetgen_result_free(&r);
 
-    /* 4. a time limit far below the work: the child is killed, no result */
+    /* 5. a time limit far below the work: the child is killed, no result */
     const double t0 = cm_wtime();
     s = cm_tetgen_run(ctx, "fine box", &box, "pq1.2a1e-7Q", 0.05, &r, &failure);
     const double dt = cm_wtime() - t0;
@@ -125,7 +137,7 @@ int main(int argc, char **argv)
     CHECK_MSG(dt < 5, "killed after %g s", dt); /* the limit plus the kill, loaded machine */
     CHECK(r.xyz == NULL);
 
-    /* 5. OpenMP still works after the forks, in the parent */
+    /* 6. OpenMP still works after the forks, in the parent */
     CHECK_NEAR(omp_sum(1000), 1000, 0);
 
     fflush(stdout);
