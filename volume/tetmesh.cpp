@@ -9,6 +9,7 @@
 #include "cadmorph/tetmesh.h"
 
 #include "tetgen_run.h"
+#include "tetmesh_gmsh.h"
 
 #include <algorithm>
 #include <array>
@@ -149,6 +150,71 @@ cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
     return CM_OK;
 }
 
+// The mesh from a mesher's nodes, tets and boundary triangles (each with its CAD face):
+// tets positively oriented (VTK), boundary triangles outward, groups "solid" and "face_<k>".
+cm_status assemble(cm_context *ctx, int n_faces, std::vector<double> &xyz,
+                   std::vector<std::array<int64_t, 4>> &tets, std::vector<int64_t> &tri,
+                   const std::vector<int> &tri_face, cm_mesh **out)
+{
+    const char *fn = "cm_tetmesh_create";
+    cm_status s = CM_OK;
+    const size_t nn = xyz.size() / 3, nt = tets.size(), nb = tri_face.size();
+    // tets positively oriented; boundary triangles away from their tet's fourth node
+    for (auto &c : tets)
+        if (orient(&xyz[3 * c[0]], &xyz[3 * c[1]], &xyz[3 * c[2]], &xyz[3 * c[3]]) < 0)
+            std::swap(c[2], c[3]);
+    std::vector<std::array<int64_t, 4>> keys;  // sorted face, then (tet's other node | -1 - tri)
+    keys.reserve(4 * nt + nb);
+    for (size_t t = 0; t < nb; ++t) {
+        std::array<int64_t, 4> k = {tri[3 * t], tri[3 * t + 1], tri[3 * t + 2], -1 - (int64_t)t};
+        std::sort(k.begin(), k.begin() + 3);
+        keys.push_back(k);
+    }
+    for (const auto &c : tets)
+        for (int f = 0; f < 4; ++f) {
+            std::array<int64_t, 4> k = {c[(f + 1) % 4], c[(f + 2) % 4], c[(f + 3) % 4], c[f]};
+            std::sort(k.begin(), k.begin() + 3);
+            keys.push_back(k);
+        }
+    std::sort(keys.begin(), keys.end());
+    for (size_t i = 0; i < keys.size(); ++i) {
+        if (keys[i][3] >= 0) continue;
+        const size_t t = (size_t)(-1 - keys[i][3]);
+        int64_t apex = -1;
+        for (size_t j = i + 1; j < keys.size() && std::equal(keys[i].begin(), keys[i].begin() + 3,
+                                                             keys[j].begin()); ++j)
+            if (keys[j][3] >= 0) apex = keys[j][3];
+        if (apex < 0)
+            return cm_error(ctx, CM_ERR_INTERNAL, "%s: boundary triangle %zu is on no tet", fn, t);
+        int64_t *f = &tri[3 * t];
+        if (orient(&xyz[3 * f[0]], &xyz[3 * f[1]], &xyz[3 * f[2]], &xyz[3 * apex]) > 0)
+            std::swap(f[1], f[2]);
+    }
+
+    mesh_guard m;
+    if ((s = cm_mesh_create(ctx, &m.m)) < 0) return s;
+    if ((s = cm_mesh_resize_nodes(ctx, m.m, nn, 0)) < 0) return s;
+    std::copy(xyz.begin(), xyz.end(), m.m->xyz);
+    if ((s = cm_mesh_reserve_cells(ctx, m.m, nt + nb, 4 * nt + 3 * nb)) < 0) return s;
+    for (const auto &c : tets)
+        if ((s = cm_mesh_add_cell(ctx, m.m, CM_CELL_TET4, c.data(), 4, 1, 1, 0)) < 0) return s;
+    for (size_t t = 0; t < nb; ++t)
+        if ((s = cm_mesh_add_cell(ctx, m.m, CM_CELL_TRI3, &tri[3 * t], 3, tri_face[t] + 1,
+                                  tri_face[t] + 1, 0)) < 0)
+            return s;
+    if ((s = cm_mesh_add_group(ctx, m.m, 3, 1, "solid")) < 0) return s;
+    std::vector<char> used(n_faces, 0);
+    for (int f : tri_face) used[f] = 1;
+    for (int f = 0; f < n_faces; ++f) {
+        if (!used[f]) continue;
+        const std::string name = "face_" + std::to_string(f);
+        if ((s = cm_mesh_add_group(ctx, m.m, 2, f + 1, name.c_str())) < 0) return s;
+    }
+    *out = m.m;
+    m.m = nullptr;
+    return CM_OK;
+}
+
 cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
                 cm_mesh **out)
 {
@@ -186,6 +252,18 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
                         "of %.3g: use a larger size or lift the limit (cadmorph mesh --force)",
                         path, h, estimate, volume, max_tets);
 
+    const double limit = o.time_limit > 0 ? o.time_limit : CM_TETMESH_TIME_LIMIT;
+    if (o.mesher == CM_MESHER_GMSH) {
+        cm_progress(ctx, "gmsh", 0, 1);
+        cmvol::raw_mesh r;
+        if ((s = cmvol::gmsh_mesh(ctx, model, h, limit, &r)) < 0) return s;
+        s = assemble(ctx, counts.faces, r.xyz, r.tets, r.tri, r.tri_face, out);
+        if (s >= 0) cm_progress(ctx, "gmsh", 1, 1);
+        return s;
+    }
+    if (o.mesher != CM_MESHER_TETGEN)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: unknown mesher %d", fn, o.mesher);
+
     const double t0 = cm_wtime();
     cad_guard surf;
     cm_cad_triangulate_options topt;
@@ -208,7 +286,6 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     for (size_t t = 0; t < T.n_triangles; ++t) marker[t] = T.tri_face[t] + 1;  // 0: no marker
     cm_tetgen_plc in = plc;
     in.marker = marker.data();
-    const double limit = o.time_limit > 0 ? o.time_limit : CM_TETMESH_TIME_LIMIT;
     // TetGen's -d reports the triangles that intersect (what two touching solids or a bad
     // triangulation give) in words a user can act on; TetGen's error path crashes (now in the
     // child), which says less
@@ -360,66 +437,12 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu new boundary nodes projected onto curved faces and edges (%.3f s)",
            n_projected, cm_wtime() - t2);
 
-    // tets positively oriented (VTK), boundary triangles outward: away from their tet's
-    // fourth node
     std::vector<std::array<int64_t, 4>> tets(nt);
-    for (size_t t = 0; t < nt; ++t) {
-        std::array<int64_t, 4> &c = tets[t];
-        for (int k = 0; k < 4; ++k) c[k] = tv.r.tet[4 * t + k];
-        if (orient(&xyz[3 * c[0]], &xyz[3 * c[1]], &xyz[3 * c[2]], &xyz[3 * c[3]]) < 0)
-            std::swap(c[2], c[3]);
-    }
-    std::vector<std::array<int64_t, 4>> keys;  // sorted face, then (tet's other node | -1 - tri)
-    keys.reserve(4 * nt + nb);
-    for (size_t t = 0; t < nb; ++t) {
-        std::array<int64_t, 4> k = {tri[3 * t], tri[3 * t + 1], tri[3 * t + 2], -1 - (int64_t)t};
-        std::sort(k.begin(), k.begin() + 3);
-        keys.push_back(k);
-    }
-    for (const auto &c : tets)
-        for (int f = 0; f < 4; ++f) {
-            std::array<int64_t, 4> k = {c[(f + 1) % 4], c[(f + 2) % 4], c[(f + 3) % 4], c[f]};
-            std::sort(k.begin(), k.begin() + 3);
-            keys.push_back(k);
-        }
-    std::sort(keys.begin(), keys.end());
-    for (size_t i = 0; i < keys.size(); ++i) {
-        if (keys[i][3] >= 0) continue;
-        const size_t t = (size_t)(-1 - keys[i][3]);
-        int64_t apex = -1;
-        for (size_t j = i + 1; j < keys.size() && std::equal(keys[i].begin(), keys[i].begin() + 3,
-                                                             keys[j].begin()); ++j)
-            if (keys[j][3] >= 0) apex = keys[j][3];
-        if (apex < 0)
-            return cm_error(ctx, CM_ERR_INTERNAL, "%s: boundary triangle %zu is on no tet", fn, t);
-        int64_t *f = &tri[3 * t];
-        if (orient(&xyz[3 * f[0]], &xyz[3 * f[1]], &xyz[3 * f[2]], &xyz[3 * apex]) > 0)
-            std::swap(f[1], f[2]);
-    }
-
-    mesh_guard m;
-    if ((s = cm_mesh_create(ctx, &m.m)) < 0) return s;
-    if ((s = cm_mesh_resize_nodes(ctx, m.m, nn, 0)) < 0) return s;
-    std::copy(xyz.begin(), xyz.end(), m.m->xyz);
-    if ((s = cm_mesh_reserve_cells(ctx, m.m, nt + nb, 4 * nt + 3 * nb)) < 0) return s;
-    for (const auto &c : tets)
-        if ((s = cm_mesh_add_cell(ctx, m.m, CM_CELL_TET4, c.data(), 4, 1, 1, 0)) < 0) return s;
-    for (size_t t = 0; t < nb; ++t)
-        if ((s = cm_mesh_add_cell(ctx, m.m, CM_CELL_TRI3, &tri[3 * t], 3, tri_face[t] + 1,
-                                  tri_face[t] + 1, 0)) < 0)
-            return s;
-    if ((s = cm_mesh_add_group(ctx, m.m, 3, 1, "solid")) < 0) return s;
-    std::vector<char> used(counts.faces, 0);
-    for (int f : tri_face) used[f] = 1;
-    for (int f = 0; f < counts.faces; ++f) {
-        if (!used[f]) continue;
-        const std::string name = "face_" + std::to_string(f);
-        if ((s = cm_mesh_add_group(ctx, m.m, 2, f + 1, name.c_str())) < 0) return s;
-    }
-    cm_progress(ctx, "tetgen", 1, 1);
-    *out = m.m;
-    m.m = nullptr;
-    return CM_OK;
+    for (size_t t = 0; t < nt; ++t)
+        for (int k = 0; k < 4; ++k) tets[t][k] = tv.r.tet[4 * t + k];
+    s = assemble(ctx, counts.faces, xyz, tets, tri, tri_face, out);
+    if (s >= 0) cm_progress(ctx, "tetgen", 1, 1);
+    return s;
 }
 
 }  // namespace
