@@ -207,17 +207,20 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
     for (size_t t = 0; t < nt; ++t)
         for (int k = 0; k < 4; ++k) out->tets[t][k] = renum[tets[4 * t + k]];
 
-    // the same geometry? gmsh's box is OpenCASCADE's, enlarged by its tolerance
+    // the same geometry and unit? gmsh's box (OpenCASCADE's, not tight on curved faces:
+    // control points, tolerances) holds ours and is of its size; the faces are checked below
     double bb[6];
     cm_cad_bbox(model, bb);
-    const double diag = cm_bbox_diagonal(bb);
-    for (int k = 0; k < 6; ++k)
-        if (!(std::fabs(hd.bbox[k] - bb[k]) <= 1e-4 * diag))
-            return cm_error(ctx, CM_ERR_MISMATCH,
-                            "%s: gmsh read another geometry: its bounding box [%g %g %g, %g %g %g] "
-                            "is not cadmorph's [%g %g %g, %g %g %g]",
-                            path, hd.bbox[0], hd.bbox[1], hd.bbox[2], hd.bbox[3], hd.bbox[4],
-                            hd.bbox[5], bb[0], bb[1], bb[2], bb[3], bb[4], bb[5]);
+    const double diag = cm_bbox_diagonal(bb), gdiag = cm_bbox_diagonal(hd.bbox);
+    bool holds = gdiag >= 0.5 * diag && gdiag <= 2 * diag;
+    for (int k = 0; k < 3; ++k)
+        holds = holds && hd.bbox[k] <= bb[k] + 1e-4 * diag && hd.bbox[k + 3] >= bb[k + 3] - 1e-4 * diag;
+    if (!holds)
+        return cm_error(ctx, CM_ERR_MISMATCH,
+                        "%s: gmsh read another geometry: its bounding box [%g %g %g, %g %g %g] "
+                        "does not fit cadmorph's [%g %g %g, %g %g %g] (another unit?)",
+                        path, hd.bbox[0], hd.bbox[1], hd.bbox[2], hd.bbox[3], hd.bbox[4],
+                        hd.bbox[5], bb[0], bb[1], bb[2], bb[3], bb[4], bb[5]);
 
     // gmsh surface -> CAD face: the face all of the surface's nodes lie on (gmsh binds faces in
     // OpenCASCADE's order, so face tag - 1 is tried first; a renumbering costs only time)

@@ -45,8 +45,26 @@ add_test(NAME cli_mesh_bad_time_limit COMMAND ${CM_RUN_CLI} --exit 1 --stderr "-
   $<TARGET_FILE:cadmorph> mesh ${MD}/bore_0.step -o ${MW}/x.vtu --time-limit 0)
 add_test(NAME cli_mesh_bad_mesher COMMAND ${CM_RUN_CLI} --exit 1 --stderr "unknown mesher 'netgen'" --
   $<TARGET_FILE:cadmorph> mesh ${MD}/bore_0.step -o ${MW}/x.vtu --mesher netgen)
+# gmsh as the mesher: quiet (nothing on stderr), no inverted tet, and the mesh is one that
+# `cadmorph morph` classifies (every boundary node on a CAD face of G) and morphs; its time
+# limit as TetGen's
+set(CD ${CM_TEST_DATA}/cad)
+add_test(NAME cli_mesh_gmsh COMMAND ${CM_RUN_CLI} --exit 0 --stderr-lines 0 --last-line
+  "min_scaled_jacobian=0\\.[0-9]+ mean_scaled_jacobian=0\\.[0-9]+ inverted=0 cells=[0-9]+" --
+  $<TARGET_FILE:cadmorph> mesh ${CD}/bore_a.step -o ${MW}/gmsh_bore_a.msh --size 0.6 --mesher gmsh)
+set_tests_properties(cli_mesh_gmsh PROPERTIES FIXTURES_SETUP cli_mesh_gmsh)
+add_test(NAME cli_mesh_gmsh_morph COMMAND ${CM_RUN_CLI} --exit 0 --stderr-lines 0 --last-line
+  ".* inverted=0 cells=[0-9]+" --
+  $<TARGET_FILE:cadmorph> morph --from ${CD}/bore_a.step --to ${CD}/bore_b.step
+  --mesh ${MW}/gmsh_bore_a.msh -o ${MW}/gmsh_bore_b.vtu)
+set_tests_properties(cli_mesh_gmsh_morph PROPERTIES FIXTURES_REQUIRED cli_mesh_gmsh)
+add_test(NAME cli_mesh_gmsh_time_limit COMMAND ${CM_RUN_CLI} --exit 2 --stderr-lines 1
+  --stderr "cadmorph mesh: [^\n]*bore_0.step: gmsh did not finish in 0.05 s"
+  --absent ${MW}/gmsh_time_limit.vtu --
+  $<TARGET_FILE:cadmorph> mesh ${MD}/bore_0.step -o ${MW}/gmsh_time_limit.vtu --size 0.05
+  --mesher gmsh --time-limit 0.05)
 set_tests_properties(cli_mesh_time_limit cli_mesh_bad_time_limit cli_mesh_bad_mesher
-  PROPERTIES LABELS "unit;cli;cad")
+  cli_mesh_gmsh cli_mesh_gmsh_morph cli_mesh_gmsh_time_limit PROPERTIES LABELS "unit;cli;cad")
 set_tests_properties(cli_mesh_bore_vtu cli_mesh_bore_msh cli_mesh_bore_vtk_gmsh cli_mesh_bore_medit cli_mesh_help
   cli_mesh_no_output cli_mesh_bad_size cli_mesh_bad_quality cli_mesh_output_is_input
   cli_mesh_no_solid cli_mesh_missing_file cli_mesh_not_step PROPERTIES LABELS "unit;cli;cad")
