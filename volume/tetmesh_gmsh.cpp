@@ -13,6 +13,8 @@ extern "C" {
 #include <gmshc.h>
 }
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -21,7 +23,44 @@ extern "C" {
 #include <map>
 #include <string>
 
+#ifndef CM_GMSH_SONAME
+#define CM_GMSH_SONAME "libgmsh.so"
+#endif
+
 namespace {
+
+// gmsh's library is opened in the child only: linked into cadmorph it would load 60 more
+// shared libraries (FLTK, OpenGL, X11, ...) into every command, 0.15 s CPU each start.
+// The prototypes are gmshc.h's own.
+#define CM_GMSH_FUNCTIONS(X)                                                                       \
+    X(gmshInitialize) X(gmshFree) X(gmshLoggerGetLastError) X(gmshOptionSetNumber)                \
+    X(gmshOptionSetString) X(gmshModelOccImportShapes) X(gmshModelOccSynchronize)                 \
+    X(gmshModelGetBoundingBox) X(gmshModelMeshGenerate) X(gmshModelMeshGetNodes)                  \
+    X(gmshModelMeshGetElementsByType) X(gmshModelGetEntities)
+
+struct gmsh_api {
+#define CM_GMSH_MEMBER(f) decltype(&::f) f = nullptr;
+    CM_GMSH_FUNCTIONS(CM_GMSH_MEMBER)
+#undef CM_GMSH_MEMBER
+};
+
+// 0 on success, else the loader's message in err
+int load_gmsh(gmsh_api *g, char *err, size_t n)
+{
+    void *lib = dlopen(CM_GMSH_SONAME, RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        std::snprintf(err, n, "cannot load gmsh's library (Debian package libgmsh4.8): %s", dlerror());
+        return 1;
+    }
+#define CM_GMSH_LOAD(f)                                                                            \
+    if (!(g->f = reinterpret_cast<decltype(&::f)>(dlsym(lib, #f)))) {                              \
+        std::snprintf(err, n, "%s has no %s", CM_GMSH_SONAME, #f);                                 \
+        return 1;                                                                                  \
+    }
+    CM_GMSH_FUNCTIONS(CM_GMSH_LOAD)
+#undef CM_GMSH_LOAD
+    return 0;
+}
 
 const uint64_t record_magic = 0x636d676d73686d73ULL;  // "cmgmshms"
 
@@ -39,84 +78,93 @@ struct job {
     double h;
 };
 
-int send_error(int fd, const char *what)
+int send_error(const gmsh_api &G, int fd, const char *what)
 {
     header hd = {};
     hd.magic = record_magic;
     hd.failed = 1;
     char *err = nullptr;
     int ierr = 0;
-    gmshLoggerGetLastError(&err, &ierr);
+    G.gmshLoggerGetLastError(&err, &ierr);
     std::snprintf(hd.msg, sizeof hd.msg, "%s%s%s", what, err && *err ? ": " : "", err ? err : "");
-    if (err) gmshFree(err);
+    if (err) G.gmshFree(err);
     return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
 }
 
 int child_work(void *arg, int fd)
 {
     const job &j = *static_cast<const job *>(arg);
+    gmsh_api G;
+    char lerr[300];
+    if (load_gmsh(&G, lerr, sizeof lerr)) {
+        header hd = {};
+        hd.magic = record_magic;
+        hd.failed = 1;
+        std::snprintf(hd.msg, sizeof hd.msg, "%s", lerr);
+        return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
+    }
     int ierr = 0;
-    gmshInitialize(0, nullptr, 0, &ierr);
-    if (ierr) return send_error(fd, "initialisation failed");
+    G.gmshInitialize(0, nullptr, 0, &ierr);
+    if (ierr) return send_error(G, fd, "initialisation failed");
     // quiet (errors still reach the logger), one thread: the fork left no OpenMP pool behind
-    gmshOptionSetNumber("General.Terminal", 0, &ierr);
-    gmshOptionSetNumber("General.NumThreads", 1, &ierr);
-    gmshOptionSetNumber("Mesh.MaxNumThreads1D", 1, &ierr);
-    gmshOptionSetNumber("Mesh.MaxNumThreads2D", 1, &ierr);
-    gmshOptionSetNumber("Mesh.MaxNumThreads3D", 1, &ierr);
-    gmshOptionSetString("Geometry.OCCTargetUnit", j.unit, &ierr);
+    G.gmshOptionSetNumber("General.Terminal", 0, &ierr);
+    G.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
+    G.gmshOptionSetNumber("Mesh.MaxNumThreads1D", 1, &ierr);
+    G.gmshOptionSetNumber("Mesh.MaxNumThreads2D", 1, &ierr);
+    G.gmshOptionSetNumber("Mesh.MaxNumThreads3D", 1, &ierr);
+    G.gmshOptionSetString("Geometry.OCCTargetUnit", j.unit, &ierr);
     int *dt = nullptr;
     size_t ndt = 0;
-    gmshModelOccImportShapes(j.path, &dt, &ndt, 0, "", &ierr);
-    if (dt) gmshFree(dt);
-    if (ierr) return send_error(fd, "cannot import the STEP file");
-    gmshModelOccSynchronize(&ierr);
-    if (ierr) return send_error(fd, "cannot synchronise the model");
+    G.gmshModelOccImportShapes(j.path, &dt, &ndt, 0, "", &ierr);
+    if (dt) G.gmshFree(dt);
+    if (ierr) return send_error(G, fd, "cannot import the STEP file");
+    G.gmshModelOccSynchronize(&ierr);
+    if (ierr) return send_error(G, fd, "cannot synchronise the model");
     header hd = {};
     hd.magic = record_magic;
-    gmshModelGetBoundingBox(-1, -1, &hd.bbox[0], &hd.bbox[1], &hd.bbox[2], &hd.bbox[3],
+    G.gmshModelGetBoundingBox(-1, -1, &hd.bbox[0], &hd.bbox[1], &hd.bbox[2], &hd.bbox[3],
                             &hd.bbox[4], &hd.bbox[5], &ierr);
-    gmshOptionSetNumber("Mesh.MeshSizeMax", j.h, &ierr);
-    gmshOptionSetNumber("Mesh.MeshSizeMin", 0, &ierr);
-    gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 12, &ierr);
-    gmshModelMeshGenerate(3, &ierr);
-    if (ierr) return send_error(fd, "meshing failed");
+    G.gmshOptionSetNumber("Mesh.MeshSizeMax", j.h, &ierr);
+    G.gmshOptionSetNumber("Mesh.MeshSizeMin", 0, &ierr);
+    G.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 12, &ierr);
+    G.gmshModelMeshGenerate(3, &ierr);
+    if (ierr) return send_error(G, fd, "meshing failed");
 
     size_t *tags = nullptr, ntags = 0, ncoord = 0, npar = 0;
     double *coord = nullptr, *par = nullptr;
-    gmshModelMeshGetNodes(&tags, &ntags, &coord, &ncoord, &par, &npar, -1, -1, 0, 0, &ierr);
-    if (ierr || ncoord != 3 * ntags) return send_error(fd, "cannot read the nodes");
+    G.gmshModelMeshGetNodes(&tags, &ntags, &coord, &ncoord, &par, &npar, -1, -1, 0, 0, &ierr);
+    if (ierr || ncoord != 3 * ntags) return send_error(G, fd, "cannot read the nodes");
     size_t max_tag = 0;
     for (size_t i = 0; i < ntags; ++i) max_tag = std::max(max_tag, tags[i]);
     std::vector<int64_t> index(max_tag + 1, -1);
     for (size_t i = 0; i < ntags; ++i) index[tags[i]] = (int64_t)i;
 
     size_t *etags = nullptr, netags = 0, *enodes = nullptr, nenodes = 0;
-    gmshModelMeshGetElementsByType(4, &etags, &netags, &enodes, &nenodes, -1, 0, 1, &ierr);
-    if (ierr || nenodes != 4 * netags) return send_error(fd, "cannot read the tets");
-    if (netags == 0) return send_error(fd, "no tets (is there a volume?)");
+    G.gmshModelMeshGetElementsByType(4, &etags, &netags, &enodes, &nenodes, -1, 0, 1, &ierr);
+    if (ierr || nenodes != 4 * netags) return send_error(G, fd, "cannot read the tets");
+    if (netags == 0) return send_error(G, fd, "no tets (is there a volume?)");
     std::vector<int64_t> tets(nenodes);
     for (size_t i = 0; i < nenodes; ++i)
         tets[i] = enodes[i] <= max_tag ? index[enodes[i]] : -1;
-    gmshFree(etags);
-    gmshFree(enodes);
+    G.gmshFree(etags);
+    G.gmshFree(enodes);
 
     int *surf = nullptr;
     size_t nsurf = 0;
-    gmshModelGetEntities(&surf, &nsurf, 2, &ierr);
+    G.gmshModelGetEntities(&surf, &nsurf, 2, &ierr);
     std::vector<int64_t> tri;
     std::vector<int32_t> tri_tag;
     for (size_t s = 0; s + 1 < nsurf; s += 2) {
         const int tag = surf[s + 1];
-        gmshModelMeshGetElementsByType(2, &etags, &netags, &enodes, &nenodes, tag, 0, 1, &ierr);
-        if (ierr || nenodes != 3 * netags) return send_error(fd, "cannot read the triangles");
+        G.gmshModelMeshGetElementsByType(2, &etags, &netags, &enodes, &nenodes, tag, 0, 1, &ierr);
+        if (ierr || nenodes != 3 * netags) return send_error(G, fd, "cannot read the triangles");
         for (size_t i = 0; i < nenodes; ++i)
             tri.push_back(enodes[i] <= max_tag ? index[enodes[i]] : -1);
         tri_tag.insert(tri_tag.end(), netags, tag);
-        gmshFree(etags);
-        gmshFree(enodes);
+        G.gmshFree(etags);
+        G.gmshFree(enodes);
     }
-    if (surf) gmshFree(surf);
+    if (surf) G.gmshFree(surf);
     hd.n_nodes = (int64_t)ntags;
     hd.n_tets = (int64_t)tets.size() / 4;
     hd.n_tris = (int64_t)tri_tag.size();
