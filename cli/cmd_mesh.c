@@ -50,9 +50,10 @@ static const cli_option options[] = {
     {.name = "--mesher", .kind = CLI_ENUM, .dest = &opt.mesher, .names = mesher_names,
      .values = mesher_values, .bad = "%.0sunknown mesher '%s' (tetgen|gmsh)",
      .label = "--mesher M",
-     .help = "tetgen (default) or gmsh (gmsh's library meshes the same STEP\n"
-             "file; --size is its maximum element size, --quality,\n"
-             "--min-dihedral and --preserve-surface are TetGen's)"},
+     .help = "gmsh (default; gmsh's library meshes the same STEP file, --size\n"
+             "is its largest element size) or tetgen (OpenCASCADE's surface\n"
+             "triangulation filled by TetGen; the default when --quality,\n"
+             "--min-dihedral or --preserve-surface is given: TetGen's options)"},
     {.name = "--time-limit", .kind = CLI_DOUBLE, .dest = &opt.time_limit, .lo = 0, .hi = NAN,
      .open = 1, .bad = "%s needs seconds > 0, got '%s'", .label = "--time-limit S",
      .help = "seconds one mesher run may take (default 600); the mesher runs\n"
@@ -69,8 +70,11 @@ static const cli_option options[] = {
 static int help(void)
 {
     printf("usage: %s\n\n"
-           "Tet mesh of the solid in G.step: OpenCASCADE triangulates the faces (watertight across\n"
-           "face borders), TetGen fills the solid with tets of bounded radius-edge ratio. Every\n"
+           "Tet mesh of the solid in G.step, by gmsh (its OpenCASCADE kernel reads the same file)\n"
+           "or by TetGen (OpenCASCADE triangulates the faces, watertight across face borders,\n"
+           "TetGen fills the solid with tets of bounded radius-edge ratio). The mesher runs in a\n"
+           "child process under a time limit: its crash or hang is an error message; when\n"
+           "TetGen fails, -Y, a looser quality bound and a perturbed surface are tried. Every\n"
            "boundary node lies on the CAD model. MESH (.msh, .vtu, .vtk, .mesh) gets the tets and\n"
            "the boundary triangles, each tagged with its CAD face (face index + 1, as in\n"
            "'cadmorph info'), and the cell field scaled_jacobian. Prints the counts, then the\n"
@@ -89,11 +93,24 @@ int cli_cmd_mesh(int argc, char **argv)
 {
     const char *cmd = "mesh", *in = NULL;
     cm_tetmesh_options_init(&opt);
+    /* "not given" marks: TetGen's own options select TetGen when --mesher is not given */
+    const double quality0 = opt.quality, dihedral0 = opt.min_dihedral;
+    opt.quality = opt.min_dihedral = NAN;
+    opt.mesher = -1;
     cli_parser p = {.cmd = cmd, .usage = usage, .options = options, .help = help,
                     .unknown = "unknown option '%s'", .pos = &in, .max_pos = 1,
                     .extra = "unexpected argument '%s'"};
     const int parsed = cli_parse(&p, argc, argv);
     if (parsed >= 0) return parsed;
+    const int tetgen_options = !isnan(opt.quality) || !isnan(opt.min_dihedral) || preserve_surface;
+    if (isnan(opt.quality)) opt.quality = quality0;
+    if (isnan(opt.min_dihedral)) opt.min_dihedral = dihedral0;
+    if (opt.mesher == CM_MESHER_GMSH && tetgen_options)
+        return cli_usage(cmd, usage, "--quality, --min-dihedral and --preserve-surface are "
+                         "TetGen's: not with --mesher gmsh");
+    /* gmsh by default: better tets than TetGen's at the same size or tet count
+     * (benchmarks/RESULTS.md, issue 18) and no crash on its error paths */
+    if (opt.mesher < 0) opt.mesher = tetgen_options ? CM_MESHER_TETGEN : CM_MESHER_GMSH;
     if (preserve_surface) opt.preserve_surface = 1;
     if (no_optimize) opt.optimize = 0;
     if (force) opt.max_tets = INFINITY;

@@ -298,7 +298,10 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
         if (s < 0) {
             // a crash or a timeout of the check itself: the meshing below says what happens
             cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: %s", cm_context_message(ctx));
-            if (failure == 3) return s;
+            if (failure == 3)
+                return cm_error(ctx, s, "%s: TetGen's intersection check did not finish in %.3g s "
+                                "(nothing more tried: raise the time limit, --time-limit, or try "
+                                "--mesher gmsh)", path, limit);
         } else if (diag.r.n_trifaces > 0) {
             std::set<int> faces;
             for (size_t t = 0; t < diag.r.n_trifaces; ++t) faces.insert(diag.r.trimarker[t] - 1);

@@ -36,8 +36,12 @@ typedef struct cm_tetmesh_options {
      * the limit: CM_ERR_UNSUPPORTED "... did not finish in N s"); <= 0:
      * CM_TETMESH_TIME_LIMIT, INFINITY: none. */
     double time_limit;
-    /* CM_MESHER_TETGEN (default) or CM_MESHER_GMSH (gmsh's library on the same STEP file,
-     * its OpenCASCADE kernel; CM_ERR_UNSUPPORTED when cadmorph was built without gmsh). */
+    /* CM_MESHER_TETGEN (the library's default, which keeps the study sweeps' meshes as
+     * recorded) or CM_MESHER_GMSH (`cadmorph mesh`'s default: gmsh's library, opened at run
+     * time, meshes the same STEP file with its OpenCASCADE kernel, `size` its largest element
+     * size; quality, min_dihedral and preserve_surface are TetGen's and ignored). gmsh's
+     * surfaces are mapped to the CAD faces by projection, so the boundary triangles carry
+     * the same face tags either way. */
     int mesher;
 } cm_tetmesh_options;
 
