@@ -20,6 +20,7 @@
 #include <stdio_ext.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/types.h>
 #include <sys/wait.h>
@@ -88,11 +89,10 @@ cm_status cm_child_run(cm_context *ctx, const char *what, cm_child_work work, vo
     int pfd[2];
     if (pipe2(pfd, O_CLOEXEC) != 0)
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: %s: no pipe: %s", fn, what, strerror(errno));
-    /* an unnamed file: nothing to remove, whatever happens to either process */
-    char log_template[] = "/tmp/cadmorph-child-XXXXXX";
-    int log_fd = mkostemp(log_template, O_CLOEXEC);
-    if (log_fd >= 0) unlink(log_template);
-    else log_fd = open("/dev/null", O_RDWR | O_CLOEXEC);
+    /* an anonymous file for the child's stdout and stderr: nothing to remove, whatever
+     * happens to either process */
+    int log_fd = memfd_create("cadmorph-child-log", MFD_CLOEXEC);
+    if (log_fd < 0) log_fd = open("/dev/null", O_RDWR | O_CLOEXEC);
 
     const pid_t parent = getpid();
     const double t0 = cm_wtime();
