@@ -24,8 +24,9 @@ void cli_constraints_help(void)
     printf(
         "  --constraint TYPE:SET     MLS only, repeatable: keep the nodes of SET on a shape of\n"
         "                            TYPE while deforming (Shape-Up, the MLS paper's section 6):\n"
-        "                            plane, circle, cylinder, line (similar copy: translation,\n"
-        "                            rotation, uniform scale) or rigid. SET: a node-list file\n"
+        "                            plane, circle, cylinder, cone, line (similar copy:\n"
+        "                            translation, rotation, uniform scale) or rigid. SET: a\n"
+        "                            node-list file\n"
         "                            (header node), else a physical group of the mesh, else a\n"
         "                            field NAME or NAME=VALUE (nodes where the node field, or of\n"
         "                            the cells where the cell field, is nonzero / equals VALUE)\n"
@@ -92,7 +93,7 @@ int cli_constraints_option(int argc, char **argv, int *i, const char *cmd, const
         cm_shape_type t;
         if (cm_shape_type_parse(NULL, name, &t) < 0) {
             cli_usage(cmd, usage,
-                      "--constraint '%s': unknown type '%s' (plane|circle|cylinder|line|rigid)", v, name);
+                      "--constraint '%s': unknown type '%s' (plane|circle|cylinder|cone|line|rigid)", v, name);
             return -1;
         }
         if (c->n >= CLI_MAX_CONSTRAINTS) {
