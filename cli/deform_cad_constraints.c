@@ -11,9 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The filter: "plane,cylinder,circle" (types) and/or "face:N" / "edge:N" (0-based ids). */
+/* The filter: "plane,cylinder,cone,circle" (types) and/or "face:N" / "edge:N" (0-based ids). */
 typedef struct cad_filter {
-    int plane, cylinder, circle;
+    int plane, cylinder, circle, cone;
     int n_faces, n_edges;
     int faces[256], edges[256];
 } cad_filter;
@@ -22,7 +22,7 @@ static cm_status parse_filter(cm_context *ctx, const char *spec, cad_filter *f)
 {
     memset(f, 0, sizeof *f);
     if (!spec || !*spec) {
-        f->plane = f->cylinder = f->circle = 1;
+        f->plane = f->cylinder = f->circle = f->cone = 1;
         return CM_OK;
     }
     const char *s = spec;
@@ -40,14 +40,16 @@ static cm_status parse_filter(cm_context *ctx, const char *spec, cad_filter *f)
             f->cylinder = 1;
         else if (!strcmp(item, "circle"))
             f->circle = 1;
+        else if (!strcmp(item, "cone"))
+            f->cone = 1;
         else if (sscanf(item, "face:%d%c", &id, &tail) == 1 && id >= 0 && f->n_faces < 256)
             f->faces[f->n_faces++] = id;
         else if (sscanf(item, "edge:%d%c", &id, &tail) == 1 && id >= 0 && f->n_edges < 256)
             f->edges[f->n_edges++] = id;
         else
             return cm_error(ctx, CM_ERR_ARGUMENT,
-                            "--cad-constraints '%s': '%s' is none of plane, cylinder, circle, "
-                            "face:N, edge:N",
+                            "--cad-constraints '%s': '%s' is none of plane, cylinder, cone, "
+                            "circle, face:N, edge:N",
                             spec, item);
         s += strcspn(s, ",");
         if (*s == ',') ++s;
@@ -73,6 +75,7 @@ static cm_status add_set(cm_context *ctx, cli_constraints *c, cm_shape_set *sets
              in->entity);
     cm_shape_type t = in->type == CM_SURFACE_SET_PLANE      ? CM_SHAPE_PLANE
                       : in->type == CM_SURFACE_SET_CYLINDER ? CM_SHAPE_CYLINDER
+                      : in->type == CM_SURFACE_SET_CONE     ? CM_SHAPE_CONE
                                                             : CM_SHAPE_CIRCLE;
     sets[c->n].type = t, sets[c->n].n = in->n, sets[c->n].nodes = nodes;
     c->type[c->n] = t;
@@ -88,8 +91,8 @@ cm_status cli_cad_constraints(cm_context *ctx, const cm_mesh *mesh, cli_constrai
     cad_filter flt;
     cm_status s = parse_filter(ctx, c->cad_filter, &flt);
     if (s < 0) return s;
-    cm_surface_set_filter sf = {flt.plane, flt.cylinder, flt.circle, flt.n_faces,
-                                flt.n_edges, flt.faces,  flt.edges};
+    cm_surface_set_filter sf = {flt.plane,   flt.cylinder, flt.circle, flt.cone,
+                                flt.n_faces, flt.n_edges,  flt.faces,  flt.edges};
     cm_cad_model *g = NULL;
     cm_surface_sets *ss = NULL;
     s = cm_cad_read(ctx, c->cad, NULL, &g);

@@ -42,10 +42,11 @@ void cli_constraints_help(void)
         "                            projections (the shapes then hold to rounding)\n"
         "  --constraints-from-cad G  volume meshes: constraints from the STEP model G of the\n"
         "                            mesh: the nodes of each planar face (with its edges and\n"
-        "                            vertices) a plane set, of each cylindrical face a cylinder\n"
-        "                            set, of each circular edge a circle set\n"
-        "  --cad-constraints LIST    which of them: plane, cylinder, circle, face:N, edge:N\n"
-        "                            (0-based ids as `cadmorph info` lists; default all types)\n");
+        "                            vertices) a plane set, of each cylindrical (conical) face\n"
+        "                            a cylinder (cone) set, of each circular edge a circle set\n"
+        "  --cad-constraints LIST    which of them: plane, cylinder, cone, circle, face:N,\n"
+        "                            edge:N (0-based ids as `cadmorph info` lists; default all\n"
+        "                            types)\n");
 }
 
 static int parse_number(const char *v, double *out)

@@ -1,6 +1,6 @@
 /* The constraint sets a CAD model already knows (issue 16, `--constraints-from-cad`): every
  * node of a planar face - on the face, its edges or their vertices - forms that face's
- * planarity set, of a cylindrical face its cylinder set, of a circular edge its circularity
+ * planarity set, of a cylindrical (conical) face its cylinder (cone) set, of a circular edge its circularity
  * set. The nodes are classified once and grouped by entity, so the cost is linear in the
  * nodes plus the entities' wire lengths, not nodes x entities. */
 #include "surface_internal.h"
@@ -91,11 +91,15 @@ static cm_status face_sets(cm_context *ctx, const cm_cad_model *g, const cm_surf
         if (s < 0) break;
         int by_id = listed(flt->faces, flt->n_faces, f);
         int plane = fi.type == CM_CAD_PLANE, cyl = fi.type == CM_CAD_CYLINDER;
-        if (by_id && !plane && !cyl)
+        int cone = fi.type == CM_CAD_CONE;
+        if (by_id && !plane && !cyl && !cone)
             return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                            "constraint sets from CAD: face %d is a %s: planes and cylinders only",
+                            "constraint sets from CAD: face %d is a %s: planes, cylinders and "
+                            "cones only",
                             f, cm_cad_surface_type_name(fi.type));
-        if (!((plane && (flt->plane || by_id)) || (cyl && (flt->cylinder || by_id)))) continue;
+        if (!((plane && (flt->plane || by_id)) || (cyl && (flt->cylinder || by_id)) ||
+              (cone && (flt->cone || by_id))))
+            continue;
         memset(mark, 0, sn->n ? sn->n : 1);
         mark_entity(gr, CM_SURFACE_ON_FACE, f, cnt->faces, mark);
         for (int w = 0; w < fi.n_wires && s >= 0; ++w) {
@@ -113,7 +117,10 @@ static cm_status face_sets(cm_context *ctx, const cm_cad_model *g, const cm_surf
         }
         if (s >= 0)
             s = add_set(ctx, out, cap, sn, mark,
-                        plane ? CM_SURFACE_SET_PLANE : CM_SURFACE_SET_CYLINDER, f, plane ? 3 : 5);
+                        plane ? CM_SURFACE_SET_PLANE
+                        : cyl ? CM_SURFACE_SET_CYLINDER
+                              : CM_SURFACE_SET_CONE,
+                        f, plane ? 3 : cyl ? 5 : 6);
     }
     return s;
 }
@@ -149,7 +156,7 @@ cm_status cm_surface_cad_sets(cm_context *ctx, const cm_cad_model *g, const cm_m
     if (!g || !mesh || !sets)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_surface_cad_sets: NULL argument");
     *sets = NULL;
-    cm_surface_set_filter all = {1, 1, 1, 0, 0, NULL, NULL};
+    cm_surface_set_filter all = {1, 1, 1, 1, 0, 0, NULL, NULL};
     const cm_surface_set_filter *flt = filter ? filter : &all;
     if (cm_mesh_count_dim(mesh, 3) == 0)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,

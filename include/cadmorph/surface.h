@@ -112,20 +112,21 @@ CM_API cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *
 typedef enum cm_surface_set_type {
     CM_SURFACE_SET_PLANE = 0,    /* the nodes of a planar face */
     CM_SURFACE_SET_CYLINDER = 1, /* the nodes of a cylindrical face */
-    CM_SURFACE_SET_CIRCLE = 2    /* the nodes of a circular edge */
+    CM_SURFACE_SET_CIRCLE = 2,   /* the nodes of a circular edge */
+    CM_SURFACE_SET_CONE = 3      /* the nodes of a conical face */
 } cm_surface_set_type;
 
 /* Which entities become sets: every face/edge of a type whose flag is set, plus the listed
  * ids (0-based) whatever the flags say. */
 typedef struct cm_surface_set_filter {
-    int plane, cylinder, circle;
+    int plane, cylinder, circle, cone;
     int n_faces, n_edges;
     const int *faces, *edges;
 } cm_surface_set_filter;
 
 typedef struct cm_surface_set {
     cm_surface_set_type type;
-    int entity;     /* the face (plane, cylinder) or edge (circle) of G */
+    int entity;     /* the face (plane, cylinder, cone) or edge (circle) of G */
     size_t n;       /* nodes, ascending */
     int64_t *nodes; /* owned by the cm_surface_sets */
 } cm_surface_set;
@@ -136,12 +137,12 @@ typedef struct cm_surface_sets {
 } cm_surface_sets;
 
 /* The constraint sets of a volume mesh lying on G: the boundary nodes are classified on G
- * (cm_surface_classify, a locator of h = shortest boundary edge / 4); a planar or
- * cylindrical face's set holds the nodes on the face, on the edges of its wires and on
+ * (cm_surface_classify, a locator of h = shortest boundary edge / 4); a planar, cylindrical
+ * or conical face's set holds the nodes on the face, on the edges of its wires and on
  * their vertices; a circular edge's set the nodes on the edge and its end vertices, so a
  * node may be in several sets. Sets with fewer nodes than their fit needs (3; cylinders 5)
- * are left out. filter NULL: all planes, cylinders and circles. A listed face that is no
- * plane or cylinder, or edge that is no circle, is CM_ERR_UNSUPPORTED; an id out of range
+ * are left out (cones 6). filter NULL: all planes, cylinders, cones and circles. A listed
+ * face that is no plane, cylinder or cone, or edge that is no circle, is CM_ERR_UNSUPPORTED; an id out of range
  * CM_ERR_MISMATCH; a mesh without volume cells CM_ERR_UNSUPPORTED. */
 CM_API cm_status cm_surface_cad_sets(cm_context *ctx, const cm_cad_model *g, const cm_mesh *mesh,
                                      const cm_surface_set_filter *filter, cm_surface_sets **sets);

@@ -1,5 +1,5 @@
 /* Constraint sets from the CAD model (surface/cad_sets.c) on the gmsh mesh of hole_a (a
- * 10 x 8 x 4 block, six planes, a through bore of radius 2 with two circles): each set is
+ * 10 x 8 x 4 block, six planes, a through bore of radius 2 with two circles) and of cone_a: each set is
  * exactly the boundary nodes within 1e-6 x diagonal of its face (trimmed projection) or
  * circle edge - checked by projecting every boundary node, not by the classification the
  * code uses -, the filter by type and id, and the errors. */
@@ -59,15 +59,16 @@ int main(int argc, char **argv)
     cm_status st = cm_surface_cad_sets(ctx, g, mesh, NULL, &sets);
     CHECK_MSG(st == CM_OK, "%s", cm_context_message(ctx));
     if (st == CM_OK) {
-        int count[3] = {0, 0, 0};
+        int count[4] = {0, 0, 0, 0};
         for (size_t i = 0; i < sets->n; ++i) {
             count[sets->set[i].type]++;
             for (size_t k = 1; k < sets->set[i].n; ++k)
                 CHECK(sets->set[i].nodes[k - 1] < sets->set[i].nodes[k]);
             check_exact(ctx, g, mesh, b, &sets->set[i], tol);
         }
-        CHECK_MSG(count[0] == 6 && count[1] == 1 && count[2] == 2, "%d planes %d cylinders %d circles",
-                  count[0], count[1], count[2]);
+        CHECK_MSG(count[0] == 6 && count[1] == 1 && count[2] == 2 && count[3] == 0,
+                  "%d planes %d cylinders %d circles %d cones", count[0], count[1], count[2],
+                  count[3]);
         /* the circles' nodes are in the bore's set and in a cap plane's */
         for (size_t i = 0; i < sets->n; ++i) {
             if (sets->set[i].type != CM_SURFACE_SET_CIRCLE) continue;
@@ -81,12 +82,12 @@ int main(int argc, char **argv)
     CHECK(sets == NULL);
 
     /* by type: circles only; by id: the bore face (0-based 6) and nothing else */
-    cm_surface_set_filter f = {0, 0, 1, 0, 0, NULL, NULL};
+    cm_surface_set_filter f = {0, 0, 1, 0, 0, 0, NULL, NULL};
     CHECK(cm_surface_cad_sets(ctx, g, mesh, &f, &sets) == CM_OK);
     CHECK(sets && sets->n == 2 && sets->set[0].type == CM_SURFACE_SET_CIRCLE);
     cm_surface_sets_destroy(&sets);
     const int bore[] = {6};
-    f = (cm_surface_set_filter){0, 0, 0, 1, 0, bore, NULL};
+    f = (cm_surface_set_filter){0, 0, 0, 0, 1, 0, bore, NULL};
     CHECK(cm_surface_cad_sets(ctx, g, mesh, &f, &sets) == CM_OK);
     CHECK(sets && sets->n == 1 && sets->set[0].type == CM_SURFACE_SET_CYLINDER &&
           sets->set[0].entity == 6);
@@ -94,10 +95,10 @@ int main(int argc, char **argv)
 
     /* errors: an edge that is a line, an id out of range, a surface mesh */
     const int line[] = {0}, far[] = {99};
-    f = (cm_surface_set_filter){0, 0, 0, 0, 1, NULL, line};
+    f = (cm_surface_set_filter){0, 0, 0, 0, 0, 1, NULL, line};
     CHECK(cm_surface_cad_sets(ctx, g, mesh, &f, &sets) == CM_ERR_UNSUPPORTED && !sets);
     CHECK(strstr(cm_context_message(ctx), "not a circle") != NULL);
-    f = (cm_surface_set_filter){0, 0, 0, 1, 0, far, NULL};
+    f = (cm_surface_set_filter){0, 0, 0, 0, 1, 0, far, NULL};
     CHECK(cm_surface_cad_sets(ctx, g, mesh, &f, &sets) == CM_ERR_MISMATCH && !sets);
     cm_mesh *surf = NULL; /* the boundary faces alone */
     CHECK(cm_mesh_create(ctx, &surf) == CM_OK);
@@ -112,6 +113,25 @@ int main(int argc, char **argv)
     cm_mesh_destroy(&surf);
 
     cm_mesh_boundary_destroy(&b);
+    cm_mesh_destroy(&mesh);
+    cm_cad_destroy(&g);
+
+    /* cone_a: its conical face's set is exactly the nodes on that face; cones only by type */
+    g = fx_model(ctx, "cone_a");
+    mesh = fx_mesh(ctx, "cone_a");
+    if (g && mesh) {
+        CHECK(cm_mesh_boundary_create(ctx, mesh, &b) == CM_OK);
+        f = (cm_surface_set_filter){0, 0, 0, 1, 0, 0, NULL, NULL};
+        st = cm_surface_cad_sets(ctx, g, mesh, &f, &sets);
+        CHECK_MSG(st == CM_OK, "%s", cm_context_message(ctx));
+        CHECK(sets && sets->n >= 1);
+        for (size_t i = 0; sets && i < sets->n; ++i) {
+            CHECK(sets->set[i].type == CM_SURFACE_SET_CONE);
+            check_exact(ctx, g, mesh, b, &sets->set[i], 1e-6 * fx_diagonal(g));
+        }
+        cm_surface_sets_destroy(&sets);
+        cm_mesh_boundary_destroy(&b);
+    }
     cm_mesh_destroy(&mesh);
     cm_cad_destroy(&g);
     cm_context_destroy(&ctx);
