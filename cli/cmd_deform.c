@@ -24,7 +24,7 @@ static void print_help(void)
     printf("usage: %s\n\n", usage_line);
     printf(
         "Deforms the mesh M (a surface mesh of triangles/quads, or a volume mesh; .msh .vtu\n"
-        ".vtk .mesh) by moving the handle nodes of H.csv, keeping the fixed nodes in place and\n"
+        ".vtk .mesh, surfaces also .obj .off .stl) by moving the handle nodes of H.csv, keeping the fixed nodes in place and\n"
         "letting every other node follow a space deformation. Writes M' with a per-node\n"
         "'displacement' field; surfaces also get 'mean_curvature' (H = |lap x|/2, cotangent\n"
         "Laplacian) and a mean-curvature summary, volume meshes the quality summary line.\n\n"
@@ -129,7 +129,7 @@ static int parse_args(int argc, char **argv, deform_args *a)
     if ((a->mls || a->shell) && (a->fix <= 0 || a->stretch + a->bend <= 0))
         return cli_usage(cmd, usage_line, "--fix must be > 0 and --stretch + --bend > 0");
     if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
+        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh .obj .off .stl)",
                          a->out);
     if (cli_same_file(a->out, a->mesh) || cli_same_file(a->out, a->handles) ||
         (a->fixed && cli_same_file(a->out, a->fixed)))
