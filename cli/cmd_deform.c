@@ -16,8 +16,9 @@
 
 static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
-    "[--method rbf|mls|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
-    "[--exact-constraints] [--threads N] [--verbose]";
+    "[--method rbf|mls|dmffd|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
+    "[--cubature N] [--cover S] [--lattice N] [--clamp E] [--exact-constraints] [--threads N] "
+    "[--verbose]";
 
 static void print_help(void)
 {
@@ -37,12 +38,20 @@ static void print_help(void)
         "  --fix-unlisted-boundary   fix every boundary node not in H.csv (volume: the\n"
         "                            boundary surface; surface: its border edges)\n"
         "  --method M                rbf (triharmonic, exact at H and F), mls (constrained\n"
-        "                            MLS, approximate; default) or shell (surfaces: the\n"
+        "                            MLS, approximate; default), dmffd (DM-FFD on a cubic\n"
+        "                            B-spline lattice enclosing M, least squares: H and F keep\n"
+        "                            their motion, the residual is the lattice's miss) or\n"
+        "                            shell (surfaces: the\n"
         "                            mesh-based shell of the paper's eq. 10, the ground truth;\n"
         "                            weights per unit area, not normalised)\n"
         "  --stretch GS, --bend GB   MLS / shell energy weights (default 1, 1)\n"
         "  --fix GF                  MLS / shell constraint weight (default 1000)\n"
         "  --samples K               MLS samples (default 2%% of the nodes, at least 500)\n"
+        "  --cubature N              MLS cubature points (default 4 K)\n"
+        "  --cover S                 MLS: samples covering every point (default 5)\n"
+        "  --lattice N               DM-FFD control points per axis (4..200, default 10)\n"
+        "  --clamp E                 DM-FFD: singular values <= E x the largest dropped\n"
+        "                            (default 1e-10)\n"
         "  --exact-constraints       MLS: H and F nodes get their prescribed value instead of\n"
         "                            the field's\n"
         "  -o, --output M'           output mesh (must not be an input)\n"
@@ -53,9 +62,9 @@ static void print_help(void)
 
 typedef struct deform_args {
     const char *mesh, *handles, *fixed, *out;
-    int fix_boundary, mls, shell, exact, threads, verbose;
-    double stretch, bend, fix;
-    size_t samples;
+    int fix_boundary, mls, shell, dmffd, exact, threads, verbose, cover, lattice;
+    double stretch, bend, fix, clamp;
+    size_t samples, cubature;
 } deform_args;
 
 static int number(const char *v, double *out)
@@ -73,7 +82,7 @@ static int parse_args(int argc, char **argv, deform_args *a)
     static const char *cmd = "deform";
     memset(a, 0, sizeof *a);
     a->mls = 1;
-    a->stretch = 1, a->bend = 1, a->fix = 1000;
+    a->stretch = 1, a->bend = 1, a->fix = 1000, a->cover = 5, a->lattice = 10;
     for (int i = 1; i < argc; ++i) {
         const char *o = argv[i], *v;
         if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
@@ -101,19 +110,31 @@ static int parse_args(int argc, char **argv, deform_args *a)
                 a->mls = 1;
             else if (!strcmp(v, "shell"))
                 a->mls = 0, a->shell = 1;
+            else if (!strcmp(v, "dmffd"))
+                a->mls = 0, a->dmffd = 1;
             else
-                return cli_usage(cmd, usage_line, "unknown method '%s' (rbf|mls|shell)", v);
+                return cli_usage(cmd, usage_line, "unknown method '%s' (rbf|mls|dmffd|shell)", v);
         } else if (!strcmp(o, "--stretch") || !strcmp(o, "--bend") || !strcmp(o, "--fix")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             double *dst = o[2] == 's' ? &a->stretch : o[2] == 'b' ? &a->bend : &a->fix;
             if (number(v, dst))
                 return cli_usage(cmd, usage_line, "%s: '%s' is not a number >= 0", o, v);
-        } else if (!strcmp(o, "--samples")) {
+        } else if (!strcmp(o, "--samples") || !strcmp(o, "--cubature")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             double d;
             if (number(v, &d) || d < 4 || d > 1e8 || d != floor(d))
-                return cli_usage(cmd, usage_line, "--samples: '%s' is not an integer >= 4", v);
-            a->samples = (size_t)d;
+                return cli_usage(cmd, usage_line, "%s: '%s' is not an integer >= 4", o, v);
+            *(o[2] == 's' ? &a->samples : &a->cubature) = (size_t)d;
+        } else if (!strcmp(o, "--cover") || !strcmp(o, "--lattice")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            double d, lo = o[2] == 'c' ? 1 : 4, hi = o[2] == 'c' ? 64 : 200;
+            if (number(v, &d) || d < lo || d > hi || d != floor(d))
+                return cli_usage(cmd, usage_line, "%s: '%s' is not an integer in %g..%g", o, v, lo, hi);
+            *(o[2] == 'c' ? &a->cover : &a->lattice) = (int)d;
+        } else if (!strcmp(o, "--clamp")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            if (number(v, &a->clamp) || !(a->clamp > 0 && a->clamp < 1))
+                return cli_usage(cmd, usage_line, "--clamp: expected a number in (0, 1), got '%s'", v);
         } else if (!strcmp(o, "--threads")) {
             if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
                 return CLI_EXIT_USAGE;
@@ -236,11 +257,14 @@ int cli_cmd_deform(int argc, char **argv)
     if (s >= 0 && a.shell && volume)
         s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: --method shell deforms surface meshes only", a.mesh);
     if (s >= 0 && a.shell) s = cm_mls_shell(ctx, mesh, con, a.stretch, a.bend, a.fix, disp);
-    if (s >= 0 && !a.mls && !a.shell) s = cm_deform_rbf(ctx, mesh->n_nodes, mesh->xyz, con, disp);
+    if (s >= 0 && !a.mls && !a.shell && !a.dmffd) s = cm_deform_rbf(ctx, mesh->n_nodes, mesh->xyz, con, disp);
+    if (s >= 0 && a.dmffd)
+        s = cm_deform_dmffd(ctx, mesh->n_nodes, mesh->xyz, con, a.lattice, a.clamp, disp, &residual);
     if (s >= 0 && a.mls) {
         cm_mls_options o;
         cm_mls_options_init(&o);
         o.stretch = a.stretch, o.bend = a.bend, o.fix = a.fix, o.samples = a.samples;
+        o.cubature = a.cubature, o.cover = a.cover;
         o.keep_constrained = a.exact;
         cm_mls *mls = NULL;
         s = cm_mls_create(ctx, mesh, con, &o, &mls);
@@ -280,7 +304,7 @@ int cli_cmd_deform(int argc, char **argv)
             if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
             if (s >= 0) {
                 printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                       a.mls ? "mls" : a.shell ? "shell" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                       a.mls ? "mls" : a.shell ? "shell" : a.dmffd ? "dmffd" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
                 printf("mean_curvature (interior vertices): before min=%.6g mean=%.6g max=%.6g; "
                        "after min=%.6g mean=%.6g max=%.6g\n",
                        h_before[0], h_before[1], h_before[2], cnt ? mn : 0,
@@ -294,7 +318,7 @@ int cli_cmd_deform(int argc, char **argv)
         if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
         if (s >= 0) {
             printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                   a.mls ? "mls" : a.shell ? "shell" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                   a.mls ? "mls" : a.shell ? "shell" : a.dmffd ? "dmffd" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
             s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
         }
     }
