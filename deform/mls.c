@@ -86,7 +86,9 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
     size_t kv = kk - ks, N = *nq;
     size_t ns = 20 * ks + (n3 ? 0 : 5 * N), nv = n3 ? (20 * kv > 5 * N ? 20 * kv : 5 * N) : 0;
     mls_dense d;
+    double t0 = cm_wtime();
     cm_status s = mls_dense_create(ctx, mesh, ns, nv, o->seed, &d);
+    double t1 = cm_wtime();
     if (s < 0) return s;
     if (d.n_s == 0) kv = kk, ks = 0; /* no surface of positive area */
     if (d.n_v == 0) ks = kk, kv = 0;
@@ -100,8 +102,10 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
     if (s >= 0 && kv) s = mls_farthest(ctx, d.xyz + 3 * d.n_s, d.n_v, kv, o->seed + 1, c + 3 * ks);
     for (size_t i = 0; i < d.n_s + d.n_v; ++i)
         w[i] = i < d.n_s ? o->surface_weight : 1;
+    double t2 = cm_wtime();
     if (s >= 0) s = mls_lloyd(ctx, d.xyz, w, d.n_s + d.n_v, o->lloyd, kk, c, NULL);
     if (s < 0) goto fail;
+    double t3 = cm_wtime();
     /* the cubature domain: the volume of a volume mesh, else the surface */
     const double *dom = d.n_v ? d.xyz + 3 * d.n_s : d.xyz;
     size_t nd = d.n_v ? d.n_v : d.n_s;
@@ -114,6 +118,10 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
     }
     s = mls_lloyd(ctx, dom, NULL, nd, o->lloyd, N, qq, mass);
     if (s < 0) goto fail;
+    cm_log(ctx, CM_LOG_DEBUG,
+           "cm_mls: sampling: %zu + %zu dense points %.3f s, farthest points %.3f s, Lloyd of the "
+           "samples %.3f s, Lloyd of the %zu cubature points %.3f s",
+           d.n_s, d.n_v, t1 - t0, t2 - t1, t3 - t2, N, cm_wtime() - t3);
     for (size_t i = 0; i < N; ++i)
         mass[i] *= measure / (double)nd;
     mls_dense_free(&d);

@@ -4,6 +4,8 @@
  * plate, the warp method). Meshes are built in code. */
 #include "cadmorph/mls.h"
 #include "cadmorph/warp.h"
+#include "deform/mls_internal.h"
+#include "test_rng.h"
 #include "test_util.h"
 
 #include <stdlib.h>
@@ -353,10 +355,48 @@ static void test_plate(cm_context *ctx)
     cm_mesh_destroy(&m);
 }
 
+/* The grid-and-heap farthest-point sampler picks exactly what the definition does (scan
+ * every point per pick, the lowest index on a tie): on random points, on a lattice (many
+ * equal distances) and on a flat set. */
+static void test_farthest(cm_context *ctx)
+{
+    for (int kind = 0; kind < 3; ++kind) {
+        size_t n = kind == 1 ? 15 * 15 * 15 : 6000, k = kind == 2 ? 700 : 400;
+        double *x = malloc(n * 3 * sizeof *x), *out = malloc(k * 3 * sizeof *out), *d = malloc(n * sizeof *d);
+        uint64_t rng = 1500 + (uint64_t)kind;
+        for (size_t i = 0; i < n; ++i)
+            for (int a = 0; a < 3; ++a)
+                x[3 * i + a] = kind == 1 ? (double)(a == 0 ? i % 15 : a == 1 ? i / 15 % 15 : i / 225) * 0.1
+                               : kind == 2 && a == 2 ? 0.5 : test_rng_range(&rng, -1, 2 + a);
+        CHECK(mls_farthest(ctx, x, n, k, 7 + (uint64_t)kind, out) == CM_OK);
+        size_t cur = n;
+        for (size_t i = 0; i < n; ++i)
+            if (!memcmp(x + 3 * i, out, 3 * sizeof *x)) cur = i;
+        CHECK(cur < n);
+        for (size_t i = 0; i < n; ++i) d[i] = 1e300;
+        size_t same = 0;
+        for (size_t j = 0; j < k && cur < n; ++j) {
+            same += !memcmp(x + 3 * cur, out + 3 * j, 3 * sizeof *x);
+            const double *c = x + 3 * cur;
+            size_t best = 0;
+            for (size_t i = 0; i < n; ++i) {
+                const double *p = x + 3 * i;
+                double e = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
+                if (e < d[i]) d[i] = e;
+                if (d[i] > d[best]) best = i;
+            }
+            cur = best;
+        }
+        CHECK_MSG(same == k, "farthest points, set %d: %zu of %zu picks as the plain scan's", kind, same, k);
+        free(x), free(out), free(d);
+    }
+}
+
 int main(void)
 {
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
+    test_farthest(ctx);
     test_basis(ctx, 0);
     test_basis(ctx, 1);
     test_deform(ctx);
