@@ -274,9 +274,11 @@ int cli_cmd_deform(int argc, char **argv)
         if (s >= 0)
             cm_log(ctx, CM_LOG_DEBUG,
                    "deform mls: %zu samples (%zu surface), %zu cubature points, %zu constrained; "
-                   "sample %.3f s, basis %.3f s, factor %.3f s (%zu entries), apply %.3f s",
+                   "sample %.3f s, basis %.3f s, factor %.3f s (%zu entries), apply %.3f s; CPU s "
+                   "%.3f, %.3f, %.3f, %.3f",
                    st.samples, st.surface_samples, st.cubature, st.constrained, st.t_sample,
-                   st.t_basis, st.t_factor, st.factor_nonzeros, st.t_apply);
+                   st.t_basis, st.t_factor, st.factor_nonzeros, st.t_apply, st.c_sample, st.c_basis,
+                   st.c_factor, st.c_apply);
         cm_mls_destroy(&mls);
     }
     double t1 = cm_wtime();

@@ -13,7 +13,7 @@
 static const char *const usage_line =
     "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] "
-    "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB] "
+    "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB --blend B] "
     "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
     "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
 

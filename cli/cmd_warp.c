@@ -13,7 +13,7 @@
 static const char *const usage_line =
     "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] "
     "[--solver S] [--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS "
-    "--bend GB] [--optimize] "
+    "--bend GB --blend B] [--optimize] "
     "[--threads N] [--verbose]";
 
 typedef struct warp_args {

@@ -77,7 +77,7 @@ extern const int cli_kernel_methods[];
 int cli_parse_size(const cli_parser *p, const cli_option *o, const char *value, void *dest);
 
 /* The MLS options of warp, morph and deform (m: a cm_mls_options lvalue, set to its defaults
- * before parsing): --samples K, --cubature N, --cover S, --stretch GS, --bend GB. */
+ * before parsing): --samples K, --cubature N, --cover S, --stretch GS, --bend GB, --blend B. */
 #define CLI_MLS_OPTIONS(m)                                                                        \
     {.name = "--samples", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_size,          \
      .dest = &(m).samples, .label = "--samples K",                                                \
@@ -92,7 +92,11 @@ int cli_parse_size(const cli_parser *p, const cli_option *o, const char *value, 
      .help = "mls: stretching weight gamma_s (default 1)"},                                       \
     {.name = "--bend", .kind = CLI_DOUBLE, .dest = &(m).bend, .lo = 0, .hi = NAN,                 \
      .bad = "%s: '%s' is not a number >= 0", .label = "--bend GB",                               \
-     .help = "mls: bending weight gamma_b (default 1)"}
+     .help = "mls: bending weight gamma_b (default 1)"},                                       \
+    {.name = "--blend", .kind = CLI_DOUBLE, .dest = &(m).blend, .lo = 0, .hi = NAN,               \
+     .bad = "%s: '%s' is not a number >= 0", .label = "--blend B",                               \
+     .help = "mls: the field's miss at the boundary decays into the interior over\n"             \
+             "B x the mean support radius (default 1.5; 0: the first cell layer takes it)"}
 
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
  * --help, CLI_EXIT_USAGE after a message on stderr. */

@@ -63,4 +63,21 @@ cm_status mls_farthest(cm_context *ctx, const double *xyz, size_t n, size_t k, u
 cm_status mls_lloyd(cm_context *ctx, const double *xyz, const double *weight, size_t n,
                     int iterations, size_t k, double *centres, double *mass);
 
+/* The residual blend (mls_blend.c): for the n free nodes within `radius` of a constrained
+ * node, width weights each (CSR with fixed-width rows) onto the constrained nodes (col: the
+ * index in the constrained list). */
+typedef struct mls_blend {
+    size_t n;
+    int width;
+    int64_t *node, *row;
+    int32_t *col;
+    double *val;
+} mls_blend;
+
+cm_status mls_blend_create(cm_context *ctx, size_t n, const double *xyz, const unsigned char *is_con,
+                           size_t n_con, const int64_t *con, double radius, mls_blend *b);
+void mls_blend_free(mls_blend *b);
+/* disp[node] += sum val r[col] (r: n_con x 3). */
+void mls_blend_apply(const mls_blend *b, const double *r, double *disp, int threads);
+
 #endif

@@ -30,10 +30,10 @@ static cm_status mls_apply(cm_context *ctx, void *state, double *disp, double *r
     cm_mls_stats st;
     cm_mls_get_stats(state, &st);
     cm_log(ctx, CM_LOG_DEBUG,
-           "warp mls: %zu samples, %zu cubature points, %zu constrained nodes; residual %.3g; "
-           "sample %.3f s, basis %.3f s, factor %.3f s, apply %.3f s",
-           st.samples, st.cubature, st.constrained, *residual, st.t_sample, st.t_basis,
-           st.t_factor, st.t_apply);
+           "warp mls: %zu samples, %zu cubature points, %zu constrained nodes, %zu blended; "
+           "residual %.3g; sample %.3f s, basis %.3f s, factor %.3f s, apply %.3f s",
+           st.samples, st.cubature, st.constrained, st.blend_nodes, *residual, st.t_sample,
+           st.t_basis, st.t_factor, st.t_apply);
     return s;
 }
 
