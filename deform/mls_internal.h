@@ -37,6 +37,8 @@ struct cm_mls_basis {
     int max_list; /* longest cell list: an upper bound on the samples covering a point */
 };
 
+/* How many samples cover x: the count mls_basis_eval returns, without evaluating. */
+int mls_basis_count(const cm_mls_basis *b, const double x[3]);
 /* Shape functions at x into caller scratch of max_list entries; grad/lap may be NULL.
  * Returns the count (0: no sample covers x). */
 int mls_basis_eval(const cm_mls_basis *b, const double x[3], int32_t *idx, double *phi,

@@ -10,7 +10,7 @@
 #include <string.h>
 
 /* Plot area inside a 960 x 540 canvas; the legend sits right of it. */
-#define PW 960
+#define PW 1100
 #define PH 540
 #define X0 85.0
 #define X1 640.0

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Section 7.2 pipe/bore hex (issue 15), the MLS options against the RBF: one absolute step
 # G(0) -> G(1) with `cadmorph morph --method mls` and the MLS options of cm_warp_options
-# (samples k, cubature N, coverage s, gamma_s, gamma_b), one row per setting, next to rbf.
+# (samples k, cubature N, coverage s, gamma_s, gamma_b, the residual blend), one row per
+# setting, next to rbf. Rows also go to WORK_DIR/hex_rows.csv.
 # usage: run_hex_options.sh BUILD_DIR WORK_DIR [MODEL...]
 set -euo pipefail
 build=$1 work=$2; shift 2
@@ -9,12 +10,20 @@ models=${*:-pipe bore}
 C=$build/cli/cadmorph M=$build/benchmarks/models
 mkdir -p "$work" && cd "$work"
 echo "# $(date -u '+%F %H:%M UTC')  $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)  nproc=$(nproc)  load=$(cut -d' ' -f1-3 /proc/loadavg)"
+echo "model,method,options,min_sj,mean_sj,inverted,residual,cpu_s" > hex_rows.csv
 echo "| model | method | options | min SJ | mean SJ | inverted | MLS residual | CPU s |"
 echo "|---|---|---|---|---|---|---|---|"
 variants=(
     ""
+    "--blend 0"
     "--samples 1000"
+    "--samples 1000 --blend 0"
+    "--samples 1500"
+    "--samples 1500 --blend 0"
     "--samples 2000"
+    "--samples 2000 --blend 0"
+    "--samples 3000"
+    "--samples 3000 --blend 0"
     "--samples 1000 --cubature 16000"
     "--cover 8"
     "--stretch 0 --bend 1"
@@ -38,6 +47,7 @@ for model in $models; do
             $(echo "$q" | sed 's/.*min_scaled_jacobian=\([^ ]*\).*/\1/') \
             $(echo "$q" | sed 's/.*mean_scaled_jacobian=\([^ ]*\).*/\1/') \
             $(echo "$q" | sed 's/.*inverted=\([^ ]*\).*/\1/') "${res:--}" "$cpu"
+        echo "$model,$method,${*:-default},$(echo "$q" | sed 's/.*min_scaled_jacobian=\([^ ]*\) mean_scaled_jacobian=\([^ ]*\) inverted=\([^ ]*\).*/\1,\2,\3/'),${res:--},$cpu" >> hex_rows.csv
     }
     row rbf
     for v in "${variants[@]}"; do
