@@ -72,6 +72,9 @@ extern const char *const cli_kernel_names[];
 extern const char *const cli_solver_names[];
 extern const int cli_solver_values[];
 extern const int cli_kernel_methods[];
+/* --mode of study and sweep: absolute, relative, both (CM_STUDY_*). */
+extern const char *const cli_study_mode_names[];
+extern const int cli_study_mode_values[];
 
 /* A count (1 .. 1e8) into a size_t (dest), e.g. --samples. */
 int cli_parse_size(const cli_parser *p, const cli_option *o, const char *value, void *dest);
