@@ -71,10 +71,13 @@ static void ticks(FILE *f, const axis *a, int vertical)
                 else
                     fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\"/>\n", q, Y0, q, Y1, col);
                 if (m != 1) continue;
+                /* decades as plain numbers (1000000, not 1e+06) up to 1e9 */
+                char lab[32];
+                snprintf(lab, sizeof lab, v >= 1 && v < 1e9 ? "%.0f" : "%g", v);
                 if (vertical)
-                    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%g</text>\n", X0 - 8, q + 4, v);
+                    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"end\">%s</text>\n", X0 - 8, q + 4, lab);
                 else
-                    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", q, Y1 + 20, v);
+                    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%s</text>\n", q, Y1 + 20, lab);
             }
         return;
     }

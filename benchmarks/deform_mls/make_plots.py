@@ -97,7 +97,7 @@ if r:
     pts = []
     for x in r:
         k = int(x["k"])
-        pts.append(("dense RBF fit + evaluation", k, float(x["rbf_total"]), "solid+markers", 1))
+        pts.append(("dense RBF fit + evaluation (best of 2)", k, float(x["rbf_total"]), "solid+markers", 1))
         pts.append(("MLS set-up (CPU)", k, float(x["mls_setup"]), "solid+markers", 0))
         pts.append(("MLS per deformation (CPU)", k, float(x["mls_apply"]), "dashed+markers", 0))
     draw("perf", pts, "Figure 4: time against centres / samples (13,342-node mesh, 1 thread)",
