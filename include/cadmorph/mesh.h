@@ -197,7 +197,8 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
 
 /* ---- files ----
  * Formats by extension: .msh (gmsh 2.2 / 4.1, ASCII / binary little-endian), .vtu (VTK XML),
- * .vtk (legacy UNSTRUCTURED_GRID, ASCII / binary), .mesh (Medit ASCII).
+ * .vtk (legacy UNSTRUCTURED_GRID, ASCII / binary), .mesh (Medit ASCII); surface meshes also
+ * .obj (Wavefront), .off and .stl (binary / ASCII; corners merged into nodes when read).
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */
@@ -207,7 +208,10 @@ typedef enum cm_mesh_format {
     CM_FORMAT_MSH,
     CM_FORMAT_VTU,
     CM_FORMAT_VTK,
-    CM_FORMAT_MEDIT
+    CM_FORMAT_MEDIT,
+    CM_FORMAT_OBJ, /* surface formats: faces (and, in .obj, lines) only */
+    CM_FORMAT_OFF,
+    CM_FORMAT_STL
 } cm_mesh_format;
 
 CM_API cm_mesh_format cm_mesh_format_from_path(const char *path);
@@ -216,7 +220,7 @@ CM_API const char *cm_mesh_format_list(void);
 
 typedef struct cm_mesh_write_options {
     int msh_version; /* 22 or 41 (default 41) */
-    int binary;      /* msh, vtk: binary; vtu: base64 data (appended raw if also `appended`) */
+    int binary;      /* msh, vtk, stl: binary; vtu: base64 data (appended raw if also `appended`) */
     int compress;    /* vtu: zlib compression (default on) */
     int appended;    /* vtu: appended raw data section */
 } cm_mesh_write_options;

@@ -18,12 +18,15 @@ cm_mesh_format cm_mesh_format_from_path(const char *path)
     if (!strcmp(ext, "vtu")) return CM_FORMAT_VTU;
     if (!strcmp(ext, "vtk")) return CM_FORMAT_VTK;
     if (!strcmp(ext, "mesh")) return CM_FORMAT_MEDIT;
+    if (!strcmp(ext, "obj")) return CM_FORMAT_OBJ;
+    if (!strcmp(ext, "off")) return CM_FORMAT_OFF;
+    if (!strcmp(ext, "stl")) return CM_FORMAT_STL;
     return CM_FORMAT_UNKNOWN;
 }
 
 const char *cm_mesh_format_list(void)
 {
-    return ".msh .vtu .vtk .mesh";
+    return ".msh .vtu .vtk .mesh .obj .off .stl";
 }
 
 void cm_mesh_write_options_init(cm_mesh_write_options *opt)
@@ -52,6 +55,9 @@ cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh)
     case CM_FORMAT_VTU: s = cm_mesh_read_vtu(ctx, path, mesh); break;
     case CM_FORMAT_VTK: s = cm_mesh_read_vtk(ctx, path, mesh); break;
     case CM_FORMAT_MEDIT: s = cm_mesh_read_medit(ctx, path, mesh); break;
+    case CM_FORMAT_OBJ: s = cm_mesh_read_obj(ctx, path, mesh); break;
+    case CM_FORMAT_OFF: s = cm_mesh_read_off(ctx, path, mesh); break;
+    case CM_FORMAT_STL: s = cm_mesh_read_stl(ctx, path, mesh); break;
     default: return unknown_extension(ctx, "cm_mesh_read", path);
     }
     if (s < 0) return s;
@@ -77,6 +83,9 @@ cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
     case CM_FORMAT_VTU: return cm_mesh_write_vtu(ctx, mesh, path, opt);
     case CM_FORMAT_VTK: return cm_mesh_write_vtk(ctx, mesh, path, opt);
     case CM_FORMAT_MEDIT: return cm_mesh_write_medit(ctx, mesh, path, opt);
+    case CM_FORMAT_OBJ: return cm_mesh_write_obj(ctx, mesh, path, opt);
+    case CM_FORMAT_OFF: return cm_mesh_write_off(ctx, mesh, path, opt);
+    case CM_FORMAT_STL: return cm_mesh_write_stl(ctx, mesh, path, opt);
     default: return unknown_extension(ctx, "cm_mesh_write", path);
     }
 }
