@@ -1,14 +1,31 @@
 /* Mesh file dispatch by extension and the helpers every reader and writer shares. */
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
+#include "foam_internal.h"
 
 #include <ctype.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+
+/* An OpenFOAM case or polyMesh directory: an existing directory, a trailing '/', a last
+ * component named polyMesh, or one without an extension that is not an existing file. */
+int cm_foam_is_path(const char *path)
+{
+    if (!path || !*path) return 0;
+    size_t l = strlen(path);
+    if (path[l - 1] == '/') return 1;
+    struct stat st;
+    if (stat(path, &st) == 0) return S_ISDIR(st.st_mode);
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    return strcmp(base, "polyMesh") == 0 || strchr(base, '.') == NULL;
+}
 
 cm_mesh_format cm_mesh_format_from_path(const char *path)
 {
+    if (cm_foam_is_path(path)) return CM_FORMAT_FOAM;
     const char *dot = path ? strrchr(path, '.') : NULL;
     if (!dot || strchr(dot, '/')) return CM_FORMAT_UNKNOWN;
     char ext[8] = {0};
@@ -33,7 +50,7 @@ void cm_mesh_write_options_init(cm_mesh_write_options *opt)
 static cm_status unknown_extension(cm_context *ctx, const char *fn, const char *path)
 {
     return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                    "%s: %s: unknown mesh extension (expected .msh, .vtu, .vtk or .mesh)", fn,
+                    "%s: %s: unknown mesh extension (expected .msh, .vtu, .vtk, .mesh or an OpenFOAM case directory)", fn,
                     path ? path : "(null)");
 }
 
@@ -47,6 +64,7 @@ cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh)
     case CM_FORMAT_VTU: s = cm_mesh_read_vtu(ctx, path, mesh); break;
     case CM_FORMAT_VTK: s = cm_mesh_read_vtk(ctx, path, mesh); break;
     case CM_FORMAT_MEDIT: s = cm_mesh_read_medit(ctx, path, mesh); break;
+    case CM_FORMAT_FOAM: s = cm_mesh_read_foam(ctx, path, mesh); break;
     default: return unknown_extension(ctx, "cm_mesh_read", path);
     }
     if (s < 0) return s;
@@ -72,6 +90,7 @@ cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
     case CM_FORMAT_VTU: return cm_mesh_write_vtu(ctx, mesh, path, opt);
     case CM_FORMAT_VTK: return cm_mesh_write_vtk(ctx, mesh, path, opt);
     case CM_FORMAT_MEDIT: return cm_mesh_write_medit(ctx, mesh, path, opt);
+    case CM_FORMAT_FOAM: return cm_mesh_write_foam(ctx, mesh, path, opt);
     default: return unknown_extension(ctx, "cm_mesh_write", path);
     }
 }
