@@ -420,7 +420,9 @@ cm_status cm_foam_label_list(cm_context *ctx, cm_foam_lex *lx, const char *what,
             }
         }
     } else {
-        for (int64_t i = 0; s == CM_OK && i < cnt; ++i) s = cm_foam_label(ctx, lx, what, &v[i]);
+        char entry[160];
+        snprintf(entry, sizeof entry, "one of the %lld entries of %s", (long long)cnt, what);
+        for (int64_t i = 0; s == CM_OK && i < cnt; ++i) s = cm_foam_label(ctx, lx, entry, &v[i]);
         if (s == CM_OK) s = cm_foam_expect(ctx, lx, ')', "')' closing the list (more entries than its size?)");
     }
     if (s != CM_OK) {
