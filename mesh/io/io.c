@@ -7,20 +7,27 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
-/* An OpenFOAM case or polyMesh directory: an existing directory, a trailing '/', a last
- * component named polyMesh, or one without an extension that is not an existing file. */
+/* An OpenFOAM case or polyMesh directory: a trailing '/', or (unless the name ends in a mesh
+ * file extension) an existing directory, a last component named polyMesh, or one without an
+ * extension that is not an existing file. */
 int cm_foam_is_path(const char *path)
 {
     if (!path || !*path) return 0;
     size_t l = strlen(path);
     if (path[l - 1] == '/') return 1;
-    struct stat st;
-    if (stat(path, &st) == 0) return S_ISDIR(st.st_mode);
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
-    return strcmp(base, "polyMesh") == 0 || strchr(base, '.') == NULL;
+    /* a name with a file format's extension stays that format, even if it is a directory */
+    static const char *const ext[] = {".msh", ".vtu", ".vtk", ".mesh"};
+    const char *dot = strrchr(base, '.');
+    for (size_t i = 0; dot && i < sizeof ext / sizeof *ext; ++i)
+        if (!strcasecmp(dot, ext[i])) return 0;
+    struct stat st;
+    if (stat(path, &st) == 0) return S_ISDIR(st.st_mode);
+    return strcmp(base, "polyMesh") == 0 || dot == NULL;
 }
 
 cm_mesh_format cm_mesh_format_from_path(const char *path)
