@@ -11,6 +11,7 @@ import argparse
 import math
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -26,21 +27,11 @@ ENV.setdefault("WM_PROJECT_DIR", "/usr/share/openfoam")
 os.makedirs(a.work, exist_ok=True)
 
 
-def timed(cmd):
-    """Runs cmd; returns (returncode, stdout, stderr, cpu seconds, peak RSS MiB)."""
-    p = subprocess.Popen(cmd, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    out, err = p.communicate()
-    # the child's own rusage: wait4 on an already reaped child is not possible, so read it
-    # from /proc-less accounting through resource's children totals, differenced
-    return p.returncode, out, err
-
-
-import resource  # noqa: E402
-
-
 def run(cmd):
+    """Runs cmd: (returncode, stdout, stderr, CPU seconds of the child, peak RSS so far MiB)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    rc, out, err = timed(cmd)
+    p = subprocess.run(cmd, env=ENV, capture_output=True, text=True)
+    rc, out, err = p.returncode, p.stdout, p.stderr
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return rc, out, err, cpu, after.ru_maxrss / 1024.0
@@ -155,10 +146,6 @@ for label, ref, ours, line, cpu in rows:
 
 # ---- read / morph / write: polyMesh vs .vtu of the same mesh ----
 vtu = os.path.join(a.work, "input.vtu")
-run([a.cadmorph, "warp", "--mesh", a.case, "--displacements", H, "-o", os.path.join(a.work, "zero.vtu")])
-rc = run([a.cadmorph, "ffd", "--help"])  # warm the binary
-conv = os.path.join(a.work, "conv_case")
-shutil.rmtree(conv, ignore_errors=True)
 # the .vtu twin: the polyMesh read and written by cadmorph (warp with an empty displacement table)
 Z = os.path.join(a.work, "none.csv")
 with open(Z, "w") as f:
@@ -175,4 +162,4 @@ shutil.rmtree(wf, ignore_errors=True)
 r_f = run([a.cadmorph, "warp", "--mesh", a.case, "--displacements", H, "-o", wf])
 r_v = run([a.cadmorph, "warp", "--mesh", vtu, "--displacements", H, "-o", os.path.join(a.work, "t.vtu")])
 print("| read + RBF warp + write (`warp`) | %.2f | %.2f |" % (r_f[3], r_v[3]))
-print("peak RSS of all runs: %.0f MiB" % resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
+print("peak RSS of the largest run: %.0f MiB" % (resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0))
