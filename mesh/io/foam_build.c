@@ -90,14 +90,48 @@ static int cmp_order(const void *x, const void *y)
     return p->face < q->face ? -1 : p->face > q->face;
 }
 
+/* A patch name OpenFOAM reads as one word: letters, digits and _ - . : + kept, anything else
+ * (white space, quotes, brackets, ';', '/', non-ASCII) becomes '_'; unnamed groups "patchN". */
 static char *name_of_group(const cm_mesh *m, int tag)
 {
-    for (size_t i = 0; i < m->n_groups; ++i)
+    const char *src = NULL;
+    for (size_t i = 0; i < m->n_groups && !src; ++i)
         if (m->groups[i].dim == 2 && m->groups[i].tag == tag && m->groups[i].name && m->groups[i].name[0])
-            return strdup(m->groups[i].name);
-    char buf[32];
-    snprintf(buf, sizeof buf, "patch%d", tag);
-    return strdup(buf);
+            src = m->groups[i].name;
+    char buf[64];
+    if (!src) {
+        snprintf(buf, sizeof buf, "patch%d", tag);
+        return strdup(buf);
+    }
+    size_t n = strlen(src);
+    char *d = malloc(n + 2);
+    if (!d) return NULL;
+    size_t k = 0;
+    if (!((src[0] >= 'a' && src[0] <= 'z') || (src[0] >= 'A' && src[0] <= 'Z') || src[0] == '_')) d[k++] = '_';
+    for (size_t i = 0; i < n; ++i) {
+        char c = src[i];
+        int ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+                 c == '-' || c == '.' || c == ':' || c == '+';
+        d[k++] = ok ? c : '_';
+    }
+    d[k] = '\0';
+    return d;
+}
+
+/* Makes patch names unique (two groups may sanitise to the same word). */
+static int unique_names(cm_foam_patch *pt, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        for (size_t j = 0; j < i; ++j)
+            if (!strcmp(pt[i].name, pt[j].name)) {
+                size_t l = strlen(pt[i].name);
+                char *r = realloc(pt[i].name, l + 24);
+                if (!r) return 0;
+                snprintf(r + l, 24, "_%zu", i);
+                pt[i].name = r;
+                j = (size_t)-1; /* check again from the start */
+            }
+    return 1;
 }
 
 cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out)
@@ -232,6 +266,7 @@ cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out
         pt->start = -1;
         if (!pt->name || !pt->type) goto nomem;
     }
+    if (!unique_names(p->patches, npatch)) goto nomem;
     for (size_t i = nint; i < b.nf; ++i) {
         cm_foam_patch *pt = &p->patches[b.f[ord[i].face].patch];
         if (pt->start < 0) pt->start = (int64_t)i;

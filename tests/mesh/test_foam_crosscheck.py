@@ -307,7 +307,41 @@ check(len(hexes) > nc // 2 and worst < 1e-9,
 print("warped: vtkOpenFOAMReader reads %d cells; %d hexahedra with Verdict's scaled Jacobian equal (worst %.2g)"
       % (internal.GetNumberOfCells(), len(hexes), worst))
 
-# 5. broken input: exit 2 with the file
+# 5. a gmsh tet mesh written as a polyMesh (faces matched between cells, patches from the
+#    physical groups): checkMesh's topology checks pass and its metrics equal cadmorph's on
+#    the .msh itself (the faces cadmorph builds from the cells)
+msh = os.path.join(WORK, "tets.msh")
+gm = subprocess.run([sys.executable, "-c", """
+import gmsh, sys
+gmsh.initialize(); gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.occ.addBox(0, 0, 0, 1, 0.6, 0.4); gmsh.model.occ.synchronize()
+for s in gmsh.model.getEntities(2):
+    t = gmsh.model.addPhysicalGroup(2, [s[1]]); gmsh.model.setPhysicalName(2, t, "side%d" % s[1])
+gmsh.model.addPhysicalGroup(3, [1])
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.15); gmsh.model.mesh.generate(3)
+gmsh.write(sys.argv[1]); gmsh.finalize()
+""", msh], capture_output=True, text=True)
+check(gm.returncode == 0, "gmsh tets: " + gm.stderr[-300:])
+conv = os.path.join(WORK, "tets_case")
+shutil.rmtree(conv, ignore_errors=True)
+zero = os.path.join(WORK, "zero.csv")
+with open(zero, "w") as f:
+    f.write("node,dx,dy,dz\n0,0,0,0\n")
+c = run([CADMORPH, "warp", "--mesh", msh, "--displacements", zero, "-o", conv])
+check(c.returncode == 0, "warp .msh -> case/: %s" % c.stderr)
+write_system(conv)
+cm = run(["checkMesh", "-case", conv], foam=True).stdout
+for ok in ("Upper triangular ordering OK.", "Cell to face addressing OK.", "Boundary definition OK."):
+    check(ok in cm, "converted tets: checkMesh lacks '%s'" % ok)
+check(len(re.findall(r"^\s+side\d+\s+\d+", cm, re.M)) == 6, "converted tets: not 6 patches")
+ref = metrics(cm)
+ours = metrics(run([CADMORPH, "quality", msh, "--foam"]).stdout)
+for k in ("max aspect ratio", "non-orthogonality", "max skewness", "volume", "face area"):
+    check(k in ref and ref.get(k) == ours.get(k), "converted tets: %s: checkMesh %s, cadmorph on .msh %s"
+          % (k, ref.get(k), ours.get(k)))
+print("tets       converted .msh: checkMesh topology OK, metrics equal cadmorph's on the .msh")
+
+# 6. broken input: exit 2 with the file
 bad = os.path.join(WORK, "broken")
 shutil.rmtree(bad, ignore_errors=True)
 shutil.copytree(box, bad)

@@ -159,6 +159,33 @@ static void volume_check(void)
     cm_mesh_destroy(&m);
 }
 
+/* patch names from hostile group names: one OpenFOAM word each, distinct */
+static void hostile_patch_names(void)
+{
+    cm_mesh *m = hex_mesh(0, 0.0);
+    /* two boundary quads of the block (z = 0 face) in groups with names no word holds */
+    const int64_t q1[4] = {0, 4, 5, 1}, q2[4] = {1, 5, 6, 2};
+    CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_QUAD4, q1, 4, 7, 7, 0) == CM_OK);
+    CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_QUAD4, q2, 4, 8, 8, 0) == CM_OK);
+    CHECK(cm_mesh_add_group(ctx, m, 2, 7, "in let;{\"x\"}") == CM_OK);
+    CHECK(cm_mesh_add_group(ctx, m, 2, 8, "in let;{'x'}") == CM_OK);
+    char dir[2300];
+    path(dir, sizeof dir, work, "foam_hostile_names");
+    CHECK_MSG(cm_mesh_write(ctx, m, dir, NULL) == CM_OK, "%s", cm_context_message(ctx));
+    cm_mesh *r = NULL;
+    CHECK_MSG(cm_mesh_read(ctx, dir, &r) == CM_OK, "%s", cm_context_message(ctx));
+    if (r) {
+        CHECK(r->n_groups == 3);
+        for (size_t g = 0; g < r->n_groups; ++g) CHECK(strpbrk(r->groups[g].name, " ;{}\"'") == NULL);
+        CHECK(r->n_groups == 3 && strcmp(r->groups[0].name, r->groups[1].name) != 0);
+        size_t in_first = 0;
+        for (size_t c = 0; c < r->n_cells; ++c) in_first += r->physical[c] == 1;
+        CHECK(in_first == 1);
+    }
+    cm_mesh_destroy(&r);
+    cm_mesh_destroy(&m);
+}
+
 static const char *const files[] = {"faces", "owner", "neighbour", "boundary"};
 
 /* a morph of a read polyMesh: points only */
@@ -478,6 +505,7 @@ int main(int argc, char **argv)
     round_trip("foam_pyramid", m, CM_CELL_PYR5);
     cm_mesh_destroy(&m);
     volume_check();
+    hostile_patch_names();
 
     points_only("foam_hex", "foam_hex_morphed", 0);
     gzip_copy("foam_tet", "foam_tet_gz");
