@@ -363,6 +363,14 @@ static cm_status list_open(cm_context *ctx, cm_foam_lex *lx, const char *what, i
         return tok_error(ctx, lx, buf, b);
     }
     *open = b.s[0];
+    /* every entry of a bracketed list takes at least one byte: a larger count is a corrupt
+     * size, reported before anything is allocated */
+    if (*open == '(' && (uint64_t)*n > lx->f->size - lx->pos)
+        return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: %s has size %lld, more than the %zu bytes left in the file",
+                        lx->f->path, lx->line, what, (long long)*n, lx->f->size - lx->pos);
+    if (*open == '{' && *n > ((int64_t)1 << 40))
+        return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: uniform list %s of size %lld", lx->f->path, lx->line,
+                        what, (long long)*n);
     return CM_OK;
 }
 
@@ -409,7 +417,7 @@ cm_status cm_foam_label_list(cm_context *ctx, cm_foam_lex *lx, const char *what,
     } else if (lx->f->binary && cnt > 0) {
         const int lb = lx->f->label_bytes;
         const char *at;
-        s = (uint64_t)cnt > SIZE_MAX / (size_t)lb ? CM_ERR_FORMAT : binary_block(ctx, lx, what, (size_t)cnt * (size_t)lb, &at);
+        s = binary_block(ctx, lx, what, (size_t)cnt * (size_t)lb, &at);
         for (int64_t i = 0; s == CM_OK && i < cnt; ++i) {
             if (lb == 4) {
                 int32_t x;
@@ -443,7 +451,6 @@ cm_status cm_foam_scalar_list(cm_context *ctx, cm_foam_lex *lx, const char *what
     int64_t cnt;
     cm_status s = list_open(ctx, lx, what, &cnt, &open);
     if (s != CM_OK) return s;
-    if ((uint64_t)cnt > SIZE_MAX / 32) return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: list size %lld too large", lx->f->path, lx->line, (long long)cnt);
     double *v = alloc_n(cnt * width, sizeof *v);
     if (cnt > 0 && !v) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory for %lld values", lx->f->path, (long long)cnt);
     if (open == '{' || !lx->f->binary || cnt == 0) {

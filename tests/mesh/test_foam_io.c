@@ -483,6 +483,56 @@ static void hostile(void)
     cm_mesh_destroy(&m);
 }
 
+/* random corruptions of a good polyMesh: never a crash, and a mesh only if it is valid */
+static void corruptions(void)
+{
+    cm_mesh *m = wedge_pyramid_mesh(1);
+    char good[2300], bad[2300];
+    path(good, sizeof good, work, "foam_fuzz_src");
+    path(bad, sizeof bad, work, "foam_fuzz");
+    CHECK(cm_mesh_write(ctx, m, good, NULL) == CM_OK);
+    CHECK(cm_mesh_write(ctx, m, bad, NULL) == CM_OK);
+    const char *all[] = {"points", "faces", "owner", "neighbour", "boundary"};
+    static const char junk[] = "0123456789(){}; \n-e.\"/*x";
+    uint64_t seed = 11;
+    int errors = 0, valid = 0, bad_mesh = 0;
+    for (int it = 0; it < 600; ++it) {
+        int f = (int)(test_rng_range(&seed, 0, 5));
+        char a[2500], b[2500];
+        snprintf(a, sizeof a, "%s/constant/polyMesh/%s", good, all[f]);
+        snprintf(b, sizeof b, "%s/constant/polyMesh/%s", bad, all[f]);
+        size_t n;
+        char *d = slurp(a, &n);
+        if (!d) continue;
+        int edits = 1 + (int)test_rng_range(&seed, 0, 4);
+        for (int e = 0; e < edits; ++e) {
+            size_t at = (size_t)test_rng_range(&seed, 0, (double)n);
+            if (test_rng_range(&seed, 0, 1) < 0.2) n = at; /* truncate */
+            else if (at < n) d[at] = junk[(int)test_rng_range(&seed, 0, sizeof junk - 1)];
+        }
+        spit(b, d, n);
+        cm_mesh *r = NULL;
+        cm_status s = cm_mesh_read(ctx, bad, &r);
+        if (s < 0) {
+            ++errors;
+            if (r || !strstr(cm_context_message(ctx), "cm_mesh_read")) ++bad_mesh;
+        } else {
+            ++valid;
+            if (!r || cm_mesh_validate(ctx, r, "fuzz") != CM_OK) ++bad_mesh;
+        }
+        cm_mesh_destroy(&r);
+        /* restore the good file */
+        free(d);
+        d = slurp(a, &n);
+        if (d) spit(b, d, n);
+        free(d);
+    }
+    CHECK_MSG(bad_mesh == 0, "%d corrupted reads returned a broken mesh or an unnamed error", bad_mesh);
+    CHECK(errors > 300);
+    printf("corruptions: %d rejected, %d still valid\n", errors, valid);
+    cm_mesh_destroy(&m);
+}
+
 int main(int argc, char **argv)
 {
     snprintf(work, sizeof work, "%s", argc > 2 ? argv[2] : ".");
@@ -512,6 +562,7 @@ int main(int argc, char **argv)
     points_only("foam_tet_gz", "foam_tet_gz_morphed", 1);
     binary_read();
     hostile();
+    corruptions();
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }
