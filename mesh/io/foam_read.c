@@ -2,7 +2,8 @@
  * owner, neighbour, boundary; optional cell/face/point zones), ASCII or binary, plain or .gz.
  * Cells become polyhedra, or tet/hex/wedge/pyramid when their faces have exactly that shape
  * (so that the scaled Jacobian is Verdict's); boundary faces are added as 2D cells with the
- * patch as physical group. The face-addressed original is kept for writing and checkMesh. */
+ * patch as physical group (tag = patch index + 1), cells in a cellZone get the zone's group
+ * (tags after the patches). The face-addressed original is kept for writing and checkMesh. */
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
 #include "foam_internal.h"
@@ -595,6 +596,16 @@ cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh)
     if (s == CM_OK) {
         if (r.p->n_points) memcpy(m->xyz, r.xyz, (size_t)r.p->n_points * 3 * sizeof(double));
         s = build_cells(&r, m);
+    }
+    /* cell zones become the volume cells' physical groups (zone k: tag k + 1; a cell in
+     * several zones keeps the last) */
+    for (size_t z = 0, k = 0; s == CM_OK && z < r.p->n_zones; ++z) {
+        const cm_foam_zone *zn = &r.p->zones[z];
+        if (zn->kind != CM_FOAM_CELL_ZONE) continue;
+        ++k;
+        s = cm_mesh_add_group(ctx, m, 3, (int)(r.p->n_patches + k), zn->name);
+        for (int64_t i = 0; s == CM_OK && i < zn->n; ++i)
+            m->physical[zn->ids[i]] = m->entity[zn->ids[i]] = (int)(r.p->n_patches + k);
     }
     if (s != CM_OK) goto fail;
     m->foam = r.p;

@@ -186,6 +186,55 @@ static void hostile_patch_names(void)
     cm_mesh_destroy(&m);
 }
 
+/* zones: read (binary-free ASCII here), cell zones as physical groups, copied on a morph */
+static void zones(void)
+{
+    char dir[2300], f[2500];
+    path(dir, sizeof dir, work, "foam_zones");
+    cm_mesh *m = hex_mesh(0, 0.1);
+    CHECK(cm_mesh_write(ctx, m, dir, NULL) == CM_OK);
+    snprintf(f, sizeof f, "%s/constant/polyMesh/cellZones", dir);
+    const char *cz = "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class regIOobject;\n    object cellZones;\n}\n"
+                     "2\n(\nporous\n{\n    type cellZone;\n    cellLabels List<label> 3(0 1 2);\n}\n"
+                     "rest\n{\n    type cellZone;\n    cellLabels List<label> 2{5};\n    meta { a 1; }\n}\n)\n";
+    spit(f, cz, strlen(cz));
+    snprintf(f, sizeof f, "%s/constant/polyMesh/faceZones", dir);
+    const char *fz = "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class regIOobject;\n    object faceZones;\n}\n"
+                     "1\n(\nbaffle\n{\n    type faceZone;\n    faceLabels List<label> 2(0 1);\n    flipMap List<bool> 2(0 1);\n}\n)\n";
+    spit(f, fz, strlen(fz));
+    cm_mesh *r = NULL;
+    cm_status s = cm_mesh_read(ctx, dir, &r);
+    CHECK_MSG(s == CM_OK, "zones: %s", cm_context_message(ctx));
+    if (r) {
+        int tag = -1;
+        for (size_t g = 0; g < r->n_groups; ++g)
+            if (r->groups[g].dim == 3 && !strcmp(r->groups[g].name, "porous")) tag = r->groups[g].tag;
+        CHECK(tag > 0 && r->physical[0] == tag && r->physical[2] == tag && r->physical[3] != tag);
+        CHECK(r->physical[5] > 0 && r->physical[5] != tag);
+        cm_mesh *w = NULL;
+        cm_mesh_copy(ctx, r, &w);
+        w->xyz[0] += 0.001;
+        char out[2300], a[2500];
+        path(out, sizeof out, work, "foam_zones_out");
+        CHECK(cm_mesh_write(ctx, w, out, NULL) == CM_OK);
+        snprintf(a, sizeof a, "%s/constant/polyMesh/faceZones", out);
+        CHECK(same_file(a, f));
+        cm_mesh_destroy(&w);
+    }
+    cm_mesh_destroy(&r);
+    /* a zone label out of range */
+    const char *czbad = "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class regIOobject;\n    object cellZones;\n}\n"
+                        "1\n(\nz\n{\n    type cellZone;\n    cellLabels List<label> 1(999);\n}\n)\n";
+    snprintf(f, sizeof f, "%s/constant/polyMesh/cellZones", dir);
+    spit(f, czbad, strlen(czbad));
+    s = cm_mesh_read(ctx, dir, &r);
+    CHECK_MSG(s == CM_ERR_FORMAT && strstr(cm_context_message(ctx), "cellZones") &&
+                  strstr(cm_context_message(ctx), "out of range"),
+              "zone out of range: %s", cm_context_message(ctx));
+    cm_mesh_destroy(&r);
+    cm_mesh_destroy(&m);
+}
+
 static const char *const files[] = {"faces", "owner", "neighbour", "boundary"};
 
 /* a morph of a read polyMesh: points only */
@@ -556,6 +605,7 @@ int main(int argc, char **argv)
     cm_mesh_destroy(&m);
     volume_check();
     hostile_patch_names();
+    zones();
 
     points_only("foam_hex", "foam_hex_morphed", 0);
     gzip_copy("foam_tet", "foam_tet_gz");
