@@ -2,7 +2,7 @@
 """A car-like body in a wind tunnel, meshed by OpenFOAM's snappyHexMesh with a boundary layer
 (second paper, section 3.6.2): a rounded box with four wheel arches and a sloped rear, built
 with gmsh's OpenCASCADE kernel (STEP and STL), a blockMesh tunnel, snappyHexMesh (castellate,
-snap, 2 layers on the body).  usage: make_case.py CASE_DIR [--base N] [--level L]
+snap, 2 layers on the body).  usage: make_case.py CASE_DIR [--base N] [--level L] [--height H] [--step-only PATH]
   --base N   background cells along the body length (default 10: ~50k cells; 20 ~ 300k)
   --level L  surface refinement level on the body (default 2)"""
 import argparse
@@ -15,14 +15,17 @@ ap = argparse.ArgumentParser()
 ap.add_argument("case")
 ap.add_argument("--base", type=int, default=10)
 ap.add_argument("--level", type=int, default=2)
+ap.add_argument("--height", type=float, default=0.32, help="body height (default 0.32)")
+ap.add_argument("--step-only", metavar="PATH", help="only write the body's STEP to PATH (a CAD edit)")
 a = ap.parse_args()
 case = a.case
-shutil.rmtree(case, ignore_errors=True)
-for d in ("system", "constant/triSurface"):
-    os.makedirs(os.path.join(case, d))
+if not a.step_only:
+    shutil.rmtree(case, ignore_errors=True)
+    for d in ("system", "constant/triSurface"):
+        os.makedirs(os.path.join(case, d))
 
 # body: length 1, width 0.45, height 0.32, ground clearance 0.05, at x in [0, 1]
-L, W, H, C = 1.0, 0.45, 0.32, 0.05
+L, W, H, C = 1.0, 0.45, a.height, 0.05
 import gmsh  # noqa: E402  (Debian python3-gmsh)
 gmsh.initialize()
 gmsh.option.setNumber("General.Terminal", 0)
@@ -32,11 +35,15 @@ occ.synchronize()
 occ.fillet([body], [e[1] for e in gmsh.model.getEntities(1)], [0.06])
 occ.synchronize()
 # sloped rear: a box rotated about y cuts the top rear
-cut = occ.addBox(0.62, -W, C + 0.22, 1.0, 2 * W, 0.6)
-occ.rotate([(3, cut)], 0.62, 0, C + 0.22, 0, 1, 0, -0.5)
+cut = occ.addBox(0.62, -W, C + 0.22 * H / 0.32, 1.0, 2 * W, 0.6)
+occ.rotate([(3, cut)], 0.62, 0, C + 0.22 * H / 0.32, 0, 1, 0, -0.5)
 arches = [occ.addCylinder(x, -W, C + 0.02, 0, 2 * W, 0, 0.075) for x in (0.2, 0.8)]
 out, _ = occ.cut([(3, 1)], [(3, cut)] + [(3, t) for t in arches])
 occ.synchronize()
+if a.step_only:
+    gmsh.write(a.step_only)
+    gmsh.finalize()
+    sys.exit(0)
 gmsh.write(os.path.join(case, "constant", "body.step"))
 gmsh.option.setNumber("Mesh.MeshSizeMax", 0.02)
 gmsh.option.setNumber("Mesh.MeshSizeMin", 0.004)
