@@ -28,7 +28,7 @@ typedef struct cm_foam_zone {
 /* Face addressing as OpenFOAM stores it: faces oriented from owner to neighbour, internal
  * faces first, boundary faces grouped by patch. */
 typedef struct cm_foam_poly {
-    int refs;                  /* shared by cm_mesh_copy: read-only after the read */
+    int refs;                  /* shared by cm_mesh_copy (atomic count): read-only after the read */
     char *dir;                 /* the polyMesh directory it was read from (NULL if built) */
     int64_t n_points, n_faces, n_internal, n_cells;
     int64_t *face_off;         /* #faces + 1 */

@@ -28,7 +28,8 @@ cm_foam_poly *cm_foam_poly_new(void)
 
 cm_foam_poly *cm_foam_poly_retain(cm_foam_poly *p)
 {
-    if (p) ++p->refs;
+    /* atomic: copies of one mesh may be made and destroyed on several threads */
+    if (p) __atomic_add_fetch(&p->refs, 1, __ATOMIC_RELAXED);
     return p;
 }
 
@@ -37,7 +38,7 @@ void cm_foam_poly_release(cm_foam_poly **pp)
     if (!pp || !*pp) return;
     cm_foam_poly *p = *pp;
     *pp = NULL;
-    if (--p->refs > 0) return;
+    if (__atomic_sub_fetch(&p->refs, 1, __ATOMIC_ACQ_REL) > 0) return;
     free(p->dir);
     free(p->face_off);
     free(p->face_nodes);
