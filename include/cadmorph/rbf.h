@@ -66,6 +66,13 @@ typedef struct cm_rbf_options {
                            * (4 instead of 8 bytes x m x local_size), but the r^3 inverses
                            * cancel so heavily that float rounding costs iterations (bracket
                            * m = 21k: 15 instead of 9, bore 22.6k: 12 instead of 10) */
+    int coarse_post;      /* [0] order of the coarse correction: 0 before the local solves,
+                           * 1 before and after them (symmetric multiplicative), 2 after
+                           * them only */
+    double overlap;       /* [0] overlap measured in distance: a subdomain also takes every
+                           * centre within overlap x H of its leaf's box (H: the coarse
+                           * space's fill distance), up to local_max centres */
+    int local_max;        /* [0] cap on a subdomain's centres for overlap > 0 */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
