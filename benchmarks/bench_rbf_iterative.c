@@ -114,6 +114,8 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--post")) o.coarse_post = atoi(b), ++i;
         else if (!strcmp(a, "--overlap")) o.overlap = atof(b), ++i;
         else if (!strcmp(a, "--local-max")) o.local_max = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-grow")) o.coarse_grow = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-max")) o.coarse_max = atoi(b), ++i;
         else if (!strcmp(a, "--restart")) o.restart = atoi(b), ++i;
         else if (!strcmp(a, "--tol")) o.tolerance = atof(b), ++i;
         else if (!strcmp(a, "--maxit")) o.max_iterations = atoi(b), ++i;

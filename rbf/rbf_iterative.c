@@ -42,6 +42,8 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->local_size = 1400;
     opt->coarse_size = 2000;
     opt->local_float = 0;
+    opt->coarse_grow = 1;
+    opt->coarse_max = 8000;
 }
 
 void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
@@ -94,12 +96,15 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
                         "cm_rbf_create: the iterative solver handles the 3D r^3 kernel only");
     if (!(o->tolerance > 0.0) || o->max_iterations < 1 || o->restart < 2 || o->leaf_size < 8 ||
-        o->local_size < o->leaf_size || o->coarse_size < 0)
+        o->local_size < o->leaf_size || o->coarse_size < 0 || o->coarse_post < 0 ||
+        o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0)
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
-                        "restart %d, leaf_size %d, local_size %d, coarse_size %d)",
+                        "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "
+                        "%d, overlap %g, local_max %d, coarse_max %d)",
                         o->tolerance, o->max_iterations, o->restart, o->leaf_size,
-                        o->local_size, o->coarse_size);
+                        o->local_size, o->coarse_size, o->coarse_post, o->overlap, o->local_max,
+                        o->coarse_max);
     cm_rbf_iter *it = calloc(1, sizeof *it);
     if (!it) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     it->q1 = malloc(m * k * sizeof *it->q1);

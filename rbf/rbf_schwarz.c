@@ -22,6 +22,8 @@
 #include <omp.h>
 #endif
 
+#define CM_RBF_COARSE_BASE_M 2e4
+
 struct cm_rbf_schwarz {
     size_t m;
     size_t nmax;      /* largest local set */
@@ -334,6 +336,19 @@ static double farthest_points(const double *c, size_t m, size_t nc, size_t *out,
     return sqrt(fill2);
 }
 
+size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m)
+{
+    size_t nc = (size_t)o->coarse_size;
+    /* coarse_grow: coarse_size is the count at 2e4 centres, grown as sqrt(m) above, so that
+     * the coarse spacing keeps closer to the fixed-size subdomains' reach (which shrinks as
+     * m^-1/2) at O(m) memory for the coarse factor */
+    if (o->coarse_grow && (double)m > CM_RBF_COARSE_BASE_M)
+        nc = (size_t)((double)nc * sqrt((double)m / CM_RBF_COARSE_BASE_M));
+    if (o->coarse_max > 0 && nc > (size_t)o->coarse_max) nc = (size_t)o->coarse_max;
+    if (nc > m / 4) nc = m / 4; /* a coarse space as fine as the problem is no coarse space */
+    return nc;
+}
+
 void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
 {
     if (!pc || !*pc) return;
@@ -499,8 +514,7 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
 static cm_status build_coarse(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p, int threads)
 {
     const size_t m = r->m;
-    size_t nc = (size_t)r->opt.coarse_size;
-    if (nc > m / 4) nc = m / 4; /* a coarse space as fine as the problem is no coarse space */
+    size_t nc = cm_rbf_coarse_count(&r->opt, m); /* a coarse space as fine as the problem is no coarse space */
     if (nc < 16) return CM_OK;
     p->nc = nc;
     p->c_idx = malloc(nc * sizeof *p->c_idx);

@@ -61,7 +61,8 @@ typedef struct cm_rbf_options {
     int local_size;       /* [1400] centres per overlapping subdomain (the leaf plus the
                            * centres nearest to its box): the overlap is the knob that
                            * matters on thin walls */
-    int coarse_size;      /* [2000] farthest-point centres of the coarse space, 0: none */
+    int coarse_size;      /* [2000] farthest-point centres of the coarse space (at m <= 2e4,
+                           * see coarse_grow), 0: none */
     int local_float;      /* [0] store the local inverse rows in float: half the memory
                            * (4 instead of 8 bytes x m x local_size), but the r^3 inverses
                            * cancel so heavily that float rounding costs iterations (bracket
@@ -73,6 +74,10 @@ typedef struct cm_rbf_options {
                            * centre within overlap x H of its leaf's box (H: the coarse
                            * space's fill distance), up to local_max centres */
     int local_max;        /* [0] cap on a subdomain's centres for overlap > 0 */
+    int coarse_grow;      /* [1] coarse_size is the count at 2e4 centres; above, it grows as
+                           * sqrt(m) (coarse factor 8 coarse^2 bytes, O(m)): bracket 59k,
+                           * 5,000 coarse centres: 17 iterations instead of 21 */
+    int coarse_max;       /* [8000] cap on the coarse centres (0: none but m/4) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
