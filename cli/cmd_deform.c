@@ -2,6 +2,7 @@
  * metaphor of the MLS paper, section 3): handle nodes H move as given, fixed nodes F stay,
  * the rest follows a space deformation (triharmonic RBF or constrained MLS). */
 #include "cli.h"
+#include "deform_constraints.h"
 
 #include "cadmorph/deform.h"
 
@@ -17,7 +18,7 @@
 static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
     "[--method rbf|mls|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
-    "[--exact-constraints] [--threads N] [--verbose]";
+    "[--exact-constraints] [--constraint TYPE:SET ...] [--threads N] [--verbose]";
 
 static void print_help(void)
 {
@@ -47,8 +48,9 @@ static void print_help(void)
         "                            the field's\n"
         "  -o, --output M'           output mesh (must not be an input)\n"
         "  --threads N               threads (default: all)\n"
-        "  --verbose                 timings and debug messages on stderr\n\n"
-        "exit codes: 0 done, 1 usage, 2 bad input.\n");
+        "  --verbose                 timings and debug messages on stderr\n");
+    cli_constraints_help();
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input.\n");
 }
 
 typedef struct deform_args {
@@ -56,6 +58,7 @@ typedef struct deform_args {
     int fix_boundary, mls, shell, exact, threads, verbose;
     double stretch, bend, fix;
     size_t samples;
+    cli_constraints cons; /* --constraint and its options (deform_constraints.c) */
 } deform_args;
 
 static int number(const char *v, double *out)
@@ -74,8 +77,12 @@ static int parse_args(int argc, char **argv, deform_args *a)
     memset(a, 0, sizeof *a);
     a->mls = 1;
     a->stretch = 1, a->bend = 1, a->fix = 1000;
+    cli_constraints_init(&a->cons);
     for (int i = 1; i < argc; ++i) {
         const char *o = argv[i], *v;
+        int r = cli_constraints_option(argc, argv, &i, cmd, usage_line, &a->cons);
+        if (r < 0) return CLI_EXIT_USAGE;
+        if (r > 0) continue;
         if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
             print_help();
             return CLI_EXIT_OK;
@@ -128,14 +135,10 @@ static int parse_args(int argc, char **argv, deform_args *a)
         return cli_usage(cmd, usage_line, "--fixed and --fix-unlisted-boundary exclude each other");
     if ((a->mls || a->shell) && (a->fix <= 0 || a->stretch + a->bend <= 0))
         return cli_usage(cmd, usage_line, "--fix must be > 0 and --stretch + --bend > 0");
-    if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
-                         a->out);
-    if (cli_same_file(a->out, a->mesh) || cli_same_file(a->out, a->handles) ||
-        (a->fixed && cli_same_file(a->out, a->fixed)))
-        return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
-                         a->out);
-    return -1;
+    if (cli_constraints_any(&a->cons) && !a->mls)
+        return cli_usage(cmd, usage_line, "--constraint needs --method mls");
+    const char *inputs[] = {a->mesh, a->handles, a->fixed, a->cons.cad};
+    return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 4) ? CLI_EXIT_USAGE : -1;
 }
 
 /* F.csv: header `node`, one 0-based index per line; blank lines and CRLF accepted. */
@@ -243,8 +246,14 @@ int cli_cmd_deform(int argc, char **argv)
         o.stretch = a.stretch, o.bend = a.bend, o.fix = a.fix, o.samples = a.samples;
         o.keep_constrained = a.exact;
         cm_mls *mls = NULL;
-        s = cm_mls_create(ctx, mesh, con, &o, &mls);
-        if (s >= 0) s = cm_mls_apply(ctx, mls, disp, &residual);
+        cm_shape_set sets[CLI_MAX_CONSTRAINTS];
+        s = cli_constraints_resolve(ctx, mesh, &a.cons, sets);
+        if (s >= 0) s = cm_mls_create(ctx, mesh, con, &o, &mls);
+        if (s >= 0 && cli_constraints_any(&a.cons))
+            s = cli_constraints_run(ctx, mls, mesh, &a.cons, sets, disp, &residual);
+        else if (s >= 0)
+            s = cm_mls_apply(ctx, mls, disp, &residual);
+        cli_constraints_free(&a.cons, sets);
         cm_mls_stats st;
         cm_mls_get_stats(mls, &st);
         if (s >= 0)

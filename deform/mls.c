@@ -72,6 +72,16 @@ const double *cm_mls_samples(const cm_mls *mls, size_t *k)
     return mls ? mls->samples : NULL;
 }
 
+/* For the Shape-Up alternation (shapeup.c), which updates a copy of the factor. */
+void mls_view_get(cm_mls *m, mls_view *v)
+{
+    v->n_nodes = m->n_nodes, v->k = m->k;
+    v->row = m->row, v->col = m->col, v->val = m->val;
+    v->n_con = m->n_con, v->con = m->con, v->wf = m->wf, v->is_con = m->is_con;
+    v->keep_constrained = m->keep_constrained;
+    v->factor = m->factor;
+}
+
 /* Sample and cubature positions (section 5): farthest points of the dense surface and
  * volume points, a combined Lloyd relaxation that weights the surface higher; cubature
  * points by Lloyd from a random subset of the integration domain's points, their volume

@@ -63,4 +63,22 @@ cm_status mls_farthest(cm_context *ctx, const double *xyz, size_t n, size_t k, u
 cm_status mls_lloyd(cm_context *ctx, const double *xyz, const double *weight, size_t n,
                     int iterations, size_t k, double *centres, double *mass);
 
+/* What the Shape-Up alternation (shapeup.c) reads of a cm_mls: Phi at the nodes (CSR), the
+ * constrained nodes and their fix weights, and the CHOLMOD factor of eq. 14 (a
+ * cholmod_factor *, to be copied, never changed). */
+typedef struct mls_view {
+    size_t n_nodes, k;
+    const int64_t *row;
+    const int32_t *col;
+    const double *val;
+    size_t n_con;
+    const int64_t *con;
+    const double *wf;
+    const unsigned char *is_con;
+    int keep_constrained;
+    void *factor;
+} mls_view;
+
+void mls_view_get(cm_mls *m, mls_view *v);
+
 #endif
