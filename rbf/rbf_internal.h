@@ -100,6 +100,9 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc);
  * the restricted local solves. out is not projected onto the null space of P'. */
 void cm_rbf_schwarz_apply(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc, const double *in,
                           double *out, int threads);
+/* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
+ * at most m / 4). */
+size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);
 size_t cm_rbf_schwarz_bytes(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc);

@@ -29,12 +29,15 @@ typedef struct cm_rbf cm_rbf;
  *   kernel, m <= 60000.
  * ITERATIVE (3D r^3 only): restarted FGMRES in the null space of the polynomial block,
  *   right-preconditioned by two-level restricted additive Schwarz: kD-tree leaves of
- *   leaf_size/2..leaf_size centres, each grown to local_size centres and solved by the
- *   projected Cholesky of its own r^3 system, after a coarse solve on coarse_size
- *   farthest-point centres. Matvecs are direct sums with compensated accumulation (the
- *   preconditioned vectors cancel too much for plain sums; rbf_sum_acc.c). Memory about
- *   8 m local_size bytes (local_float: 4) plus the Krylov basis, 16 m restart bytes per
- *   component; time O(m local_size^2) to set up, O(m^2) per iteration.
+ *   leaf_size/2..leaf_size centres, each grown to local_size centres (more, up to
+ *   local_max, where centres within overlap x the coarse fill distance are left) and solved
+ *   by the projected Cholesky of its own r^3 system, after a coarse solve on coarse_size
+ *   farthest-point centres (grown as sqrt(m) above 2e4 centres). Matvecs are direct sums
+ *   with compensated accumulation (the preconditioned vectors cancel too much for plain
+ *   sums; rbf_sum_acc.c), the weights are accumulated in double-double. Memory about
+ *   8 m (mean subdomain size) bytes (local_float: 4) plus the coarse factor (8 coarse^2)
+ *   and the Krylov basis, 16 m restart bytes per component; time O(m local^2) to set up,
+ *   O(m^2) per iteration.
  * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
  *   crossover near 7,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
  *   iterative above; dense for the other kernels.
@@ -61,11 +64,26 @@ typedef struct cm_rbf_options {
     int local_size;       /* [1400] centres per overlapping subdomain (the leaf plus the
                            * centres nearest to its box): the overlap is the knob that
                            * matters on thin walls */
-    int coarse_size;      /* [2000] farthest-point centres of the coarse space, 0: none */
+    int coarse_size;      /* [2000] farthest-point centres of the coarse space (at m <= 2e4,
+                           * see coarse_grow), 0: none */
     int local_float;      /* [0] store the local inverse rows in float: half the memory
                            * (4 instead of 8 bytes x m x local_size), but the r^3 inverses
                            * cancel so heavily that float rounding costs iterations (bracket
                            * m = 21k: 15 instead of 9, bore 22.6k: 12 instead of 10) */
+    int coarse_post;      /* [0] order of the coarse correction: 0 before the local solves,
+                           * 1 before and after them (symmetric multiplicative), 2 after
+                           * them only */
+    double overlap;       /* [3] overlap measured in distance: a subdomain also takes every
+                           * centre within overlap x H of its leaf's box (H: the coarse
+                           * space's fill distance), up to local_max centres; 0: by count
+                           * only. Grows the subdomains where the nodes are dense (edges,
+                           * thin features): bracket 59k, first cycle 9-10 iterations
+                           * instead of 12-13 at 1,501 centres on average instead of 1,400 */
+    int local_max;        /* [2800] cap on a subdomain's centres for overlap > 0 */
+    int coarse_grow;      /* [1] coarse_size is the count at 2e4 centres; above, it grows as
+                           * sqrt(m) (coarse factor 8 coarse^2 bytes, O(m)): bracket 59k,
+                           * 5,000 coarse centres: 17 iterations instead of 21 */
+    int coarse_max;       /* [8000] cap on the coarse centres (0: none but m/4) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
