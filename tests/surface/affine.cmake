@@ -15,8 +15,3 @@ foreach(mode surface morph general)
   set_tests_properties(test_affine_${mode} PROPERTIES LABELS "unit;cad"
     FIXTURES_REQUIRED "affine_steps;surface_meshes")
 endforeach()
-# The whole morph of the GTransform pairs needs a correspondence that allows a change of
-# surface type (issue 18 section 1, cm_cad_compare in cad/model.cpp, another branch): until
-# it is merged, cm_cad_compare refuses these pairs ("face 0: plane in G, bspline in G'") and
-# the test stays disabled. Their surface morph is checked above (test_affine_surface).
-set_tests_properties(test_affine_general PROPERTIES DISABLED TRUE)
