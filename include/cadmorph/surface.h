@@ -2,7 +2,7 @@
  * model G (vertex | edge | face) and the CAD-aware surface morph G -> G' (paper section 4):
  * vertices go to the matching vertex, edge nodes keep their normalised arc length, face
  * nodes are moved in parameter space by a 2D thin-plate RBF fitted on the face's boundary
- * samples and evaluated on the matching face of G'.
+ * samples and evaluated on the matching face of G'; an affine edit is reproduced exactly.
  * Conventions: see core.h. Node indices are 0-based mesh node indices.
  */
 #ifndef CADMORPH_SURFACE_H
@@ -79,6 +79,12 @@ typedef struct cm_surface_morph_options {
      * bbox diagonal / 100. Defaults: 0, 8, 200. */
     double spacing;
     int min_per_edge, max_per_edge;
+    /* Affine edits (G' = A G + b) reproduced exactly: A, b are fitted on the vertices; when
+     * they reproduce every vertex within affine_tol x the bbox diagonal of G', each edge and
+     * face that they map onto G' (points spread over it land within that tolerance) sends
+     * its nodes to the images of their feet on G instead of equal arc length and the
+     * parameter warp. Default 1e-9; 0 turns it off. RBF method only. */
+    double affine_tol;
 } cm_surface_morph_options;
 
 CM_API void cm_surface_morph_options_init(cm_surface_morph_options *opt);
@@ -90,6 +96,11 @@ typedef struct cm_surface_morph_stats {
                                    they are put on the closest point of f'_k instead */
     int64_t worst_outside_node; /* mesh node, -1 if none */
     double worst_outside_dist;  /* how far f'_k(u',v') was from the trimmed face */
+    size_t edges_affine;        /* edges and faces (with nodes) moved as affine images */
+    size_t faces_affine;
+    int affine;                 /* 1 if the vertices moved by one affine map */
+    double affine_residual;     /* largest miss of that map at the vertices (INFINITY: no fit,
+                                   fewer than 4 or coplanar vertices) */
 } cm_surface_morph_stats;
 
 /* Morphs the classified nodes from G to G' (models that correspond: cm_cad_compare).
