@@ -132,6 +132,22 @@ int cli_parse_warp_method(const cli_parser *p, const cli_option *o, const char *
 }
 
 const char *const cli_kernel_names[] = {"triharmonic", "biharmonic", NULL};
-const char *const cli_solver_names[] = {"auto", "dense", "iterative", NULL};
-const int cli_solver_values[] = {CM_RBF_SOLVER_AUTO, CM_RBF_SOLVER_DENSE, CM_RBF_SOLVER_ITERATIVE};
+const char *const cli_solver_names[] = {"auto", "dense", "iterative", "petsc", NULL};
+const int cli_solver_values[] = {CM_RBF_SOLVER_AUTO, CM_RBF_SOLVER_DENSE, CM_RBF_SOLVER_ITERATIVE,
+                                 CM_RBF_SOLVER_PETSC};
+
+int cli_check_solver(const char *cmd, const char *usage, int solver)
+{
+    if (solver == CM_RBF_SOLVER_PETSC && !cm_rbf_petsc_available())
+        return cli_usage(cmd, usage, "--solver petsc: this cadmorph was built without PETSc "
+                         "(configure with -DCADMORPH_WITH_PETSC=ON)");
+    return -1;
+}
+
+int cli_output_rank(void)
+{
+    int rank;
+    cm_rbf_petsc_rank(&rank, NULL);
+    return rank == 0;
+}
 const int cli_kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};

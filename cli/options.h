@@ -71,6 +71,12 @@ extern const char *const cli_kernel_names[];
 /* --solver of the RBF warps: auto, dense, iterative (cm_rbf_solver). */
 extern const char *const cli_solver_names[];
 extern const int cli_solver_values[];
+/* -1 if the --solver value can run in this build, else the usage exit code after saying why
+ * (petsc without PETSc). */
+int cli_check_solver(const char *cmd, const char *usage, int solver);
+/* 1 on the rank that writes outputs and prints reports: rank 0 under mpirun with --solver
+ * petsc (the other ranks compute the same result), and always without MPI. */
+int cli_output_rank(void);
 extern const int cli_kernel_methods[];
 
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
