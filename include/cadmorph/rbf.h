@@ -89,7 +89,8 @@ typedef struct cm_rbf_stats {
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
     int matvecs;           /* last solve: direct-summation products with the m x m matrix
-                            * (one per iteration and restart, all components together) */
+                            * (one per iteration and restart, all components together;
+                            * PETSC: the components one after the other, each counted) */
     double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| over all components
                             * (exactness at the centres, by direct summation after the solve;
                             * iterative: with compensated sums) */
