@@ -36,6 +36,10 @@ int cli_make_dir(const char *cmd, const char *dir);
 
 /* Non-zero if the two paths name the same file (an existing output that is an input). */
 int cli_same_file(const char *a, const char *b);
+/* The checks of a mesh output before any work: a known mesh format, and none of the n inputs
+ * (NULL entries skipped). 0, or CLI_EXIT_USAGE after a usage message. */
+int cli_check_mesh_output(const char *cmd, const char *usage, const char *out,
+                          const char *const *inputs, size_t n);
 
 /* Argument helpers: the value after an option, or NULL (and a usage message) if missing. */
 const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char *usage);

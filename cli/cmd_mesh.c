@@ -85,10 +85,7 @@ int cli_cmd_mesh(int argc, char **argv)
     if (force) opt.max_tets = INFINITY;
     if (!in) return cli_usage(cmd, usage, "missing G.step");
     if (!out) return cli_usage(cmd, usage, "missing -o MESH");
-    if (cm_mesh_format_from_path(out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage, "%s: unknown mesh format (.msh, .vtu, .vtk, .mesh)", out);
-    if (cli_same_file(out, in))
-        return cli_usage(cmd, usage, "output %s is the input: refusing to overwrite it", out);
+    if (cli_check_mesh_output(cmd, usage, out, &in, 1)) return CLI_EXIT_USAGE;
 
     cm_context *ctx = cli_context_create(cmd, verbose, threads);
     if (!ctx) return CLI_EXIT_INTERNAL;

@@ -100,13 +100,8 @@ static int parse_args(int argc, char **argv, warp_args *a)
     if (!a->csv) return cli_usage(cmd, usage_line, "--displacements is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
     if (cli_check_solver(cmd, usage_line, a->solver) >= 0) return CLI_EXIT_USAGE;
-    if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
-                         a->out);
-    if (cli_same_file(a->out, a->mesh) || cli_same_file(a->out, a->csv))
-        return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
-                         a->out);
-    return -1;
+    const char *inputs[] = {a->mesh, a->csv};
+    return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 2) ? CLI_EXIT_USAGE : -1;
 }
 
 int cli_cmd_warp(int argc, char **argv)

@@ -150,6 +150,18 @@ int cli_same_file(const char *a, const char *b)
     return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
+int cli_check_mesh_output(const char *cmd, const char *usage, const char *out,
+                          const char *const *inputs, size_t n)
+{
+    if (cm_mesh_format_from_path(out) == CM_FORMAT_UNKNOWN)
+        return cli_usage(cmd, usage, "%s: unknown mesh extension (%s)", out,
+                         cm_mesh_format_list());
+    for (size_t k = 0; k < n; ++k)
+        if (inputs[k] && cli_same_file(out, inputs[k]))
+            return cli_usage(cmd, usage, "output %s is an input: refusing to overwrite it", out);
+    return 0;
+}
+
 int cli_threads_value(int argc, char **argv, int *i, const char *cmd, const char *usage,
                       int *threads)
 {

@@ -3,6 +3,7 @@
 
 #include "cli.h"
 
+#include "cadmorph/study.h"
 #include "cadmorph/warp.h"
 
 #include <errno.h>
@@ -151,3 +152,5 @@ int cli_output_rank(void)
     return rank == 0;
 }
 const int cli_kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};
+const char *const cli_study_mode_names[] = {"absolute", "relative", "both", NULL};
+const int cli_study_mode_values[] = {CM_STUDY_ABSOLUTE, CM_STUDY_RELATIVE, CM_STUDY_BOTH};

@@ -78,6 +78,9 @@ int cli_check_solver(const char *cmd, const char *usage, int solver);
  * petsc (the other ranks compute the same result), and always without MPI. */
 int cli_output_rank(void);
 extern const int cli_kernel_methods[];
+/* --mode of study and sweep: absolute, relative, both (CM_STUDY_*). */
+extern const char *const cli_study_mode_names[];
+extern const int cli_study_mode_values[];
 
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
  * --help, CLI_EXIT_USAGE after a message on stderr. */
