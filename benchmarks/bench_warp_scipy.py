@@ -15,7 +15,8 @@ the moved nodes to scipy's divided by the range of the displacement data.
 
 usage: bench_warp_scipy.py CADMORPH MESH.vtu MORPHED.vtu WORKDIR [SOLVER ...]
        (SOLVER: auto dense iterative; default auto. The scipy child is this file with
-       --scipy.)"""
+       --scipy.)
+       bench_warp_scipy.py --csv MESH.vtu MORPHED.vtu D.csv   (only the displacement table)"""
 import os
 import resource
 import subprocess
@@ -76,24 +77,32 @@ def run(cmd, env):
     return wall, cpu, r1.ru_maxrss / 1024.0, ",".join(core) or "?", p
 
 
+def write_csv(mesh_path, morphed_path, csv):
+    """D.csv: the boundary nodes of MESH with the displacement the morph gave them."""
+    import meshio
+    mesh = meshio.read(mesh_path)
+    disp = np.asarray(meshio.read(morphed_path).point_data["displacement"])
+    b = boundary_nodes(mesh.cells_dict["tetra"])
+    with open(csv, "w") as f:
+        f.write("node,dx,dy,dz\n")
+        for i in b:
+            f.write(f"{i},{disp[i, 0]:.17g},{disp[i, 1]:.17g},{disp[i, 2]:.17g}\n")
+    return mesh, b, disp[b].max() - disp[b].min()
+
+
 def main():
     if sys.argv[1] == "--scipy":
         scipy_child(*sys.argv[2:5])
+        return
+    if sys.argv[1] == "--csv":
+        write_csv(*sys.argv[2:5])
         return
     import meshio
     cadmorph, mesh_path, morphed_path, work = sys.argv[1:5]
     solvers = sys.argv[5:] or ["auto"]
     os.makedirs(work, exist_ok=True)
-    mesh = meshio.read(mesh_path)
-    morphed = meshio.read(morphed_path)
-    disp = np.asarray(morphed.point_data["displacement"])
-    b = boundary_nodes(mesh.cells_dict["tetra"])
     csv = os.path.join(work, "boundary_disp.csv")
-    with open(csv, "w") as f:
-        f.write("node,dx,dy,dz\n")
-        for i in b:
-            f.write(f"{i},{disp[i, 0]:.17g},{disp[i, 1]:.17g},{disp[i, 2]:.17g}\n")
-    rng = disp[b].max() - disp[b].min()
+    mesh, b, rng = write_csv(mesh_path, morphed_path, csv)
     env = dict(os.environ, OPENBLAS_VERBOSE="2")
     print(f"# {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())} nproc={os.cpu_count()} "
           f"OPENBLAS_CORETYPE={os.environ.get('OPENBLAS_CORETYPE', '-')} "
