@@ -79,7 +79,7 @@ CM_API void cm_rbf_options_init(cm_rbf_options *opt);
 
 /* Figures of the last create and solve (cm_rbf_stats). */
 typedef struct cm_rbf_stats {
-    cm_rbf_solver solver;  /* the one used: DENSE or ITERATIVE */
+    cm_rbf_solver solver;  /* the one used: DENSE, ITERATIVE or PETSC */
     size_t centres;        /* after merging duplicates */
     int subdomains;        /* iterative: Schwarz subdomains; 0 for dense */
     int coarse_size;       /* iterative: coarse centres */
