@@ -145,6 +145,24 @@ int cli_check_solver(const char *cmd, const char *usage, int solver)
     return -1;
 }
 
+int cli_mpi_ranks(cm_context *ctx, const char *cmd, int *rank, int *ranks)
+{
+    *rank = 0;
+    *ranks = 1;
+    const char *v = getenv("OMPI_COMM_WORLD_SIZE");
+    if (!v) v = getenv("PMI_SIZE");
+    if (!v || atoi(v) <= 1) return 0;
+    if (!cm_rbf_petsc_available()) {
+        fprintf(stderr, "cadmorph %s: started by mpirun with %s ranks, but this cadmorph was "
+                "built without PETSc/MPI (configure with -DCADMORPH_WITH_PETSC=ON)\n", cmd, v);
+        return CLI_EXIT_USAGE;
+    }
+    cm_status s = cm_rbf_petsc_initialize(ctx);
+    if (s < 0) return cli_fail(ctx, cmd, s);
+    cm_rbf_petsc_rank(rank, ranks);
+    return 0;
+}
+
 int cli_output_rank(void)
 {
     int rank;

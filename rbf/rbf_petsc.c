@@ -111,6 +111,58 @@ void cm_rbf_petsc_finalize(void)
     g_initialised_here = 0;
 }
 
+cm_status cm_rbf_petsc_allgather(cm_context *ctx, const void *mine, size_t n, size_t size,
+                                 void **all, size_t *n_all)
+{
+    int rank, ranks;
+    cm_rbf_petsc_rank(&rank, &ranks);
+    *all = NULL;
+    *n_all = 0;
+    long long my = (long long)n, *cnt = malloc((size_t)ranks * sizeof *cnt);
+    int *bytes = malloc(2 * (size_t)ranks * sizeof *bytes);
+    cm_status st = CM_OK;
+    if (!cnt || !bytes) {
+        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_petsc_allgather: out of memory");
+        goto done;
+    }
+    /* a rank out of memory still takes part, or the others would wait for it forever */
+    if (ranks > 1 &&
+        MPI_Allgather(&my, 1, MPI_LONG_LONG, cnt, 1, MPI_LONG_LONG, PETSC_COMM_WORLD) != MPI_SUCCESS) {
+        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_petsc_allgather: MPI_Allgather failed");
+        goto done;
+    }
+    if (ranks == 1) cnt[0] = my;
+    size_t total = 0;
+    for (int q = 0; q < ranks; ++q) {
+        if ((double)total * (double)size + (double)cnt[q] * (double)size > 2e9) {
+            st = cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_rbf_petsc_allgather: more than 2 GB");
+            goto done;
+        }
+        bytes[q] = (int)((size_t)cnt[q] * size);
+        bytes[ranks + q] = (int)(total * size);
+        total += (size_t)cnt[q];
+    }
+    *all = malloc(total * size > 0 ? total * size : 1);
+    if (!*all) {
+        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_petsc_allgather: out of memory");
+        goto done;
+    }
+    if (ranks == 1) {
+        if (n) memcpy(*all, mine, n * size);
+    } else if (MPI_Allgatherv(mine, bytes[rank], MPI_BYTE, *all, bytes, bytes + ranks, MPI_BYTE,
+                              PETSC_COMM_WORLD) != MPI_SUCCESS) {
+        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_petsc_allgather: MPI_Allgatherv failed");
+        free(*all);
+        *all = NULL;
+        goto done;
+    }
+    *n_all = total;
+done:
+    free(cnt);
+    free(bytes);
+    return st;
+}
+
 /* v -= Q1 (Q1' v) on every component, twice, as project() in rbf_iterative.c. */
 static PetscErrorCode project(cm_rbf_petsc *ps, Vec v)
 {

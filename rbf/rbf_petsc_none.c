@@ -2,6 +2,9 @@
  * asking for it is a clear error, the rest of the API is inert. */
 #include "rbf_internal.h"
 
+#include <stdlib.h>
+#include <string.h>
+
 int cm_rbf_petsc_available(void) { return 0; }
 
 cm_status cm_rbf_petsc_initialize(cm_context *ctx)
@@ -18,6 +21,17 @@ void cm_rbf_petsc_rank(int *rank, int *size)
 }
 
 void cm_rbf_petsc_finalize(void) {}
+
+cm_status cm_rbf_petsc_allgather(cm_context *ctx, const void *mine, size_t n, size_t size,
+                                 void **all, size_t *n_all)
+{
+    *all = malloc(n * size > 0 ? n * size : 1);
+    *n_all = 0;
+    if (!*all) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_petsc_allgather: out of memory");
+    if (n) memcpy(*all, mine, n * size);
+    *n_all = n;
+    return CM_OK;
+}
 
 cm_status cm_rbf_petsc_setup(cm_context *ctx, cm_rbf *r, int threads)
 {

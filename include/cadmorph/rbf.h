@@ -152,6 +152,11 @@ CM_API void cm_rbf_petsc_rank(int *rank, int *size);
 /* Finalises PETSc (and MPI) if cm_rbf_petsc_initialize initialised it; collective, call it
  * once before the program ends, after destroying every PETSC-solver cm_rbf. */
 CM_API void cm_rbf_petsc_finalize(void);
+/* Every rank's n records of `size` bytes (mine) to every rank: *all (malloc'd, free() it)
+ * gets them in rank order, *n_all their count; collective. On one rank, or without PETSc, a
+ * copy of mine. Plain-data records only (a study's rows: cm_study_run with ranks > 1). */
+CM_API cm_status cm_rbf_petsc_allgather(cm_context *ctx, const void *mine, size_t n, size_t size,
+                                        void **all, size_t *n_all);
 
 #ifdef __cplusplus
 }
