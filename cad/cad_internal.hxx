@@ -38,6 +38,11 @@ struct cm_cad_model {
     std::vector<int> wire_offset;              // #wires + 1 into wire_edge / wire_rev
     std::vector<int> wire_edge, wire_rev;      // oriented edges of all wires
     std::vector<int> edge_face_offset, edge_face;  // edge -> adjacent faces
+    // For the correspondence of G and G' (correspond.cpp): a point of each entity (face centre
+    // of mass, edge mid-parameter point) and the shell of each face, the solid of each shell
+    // (-1 if none).
+    std::vector<double> face_center, edge_mid;     // #faces x 3, #edges x 3
+    std::vector<int> face_shell, shell_solid;
 
     TopoDS_Face face(int i) const { return TopoDS::Face(faces(i + 1)); }
     TopoDS_Edge edge(int i) const { return TopoDS::Edge(edges(i + 1)); }

@@ -127,13 +127,18 @@ cm_status cm_cad_edge_t_to_s(cm_context *ctx, const cm_cad_model *model, int edg
     if (n && (!t || !s)) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL t or s", fn);
     const cm_cad_edge_info &ei = model->edge_info[edge];
     const double t1 = ei.t_range[0], t2 = ei.t_range[1];
+    // a flipped edge (cm_cad_match) measures s in its counterpart's direction
+    const bool flip = ei.flipped;
     if (ei.degenerate || !(ei.length > 0)) {
-        for (size_t i = 0; i < n; ++i)
+        for (size_t i = 0; i < n; ++i) {
             s[i] = std::min(std::max((t[i] - t1) / (t2 - t1), 0.0), 1.0);
+            if (flip) s[i] = 1.0 - s[i];
+        }
         return CM_OK;
     }
     return parallel_over(ctx, fn, model, n, [&](cmcad::adaptors &a, size_t i) {
         s[i] = std::min(std::max(length_to(a.curve(edge), t[i]) / ei.length, 0.0), 1.0);
+        if (flip) s[i] = 1.0 - s[i];
     });
 }
 
@@ -146,12 +151,14 @@ cm_status cm_cad_edge_s_to_t(cm_context *ctx, const cm_cad_model *model, int edg
     if (n && (!t || !s)) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL t or s", fn);
     const cm_cad_edge_info &ei = model->edge_info[edge];
     const double t1 = ei.t_range[0], t2 = ei.t_range[1];
+    const bool flip = ei.flipped;
     if (ei.degenerate || !(ei.length > 0)) {
-        for (size_t i = 0; i < n; ++i) t[i] = t1 + std::min(std::max(s[i], 0.0), 1.0) * (t2 - t1);
+        for (size_t i = 0; i < n; ++i)
+            t[i] = t1 + std::min(std::max(flip ? 1.0 - s[i] : s[i], 0.0), 1.0) * (t2 - t1);
         return CM_OK;
     }
     return parallel_over(ctx, fn, model, n, [&](cmcad::adaptors &a, size_t i) {
-        t[i] = param_at(a.curve(edge), s[i], ei.length);
+        t[i] = param_at(a.curve(edge), flip ? 1.0 - s[i] : s[i], ei.length);
     });
 }
 
@@ -226,7 +233,7 @@ cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model, int f
                     gp_Pnt2d q = pc->Value(t);
                     b->uv[2 * j] = q.X(), b->uv[2 * j + 1] = q.Y();
                     b->xyz[3 * j] = p.X(), b->xyz[3 * j + 1] = p.Y(), b->xyz[3 * j + 2] = p.Z();
-                    b->edge[j] = e, b->s[j] = s, b->wire[j] = w - w0;
+                    b->edge[j] = e, b->s[j] = ei.flipped ? 1.0 - s : s, b->wire[j] = w - w0;
                 }
             }
         }

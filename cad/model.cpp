@@ -140,6 +140,18 @@ void index_topology(cm_cad_model *m)
     TopExp::MapShapes(m->shape, TopAbs_SHELL, shells);
     m->counts.solids = solids.Extent();
     m->counts.shells = shells.Extent();
+    m->shell_solid.assign(shells.Extent(), -1);
+    for (int s = 1; s <= solids.Extent(); ++s)
+        for (TopExp_Explorer x(solids(s), TopAbs_SHELL); x.More(); x.Next()) {
+            int k = shells.FindIndex(x.Current());
+            if (k > 0 && m->shell_solid[k - 1] < 0) m->shell_solid[k - 1] = s - 1;
+        }
+    m->face_shell.assign(m->faces.Extent(), -1);
+    for (int s = 1; s <= shells.Extent(); ++s)
+        for (TopExp_Explorer x(shells(s), TopAbs_FACE); x.More(); x.Next()) {
+            int k = m->faces.FindIndex(x.Current());
+            if (k > 0 && m->face_shell[k - 1] < 0) m->face_shell[k - 1] = s - 1;
+        }
     m->counts.faces = m->faces.Extent();
     m->counts.edges = m->edges.Extent();
     m->counts.vertices = m->vertices.Extent();
@@ -164,13 +176,17 @@ void index_topology(cm_cad_model *m)
         info.closed = !v1.IsNull() && v1.IsSame(v2);
         info.degenerate = BRep_Tool::Degenerated(e);
         info.type = CM_CAD_OTHER_CURVE;
+        gp_Pnt mid;
+        if (!v1.IsNull()) mid = BRep_Tool::Pnt(v1);
         if (!info.degenerate && BRep_Tool::IsGeometric(e)) {
             BRepAdaptor_Curve c(e);
             info.type = curve_type(c.GetType());
             info.length = GCPnts_AbscissaPoint::Length(c);
+            mid = c.Value(0.5 * (info.t_range[0] + info.t_range[1]));
         } else {
             info.degenerate = 1;
         }
+        m->edge_mid.insert(m->edge_mid.end(), {mid.X(), mid.Y(), mid.Z()});
         Bnd_Box b;
         BRepBndLib::AddOptimal(e, b, false, false);
         box_to(b, info.bbox);
@@ -205,6 +221,17 @@ void index_topology(cm_cad_model *m)
         GProp_GProps props;
         BRepGProp::SurfaceProperties(f, props);
         info.area = props.Mass();
+        gp_Pnt c = info.area > 0 ? props.CentreOfMass() : gp_Pnt();
+        if (!(info.area > 0)) {
+            Bnd_Box fb;
+            BRepBndLib::Add(f, fb, false);
+            if (!fb.IsVoid()) {
+                double x0, y0, z0, x1, y1, z1;
+                fb.Get(x0, y0, z0, x1, y1, z1);
+                c.SetCoord(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1));
+            }
+        }
+        m->face_center.insert(m->face_center.end(), {c.X(), c.Y(), c.Z()});
         Bnd_Box b;
         BRepBndLib::AddOptimal(f, b, false, false);
         box_to(b, info.bbox);
@@ -254,14 +281,6 @@ void index_topology(cm_cad_model *m)
 const char *what_error(int err) { return strerror(err); }
 
 }  // namespace
-
-/* A circle is an ellipse with equal axes: tilting a cylindrical bore turns its circular rims
- * into ellipses while the topology stays the same, so the two types correspond. */
-static bool same_curve_family(cm_cad_curve_type a, cm_cad_curve_type b)
-{
-    auto conic = [](cm_cad_curve_type t) { return t == CM_CAD_CIRCLE || t == CM_CAD_ELLIPSE; };
-    return a == b || (conic(a) && conic(b));
-}
 
 extern "C" {
 
@@ -478,110 +497,6 @@ cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge
     if (faces) *faces = model->edge_face.data() + b;
     if (n) *n = e - b;
     return CM_OK;
-}
-
-cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
-                         int max_report)
-{
-    if (!g || !g2) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_cad_compare: NULL model");
-    if (max_report < 1) max_report = 1;
-    return cmcad::guard(ctx, "cm_cad_compare", [&]() -> cm_status {
-        std::vector<std::string> diff;
-        size_t total = 0;
-        char line[256];
-        auto add = [&](const char *s) {
-            if ((int)diff.size() < max_report) diff.push_back(s);
-            ++total;
-        };
-        const cm_cad_counts &a = g->counts, &b = g2->counts;
-        const struct {
-            const char *name;
-            int x, y;
-        } counts[] = {{"solids", a.solids, b.solids}, {"shells", a.shells, b.shells},
-                      {"faces", a.faces, b.faces},    {"wires", a.wires, b.wires},
-                      {"edges", a.edges, b.edges},    {"vertices", a.vertices, b.vertices}};
-        for (const auto &c : counts)
-            if (c.x != c.y) {
-                snprintf(line, sizeof line, "%s: %d in G, %d in G'", c.name, c.x, c.y);
-                add(line);
-            }
-        int nf = std::min(a.faces, b.faces), ne = std::min(a.edges, b.edges);
-        for (int i = 0; i < nf; ++i) {
-            const cm_cad_face_info &p = g->face_info[i], &q = g2->face_info[i];
-            if (p.type != q.type) {
-                snprintf(line, sizeof line, "face %d: %s in G, %s in G'", i,
-                         cm_cad_surface_type_name(p.type), cm_cad_surface_type_name(q.type));
-                add(line);
-                continue;
-            }
-            if (p.n_wires != q.n_wires) {
-                snprintf(line, sizeof line, "face %d: %d wires in G, %d in G'", i, p.n_wires,
-                         q.n_wires);
-                add(line);
-                continue;
-            }
-            for (int w = 0; w < p.n_wires; ++w) {
-                int wa = g->face_wire_offset[i] + w, wb = g2->face_wire_offset[i] + w;
-                int ba = g->wire_offset[wa], ea = g->wire_offset[wa + 1];
-                int bb = g2->wire_offset[wb], eb = g2->wire_offset[wb + 1];
-                bool same = ea - ba == eb - bb;
-                for (int k = 0; same && k < ea - ba; ++k)
-                    same = g->wire_edge[ba + k] == g2->wire_edge[bb + k] &&
-                           g->wire_rev[ba + k] == g2->wire_rev[bb + k];
-                if (!same) {
-                    snprintf(line, sizeof line,
-                             "face %d wire %d: %d edges starting %s%d in G, %d starting %s%d in G'",
-                             i, w, ea - ba, ea > ba && g->wire_rev[ba] ? "-" : "",
-                             ea > ba ? g->wire_edge[ba] : -1, eb - bb,
-                             eb > bb && g2->wire_rev[bb] ? "-" : "",
-                             eb > bb ? g2->wire_edge[bb] : -1);
-                    add(line);
-                    break;
-                }
-            }
-        }
-        for (int i = 0; i < ne; ++i) {
-            const cm_cad_edge_info &p = g->edge_info[i], &q = g2->edge_info[i];
-            if (!same_curve_family(p.type, q.type) || p.degenerate != q.degenerate) {
-                snprintf(line, sizeof line, "edge %d: %s in G, %s in G'", i,
-                         p.degenerate ? "degenerate" : cm_cad_curve_type_name(p.type),
-                         q.degenerate ? "degenerate" : cm_cad_curve_type_name(q.type));
-                add(line);
-            } else if (p.vertex[0] != q.vertex[0] || p.vertex[1] != q.vertex[1]) {
-                snprintf(line, sizeof line, "edge %d: vertices (%d,%d) in G, (%d,%d) in G'", i,
-                         p.vertex[0], p.vertex[1], q.vertex[0], q.vertex[1]);
-                add(line);
-            }
-        }
-        if (total == 0) {
-            // Same topology but another scale: a file in mm against the same numbers declared
-            // in m morphs to a x1000 result. Orders of magnitude are an error, another unit
-            // name alone (converted to the same unit) a warning.
-            auto diag = [](const double *b) {
-                return std::sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
-                                 (b[5] - b[2]) * (b[5] - b[2]));
-            };
-            const double d1 = diag(g->bbox), d2 = diag(g2->bbox);
-            const double ratio = d1 > 0 && d2 > 0 ? std::max(d1 / d2, d2 / d1) : 1.0;
-            const bool units_differ = g->file_unit != g2->file_unit;
-            if (ratio >= 100)
-                return cm_error(ctx, CM_ERR_MISMATCH,
-                                "%s and %s: G and G' differ in size by %.3gx (bounding-box diagonals %g and %g "
-                                "%s; file units %s and %s): check the units of the STEP files",
-                                g->path.c_str(), g2->path.c_str(), ratio, d1, d2, g->unit.c_str(), g->file_unit.c_str(),
-                                g2->file_unit.c_str());
-            if (units_differ)
-                cm_log(ctx, CM_LOG_WARNING,
-                       "G is in %s, G' in %s (both read as %s): check that this is intended",
-                       g->file_unit.c_str(), g2->file_unit.c_str(), g->unit.c_str());
-            return CM_OK;
-        }
-        std::string msg = "topology of G and G' differs (" + std::to_string(total) +
-                          (total == 1 ? " difference): " : " differences): ");
-        for (size_t i = 0; i < diff.size(); ++i) msg += (i ? "; " : "") + diff[i];
-        if (total > diff.size()) msg += "; ...";
-        return cm_error(ctx, CM_ERR_MISMATCH, "%s", msg.c_str());
-    });
 }
 
 }  // extern "C"

@@ -1,6 +1,6 @@
 /* `cadmorph info`: the topology summary of a STEP file (faces, edges, vertices, types, sizes)
- * and, with --compare, the verdict on whether a second file corresponds to it (same topology
- * in the same order, DESIGN.md: G and G'). */
+ * and, with --compare, the verdict on whether a second file corresponds to it (the same
+ * topology as a graph, in any numbering, DESIGN.md: G and G') and the correspondence found. */
 #include "cli.h"
 #include "options.h"
 
@@ -10,19 +10,27 @@
 #include <string.h>
 
 static const char *const usage_line =
-    "cadmorph info G.step [--compare G2.step] [--cad-unit mm|cm|m|in|ft|...] [--faces] [--edges]";
+    "cadmorph info G.step [--compare G2.step [--map OUT.csv]] [--cad-unit mm|cm|m|in|ft|...] "
+    "[--faces] [--edges] [--verbose]";
 
-static const char *other;
+static const char *other, *map_path;
 static cm_cad_read_options opt;
-static int faces, edges;
+static int faces, edges, verbose;
 
 static int print_help(void);
 
 static const cli_option options[] = {
     {.name = "--help", .alias = "-h", .kind = CLI_HELP},
     {.name = "--compare", .kind = CLI_STRING, .dest = &other, .label = "--compare G2.step",
-     .help = "check that G2 corresponds to G (same counts, surface and curve\n"
-             "types, face-edge-vertex incidence); lists the first differences"},
+     .help = "check that G2 corresponds to G (the same solids, shells, faces,\n"
+             "wires, edges, vertices and incidences in any numbering; surface\n"
+             "and curve types may change); prints the correspondence, or the\n"
+             "first differences"},
+    {.name = "--map", .kind = CLI_STRING, .dest = &map_path, .label = "--map OUT.csv",
+     .help = "with --compare: the correspondence as CSV (kind,index_in_G,\n"
+             "index_in_G',orientation,type_G,type_G')"},
+    {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &verbose,
+     .label = "--verbose", .help = "debug messages on stderr (type changes, renumbering)"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &opt.unit, .label = "--cad-unit U",
      .help = "length unit of the coordinates (default mm): mm cm m km in ft mi um"},
     {.name = "--faces", .kind = CLI_FLAG, .dest = &faces, .label = "--faces",
@@ -40,6 +48,8 @@ static int print_help(void)
            "options:\n");
     cli_print_options(stdout, options, 20);
     printf("\nexit codes: 0 done (and G2 corresponds), 1 usage, 2 bad input or G2 differs.\n");
+    printf("With --compare, the correspondence: faces, edges and vertices of G2 numbered otherwise\n"
+           "and edges that run the other way (cadmorph morph renumbers G2 the same way).\n");
     return CLI_EXIT_OK;
 }
 
@@ -106,6 +116,68 @@ static void print_model(const char *path, const cm_cad_model *m, int faces, int 
         }
 }
 
+static const char *edge_type(const cm_cad_model *m, int e)
+{
+    cm_cad_edge_info ei;
+    if (cm_cad_edge_get_info(NULL, m, e, &ei) != CM_OK) return "?";
+    return ei.degenerate ? "degenerate" : cm_cad_curve_type_name(ei.type);
+}
+
+static const char *face_type(const cm_cad_model *m, int f)
+{
+    cm_cad_face_info fi;
+    if (cm_cad_face_get_info(NULL, m, f, &fi) != CM_OK) return "?";
+    return cm_cad_surface_type_name(fi.type);
+}
+
+/* The summary of the correspondence on stdout: what is renumbered, flipped, of another type. */
+static void print_correspondence(const cm_cad_model *g, const cm_cad_model *g2,
+                                 const cm_cad_correspondence *c)
+{
+    int fmoved = 0, emoved = 0, eflip = 0, vmoved = 0, frev = 0;
+    for (int f = 0; f < c->counts.faces; ++f) fmoved += c->face[f] != f, frev += c->face_reversed[f];
+    for (int e = 0; e < c->counts.edges; ++e) emoved += c->edge[e] != e, eflip += c->edge_flipped[e];
+    for (int v = 0; v < c->counts.vertices; ++v) vmoved += c->vertex[v] != v;
+    printf("correspondence: %d of %d faces, %d of %d edges, %d of %d vertices numbered otherwise "
+           "in G'; %d edges run the other way, %d faces have the opposite surface normal\n",
+           fmoved, c->counts.faces, emoved, c->counts.edges, vmoved, c->counts.vertices, eflip,
+           frev);
+    printf("type changes: %d faces, %d edges\n", c->face_type_changes, c->edge_type_changes);
+    int shown = 0;
+    for (int f = 0; f < c->counts.faces && shown < 20; ++f)
+        if (c->face[f] != f || strcmp(face_type(g, f), face_type(g2, c->face[f]))) {
+            printf("  face %d -> %d (%s -> %s)\n", f, c->face[f], face_type(g, f),
+                   face_type(g2, c->face[f]));
+            ++shown;
+        }
+    for (int e = 0; e < c->counts.edges && shown < 40; ++e)
+        if (c->edge[e] != e || c->edge_flipped[e] || strcmp(edge_type(g, e), edge_type(g2, c->edge[e]))) {
+            printf("  edge %d -> %s%d (%s -> %s)\n", e, c->edge_flipped[e] ? "-" : "", c->edge[e],
+                   edge_type(g, e), edge_type(g2, c->edge[e]));
+            ++shown;
+        }
+    if (shown >= 20) printf("  ... (--map OUT.csv lists all)\n");
+}
+
+static cm_status write_map(cm_context *ctx, const char *path, const cm_cad_model *g,
+                           const cm_cad_model *g2, const cm_cad_correspondence *c)
+{
+    cm_outfile out;
+    cm_status s = cm_outfile_open(ctx, path, &out);
+    if (s != CM_OK) return s;
+    fprintf(out.f, "kind,index_in_G,index_in_G',orientation,type_G,type_G'\n");
+    for (int f = 0; f < c->counts.faces; ++f)
+        fprintf(out.f, "face,%d,%d,%s,%s,%s\n", f, c->face[f],
+                c->face_reversed[f] ? "reversed" : "same", face_type(g, f),
+                face_type(g2, c->face[f]));
+    for (int e = 0; e < c->counts.edges; ++e)
+        fprintf(out.f, "edge,%d,%d,%s,%s,%s\n", e, c->edge[e],
+                c->edge_flipped[e] ? "reversed" : "same", edge_type(g, e), edge_type(g2, c->edge[e]));
+    for (int v = 0; v < c->counts.vertices; ++v)
+        fprintf(out.f, "vertex,%d,%d,same,vertex,vertex\n", v, c->vertex[v]);
+    return cm_outfile_commit(ctx, &out);
+}
+
 int cli_cmd_info(int argc, char **argv)
 {
     static const char *cmd = "info";
@@ -117,10 +189,14 @@ int cli_cmd_info(int argc, char **argv)
     const int parsed = cli_parse(&p, argc, argv);
     if (parsed >= 0) return parsed;
     if (!path) return cli_usage(cmd, usage_line, "no STEP file given");
+    if (map_path && !other) return cli_usage(cmd, usage_line, "--map needs --compare G2.step");
+    if (map_path && (cli_same_file(map_path, path) || cli_same_file(map_path, other)))
+        return cli_usage(cmd, usage_line, "--map %s would overwrite an input", map_path);
 
-    cm_context *ctx = cli_context_create("info", 0, 0);
+    cm_context *ctx = cli_context_create("info", verbose, 0);
     if (!ctx) return CLI_EXIT_INTERNAL;
     cm_cad_model *g = NULL, *g2 = NULL;
+    cm_cad_correspondence *corr = NULL;
     int rc = CLI_EXIT_OK;
     cm_status st = cm_cad_read(ctx, path, &opt, &g);
     if (st == CM_ERR_ARGUMENT) {
@@ -137,20 +213,29 @@ int cli_cmd_info(int argc, char **argv)
             rc = cli_fail(ctx, cmd, st);
             goto done;
         }
-        st = cm_cad_compare(ctx, g, g2, 5);
+        st = cm_cad_correspond(ctx, g, g2, 5, &corr);
         if (st < 0) {
             rc = cli_fail(ctx, cmd, st);
             goto done;
+        }
+        if (map_path) {
+            st = write_map(ctx, map_path, g, g2, corr);
+            if (st < 0) {
+                rc = cli_fail(ctx, cmd, st);
+                goto done;
+            }
         }
     }
     print_model(path, g, faces, edges);
     if (g2) {
         cm_cad_counts c;
         cm_cad_get_counts(g, &c);
-        printf("%s corresponds to %s: %d faces, %d edges, %d vertices in the same order\n", other,
-               path, c.faces, c.edges, c.vertices);
+        printf("%s corresponds to %s: %d faces, %d edges, %d vertices%s\n", other, path, c.faces,
+               c.edges, c.vertices, corr->renumbered ? " (numbered otherwise)" : " in the same order");
+        print_correspondence(g, g2, corr);
     }
 done:
+    cm_cad_correspondence_destroy(&corr);
     cm_cad_destroy(&g);
     cm_cad_destroy(&g2);
     cm_context_destroy(&ctx);

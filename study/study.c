@@ -212,7 +212,7 @@ static cm_status run_variant(cm_context *ctx, study *w, size_t i, cm_cad_model *
     if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "study: %s: %s", label, cm_context_message(ctx));
     /* checked here, before any morpher sees g: a variant of another topology touches none */
     if (s >= 0) {
-        s = cm_cad_compare(ctx, w->g0, g, 5);
+        s = cm_cad_match(ctx, w->g0, g, 5, NULL); /* renumbers the variant like G0 */
         if (s < 0) s = cm_error_prefix(ctx, s, "not a variant of G0");
     }
     double t_load = cm_wtime() - t0;

@@ -81,7 +81,7 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
     for (size_t i = 0; i < n_geom && s >= 0; ++i) {
         s = cm_cad_read(ctx, path[i], &ro, &g[i]);
         if (s >= 0 && i > 0) {
-            s = cm_cad_compare(ctx, g[i - 1], g[i], 5);
+            s = cm_cad_match(ctx, g[i - 1], g[i], 5, NULL); /* renumbers G' like G */
             if (s < 0)
                 s = cm_error_prefix(ctx, s, "%s and %s do not correspond", path[i - 1], path[i]);
         }

@@ -1,8 +1,11 @@
 /* cadmorph cad: STEP models through OpenCASCADE — topology, correspondence of G and G',
  * evaluation, trimmed dense sampling with a kD-tree, projection (paper section 4).
  * Conventions: see core.h. Faces, edges and vertices are numbered once per model, 0-based,
- * in OpenCASCADE's TopExp::MapShapes order; a model re-exported after a dimension change
- * keeps that order, which is what cm_cad_compare verifies.
+ * in OpenCASCADE's TopExp::MapShapes order. G' may number its entities otherwise (a re-export
+ * reorders faces and edges, renumbers the edges of seamed wires, reverses edges):
+ * cm_cad_match finds the correspondence of the topologies as graphs and renumbers G' so that
+ * entity i of G' is the counterpart of entity i of G; everything downstream indexes G' by G's
+ * indices.
  * Lengths are in the model's target unit (cm_cad_read_options.unit, millimetre by default).
  * Parameters: faces (u, v), edges t, both in OpenCASCADE's parameterisation of the
  * underlying surface/curve; s in [0, 1] is the normalised arc length along an edge in its
@@ -86,6 +89,11 @@ typedef struct cm_cad_edge_info {
     int closed;               /* first vertex == last vertex */
     double length;
     double bbox[6];
+    /* 1 in a G' renumbered by cm_cad_match where this edge runs against its counterpart in G:
+     * s (arc length fraction, cm_cad_edge_t_to_s and _s_to_t, cm_cad_boundary.s) is then
+     * measured in G's direction, from vertex[1] to vertex[0]; t, t_range, vertex and the
+     * wires' reversed flags stay OpenCASCADE's. 0 otherwise. */
+    int flipped;
 } cm_cad_edge_info;
 
 CM_API cm_status cm_cad_face_get_info(cm_context *ctx, const cm_cad_model *model, int face,
@@ -117,9 +125,48 @@ CM_API cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, i
  * CM_ERR_UNSUPPORTED naming the first such pair (1-based, in TopExp order) otherwise. */
 CM_API cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model);
 
-/* G and G' correspond: counts, surface and curve types (a circle may become an ellipse),
- * edge -> vertices and face -> wires -> oriented edges all match. CM_OK if so; CM_ERR_MISMATCH with up to
- * max_report differences in the message ("face 12: plane in G, cylinder in G'") if not. */
+/* ---- correspondence of G and G' ---- */
+
+/* The correspondence of the topology of G and G' as graphs: solids, shells, faces, wires,
+ * edges and vertices with their incidences and orientations. Adjacency decides first (a
+ * matched face and an oriented edge of one of its wires fix the neighbours across every
+ * edge); the distance of the entities' points relative to the model size decides between
+ * candidates; the identity numbering is preferred when it is consistent. A change of surface
+ * or curve type is allowed (logged at CM_LOG_DEBUG). Arrays are indexed by G's entities and
+ * hold the index of the counterpart in G'. All arrays are owned by the struct. */
+typedef struct cm_cad_correspondence {
+    cm_cad_counts counts;     /* of G */
+    int *face;                /* #faces */
+    int *face_reversed;       /* #faces: 1 where the counterpart's surface normal runs
+                                 against the face (cm_cad_face_info.reversed differs) */
+    int *edge;                /* #edges */
+    int *edge_flipped;        /* #edges: 1 where the counterpart runs the other way */
+    int *vertex;              /* #vertices */
+    int renumbered;           /* faces, edges, vertices or wire starts numbered otherwise, or
+                                 edges flipped: cm_cad_match renumbers G' */
+    int face_type_changes;    /* faces whose surface type differs (plane -> bspline, ...) */
+    int edge_type_changes;    /* edges whose curve type differs */
+} cm_cad_correspondence;
+
+/* The correspondence of G and G' (both unchanged). CM_OK with *out if they correspond;
+ * CM_ERR_MISMATCH and *out NULL if not, the message naming up to max_report differences in
+ * words ("face 12 (plane, 4 edges) has no counterpart: G' has a hole there") and the counts
+ * that differ ("faces: 9 in G, 10 in G'"). Refuses models whose sizes differ by 100x or more
+ * (units); logs a warning when their file units differ. out may be NULL. */
+CM_API cm_status cm_cad_correspond(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+                                   int max_report, cm_cad_correspondence **out);
+CM_API void cm_cad_correspondence_destroy(cm_cad_correspondence **c);
+
+/* cm_cad_correspond, then G' is renumbered in place: its faces, edges, vertices take the
+ * indices of their counterparts in G, the wires of each face G's order and start edge, and
+ * edges that run the other way are marked flipped (cm_cad_edge_info.flipped). Call it before
+ * anything indexes G' (a locator, a morpher): those keep indices. out may be NULL. */
+CM_API cm_status cm_cad_match(cm_context *ctx, const cm_cad_model *g, cm_cad_model *g2,
+                              int max_report, cm_cad_correspondence **out);
+
+/* G and G' correspond in G's numbering (as after cm_cad_match): CM_OK if so; CM_ERR_MISMATCH
+ * with the differences (as cm_cad_correspond) if not, or saying that G' needs renumbering by
+ * cm_cad_match when they correspond only with another numbering. */
 CM_API cm_status cm_cad_compare(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
                          int max_report);
 
