@@ -105,6 +105,8 @@ static int print_help(void)
         "status and message), study.svg (min scaled Jacobian per variant; solid absolute,\n"
         "dashed relative) and <method>_<mode>_<variant>.vtu (with 'scaled_jacobian' and\n"
         "'displacement'; <variant>: the STEP file's name without extension).\n\n"
+        "mpirun -n K cadmorph study --mode absolute ... (builds with -DCADMORPH_WITH_PETSC=ON):\n"
+        "variant i runs on rank i mod K; rank 0 writes study.csv and study.svg.\n\n"
         "options:\n");
     cli_print_options(stdout, options, 22);
     printf("\nProgress (on a terminal): the variant count and an estimate of the time left.\n"
