@@ -59,6 +59,12 @@ void cli_print_quality_line(FILE *out, const cm_quality_stats *all);
 cm_status cli_print_quality(cm_context *ctx, const cm_mesh *mesh, const double *sj, FILE *out,
                             cm_quality_stats *all);
 
+/* When volume cells are inverted (scaled Jacobian <= 0, NaN, collapsed): one warning line on
+ * stderr, "cadmorph <cmd>: warning: <k> inverted cells ...; the worst is cell <i> (0-based,
+ * <type>, scaled Jacobian <v>) at (<x>, <y>, <z>)" - the summary line alone is easy to miss.
+ * Returns k. */
+size_t cli_warn_inverted(const char *cmd, const cm_mesh *mesh, const double *sj);
+
 /* OpenBLAS set-up (cli/blas_reexec.c), first thing in main: may execute the program again
  * with OPENBLAS_CORETYPE and OPENBLAS_NUM_THREADS set (blas.h); says so under --verbose. */
 void cli_blas_setup(int argc, char **argv);

@@ -288,6 +288,8 @@ int cli_cmd_morph(int argc, char **argv)
                r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
         s = cli_print_quality(ctx, r->mesh, r->sj, stdout, NULL);
         if (s < 0 && rc == CLI_EXIT_OK) rc = cli_fail(ctx, "morph", s);
+        /* --fail-on-inverted said so already */
+        if (s >= 0 && rc == CLI_EXIT_OK) cli_warn_inverted("morph", r->mesh, r->sj);
     }
     cm_morph_result_destroy(&r);
     cm_context_destroy(&ctx);

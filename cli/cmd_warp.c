@@ -146,6 +146,7 @@ int cli_cmd_warp(int argc, char **argv)
     if (s >= 0 && writer) s = cm_mesh_write(ctx, mesh, a.out, NULL);
     /* the report only once the mesh is written: its last line is what scripts parse */
     if (s >= 0 && writer) s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
+    if (s >= 0 && writer) cli_warn_inverted("warp", mesh, sj);
     rc = s < 0 ? cli_fail(ctx, "warp", s) : CLI_EXIT_OK;
     free(disp);
     free(listed);

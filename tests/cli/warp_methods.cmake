@@ -56,7 +56,7 @@ foreach(model bore pipe)
   add_test(NAME warp_methods_${model}_step
     COMMAND $<TARGET_FILE:cm_model> ${model} 0 ${BM}/${model}.step)
   add_test(NAME warp_methods_${model}_tet
-    COMMAND $<TARGET_FILE:cadmorph> mesh ${BM}/${model}.step -o ${BM}/${model}_tet.msh --size 0.25)
+    COMMAND $<TARGET_FILE:cadmorph> mesh ${BM}/${model}.step -o ${BM}/${model}_tet.msh --size 0.25 --mesher tetgen)
   add_test(NAME warp_methods_${model}_hex
     COMMAND $<TARGET_FILE:cm_hexmesh> ${model} ${BM}/${model}_hex.msh 0.6667)
   set_tests_properties(warp_methods_${model}_step PROPERTIES LABELS "cli;volume"
