@@ -81,6 +81,10 @@ int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
     return 1;
 }
 
+const double *cm_rbf_iterative_q1(const cm_rbf *r) { return r->iter ? r->iter->q1 : NULL; }
+
+const cm_rbf_schwarz *cm_rbf_iterative_pc(const cm_rbf *r) { return r->iter ? r->iter->pc : NULL; }
+
 void cm_rbf_iterative_destroy(cm_rbf_iter **it)
 {
     if (!it || !*it) return;

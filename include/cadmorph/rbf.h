@@ -41,13 +41,20 @@ typedef struct cm_rbf cm_rbf;
  * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
  *   crossover near 7,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
  *   iterative above; dense for the other kernels.
+ * PETSC: the ITERATIVE solver distributed over the MPI ranks of PETSC_COMM_WORLD through
+ *   PETSc (only in builds with -DCADMORPH_WITH_PETSC=ON; otherwise create fails with
+ *   CM_ERR_UNSUPPORTED): KSPFGMRES on a MatShell whose rows (the r^3 kernel sums) are split
+ *   over the ranks, the same Schwarz preconditioner as a PCSHELL. Create, solve and
+ *   evaluate are then collective: every rank calls them with the same centres and values
+ *   (each holds all centres and gets all weights); see cm_rbf_petsc_initialize.
  * cm_rbf_evaluate works for both; an iterative fit evaluates with compensated sums too
  * (about 2.8x the time of plain sums), so it reproduces the data at the centres to its
  * residual, where plain sums, as the dense path uses, stop at the floor in cm_rbf_stats. */
 typedef enum cm_rbf_solver {
     CM_RBF_SOLVER_AUTO = 0,
     CM_RBF_SOLVER_DENSE = 1,
-    CM_RBF_SOLVER_ITERATIVE = 2
+    CM_RBF_SOLVER_ITERATIVE = 2,
+    CM_RBF_SOLVER_PETSC = 3
 } cm_rbf_solver;
 
 /* Options of cm_rbf_create_opt; cm_rbf_options_init fills the defaults (in brackets).
@@ -90,7 +97,7 @@ CM_API void cm_rbf_options_init(cm_rbf_options *opt);
 
 /* Figures of the last create and solve (cm_rbf_stats). */
 typedef struct cm_rbf_stats {
-    cm_rbf_solver solver;  /* the one used: DENSE or ITERATIVE */
+    cm_rbf_solver solver;  /* the one used: DENSE, ITERATIVE or PETSC */
     size_t centres;        /* after merging duplicates */
     int subdomains;        /* iterative: Schwarz subdomains; 0 for dense */
     int coarse_size;       /* iterative: coarse centres */
@@ -100,7 +107,8 @@ typedef struct cm_rbf_stats {
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
     int matvecs;           /* last solve: direct-summation products with the m x m matrix
-                            * (one per iteration and restart, all components together) */
+                            * (one per iteration and restart, all components together;
+                            * PETSC: the components one after the other, each counted) */
     double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| over all components
                             * (exactness at the centres, by direct summation after the solve;
                             * iterative: with compensated sums) */
@@ -146,6 +154,27 @@ CM_API cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, c
 
 /* Centres after merging duplicates. */
 CM_API size_t cm_rbf_centre_count(const cm_rbf *rbf);
+
+/* ---- the distributed solver (CM_RBF_SOLVER_PETSC) ----
+ * 1 if this build has it (-DCADMORPH_WITH_PETSC=ON), else 0 and the calls below do nothing. */
+CM_API int cm_rbf_petsc_available(void);
+/* Initialises PETSc (and MPI) once per process, collectively over the ranks that mpirun
+ * started, unless the caller already did; PETSc's own options come from the PETSC_OPTIONS
+ * environment variable (prefix cm_: PETSC_OPTIONS=-cm_ksp_monitor). Called by cm_rbf_create
+ * for the PETSC solver by itself; a program calls it first when it needs the rank earlier.
+ * CM_ERR_UNSUPPORTED without PETSc. */
+CM_API cm_status cm_rbf_petsc_initialize(cm_context *ctx);
+/* This process's rank and the number of ranks (0 and 1 before initialisation or without
+ * PETSc); either pointer may be NULL. */
+CM_API void cm_rbf_petsc_rank(int *rank, int *size);
+/* Finalises PETSc (and MPI) if cm_rbf_petsc_initialize initialised it; collective, call it
+ * once before the program ends, after destroying every PETSC-solver cm_rbf. */
+CM_API void cm_rbf_petsc_finalize(void);
+/* Every rank's n records of `size` bytes (mine) to every rank: *all (malloc'd, free() it)
+ * gets them in rank order, *n_all their count; collective. On one rank, or without PETSc, a
+ * copy of mine. Plain-data records only (a study's rows: cm_study_run with ranks > 1). */
+CM_API cm_status cm_rbf_petsc_allgather(cm_context *ctx, const void *mine, size_t n, size_t size,
+                                        void **all, size_t *n_all);
 
 #ifdef __cplusplus
 }
