@@ -152,8 +152,8 @@ static void print_correspondence(const cm_cad_model *g, const cm_cad_model *g2,
         }
     for (int e = 0; e < c->counts.edges && shown < 40; ++e)
         if (c->edge[e] != e || c->edge_flipped[e] || strcmp(edge_type(g, e), edge_type(g2, c->edge[e]))) {
-            printf("  edge %d -> %s%d (%s -> %s)\n", e, c->edge_flipped[e] ? "-" : "", c->edge[e],
-                   edge_type(g, e), edge_type(g2, c->edge[e]));
+            printf("  edge %d -> %d%s (%s -> %s)\n", e, c->edge[e],
+                   c->edge_flipped[e] ? " reversed" : "", edge_type(g, e), edge_type(g2, c->edge[e]));
             ++shown;
         }
     if (shown >= 20) printf("  ... (--map OUT.csv lists all)\n");
