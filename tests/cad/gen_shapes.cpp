@@ -16,7 +16,12 @@
 #include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRep_Tool.hxx>
 #include <ShapeCustom.hxx>
+#include <ShapeFix_Face.hxx>
 #include <ShapeFix_Solid.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <GeomAPI_PointsToBSpline.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <TColgp_Array1OfPnt.hxx>
 #include <TopoDS_Vertex.hxx>
 #include <gp_GTrsf.hxx>
 #include <BRepAdaptor_Surface.hxx>
@@ -180,6 +185,41 @@ static TopoDS_Shape rebuilt_polyhedron(const TopoDS_Shape &s, unsigned seed)
     return fix.Solid();
 }
 
+// A B-spline face bounded by curves that lie 2e-5 off its surface, pcurves by projection (as
+// OpenCASCADE builds them for industrial STEP files without pcurves): the face's boundary is
+// only known to the edges' tolerance.
+static TopoDS_Shape loose_bspline_face(const Handle(Geom_BSplineSurface) & bs)
+{
+    double u0, u1, v0, v1;
+    bs->Bounds(u0, u1, v0, v1);
+    const double du = 0.1 * (u1 - u0), dv = 0.1 * (v1 - v0);
+    // a rectangle inside the surface's box, in uv, run counter-clockwise
+    const double cu[5] = {u0 + du, u1 - du, u1 - du, u0 + du, u0 + du};
+    const double cv[5] = {v0 + dv, v0 + dv, v1 - dv, v1 - dv, v0 + dv};
+    BRepBuilderAPI_MakeWire mw;
+    std::vector<TopoDS_Vertex> corner;
+    for (int k = 0; k < 4; ++k)
+        corner.push_back(BRepBuilderAPI_MakeVertex(bs->Value(cu[k], cv[k]).Translated(gp_Vec(0, 0, 2e-5))));
+    for (int k = 0; k < 4; ++k) {
+        TColgp_Array1OfPnt pts(1, 12);
+        for (int i = 1; i <= 12; ++i) {
+            double a = (i - 1) / 11.0;
+            gp_Pnt p = bs->Value(cu[k] + a * (cu[k + 1] - cu[k]), cv[k] + a * (cv[k + 1] - cv[k]));
+            pts(i) = p.Translated(gp_Vec(0, 0, 2e-5));
+        }
+        Handle(Geom_BSplineCurve) c = GeomAPI_PointsToBSpline(pts, 3, 8, GeomAbs_C2, 1e-9).Curve();
+        mw.Add(BRepBuilderAPI_MakeEdge(c, corner[k], corner[(k + 1) % 4]).Edge());
+    }
+    TopoDS_Face f = BRepBuilderAPI_MakeFace(bs, mw.Wire(), true).Face();
+    ShapeFix_Face fix(f);
+    fix.Perform();
+    TopoDS_Shell shell;
+    BRep_Builder bb;
+    bb.MakeShell(shell);
+    bb.Add(shell, fix.Face());
+    return shell;
+}
+
 // A spindle torus (minor radius 2 > major radius 1) closed by the plane z = -1.2: the
 // apple-shaped outer part of the torus (v from -asin 0.6 to 2 pi / 3, where it meets the
 // axis), sewn to a disc.
@@ -266,7 +306,8 @@ int main(int argc, char **argv)
                      {"part_revolution", ShapeCustom::ConvertToRevolution(part)},
                      {"block", block},
                      {"block_rebuilt", rebuilt_polyhedron(block, 3)},
-                     {"spindle", spindle_part()}};
+                     {"spindle", spindle_part()},
+                     {"loose_bspline", loose_bspline_face(bs)}};
         for (auto &p : pairs)
             if (!write_step(p.s, dir + "/" + p.name + ".step")) {
                 fprintf(stderr, "gen_shapes: cannot write %s\n", p.name);
