@@ -119,6 +119,19 @@ static TopoDS_Shape grooved_part(bool extra_hole)
     return part;
 }
 
+// A plate with a row of n equal holes, stretched by sx about its centre: in G' (sx = 2.5) the
+// outer holes are nearer to other holes of G than to their own, and only the numbering
+// (kept by the edit) places them.
+static TopoDS_Shape hole_row(int n, double sx)
+{
+    TopoDS_Shape s = BRepPrimAPI_MakeBox(gp_Pnt(5.0 * n * (1 - sx), 0, 0), 10.0 * n * sx, 10, 4).Shape();
+    for (int i = 0; i < n; ++i) {
+        gp_Pnt c(5.0 * n + (5 + 10 * i - 5.0 * n) * sx, 5, -1);
+        s = BRepAlgoAPI_Cut(s, BRepPrimAPI_MakeCylinder(gp_Ax2(c, gp_Dir(0, 0, 1)), 2, 6).Shape()).Shape();
+    }
+    return s;
+}
+
 // Non-uniform scale and shear (planes, cylinders and tori become B-splines).
 static TopoDS_Shape gtransformed(const TopoDS_Shape &s)
 {
@@ -307,7 +320,9 @@ int main(int argc, char **argv)
                      {"block", block},
                      {"block_rebuilt", rebuilt_polyhedron(block, 3)},
                      {"spindle", spindle_part()},
-                     {"loose_bspline", loose_bspline_face(bs)}};
+                     {"loose_bspline", loose_bspline_face(bs)},
+                     {"row_a", hole_row(6, 1.0)},
+                     {"row_b", hole_row(6, 2.5)}};
         for (auto &p : pairs)
             if (!write_step(p.s, dir + "/" + p.name + ".step")) {
                 fprintf(stderr, "gen_shapes: cannot write %s\n", p.name);
