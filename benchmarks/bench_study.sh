@@ -28,7 +28,7 @@ echo "| mesh size | nodes | boundary nodes | variants | wall s | CPU s | one-tim
 echo "|---|---|---|---|---|---|---|---|---|---|"
 for size in $sizes; do
     mesh=$work/M0_$size.vtu
-    "$cadmorph" mesh "$work/G0.step" -o "$mesh" --size "$size" >/dev/null
+    "$cadmorph" mesh "$work/G0.step" -o "$mesh" --size "$size" --mesher tetgen >/dev/null
     for n in 1 20; do
         /usr/bin/time -f "wall_s=%e user_s=%U sys_s=%S" -o "$work/time_$n.txt" \
             "$cadmorph" study --from "$work/G0.step" --mesh "$mesh" --variants "$work/v$n/*.step" \

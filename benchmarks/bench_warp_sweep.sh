@@ -18,9 +18,9 @@ cd "$work"
 echo "# $(date -u '+%Y-%m-%d %H:%M UTC')  $(lscpu | sed -n 's/^Model name: *//p')  nproc=$(nproc)  threads=$threads  load=$(cut -d' ' -f1-3 /proc/loadavg)"
 for m in bore pipe bracket; do "$bin/benchmarks/models/cm_model" $m 0 $m.step >/dev/null; done
 [ -f bracket_tet.msh ] && [ -f pipe_hex.msh ] || {
-"$bin/cli/cadmorph" mesh bore.step -o bore_tet.msh --size 0.25 >/dev/null
-"$bin/cli/cadmorph" mesh pipe.step -o pipe_tet.msh --size 0.2 >/dev/null
-"$bin/cli/cadmorph" mesh bracket.step -o bracket_tet.msh --size 0.25 >/dev/null
+"$bin/cli/cadmorph" mesh bore.step -o bore_tet.msh --size 0.25 --mesher tetgen >/dev/null
+"$bin/cli/cadmorph" mesh pipe.step -o pipe_tet.msh --size 0.2 --mesher tetgen >/dev/null
+"$bin/cli/cadmorph" mesh bracket.step -o bracket_tet.msh --size 0.25 --mesher tetgen >/dev/null
 "$bin/benchmarks/models/cm_hexmesh" bore bore_hex.msh 0.6667 >/dev/null
 "$bin/benchmarks/models/cm_hexmesh" pipe pipe_hex.msh 1 >/dev/null
 }

@@ -36,6 +36,10 @@ int cli_make_dir(const char *cmd, const char *dir);
 
 /* Non-zero if the two paths name the same file (an existing output that is an input). */
 int cli_same_file(const char *a, const char *b);
+/* The checks of a mesh output before any work: a known mesh format, and none of the n inputs
+ * (NULL entries skipped). 0, or CLI_EXIT_USAGE after a usage message. */
+int cli_check_mesh_output(const char *cmd, const char *usage, const char *out,
+                          const char *const *inputs, size_t n);
 
 /* Argument helpers: the value after an option, or NULL (and a usage message) if missing. */
 const char *cli_value(int argc, char **argv, int *i, const char *cmd, const char *usage);
@@ -54,6 +58,12 @@ void cli_print_quality_line(FILE *out, const cm_quality_stats *all);
  * overall stats. */
 cm_status cli_print_quality(cm_context *ctx, const cm_mesh *mesh, const double *sj, FILE *out,
                             cm_quality_stats *all);
+
+/* When volume cells are inverted (scaled Jacobian <= 0, NaN, collapsed): one warning line on
+ * stderr, "cadmorph <cmd>: warning: <k> inverted cells ...; the worst is cell <i> (0-based,
+ * <type>, scaled Jacobian <v>) at (<x>, <y>, <z>)" - the summary line alone is easy to miss.
+ * Returns k. */
+size_t cli_warn_inverted(const char *cmd, const cm_mesh *mesh, const double *sj);
 
 /* OpenBLAS set-up (cli/blas_reexec.c), first thing in main: may execute the program again
  * with OPENBLAS_CORETYPE and OPENBLAS_NUM_THREADS set (blas.h); says so under --verbose. */

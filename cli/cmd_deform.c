@@ -128,14 +128,8 @@ static int parse_args(int argc, char **argv, deform_args *a)
         return cli_usage(cmd, usage_line, "--fixed and --fix-unlisted-boundary exclude each other");
     if ((a->mls || a->shell) && (a->fix <= 0 || a->stretch + a->bend <= 0))
         return cli_usage(cmd, usage_line, "--fix must be > 0 and --stretch + --bend > 0");
-    if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
-                         a->out);
-    if (cli_same_file(a->out, a->mesh) || cli_same_file(a->out, a->handles) ||
-        (a->fixed && cli_same_file(a->out, a->fixed)))
-        return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
-                         a->out);
-    return -1;
+    const char *inputs[] = {a->mesh, a->handles, a->fixed};
+    return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 3) ? CLI_EXIT_USAGE : -1;
 }
 
 /* F.csv: header `node`, one 0-based index per line; blank lines and CRLF accepted. */

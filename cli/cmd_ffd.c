@@ -97,14 +97,8 @@ static int parse_args(int argc, char **argv, ffd_args *a)
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->lattice) return cli_usage(cmd, usage_line, "--lattice is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
-    if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
-                         a->out);
-    if (cli_same_file(a->out, a->mesh) || cli_same_file(a->out, a->lattice) ||
-        (a->csv && cli_same_file(a->out, a->csv)))
-        return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
-                         a->out);
-    return -1;
+    const char *inputs[] = {a->mesh, a->lattice, a->csv};
+    return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 3) ? CLI_EXIT_USAGE : -1;
 }
 
 /* The lattice and control displacements of the .prm (and the CSV). */

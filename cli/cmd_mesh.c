@@ -14,11 +14,14 @@
 
 static const char *const usage =
     "cadmorph mesh G.step -o MESH [--size H] [--quality Q] [--preserve-surface] "
-    "[--min-dihedral D] [--no-optimize] [--force] [--cad-unit U] [--threads N] [-v] [-h|--help]";
+    "[--min-dihedral D] [--no-optimize] [--force] [--mesher tetgen|gmsh] [--time-limit S] "
+    "[--cad-unit U] [--threads N] [-v] [-h|--help]";
 
 static const char *out, *unit;
 static cm_tetmesh_options opt;
 static int threads, verbose, preserve_surface, no_optimize, force;
+static const char *const mesher_names[] = {"tetgen", "gmsh", NULL};
+static const int mesher_values[] = {CM_MESHER_TETGEN, CM_MESHER_GMSH};
 
 static const cli_option options[] = {
     {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &out, .label = "-o MESH",
@@ -44,6 +47,17 @@ static const cli_option options[] = {
     {.name = "--force", .kind = CLI_FLAG, .dest = &force, .label = "--force",
      .help = "mesh even when the estimated tet count exceeds 1e7 (refused\n"
              "otherwise, exit code 4, with the estimate)"},
+    {.name = "--mesher", .kind = CLI_ENUM, .dest = &opt.mesher, .names = mesher_names,
+     .values = mesher_values, .bad = "%.0sunknown mesher '%s' (tetgen|gmsh)",
+     .label = "--mesher M",
+     .help = "gmsh (default; gmsh's library meshes the same STEP file, --size\n"
+             "is its largest element size) or tetgen (OpenCASCADE's surface\n"
+             "triangulation filled by TetGen; the default when --quality,\n"
+             "--min-dihedral or --preserve-surface is given: TetGen's options)"},
+    {.name = "--time-limit", .kind = CLI_DOUBLE, .dest = &opt.time_limit, .lo = 0, .hi = NAN,
+     .open = 1, .bad = "%s needs seconds > 0, got '%s'", .label = "--time-limit S",
+     .help = "seconds one mesher run may take (default 600); the mesher runs\n"
+             "in a child process, so its crash or hang is an error message"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &unit, .label = "--cad-unit U",
      .help = "length unit of the coordinates (default mm)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",
@@ -56,8 +70,11 @@ static const cli_option options[] = {
 static int help(void)
 {
     printf("usage: %s\n\n"
-           "Tet mesh of the solid in G.step: OpenCASCADE triangulates the faces (watertight across\n"
-           "face borders), TetGen fills the solid with tets of bounded radius-edge ratio. Every\n"
+           "Tet mesh of the solid in G.step, by gmsh (its OpenCASCADE kernel reads the same file)\n"
+           "or by TetGen (OpenCASCADE triangulates the faces, watertight across face borders,\n"
+           "TetGen fills the solid with tets of bounded radius-edge ratio). The mesher runs in a\n"
+           "child process under a time limit: its crash or hang is an error message; when\n"
+           "TetGen fails, -Y, a looser quality bound and a perturbed surface are tried. Every\n"
            "boundary node lies on the CAD model. MESH (.msh, .vtu, .vtk, .mesh) gets the tets and\n"
            "the boundary triangles, each tagged with its CAD face (face index + 1, as in\n"
            "'cadmorph info'), and the cell field scaled_jacobian. Prints the counts, then the\n"
@@ -66,8 +83,9 @@ static int help(void)
            "options:\n",
            usage);
     cli_print_options(stdout, options, 20);
-    printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable STEP, no closed solid, TetGen\n"
-           "failure, touching solids), 4 out of memory or beyond the tet limit, internal error.\n");
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable STEP, no closed solid, touching\n"
+           "solids, the mesher failed, crashed or ran out of time: the message says what was\n"
+           "tried), 4 out of memory or beyond the tet limit, internal error.\n");
     return CLI_EXIT_OK;
 }
 
@@ -75,20 +93,30 @@ int cli_cmd_mesh(int argc, char **argv)
 {
     const char *cmd = "mesh", *in = NULL;
     cm_tetmesh_options_init(&opt);
+    /* "not given" marks: TetGen's own options select TetGen when --mesher is not given */
+    const double quality0 = opt.quality, dihedral0 = opt.min_dihedral;
+    opt.quality = opt.min_dihedral = NAN;
+    opt.mesher = -1;
     cli_parser p = {.cmd = cmd, .usage = usage, .options = options, .help = help,
                     .unknown = "unknown option '%s'", .pos = &in, .max_pos = 1,
                     .extra = "unexpected argument '%s'"};
     const int parsed = cli_parse(&p, argc, argv);
     if (parsed >= 0) return parsed;
+    const int tetgen_options = !isnan(opt.quality) || !isnan(opt.min_dihedral) || preserve_surface;
+    if (isnan(opt.quality)) opt.quality = quality0;
+    if (isnan(opt.min_dihedral)) opt.min_dihedral = dihedral0;
+    if (opt.mesher == CM_MESHER_GMSH && tetgen_options)
+        return cli_usage(cmd, usage, "--quality, --min-dihedral and --preserve-surface are "
+                         "TetGen's: not with --mesher gmsh");
+    /* gmsh by default: better tets than TetGen's at the same size or tet count
+     * (benchmarks/RESULTS.md, issue 18) and no crash on its error paths */
+    if (opt.mesher < 0) opt.mesher = tetgen_options ? CM_MESHER_TETGEN : CM_MESHER_GMSH;
     if (preserve_surface) opt.preserve_surface = 1;
     if (no_optimize) opt.optimize = 0;
     if (force) opt.max_tets = INFINITY;
     if (!in) return cli_usage(cmd, usage, "missing G.step");
     if (!out) return cli_usage(cmd, usage, "missing -o MESH");
-    if (cm_mesh_format_from_path(out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage, "%s: unknown mesh format (.msh, .vtu, .vtk, .mesh)", out);
-    if (cli_same_file(out, in))
-        return cli_usage(cmd, usage, "output %s is the input: refusing to overwrite it", out);
+    if (cli_check_mesh_output(cmd, usage, out, &in, 1)) return CLI_EXIT_USAGE;
 
     cm_context *ctx = cli_context_create(cmd, verbose, threads);
     if (!ctx) return CLI_EXIT_INTERNAL;

@@ -188,16 +188,12 @@ static int parse_args(int argc, char **argv, morph_args *a)
         return cli_usage(cmd, usage_line, "--keep-partial goes with --steps auto");
     if (a->n_via && !a->relative)
         return cli_usage(cmd, usage_line, "--via needs --relative (a morph through them)");
-    if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
-                         a->out);
     const char *inputs[3 + MORPH_MAX_VIA] = {a->from, a->to, a->mesh};
     for (size_t k = 0; k < a->n_via; ++k)
         inputs[3 + k] = a->via[k];
+    if (cli_check_mesh_output(cmd, usage_line, a->out, inputs, 3 + a->n_via))
+        return CLI_EXIT_USAGE;
     for (size_t k = 0; k < 3 + a->n_via; ++k) {
-        if (cli_same_file(a->out, inputs[k]))
-            return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
-                             a->out);
         if (a->report && cli_same_file(a->report, inputs[k]))
             return cli_usage(cmd, usage_line, "report %s is an input: refusing to overwrite it",
                              a->report);
@@ -287,6 +283,8 @@ int cli_cmd_morph(int argc, char **argv)
                r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
         s = cli_print_quality(ctx, r->mesh, r->sj, stdout, NULL);
         if (s < 0 && rc == CLI_EXIT_OK) rc = cli_fail(ctx, "morph", s);
+        /* --fail-on-inverted said so already */
+        if (s >= 0 && rc == CLI_EXIT_OK) cli_warn_inverted("morph", r->mesh, r->sj);
     }
     cm_morph_result_destroy(&r);
     cm_context_destroy(&ctx);

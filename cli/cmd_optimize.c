@@ -63,10 +63,7 @@ int cli_cmd_optimize(int argc, char **argv)
     if (parsed >= 0) return parsed;
     if (!in) return cli_usage(cmd, usage_line, "missing MESH");
     if (!out) return cli_usage(cmd, usage_line, "-o is required");
-    if (cm_mesh_format_from_path(out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)", out);
-    if (cli_same_file(out, in))
-        return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it", out);
+    if (cli_check_mesh_output(cmd, usage_line, out, &in, 1)) return CLI_EXIT_USAGE;
 
     cm_context *ctx = cli_context_create(cmd, verbose, threads);
     if (!ctx) return CLI_EXIT_INTERNAL;

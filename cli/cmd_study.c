@@ -2,6 +2,7 @@
  * exported from a CAD program), by one or more methods, absolutely and/or relatively;
  * study.csv, study.svg and the meshes in the output directory, a summary on stdout. */
 #include "cli.h"
+#include "options.h"
 
 #include "cadmorph/study.h"
 
@@ -14,10 +15,83 @@ static const char *const usage_line =
     "[--mode absolute|relative|both] [--methods LIST] [--write-meshes none|all|failed] "
     "[--steps K|auto] [--optimize] [--cad-unit U] [--threads N] [--verbose]";
 
-static void print_help(void)
+enum { MAX_METHODS = 16 };
+
+typedef struct study_args {
+    const char *from, *mesh, *variants, *out, *unit, *methods;
+    int modes, write_meshes, threads, verbose, steps, optimize;
+    cm_study_method list[MAX_METHODS];
+    size_t n_methods;
+} study_args;
+
+static study_args args;
+
+static int print_help(void);
+
+/* --steps K (1..1000) or --steps auto */
+static int parse_steps(const cli_parser *p, const cli_option *o, const char *v, void *dest)
 {
-    char methods[512];
+    (void)o;
+    char *end;
+    const long n = strtol(v, &end, 10);
+    if (!strcmp(v, "auto"))
+        *(int *)dest = CM_MORPH_STEPS_AUTO;
+    else if (end == v || *end || n < 1 || n > 1000)
+        return cli_usage(p->cmd, p->usage, "--steps: expected 1..1000 or auto, got '%s'", v);
+    else
+        *(int *)dest = (int)n;
+    return 0;
+}
+
+static const char *method_help(void)
+{
+    static char methods[512];
     cm_study_method_help(methods, sizeof methods);
+    return methods;
+}
+
+static const char *const write_names[] = {"none", "all", "failed", NULL};
+static const int write_values[] = {CM_STUDY_WRITE_NONE, CM_STUDY_WRITE_ALL,
+                                   CM_STUDY_WRITE_FAILED};
+
+static const cli_option options[] = {
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP},
+    {.name = "--from", .kind = CLI_STRING, .dest = &args.from, .label = "--from G0.step",
+     .help = "the geometry M0 is a mesh of"},
+    {.name = "--mesh", .kind = CLI_STRING, .dest = &args.mesh, .label = "--mesh M0",
+     .help = "volume mesh of G0 (.msh .vtu .vtk .mesh)"},
+    {.name = "--variants", .kind = CLI_STRING, .dest = &args.variants, .label = "--variants LIST",
+     .help = "a text file of STEP paths, one per line ('#' comments; relative\n"
+             "paths are relative to the list file), or a quoted glob pattern\n"
+             "such as 'designs/*.step' (sorted)"},
+    {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
+     .label = "-o, --output DIR", .help = "output directory (created if missing)"},
+    {.name = "--mode", .kind = CLI_ENUM, .dest = &args.modes, .names = cli_study_mode_names,
+     .values = cli_study_mode_values, .bad = "%.0sunknown mode '%s'", .label = "--mode M",
+     .help = "absolute, relative or both (default absolute)"},
+    {.name = "--methods", .kind = CLI_STRING, .dest = &args.methods, .label = "--methods LIST",
+     .help = "comma-separated (default rbf-s): %s", .help_arg = method_help},
+    {.name = "--write-meshes", .kind = CLI_ENUM, .dest = &args.write_meshes,
+     .names = write_names, .values = write_values, .bad = "%s: none, all or failed, got '%s'",
+     .label = "--write-meshes W",
+     .help = "none, all (default) or failed (results with inverted cells)"},
+    {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_steps,
+     .dest = &args.steps, .label = "--steps K|auto",
+     .help = "increments of each morph (default 1), or adaptive steps as\n"
+             "in morph --steps auto (a variant without a valid step is a row\n"
+             "with its error)"},
+    {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.optimize, .label = "--optimize",
+     .help = "interior optimisation after each morph step"},
+    {.name = "--cad-unit", .kind = CLI_STRING, .dest = &args.unit, .label = "--cad-unit U",
+     .help = "unit of the mesh coordinates (mm default; cm m in ft um ...)"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
+     .help = "threads (default: all)"},
+    {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
+     .label = "--verbose", .help = "debug messages on stderr"},
+    {0}};
+
+static int print_help(void)
+{
     printf("usage: %s\n\n", usage_line);
     printf(
         "Morphs the mesh M0 of G0 onto every variant G of the list (same topology as G0, other\n"
@@ -30,112 +104,34 @@ static void print_help(void)
         "status and message), study.svg (min scaled Jacobian per variant; solid absolute,\n"
         "dashed relative) and <method>_<mode>_<variant>.vtu (with 'scaled_jacobian' and\n"
         "'displacement'; <variant>: the STEP file's name without extension).\n\n"
-        "options:\n"
-        "  --from G0.step        the geometry M0 is a mesh of\n"
-        "  --mesh M0             volume mesh of G0 (.msh .vtu .vtk .mesh)\n"
-        "  --variants LIST       a text file of STEP paths, one per line ('#' comments; relative\n"
-        "                        paths are relative to the list file), or a quoted glob pattern\n"
-        "                        such as 'designs/*.step' (sorted)\n"
-        "  -o, --output DIR      output directory (created if missing)\n"
-        "  --mode M              absolute, relative or both (default absolute)\n"
-        "  --methods LIST        comma-separated (default rbf-s): %s\n"
-        "  --write-meshes W      none, all (default) or failed (results with inverted cells)\n"
-        "  --steps K|auto        increments of each morph (default 1), or adaptive steps as\n"
-        "                        in morph --steps auto (a variant without a valid step is a row\n"
-        "                        with its error)\n"
-        "  --optimize            interior optimisation after each morph step\n"
-        "  --cad-unit U          unit of the mesh coordinates (mm default; cm m in ft um ...)\n"
-        "  --threads N           threads (default: all)\n"
-        "  --verbose             debug messages on stderr\n\n"
-        "Progress (on a terminal): the variant count and an estimate of the time left.\n"
-        "exit codes: 0 done (failed variants are warnings on stderr and rows in study.csv),\n"
-        "1 usage, 2 bad input (G0, M0 or the list: one line naming the file), 4 internal "
-        "error.\n",
-        methods);
+        "options:\n");
+    cli_print_options(stdout, options, 22);
+    printf("\nProgress (on a terminal): the variant count and an estimate of the time left.\n"
+           "exit codes: 0 done (failed variants are warnings on stderr and rows in study.csv),\n"
+           "1 usage, 2 bad input (G0, M0 or the list: one line naming the file), 4 internal "
+           "error.\n");
+    return CLI_EXIT_OK;
 }
 
-enum { MAX_METHODS = 16 };
-
-typedef struct study_args {
-    const char *from, *mesh, *variants, *out, *unit;
-    int modes, write_meshes, threads, verbose, steps, optimize;
-    cm_study_method methods[MAX_METHODS];
-    size_t n_methods;
-} study_args;
-
+/* Returns -1 to go on, else the exit code. */
 static int parse_args(int argc, char **argv, study_args *a)
 {
     static const char *cmd = "study";
-    memset(a, 0, sizeof *a);
-    a->modes = CM_STUDY_ABSOLUTE;
-    a->write_meshes = CM_STUDY_WRITE_ALL;
-    a->steps = 1;
-    const char *methods = "rbf-s";
-    for (int i = 1; i < argc; ++i) {
-        const char *o = argv[i], *v;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            print_help();
-            return CLI_EXIT_OK;
-        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
-            a->verbose = 1;
-        } else if (!strcmp(o, "--from")) {
-            if (!(a->from = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--mesh")) {
-            if (!(a->mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--variants")) {
-            if (!(a->variants = cli_value(argc, argv, &i, cmd, usage_line)))
-                return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(a->out = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--cad-unit")) {
-            if (!(a->unit = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--mode")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (!strcmp(v, "absolute"))
-                a->modes = CM_STUDY_ABSOLUTE;
-            else if (!strcmp(v, "relative"))
-                a->modes = CM_STUDY_RELATIVE;
-            else if (!strcmp(v, "both"))
-                a->modes = CM_STUDY_BOTH;
-            else
-                return cli_usage(cmd, usage_line, "unknown mode '%s'", v);
-        } else if (!strcmp(o, "--methods")) {
-            if (!(methods = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--optimize")) {
-            a->optimize = 1;
-        } else if (!strcmp(o, "--steps")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            char *end;
-            long n = strtol(v, &end, 10);
-            if (!strcmp(v, "auto"))
-                a->steps = CM_MORPH_STEPS_AUTO;
-            else if (end == v || *end || n < 1 || n > 1000)
-                return cli_usage(cmd, usage_line, "--steps: expected 1..1000 or auto, got '%s'", v);
-            else
-                a->steps = (int)n;
-        } else if (!strcmp(o, "--write-meshes")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (!strcmp(v, "none"))
-                a->write_meshes = CM_STUDY_WRITE_NONE;
-            else if (!strcmp(v, "all"))
-                a->write_meshes = CM_STUDY_WRITE_ALL;
-            else if (!strcmp(v, "failed"))
-                a->write_meshes = CM_STUDY_WRITE_FAILED;
-            else
-                return cli_usage(cmd, usage_line, "--write-meshes: none, all or failed, got '%s'",
-                                 v);
-        } else if (!strcmp(o, "--threads")) {
-            if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
-                return CLI_EXIT_USAGE;
-        } else {
-            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
-        }
-    }
+    memset(&args, 0, sizeof args);
+    args.modes = CM_STUDY_ABSOLUTE;
+    args.write_meshes = CM_STUDY_WRITE_ALL;
+    args.steps = 1;
+    args.methods = "rbf-s";
+    cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
+                    .unknown = "unknown argument '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    *a = args;
+    if (parsed >= 0) return parsed;
     if (!a->from || !a->mesh || !a->variants || !a->out)
         return cli_usage(cmd, usage_line, "--from, --mesh, --variants and -o are required");
     cm_context *ctx = NULL;
     if (cm_context_create(&ctx) != CM_OK) return cli_usage(cmd, usage_line, "out of memory");
-    cm_status s = cm_study_methods_parse(ctx, methods, a->methods, MAX_METHODS, &a->n_methods);
+    cm_status s = cm_study_methods_parse(ctx, a->methods, a->list, MAX_METHODS, &a->n_methods);
     if (s < 0) cli_usage(cmd, usage_line, "--methods: %s", cm_context_message(ctx));
     cm_context_destroy(&ctx);
     return s < 0 ? CLI_EXIT_USAGE : -1;
@@ -186,7 +182,7 @@ static int run(cm_context *ctx, const study_args *a)
             cm_study_options so;
             cm_study_options_init(&so);
             so.modes = a->modes;
-            so.methods = a->methods;
+            so.methods = a->list;
             so.n_methods = a->n_methods;
             so.write_meshes = a->write_meshes;
             so.out_dir = a->out;

@@ -2,6 +2,7 @@
  * G(t) for t = 1/N .. 1 by several methods, absolutely and/or relatively; sweep.csv, sweep.svg
  * and the meshes at 50 and 100 % in the output directory, a summary on stdout. */
 #include "cli.h"
+#include "options.h"
 
 #include "cadmorph/study.h"
 
@@ -14,40 +15,6 @@ static const char *const usage_line =
     "--steps N -o DIR [--size H] [--methods LIST] [--adaptive] [--optimize] [--write-step] "
     "[--threads N] [--verbose]";
 
-static void print_help(void)
-{
-    printf("usage: %s\n\n", usage_line);
-    printf(
-        "Morphs a mesh M(0) of the benchmark model G(0) onto G(t), t = 1/N, 2/N, ..., 1, and\n"
-        "compares methods: rbf-s (CAD-aware surface morph + triharmonic warp), project (closest\n"
-        "point on G(t) + triharmonic warp), rbf-s-biharmonic (surface morph + biharmonic warp).\n"
-        "absolute: every M(t) from M(0) (classification and warp factorisation once, reused for\n"
-        "every t); relative: M(t) from M(t - 1/N), classification and warp redone per step.\n\n"
-        "Writes in DIR: sweep.csv (one row per mode x method x step: quality, largest distance\n"
-        "of the boundary to G(t), stage times), sweep.svg (min scaled Jacobian against percent\n"
-        "of parameter change; solid absolute, dashed relative) and <method>_<mode>_050.vtu /\n"
-        "_100.vtu (the meshes at 50 and 100 %%, with 'scaled_jacobian' and 'displacement';\n"
-        "for an odd N the middle one is the step just past 50 %%, named by its percent).\n\n"
-        "options:\n"
-        "  MODEL              bore, pipe or bracket (the built-in models)\n"
-        "  --mesh M           tet: TetGen mesh of G(0) at --size; hex: the O-grid hex mesh\n"
-        "                     (bore, pipe); or a mesh file of G(0) (default tet)\n"
-        "  --size H           tet edge length (default 0.2); hex: cells of about H (default\n"
-        "                     0.1)\n"
-        "  --mode M           absolute, relative or both (default both)\n"
-        "  --steps N          parameter steps (default 10)\n"
-        "  --adaptive         each morph with adaptive steps (as morph --steps auto)\n"
-        "  --optimize         each morph with interior optimisation (as morph --optimize)\n"
-        "  -o, --output DIR   output directory (created if missing)\n"
-        "  --methods LIST     comma-separated study methods (default the three above;\n"
-        "                     see 'cadmorph study --help')\n"
-        "  --write-step       keep G(t) as DIR/G_<t>.step\n"
-        "  --threads N        threads (default: all)\n"
-        "  --verbose          debug messages on stderr\n\n"
-        "exit codes: 0 done (a method that failed on the way is a warning on stderr), 1 usage,\n"
-        "2 bad input, 4 internal error.\n");
-}
-
 enum { MAX_METHODS = 16 };
 
 typedef struct sweep_args {
@@ -56,16 +23,22 @@ typedef struct sweep_args {
     int threads, verbose;
 } sweep_args;
 
+static sweep_args args;
+
+static int print_help(void);
+
 /* The list in the sweeps' table order (rbf-s, project, rbf-s-biharmonic, then the others as
  * given), as the plot and summary have always shown them. */
-static int parse_methods(const char *v, sweep_args *a)
+static int parse_methods(const cli_parser *p, const cli_option *o, const char *v, void *dest)
 {
+    (void)o;
+    sweep_args *a = dest;
     cm_context *ctx = NULL;
-    if (cm_context_create(&ctx) != CM_OK) return cli_usage("sweep", usage_line, "out of memory");
+    if (cm_context_create(&ctx) != CM_OK) return cli_usage(p->cmd, p->usage, "out of memory");
     size_t n = 0;
     cm_status s = cm_study_methods_parse(ctx, v, a->methods, MAX_METHODS, &n);
     if (s < 0) {
-        cli_usage("sweep", usage_line, "--methods: %s", cm_context_message(ctx));
+        cli_usage(p->cmd, p->usage, "--methods: %s", cm_context_message(ctx));
         cm_context_destroy(&ctx);
         return CLI_EXIT_USAGE;
     }
@@ -83,69 +56,79 @@ static int parse_methods(const char *v, sweep_args *a)
     return 0;
 }
 
+static const cli_option options[] = {
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP},
+    {.name = "MODEL", .kind = CLI_NOTE, .label = "MODEL",
+     .help = "bore, pipe or bracket (the built-in models)"},
+    {.name = "--mesh", .kind = CLI_STRING, .dest = &args.opt.mesh, .label = "--mesh M",
+     .help = "tet: TetGen mesh of G(0) at --size; hex: the O-grid hex mesh\n"
+             "(bore, pipe); or a mesh file of G(0) (default tet)"},
+    {.name = "--size", .kind = CLI_DOUBLE, .dest = &args.opt.size, .lo = 0, .hi = 1e6, .open = 1,
+     .bad = "%s: expected a positive length, got '%s'", .label = "--size H",
+     .help = "tet edge length (default 0.2); hex: cells of about H (default\n0.1)"},
+    {.name = "--mode", .kind = CLI_ENUM, .dest = &args.opt.modes, .names = cli_study_mode_names,
+     .values = cli_study_mode_values, .bad = "%.0sunknown mode '%s'", .label = "--mode M",
+     .help = "absolute, relative or both (default both)"},
+    {.name = "--steps", .kind = CLI_INT, .dest = &args.opt.steps, .lo = 1, .hi = 1000,
+     .bad = "%s: expected 1..1000, got '%s'", .label = "--steps N",
+     .help = "parameter steps (default 10)"},
+    {.name = "--adaptive", .kind = CLI_FLAG, .dest = &args.opt.adaptive, .label = "--adaptive",
+     .help = "each morph with adaptive steps (as morph --steps auto)"},
+    {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.opt.optimize, .label = "--optimize",
+     .help = "each morph with interior optimisation (as morph --optimize)"},
+    {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.opt.out_dir,
+     .label = "-o, --output DIR", .help = "output directory (created if missing)"},
+    {.name = "--methods", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_methods,
+     .dest = &args, .label = "--methods LIST",
+     .help = "comma-separated study methods (default the three above;\n"
+             "see 'cadmorph study --help')"},
+    {.name = "--write-step", .kind = CLI_FLAG, .dest = &args.opt.write_step,
+     .label = "--write-step", .help = "keep G(t) as DIR/G_<t>.step"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
+     .help = "threads (default: all)"},
+    {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
+     .label = "--verbose", .help = "debug messages on stderr"},
+    {0}};
+
+static int print_help(void)
+{
+    printf("usage: %s\n\n", usage_line);
+    printf(
+        "Morphs a mesh M(0) of the benchmark model G(0) onto G(t), t = 1/N, 2/N, ..., 1, and\n"
+        "compares methods: rbf-s (CAD-aware surface morph + triharmonic warp), project (closest\n"
+        "point on G(t) + triharmonic warp), rbf-s-biharmonic (surface morph + biharmonic warp).\n"
+        "absolute: every M(t) from M(0) (classification and warp factorisation once, reused for\n"
+        "every t); relative: M(t) from M(t - 1/N), classification and warp redone per step.\n\n"
+        "Writes in DIR: sweep.csv (one row per mode x method x step: quality, largest distance\n"
+        "of the boundary to G(t), stage times), sweep.svg (min scaled Jacobian against percent\n"
+        "of parameter change; solid absolute, dashed relative) and <method>_<mode>_050.vtu /\n"
+        "_100.vtu (the meshes at 50 and 100 %%, with 'scaled_jacobian' and 'displacement';\n"
+        "for an odd N the middle one is the step just past 50 %%, named by its percent).\n\n"
+        "options:\n");
+    cli_print_options(stdout, options, 19);
+    printf("\nexit codes: 0 done (a method that failed on the way is a warning on stderr), 1 "
+           "usage,\n2 bad input, 4 internal error.\n");
+    return CLI_EXIT_OK;
+}
+
+/* Returns -1 to go on, else the exit code. */
 static int parse_args(int argc, char **argv, sweep_args *a)
 {
     static const char *cmd = "sweep";
-    memset(a, 0, sizeof *a);
-    cm_sweep_options_init(&a->opt);
-    a->opt.out_dir = NULL;
-    const char *model = NULL;
-    for (int i = 1; i < argc; ++i) {
-        const char *o = argv[i], *v;
-        char *end;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            print_help();
-            return CLI_EXIT_OK;
-        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
-            a->verbose = 1;
-        } else if (!strcmp(o, "--write-step")) {
-            a->opt.write_step = 1;
-        } else if (!strcmp(o, "--mesh")) {
-            if (!(a->opt.mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(a->opt.out_dir = cli_value(argc, argv, &i, cmd, usage_line)))
-                return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--mode")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (!strcmp(v, "absolute"))
-                a->opt.modes = CM_STUDY_ABSOLUTE;
-            else if (!strcmp(v, "relative"))
-                a->opt.modes = CM_STUDY_RELATIVE;
-            else if (!strcmp(v, "both"))
-                a->opt.modes = CM_STUDY_BOTH;
-            else
-                return cli_usage(cmd, usage_line, "unknown mode '%s'", v);
-        } else if (!strcmp(o, "--methods")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (parse_methods(v, a)) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--adaptive")) {
-            a->opt.adaptive = 1;
-        } else if (!strcmp(o, "--optimize")) {
-            a->opt.optimize = 1;
-        } else if (!strcmp(o, "--steps")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            long n = strtol(v, &end, 10);
-            if (end == v || *end || n < 1 || n > 1000)
-                return cli_usage(cmd, usage_line, "--steps: expected 1..1000, got '%s'", v);
-            a->opt.steps = (int)n;
-        } else if (!strcmp(o, "--size")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            double h = strtod(v, &end);
-            if (end == v || *end || !(h > 0) || h > 1e6)
-                return cli_usage(cmd, usage_line, "--size: expected a positive length, got '%s'",
-                                 v);
-            a->opt.size = h;
-        } else if (!strcmp(o, "--threads")) {
-            if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
-                return CLI_EXIT_USAGE;
-        } else if (o[0] == '-') {
-            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
-        } else if (model) {
-            return cli_usage(cmd, usage_line, "one model only, got '%s' and '%s'", model, o);
-        } else {
-            model = o;
-        }
-    }
+    memset(&args, 0, sizeof args);
+    cm_sweep_options_init(&args.opt);
+    args.opt.out_dir = NULL;
+    const char *pos[2] = {NULL, NULL};
+    cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
+                    .unknown = "unknown argument '%s'", .pos = pos, .max_pos = 2,
+                    .extra = "one model only, got '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    *a = args;
+    if (a->opt.methods == args.methods) a->opt.methods = a->methods; /* into the copy */
+    if (parsed >= 0) return parsed;
+    const char *model = pos[0];
+    if (p.n_pos > 1)
+        return cli_usage(cmd, usage_line, "one model only, got '%s' and '%s'", model, pos[1]);
     if (!model) return cli_usage(cmd, usage_line, "MODEL is required (bore, pipe, bracket)");
     if (strcmp(model, "bore") && strcmp(model, "pipe") && strcmp(model, "bracket"))
         return cli_usage(cmd, usage_line, "unknown model '%s' (bore, pipe, bracket)", model);

@@ -97,13 +97,8 @@ static int parse_args(int argc, char **argv, warp_args *a)
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->csv) return cli_usage(cmd, usage_line, "--displacements is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
-    if (cm_mesh_format_from_path(a->out) == CM_FORMAT_UNKNOWN)
-        return cli_usage(cmd, usage_line, "%s: unknown mesh extension (.msh .vtu .vtk .mesh)",
-                         a->out);
-    if (cli_same_file(a->out, a->mesh) || cli_same_file(a->out, a->csv))
-        return cli_usage(cmd, usage_line, "output %s is an input: refusing to overwrite it",
-                         a->out);
-    return -1;
+    const char *inputs[] = {a->mesh, a->csv};
+    return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 2) ? CLI_EXIT_USAGE : -1;
 }
 
 int cli_cmd_warp(int argc, char **argv)
@@ -146,6 +141,7 @@ int cli_cmd_warp(int argc, char **argv)
     if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
     /* the report only once the mesh is written: its last line is what scripts parse */
     if (s >= 0) s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
+    if (s >= 0) cli_warn_inverted("warp", mesh, sj);
     rc = s < 0 ? cli_fail(ctx, "warp", s) : CLI_EXIT_OK;
     free(disp);
     free(listed);

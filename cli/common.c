@@ -2,6 +2,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <stdio.h>
@@ -150,6 +151,18 @@ int cli_same_file(const char *a, const char *b)
     return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
+int cli_check_mesh_output(const char *cmd, const char *usage, const char *out,
+                          const char *const *inputs, size_t n)
+{
+    if (cm_mesh_format_from_path(out) == CM_FORMAT_UNKNOWN)
+        return cli_usage(cmd, usage, "%s: unknown mesh extension (%s)", out,
+                         cm_mesh_format_list());
+    for (size_t k = 0; k < n; ++k)
+        if (inputs[k] && cli_same_file(out, inputs[k]))
+            return cli_usage(cmd, usage, "output %s is an input: refusing to overwrite it", out);
+    return 0;
+}
+
 int cli_threads_value(int argc, char **argv, int *i, const char *cmd, const char *usage,
                       int *threads)
 {
@@ -189,6 +202,34 @@ void cli_print_quality_line(FILE *out, const cm_quality_stats *all)
 {
     fprintf(out, "min_scaled_jacobian=%.6g mean_scaled_jacobian=%.6g inverted=%zu cells=%zu\n", all->min,
             all->mean, all->inverted, all->count);
+}
+
+size_t cli_warn_inverted(const char *cmd, const cm_mesh *mesh, const double *sj)
+{
+    size_t n = 0, worst = (size_t)-1;
+    double wv = INFINITY;
+    for (size_t c = 0; c < mesh->n_cells; ++c) {
+        const cm_cell_info *info = cm_cell_type_info((cm_cell_type)mesh->type[c]);
+        if (!info || info->dim < 3) continue;
+        /* as cm_quality_summarize counts: NaN (undefined) and Verdict's +-1e30 (collapsed) too */
+        const double v = isnan(sj[c]) ? -INFINITY : fabs(sj[c]) >= 1e30 ? 0.0 : sj[c];
+        if (v > 0) continue;
+        ++n;
+        if (worst == (size_t)-1 || v < wv) wv = v, worst = c;
+    }
+    if (n == 0) return 0;
+    double centre[3] = {0, 0, 0};
+    const int64_t *nodes = mesh->conn + mesh->offset[worst];
+    const int64_t k = mesh->offset[worst + 1] - mesh->offset[worst];
+    for (int64_t i = 0; i < k; ++i)
+        for (int d = 0; d < 3; ++d) centre[d] += mesh->xyz[3 * nodes[i] + d] / (double)k;
+    fprintf(stderr,
+            "cadmorph %s: warning: %zu inverted cell%s (scaled Jacobian <= 0); the worst is cell %zu "
+            "(0-based, %s, scaled Jacobian %.6g) at (%.6g, %.6g, %.6g)\n",
+            cmd, n, n == 1 ? "" : "s", worst,
+            cm_cell_type_info((cm_cell_type)mesh->type[worst])->name, isnan(sj[worst]) ? NAN : wv,
+            centre[0], centre[1], centre[2]);
+    return n;
 }
 
 cm_status cli_print_quality(cm_context *ctx, const cm_mesh *mesh, const double *sj, FILE *out,

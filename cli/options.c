@@ -3,6 +3,7 @@
 
 #include "cli.h"
 
+#include "cadmorph/study.h"
 #include "cadmorph/warp.h"
 
 #include <errno.h>
@@ -135,3 +136,5 @@ const char *const cli_kernel_names[] = {"triharmonic", "biharmonic", NULL};
 const char *const cli_solver_names[] = {"auto", "dense", "iterative", NULL};
 const int cli_solver_values[] = {CM_RBF_SOLVER_AUTO, CM_RBF_SOLVER_DENSE, CM_RBF_SOLVER_ITERATIVE};
 const int cli_kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};
+const char *const cli_study_mode_names[] = {"absolute", "relative", "both", NULL};
+const int cli_study_mode_values[] = {CM_STUDY_ABSOLUTE, CM_STUDY_RELATIVE, CM_STUDY_BOTH};

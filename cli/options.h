@@ -72,6 +72,9 @@ extern const char *const cli_kernel_names[];
 extern const char *const cli_solver_names[];
 extern const int cli_solver_values[];
 extern const int cli_kernel_methods[];
+/* --mode of study and sweep: absolute, relative, both (CM_STUDY_*). */
+extern const char *const cli_study_mode_names[];
+extern const int cli_study_mode_values[];
 
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
  * --help, CLI_EXIT_USAGE after a message on stderr. */

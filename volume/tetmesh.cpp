@@ -8,7 +8,8 @@
 #include "cadmorph/optimize.h"
 #include "cadmorph/tetmesh.h"
 
-#include <tetgen.h>
+#include "tetgen_run.h"
+#include "tetmesh_gmsh.h"
 
 #include <algorithm>
 #include <array>
@@ -23,22 +24,14 @@
 
 namespace {
 
-const char *tetgen_reason(int code)
-{
-    switch (code) {
-    case 1: return "out of memory";
-    case 2: return "internal error";
-    case 3: return "the surface intersects itself";
-    case 4: return "a very small input feature";
-    case 5: return "two very close input facets";
-    case 10: return "invalid input";
-    default: return "unknown error";
-    }
-}
-
 struct cad_guard {
     cm_cad_triangulation *t = nullptr;
     ~cad_guard() { cm_cad_triangulation_destroy(&t); }
+};
+
+struct tetgen_result {
+    cm_tetgen_result r = {};
+    ~tetgen_result() { cm_tetgen_result_free(&r); }
 };
 
 struct mesh_guard {
@@ -157,161 +150,19 @@ cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
     return CM_OK;
 }
 
-cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
-                cm_mesh **out)
+// The mesh from a mesher's nodes, tets and boundary triangles (each with its CAD face):
+// tets positively oriented (VTK), boundary triangles outward, groups "solid" and "face_<k>".
+cm_status assemble(cm_context *ctx, int n_faces, std::vector<double> &xyz,
+                   std::vector<std::array<int64_t, 4>> &tets, std::vector<int64_t> &tri,
+                   const std::vector<int> &tri_face, cm_mesh **out)
 {
     const char *fn = "cm_tetmesh_create";
-    cm_cad_counts counts;
-    cm_cad_get_counts(model, &counts);
-    if (counts.solids == 0)
-        return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: the model has no solid (%d faces)", fn,
-                        counts.faces);
-    const char *path = cm_cad_path(model);
-    cm_status s = cm_cad_check_solids_apart(ctx, model);
-    if (s < 0) return s;
-    double bb[6];
-    cm_cad_bbox(model, bb);
-    const double h = o.size > 0 ? o.size : cm_bbox_diagonal(bb) / 20;
-    const double q = o.quality > 0 ? o.quality : 1.4;
-    if (!std::isfinite(h) || !std::isfinite(q) || q < 1.0)
-        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: size %g or quality %g out of range (quality >= 1)",
-                        fn, h, q);
-    /* TetGen's refinement need not end for dihedral bounds much above 18 degrees */
-    if (!(o.min_dihedral >= 0 && o.min_dihedral <= 20))
-        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: minimum dihedral angle %g out of [0, 20] degrees",
-                        fn, o.min_dihedral);
-    const double vmax = h * h * h * std::sqrt(2.0) / 12.0;  // regular tet of edge h
-    // TetGen's tets average about a third of the volume bound (measured on the bore model,
-    // sizes 0.1-0.3: 2.4-2.9): estimate before the surface triangulation, which grows as
-    // 1/h^2 itself
-    double volume = 0;
-    if ((s = cm_cad_volume(ctx, model, &volume)) < 0) return s;
-    const double estimate = 3.0 * std::fabs(volume) / vmax;
-    const double max_tets = o.max_tets > 0 ? o.max_tets : CM_TETMESH_MAX_TETS;
-    if (!(estimate <= max_tets))
-        return cm_error(ctx, CM_ERR_NOMEM,
-                        "%s: size %g would make about %.2g tets (volume %g), more than the limit "
-                        "of %.3g: use a larger size or lift the limit (cadmorph mesh --force)",
-                        path, h, estimate, volume, max_tets);
-
-    const double t0 = cm_wtime();
-    cad_guard surf;
-    cm_cad_triangulate_options topt;
-    cm_cad_triangulate_options_init(&topt);
-    topt.size = h;
-    s = cm_cad_triangulate(ctx, model, &topt, &surf.t);
-    if (s < 0) return s;
-    const cm_cad_triangulation &T = *surf.t;
-    if (T.n_open_edges)
-        return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                        "%s: the faces do not close a solid (%zu open or non-manifold edges)", fn,
-                        T.n_open_edges);
-    const double t1 = cm_wtime();
-    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: surface %zu nodes, %zu triangles (%.3f s)", T.n_nodes,
-           T.n_triangles, t1 - t0);
-    cm_progress(ctx, "tetgen", 0, 1);
-
-    tetgenio in, tv;
-    in.firstnumber = 0;
-    in.numberofpoints = (int)T.n_nodes;
-    in.pointlist = new REAL[3 * T.n_nodes];
-    std::copy(T.xyz, T.xyz + 3 * T.n_nodes, in.pointlist);
-    in.numberoffacets = (int)T.n_triangles;
-    in.facetlist = new tetgenio::facet[T.n_triangles];
-    in.facetmarkerlist = new int[T.n_triangles];
-    for (size_t t = 0; t < T.n_triangles; ++t) {
-        tetgenio::facet &f = in.facetlist[t];
-        tetgenio::init(&f);
-        f.numberofpolygons = 1;
-        f.polygonlist = new tetgenio::polygon[1];
-        tetgenio::init(&f.polygonlist[0]);
-        f.polygonlist[0].numberofvertices = 3;
-        f.polygonlist[0].vertexlist = new int[3];
-        for (int k = 0; k < 3; ++k) f.polygonlist[0].vertexlist[k] = (int)T.tri[3 * t + k];
-        in.facetmarkerlist[t] = T.tri_face[t] + 1;  // 0 would mean "no marker"
-    }
-    // TetGen's error path frees its memory pools twice (terminatetetgen, then ~tetgenmesh)
-    // and crashes, so nothing may reach it that a check can find first: -d reports the
-    // triangles that intersect (what two touching solids or a bad triangulation give)
-    // without that path.
-    {
-        const double td = cm_wtime();
-        tetgenio diag;
-        char dsw[] = "pdQ";
-        try {
-            tetrahedralize(dsw, &in, &diag);
-        } catch (int code) {
-            return cm_error(ctx, code == 1 ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
-                            "%s: TetGen's intersection check failed with code %d (%s)", path,
-                            code, tetgen_reason(code));
-        }
-        if (diag.numberoftrifaces > 0) {
-            std::set<int> faces;
-            for (int t = 0; t < diag.numberoftrifaces && diag.trifacemarkerlist; ++t)
-                faces.insert(diag.trifacemarkerlist[t] - 1);
-            std::string list;
-            int shown = 0;
-            for (int f : faces) {
-                if (shown++ == 8) {
-                    list += ", ...";
-                    break;
-                }
-                list += (list.empty() ? "" : ", ") + std::to_string(f);
-            }
-            return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                            "%s: the surface triangulation intersects itself (%d triangles on "
-                            "CAD faces %s): TetGen cannot mesh it",
-                            path, diag.numberoftrifaces, list.c_str());
-        }
-        cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: no intersecting triangles (%.3f s)",
-               cm_wtime() - td);
-    }
-    char sw[128];
-    /* the dihedral bound (after the radius-edge ratio) is what removes most slivers: TetGen's
-     * -O optimisation levels changed no measured quality (benchmarks/RESULTS.md, issue 13) */
-    char dihedral[32] = "";
-    if (o.min_dihedral > 0) std::snprintf(dihedral, sizeof dihedral, "/%.6g", o.min_dihedral);
-    std::snprintf(sw, sizeof sw, "pzq%.6g%sa%.6g%sQ", q, dihedral, vmax,
-                  o.preserve_surface ? "Y" : "");
-    try {
-        tetrahedralize(sw, &in, &tv);
-    } catch (int code) {
-        return cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen failed with code %d (%s), switches %s",
-                        fn, code, tetgen_reason(code), sw);
-    }
-    if (tv.numberoftetrahedra <= 0 || tv.numberofcorners != 4)
-        return cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen made no linear tets (switches %s)", fn, sw);
-
-    const size_t nn = (size_t)tv.numberofpoints, nt = (size_t)tv.numberoftetrahedra,
-                 nb = (size_t)tv.numberoftrifaces;
-    std::vector<double> xyz(tv.pointlist, tv.pointlist + 3 * nn);
-    std::vector<int64_t> tri(nb * 3);
-    std::vector<int> tri_face(nb);
-    for (size_t t = 0; t < nb; ++t) {
-        for (int k = 0; k < 3; ++k) tri[3 * t + k] = tv.trifacelist[3 * t + k];
-        tri_face[t] = tv.trifacemarkerlist ? tv.trifacemarkerlist[t] - 1 : -1;
-        if (tri_face[t] < 0 || tri_face[t] >= counts.faces)
-            return cm_error(ctx, CM_ERR_INTERNAL, "%s: boundary triangle %zu without a CAD face", fn, t);
-    }
-    const double t2 = cm_wtime();
-    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -%s: %zu nodes, %zu tets (%.3f s)", sw, nn, nt, t2 - t1);
-    // TetGen keeps the input points first and in order; the others are its Steiner points
-    size_t n_projected = 0;
-    if (!o.preserve_surface &&
-        (s = project_new_nodes(ctx, model, T, T.n_nodes, xyz, tri, tri_face, &n_projected)) < 0)
-        return s;
-    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu new boundary nodes projected onto curved faces and edges (%.3f s)",
-           n_projected, cm_wtime() - t2);
-
-    // tets positively oriented (VTK), boundary triangles outward: away from their tet's
-    // fourth node
-    std::vector<std::array<int64_t, 4>> tets(nt);
-    for (size_t t = 0; t < nt; ++t) {
-        std::array<int64_t, 4> &c = tets[t];
-        for (int k = 0; k < 4; ++k) c[k] = tv.tetrahedronlist[4 * t + k];
+    cm_status s = CM_OK;
+    const size_t nn = xyz.size() / 3, nt = tets.size(), nb = tri_face.size();
+    // tets positively oriented; boundary triangles away from their tet's fourth node
+    for (auto &c : tets)
         if (orient(&xyz[3 * c[0]], &xyz[3 * c[1]], &xyz[3 * c[2]], &xyz[3 * c[3]]) < 0)
             std::swap(c[2], c[3]);
-    }
     std::vector<std::array<int64_t, 4>> keys;  // sorted face, then (tet's other node | -1 - tri)
     keys.reserve(4 * nt + nb);
     for (size_t t = 0; t < nb; ++t) {
@@ -352,17 +203,249 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
                                   tri_face[t] + 1, 0)) < 0)
             return s;
     if ((s = cm_mesh_add_group(ctx, m.m, 3, 1, "solid")) < 0) return s;
-    std::vector<char> used(counts.faces, 0);
+    std::vector<char> used(n_faces, 0);
     for (int f : tri_face) used[f] = 1;
-    for (int f = 0; f < counts.faces; ++f) {
+    for (int f = 0; f < n_faces; ++f) {
         if (!used[f]) continue;
         const std::string name = "face_" + std::to_string(f);
         if ((s = cm_mesh_add_group(ctx, m.m, 2, f + 1, name.c_str())) < 0) return s;
     }
-    cm_progress(ctx, "tetgen", 1, 1);
     *out = m.m;
     m.m = nullptr;
     return CM_OK;
+}
+
+cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
+                cm_mesh **out)
+{
+    const char *fn = "cm_tetmesh_create";
+    cm_cad_counts counts;
+    cm_cad_get_counts(model, &counts);
+    if (counts.solids == 0)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: the model has no solid (%d faces)", fn,
+                        counts.faces);
+    const char *path = cm_cad_path(model);
+    cm_status s = cm_cad_check_solids_apart(ctx, model);
+    if (s < 0) return s;
+    double bb[6];
+    cm_cad_bbox(model, bb);
+    const double h = o.size > 0 ? o.size : cm_bbox_diagonal(bb) / 20;
+    const double q = o.quality > 0 ? o.quality : 1.4;
+    if (!std::isfinite(h) || !std::isfinite(q) || q < 1.0)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: size %g or quality %g out of range (quality >= 1)",
+                        fn, h, q);
+    /* TetGen's refinement need not end for dihedral bounds much above 18 degrees */
+    if (!(o.min_dihedral >= 0 && o.min_dihedral <= 20))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: minimum dihedral angle %g out of [0, 20] degrees",
+                        fn, o.min_dihedral);
+    const double vmax = h * h * h * std::sqrt(2.0) / 12.0;  // regular tet of edge h
+    // TetGen's tets average about a third of the volume bound (measured on the bore model,
+    // sizes 0.1-0.3: 2.4-2.9): estimate before the surface triangulation, which grows as
+    // 1/h^2 itself
+    double volume = 0;
+    if ((s = cm_cad_volume(ctx, model, &volume)) < 0) return s;
+    const double estimate = 3.0 * std::fabs(volume) / vmax;
+    const double max_tets = o.max_tets > 0 ? o.max_tets : CM_TETMESH_MAX_TETS;
+    if (!(estimate <= max_tets))
+        return cm_error(ctx, CM_ERR_NOMEM,
+                        "%s: size %g would make about %.2g tets (volume %g), more than the limit "
+                        "of %.3g: use a larger size or lift the limit (cadmorph mesh --force)",
+                        path, h, estimate, volume, max_tets);
+
+    const double limit = o.time_limit > 0 ? o.time_limit : CM_TETMESH_TIME_LIMIT;
+    if (o.mesher == CM_MESHER_GMSH) {
+        cm_progress(ctx, "gmsh", 0, 1);
+        cmvol::raw_mesh r;
+        if ((s = cmvol::gmsh_mesh(ctx, model, h, limit, &r)) < 0) return s;
+        s = assemble(ctx, counts.faces, r.xyz, r.tets, r.tri, r.tri_face, out);
+        if (s >= 0) cm_progress(ctx, "gmsh", 1, 1);
+        return s;
+    }
+    if (o.mesher != CM_MESHER_TETGEN)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: unknown mesher %d", fn, o.mesher);
+
+    const double t0 = cm_wtime();
+    cad_guard surf;
+    cm_cad_triangulate_options topt;
+    cm_cad_triangulate_options_init(&topt);
+    topt.size = h;
+    s = cm_cad_triangulate(ctx, model, &topt, &surf.t);
+    if (s < 0) return s;
+    const cm_cad_triangulation &T = *surf.t;
+    if (T.n_open_edges)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "%s: the faces do not close a solid (%zu open or non-manifold edges)", fn,
+                        T.n_open_edges);
+    const double t1 = cm_wtime();
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: surface %zu nodes, %zu triangles (%.3f s)", T.n_nodes,
+           T.n_triangles, t1 - t0);
+    cm_progress(ctx, "tetgen", 0, 1);
+
+    const cm_tetgen_plc plc = {T.n_nodes, T.n_triangles, T.xyz, T.tri, nullptr};
+    std::vector<int> marker(T.n_triangles);
+    for (size_t t = 0; t < T.n_triangles; ++t) marker[t] = T.tri_face[t] + 1;  // 0: no marker
+    cm_tetgen_plc in = plc;
+    in.marker = marker.data();
+    // TetGen's -d reports the triangles that intersect (what two touching solids or a bad
+    // triangulation give) in words a user can act on; TetGen's error path crashes (now in the
+    // child), which says less
+    {
+        const double td = cm_wtime();
+        tetgen_result diag;
+        int failure = 0;
+        s = cm_tetgen_run(ctx, path, &in, "pdQ", limit, &diag.r, &failure);
+        if (s < 0 && failure == 0) return s;
+        if (s < 0) {
+            // a crash or a timeout of the check itself: the meshing below says what happens
+            cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: %s", cm_context_message(ctx));
+            if (failure == 3)
+                return cm_error(ctx, s, "%s: TetGen's intersection check did not finish in %.3g s "
+                                "(nothing more tried: raise the time limit, --time-limit, or try "
+                                "--mesher gmsh)", path, limit);
+        } else if (diag.r.n_trifaces > 0) {
+            std::set<int> faces;
+            for (size_t t = 0; t < diag.r.n_trifaces; ++t) faces.insert(diag.r.trimarker[t] - 1);
+            std::string list;
+            int shown = 0;
+            for (int f : faces) {
+                if (shown++ == 8) {
+                    list += ", ...";
+                    break;
+                }
+                list += (list.empty() ? "" : ", ") + std::to_string(f);
+            }
+            return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                            "%s: the surface triangulation intersects itself (%zu triangles on "
+                            "CAD faces %s): TetGen cannot mesh it",
+                            path, diag.r.n_trifaces, list.c_str());
+        } else {
+            cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: no intersecting triangles (%.3f s)",
+                   cm_wtime() - td);
+        }
+    }
+
+    // What helps when TetGen crashes, asserts or gives up on a valid surface: keeping the
+    // surface (-Y: no Steiner points on it, where fillcavity's assertion was met), a looser
+    // quality bound (less refinement near degenerate spots), a surface moved off its exact
+    // cocircular and coplanar configurations (its nodes put back afterwards)
+    struct attempt {
+        const char *label;
+        bool keep_surface;
+        double q, dihedral;
+        bool perturb;
+    };
+    std::vector<attempt> attempts = {{"the switches asked for", o.preserve_surface != 0, q,
+                                      o.min_dihedral, false}};
+    if (!o.preserve_surface) attempts.push_back({"-Y (surface kept)", true, q, o.min_dihedral, false});
+    if (q < 2 || o.min_dihedral > 0)
+        attempts.push_back({"quality q2 without a dihedral bound", o.preserve_surface != 0,
+                            std::max(q, 2.0), 0, false});
+    attempts.push_back({"a surface perturbed by 1e-6 x size", o.preserve_surface != 0, q,
+                        o.min_dihedral, true});
+    tetgen_result tv;
+    std::string tried;
+    bool preserved = o.preserve_surface != 0;
+    char sw[128] = "";
+    std::vector<double> perturbed;
+    size_t chosen = attempts.size();
+    for (size_t a = 0; a < attempts.size(); ++a) {
+        const attempt &at = attempts[a];
+        /* the dihedral bound (after the radius-edge ratio) is what removes most slivers:
+         * TetGen's -O optimisation levels changed no measured quality (benchmarks/RESULTS.md,
+         * issue 13) */
+        char dihedral[32] = "";
+        if (at.dihedral > 0) std::snprintf(dihedral, sizeof dihedral, "/%.6g", at.dihedral);
+        std::snprintf(sw, sizeof sw, "pzq%.6g%sa%.6g%sQ", at.q, dihedral, vmax,
+                      at.keep_surface ? "Y" : "");
+        in.xyz = T.xyz;
+        if (at.perturb) {
+            // a fixed sequence: the same model gives the same mesh
+            perturbed.assign(T.xyz, T.xyz + 3 * T.n_nodes);
+            uint64_t state = 0x9e3779b97f4a7c15ULL;
+            for (double &x : perturbed) {
+                state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+                x += 1e-6 * h * ((double)(state >> 11) / 9007199254740992.0 - 0.5);
+            }
+            in.xyz = perturbed.data();
+        }
+        int failure = 0;
+        s = cm_tetgen_run(ctx, path, &in, sw, limit, &tv.r, &failure);
+        if (s >= 0 && (tv.r.n_tets == 0 || tv.r.corners != 4)) {
+            cm_tetgen_result_free(&tv.r);
+            s = cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen made no linear tets (switches %s)", path, sw);
+        }
+        if (s >= 0 && at.perturb) {
+            // the input nodes go back onto the CAD model: refused if that inverts a tet
+            size_t flipped = 0;
+            std::vector<double> back(tv.r.xyz, tv.r.xyz + 3 * tv.r.n_points);
+            std::copy(T.xyz, T.xyz + 3 * T.n_nodes, back.begin());
+            for (size_t t = 0; t < tv.r.n_tets; ++t) {
+                const int32_t *c = &tv.r.tet[4 * t];
+                const double before = orient(&tv.r.xyz[3 * c[0]], &tv.r.xyz[3 * c[1]],
+                                             &tv.r.xyz[3 * c[2]], &tv.r.xyz[3 * c[3]]);
+                const double after = orient(&back[3 * c[0]], &back[3 * c[1]], &back[3 * c[2]],
+                                            &back[3 * c[3]]);
+                if ((before > 0) != (after > 0) || after == 0) ++flipped;
+            }
+            if (flipped) {
+                cm_tetgen_result_free(&tv.r);
+                s = cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen meshed the perturbed surface, but "
+                             "putting its nodes back inverts %zu tets", path, flipped);
+            } else {
+                std::copy(back.begin(), back.end(), tv.r.xyz);
+            }
+        }
+        if (s >= 0) {
+            chosen = a;
+            preserved = at.keep_surface;
+            break;
+        }
+        std::string why = cm_context_message(ctx);
+        const std::string prefix = std::string(path) + ": ";
+        if (why.compare(0, prefix.size(), prefix) == 0) why.erase(0, prefix.size());
+        tried += std::string(tried.empty() ? "" : "; ") + at.label + ": " + why;
+        if (failure == 3) break;  // a hang is not retried: each would take the whole limit
+    }
+    if (chosen == attempts.size()) {
+        const bool hung = tried.find("did not finish") != std::string::npos;
+        return cm_error(ctx, s < 0 ? s : CM_ERR_NUMERIC, "%s: TetGen could not mesh it. Tried %s%s",
+                        path, tried.c_str(),
+                        hung ? " (nothing more: raise the time limit, --time-limit, or try "
+                               "--mesher gmsh)"
+                             : " (try --mesher gmsh)");
+    }
+    if (chosen > 0)
+        cm_log(ctx, CM_LOG_WARNING, "%s: TetGen meshed with %s (switches %s) after: %s", path,
+               attempts[chosen].label, sw, tried.c_str());
+
+    if (tv.r.trimarker == nullptr && tv.r.n_trifaces)
+        return cm_error(ctx, CM_ERR_INTERNAL, "%s: TetGen gave no face markers", fn);
+    const size_t nn = tv.r.n_points, nt = tv.r.n_tets, nb = tv.r.n_trifaces;
+    std::vector<double> xyz(tv.r.xyz, tv.r.xyz + 3 * nn);
+    std::vector<int64_t> tri(nb * 3);
+    std::vector<int> tri_face(nb);
+    for (size_t t = 0; t < nb; ++t) {
+        for (int k = 0; k < 3; ++k) tri[3 * t + k] = tv.r.triface[3 * t + k];
+        tri_face[t] = tv.r.trimarker[t] - 1;
+        if (tri_face[t] < 0 || tri_face[t] >= counts.faces)
+            return cm_error(ctx, CM_ERR_INTERNAL, "%s: boundary triangle %zu without a CAD face", fn, t);
+    }
+    const double t2 = cm_wtime();
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -%s: %zu nodes, %zu tets (%.3f s)", sw, nn, nt, t2 - t1);
+    // TetGen keeps the input points first and in order; the others are its Steiner points
+    size_t n_projected = 0;
+    if (!preserved &&
+        (s = project_new_nodes(ctx, model, T, T.n_nodes, xyz, tri, tri_face, &n_projected)) < 0)
+        return s;
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu new boundary nodes projected onto curved faces and edges (%.3f s)",
+           n_projected, cm_wtime() - t2);
+
+    std::vector<std::array<int64_t, 4>> tets(nt);
+    for (size_t t = 0; t < nt; ++t)
+        for (int k = 0; k < 4; ++k) tets[t][k] = tv.r.tet[4 * t + k];
+    s = assemble(ctx, counts.faces, xyz, tets, tri, tri_face, out);
+    if (s >= 0) cm_progress(ctx, "tetgen", 1, 1);
+    return s;
 }
 
 }  // namespace
@@ -376,6 +459,8 @@ extern "C" void cm_tetmesh_options_init(cm_tetmesh_options *opt)
     opt->optimize = 1;
     opt->min_dihedral = 12;
     opt->max_tets = 0;
+    opt->time_limit = 0;
+    opt->mesher = CM_MESHER_TETGEN;
 }
 
 extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
@@ -402,9 +487,6 @@ extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *mode
         return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", fn);
     } catch (const std::exception &e) {
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: %s", fn, e.what());
-    } catch (int code) {
-        return cm_error(ctx, code == 1 ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
-                        "%s: TetGen failed with code %d (%s)", fn, code, tetgen_reason(code));
     } catch (...) {
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: unknown exception", fn);
     }

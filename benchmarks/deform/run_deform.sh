@@ -21,7 +21,7 @@ OPENBLAS_VERBOSE=2 "$bench" perf "$work" "$threads"
 cd "$work/pipe"
 steps="0.2 0.4 0.6 0.8 1.0"
 for t in 0 $steps; do "$build/benchmarks/models/cm_model" pipe "$t" "pipe_$t.step"; done
-"$cadmorph" mesh pipe_0.step -o pipe_tet.vtu --size 0.2 | tail -1
+"$cadmorph" mesh pipe_0.step -o pipe_tet.vtu --size 0.2 --mesher tetgen | tail -1
 "$build/benchmarks/models/cm_hexmesh" pipe pipe_hex.vtu | tail -1
 for mesh in tet hex; do
     targets=""

@@ -13,7 +13,7 @@ for run in "bore 0.173" "bore 0.084" "pipe 0.118" "pipe 0.052" "bracket 0.18" "b
     model=$1 size=$2
     "$build/benchmarks/models/cm_model" "$model" 0 "$work/$model.step"
     /usr/bin/time -f "rss_kb=%M wall_s=%e" "$build/cli/cadmorph" mesh "$work/$model.step" \
-        -o "$work/${model}_$size.vtu" --size "$size" -v >"$work/out.txt" 2>"$work/err.txt"
+        -o "$work/${model}_$size.vtu" --size "$size" --mesher tetgen -v >"$work/out.txt" 2>"$work/err.txt"
     awk -v model="$model" -v size="$size" '
         FNR == 1 && FILENAME ~ /out/ { for (i = 1; i <= NF; ++i) { split($i, kv, "="); v[kv[1]] = kv[2] } }
         /^min_scaled_jacobian/ { for (i = 1; i <= NF; ++i) { split($i, kv, "="); v[kv[1]] = kv[2] } }

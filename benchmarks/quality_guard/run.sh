@@ -64,7 +64,7 @@ echo "part,cells,min_sj,p01_sj,cells_default,min_sj_default,p01_sj_default,cpu_s
 /usr/bin/python3 "$here/make_parts.py" "$O" > /dev/null 2>&1
 for p in bore_0 pipe_0 bracket_0 gmsh_flange gmsh_bracket; do
   t0=$(run "$O/m.out" $C mesh "$O/$p.step" -o "$O/m.vtu" --min-dihedral 0 --no-optimize)
-  t1=$(run "$O/mo.out" $C mesh "$O/$p.step" -o "$O/m.vtu")
+  t1=$(run "$O/mo.out" $C mesh "$O/$p.step" -o "$O/m.vtu" --mesher tetgen)
   r0=$(grep '^tet4' "$O/m.out" | awk '{print $2","$3","$5}')
   r1=$(grep '^tet4' "$O/mo.out" | awk '{print $2","$3","$5}')
   echo "$p,$r0,$r1,${t0#*,},${t1#*,}"

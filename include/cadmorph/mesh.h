@@ -211,6 +211,8 @@ typedef enum cm_mesh_format {
 } cm_mesh_format;
 
 CM_API cm_mesh_format cm_mesh_format_from_path(const char *path);
+/* The extensions cm_mesh_read and cm_mesh_write know, for messages: ".msh .vtu .vtk .mesh". */
+CM_API const char *cm_mesh_format_list(void);
 
 typedef struct cm_mesh_write_options {
     int msh_version; /* 22 or 41 (default 41) */

@@ -32,7 +32,23 @@ typedef struct cm_tetmesh_options {
     /* Refused (CM_ERR_NOMEM, with the estimate) when the tets expected from the model's volume
      * and `size` exceed this; <= 0: CM_TETMESH_MAX_TETS. INFINITY lifts the limit. */
     double max_tets;
+    /* Seconds of wall time one mesher run may take (it runs in a child process, killed at
+     * the limit: CM_ERR_UNSUPPORTED "... did not finish in N s"); <= 0:
+     * CM_TETMESH_TIME_LIMIT, INFINITY: none. */
+    double time_limit;
+    /* CM_MESHER_TETGEN (the library's default, which keeps the study sweeps' meshes as
+     * recorded) or CM_MESHER_GMSH (`cadmorph mesh`'s default: gmsh's library, opened at run
+     * time, meshes the same STEP file with its OpenCASCADE kernel, `size` its largest element
+     * size; quality, min_dihedral and preserve_surface are TetGen's and ignored). gmsh's
+     * surfaces are mapped to the CAD faces by projection, so the boundary triangles carry
+     * the same face tags either way. */
+    int mesher;
 } cm_tetmesh_options;
+
+enum { CM_MESHER_TETGEN = 0, CM_MESHER_GMSH = 1 };
+
+/* Default time limit of one mesher run, seconds: a 1e7-tet mesh takes TetGen a few minutes. */
+#define CM_TETMESH_TIME_LIMIT 600.0
 
 /* Default bound on the estimated tet count: ~3 GB in TetGen and the mesh, minutes of work. */
 #define CM_TETMESH_MAX_TETS 1e7
@@ -42,13 +58,18 @@ CM_API void cm_tetmesh_options_init(cm_tetmesh_options *opt);
 /* Tet mesh of the model's solids. The mesh holds the nodes, the tets (physical 1, entity 1,
  * group "solid") and the boundary triangles, outward, each with physical and entity tag
  * face + 1 of the CAD face it lies on (groups "face_<k>", k 0-based as in cad.h).
+ * The mesher runs in a child process: its crash, abort (TetGen 1.5.0 on some valid
+ * surfaces) or hang is a status, never a signal. When TetGen fails, cadmorph tries again with
+ * the surface kept (-Y), a looser quality bound (q 2, no dihedral bound) and a surface
+ * perturbed by 1e-6 x size (its nodes put back after); success after a retry logs a warning
+ * naming what worked, failure names everything tried. A timeout is not retried.
  * Errors: CM_ERR_UNSUPPORTED for a model without a solid, whose faces do not close
  * (message: number of open edges), whose solids touch or overlap (cm_cad_check_solids_apart)
  * or whose surface triangulation intersects itself (TetGen's -d check, run first because
  * TetGen's own error path crashes), CM_ERR_NOMEM beyond max_tets, CM_ERR_CAD for a surface triangulation failure,
- * CM_ERR_NUMERIC with TetGen's code and its meaning when TetGen gives up (self-intersecting
- * or too close facets, tiny features), CM_ERR_NOMEM. TetGen itself may print a line on
- * stdout before it fails (it does so unconditionally). Not thread-safe on one model. */
+ * CM_ERR_NUMERIC with TetGen's code and its meaning, or its crash, when every retry failed,
+ * CM_ERR_UNSUPPORTED at the time limit, CM_ERR_NOMEM. What the mesher prints goes into the
+ * message's tail, never to stdout. Not thread-safe on one model. */
 CM_API cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
                             const cm_tetmesh_options *opt, cm_mesh **mesh);
 

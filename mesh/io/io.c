@@ -21,6 +21,11 @@ cm_mesh_format cm_mesh_format_from_path(const char *path)
     return CM_FORMAT_UNKNOWN;
 }
 
+const char *cm_mesh_format_list(void)
+{
+    return ".msh .vtu .vtk .mesh";
+}
+
 void cm_mesh_write_options_init(cm_mesh_write_options *opt)
 {
     if (!opt) return;
@@ -33,8 +38,8 @@ void cm_mesh_write_options_init(cm_mesh_write_options *opt)
 static cm_status unknown_extension(cm_context *ctx, const char *fn, const char *path)
 {
     return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                    "%s: %s: unknown mesh extension (expected .msh, .vtu, .vtk or .mesh)", fn,
-                    path ? path : "(null)");
+                    "%s: %s: unknown mesh extension (expected one of %s)", fn,
+                    path ? path : "(null)", cm_mesh_format_list());
 }
 
 cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh)

@@ -42,6 +42,18 @@ cm_warp_cli_test(cli_warp_flat ${CM_RUN_CLI} --exit 2 --stderr-lines 1
   --stderr "^cadmorph warp: .*flat\\.vtk: .*component 0" --
   $<TARGET_FILE:cadmorph> warp --mesh ${WD}/flat.vtk --displacements ${WD}/none.csv
   -o ${W}/cli_flat.vtu)
+# inverted cells: exit 0 (the mesh is written) with one warning line naming the count and the
+# worst cell: corner 0 of the unit cube pushed past the centre inverts the 6 tets around it,
+# the worst (cell 5, SJ -0.192587) is the summary's minimum; none on the unmoved cube
+cm_warp_cli_test(cli_warp_inverted_warns ${CM_RUN_CLI} --exit 0 --stderr-lines 1
+  --stderr "^cadmorph warp: warning: 6 inverted cells \\(scaled Jacobian <= 0\\). the worst is cell 5 \\(0-based, tet4, scaled Jacobian -0\\.192587\\) at \\(0\\.825, 0\\.575, 1\\.075\\)"
+  --last-line "min_scaled_jacobian=-0\\.192587 .* inverted=6 cells=12" --
+  $<TARGET_FILE:cadmorph> warp --mesh ${WD}/cube.vtk --displacements ${WD}/invert.csv
+  -o ${W}/cli_inverted.vtu)
+cm_warp_cli_test(cli_warp_no_inverted_no_warning ${CM_RUN_CLI} --exit 0 --stderr-lines 0
+  --last-line "min_scaled_jacobian=0\\.57735 .* inverted=0 cells=12" --
+  $<TARGET_FILE:cadmorph> warp --mesh ${WD}/cube.vtk --displacements ${WD}/none.csv
+  -o ${W}/cli_not_inverted.vtu)
 # output equal to the input: usage error, the input untouched
 cm_warp_cli_test(cli_warp_same_file ${CM_RUN_CLI} --exit 1 --stderr "is an input"
   --unchanged ${W}/sphere.vtu --

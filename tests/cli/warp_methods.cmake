@@ -47,40 +47,42 @@ set_tests_properties(cli_warp_method_unknown PROPERTIES LABELS "cli;volume"
 
 # The benchmark models: bore and pipe, TetGen tets (cadmorph mesh) and O-grid hexes
 # (cm_hexmesh) at the sweeps' sizes, an affine motion of their boundary through each method.
+# Each stage is a fixture of the next, so any one test can run alone (ctest -R).
 set(BM ${CM_TEST_WORK}/staten_models)
 add_test(NAME warp_methods_models_setup COMMAND ${CMAKE_COMMAND} -E make_directory ${BM})
 set_tests_properties(warp_methods_models_setup PROPERTIES FIXTURES_SETUP staten_models_dir
   LABELS "cli;volume")
-set(model_tests)
 foreach(model bore pipe)
   add_test(NAME warp_methods_${model}_step
     COMMAND $<TARGET_FILE:cm_model> ${model} 0 ${BM}/${model}.step)
   add_test(NAME warp_methods_${model}_tet
-    COMMAND $<TARGET_FILE:cadmorph> mesh ${BM}/${model}.step -o ${BM}/${model}_tet.msh --size 0.25)
+    COMMAND $<TARGET_FILE:cadmorph> mesh ${BM}/${model}.step -o ${BM}/${model}_tet.msh --size 0.25 --mesher tetgen)
   add_test(NAME warp_methods_${model}_hex
     COMMAND $<TARGET_FILE:cm_hexmesh> ${model} ${BM}/${model}_hex.msh 0.6667)
-  set_tests_properties(warp_methods_${model}_step warp_methods_${model}_hex PROPERTIES
-    LABELS "cli;volume" FIXTURES_REQUIRED staten_models_dir)
+  set_tests_properties(warp_methods_${model}_step PROPERTIES LABELS "cli;volume"
+    FIXTURES_REQUIRED staten_models_dir FIXTURES_SETUP staten_${model}_step)
+  set_tests_properties(warp_methods_${model}_hex PROPERTIES LABELS "cli;volume"
+    FIXTURES_REQUIRED staten_models_dir FIXTURES_SETUP staten_${model}_hex_mesh)
   set_tests_properties(warp_methods_${model}_tet PROPERTIES LABELS "cli;volume"
-    FIXTURES_REQUIRED staten_models_dir DEPENDS warp_methods_${model}_step)
+    FIXTURES_REQUIRED "staten_models_dir;staten_${model}_step"
+    FIXTURES_SETUP staten_${model}_tet_mesh)
   foreach(kind tet hex)
     set(base ${BM}/${model}_${kind})
     add_test(NAME warp_methods_${model}_${kind}_csv COMMAND ${CHK} affine-csv ${base}.msh ${base}_affine.csv)
     set_tests_properties(warp_methods_${model}_${kind}_csv PROPERTIES LABELS "cli;volume"
-      FIXTURES_REQUIRED staten_models_dir DEPENDS warp_methods_${model}_${kind})
+      FIXTURES_REQUIRED staten_${model}_${kind}_mesh FIXTURES_SETUP staten_${model}_${kind})
     set(outs)
-    set(runs)
     foreach(method femwarp lbwarp simplex)
       add_test(NAME cli_warp_${method}_${model}_${kind}
         COMMAND $<TARGET_FILE:cadmorph> warp --method ${method} --mesh ${base}.msh
                 --displacements ${base}_affine.csv -o ${base}_${method}.vtu)
       set_tests_properties(cli_warp_${method}_${model}_${kind} PROPERTIES LABELS "cli;volume"
-        FIXTURES_REQUIRED staten_models_dir DEPENDS warp_methods_${model}_${kind}_csv)
+        FIXTURES_REQUIRED staten_${model}_${kind}
+        FIXTURES_SETUP staten_${model}_${kind}_warps)
       list(APPEND outs ${base}_${method}.vtu)
-      list(APPEND runs cli_warp_${method}_${model}_${kind})
     endforeach()
     add_test(NAME cli_warp_methods_affine_${model}_${kind} COMMAND ${CHK} affine ${base}.msh ${outs})
     set_tests_properties(cli_warp_methods_affine_${model}_${kind} PROPERTIES LABELS "cli;volume"
-      FIXTURES_REQUIRED staten_models_dir DEPENDS "${runs}")
+      FIXTURES_REQUIRED "staten_${model}_${kind};staten_${model}_${kind}_warps")
   endforeach()
 endforeach()

@@ -3,7 +3,8 @@
  * tet; every boundary node on the analytic bore (a box face or the bore's cylinder, 1e-9);
  * the boundary triangles are exactly the tets' free faces, outward (their divergence-theorem
  * volume equals the tets'); tet volume = BRepGProp volume = 4*4*2 - pi*0.6^2*2 (1e-2 rel.);
- * more nodes for a smaller size; also with the surface kept as OpenCASCADE made it. And a STEP without a solid is refused. */
+ * more nodes for a smaller size; also with the surface kept as OpenCASCADE made it; each
+ * boundary triangle's nodes on the CAD face its tag names (1e-9); the same with gmsh. And a STEP without a solid is refused. */
 #include "cadmorph/tetmesh.h"
 #include "test_mesh.h"
 #include "test_util.h"
@@ -29,12 +30,13 @@ static double bore_distance(const double *p)
 }
 
 static size_t mesh_and_check(cm_context *ctx, const cm_cad_model *model, double size, int preserve,
-                             double cad_volume)
+                             double cad_volume, int mesher)
 {
     cm_tetmesh_options opt;
     cm_tetmesh_options_init(&opt);
     opt.size = size;
     opt.preserve_surface = preserve;
+    opt.mesher = mesher;
     cm_mesh *m = NULL;
     cm_status s = cm_tetmesh_create(ctx, model, &opt, &m);
     CHECK_MSG(s == CM_OK, "size %g: %s", size, cm_context_message(ctx));
@@ -48,7 +50,7 @@ static size_t mesh_and_check(cm_context *ctx, const cm_cad_model *model, double 
     CHECK_MSG(all.inverted == 0 && all.min > 0, "size %g: %zu inverted, min %g", size, all.inverted,
               all.min);
 
-    double vol = 0, div_vol = 0, worst = 0;
+    double vol = 0, div_vol = 0, worst = 0, worst_tag = 0;
     size_t n_tri = 0, n_tet = 0, bad_tags = 0;
     unsigned char *on_boundary = calloc(m->n_nodes, 1);
     const double origin[3] = {0, 0, 1};
@@ -62,7 +64,18 @@ static size_t mesh_and_check(cm_context *ctx, const cm_cad_model *model, double 
             /* outward triangles: the cones from any point sum to the enclosed volume */
             div_vol += test_tet_volume(origin, &m->xyz[3 * n[0]], &m->xyz[3 * n[1]], &m->xyz[3 * n[2]]);
             for (int k = 0; k < 3; ++k) on_boundary[n[k]] = 1;
-            if (m->entity[c] < 1 || m->entity[c] > 7) ++bad_tags;
+            if (m->entity[c] < 1 || m->entity[c] > 7) {
+                ++bad_tags;
+                continue;
+            }
+            /* the tag names the CAD face the triangle lies on (what cadmorph morph needs); one
+             * triangle in 8 (an unseeded projection costs a grid search) */
+            if (n_tri % 8) continue;
+            double p[9], d[3];
+            for (int k = 0; k < 3; ++k) memcpy(&p[3 * k], &m->xyz[3 * n[k]], sizeof(double) * 3);
+            CHECK(cm_cad_project_face(ctx, model, m->entity[c] - 1, p, 3, NULL, NULL, d, NULL) == CM_OK);
+            for (int k = 0; k < 3; ++k)
+                if (d[k] > worst_tag) worst_tag = d[k];
         }
     }
     size_t n_bnodes = 0;
@@ -74,6 +87,8 @@ static size_t mesh_and_check(cm_context *ctx, const cm_cad_model *model, double 
     }
     CHECK_MSG(worst <= 1e-9, "size %g: a boundary node is %g off the bore", size, worst);
     CHECK(bad_tags == 0);
+    CHECK_MSG(worst_tag <= 1e-9, "%s size %g: a boundary node is %g off the face of its triangle",
+              mesher == CM_MESHER_GMSH ? "gmsh" : "TetGen", size, worst_tag);
     CHECK_NEAR(vol, cad_volume, 1e-2 * cad_volume);
     CHECK_NEAR(div_vol, vol, 1e-9 * vol);
 
@@ -84,8 +99,8 @@ static size_t mesh_and_check(cm_context *ctx, const cm_cad_model *model, double 
         CHECK(b->n_nodes == n_bnodes);
         CHECK(b->n_components == 1);
     }
-    printf("size %g%s: %zu nodes, %zu tets, %zu triangles, min SJ %g, volume %.6f, "
-           "max boundary distance %g\n", size, preserve ? " (surface preserved)" : "", m->n_nodes, n_tet, n_tri, all.min, vol, worst);
+    printf("%s size %g%s: %zu nodes, %zu tets, %zu triangles, min SJ %g, volume %.6f, "
+           "max boundary distance %g\n", mesher == CM_MESHER_GMSH ? "gmsh" : "TetGen", size, preserve ? " (surface preserved)" : "", m->n_nodes, n_tet, n_tri, all.min, vol, worst);
     const size_t nodes = m->n_nodes;
     cm_mesh_boundary_destroy(&b);
     free(on_boundary);
@@ -122,12 +137,17 @@ int main(int argc, char **argv)
         }
         cm_cad_triangulation_destroy(&t);
 
-        const size_t coarse = mesh_and_check(ctx, model, 0.4, 0, cad_volume);
-        const size_t fine = mesh_and_check(ctx, model, 0.25, 0, cad_volume);
+        const size_t coarse = mesh_and_check(ctx, model, 0.4, 0, cad_volume, CM_MESHER_TETGEN);
+        const size_t fine = mesh_and_check(ctx, model, 0.25, 0, cad_volume, CM_MESHER_TETGEN);
         /* OpenCASCADE's own surface nodes, unrefined by TetGen */
-        mesh_and_check(ctx, model, 0.25, 1, cad_volume);
+        mesh_and_check(ctx, model, 0.25, 1, cad_volume, CM_MESHER_TETGEN);
         /* (0.4 / 0.25)^3 = 4.1 times the nodes in theory; ask for 1.5 */
         CHECK_MSG(fine > 1.5 * coarse, "%zu nodes at size 0.25, %zu at 0.4", fine, coarse);
+        /* gmsh, after the OpenMP loops above (optimisation, quality): its child must not
+         * wait for the parent's thread pool */
+        const size_t gcoarse = mesh_and_check(ctx, model, 0.4, 0, cad_volume, CM_MESHER_GMSH);
+        const size_t gfine = mesh_and_check(ctx, model, 0.25, 0, cad_volume, CM_MESHER_GMSH);
+        CHECK_MSG(gfine > 1.5 * gcoarse, "gmsh: %zu nodes at size 0.25, %zu at 0.4", gfine, gcoarse);
     }
     cm_cad_destroy(&model);
 

@@ -1,0 +1,318 @@
+// gmsh as the second mesher: its C API (gmshc.h) in a forked child (child_process.h), since
+// gmsh can crash or run long too. The child reads the STEP file with gmsh's OpenCASCADE
+// kernel (the same OpenCASCADE 7.6 as cad/), meshes in 3D on one thread (no OpenMP pool after
+// a fork) and sends nodes, tets and the boundary triangles with their gmsh surface tags. The
+// parent maps each gmsh surface to the CAD face all its nodes lie on, so that the boundary
+// triangles carry our face indices as the TetGen path's do.
+#include "tetmesh_gmsh.h"
+
+#include "child_process.h"
+
+// gmshc.h declares C functions without extern "C" of its own
+extern "C" {
+#include <gmshc.h>
+}
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <string>
+
+#ifndef CM_GMSH_SONAME
+#define CM_GMSH_SONAME "libgmsh.so"
+#endif
+
+namespace {
+
+// gmsh's library is opened in the child only: linked into cadmorph it would load 60 more
+// shared libraries (FLTK, OpenGL, X11, ...) into every command, 0.15 s CPU each start.
+// The prototypes are gmshc.h's own.
+#define CM_GMSH_FUNCTIONS(X)                                                                       \
+    X(gmshInitialize) X(gmshFree) X(gmshLoggerGetLastError) X(gmshOptionSetNumber)                \
+    X(gmshOptionSetString) X(gmshModelOccImportShapes) X(gmshModelOccSynchronize)                 \
+    X(gmshModelGetBoundingBox) X(gmshModelMeshGenerate) X(gmshModelMeshGetNodes)                  \
+    X(gmshModelMeshGetElementsByType) X(gmshModelGetEntities)
+
+struct gmsh_api {
+#define CM_GMSH_MEMBER(f) decltype(&::f) f = nullptr;
+    CM_GMSH_FUNCTIONS(CM_GMSH_MEMBER)
+#undef CM_GMSH_MEMBER
+};
+
+// 0 on success, else the loader's message in err
+int load_gmsh(gmsh_api *g, char *err, size_t n)
+{
+    void *lib = dlopen(CM_GMSH_SONAME, RTLD_NOW | RTLD_LOCAL);
+    if (!lib) {
+        std::snprintf(err, n, "cannot load gmsh's library (Debian package libgmsh4.8): %s", dlerror());
+        return 1;
+    }
+#define CM_GMSH_LOAD(f)                                                                            \
+    if (!(g->f = reinterpret_cast<decltype(&::f)>(dlsym(lib, #f)))) {                              \
+        std::snprintf(err, n, "%s has no %s", CM_GMSH_SONAME, #f);                                 \
+        return 1;                                                                                  \
+    }
+    CM_GMSH_FUNCTIONS(CM_GMSH_LOAD)
+#undef CM_GMSH_LOAD
+    return 0;
+}
+
+const uint64_t record_magic = 0x636d676d73686d73ULL;  // "cmgmshms"
+
+struct header {
+    uint64_t magic;
+    int64_t failed;  // 1: gmsh reported an error, message in msg
+    int64_t n_nodes, n_tets, n_tris;
+    double bbox[6];
+    char msg[400];
+};
+
+struct job {
+    const char *path;
+    const char *unit;  // OpenCASCADE's name of the target unit ("MM", "M", "INCH", ...)
+    double h;
+};
+
+int send_error(const gmsh_api &G, int fd, const char *what)
+{
+    header hd = {};
+    hd.magic = record_magic;
+    hd.failed = 1;
+    char *err = nullptr;
+    int ierr = 0;
+    G.gmshLoggerGetLastError(&err, &ierr);
+    std::snprintf(hd.msg, sizeof hd.msg, "%s%s%s", what, err && *err ? ": " : "", err ? err : "");
+    if (err) G.gmshFree(err);
+    return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
+}
+
+int child_work(void *arg, int fd)
+{
+    const job &j = *static_cast<const job *>(arg);
+    gmsh_api G;
+    char lerr[300];
+    if (load_gmsh(&G, lerr, sizeof lerr)) {
+        header hd = {};
+        hd.magic = record_magic;
+        hd.failed = 1;
+        std::snprintf(hd.msg, sizeof hd.msg, "%s", lerr);
+        return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
+    }
+    int ierr = 0;
+    G.gmshInitialize(0, nullptr, 0, &ierr);
+    if (ierr) return send_error(G, fd, "initialisation failed");
+    // quiet (errors still reach the logger), one thread: the fork left no OpenMP pool behind
+    G.gmshOptionSetNumber("General.Terminal", 0, &ierr);
+    G.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
+    G.gmshOptionSetNumber("Mesh.MaxNumThreads1D", 1, &ierr);
+    G.gmshOptionSetNumber("Mesh.MaxNumThreads2D", 1, &ierr);
+    G.gmshOptionSetNumber("Mesh.MaxNumThreads3D", 1, &ierr);
+    G.gmshOptionSetString("Geometry.OCCTargetUnit", j.unit, &ierr);
+    int *dt = nullptr;
+    size_t ndt = 0;
+    G.gmshModelOccImportShapes(j.path, &dt, &ndt, 0, "", &ierr);
+    if (dt) G.gmshFree(dt);
+    if (ierr) return send_error(G, fd, "cannot import the STEP file");
+    G.gmshModelOccSynchronize(&ierr);
+    if (ierr) return send_error(G, fd, "cannot synchronise the model");
+    header hd = {};
+    hd.magic = record_magic;
+    G.gmshModelGetBoundingBox(-1, -1, &hd.bbox[0], &hd.bbox[1], &hd.bbox[2], &hd.bbox[3],
+                            &hd.bbox[4], &hd.bbox[5], &ierr);
+    G.gmshOptionSetNumber("Mesh.MeshSizeMax", j.h, &ierr);
+    G.gmshOptionSetNumber("Mesh.MeshSizeMin", 0, &ierr);
+    G.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 12, &ierr);
+    G.gmshModelMeshGenerate(3, &ierr);
+    if (ierr) return send_error(G, fd, "meshing failed");
+
+    size_t *tags = nullptr, ntags = 0, ncoord = 0, npar = 0;
+    double *coord = nullptr, *par = nullptr;
+    G.gmshModelMeshGetNodes(&tags, &ntags, &coord, &ncoord, &par, &npar, -1, -1, 0, 0, &ierr);
+    if (ierr || ncoord != 3 * ntags) return send_error(G, fd, "cannot read the nodes");
+    size_t max_tag = 0;
+    for (size_t i = 0; i < ntags; ++i) max_tag = std::max(max_tag, tags[i]);
+    std::vector<int64_t> index(max_tag + 1, -1);
+    for (size_t i = 0; i < ntags; ++i) index[tags[i]] = (int64_t)i;
+
+    size_t *etags = nullptr, netags = 0, *enodes = nullptr, nenodes = 0;
+    G.gmshModelMeshGetElementsByType(4, &etags, &netags, &enodes, &nenodes, -1, 0, 1, &ierr);
+    if (ierr || nenodes != 4 * netags) return send_error(G, fd, "cannot read the tets");
+    if (netags == 0) return send_error(G, fd, "no tets (is there a volume?)");
+    std::vector<int64_t> tets(nenodes);
+    for (size_t i = 0; i < nenodes; ++i)
+        tets[i] = enodes[i] <= max_tag ? index[enodes[i]] : -1;
+    G.gmshFree(etags);
+    G.gmshFree(enodes);
+
+    int *surf = nullptr;
+    size_t nsurf = 0;
+    G.gmshModelGetEntities(&surf, &nsurf, 2, &ierr);
+    std::vector<int64_t> tri;
+    std::vector<int32_t> tri_tag;
+    for (size_t s = 0; s + 1 < nsurf; s += 2) {
+        const int tag = surf[s + 1];
+        G.gmshModelMeshGetElementsByType(2, &etags, &netags, &enodes, &nenodes, tag, 0, 1, &ierr);
+        if (ierr || nenodes != 3 * netags) return send_error(G, fd, "cannot read the triangles");
+        for (size_t i = 0; i < nenodes; ++i)
+            tri.push_back(enodes[i] <= max_tag ? index[enodes[i]] : -1);
+        tri_tag.insert(tri_tag.end(), netags, tag);
+        G.gmshFree(etags);
+        G.gmshFree(enodes);
+    }
+    if (surf) G.gmshFree(surf);
+    hd.n_nodes = (int64_t)ntags;
+    hd.n_tets = (int64_t)tets.size() / 4;
+    hd.n_tris = (int64_t)tri_tag.size();
+    if (cm_child_write(fd, &hd, sizeof hd) || cm_child_write(fd, coord, 8 * ncoord) ||
+        cm_child_write(fd, tets.data(), 8 * tets.size()) ||
+        cm_child_write(fd, tri.data(), 8 * tri.size()) ||
+        cm_child_write(fd, tri_tag.data(), 4 * tri_tag.size()))
+        return 3;
+    // no gmshFinalize, no frees: the process ends here
+    return 0;
+}
+
+// OpenCASCADE's unit names (xstep.cascade.unit) for cad.h's target units
+const char *occ_unit(const char *u)
+{
+    static const char *const map[][2] = {{"mm", "MM"}, {"cm", "CM"}, {"m", "M"},   {"km", "KM"},
+                                         {"in", "INCH"}, {"ft", "FT"}, {"mi", "MI"}, {"um", "UM"}};
+    for (const auto &m : map)
+        if (u && !std::strcmp(u, m[0])) return m[1];
+    return "MM";
+}
+
+}  // namespace
+
+cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
+                           double time_limit, raw_mesh *out)
+{
+    const char *path = cm_cad_path(model);
+    job j = {path, occ_unit(cm_cad_unit(model)), h};
+    char *data = nullptr;
+    size_t size = 0;
+    cm_child_outcome o;
+    cm_status s = cm_child_run(ctx, "gmsh", child_work, &j, time_limit, &data, &size, &o);
+    if (s < 0) return s;
+    if (o.timed_out || o.signal || o.exit_code != 0) {
+        std::free(data);
+        char how[700];
+        cm_child_describe(&o, how, sizeof how);
+        return cm_error(ctx, o.timed_out ? CM_ERR_UNSUPPORTED : CM_ERR_NUMERIC, "%s: gmsh %s%s",
+                        path, how, o.timed_out ? " (raise the time limit, --time-limit)" : "");
+    }
+    header hd;
+    if (size < sizeof hd || (std::memcpy(&hd, data, sizeof hd), hd.magic != record_magic)) {
+        std::free(data);
+        return cm_error(ctx, CM_ERR_INTERNAL, "%s: gmsh's child sent no record (%zu bytes)", path, size);
+    }
+    if (hd.failed) {
+        std::free(data);
+        hd.msg[sizeof hd.msg - 1] = '\0';
+        return cm_error(ctx, CM_ERR_NUMERIC, "%s: gmsh: %s", path, hd.msg);
+    }
+    const size_t nn = (size_t)hd.n_nodes, nt = (size_t)hd.n_tets, nb = (size_t)hd.n_tris;
+    const size_t need = sizeof hd + 8 * (3 * nn + 4 * nt + 3 * nb) + 4 * nb;
+    if (hd.n_nodes < 0 || hd.n_tets < 0 || hd.n_tris < 0 || size != need) {
+        std::free(data);
+        return cm_error(ctx, CM_ERR_INTERNAL, "%s: gmsh's child sent %zu bytes, %zu expected",
+                        path, size, need);
+    }
+    const char *c = data + sizeof hd;
+    out->xyz.assign((const double *)c, (const double *)c + 3 * nn);
+    c += 8 * 3 * nn;
+    std::vector<int64_t> tets((const int64_t *)c, (const int64_t *)c + 4 * nt);
+    c += 8 * 4 * nt;
+    out->tri.assign((const int64_t *)c, (const int64_t *)c + 3 * nb);
+    c += 8 * 3 * nb;
+    std::vector<int32_t> tri_tag((const int32_t *)c, (const int32_t *)c + nb);
+    std::free(data);
+    for (int64_t v : tets)
+        if (v < 0 || (size_t)v >= nn)
+            return cm_error(ctx, CM_ERR_INTERNAL, "%s: a gmsh tet has a node that is not in the mesh", path);
+    for (int64_t v : out->tri)
+        if (v < 0 || (size_t)v >= nn)
+            return cm_error(ctx, CM_ERR_INTERNAL, "%s: a gmsh triangle has a node that is not in the mesh", path);
+    // only the nodes of tets (gmsh keeps the nodes of every entity it meshed)
+    std::vector<int64_t> renum(nn, -1);
+    size_t kept = 0;
+    for (int64_t v : tets)
+        if (renum[v] < 0) renum[v] = (int64_t)kept++;
+    for (int64_t v : out->tri)
+        if (renum[v] < 0)
+            return cm_error(ctx, CM_ERR_INTERNAL, "%s: a gmsh boundary triangle is on no tet", path);
+    std::vector<double> xyz(3 * kept);
+    for (size_t i = 0; i < nn; ++i)
+        if (renum[i] >= 0) std::copy(&out->xyz[3 * i], &out->xyz[3 * i] + 3, &xyz[3 * renum[i]]);
+    out->xyz.swap(xyz);
+    for (int64_t &v : out->tri) v = renum[v];
+    out->tets.resize(nt);
+    for (size_t t = 0; t < nt; ++t)
+        for (int k = 0; k < 4; ++k) out->tets[t][k] = renum[tets[4 * t + k]];
+
+    // the same geometry and unit? gmsh's box (OpenCASCADE's, not tight on curved faces:
+    // control points, tolerances) holds ours and is of its size; the faces are checked below
+    double bb[6];
+    cm_cad_bbox(model, bb);
+    const double diag = cm_bbox_diagonal(bb), gdiag = cm_bbox_diagonal(hd.bbox);
+    bool holds = gdiag >= 0.5 * diag && gdiag <= 2 * diag;
+    for (int k = 0; k < 3; ++k)
+        holds = holds && hd.bbox[k] <= bb[k] + 1e-4 * diag && hd.bbox[k + 3] >= bb[k + 3] - 1e-4 * diag;
+    if (!holds)
+        return cm_error(ctx, CM_ERR_MISMATCH,
+                        "%s: gmsh read another geometry: its bounding box [%g %g %g, %g %g %g] "
+                        "does not fit cadmorph's [%g %g %g, %g %g %g] (another unit?)",
+                        path, hd.bbox[0], hd.bbox[1], hd.bbox[2], hd.bbox[3], hd.bbox[4],
+                        hd.bbox[5], bb[0], bb[1], bb[2], bb[3], bb[4], bb[5]);
+
+    // gmsh surface -> CAD face: the face all of the surface's nodes lie on (gmsh binds faces in
+    // OpenCASCADE's order, so face tag - 1 is tried first; a renumbering costs only time)
+    cm_cad_counts counts;
+    cm_cad_get_counts(model, &counts);
+    const double tol = 1e-7 * diag;
+    std::map<int, std::vector<int64_t>> nodes_of;
+    for (size_t t = 0; t < nb; ++t)
+        for (int k = 0; k < 3; ++k) nodes_of[tri_tag[t]].push_back(out->tri[3 * t + k]);
+    std::map<int, int> face_of;
+    std::vector<int> taken(counts.faces, 0);
+    for (auto &sn : nodes_of) {
+        std::vector<int64_t> &v = sn.second;
+        std::sort(v.begin(), v.end());
+        v.erase(std::unique(v.begin(), v.end()), v.end());
+        // up to 24 nodes spread over the surface's list
+        std::vector<double> p;
+        const size_t step = std::max<size_t>(1, v.size() / 24);
+        for (size_t i = 0; i < v.size(); i += step)
+            p.insert(p.end(), &out->xyz[3 * v[i]], &out->xyz[3 * v[i]] + 3);
+        const size_t np = p.size() / 3;
+        std::vector<double> dist(np);
+        int found = -1;
+        double best = INFINITY;
+        for (int k = -1; k < counts.faces && found < 0; ++k) {
+            const int f = k < 0 ? sn.first - 1 : k;
+            if (f < 0 || f >= counts.faces || (k >= 0 && f == sn.first - 1) || taken[f]) continue;
+            s = cm_cad_project_face(ctx, model, f, p.data(), np, nullptr, nullptr, dist.data(), nullptr);
+            if (s < 0) return s;
+            const double worst = *std::max_element(dist.begin(), dist.end());
+            best = std::min(best, worst);
+            if (worst <= tol) found = f;
+        }
+        if (found < 0)
+            return cm_error(ctx, CM_ERR_MISMATCH,
+                            "%s: gmsh's surface %d lies on no CAD face (closest: %.3g away): "
+                            "gmsh's geometry is not cadmorph's",
+                            path, sn.first, best);
+        taken[found] = 1;
+        face_of[sn.first] = found;
+    }
+    out->tri_face.resize(nb);
+    for (size_t t = 0; t < nb; ++t) out->tri_face[t] = face_of[tri_tag[t]];
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: gmsh: %zu nodes, %zu tets, %zu boundary triangles on %zu "
+           "faces (%.3f s)", nn, nt, nb, nodes_of.size(), o.seconds);
+    return CM_OK;
+}
