@@ -694,6 +694,7 @@ cm_cad_correspondence *make_result(const cm_cad_model *g, const cm_cad_model *g2
     for (size_t e = 0; e < ne; ++e) c->edge[e] = s.e[e], c->edge_flipped[e] = s.eflip[e];
     for (size_t v = 0; v < nv; ++v) c->vertex[v] = s.v[v];
     c->renumbered = renumbered;
+    for (size_t w = 0; w < s.w.size(); ++w) c->wires_restarted += s.w[w] != (int)w || s.wrot[w] != 0;
     return c;
 }
 
