@@ -15,7 +15,8 @@ foreach(t model project sample boundary)
 endforeach()
 # the correspondence of G and G' as graphs, and a morph onto a renumbered identical G'
 cm_add_unit_test(test_cad_correspond test_cad_correspond.c LIBS cm_morph cm_cad LABELS cad)
-set_tests_properties(test_cad_correspond PROPERTIES FIXTURES_REQUIRED cad_shapes)
+set_tests_properties(test_cad_correspond PROPERTIES FIXTURES_REQUIRED cad_shapes
+                     FIXTURES_SETUP cad_part_mesh)
 
 # cadmorph info: exit codes and one-line messages on real files (bad input: one stderr line).
 function(cm_cad_cli name code regex)
@@ -50,3 +51,11 @@ cm_cad_cli(cad_cli_map_needs_compare 1 "--map needs --compare" info ${CM_CAD_WOR
 add_test(NAME cad_cli_compare_map_csv COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/check_map.py
          ${CM_CAD_WORK}/block_map.csv 6 12 8)
 set_tests_properties(cad_cli_compare_map_csv PROPERTIES LABELS "cad;cli" DEPENDS cad_cli_compare_renumbered)
+# cadmorph morph renumbers G' (a re-sewn, reordered copy of G) and says so under --verbose
+add_test(NAME cad_cli_morph_renumbered COMMAND ${CM_RUN_CLI} --exit 0
+         --stderr "correspondence: G' is numbered otherwise than G: renumbered"
+         --stdout "inverted=0 cells=[1-9]" --
+         $<TARGET_FILE:cadmorph> morph --from ${CM_CAD_WORK}/part.step --to ${CM_CAD_WORK}/part_renumbered.step
+         --mesh ${CM_CAD_WORK}/part_m.vtu -o ${CM_CAD_WORK}/part_renumbered_m.vtu --verbose)
+set_tests_properties(cad_cli_morph_renumbered PROPERTIES LABELS "cad;cli"
+                     FIXTURES_REQUIRED "cad_shapes;cad_part_mesh")
