@@ -53,6 +53,10 @@ int cli_threads_parse(const char *cmd, const char *usage, const char *v, int *th
  * ends with (DESIGN.md): "min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k>
  * cells=<n>" (%.6g; cells = volume cells). */
 void cli_print_quality_line(FILE *out, const cm_quality_stats *all);
+/* checkMesh's layout of the OpenFOAM metrics, then one line
+ * max_aspect_ratio=.. max_non_orthogonality=.. avg_non_orthogonality=.. max_skewness=..
+ * wrong_pyramids=.. negative_volumes=.. failed_checks=.. cells=.. (quality_foam_print.c) */
+void cli_print_foam_quality(const cm_foam_quality *q, FILE *out);
 /* One row per present (linear) cell type - type, cells, min, mean, 1st percentile, inverted -
  * then the line above. sj: #cells as from cm_mesh_quality; all (may be NULL) receives the
  * overall stats. */
@@ -83,5 +87,6 @@ int cli_cmd_study(int argc, char **argv);
 int cli_cmd_demo(int argc, char **argv);
 int cli_cmd_optimize(int argc, char **argv);
 int cli_cmd_ffd(int argc, char **argv);
+int cli_cmd_detect(int argc, char **argv);
 
 #endif

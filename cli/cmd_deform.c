@@ -2,6 +2,7 @@
  * metaphor of the MLS paper, section 3): handle nodes H move as given, fixed nodes F stay,
  * the rest follows a space deformation (triharmonic RBF or constrained MLS). */
 #include "cli.h"
+#include "deform_constraints.h"
 
 #include "cadmorph/deform.h"
 
@@ -16,15 +17,16 @@
 
 static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
-    "[--method rbf|mls|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
-    "[--exact-constraints] [--threads N] [--verbose]";
+    "[--method rbf|mls|dmffd|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
+    "[--cubature N] [--cover S] [--lattice N] [--clamp E] [--exact-constraints] "
+    "[--constraint TYPE:SET ...] [--threads N] [--verbose]";
 
 static void print_help(void)
 {
     printf("usage: %s\n\n", usage_line);
     printf(
         "Deforms the mesh M (a surface mesh of triangles/quads, or a volume mesh; .msh .vtu\n"
-        ".vtk .mesh) by moving the handle nodes of H.csv, keeping the fixed nodes in place and\n"
+        ".vtk .mesh, surfaces also .obj .off .stl) by moving the handle nodes of H.csv, keeping the fixed nodes in place and\n"
         "letting every other node follow a space deformation. Writes M' with a per-node\n"
         "'displacement' field; surfaces also get 'mean_curvature' (H = |lap x|/2, cotangent\n"
         "Laplacian) and a mean-curvature summary, volume meshes the quality summary line.\n\n"
@@ -37,25 +39,35 @@ static void print_help(void)
         "  --fix-unlisted-boundary   fix every boundary node not in H.csv (volume: the\n"
         "                            boundary surface; surface: its border edges)\n"
         "  --method M                rbf (triharmonic, exact at H and F), mls (constrained\n"
-        "                            MLS, approximate; default) or shell (surfaces: the\n"
+        "                            MLS, approximate; default), dmffd (DM-FFD on a cubic\n"
+        "                            B-spline lattice enclosing M, least squares: H and F keep\n"
+        "                            their motion, the residual is the lattice's miss) or\n"
+        "                            shell (surfaces: the\n"
         "                            mesh-based shell of the paper's eq. 10, the ground truth;\n"
         "                            weights per unit area, not normalised)\n"
         "  --stretch GS, --bend GB   MLS / shell energy weights (default 1, 1)\n"
         "  --fix GF                  MLS / shell constraint weight (default 1000)\n"
         "  --samples K               MLS samples (default 2%% of the nodes, at least 500)\n"
+        "  --cubature N              MLS cubature points (default 4 K)\n"
+        "  --cover S                 MLS: samples covering every point (default 5)\n"
+        "  --lattice N               DM-FFD control points per axis (4..200, default 10)\n"
+        "  --clamp E                 DM-FFD: singular values <= E x the largest dropped\n"
+        "                            (default 1e-10)\n"
         "  --exact-constraints       MLS: H and F nodes get their prescribed value instead of\n"
         "                            the field's\n"
         "  -o, --output M'           output mesh (must not be an input)\n"
         "  --threads N               threads (default: all)\n"
-        "  --verbose                 timings and debug messages on stderr\n\n"
-        "exit codes: 0 done, 1 usage, 2 bad input.\n");
+        "  --verbose                 timings and debug messages on stderr\n");
+    cli_constraints_help();
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input.\n");
 }
 
 typedef struct deform_args {
     const char *mesh, *handles, *fixed, *out;
-    int fix_boundary, mls, shell, exact, threads, verbose;
-    double stretch, bend, fix;
-    size_t samples;
+    int fix_boundary, mls, shell, dmffd, exact, threads, verbose, cover, lattice;
+    double stretch, bend, fix, clamp;
+    size_t samples, cubature;
+    cli_constraints cons; /* --constraint and its options (deform_constraints.c) */
 } deform_args;
 
 static int number(const char *v, double *out)
@@ -73,9 +85,13 @@ static int parse_args(int argc, char **argv, deform_args *a)
     static const char *cmd = "deform";
     memset(a, 0, sizeof *a);
     a->mls = 1;
-    a->stretch = 1, a->bend = 1, a->fix = 1000;
+    a->stretch = 1, a->bend = 1, a->fix = 1000, a->cover = 5, a->lattice = 10;
+    cli_constraints_init(&a->cons);
     for (int i = 1; i < argc; ++i) {
         const char *o = argv[i], *v;
+        int r = cli_constraints_option(argc, argv, &i, cmd, usage_line, &a->cons);
+        if (r < 0) return CLI_EXIT_USAGE;
+        if (r > 0) continue;
         if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
             print_help();
             return CLI_EXIT_OK;
@@ -101,19 +117,31 @@ static int parse_args(int argc, char **argv, deform_args *a)
                 a->mls = 1;
             else if (!strcmp(v, "shell"))
                 a->mls = 0, a->shell = 1;
+            else if (!strcmp(v, "dmffd"))
+                a->mls = 0, a->dmffd = 1;
             else
-                return cli_usage(cmd, usage_line, "unknown method '%s' (rbf|mls|shell)", v);
+                return cli_usage(cmd, usage_line, "unknown method '%s' (rbf|mls|dmffd|shell)", v);
         } else if (!strcmp(o, "--stretch") || !strcmp(o, "--bend") || !strcmp(o, "--fix")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             double *dst = o[2] == 's' ? &a->stretch : o[2] == 'b' ? &a->bend : &a->fix;
             if (number(v, dst))
                 return cli_usage(cmd, usage_line, "%s: '%s' is not a number >= 0", o, v);
-        } else if (!strcmp(o, "--samples")) {
+        } else if (!strcmp(o, "--samples") || !strcmp(o, "--cubature")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             double d;
             if (number(v, &d) || d < 4 || d > 1e8 || d != floor(d))
-                return cli_usage(cmd, usage_line, "--samples: '%s' is not an integer >= 4", v);
-            a->samples = (size_t)d;
+                return cli_usage(cmd, usage_line, "%s: '%s' is not an integer >= 4", o, v);
+            *(o[2] == 's' ? &a->samples : &a->cubature) = (size_t)d;
+        } else if (!strcmp(o, "--cover") || !strcmp(o, "--lattice")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            double d, lo = o[2] == 'c' ? 1 : 4, hi = o[2] == 'c' ? 64 : 200;
+            if (number(v, &d) || d < lo || d > hi || d != floor(d))
+                return cli_usage(cmd, usage_line, "%s: '%s' is not an integer in %g..%g", o, v, lo, hi);
+            *(o[2] == 'c' ? &a->cover : &a->lattice) = (int)d;
+        } else if (!strcmp(o, "--clamp")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            if (number(v, &a->clamp) || !(a->clamp > 0 && a->clamp < 1))
+                return cli_usage(cmd, usage_line, "--clamp: expected a number in (0, 1), got '%s'", v);
         } else if (!strcmp(o, "--threads")) {
             if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
                 return CLI_EXIT_USAGE;
@@ -128,8 +156,10 @@ static int parse_args(int argc, char **argv, deform_args *a)
         return cli_usage(cmd, usage_line, "--fixed and --fix-unlisted-boundary exclude each other");
     if ((a->mls || a->shell) && (a->fix <= 0 || a->stretch + a->bend <= 0))
         return cli_usage(cmd, usage_line, "--fix must be > 0 and --stretch + --bend > 0");
-    const char *inputs[] = {a->mesh, a->handles, a->fixed};
-    return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 3) ? CLI_EXIT_USAGE : -1;
+    if (cli_constraints_any(&a->cons) && !a->mls)
+        return cli_usage(cmd, usage_line, "--constraint needs --method mls");
+    const char *inputs[] = {a->mesh, a->handles, a->fixed, a->cons.cad};
+    return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 4) ? CLI_EXIT_USAGE : -1;
 }
 
 /* F.csv: header `node`, one 0-based index per line; blank lines and CRLF accepted. */
@@ -230,23 +260,34 @@ int cli_cmd_deform(int argc, char **argv)
     if (s >= 0 && a.shell && volume)
         s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: --method shell deforms surface meshes only", a.mesh);
     if (s >= 0 && a.shell) s = cm_mls_shell(ctx, mesh, con, a.stretch, a.bend, a.fix, disp);
-    if (s >= 0 && !a.mls && !a.shell) s = cm_deform_rbf(ctx, mesh->n_nodes, mesh->xyz, con, disp);
+    if (s >= 0 && !a.mls && !a.shell && !a.dmffd) s = cm_deform_rbf(ctx, mesh->n_nodes, mesh->xyz, con, disp);
+    if (s >= 0 && a.dmffd)
+        s = cm_deform_dmffd(ctx, mesh->n_nodes, mesh->xyz, con, a.lattice, a.clamp, disp, &residual);
     if (s >= 0 && a.mls) {
         cm_mls_options o;
         cm_mls_options_init(&o);
         o.stretch = a.stretch, o.bend = a.bend, o.fix = a.fix, o.samples = a.samples;
+        o.cubature = a.cubature, o.cover = a.cover;
         o.keep_constrained = a.exact;
         cm_mls *mls = NULL;
-        s = cm_mls_create(ctx, mesh, con, &o, &mls);
-        if (s >= 0) s = cm_mls_apply(ctx, mls, disp, &residual);
+        cm_shape_set sets[CLI_MAX_CONSTRAINTS];
+        s = cli_constraints_resolve(ctx, mesh, &a.cons, sets);
+        if (s >= 0) s = cm_mls_create(ctx, mesh, con, &o, &mls);
+        if (s >= 0 && cli_constraints_any(&a.cons))
+            s = cli_constraints_run(ctx, mls, mesh, &a.cons, sets, disp, &residual);
+        else if (s >= 0)
+            s = cm_mls_apply(ctx, mls, disp, &residual);
+        cli_constraints_free(&a.cons, sets);
         cm_mls_stats st;
         cm_mls_get_stats(mls, &st);
         if (s >= 0)
             cm_log(ctx, CM_LOG_DEBUG,
                    "deform mls: %zu samples (%zu surface), %zu cubature points, %zu constrained; "
-                   "sample %.3f s, basis %.3f s, factor %.3f s (%zu entries), apply %.3f s",
+                   "sample %.3f s, basis %.3f s, factor %.3f s (%zu entries), apply %.3f s; CPU s "
+                   "%.3f, %.3f, %.3f, %.3f",
                    st.samples, st.surface_samples, st.cubature, st.constrained, st.t_sample,
-                   st.t_basis, st.t_factor, st.factor_nonzeros, st.t_apply);
+                   st.t_basis, st.t_factor, st.factor_nonzeros, st.t_apply, st.c_sample, st.c_basis,
+                   st.c_factor, st.c_apply);
         cm_mls_destroy(&mls);
     }
     double t1 = cm_wtime();
@@ -274,7 +315,7 @@ int cli_cmd_deform(int argc, char **argv)
             if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
             if (s >= 0) {
                 printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                       a.mls ? "mls" : a.shell ? "shell" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                       a.mls ? "mls" : a.shell ? "shell" : a.dmffd ? "dmffd" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
                 printf("mean_curvature (interior vertices): before min=%.6g mean=%.6g max=%.6g; "
                        "after min=%.6g mean=%.6g max=%.6g\n",
                        h_before[0], h_before[1], h_before[2], cnt ? mn : 0,
@@ -288,7 +329,7 @@ int cli_cmd_deform(int argc, char **argv)
         if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
         if (s >= 0) {
             printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                   a.mls ? "mls" : a.shell ? "shell" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                   a.mls ? "mls" : a.shell ? "shell" : a.dmffd ? "dmffd" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
             s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
         }
     }

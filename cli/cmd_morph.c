@@ -5,6 +5,7 @@
 
 #include "cadmorph/morph.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,7 +13,7 @@
 static const char *const usage_line =
     "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] "
-    "[--lattice N [--clamp E]] "
+    "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB --blend B] "
     "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
     "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
 
@@ -135,6 +136,7 @@ static const cli_option options[] = {
      .hi = 1, .open = 3, .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--clamp E",
      .help = "dmffd: singular values <= E x the largest are dropped\n"
              "(default 1e-10; 1e-2 keeps coarse lattices usable)"},
+    CLI_MLS_OPTIONS(args.opt.method.warp.mls),
     {.name = "--report", .kind = CLI_STRING, .dest = &args.report, .label = "--report R.csv",
      .help = "one row per step: quality, distance to G1, stage times"},
     {.name = "--fail-on-inverted", .kind = CLI_FLAG, .dest = &args.fail_on_inverted,

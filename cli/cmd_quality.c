@@ -6,15 +6,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const usage = "cadmorph quality MESH [--csv OUT.csv] [--threads N] [-h|--help]";
+static const char *const usage = "cadmorph quality MESH [--csv OUT.csv] [--foam] [--threads N] [-h|--help]";
 
 static const char *csv;
-static int threads;
+static int threads, foam;
 
 static const cli_option options[] = {
     {.name = "--csv", .kind = CLI_STRING, .dest = &csv, .label = "--csv OUT.csv",
      .help = "write cell,type,scaled_jacobian for every volume cell (cell: 0-based\n"
              "index among all elements of the file)"},
+    {.name = "--foam", .kind = CLI_FLAG, .dest = &foam, .label = "--foam",
+     .help = "first OpenFOAM checkMesh's geometry checks (v1912 definitions: aspect ratio,\n"
+             "non-orthogonality, skewness, face pyramids, volumes) in checkMesh's layout and\n"
+             "the line max_aspect_ratio=.. max_non_orthogonality=.. avg_non_orthogonality=..\n"
+             "max_skewness=.. wrong_pyramids=.. negative_volumes=.. failed_checks=.. cells=..;\n"
+             "on a polyMesh its own faces, on other meshes the faces of the volume cells"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",
      .help = "threads for the computation (default: all)"},
     {.name = "--help", .alias = "-h", .kind = CLI_HELP, .label = "-h, --help", .help = "this text"},
@@ -24,8 +30,9 @@ static int help(void)
 {
     printf("usage: %s\n\n"
            "Scaled Jacobian (as Verdict / VTK's vtkMeshQuality define it) of every volume cell of\n"
-           "MESH (.msh, .vtu, .vtk, .mesh). Prints one row per cell type - cells, minimum, mean,\n"
-           "1st percentile, inverted (scaled Jacobian <= 0) - and ends with the line\n"
+           "MESH (.msh, .vtu, .vtk, .mesh, an OpenFOAM case or polyMesh directory). Prints one row\n"
+           "per cell type - cells, minimum, mean, 1st percentile, inverted (scaled Jacobian <= 0) -\n"
+           "and ends with the line\n"
            "  min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k> cells=<n>\n\n"
            "options:\n",
            usage);
@@ -75,6 +82,14 @@ int cli_cmd_quality(int argc, char **argv)
                 mesh_path);
         rc = CLI_EXIT_BAD_INPUT;
         goto done;
+    }
+    if (foam) {
+        cm_foam_quality fq;
+        if ((s = cm_mesh_quality_foam(ctx, mesh, &fq)) < 0) {
+            rc = cli_fail(ctx, cmd, s);
+            goto done;
+        }
+        cli_print_foam_quality(&fq, stdout);
     }
     sj = malloc((mesh->n_cells ? mesh->n_cells : 1) * sizeof *sj);
     if (!sj) {

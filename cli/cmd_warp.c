@@ -5,13 +5,15 @@
 
 #include "cadmorph/warp.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 static const char *const usage_line =
     "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] "
-    "[--solver S] [--lattice N [--clamp E]] [--optimize] "
+    "[--solver S] [--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS "
+    "--bend GB --blend B] [--optimize] "
     "[--threads N] [--verbose]";
 
 typedef struct warp_args {
@@ -19,6 +21,7 @@ typedef struct warp_args {
     cm_warp_method method;
     int threads, verbose, optimize, lattice, solver;
     double clamp;
+    cm_mls_options mls;
 } warp_args;
 
 static warp_args args;
@@ -59,6 +62,7 @@ static const cli_option options[] = {
      .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--clamp E",
      .help = "dmffd: singular values <= E x the largest are dropped\n"
              "(default 1e-10; 1e-2 keeps coarse lattices usable)"},
+    CLI_MLS_OPTIONS(args.mls),
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
      .help = "threads for evaluation and quality (default: all)"},
     {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
@@ -89,6 +93,7 @@ static int parse_args(int argc, char **argv, warp_args *a)
     static const char *cmd = "warp";
     memset(&args, 0, sizeof args);
     args.method = CM_WARP_RBF;
+    cm_mls_options_init(&args.mls);
     cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
                     .unknown = "unknown argument '%s'"};
     const int parsed = cli_parse(&p, argc, argv);
@@ -125,6 +130,7 @@ int cli_cmd_warp(int argc, char **argv)
     opt.lattice = a.lattice;
     opt.solver = (cm_rbf_solver)a.solver;
     opt.clamp = a.clamp;
+    opt.mls = a.mls;
     cm_warp_mesh_stats st;
     if (s >= 0) {
         cm_optimize_options oo;

@@ -22,6 +22,7 @@ static const cli_command commands[] = {
     {"deform", cli_cmd_deform, "handle-based deformation of a surface or volume mesh (RBF, MLS, shell)"},
     {"warp", cli_cmd_warp, "move interior nodes by an RBF warp of given boundary displacements"},
     {"ffd", cli_cmd_ffd, "free-form deformation of a mesh by a control lattice (PyGeM .prm accepted)"},
+    {"detect", cli_cmd_detect, "planes, cylinders, spheres, cones of a surface mesh (efficient RANSAC)"},
     {"mesh", cli_cmd_mesh, "tet mesh of a STEP solid (OpenCASCADE surface + TetGen)"},
     {"optimize", cli_cmd_optimize, "move interior nodes to untangle and raise the worst cells"},
     {"info", cli_cmd_info, "topology summary of a STEP file, correspondence with another"},

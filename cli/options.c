@@ -132,6 +132,17 @@ int cli_parse_warp_method(const cli_parser *p, const cli_option *o, const char *
     return 0;
 }
 
+int cli_parse_size(const cli_parser *p, const cli_option *o, const char *v, void *dest)
+{
+    char *end = NULL;
+    errno = 0;
+    const long long n = strtoll(v, &end, 10);
+    if (errno || end == v || *end || n < 1 || n > 100000000)
+        return cli_usage(p->cmd, p->usage, "%s: expected an integer in 1..1e8, got '%s'", o->name, v);
+    *(size_t *)dest = (size_t)n;
+    return 0;
+}
+
 const char *const cli_kernel_names[] = {"triharmonic", "biharmonic", NULL};
 const char *const cli_solver_names[] = {"auto", "dense", "iterative", NULL};
 const int cli_solver_values[] = {CM_RBF_SOLVER_AUTO, CM_RBF_SOLVER_DENSE, CM_RBF_SOLVER_ITERATIVE};

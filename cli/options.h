@@ -76,6 +76,31 @@ extern const int cli_kernel_methods[];
 extern const char *const cli_study_mode_names[];
 extern const int cli_study_mode_values[];
 
+/* A count (1 .. 1e8) into a size_t (dest), e.g. --samples. */
+int cli_parse_size(const cli_parser *p, const cli_option *o, const char *value, void *dest);
+
+/* The MLS options of warp, morph and deform (m: a cm_mls_options lvalue, set to its defaults
+ * before parsing): --samples K, --cubature N, --cover S, --stretch GS, --bend GB, --blend B. */
+#define CLI_MLS_OPTIONS(m)                                                                        \
+    {.name = "--samples", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_size,          \
+     .dest = &(m).samples, .label = "--samples K",                                                \
+     .help = "mls: samples k (default 2%% of the nodes, at least 500)"},                          \
+    {.name = "--cubature", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_size,         \
+     .dest = &(m).cubature, .label = "--cubature N", .help = "mls: cubature points (default 4 k)"}, \
+    {.name = "--cover", .kind = CLI_INT, .dest = &(m).cover, .lo = 1, .hi = 64,                   \
+     .bad = "%s: expected 1..64 samples covering every point, got '%s'", .label = "--cover S",    \
+     .help = "mls: samples covering every point (default 5)"},                                    \
+    {.name = "--stretch", .kind = CLI_DOUBLE, .dest = &(m).stretch, .lo = 0, .hi = NAN,           \
+     .bad = "%s: '%s' is not a number >= 0", .label = "--stretch GS",                            \
+     .help = "mls: stretching weight gamma_s (default 1)"},                                       \
+    {.name = "--bend", .kind = CLI_DOUBLE, .dest = &(m).bend, .lo = 0, .hi = NAN,                 \
+     .bad = "%s: '%s' is not a number >= 0", .label = "--bend GB",                               \
+     .help = "mls: bending weight gamma_b (default 1)"},                                       \
+    {.name = "--blend", .kind = CLI_DOUBLE, .dest = &(m).blend, .lo = 0, .hi = NAN,               \
+     .bad = "%s: '%s' is not a number >= 0", .label = "--blend B",                               \
+     .help = "mls: the field's miss at the boundary decays into the interior over\n"             \
+             "B x the mean support radius (default 1.5; 0: the first cell layer takes it)"}
+
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
  * --help, CLI_EXIT_USAGE after a message on stderr. */
 int cli_parse(cli_parser *p, int argc, char **argv);

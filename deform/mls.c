@@ -1,12 +1,14 @@
 /* The MLS space deformation of a mesh (paper sections 4-5, eq. 14): samples and cubature
  * points, the sparse matrices Phi (nodes), G and L (cubature points), the normal equations
  * factored by CHOLMOD once, one solve and one sparse product per displacement. */
+#define _POSIX_C_SOURCE 200809L
 #include "mls_internal.h"
 
 #include <cholmod.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 struct cm_mls {
     size_t n_nodes, k;
@@ -21,11 +23,20 @@ struct cm_mls {
     unsigned char *is_con;
     double *wf; /* #constrained: fix weight of each (gamma_f / size of its group) */
     int keep_constrained;
+    mls_blend blend; /* keep_constrained: the residual's way into the free nodes */
+    double *rc;      /* #constrained x 3: the field's miss (scratch) */
     cholmod_common cc;
     cholmod_factor *factor;
     double *coef; /* k x 3 scratch */
     cm_mls_stats stats;
 };
+
+/* CPU seconds of the process (all threads): on a loaded machine the wall clock says little. */
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    return clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) ? 0 : (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 void cm_mls_options_init(cm_mls_options *opt)
 {
@@ -39,6 +50,7 @@ void cm_mls_options_init(cm_mls_options *opt)
     opt->bend = 1;
     opt->fix = 1000;
     opt->keep_constrained = 1;
+    opt->blend = 1.5;
     opt->seed = 1;
 }
 
@@ -55,6 +67,8 @@ void cm_mls_destroy(cm_mls **mls)
     free(m->is_con);
     free(m->wf);
     free(m->coef);
+    free(m->rc);
+    mls_blend_free(&m->blend);
     if (m->factor) cholmod_free_factor(&m->factor, &m->cc);
     cholmod_finish(&m->cc);
     free(m);
@@ -72,6 +86,16 @@ const double *cm_mls_samples(const cm_mls *mls, size_t *k)
     return mls ? mls->samples : NULL;
 }
 
+/* For the Shape-Up alternation (shapeup.c), which updates a copy of the factor. */
+void mls_view_get(cm_mls *m, mls_view *v)
+{
+    v->n_nodes = m->n_nodes, v->k = m->k;
+    v->row = m->row, v->col = m->col, v->val = m->val;
+    v->n_con = m->n_con, v->con = m->con, v->wf = m->wf, v->is_con = m->is_con;
+    v->keep_constrained = m->keep_constrained;
+    v->factor = m->factor;
+}
+
 /* Sample and cubature positions (section 5): farthest points of the dense surface and
  * volume points, a combined Lloyd relaxation that weights the surface higher; cubature
  * points by Lloyd from a random subset of the integration domain's points, their volume
@@ -86,7 +110,9 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
     size_t kv = kk - ks, N = *nq;
     size_t ns = 20 * ks + (n3 ? 0 : 5 * N), nv = n3 ? (20 * kv > 5 * N ? 20 * kv : 5 * N) : 0;
     mls_dense d;
+    double t0 = cm_wtime();
     cm_status s = mls_dense_create(ctx, mesh, ns, nv, o->seed, &d);
+    double t1 = cm_wtime();
     if (s < 0) return s;
     if (d.n_s == 0) kv = kk, ks = 0; /* no surface of positive area */
     if (d.n_v == 0) ks = kk, kv = 0;
@@ -100,8 +126,10 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
     if (s >= 0 && kv) s = mls_farthest(ctx, d.xyz + 3 * d.n_s, d.n_v, kv, o->seed + 1, c + 3 * ks);
     for (size_t i = 0; i < d.n_s + d.n_v; ++i)
         w[i] = i < d.n_s ? o->surface_weight : 1;
+    double t2 = cm_wtime();
     if (s >= 0) s = mls_lloyd(ctx, d.xyz, w, d.n_s + d.n_v, o->lloyd, kk, c, NULL);
     if (s < 0) goto fail;
+    double t3 = cm_wtime();
     /* the cubature domain: the volume of a volume mesh, else the surface */
     const double *dom = d.n_v ? d.xyz + 3 * d.n_s : d.xyz;
     size_t nd = d.n_v ? d.n_v : d.n_s;
@@ -114,6 +142,10 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
     }
     s = mls_lloyd(ctx, dom, NULL, nd, o->lloyd, N, qq, mass);
     if (s < 0) goto fail;
+    cm_log(ctx, CM_LOG_DEBUG,
+           "cm_mls: sampling: %zu + %zu dense points %.3f s, farthest points %.3f s, Lloyd of the "
+           "samples %.3f s, Lloyd of the %zu cubature points %.3f s",
+           d.n_s, d.n_v, t1 - t0, t2 - t1, t3 - t2, N, cm_wtime() - t3);
     for (size_t i = 0; i < N; ++i)
         mass[i] *= measure / (double)nd;
     mls_dense_free(&d);
@@ -141,21 +173,13 @@ static cm_status eval_rows(cm_context *ctx, const cm_mls_basis *b, size_t n, con
 {
     int64_t *row = calloc(n + 1, sizeof *row);
     if (!row) return cm_error(ctx, CM_ERR_NOMEM, "cm_mls_create: out of memory");
-    int ml = b->max_list > 0 ? b->max_list : 1;
     int nt = cm_context_threads_for(ctx, n, 1000);
     size_t unc = 0;
-#pragma omp parallel num_threads(nt) if (nt > 1) reduction(+ : unc)
-    {
-        int32_t *idx = malloc((size_t)ml * sizeof *idx);
-        double *phi = malloc((size_t)ml * sizeof *phi);
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < n; ++i) {
-            int m = idx && phi ? mls_basis_eval(b, x + 3 * i, idx, phi, NULL, NULL) : -1;
-            row[i + 1] = m;
-            if (m == 0) ++unc;
-        }
-        free(idx);
-        free(phi);
+#pragma omp parallel for schedule(static) num_threads(nt) if (nt > 1) reduction(+ : unc)
+    for (size_t i = 0; i < n; ++i) {
+        int m = mls_basis_count(b, x + 3 * i); /* the row lengths: no evaluation needed */
+        row[i + 1] = m;
+        if (m == 0) ++unc;
     }
     *uncovered = unc;
     for (size_t i = 0; i < n; ++i)
@@ -280,6 +304,8 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
         o = *opt;
     else
         cm_mls_options_init(&o);
+    if (!(o.blend >= 0))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mls_create: blend %g: need >= 0", o.blend);
     if (!(o.stretch >= 0) || !(o.bend >= 0) || !(o.fix > 0) || o.stretch + o.bend <= 0)
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_mls_create: weights stretch %g, bend %g, fix %g: need stretch, bend "
@@ -307,7 +333,7 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
         s = cm_error(ctx, CM_ERR_ARGUMENT, "cm_mls_create: no constrained node");
         goto done;
     }
-    double t0 = cm_wtime();
+    double t0 = cm_wtime(), c0 = cpu_seconds();
     size_t k = o.samples ? o.samples : (n / 50 > 500 ? n / 50 : 500);
     if (k > n) k = n;
     if (k < 4) {
@@ -318,7 +344,7 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
     s = place_points(ctx, mesh, &o, &k, &ks, &N, &m->samples, &q, &qv);
     if (s < 0) goto done;
     m->k = k;
-    double t1 = cm_wtime();
+    double t1 = cm_wtime(), c1 = cpu_seconds();
     cover = malloc((n + N) * 3 * sizeof *cover);
     if (!cover) {
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_mls_create: out of memory");
@@ -339,7 +365,7 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
                      unc, qunc);
         goto done;
     }
-    double t2 = cm_wtime();
+    double t2 = cm_wtime(), c2 = cpu_seconds();
     /* the length that makes the three terms comparable: the mean support radius, i.e. the
      * resolution of the subspace (the bounding box would let bending swamp the constraints
      * of any feature smaller than the model) */
@@ -369,8 +395,14 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
     s = factor_system(ctx, m, N, qv, qrow, qcol, qgrad, qlap, o.stretch * L * L / V,
                       o.bend * L * L * L * L / V);
     if (s < 0) goto done;
+    if (m->keep_constrained && o.blend > 0) {
+        s = mls_blend_create(ctx, n, mesh->xyz, m->is_con, m->n_con, m->con, o.blend * L, &m->blend);
+        if (s < 0) goto done;
+        m->stats.blend_nodes = m->blend.n;
+    }
     m->coef = malloc(k * 3 * sizeof *m->coef);
-    if (!m->coef) {
+    m->rc = malloc(m->n_con * 3 * sizeof *m->rc);
+    if (!m->coef || !m->rc) {
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_mls_create: out of memory");
         goto done;
     }
@@ -382,6 +414,9 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
     m->stats.t_sample = t1 - t0;
     m->stats.t_basis = t2 - t1;
     m->stats.t_factor = cm_wtime() - t2;
+    m->stats.c_sample = c1 - c0;
+    m->stats.c_basis = c2 - c1;
+    m->stats.c_factor = cpu_seconds() - c2;
 done:
     free(q), free(qv), free(qval), free(qgrad), free(qlap), free(qrow), free(qcol), free(cover);
     if (s < 0)
@@ -394,7 +429,7 @@ done:
 cm_status cm_mls_apply(cm_context *ctx, cm_mls *m, double *disp, double *residual)
 {
     if (!m || !disp) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mls_apply: NULL argument");
-    double t0 = cm_wtime();
+    double t0 = cm_wtime(), c0 = cpu_seconds();
     size_t k = m->k;
     cholmod_dense *b = cholmod_zeros(k, 3, CHOLMOD_REAL, &m->cc);
     if (!b) return cm_error(ctx, CM_ERR_NOMEM, "cm_mls_apply: out of memory");
@@ -433,7 +468,23 @@ cm_status cm_mls_apply(cm_context *ctx, cm_mls *m, double *disp, double *residua
     }
     if (!isfinite(res))
         return cm_error(ctx, CM_ERR_NUMERIC, "cm_mls_apply: non-finite displacement");
+    if (m->keep_constrained && m->blend.n) {
+        /* the miss at each constrained node (its disp is the prescribed value), then into the
+         * band of free nodes around them */
+#pragma omp parallel for schedule(static) num_threads(nt) if (nt > 1)
+        for (size_t i = 0; i < m->n_con; ++i) {
+            int64_t v = m->con[i];
+            double d[3] = {0, 0, 0};
+            for (int64_t p = m->row[v]; p < m->row[v + 1]; ++p)
+                for (int a = 0; a < 3; ++a)
+                    d[a] += m->val[p] * m->coef[3 * (size_t)m->col[p] + a];
+            for (int a = 0; a < 3; ++a)
+                m->rc[3 * i + a] = disp[3 * v + a] - d[a];
+        }
+        mls_blend_apply(&m->blend, m->rc, disp, nt);
+    }
     if (residual) *residual = res;
     m->stats.t_apply = cm_wtime() - t0;
+    m->stats.c_apply = cpu_seconds() - c0;
     return CM_OK;
 }

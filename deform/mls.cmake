@@ -5,6 +5,7 @@ add_library(cm_mls STATIC
   ${CMAKE_CURRENT_LIST_DIR}/mls_basis.c   # shape functions, gradients, Laplacians
   ${CMAKE_CURRENT_LIST_DIR}/mls_grid.c    # uniform-grid nearest samples
   ${CMAKE_CURRENT_LIST_DIR}/mls_sample.c  # dense sampling, farthest points, Lloyd
+  ${CMAKE_CURRENT_LIST_DIR}/mls_blend.c   # the residual carried into the free nodes
   ${CMAKE_CURRENT_LIST_DIR}/mls_curvature.c  # cotangent mean curvature of surfaces
   ${CMAKE_CURRENT_LIST_DIR}/mls_shell.c      # the mesh-based shell of section 3 (ground truth)
 )

@@ -206,6 +206,26 @@ static double dot4(const double *a, const double *b)
  * differentiating, and M stays well conditioned far from the origin. With
  * gamma = M+ p(x): phi_j = w_j gamma.P_j, gamma_,k = M+ (p_,k - M_,k gamma),
  * lap gamma = -M+ (lap M gamma + 2 sum_k M_,k gamma_,k) (p is linear). */
+int mls_basis_count(const cm_mls_basis *b, const double x[3])
+{
+    int ci[3];
+    for (int a = 0; a < 3; ++a) {
+        double t = floor((x[a] - b->lo[a]) / b->h);
+        if (!(t >= 0) || t >= b->n[a]) return 0;
+        ci[a] = (int)t;
+    }
+    size_t c = ((size_t)ci[2] * b->n[1] + ci[1]) * b->n[0] + ci[0];
+    int m = 0;
+    for (int32_t p = b->start[c]; p < b->start[c + 1]; ++p) {
+        int32_t j = b->items[p];
+        const double *cj = b->c + 3 * (size_t)j;
+        double d2 = (x[0] - cj[0]) * (x[0] - cj[0]) + (x[1] - cj[1]) * (x[1] - cj[1]) +
+                    (x[2] - cj[2]) * (x[2] - cj[2]);
+        m += d2 < b->sigma[j] * b->sigma[j];
+    }
+    return m;
+}
+
 int mls_basis_eval(const cm_mls_basis *b, const double x[3], int32_t *idx, double *phi,
                    double *grad, double *lap)
 {
@@ -254,14 +274,19 @@ int mls_basis_eval(const cm_mls_basis *b, const double x[3], int32_t *idx, doubl
         for (int d = 0; d < 3; ++d)
             t[5 + d] = wr * dx[d];
         t[8] = -k2 * (cs + 2 * sinc);
-        for (int i = 0; i < 4; ++i)
-            for (int j = 0; j < 4; ++j) {
-                double pp = t[i] * t[j];
-                M[4 * i + j] += w * pp;
-                for (int d = 0; d < 3; ++d)
-                    Mk[d][4 * i + j] += t[5 + d] * pp;
-                ML[4 * i + j] += t[8] * pp;
-            }
+        if (grad || lap)
+            for (int i = 0; i < 4; ++i)
+                for (int j = 0; j < 4; ++j) {
+                    double pp = t[i] * t[j];
+                    M[4 * i + j] += w * pp;
+                    for (int d = 0; d < 3; ++d)
+                        Mk[d][4 * i + j] += t[5 + d] * pp;
+                    ML[4 * i + j] += t[8] * pp;
+                }
+        else /* values only (the nodes): the derivative moments are not needed */
+            for (int i = 0; i < 4; ++i)
+                for (int j = 0; j < 4; ++j)
+                    M[4 * i + j] += w * (t[i] * t[j]);
     }
     double Mi[16], g[4], e1[4] = {1, 0, 0, 0}, gk[3][4], lg[4];
     pinv4(M, Mi);

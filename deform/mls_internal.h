@@ -37,6 +37,8 @@ struct cm_mls_basis {
     int max_list; /* longest cell list: an upper bound on the samples covering a point */
 };
 
+/* How many samples cover x: the count mls_basis_eval returns, without evaluating. */
+int mls_basis_count(const cm_mls_basis *b, const double x[3]);
 /* Shape functions at x into caller scratch of max_list entries; grad/lap may be NULL.
  * Returns the count (0: no sample covers x). */
 int mls_basis_eval(const cm_mls_basis *b, const double x[3], int32_t *idx, double *phi,
@@ -62,5 +64,40 @@ cm_status mls_farthest(cm_context *ctx, const double *xyz, size_t n, size_t k, u
  * (sum of the weights of the points closest to each centre, may be NULL). */
 cm_status mls_lloyd(cm_context *ctx, const double *xyz, const double *weight, size_t n,
                     int iterations, size_t k, double *centres, double *mass);
+
+/* What the Shape-Up alternation (shapeup.c) reads of a cm_mls: Phi at the nodes (CSR), the
+ * constrained nodes and their fix weights, and the CHOLMOD factor of eq. 14 (a
+ * cholmod_factor *, to be copied, never changed). */
+typedef struct mls_view {
+    size_t n_nodes, k;
+    const int64_t *row;
+    const int32_t *col;
+    const double *val;
+    size_t n_con;
+    const int64_t *con;
+    const double *wf;
+    const unsigned char *is_con;
+    int keep_constrained;
+    void *factor;
+} mls_view;
+
+void mls_view_get(cm_mls *m, mls_view *v);
+
+/* The residual blend (mls_blend.c): for the n free nodes within `radius` of a constrained
+ * node, width weights each (CSR with fixed-width rows) onto the constrained nodes (col: the
+ * index in the constrained list). */
+typedef struct mls_blend {
+    size_t n;
+    int width;
+    int64_t *node, *row;
+    int32_t *col;
+    double *val;
+} mls_blend;
+
+cm_status mls_blend_create(cm_context *ctx, size_t n, const double *xyz, const unsigned char *is_con,
+                           size_t n_con, const int64_t *con, double radius, mls_blend *b);
+void mls_blend_free(mls_blend *b);
+/* disp[node] += sum val r[col] (r: n_con x 3). */
+void mls_blend_apply(const mls_blend *b, const double *r, double *disp, int threads);
 
 #endif

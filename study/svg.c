@@ -2,6 +2,7 @@
  * change), one polyline per method and mode (solid absolute, dashed relative), written by hand
  * so that cadmorph needs no plotting package. */
 #include "cadmorph/study.h"
+#include "svg_common.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -15,53 +16,20 @@
 #define PY0 60.0
 #define PY1 450.0
 
-/* By cm_study_method_slot: the sweeps' three methods keep their colours. */
-static const char *const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e",
-                                      "#8c564b", "#e377c2", "#17becf", "#7f7f7f", "#bcbd22"};
-enum { N_COLOURS = sizeof colours / sizeof *colours };
 /* Curves of methods that agree lie on top of each other: the later ones are drawn thinner so
  * that the earlier stay visible. */
 static const double widths[] = {4, 2.5, 1.5};
 
+/* By cm_study_method_slot: the sweeps' three methods keep their colours. */
 static const char *colour(const cm_study_result *r, size_t m)
 {
-    return colours[cm_study_method_slot(&r->methods[m], m) % N_COLOURS];
+    return cm_svg_colours[cm_study_method_slot(&r->methods[m], m) % CM_SVG_N_COLOURS];
 }
 
 static double width(const cm_study_result *r, size_t m)
 {
     int k = cm_study_method_slot(&r->methods[m], m);
     return k < 3 ? widths[k] : 1.5;
-}
-
-/* Writes s with &, <, > and quotes escaped (model and mesh names come from the user). */
-static void xml_text(FILE *f, const char *s)
-{
-    for (; *s; ++s) {
-        switch (*s) {
-        case '&':
-            fputs("&amp;", f);
-            break;
-        case '<':
-            fputs("&lt;", f);
-            break;
-        case '>':
-            fputs("&gt;", f);
-            break;
-        case '"':
-            fputs("&quot;", f);
-            break;
-        default:
-            fputc(*s, f);
-        }
-    }
-}
-
-/* A tick step of 1, 2 or 5 x 10^k giving about 5 to 10 ticks over span. */
-static double tick_step(double span)
-{
-    double raw = span / 6, p = pow(10, floor(log10(raw))), f = raw / p;
-    return (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10) * p;
 }
 
 /* A collapsing method (min SJ down to -1) would squeeze the curves that matter into a few
@@ -97,7 +65,7 @@ static void axes(FILE *f, const frame *fr, const char *x_label)
         fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%g</text>\n", px(fr, x),
                 PY1 + 20, x);
     }
-    double step = tick_step(fr->yhi - fr->ylo);
+    double step = cm_svg_tick_step(fr->yhi - fr->ylo);
     for (double y = ceil(fr->ylo / step - 1e-9) * step; y <= fr->yhi + 1e-9 * step; y += step) {
         double v = fabs(y) < 1e-9 * step ? 0 : y;
         fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"%s\"/>\n", PX0,
@@ -122,7 +90,7 @@ static void axes(FILE *f, const frame *fr, const char *x_label)
                 PX0 + 6, PY1 - 6, SVG_Y_CLIP);
     }
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">", (PX0 + PX1) / 2, PY1 + 45);
-    xml_text(f, x_label);
+    cm_svg_text(f, x_label);
     fputs("</text>\n", f);
     fprintf(f,
             "<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\" "
@@ -188,9 +156,9 @@ static void failed_marks(FILE *f, const cm_study_result *r, const frame *fr)
                 "<path d=\"M%.1f %.1f l8 8 m0 -8 l-8 8\" stroke=\"#888\" stroke-width=\"2\">"
                 "<title>",
                 x - 4, PY1 - 12);
-        xml_text(f, w->label);
+        cm_svg_text(f, w->label);
         fputs(": ", f);
-        xml_text(f, w->message);
+        cm_svg_text(f, w->message);
         fputs("</title></path>\n", f);
     }
 }
@@ -200,7 +168,7 @@ cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const ch
     if (!r || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_write_svg: NULL input");
     frame fr = {r->min_sj0, r->min_sj0, r->x_max > 0 ? r->x_max : 1, r->x_tick, 0};
     if (!(fr.xtick > 0)) {
-        fr.xtick = tick_step(fr.xmax);
+        fr.xtick = cm_svg_tick_step(fr.xmax);
         if (fr.xtick < 1 && fr.xmax >= 1) fr.xtick = 1; /* variants are counted */
     }
     for (size_t i = 0; i < r->n_rows; ++i) {
@@ -229,9 +197,9 @@ cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const ch
             "<text x=\"%.1f\" y=\"32\" font-family=\"sans-serif\" font-size=\"17\" "
             "text-anchor=\"middle\">",
             (PX0 + PX1) / 2);
-    xml_text(f, r->model);
+    cm_svg_text(f, r->model);
     fputs(", ", f);
-    xml_text(f, r->mesh);
+    cm_svg_text(f, r->mesh);
     /* a family counted in variants is a study; one in percent of a parameter a sweep */
     fprintf(f, " mesh (%zu nodes, %zu cells): min scaled Jacobian over the %s</text>\n",
             r->nodes, r->cells, strcmp(r->x_label, "variant") ? "sweep" : "study");
@@ -251,7 +219,7 @@ cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const ch
                     "<text x=\"%.1f\" y=\"%.1f\" font-family=\"sans-serif\" "
                     "font-size=\"13\">",
                     PX1 + 68, y + 4);
-            xml_text(f, r->methods[m].name);
+            cm_svg_text(f, r->methods[m].name);
             fprintf(f, ", %s</text>\n", cm_study_mode_name(mode));
         }
     fprintf(f, "</svg>\n");

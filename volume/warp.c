@@ -52,6 +52,7 @@ void cm_warp_options_init(cm_warp_options *opt)
     if (!opt) return;
     memset(opt, 0, sizeof *opt);
     opt->method = CM_WARP_RBF;
+    cm_mls_options_init(&opt->mls);
 }
 
 cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,

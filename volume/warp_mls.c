@@ -1,5 +1,5 @@
 /* The MLS warp method (deform/, mls.h): one constrained MLS space deformation over the whole
- * mesh, every component at once, with the default weights. Approximate: the
+ * mesh, every component at once, with the options of cm_warp_options.mls. Approximate: the
  * constrained nodes keep their prescribed displacement and the apply reports how far the
  * field missed them. */
 #include "warp_method.h"
@@ -13,9 +13,7 @@ static cm_status mls_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
                             void **state)
 {
     (void)b;
-    (void)opt;
-    cm_mls_options o;
-    cm_mls_options_init(&o);
+    cm_mls_options o = opt->mls;
     /* the defaults (gamma_f = 1000): on the pipe hex a stiffer penalty (1e4 ... 1e7) meets the
      * boundary closer but leaves a worse first cell layer (benchmarks/RESULTS.md) */
     cm_mls *m = NULL;
@@ -32,10 +30,10 @@ static cm_status mls_apply(cm_context *ctx, void *state, double *disp, double *r
     cm_mls_stats st;
     cm_mls_get_stats(state, &st);
     cm_log(ctx, CM_LOG_DEBUG,
-           "warp mls: %zu samples, %zu cubature points, %zu constrained nodes; residual %.3g; "
-           "sample %.3f s, basis %.3f s, factor %.3f s, apply %.3f s",
-           st.samples, st.cubature, st.constrained, *residual, st.t_sample, st.t_basis,
-           st.t_factor, st.t_apply);
+           "warp mls: %zu samples, %zu cubature points, %zu constrained nodes, %zu blended; "
+           "residual %.3g; sample %.3f s, basis %.3f s, factor %.3f s, apply %.3f s",
+           st.samples, st.cubature, st.constrained, st.blend_nodes, *residual, st.t_sample,
+           st.t_basis, st.t_factor, st.t_apply);
     return s;
 }
 

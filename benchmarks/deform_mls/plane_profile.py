@@ -9,7 +9,8 @@ bending and pure stretching.
   mls:          `cadmorph deform --method mls` (spatial energies of section 5, 1,000 samples).
 Prints the mean curvature H = |lap x| / 2 averaged over x bins of the strip |y - 0.5| < 0.03,
 and the RMS of H - H_truth over interior vertices. Also checks cadmorph's mean_curvature
-field against this script's H of the same mesh.
+field against this script's H of the same mesh. Writes the profiles (20 bins) to
+WORK_DIR/plane_profile_bending.csv and _stretching.csv (series,x,y,style) for mls_plot.
 usage: plane_profile.py CADMORPH WORK_DIR"""
 import subprocess, sys, os, time
 import numpy as np
@@ -102,6 +103,15 @@ for label, gs, gb in (("bending", 0.0, 1.0), ("stretching", 1.0, 0.0)):
     print("| method | " + " | ".join("x~%.2f" % (0.5 * (bins[i] + bins[i + 1])) for i in range(10)) +
           " | RMS(H - H_truth) | max H | time s |")
     print("|---" * 14 + "|")
+    fine = np.linspace(0, 1, 21)
+    with open("plane_profile_%s.csv" % label, "w") as f:
+        f.write("series,x,y,style\n")
+        for name, (H, tt) in res.items():
+            for i in range(20):
+                sel = strip & (X[:, 0] >= fine[i]) & (X[:, 0] < fine[i + 1])
+                if sel.any():
+                    f.write("%s,%.3f,%.6g,%s\n" % (name.replace(",", ";"), 0.5 * (fine[i] + fine[i + 1]), np.mean(H[sel]),
+                                                  "solid+markers" if name.startswith("truth") else "dashed+markers"))
     for name, (H, tt) in res.items():
         prof = [np.mean(H[strip & (X[:, 0] >= bins[i]) & (X[:, 0] < bins[i + 1])]) for i in range(10)]
         rms = np.sqrt(np.mean((H - H_true)[~border] ** 2))

@@ -190,6 +190,15 @@ CM_API cm_status cm_ffd_read_displacements(cm_context *ctx, const char *path, co
 CM_API cm_status cm_deform_rbf(cm_context *ctx, size_t n, const double *xyz,
                                const unsigned char *constrained, double *disp);
 
+/* The DM-FFD space deformation (handles): a cubic B-spline lattice of lattice^3 control
+ * points (4..200) enclosing all n points, DM-FFD through the constrained points with singular
+ * values <= clamp x sigma_max clamped (clamp <= 0: the default 1e-10), written at the others.
+ * The constrained points keep their disp; *residual (may be NULL): the lattice's max miss of
+ * them, |Phi C - H|_inf. Needs no cells. */
+CM_API cm_status cm_deform_dmffd(cm_context *ctx, size_t n, const double *xyz,
+                                 const unsigned char *constrained, int lattice, double clamp,
+                                 double *disp, double *residual);
+
 #ifdef __cplusplus
 }
 #endif

@@ -105,6 +105,9 @@ typedef struct cm_mesh {
 
     /* private: allocated lengths */
     size_t cap_nodes, cap_cells, cap_conn;
+    /* private: the OpenFOAM polyMesh the mesh was read from (faces, owner, patches, how
+     * `points` was stored), shared by copies; NULL for other formats */
+    struct cm_foam_poly *foam;
 } cm_mesh;
 
 CM_API cm_status cm_mesh_create(cm_context *ctx, cm_mesh **mesh);
@@ -197,7 +200,12 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
 
 /* ---- files ----
  * Formats by extension: .msh (gmsh 2.2 / 4.1, ASCII / binary little-endian), .vtu (VTK XML),
- * .vtk (legacy UNSTRUCTURED_GRID, ASCII / binary), .mesh (Medit ASCII).
+ * .vtk (legacy UNSTRUCTURED_GRID, ASCII / binary), .mesh (Medit ASCII); surface meshes also
+ * .obj (Wavefront), .off and .stl (binary / ASCII; corners merged into nodes when read); and
+ * OpenFOAM polyMesh for a path that is a directory, ends in '/', is named polyMesh or has no
+ * extension (a case directory: its constant/polyMesh is read or written; ASCII / binary,
+ * plain / .gz). A polyMesh read and written back changes `points` only: the other files are
+ * copied byte for byte.
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */
@@ -207,16 +215,21 @@ typedef enum cm_mesh_format {
     CM_FORMAT_MSH,
     CM_FORMAT_VTU,
     CM_FORMAT_VTK,
-    CM_FORMAT_MEDIT
+    CM_FORMAT_MEDIT,
+    CM_FORMAT_OBJ, /* surface formats: faces (and, in .obj, lines) only */
+    CM_FORMAT_OFF,
+    CM_FORMAT_STL,
+    CM_FORMAT_FOAM /* OpenFOAM polyMesh: a case directory or its constant/polyMesh */
 } cm_mesh_format;
 
 CM_API cm_mesh_format cm_mesh_format_from_path(const char *path);
-/* The extensions cm_mesh_read and cm_mesh_write know, for messages: ".msh .vtu .vtk .mesh". */
+/* The extensions cm_mesh_read and cm_mesh_write know, for messages:
+ * ".msh .vtu .vtk .mesh, or an OpenFOAM case directory". */
 CM_API const char *cm_mesh_format_list(void);
 
 typedef struct cm_mesh_write_options {
     int msh_version; /* 22 or 41 (default 41) */
-    int binary;      /* msh, vtk: binary; vtu: base64 data (appended raw if also `appended`) */
+    int binary;      /* msh, vtk, stl: binary; vtu: base64 data (appended raw if also `appended`) */
     int compress;    /* vtu: zlib compression (default on) */
     int appended;    /* vtu: appended raw data section */
 } cm_mesh_write_options;
@@ -273,6 +286,42 @@ typedef struct cm_quality_stats {
  * output may be NULL. sj as from cm_mesh_quality. */
 CM_API cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const double *sj,
                                       cm_quality_stats *per_type, cm_quality_stats *all);
+
+/* ---- OpenFOAM checkMesh's geometry checks (as OpenFOAM v1912 defines them) ----
+ * Face centres and areas by the triangle fan about the face's point average, cell centres
+ * and volumes by face pyramids about the face-centre average; non-orthogonality over internal
+ * faces (degrees), skewness over all faces (boundary faces against their mirror), aspect
+ * ratio from the cell's summed |area| components, face pyramids of owner and neighbour.
+ * Thresholds are checkMesh's: aspect ratio 1000, non-orthogonality 70 degrees (error past
+ * 90), skewness 4, cell openness 1e-6. Uses the polyMesh's own faces when the mesh was read
+ * from one, else the faces of its volume cells (matched between cells). */
+typedef struct cm_foam_quality {
+    size_t points, faces, internal_faces, cells, patches;
+    size_t hexahedra, prisms, pyramids, tetrahedra, polyhedra; /* by cadmorph's recognition */
+    double bbox[6];
+    int directions[3];              /* 1: geometric direction, -1: empty (2D) */
+    double boundary_openness[3];
+    double max_cell_openness;
+    size_t open_cells;
+    double max_aspect_ratio;
+    size_t high_aspect_cells;       /* aspect ratio > 1000 */
+    int64_t worst_aspect_cell;
+    double min_face_area, max_face_area;
+    size_t zero_area_faces;
+    double min_volume, max_volume, total_volume;
+    size_t negative_volume_cells;   /* volume < 1e-300 */
+    double max_non_orthogonality, avg_non_orthogonality; /* degrees */
+    size_t severe_non_orthogonal_faces, non_orthogonality_errors;
+    int64_t worst_non_orthogonal_face;
+    size_t wrong_pyramids;          /* faces with a pyramid volume < -1e-15 (owner and neighbour) */
+    double max_skewness;
+    size_t high_skew_faces;         /* skewness > 4 */
+    int64_t worst_skew_face;
+    int boundary_open;              /* boundary openness > 1e-6 */
+    size_t failed_checks;           /* as checkMesh counts them ("Failed N mesh checks.") */
+} cm_foam_quality;
+
+CM_API cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_quality *q);
 
 #ifdef __cplusplus
 }

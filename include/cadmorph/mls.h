@@ -55,6 +55,10 @@ typedef struct cm_mls_options {
     double fix;            /* gamma_f (1000) */
     int keep_constrained;  /* apply: constrained nodes keep their prescribed value (1) or get
                               the field's value (0) */
+    double blend;          /* keep_constrained: the field's miss at the constrained nodes is
+                              carried into the free nodes near them and decays over blend x
+                              the mean support radius (1.5; 0: off, the miss stays in the
+                              first cell layer) */
     uint64_t seed;         /* random sampling (1) */
 } cm_mls_options;
 
@@ -83,7 +87,9 @@ typedef struct cm_mls_stats {
     size_t samples, surface_samples, cubature, constrained;
     size_t phi_nonzeros;    /* shape-function values stored for the nodes */
     size_t factor_nonzeros; /* entries of the Cholesky factor */
+    size_t blend_nodes;     /* free nodes the residual blend reaches (options.blend) */
     double t_sample, t_basis, t_factor, t_apply; /* seconds (t_apply: the last call) */
+    double c_sample, c_basis, c_factor, c_apply; /* the same as CPU seconds of the process */
 } cm_mls_stats;
 
 CM_API void cm_mls_get_stats(const cm_mls *mls, cm_mls_stats *stats);

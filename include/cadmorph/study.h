@@ -199,6 +199,30 @@ CM_API cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, c
  * failed variants are marked on the x axis. */
 CM_API cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const char *path);
 
+/* ---- the general line plot (the benchmarks' figures) ---- */
+
+typedef struct cm_plot_series {
+    const char *name; /* legend */
+    size_t n;
+    const double *x, *y; /* n points each; non-finite ones (and <= 0 on a log axis) skipped */
+    int dashed;          /* dashed line */
+    int markers;         /* a dot per point */
+    int colour;          /* slot in the colour table; -1: the series' index */
+} cm_plot_series;
+
+typedef struct cm_plot {
+    const char *title, *x_label, *y_label;
+    const char *note; /* a line under the plot, or NULL */
+    int log_x, log_y;
+    double y_min, y_max; /* linear y range if y_min < y_max (values outside are drawn on the
+                            frame as triangles), else fitted to the data */
+    size_t n_series;
+    const cm_plot_series *series;
+} cm_plot;
+
+/* Writes the plot as SVG (atomically, like the meshes). */
+CM_API cm_status cm_plot_write_svg(cm_context *ctx, const cm_plot *p, const char *path);
+
 /* ---- sweeps of the built-in models (models.h): `cadmorph sweep` and `demo` ---- */
 
 typedef struct cm_sweep_options {

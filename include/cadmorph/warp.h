@@ -15,6 +15,7 @@
 #define CADMORPH_WARP_H
 
 #include "cadmorph/mesh.h"
+#include "cadmorph/mls.h"
 #include "cadmorph/optimize.h"
 #include "cadmorph/rbf.h"
 
@@ -53,6 +54,9 @@ typedef struct cm_warp_options {
     int lattice;
     /* DM-FFD: singular values <= clamp x sigma_max are truncated; 0 = 1e-10 */
     double clamp;
+    /* MLS: samples k, cubature N, coverage s, gamma_s, gamma_b, ... (mls.h; set to
+     * cm_mls_options_init's defaults by cm_warp_options_init) */
+    cm_mls_options mls;
 } cm_warp_options;
 
 CM_API void cm_warp_options_init(cm_warp_options *opt);

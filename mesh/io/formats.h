@@ -18,5 +18,17 @@ cm_status cm_mesh_write_vtk(cm_context *ctx, const cm_mesh *mesh, const char *pa
 cm_status cm_mesh_read_medit(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_medit(cm_context *ctx, const cm_mesh *mesh, const char *path,
                               const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_obj(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_obj(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_off(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_off(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_stl(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_stl(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                             const cm_mesh_write_options *opt);
 
 #endif

@@ -1,29 +1,57 @@
 /* Mesh file dispatch by extension and the helpers every reader and writer shares. */
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
+#include "foam_internal.h"
 
 #include <ctype.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
-cm_mesh_format cm_mesh_format_from_path(const char *path)
+/* The format a file name's extension names (CM_FORMAT_UNKNOWN for none or another). */
+static cm_mesh_format format_of_extension(const char *path)
 {
     const char *dot = path ? strrchr(path, '.') : NULL;
     if (!dot || strchr(dot, '/')) return CM_FORMAT_UNKNOWN;
     char ext[8] = {0};
-    for (size_t i = 0; i < sizeof ext - 1 && dot[1 + i]; ++i) ext[i] = (char)tolower((unsigned char)dot[1 + i]);
     if (strlen(dot + 1) >= sizeof ext) return CM_FORMAT_UNKNOWN;
+    for (size_t i = 0; dot[1 + i]; ++i) ext[i] = (char)tolower((unsigned char)dot[1 + i]);
     if (!strcmp(ext, "msh")) return CM_FORMAT_MSH;
     if (!strcmp(ext, "vtu")) return CM_FORMAT_VTU;
     if (!strcmp(ext, "vtk")) return CM_FORMAT_VTK;
     if (!strcmp(ext, "mesh")) return CM_FORMAT_MEDIT;
+    if (!strcmp(ext, "obj")) return CM_FORMAT_OBJ;
+    if (!strcmp(ext, "off")) return CM_FORMAT_OFF;
+    if (!strcmp(ext, "stl")) return CM_FORMAT_STL;
     return CM_FORMAT_UNKNOWN;
+}
+
+/* An OpenFOAM case or polyMesh directory: a trailing '/', or (unless the name ends in a mesh
+ * file extension) an existing directory, a last component named polyMesh, or one without an
+ * extension that is not an existing file. */
+int cm_foam_is_path(const char *path)
+{
+    if (!path || !*path) return 0;
+    size_t l = strlen(path);
+    if (path[l - 1] == '/') return 1;
+    /* a name with a file format's extension stays that format, even if it is a directory */
+    if (format_of_extension(path) != CM_FORMAT_UNKNOWN) return 0;
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    struct stat st;
+    if (stat(path, &st) == 0) return S_ISDIR(st.st_mode);
+    return strcmp(base, "polyMesh") == 0 || strchr(base, '.') == NULL;
+}
+
+cm_mesh_format cm_mesh_format_from_path(const char *path)
+{
+    return cm_foam_is_path(path) ? CM_FORMAT_FOAM : format_of_extension(path);
 }
 
 const char *cm_mesh_format_list(void)
 {
-    return ".msh .vtu .vtk .mesh";
+    return ".msh .vtu .vtk .mesh .obj .off .stl, or an OpenFOAM case directory";
 }
 
 void cm_mesh_write_options_init(cm_mesh_write_options *opt)
@@ -52,6 +80,10 @@ cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh)
     case CM_FORMAT_VTU: s = cm_mesh_read_vtu(ctx, path, mesh); break;
     case CM_FORMAT_VTK: s = cm_mesh_read_vtk(ctx, path, mesh); break;
     case CM_FORMAT_MEDIT: s = cm_mesh_read_medit(ctx, path, mesh); break;
+    case CM_FORMAT_OBJ: s = cm_mesh_read_obj(ctx, path, mesh); break;
+    case CM_FORMAT_OFF: s = cm_mesh_read_off(ctx, path, mesh); break;
+    case CM_FORMAT_STL: s = cm_mesh_read_stl(ctx, path, mesh); break;
+    case CM_FORMAT_FOAM: s = cm_mesh_read_foam(ctx, path, mesh); break;
     default: return unknown_extension(ctx, "cm_mesh_read", path);
     }
     if (s < 0) return s;
@@ -77,6 +109,10 @@ cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
     case CM_FORMAT_VTU: return cm_mesh_write_vtu(ctx, mesh, path, opt);
     case CM_FORMAT_VTK: return cm_mesh_write_vtk(ctx, mesh, path, opt);
     case CM_FORMAT_MEDIT: return cm_mesh_write_medit(ctx, mesh, path, opt);
+    case CM_FORMAT_OBJ: return cm_mesh_write_obj(ctx, mesh, path, opt);
+    case CM_FORMAT_OFF: return cm_mesh_write_off(ctx, mesh, path, opt);
+    case CM_FORMAT_STL: return cm_mesh_write_stl(ctx, mesh, path, opt);
+    case CM_FORMAT_FOAM: return cm_mesh_write_foam(ctx, mesh, path, opt);
     default: return unknown_extension(ctx, "cm_mesh_write", path);
     }
 }

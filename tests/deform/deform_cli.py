@@ -117,6 +117,103 @@ for method in ("mls", "rbf"):
             check(w.returncode == 0 and np.abs(d - dw).max() < 1e-12,
                   "box rbf vs warp: %g" % np.abs(d - dw).max())
 
+# --method dmffd on the box: the handle face keeps its motion, the interior follows, valid
+rc, out, err = run("--mesh", "box.vtk", "--handles", "box_H.csv", "--fix-unlisted-boundary",
+                   "--method", "dmffd", "--lattice", "6", "-o", "box_dmffd.vtu")
+check(rc == 0 and out.startswith("deform: dmffd, %d handle nodes" % len(face)), "box dmffd: exit %d %s %s" % (rc, out, err))
+check(re.search(r"inverted=0 cells=216\n$", out), "box dmffd: quality line: " + out)
+if rc == 0:
+    d = meshio.read("box_dmffd.vtu").point_data["displacement"]
+    check(np.abs(d[face, 0] - 0.1).max() == 0, "box dmffd: handles keep their motion")
+    # least norm: the lattice moves the centre less than the RBF's 0.05 (0.008 here)
+    check(0.004 < d[mid, 0] < 0.09, "box dmffd: interior node follows: %g" % d[mid, 0])
+    res = float(re.search(r"residual (\S+)", out).group(1))
+    check(0 < res < 0.1, "box dmffd: residual (the lattice's miss) %g" % res)
+# a coarser clamp changes the least-squares solution
+rc2, out2, _ = run("--mesh", "box.vtk", "--handles", "box_H.csv", "--fix-unlisted-boundary",
+                   "--method", "dmffd", "--lattice", "6", "--clamp", "0.5", "-o", "box_dmffd2.vtu")
+check(rc2 == 0 and re.search(r"residual (\S+)", out2).group(1) != re.search(r"residual (\S+)", out).group(1),
+      "box dmffd --clamp 0.5 changes the residual: %s / %s" % (out, out2))
+
+# the MLS options reach the deformation: cubature, coverage and weights change the result
+base = None
+for extra in ([], ["--cubature", "900"], ["--cover", "8"], ["--stretch", "0"], ["--bend", "0"]):
+    rc, out, err = run("--mesh", "plate.vtk", "--handles", "plate_H.csv", "--fix-unlisted-boundary",
+                       "--samples", "200", *extra, "-o", "plate_opt.vtu")
+    check(rc == 0, "plate mls %s: exit %d %s" % (extra, rc, err))
+    if rc:
+        continue
+    d = meshio.read("plate_opt.vtu").point_data["displacement"]
+    if base is None:
+        base = d
+    else:
+        check(np.abs(d - base).max() > 1e-6, "plate mls %s: same field as the defaults" % extra)
+
+# a gmsh surface mesh (.msh: a spherical cap of triangles) in, the surface formats out
+import gmsh
+gmsh.initialize()
+gmsh.option.setNumber("General.Verbosity", 0)
+gmsh.model.add("cap")
+gmsh.model.occ.addSphere(0, 0, 0, 1, 1, -np.pi / 2, 0.2, 2 * np.pi)
+gmsh.model.occ.synchronize()
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.12)
+gmsh.model.mesh.generate(2)
+gmsh.write("cap.msh")
+gmsh.finalize()
+cap = meshio.read("cap.msh")
+top = np.nonzero(cap.points[:, 2] > 0.1)[0]
+with open("cap_H.csv", "w") as f:
+    f.write("node,dx,dy,dz\n" + "".join("%d,0,0,0.1\n" % v for v in top))
+low = np.nonzero(cap.points[:, 2] < -0.9)[0]
+with open("cap_F.csv", "w") as f:
+    f.write("node\n" + "".join("%d\n" % v for v in low))
+outs = {}
+for method, fmt in (("mls", "obj"), ("rbf", "stl"), ("dmffd", "off"), ("mls", "vtu")):
+    name = "cap_%s.%s" % (method, fmt)
+    rc, out, err = run("--mesh", "cap.msh", "--handles", "cap_H.csv", "--fixed", "cap_F.csv",
+                       "--method", method, "--samples", "300", "-o", name)
+    check(rc == 0 and "mean_curvature (interior vertices)" in out, "gmsh cap %s -> %s: exit %d %s %s" % (method, fmt, rc, out, err))
+    if rc == 0:
+        m = meshio.read(name)
+        outs[name] = m
+        moved = m.points[top] - cap.points[top] if fmt != "stl" else None
+        if moved is not None:
+            check(np.abs(moved[:, 2] - 0.1).max() < 1e-2, "%s: handles lifted (%g)" % (name, np.abs(moved[:, 2] - 0.1).max()))
+# the .obj written by mls reads back through cadmorph (a surface mesh in .obj in, .stl out)
+if "cap_mls.obj" in outs:
+    with open("capobj_H.csv", "w") as f:
+        f.write("node,dx,dy,dz\n" + "".join("%d,0.05,0,0\n" % v for v in top))
+    rc, out, err = run("--mesh", "cap_mls.obj", "--handles", "capobj_H.csv", "--fix-unlisted-boundary",
+                       "--method", "rbf", "-o", "cap_again.stl")
+    check(rc == 0, "obj in: exit %d %s" % (rc, err))
+
+# a gmsh volume mesh (.msh of tets) through deform
+vol = os.path.join(sys.argv[2], "msh", "box_hole_41.msh")
+vm = meshio.read(vol)
+vh = np.nonzero(vm.points[:, 0] > vm.points[:, 0].max() - 1e-9)[0]
+with open("vol_H.csv", "w") as f:
+    f.write("node,dx,dy,dz\n" + "".join("%d,%g,0,0\n" % (v, 0.02 * np.ptp(vm.points[:, 0])) for v in vh))
+for method in ("mls", "dmffd"):
+    rc, out, err = run("--mesh", vol, "--handles", "vol_H.csv", "--fix-unlisted-boundary",
+                       "--method", method, "-o", "vol_%s.vtu" % method)
+    check(rc == 0 and re.search(r"inverted=0 cells=\d+\n$", out), "gmsh volume %s: exit %d %s %s" % (method, rc, out, err))
+
+# the MLS options of `cadmorph warp` (cm_warp_options.mls) and their place in morph's help
+fields = []
+for extra in ([], ["--samples", "120", "--cubature", "600", "--cover", "6", "--stretch", "0", "--bend", "2"]):
+    w = subprocess.run([cad, "warp", "--mesh", "box.vtk", "--displacements", "box_H.csv", "--method", "mls",
+                        *extra, "-o", "box_wmls.vtu"], capture_output=True, text=True)
+    check(w.returncode == 0 and "inverted=0" in w.stdout, "warp mls %s: %s %s" % (extra, w.stdout, w.stderr))
+    if w.returncode == 0:
+        fields.append(meshio.read("box_wmls.vtu").point_data["displacement"])
+check(len(fields) == 2 and np.abs(fields[0] - fields[1]).max() > 1e-4, "warp mls: options change the field")
+w = subprocess.run([cad, "warp", "--mesh", "box.vtk", "--displacements", "box_H.csv", "--method", "mls",
+                    "--cubature", "0", "-o", "box_wmls.vtu"], capture_output=True, text=True)
+check(w.returncode == 1 and "--cubature: expected an integer in 1..1e8, got '0'" in w.stderr, "warp --cubature 0: " + w.stderr)
+h = subprocess.run([cad, "morph", "--help"], capture_output=True, text=True)
+check(all(o in h.stdout for o in ("--samples K", "--cubature N", "--cover S", "--stretch GS", "--bend GB")),
+      "morph --help lists the MLS options")
+
 # error paths
 with open("bad_F.csv", "w") as f:
     f.write("node\n99999\n")
@@ -134,6 +231,11 @@ for args, code, msg in (
          "unknown method"),
         (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "--stretch", "-1", "-o", "x.vtu"], 1,
          "not a number"),
+        (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "--method", "dmffd", "--lattice", "3", "-o", "x.vtu"], 1,
+         "--lattice: '3' is not an integer in 4..200"),
+        (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "--cover", "0", "-o", "x.vtu"], 1,
+         "--cover: '0' is not an integer"),
+        (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "-o", "x.ply"], 1, "unknown mesh extension"),
         (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "-o", "plate.vtk"], 1, "is an input")):
     rc, out, err = run(*args)
     check(rc == code and re.search(msg, err), "%s: exit %d (want %d), %s" % (args, rc, code, err))

@@ -4,8 +4,11 @@
  * plate, the warp method). Meshes are built in code. */
 #include "cadmorph/mls.h"
 #include "cadmorph/warp.h"
+#include "deform/mls_internal.h"
+#include "test_rng.h"
 #include "test_util.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -353,10 +356,107 @@ static void test_plate(cm_context *ctx)
     cm_mesh_destroy(&m);
 }
 
+/* The grid-and-heap farthest-point sampler picks exactly what the definition does (scan
+ * every point per pick, the lowest index on a tie): on random points, on a lattice (many
+ * equal distances) and on a flat set. */
+static void test_farthest(cm_context *ctx)
+{
+    for (int kind = 0; kind < 3; ++kind) {
+        size_t n = kind == 1 ? 15 * 15 * 15 : 6000, k = kind == 2 ? 700 : 400;
+        double *x = malloc(n * 3 * sizeof *x), *out = malloc(k * 3 * sizeof *out), *d = malloc(n * sizeof *d);
+        uint64_t rng = 1500 + (uint64_t)kind;
+        for (size_t i = 0; i < n; ++i)
+            for (int a = 0; a < 3; ++a)
+                x[3 * i + a] = kind == 1 ? (double)(a == 0 ? i % 15 : a == 1 ? i / 15 % 15 : i / 225) * 0.1
+                               : kind == 2 && a == 2 ? 0.5 : test_rng_range(&rng, -1, 2 + a);
+        CHECK(mls_farthest(ctx, x, n, k, 7 + (uint64_t)kind, out) == CM_OK);
+        size_t cur = n;
+        for (size_t i = 0; i < n; ++i)
+            if (!memcmp(x + 3 * i, out, 3 * sizeof *x)) cur = i;
+        CHECK(cur < n);
+        for (size_t i = 0; i < n; ++i) d[i] = 1e300;
+        size_t same = 0;
+        for (size_t j = 0; j < k && cur < n; ++j) {
+            same += !memcmp(x + 3 * cur, out + 3 * j, 3 * sizeof *x);
+            const double *c = x + 3 * cur;
+            size_t best = 0;
+            for (size_t i = 0; i < n; ++i) {
+                const double *p = x + 3 * i;
+                double e = (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
+                if (e < d[i]) d[i] = e;
+                if (d[i] > d[best]) best = i;
+            }
+            cur = best;
+        }
+        CHECK_MSG(same == k, "farthest points, set %d: %zu of %zu picks as the plain scan's", kind, same, k);
+        free(x), free(out), free(d);
+    }
+}
+
+/* The residual blend (options.blend): constrained nodes keep their prescribed motion either
+ * way; the first layer of free nodes next to a wiggly handle the subspace cannot follow sees a
+ * smaller jump to it with the blend; a band narrower than the node spacing changes nothing. */
+static void test_blend(cm_context *ctx)
+{
+    cm_mesh *m = NULL;
+    cm_mesh_create(ctx, &m);
+    add_box(ctx, m, 10, 0);
+    size_t n = m->n_nodes;
+    unsigned char *con = calloc(n, 1);
+    double *d[3] = {calloc(3 * n, sizeof(double)), calloc(3 * n, sizeof(double)), calloc(3 * n, sizeof(double))};
+    const double blend[3] = {0, 1.5, 0.01};
+    size_t blended[3] = {0, 0, 0};
+    double res[3] = {0, 0, 0};
+    for (int v = 0; v < 3; ++v) {
+        for (size_t i = 0; i < n; ++i) {
+            const double *x = m->xyz + 3 * i;
+            con[i] = x[0] < 1e-9 || x[0] > 1 - 1e-9;
+            if (x[0] > 1 - 1e-9) d[v][3 * i] = 0.05 * sin(27 * x[1] + 0.3) * cos(19 * x[2]);
+        }
+        cm_mls_options o;
+        cm_mls_options_init(&o);
+        o.samples = 120;
+        o.blend = blend[v];
+        cm_mls *mls = NULL;
+        CHECK(cm_mls_create(ctx, m, con, &o, &mls) == CM_OK);
+        if (!mls) continue;
+        CHECK(cm_mls_apply(ctx, mls, d[v], &res[v]) == CM_OK);
+        cm_mls_stats st;
+        cm_mls_get_stats(mls, &st);
+        blended[v] = st.blend_nodes;
+        cm_mls_destroy(&mls);
+    }
+    /* the jump across the first layer at x = 1: |d(1 - h) - d(1)| over the face */
+    double jump[2] = {0, 0}, h = 0.1;
+    int same_con = 1;
+    for (size_t i = 0; i < n; ++i) {
+        const double *x = m->xyz + 3 * i;
+        if (con[i]) same_con &= d[0][3 * i] == d[1][3 * i] && d[0][3 * i + 1] == d[1][3 * i + 1];
+        if (fabs(x[0] - (1 - h)) > 1e-9) continue;
+        for (size_t j = 0; j < n; ++j) {
+            const double *y = m->xyz + 3 * j;
+            if (y[0] > 1 - 1e-9 && fabs(y[1] - x[1]) < 1e-9 && fabs(y[2] - x[2]) < 1e-9)
+                for (int v = 0; v < 2; ++v) jump[v] += fabs(d[v][3 * i] - d[v][3 * j]);
+        }
+    }
+    CHECK(same_con);
+    CHECK_MSG(res[0] > 0.01, "the handle should be beyond the subspace: residual %g", res[0]);
+    CHECK_MSG(blended[0] == 0 && blended[1] > n / 4 && blended[2] == 0, "blended nodes %zu %zu %zu",
+              blended[0], blended[1], blended[2]);
+    CHECK_MSG(jump[1] < 0.85 * jump[0], "first-layer jump %g with the blend vs %g without", jump[1], jump[0]);
+    CHECK_MSG(!memcmp(d[0], d[2], 3 * n * sizeof(double)), "a band narrower than a cell changed the field");
+    printf("blend: first-layer jump %.3g -> %.3g, %zu nodes blended\n", jump[0], jump[1], blended[1]);
+    for (int v = 0; v < 3; ++v) free(d[v]);
+    free(con);
+    cm_mesh_destroy(&m);
+}
+
 int main(void)
 {
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
+    test_farthest(ctx);
+    test_blend(ctx);
     test_basis(ctx, 0);
     test_basis(ctx, 1);
     test_deform(ctx);

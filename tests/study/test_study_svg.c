@@ -46,6 +46,43 @@ static char *svg_of(cm_context *ctx, const char *dir, const double *sj1, int n, 
     return buf;
 }
 
+/* cm_plot_write_svg: log axes at decades, a value beyond the fixed y range drawn on the frame
+ * (with its value), non-positive values left out of a log axis, names escaped. */
+static void test_plot(cm_context *ctx, const char *dir)
+{
+    const double x[4] = {1000, 2000, 4000, 8000}, y1[4] = {0.05, 0.4, 2.5, 14.5}, y2[4] = {2.0, 0, 7.2, 14.9};
+    const double sj[3] = {0.12, 0.05, -0.9}, k[3] = {500, 1000, 2000};
+    cm_plot_series s[2] = {{"rbf <dense>", 4, x, y1, 0, 1, -1}, {"mls & co", 4, x, y2, 1, 1, -1}};
+    cm_plot p = {"time", "k", "s", "a note", 1, 1, 0, 0, 2, s};
+    char path[4096];
+    snprintf(path, sizeof path, "%s/plot_log.svg", dir);
+    CHECK(cm_plot_write_svg(ctx, &p, path) == CM_OK);
+    char *t = NULL;
+    size_t n = 0;
+    CHECK(cm_file_read(ctx, path, &t, &n) == CM_OK);
+    if (t) {
+        CHECK_MSG(strstr(t, ">1000<") && strstr(t, ">10000<") && strstr(t, ">0.01<") && strstr(t, ">100<"),
+                  "%s: decade ticks", path);
+        CHECK_MSG(strstr(t, "rbf &lt;dense&gt;") && strstr(t, "mls &amp; co"), "%s: names not escaped", path);
+        CHECK_MSG(strstr(t, "stroke-dasharray") != NULL, "%s: no dashed series", path);
+        /* the 0 of the second series is not on the log axis: 3 markers, not 4 */
+        size_t dots = 0;
+        for (const char *q = t; (q = strstr(q, "<circle")); ++q) ++dots;
+        CHECK_MSG(dots == 7, "%s: %zu markers (want 4 + 3)", path, dots);
+    }
+    free(t);
+    cm_plot_series c = {"sj", 3, k, sj, 0, 1, 2};
+    cm_plot q = {"sphere", "k", "min SJ", NULL, 0, 0, -0.2, 0.2, 1, &c};
+    snprintf(path, sizeof path, "%s/plot_clip.svg", dir);
+    CHECK(cm_plot_write_svg(ctx, &q, path) == CM_OK);
+    t = NULL;
+    CHECK(cm_file_read(ctx, path, &t, &n) == CM_OK);
+    if (t) CHECK_MSG(strstr(t, "<title>-0.9</title>") != NULL, "%s: the clipped value is not marked", path);
+    free(t);
+    cm_plot bad = {"x", "x", "y", NULL, 0, 0, 0, 0, 2, NULL};
+    CHECK(cm_plot_write_svg(ctx, &bad, path) == CM_ERR_ARGUMENT);
+}
+
 int main(int argc, char **argv)
 {
     const char *dir = argc > 2 ? argv[2] : ".";
@@ -64,6 +101,7 @@ int main(int argc, char **argv)
     s = svg_of(ctx, dir, fine, 4, path);
     CHECK_MSG(strstr(s, "clipped") == NULL && strstr(s, "<title>") == NULL, "%s: clipped", path);
     CHECK_MSG(strstr(s, ">-0.4<") == NULL, "%s: the axis goes below its lowest value", path);
+    test_plot(ctx, dir);
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }

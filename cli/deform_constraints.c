@@ -1,0 +1,371 @@
+/* `cadmorph deform --constraint TYPE:SET`: parsing of the constraint specs, the node sets
+ * they name (a node-list file, a physical group, a field of the mesh) and the Shape-Up run
+ * with its report. No algorithm here: the projections and the alternation are deform/'s. */
+#include "deform_constraints.h"
+
+#include "cli.h"
+
+#include <errno.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+void cli_constraints_init(cli_constraints *c)
+{
+    memset(c, 0, sizeof *c);
+    cm_shapeup_options_init(&c->opt);
+}
+
+void cli_constraints_help(void)
+{
+    printf(
+        "  --constraint TYPE:SET     MLS only, repeatable: keep the nodes of SET on a shape of\n"
+        "                            TYPE while deforming (Shape-Up, the MLS paper's section 6):\n"
+        "                            plane, circle, cylinder, line (similar copy: translation,\n"
+        "                            rotation, uniform scale) or rigid. SET: a node-list file\n"
+        "                            (header node), else a physical group of the mesh, else a\n"
+        "                            field NAME or NAME=VALUE (nodes where the node field, or of\n"
+        "                            the cells where the cell field, is nonzero / equals VALUE)\n"
+        "  --constraint-weight GC    gamma_c (default 10)\n"
+        "  --constraint-iterations N cap on the alternations (default 10000)\n"
+        "  --constraint-tolerance T  stop when no constrained node moves more than T x the\n"
+        "                            bounding-box diagonal in one alternation (default 1e-9)\n"
+        "  --dense-constraints       mean-centred C (dense per set) instead of subtracting one\n"
+        "                            point (section 6.1, the default)\n"
+        "  --constraint-anderson M   Anderson acceleration over the last M iterates (1..64;\n"
+        "                            default off: the paper's plain alternation)\n"
+        "  --constraint-snap         after the alternation, put the constrained nodes on their\n"
+        "                            projections (the shapes then hold to rounding)\n"
+        "  --constraints-from-cad G  volume meshes: constraints from the STEP model G of the\n"
+        "                            mesh: the nodes of each planar face (with its edges and\n"
+        "                            vertices) a plane set, of each cylindrical face a cylinder\n"
+        "                            set, of each circular edge a circle set\n"
+        "  --cad-constraints LIST    which of them: plane, cylinder, circle, face:N, edge:N\n"
+        "                            (0-based ids as `cadmorph info` lists; default all types)\n");
+}
+
+static int parse_number(const char *v, double *out)
+{
+    char *end;
+    errno = 0;
+    double d = strtod(v, &end);
+    if (errno || *end || end == v || !isfinite(d)) return -1;
+    *out = d;
+    return 0;
+}
+
+int cli_constraints_option(int argc, char **argv, int *i, const char *cmd, const char *usage,
+                           cli_constraints *c)
+{
+    const char *o = argv[*i], *v;
+    double d;
+    if (!strcmp(o, "--dense-constraints")) {
+        c->opt.sparse = 0;
+        return 1;
+    }
+    if (!strcmp(o, "--constraint-snap")) {
+        c->opt.snap = 1;
+        return 1;
+    }
+    if (!strcmp(o, "--constraints-from-cad") || !strcmp(o, "--cad-constraints")) {
+        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
+        if (o[2] == 'c' && o[3] == 'o')
+            c->cad = v;
+        else
+            c->cad_filter = v;
+        return 1;
+    }
+    if (!strcmp(o, "--constraint")) {
+        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
+        const char *colon = strchr(v, ':');
+        char name[16];
+        size_t len = colon ? (size_t)(colon - v) : 0;
+        if (!colon || len == 0 || len >= sizeof name || !colon[1]) {
+            cli_usage(cmd, usage, "--constraint '%s': expected TYPE:SET", v);
+            return -1;
+        }
+        memcpy(name, v, len);
+        name[len] = 0;
+        cm_shape_type t;
+        if (cm_shape_type_parse(NULL, name, &t) < 0) {
+            cli_usage(cmd, usage,
+                      "--constraint '%s': unknown type '%s' (plane|circle|cylinder|line|rigid)", v, name);
+            return -1;
+        }
+        if (c->n >= CLI_MAX_CONSTRAINTS) {
+            cli_usage(cmd, usage, "more than %d --constraint options", CLI_MAX_CONSTRAINTS);
+            return -1;
+        }
+        c->type[c->n] = t;
+        c->set[c->n++] = colon + 1;
+        return 1;
+    }
+    if (!strcmp(o, "--constraint-anderson")) {
+        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
+        if (parse_number(v, &d) || d < 1 || d > 64 || d != floor(d)) {
+            cli_usage(cmd, usage, "%s: '%s' is not an integer in 1..64", o, v);
+            return -1;
+        }
+        c->opt.anderson = (int)d;
+        return 1;
+    }
+    if (!strcmp(o, "--constraint-weight") || !strcmp(o, "--constraint-tolerance") ||
+        !strcmp(o, "--constraint-iterations")) {
+        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
+        if (parse_number(v, &d) || d < 0) {
+            cli_usage(cmd, usage, "%s: '%s' is not a number >= 0", o, v);
+            return -1;
+        }
+        if (o[13] == 'w') {
+            if (!(d > 0)) {
+                cli_usage(cmd, usage, "%s: must be > 0", o);
+                return -1;
+            }
+            c->opt.weight = d;
+        } else if (o[13] == 't') {
+            c->opt.tolerance = d;
+        } else {
+            if (d != floor(d) || d > 1e9) {
+                cli_usage(cmd, usage, "%s: '%s' is not an integer", o, v);
+                return -1;
+            }
+            c->opt.max_iterations = (int)d;
+        }
+        return 1;
+    }
+    return 0;
+}
+
+/* A node-list file: header `node`, one 0-based index per line. */
+static cm_status read_nodes(cm_context *ctx, const char *path, size_t n, unsigned char *mark)
+{
+    char *data = NULL;
+    size_t size = 0;
+    cm_status s = cm_file_read(ctx, path, &data, &size);
+    if (s < 0) return s;
+    char *p = data;
+    long line = 0;
+    int header = 0;
+    while (p && *p) {
+        char *e = strchr(p, '\n');
+        if (e) *e = 0;
+        ++line;
+        size_t len = strlen(p);
+        while (len && (p[len - 1] == '\r' || p[len - 1] == ' ')) p[--len] = 0;
+        if (len) {
+            if (!header) {
+                if (strcmp(p, "node")) {
+                    s = cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: expected the header 'node'", path, line);
+                    break;
+                }
+                header = 1;
+            } else {
+                char *end;
+                errno = 0;
+                long long v = strtoll(p, &end, 10);
+                if (errno || *end || end == p) {
+                    s = cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: '%s' is not a node index", path, line, p);
+                    break;
+                }
+                if (v < 0 || (unsigned long long)v >= n) {
+                    s = cm_error(ctx, CM_ERR_MISMATCH, "%s:%ld: node %lld out of range (%zu nodes)",
+                                 path, line, v, n);
+                    break;
+                }
+                mark[v] = 1;
+            }
+        }
+        p = e ? e + 1 : NULL;
+    }
+    if (s >= 0 && !header) s = cm_error(ctx, CM_ERR_FORMAT, "%s: empty (expected the header 'node')", path);
+    free(data);
+    return s;
+}
+
+static void mark_cell(const cm_mesh *m, size_t c, unsigned char *mark)
+{
+    if (m->type[c] == CM_CELL_POLYHEDRON) {
+        int64_t p = m->offset[c], nf = m->conn[p++];
+        for (int64_t f = 0; f < nf; ++f) {
+            int64_t k = m->conn[p++];
+            for (int64_t j = 0; j < k; ++j)
+                mark[m->conn[p++]] = 1;
+        }
+        return;
+    }
+    for (int64_t p = m->offset[c]; p < m->offset[c + 1]; ++p)
+        mark[m->conn[p]] = 1;
+}
+
+/* SET as a group or a field of the mesh; CM_ERR_ARGUMENT naming what the mesh has when
+ * nothing matches. */
+static cm_status mesh_set(cm_context *ctx, const cm_mesh *m, const char *set, unsigned char *mark)
+{
+    int found = 0;
+    for (size_t g = 0; g < m->n_groups; ++g) {
+        const cm_mesh_group *gr = m->groups + g;
+        if (!gr->name || strcmp(gr->name, set)) continue;
+        found = 1;
+        for (size_t c = 0; c < m->n_cells; ++c) {
+            const cm_cell_info *inf = cm_cell_type_info((cm_cell_type)m->type[c]);
+            if (m->physical && m->physical[c] == gr->tag && inf && inf->dim == gr->dim)
+                mark_cell(m, c, mark);
+        }
+    }
+    if (found) return CM_OK;
+    char name[256];
+    const char *eq = strchr(set, '=');
+    size_t len = eq ? (size_t)(eq - set) : strlen(set);
+    double value = 0;
+    if (len >= sizeof name) len = sizeof name - 1;
+    memcpy(name, set, len);
+    name[len] = 0;
+    if (eq && parse_number(eq + 1, &value))
+        return cm_error(ctx, CM_ERR_MISMATCH, "constraint set '%s': '%s' is not a number", set, eq + 1);
+    for (int loc = 0; loc < 2 && !found; ++loc) {
+        const cm_field *f = cm_mesh_find_field(m, name, loc ? CM_FIELD_CELL : CM_FIELD_NODE);
+        if (!f) continue;
+        found = 1;
+        size_t count = loc ? m->n_cells : m->n_nodes;
+        for (size_t i = 0; i < count; ++i) {
+            double v = f->data[(size_t)f->components * i];
+            if (eq ? v == value : v != 0) {
+                if (loc)
+                    mark_cell(m, i, mark);
+                else
+                    mark[i] = 1;
+            }
+        }
+    }
+    if (found) return CM_OK;
+    char have[512] = "";
+    size_t used = 0;
+    for (size_t g = 0; g < m->n_groups && used + 64 < sizeof have; ++g)
+        if (m->groups[g].name)
+            used += (size_t)snprintf(have + used, sizeof have - used, "%s%s", used ? ", " : "",
+                                     m->groups[g].name);
+    for (size_t f = 0; f < m->n_fields && used + 64 < sizeof have; ++f)
+        used += (size_t)snprintf(have + used, sizeof have - used, "%s%s (field)", used ? ", " : "",
+                                 m->fields[f].name);
+    return cm_error(ctx, CM_ERR_MISMATCH,
+                    "constraint set '%s': no such file, physical group or field (the mesh has: %s)",
+                    set, used ? have : "none");
+}
+
+int cli_constraints_any(const cli_constraints *c)
+{
+    return c->n > 0 || c->cad != NULL;
+}
+
+cm_status cli_constraints_resolve(cm_context *ctx, const cm_mesh *mesh, cli_constraints *c,
+                                  cm_shape_set *sets)
+{
+    size_t n = mesh->n_nodes;
+    memset(sets, 0, CLI_MAX_CONSTRAINTS * sizeof *sets);
+    unsigned char *mark = malloc(n ? n : 1);
+    if (!mark) return cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+    cm_status s = CM_OK;
+    for (int t = 0; t < c->n && s >= 0; ++t) {
+        memset(mark, 0, n ? n : 1);
+        struct stat st;
+        if (stat(c->set[t], &st) == 0 && S_ISREG(st.st_mode))
+            s = read_nodes(ctx, c->set[t], n, mark);
+        else
+            s = mesh_set(ctx, mesh, c->set[t], mark);
+        if (s < 0) break;
+        size_t k = 0;
+        for (size_t i = 0; i < n; ++i)
+            k += mark[i] != 0;
+        int64_t *nodes = malloc((k ? k : 1) * sizeof *nodes);
+        if (!nodes) {
+            s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+            break;
+        }
+        k = 0;
+        for (size_t i = 0; i < n; ++i)
+            if (mark[i]) nodes[k++] = (int64_t)i;
+        sets[t].type = c->type[t];
+        sets[t].n = k;
+        sets[t].nodes = nodes;
+        if (k == 0) s = cm_error(ctx, CM_ERR_MISMATCH, "constraint set '%s': no node", c->set[t]);
+    }
+    free(mark);
+    if (s >= 0 && c->cad) s = cli_cad_constraints(ctx, mesh, c, sets);
+    if (s >= 0 && c->cad && c->n == 0)
+        s = cm_error(ctx, CM_ERR_MISMATCH, "%s: no plane, cylinder or circle to constrain (filter %s)",
+                     c->cad, c->cad_filter ? c->cad_filter : "all");
+    return s;
+}
+
+void cli_constraints_free(cli_constraints *c, cm_shape_set *sets)
+{
+    for (int t = 0; t < CLI_MAX_CONSTRAINTS; ++t) {
+        free((void *)sets[t].nodes);
+        sets[t].nodes = NULL;
+        free(c->owned[t]);
+        c->owned[t] = NULL;
+    }
+}
+
+cm_status cli_constraints_run(cm_context *ctx, cm_mls *mls, cm_mesh *mesh,
+                              const cli_constraints *c, const cm_shape_set *sets, double *disp,
+                              double *fix_residual)
+{
+    cm_shapeup *su = NULL;
+    cm_status s = cm_shapeup_create(ctx, mls, mesh, (size_t)c->n, sets, &c->opt, &su);
+    if (s < 0) return s;
+    double *r0 = malloc((size_t)c->n * 2 * sizeof *r0);
+    if (!r0) {
+        cm_shapeup_destroy(&su);
+        return cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+    }
+    double *r1 = r0 + c->n;
+    cm_shapeup_report rep;
+    s = cm_shapeup_apply(ctx, su, disp, r0, r1, &rep);
+    cm_shapeup_destroy(&su);
+    /* which set each node is in (the last one listed), for ParaView and the tests */
+    double *field = NULL;
+    if (s >= 0) {
+        cm_status fs = cm_mesh_add_field(ctx, mesh, "constraint_set", CM_FIELD_NODE, 1, &field);
+        if (fs < 0) s = fs;
+    }
+    if (field) {
+        for (size_t i = 0; i < mesh->n_nodes; ++i)
+            field[i] = -1;
+        for (int t = 0; t < c->n; ++t)
+            for (size_t i = 0; i < sets[t].n; ++i)
+                field[sets[t].nodes[i]] = t;
+    }
+    if (s >= 0) {
+        double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
+        for (size_t i = 0; i < mesh->n_nodes; ++i)
+            for (int a = 0; a < 3; ++a)
+                lo[a] = fmin(lo[a], mesh->xyz[3 * i + a]), hi[a] = fmax(hi[a], mesh->xyz[3 * i + a]);
+        double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                           (hi[2] - lo[2]) * (hi[2] - lo[2]));
+        for (int t = 0; t < c->n; ++t)
+            printf("constraint %s:%s: %zu nodes, residual before %.6g after %.6g (%.3g of the "
+                   "diagonal)\n",
+                   cm_shape_type_name(c->type[t]), c->set[t], sets[t].n, r0[t], r1[t],
+                   diag > 0 ? r1[t] / diag : r1[t]);
+        printf("shape-up: %d iterations, %s (last move %.3g), C %s with %zu entries, factor %zu "
+               "entries, update %.3f s, iterations %.3f s\n",
+               rep.iterations, rep.converged ? "converged" : "NOT converged", rep.last_move,
+               c->opt.sparse ? "sparse" : "mean-centred", rep.c_nonzeros, rep.factor_nonzeros,
+               rep.t_factor, rep.t_iterate);
+        if (c->opt.snap)
+            printf("snap: constrained nodes moved onto their projections by at most %.6g\n",
+                   rep.snap_move);
+        if (s > 0) {
+            /* the cap was hit: a result, with the warning on stderr */
+            fprintf(stderr, "cadmorph deform: warning: %s\n", cm_context_message(ctx));
+            s = CM_OK;
+        }
+        *fix_residual = rep.fix_residual;
+    }
+    free(r0);
+    return s;
+}

@@ -1,0 +1,623 @@
+/* OpenFOAM polyMesh reader: a case directory or its constant/polyMesh (points, faces,
+ * owner, neighbour, boundary; optional cell/face/point zones), ASCII or binary, plain or .gz.
+ * Cells become polyhedra, or tet/hex/wedge/pyramid when their faces have exactly that shape
+ * (so that the scaled Jacobian is Verdict's); boundary faces are added as 2D cells with the
+ * patch as physical group (tag = patch index + 1), cells in a cellZone get the zone's group
+ * (tags after the patches). The face-addressed original is kept for writing and checkMesh. */
+#define _POSIX_C_SOURCE 200809L
+#include "formats.h"
+#include "foam_internal.h"
+#include "../cell_faces.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* ---- the shared record ---- */
+
+cm_foam_poly *cm_foam_poly_new(void)
+{
+    cm_foam_poly *p = calloc(1, sizeof *p);
+    if (p) {
+        p->refs = 1;
+        p->label_bytes = 4;
+        p->scalar_bytes = 8;
+    }
+    return p;
+}
+
+cm_foam_poly *cm_foam_poly_retain(cm_foam_poly *p)
+{
+    /* atomic: copies of one mesh may be made and destroyed on several threads */
+    if (p) __atomic_add_fetch(&p->refs, 1, __ATOMIC_RELAXED);
+    return p;
+}
+
+void cm_foam_poly_release(cm_foam_poly **pp)
+{
+    if (!pp || !*pp) return;
+    cm_foam_poly *p = *pp;
+    *pp = NULL;
+    if (__atomic_sub_fetch(&p->refs, 1, __ATOMIC_ACQ_REL) > 0) return;
+    free(p->dir);
+    free(p->face_off);
+    free(p->face_nodes);
+    free(p->owner);
+    free(p->neighbour);
+    for (size_t i = 0; i < p->n_patches; ++i) {
+        free(p->patches[i].name);
+        free(p->patches[i].type);
+        free(p->patches[i].dict);
+    }
+    free(p->patches);
+    for (size_t i = 0; i < p->n_zones; ++i) {
+        free(p->zones[i].name);
+        free(p->zones[i].ids);
+        free(p->zones[i].flip);
+    }
+    free(p->zones);
+    free(p->points_head);
+    free(p->points_tail);
+    free(p);
+}
+
+static int is_dir(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+static int exists(const char *dir, const char *name)
+{
+    char buf[4096];
+    struct stat st;
+    return cm_foam_join(buf, sizeof buf, dir, name, NULL) == 0 && stat(buf, &st) == 0;
+}
+
+char *cm_foam_polymesh_dir(const char *path)
+{
+    size_t l = strlen(path);
+    while (l > 1 && path[l - 1] == '/') --l;
+    const char *base = path + l;
+    while (base > path && base[-1] != '/') --base;
+    char *d;
+    int as_is = (size_t)(path + l - base) == 8 && !memcmp(base, "polyMesh", 8);
+    if (!as_is && l < 4000) {
+        char tmp[4096];
+        memcpy(tmp, path, l);
+        tmp[l] = '\0';
+        /* a directory that holds the polyMesh files itself, whatever its name */
+        as_is = is_dir(tmp) && (exists(tmp, "faces") || exists(tmp, "faces.gz")) && !exists(tmp, "constant");
+    }
+    if (as_is) {
+        d = malloc(l + 1);
+        if (d) {
+            memcpy(d, path, l);
+            d[l] = '\0';
+        }
+        return d;
+    }
+    d = malloc(l + sizeof "/constant/polyMesh");
+    if (d) {
+        memcpy(d, path, l);
+        memcpy(d + l, "/constant/polyMesh", sizeof "/constant/polyMesh");
+    }
+    return d;
+}
+
+/* ---- boundary and zones ---- */
+
+static char *dup_n(const char *s, size_t n)
+{
+    char *d = malloc(n + 1);
+    if (d) {
+        memcpy(d, s, n);
+        d[n] = '\0';
+    }
+    return d;
+}
+
+static int tok_is(cm_foam_tok t, const char *w)
+{
+    size_t n = strlen(w);
+    return t.kind == CM_FOAM_WORD && t.len == n && !memcmp(t.s, w, n);
+}
+
+/* Skips the value of an entry whose key was just read: up to its ';', or one {...} sub-dictionary. */
+static cm_status skip_entry(cm_context *ctx, cm_foam_lex *lx)
+{
+    cm_foam_tok t = cm_foam_peek(lx);
+    if (t.kind == CM_FOAM_PUNCT && t.s[0] == '{') {
+        int depth = 0;
+        for (;;) {
+            t = cm_foam_next(lx);
+            if (t.kind == CM_FOAM_EOF) return cm_foam_expect(ctx, lx, '}', "'}' closing a sub-dictionary");
+            if (t.kind == CM_FOAM_PUNCT && t.s[0] == '{') ++depth;
+            if (t.kind == CM_FOAM_PUNCT && t.s[0] == '}' && --depth == 0) return CM_OK;
+        }
+    }
+    cm_status s = cm_foam_skip_value(ctx, lx, "';' ending the entry");
+    if (s == CM_OK) s = cm_foam_expect(ctx, lx, ';', "';' ending the entry");
+    return s;
+}
+
+static cm_status read_boundary(cm_context *ctx, const char *dir, cm_foam_poly *p)
+{
+    cm_foam_file f;
+    cm_status s = cm_foam_file_load(ctx, dir, "boundary", 0, &f);
+    if (s != CM_OK) return s;
+    cm_foam_lex lx;
+    cm_foam_lex_init(&lx, &f, f.body);
+    int64_t n = 0;
+    char w[600];
+    s = cm_foam_label(ctx, &lx, "the number of patches", &n);
+    if (s == CM_OK && (n < 0 || n > 1000000))
+        s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %lld patches", cm_foam_where(&lx, w, sizeof w), (long long)n);
+    if (s == CM_OK) s = cm_foam_expect(ctx, &lx, '(', "'(' opening the patch list");
+    if (s == CM_OK && n > 0 && !(p->patches = calloc((size_t)n, sizeof *p->patches)))
+        s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    for (int64_t i = 0; s == CM_OK && i < n; ++i) {
+        cm_foam_patch *pt = &p->patches[i];
+        pt->start = pt->n = -1;
+        cm_foam_tok name = cm_foam_next(&lx);
+        if (name.kind != CM_FOAM_WORD && name.kind != CM_FOAM_STRING) {
+            s = cm_foam_expect(ctx, &lx, '?', "a patch name");
+            break;
+        }
+        p->n_patches = (size_t)i + 1;
+        if (!(pt->name = dup_n(name.s, name.len))) s = CM_ERR_NOMEM;
+        if (s == CM_OK) s = cm_foam_expect(ctx, &lx, '{', "'{' opening the patch dictionary");
+        size_t begin = lx.pos;
+        while (s == CM_OK) {
+            cm_foam_tok key = cm_foam_next(&lx);
+            if (key.kind == CM_FOAM_PUNCT && key.s[0] == '}') {
+                if (!(pt->dict = dup_n(f.data + begin, key.at - begin))) s = CM_ERR_NOMEM;
+                break;
+            }
+            if (key.kind != CM_FOAM_WORD) {
+                s = cm_foam_expect(ctx, &lx, '}', "an entry or '}' in the patch dictionary");
+                break;
+            }
+            if (tok_is(key, "type")) {
+                cm_foam_tok v = cm_foam_next(&lx);
+                if (!(pt->type = dup_n(v.s ? v.s : "", v.len))) s = CM_ERR_NOMEM;
+                if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ';', "';' after the patch type");
+            } else if (tok_is(key, "nFaces") || tok_is(key, "startFace")) {
+                s = cm_foam_label(ctx, &lx, key.s[0] == 'n' ? "nFaces" : "startFace", key.s[0] == 'n' ? &pt->n : &pt->start);
+                if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ';', "';' after the value");
+            } else {
+                s = skip_entry(ctx, &lx);
+            }
+        }
+        if (s == CM_OK && (pt->n < 0 || pt->start < 0))
+            s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: patch '%s': missing or negative nFaces/startFace",
+                         f.path, pt->name);
+    }
+    if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ')', "')' closing the patch list (more patches than its size?)");
+    if (s == CM_ERR_NOMEM) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    cm_foam_file_free(&f);
+    return s;
+}
+
+static cm_status read_zones(cm_context *ctx, const char *dir, const char *name, cm_foam_zone_kind kind,
+                            cm_foam_poly *p)
+{
+    cm_foam_file f;
+    cm_status s = cm_foam_file_load(ctx, dir, name, 1, &f);
+    if (s != CM_OK || !f.data) return s;
+    cm_foam_lex lx;
+    cm_foam_lex_init(&lx, &f, f.body);
+    int64_t n = 0;
+    s = cm_foam_label(ctx, &lx, "the number of zones", &n);
+    if (s == CM_OK && (n < 0 || n > 1000000)) s = cm_foam_expect(ctx, &lx, '?', "a zone count");
+    if (s == CM_OK) s = cm_foam_expect(ctx, &lx, '(', "'(' opening the zone list");
+    cm_foam_zone *z = NULL;
+    if (s == CM_OK && n > 0) {
+        z = realloc(p->zones, (p->n_zones + (size_t)n) * sizeof *z);
+        if (!z) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+        else p->zones = z;
+    }
+    const char *labels = kind == CM_FOAM_CELL_ZONE ? "cellLabels" : kind == CM_FOAM_FACE_ZONE ? "faceLabels" : "pointLabels";
+    const int64_t limit = kind == CM_FOAM_CELL_ZONE ? p->n_cells : kind == CM_FOAM_FACE_ZONE ? p->n_faces : p->n_points;
+    for (int64_t i = 0; s == CM_OK && i < n; ++i) {
+        cm_foam_zone *zn = &p->zones[p->n_zones];
+        memset(zn, 0, sizeof *zn);
+        zn->kind = kind;
+        ++p->n_zones;
+        cm_foam_tok nm = cm_foam_next(&lx);
+        if (nm.kind != CM_FOAM_WORD && nm.kind != CM_FOAM_STRING) {
+            s = cm_foam_expect(ctx, &lx, '?', "a zone name");
+            break;
+        }
+        if (!(zn->name = dup_n(nm.s, nm.len))) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+        if (s == CM_OK) s = cm_foam_expect(ctx, &lx, '{', "'{' opening the zone");
+        while (s == CM_OK) {
+            cm_foam_tok key = cm_foam_next(&lx);
+            if (key.kind == CM_FOAM_PUNCT && key.s[0] == '}') break;
+            if (key.kind != CM_FOAM_WORD) {
+                s = cm_foam_expect(ctx, &lx, '}', "an entry or '}' in the zone");
+                break;
+            }
+            if (tok_is(key, labels)) {
+                s = cm_foam_label_list(ctx, &lx, labels, &zn->ids, &zn->n);
+                for (int64_t k = 0; s == CM_OK && k < zn->n; ++k)
+                    if (zn->ids[k] < 0 || zn->ids[k] >= limit)
+                        s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: zone '%s': label %lld out of range [0, %lld)",
+                                     f.path, zn->name, (long long)zn->ids[k], (long long)limit);
+                if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ';', "';' after the labels");
+            } else if (tok_is(key, "flipMap")) {
+                int64_t nf = 0;
+                s = cm_foam_bool_list(ctx, &lx, "flipMap", &zn->flip, &nf);
+                if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ';', "';' after flipMap");
+            } else {
+                s = skip_entry(ctx, &lx);
+            }
+        }
+    }
+    if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ')', "')' closing the zone list");
+    cm_foam_file_free(&f);
+    return s;
+}
+
+/* ---- cell shapes ---- */
+
+/* Does the cyclic sequence a (n) equal b (n) up to rotation? */
+static int same_cycle(const int64_t *a, const int64_t *b, int n)
+{
+    for (int r = 0; r < n; ++r) {
+        int k = 0;
+        while (k < n && a[k] == b[(k + r) % n]) ++k;
+        if (k == n) return 1;
+    }
+    return 0;
+}
+
+/* The cell's outward faces: nf faces, sizes fs[], nodes fn[i][0..fs[i]). Tries to order the
+ * corners as the VTK type `type` (whose face table must match face for face); returns 1 and
+ * fills out[] on success. */
+static int match_shape(cm_cell_type type, int nf, const int *fs, int64_t (*fn)[4], int64_t *out)
+{
+    const cm_face_table *t = cm_cell_face_table(type);
+    const int corners = cm_cell_type_info(type)->corners;
+    if (!t || t->n_faces != nf) return 0;
+    /* face sizes must be a permutation of the table's */
+    int want[5] = {0}, have[5] = {0};
+    for (int i = 0; i < nf; ++i) {
+        ++want[t->size[i]];
+        if (fs[i] > 4) return 0;
+        ++have[fs[i]];
+    }
+    if (want[3] != have[3] || want[4] != have[4]) return 0;
+    /* anchor: table face 0 onto the first cell face of the same size */
+    int a = 0;
+    while (fs[a] != t->size[0]) ++a;
+    int64_t g[8];
+    for (int i = 0; i < 8; ++i) g[i] = -1;
+    for (int k = 0; k < t->size[0]; ++k) g[t->node[0][k]] = fn[a][k];
+    /* each other corner: the unique node joined by an edge to an anchored one and not in the
+     * anchor face */
+    for (int pass = 0; pass < 2; ++pass)
+        for (int L = 0; L < corners; ++L) {
+            if (g[L] >= 0) continue;
+            for (int tf = 0; tf < nf && g[L] < 0; ++tf)
+                for (int k = 0; k < t->size[tf] && g[L] < 0; ++k) {
+                    int u = t->node[tf][k], v = t->node[tf][(k + 1) % t->size[tf]];
+                    int K = u == L ? v : v == L ? u : -1;
+                    if (K < 0 || g[K] < 0) continue;
+                    /* candidate: the cell edge from g[K] to a node not yet used */
+                    int64_t cand = -1;
+                    int many = 0;
+                    for (int cf = 0; cf < nf; ++cf)
+                        for (int j = 0; j < fs[cf]; ++j) {
+                            int64_t p = fn[cf][j], q = fn[cf][(j + 1) % fs[cf]];
+                            int64_t o = p == g[K] ? q : q == g[K] ? p : -1;
+                            if (o < 0) continue;
+                            int used = 0;
+                            for (int m = 0; m < corners; ++m) used |= g[m] == o;
+                            if (used) continue;
+                            if (cand >= 0 && cand != o) many = 1;
+                            cand = o;
+                        }
+                    if (cand >= 0 && !many) g[L] = cand;
+                }
+        }
+    for (int L = 0; L < corners; ++L)
+        if (g[L] < 0) return 0;
+    for (int i = 0; i < corners; ++i)
+        for (int j = i + 1; j < corners; ++j)
+            if (g[i] == g[j]) return 0;
+    /* every table face must be a cell face with the same orientation */
+    int usedf[6] = {0};
+    for (int tf = 0; tf < nf; ++tf) {
+        int64_t want_nodes[4];
+        for (int k = 0; k < t->size[tf]; ++k) want_nodes[k] = g[t->node[tf][k]];
+        int found = 0;
+        for (int cf = 0; cf < nf && !found; ++cf)
+            if (!usedf[cf] && fs[cf] == t->size[tf] && same_cycle(want_nodes, fn[cf], fs[cf])) found = usedf[cf] = 1;
+        if (!found) return 0;
+    }
+    memcpy(out, g, (size_t)corners * sizeof *g);
+    return 1;
+}
+
+/* ---- the reader ---- */
+
+typedef struct reader {
+    cm_context *ctx;
+    const char *path;
+    char *dir;
+    cm_foam_poly *p;
+    double *xyz;
+} reader;
+
+static cm_status read_points(reader *r)
+{
+    cm_foam_file f;
+    cm_status s = cm_foam_file_load(r->ctx, r->dir, "points", 0, &f);
+    if (s != CM_OK) return s;
+    cm_foam_lex lx;
+    cm_foam_lex_init(&lx, &f, f.body);
+    size_t head = cm_foam_peek(&lx).at;
+    s = cm_foam_scalar_list(r->ctx, &lx, "points", 3, &r->xyz, &r->p->n_points);
+    if (s == CM_OK) {
+        cm_foam_poly *p = r->p;
+        p->points_head = dup_n(f.data, head);
+        p->points_head_len = head;
+        p->points_tail = dup_n(f.data + lx.pos, f.size - lx.pos);
+        p->points_tail_len = f.size - lx.pos;
+        p->points_binary = f.binary;
+        p->points_gz = f.gz;
+        p->scalar_bytes = f.scalar_bytes;
+        p->label_bytes = f.label_bytes;
+        if (!p->points_head || !p->points_tail) s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    }
+    cm_foam_file_free(&f);
+    return s;
+}
+
+static cm_status read_labels(reader *r, const char *name, int64_t **v, int64_t *n)
+{
+    cm_foam_file f;
+    cm_status s = cm_foam_file_load(r->ctx, r->dir, name, 0, &f);
+    if (s != CM_OK) return s;
+    cm_foam_lex lx;
+    cm_foam_lex_init(&lx, &f, f.body);
+    s = cm_foam_label_list(r->ctx, &lx, name, v, n);
+    cm_foam_file_free(&f);
+    return s;
+}
+
+static cm_status read_faces(reader *r)
+{
+    cm_foam_file f;
+    cm_status s = cm_foam_file_load(r->ctx, r->dir, "faces", 0, &f);
+    if (s != CM_OK) return s;
+    cm_foam_lex lx;
+    cm_foam_lex_init(&lx, &f, f.body);
+    int compact = strcmp(f.cls, "faceCompactList") == 0;
+    s = cm_foam_face_list(r->ctx, &lx, compact, "faces", &r->p->face_off, &r->p->face_nodes, &r->p->n_faces);
+    char *fp = f.path;
+    f.path = NULL;
+    for (int64_t i = 0; s == CM_OK && i < r->p->n_faces; ++i) {
+        int64_t b = r->p->face_off[i], e = r->p->face_off[i + 1];
+        if (e - b < 3)
+            s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld has %lld nodes (at least 3 expected)", fp,
+                         (long long)i, (long long)(e - b));
+        for (int64_t k = b; s == CM_OK && k < e; ++k)
+            if (r->p->face_nodes[k] < 0 || r->p->face_nodes[k] >= r->p->n_points)
+                s = cm_error(r->ctx, CM_ERR_FORMAT,
+                             "cm_mesh_read: %s: face %lld: point index %lld out of range [0, %lld) (points has %lld)",
+                             fp, (long long)i, (long long)r->p->face_nodes[k], (long long)r->p->n_points,
+                             (long long)r->p->n_points);
+    }
+    free(fp);
+    cm_foam_file_free(&f);
+    return s;
+}
+
+static cm_status check_addressing(reader *r, int64_t n_owner, int64_t n_nei)
+{
+    cm_foam_poly *p = r->p;
+    char own[4200], nei[4200];
+    cm_foam_join(own, sizeof own, r->dir, "owner", NULL);
+    cm_foam_join(nei, sizeof nei, r->dir, "neighbour", NULL);
+    if (n_owner != p->n_faces)
+        return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %lld entries, but faces has %lld faces", own,
+                        (long long)n_owner, (long long)p->n_faces);
+    if (n_nei > p->n_faces)
+        return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %lld entries, more than the %lld faces", nei,
+                        (long long)n_nei, (long long)p->n_faces);
+    p->n_internal = n_nei;
+    int64_t maxc = -1;
+    for (int64_t i = 0; i < p->n_faces; ++i) {
+        if (p->owner[i] < 0)
+            return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld: negative owner %lld", own, (long long)i,
+                            (long long)p->owner[i]);
+        if (p->owner[i] > maxc) maxc = p->owner[i];
+    }
+    for (int64_t i = 0; i < n_nei; ++i) {
+        if (p->neighbour[i] < 0)
+            return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld: negative neighbour %lld", nei,
+                            (long long)i, (long long)p->neighbour[i]);
+        if (p->neighbour[i] == p->owner[i])
+            return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld: owner and neighbour are both cell %lld",
+                            nei, (long long)i, (long long)p->owner[i]);
+        if (p->neighbour[i] > maxc) maxc = p->neighbour[i];
+    }
+    p->n_cells = maxc + 1;
+    if (p->n_cells == 0)
+        return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: no cells (owner is empty)", own);
+    /* patches: contiguous, from the first boundary face to the last face */
+    int64_t at = p->n_internal;
+    for (size_t i = 0; i < p->n_patches; ++i) {
+        const cm_foam_patch *pt = &p->patches[i];
+        if (pt->start != at || pt->n > p->n_faces - at)
+            return cm_error(r->ctx, CM_ERR_FORMAT,
+                            "cm_mesh_read: %s/boundary: patch '%s': startFace %lld nFaces %lld, expected startFace %lld "
+                            "and at most %lld faces",
+                            r->dir, pt->name, (long long)pt->start, (long long)pt->n, (long long)at,
+                            (long long)(p->n_faces - at));
+        at += pt->n;
+    }
+    if (at != p->n_faces)
+        return cm_error(r->ctx, CM_ERR_FORMAT,
+                        "cm_mesh_read: %s/boundary: the patches cover faces up to %lld, but there are %lld faces "
+                        "(%lld internal)",
+                        r->dir, (long long)at, (long long)p->n_faces, (long long)p->n_internal);
+    return CM_OK;
+}
+
+static cm_status build_cells(reader *r, cm_mesh *m)
+{
+    cm_foam_poly *p = r->p;
+    const int64_t nc = p->n_cells;
+    int64_t *cstart = calloc((size_t)nc + 1, sizeof *cstart);
+    int64_t *cface = malloc((size_t)(p->n_faces + p->n_internal + 1) * sizeof *cface);
+    int64_t *stream = NULL;
+    size_t stream_cap = 0;
+    cm_status s = CM_OK;
+    if (!cstart || !cface) {
+        s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory for the cells");
+        goto done;
+    }
+    for (int64_t f = 0; f < p->n_faces; ++f) ++cstart[p->owner[f] + 1];
+    for (int64_t f = 0; f < p->n_internal; ++f) ++cstart[p->neighbour[f] + 1];
+    for (int64_t c = 0; c < nc; ++c) {
+        if (cstart[c + 1] < 4) {
+            s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s/owner: cell %lld has %lld faces (at least 4 expected)",
+                         r->dir, (long long)c, (long long)cstart[c + 1]);
+            goto done;
+        }
+        cstart[c + 1] += cstart[c];
+    }
+    {
+        int64_t *fill = malloc((size_t)nc * sizeof *fill);
+        if (!fill) {
+            s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+            goto done;
+        }
+        memcpy(fill, cstart, (size_t)nc * sizeof *fill);
+        /* signed: -(f+1) marks a face the cell sees from the neighbour side */
+        for (int64_t f = 0; f < p->n_faces; ++f) cface[fill[p->owner[f]]++] = f + 1;
+        for (int64_t f = 0; f < p->n_internal; ++f) cface[fill[p->neighbour[f]]++] = -(f + 1);
+        free(fill);
+    }
+    s = cm_mesh_reserve_cells(r->ctx, m, (size_t)(nc + p->n_faces - p->n_internal),
+                              (size_t)(p->face_off[p->n_faces] * 2 + 2 * nc));
+    for (int64_t c = 0; s == CM_OK && c < nc; ++c) {
+        const int nf = (int)(cstart[c + 1] - cstart[c]);
+        size_t need = 1;
+        for (int i = 0; i < nf; ++i) {
+            int64_t f = llabs(cface[cstart[c] + i]) - 1;
+            need += 1 + (size_t)(p->face_off[f + 1] - p->face_off[f]);
+        }
+        if (need > stream_cap) {
+            int64_t *ns = realloc(stream, 2 * need * sizeof *ns);
+            if (!ns) {
+                s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+                break;
+            }
+            stream = ns;
+            stream_cap = 2 * need;
+        }
+        size_t k = 0;
+        stream[k++] = nf;
+        int fs[6];
+        int64_t fn[6][4];
+        int small = nf <= 6;
+        for (int i = 0; i < nf; ++i) {
+            int64_t sf = cface[cstart[c] + i], f = llabs(sf) - 1;
+            const int64_t *nodes = p->face_nodes + p->face_off[f];
+            int64_t n = p->face_off[f + 1] - p->face_off[f];
+            stream[k++] = n;
+            for (int64_t j = 0; j < n; ++j)
+                /* outward: as stored for the owner, reversed (first node kept) for the neighbour */
+                stream[k + (size_t)j] = sf > 0 ? nodes[j] : nodes[(n - j) % n];
+            if (small && n <= 4) {
+                fs[i] = (int)n;
+                memcpy(fn[i], stream + k, (size_t)n * sizeof *stream);
+            } else {
+                small = 0;
+            }
+            k += (size_t)n;
+        }
+        int64_t corners[8];
+        static const cm_cell_type shapes[] = {CM_CELL_HEX8, CM_CELL_TET4, CM_CELL_WEDGE6, CM_CELL_PYR5};
+        cm_cell_type type = CM_CELL_POLYHEDRON;
+        for (int t = 0; small && t < 4 && type == CM_CELL_POLYHEDRON; ++t)
+            if (match_shape(shapes[t], nf, fs, fn, corners)) type = shapes[t];
+        if (type == CM_CELL_POLYHEDRON) s = cm_mesh_add_cell(r->ctx, m, type, stream, k, 0, 0, 0);
+        else s = cm_mesh_add_cell(r->ctx, m, type, corners, (size_t)cm_cell_type_info(type)->corners, 0, 0, 0);
+    }
+    /* boundary faces as 2D cells, physical group = patch index + 1 */
+    for (size_t i = 0; s == CM_OK && i < p->n_patches; ++i) {
+        const cm_foam_patch *pt = &p->patches[i];
+        s = cm_mesh_add_group(r->ctx, m, 2, (int)i + 1, pt->name);
+        for (int64_t f = pt->start; s == CM_OK && f < pt->start + pt->n; ++f) {
+            int64_t n = p->face_off[f + 1] - p->face_off[f];
+            cm_cell_type t = n == 3 ? CM_CELL_TRI3 : n == 4 ? CM_CELL_QUAD4 : CM_CELL_POLYGON;
+            s = cm_mesh_add_cell(r->ctx, m, t, p->face_nodes + p->face_off[f], (size_t)n, (int)i + 1, (int)i + 1, 0);
+        }
+    }
+done:
+    free(cstart);
+    free(cface);
+    free(stream);
+    return s;
+}
+
+cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh)
+{
+    *mesh = NULL;
+    reader r = {ctx, path, cm_foam_polymesh_dir(path), cm_foam_poly_new(), NULL};
+    cm_mesh *m = NULL;
+    cm_status s = CM_OK;
+    if (!r.dir || !r.p) {
+        s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+        goto fail;
+    }
+    if (!is_dir(r.dir)) {
+        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: no polyMesh directory %s", path, r.dir);
+        goto fail;
+    }
+    r.p->dir = strdup(r.dir);
+    int64_t n_owner = 0, n_nei = 0;
+    if (!r.p->dir) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    if (s == CM_OK) s = read_points(&r);
+    if (s == CM_OK) s = read_faces(&r);
+    if (s == CM_OK) s = read_labels(&r, "owner", &r.p->owner, &n_owner);
+    if (s == CM_OK) s = read_labels(&r, "neighbour", &r.p->neighbour, &n_nei);
+    if (s == CM_OK) s = read_boundary(ctx, r.dir, r.p);
+    if (s == CM_OK) s = check_addressing(&r, n_owner, n_nei);
+    if (s == CM_OK) s = read_zones(ctx, r.dir, "cellZones", CM_FOAM_CELL_ZONE, r.p);
+    if (s == CM_OK) s = read_zones(ctx, r.dir, "faceZones", CM_FOAM_FACE_ZONE, r.p);
+    if (s == CM_OK) s = read_zones(ctx, r.dir, "pointZones", CM_FOAM_POINT_ZONE, r.p);
+    if (s == CM_OK) s = cm_mesh_create(ctx, &m);
+    if (s == CM_OK) s = cm_mesh_resize_nodes(ctx, m, (size_t)r.p->n_points, 0);
+    if (s == CM_OK) {
+        if (r.p->n_points) memcpy(m->xyz, r.xyz, (size_t)r.p->n_points * 3 * sizeof(double));
+        s = build_cells(&r, m);
+    }
+    /* cell zones become the volume cells' physical groups (zone k: tag k + 1; a cell in
+     * several zones keeps the last) */
+    for (size_t z = 0, k = 0; s == CM_OK && z < r.p->n_zones; ++z) {
+        const cm_foam_zone *zn = &r.p->zones[z];
+        if (zn->kind != CM_FOAM_CELL_ZONE) continue;
+        ++k;
+        s = cm_mesh_add_group(ctx, m, 3, (int)(r.p->n_patches + k), zn->name);
+        for (int64_t i = 0; s == CM_OK && i < zn->n; ++i)
+            m->physical[zn->ids[i]] = m->entity[zn->ids[i]] = (int)(r.p->n_patches + k);
+    }
+    if (s != CM_OK) goto fail;
+    m->foam = r.p;
+    free(r.xyz);
+    free(r.dir);
+    *mesh = m;
+    return CM_OK;
+fail:
+    cm_mesh_destroy(&m);
+    cm_foam_poly_release(&r.p);
+    free(r.xyz);
+    free(r.dir);
+    return s < 0 ? s : CM_ERR_FORMAT;
+}
