@@ -59,3 +59,16 @@ add_test(NAME cad_cli_morph_renumbered COMMAND ${CM_RUN_CLI} --exit 0
          --mesh ${CM_CAD_WORK}/part_m.vtu -o ${CM_CAD_WORK}/part_renumbered_m.vtu --verbose)
 set_tests_properties(cad_cli_morph_renumbered PROPERTIES LABELS "cad;cli"
                      FIXTURES_REQUIRED "cad_shapes;cad_part_mesh")
+# NurbsConvert changes the parameterisation only: the morph must leave every node in place
+# (the surface morph finds the identity as an affine map; a (u,v) warp alone slid face nodes
+# by 1 % of the diagonal along G')
+add_test(NAME cad_cli_morph_nurbs COMMAND $<TARGET_FILE:cadmorph> morph
+         --from ${CM_CAD_WORK}/part.step --to ${CM_CAD_WORK}/part_nurbs.step
+         --mesh ${CM_CAD_WORK}/part_m.vtu -o ${CM_CAD_WORK}/part_nurbs_m.vtu)
+set_tests_properties(cad_cli_morph_nurbs PROPERTIES LABELS "cad;cli"
+                     FIXTURES_REQUIRED "cad_shapes;cad_part_mesh" FIXTURES_SETUP cad_part_nurbs_m)
+add_test(NAME cad_cli_morph_nurbs_in_place COMMAND ${CM_PYTHON}
+         ${PROJECT_SOURCE_DIR}/tests/cli/compare_moved.py ${CM_CAD_WORK}/part_m.vtu
+         ${CM_CAD_WORK}/part_nurbs_m.vtu 1e-9 diagonal)
+set_tests_properties(cad_cli_morph_nurbs_in_place PROPERTIES LABELS "cad;cli"
+                     FIXTURES_REQUIRED cad_part_nurbs_m)
