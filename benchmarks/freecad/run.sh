@@ -3,7 +3,8 @@
 # info --compare of every edit and re-export, mesh by gmsh and TetGen, morph of each mesh onto
 # the edits (--steps auto when one step inverts) and onto the re-export, detect on a gmsh surface
 # mesh scored against the CAD face types.
-#   benchmarks/freecad/run.sh CADMORPH DIR   (DIR holds make_parts.py's STEP files)
+#   benchmarks/freecad/run.sh CADMORPH DIR   (DIR holds the STEP files of
+#   tests/data/freecad/make_parts.py: CM_FREECAD_OUT=DIR freecadcmd tests/data/freecad/make_parts.py)
 set -u
 C=$1; D=$2; H=$(dirname "$0")
 export OPENBLAS_VERBOSE=0
@@ -14,7 +15,7 @@ for p in shaft plate bracket; do
     b=$(basename "$g" .step)
     "$C" info "$D/${p}_0.step" --compare "$g" --map "$D/map_$b.csv" --verbose > "$D/cmp_$b.txt" 2>&1
     echo "compare ${p}_0 $b: exit $? | $(grep -v '^ ' "$D/cmp_$b.txt" | tail -3 | tr '\n' '|' | cut -c1-300)"
-    echo "  map rows with another index or orientation: $(awk -F, 'NR>1 && ($2!=$3 || ($4!="" && $4!="+" && $4!="1")) ' "$D/map_$b.csv" | wc -l), type changes: $(awk -F, 'NR>1 && $5!=$6' "$D/map_$b.csv" | wc -l)"
+    echo "  map rows with another index or orientation: $(awk -F, 'NR>1 && ($2!=$3 || $4!="same") ' "$D/map_$b.csv" | wc -l), type changes: $(awk -F, 'NR>1 && $5!=$6' "$D/map_$b.csv" | wc -l)"
   done
   for m in gmsh tetgen; do
     /usr/bin/time -f "cpu %U %S wall %e" timeout 900 "$C" mesh "$D/${p}_0.step" -o "$D/${p}_$m.msh" --mesher $m --threads 1 -v > "$D/mesh_${p}_$m.txt" 2>&1
