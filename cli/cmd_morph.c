@@ -14,7 +14,7 @@ static const char *const usage_line =
     "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] "
     "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB --blend B] "
-    "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
+    "[--steps auto [--min-sj F] [--keep-partial] [--no-escalate]] [--optimize] [--report R.csv] "
     "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
 
 #define MORPH_MAX_VIA 256
@@ -22,7 +22,7 @@ static const char *const usage_line =
 typedef struct morph_args {
     const char *from, *to, *mesh, *out, *report, *unit;
     cm_morph_options opt;
-    int fail_on_inverted, threads, verbose, relative, keep_partial;
+    int fail_on_inverted, threads, verbose, relative, keep_partial, no_escalate;
     char via_list[8192]; /* --via, split in place at the commas */
     const char *via[MORPH_MAX_VIA];
     size_t n_via;
@@ -104,6 +104,11 @@ static const cli_option options[] = {
     {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.opt.optimize, .label = "--optimize",
      .help = "optimise the interior nodes after every step (boundary nodes\n"
              "stay on G1): untangles and raises the worst cells"},
+    {.name = "--no-escalate", .kind = CLI_FLAG, .dest = &args.no_escalate,
+     .label = "--no-escalate",
+     .help = "--steps auto without --optimize: exit 3 when no step is valid\n"
+             "(default: the rest of the motion is retried with --optimize,\n"
+             "with a warning)"},
     {.name = "--relative", .kind = CLI_FLAG, .dest = &args.relative},
     {.name = "--via", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_via, .dest = &args,
      .label = "--relative --via L",
@@ -180,6 +185,7 @@ static int parse_args(int argc, char **argv, morph_args *a)
                     .unknown = "unknown argument '%s'"};
     const int parsed = cli_parse(&p, argc, argv);
     if (args.unit) args.opt.cad_unit = args.unit;
+    if (args.no_escalate) args.opt.escalate = 0;
     *a = args;
     for (size_t k = 0; k < a->n_via; ++k) /* into a's own copy of the list */
         a->via[k] = a->via_list + (args.via[k] - args.via_list);

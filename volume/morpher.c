@@ -58,6 +58,7 @@ void cm_morph_options_init(cm_morph_options *opt)
     opt->keep_fraction = 0;
     opt->min_fraction = 1.0 / 256;
     opt->optimize = 0;
+    opt->escalate = 1;
     cm_optimize_options_init(&opt->optimize_options);
     cm_classify_options_init(&opt->classify);
     cm_surface_morph_options_init(&opt->morph);
@@ -288,9 +289,10 @@ static cm_morph_step *new_row(cm_context *ctx, cm_morpher *mp)
 /* The mesh at fraction f of the boundary motion: the boundary blended linearly from M's
  * boundary to the surface morph's positions (exactly those at f = 1), the interior by the
  * warp of the move from `from` (the shared factorisation when from is the start mesh, else
- * one of its own on from), then optimised if asked; measured into row. */
+ * one of its own on from), then optimised if `optimize`; measured into row. */
 static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo, double f,
-                       int shared, const double *from, double *xyz, cm_morph_step *row)
+                       int shared, int optimize, const double *from, double *xyz,
+                       cm_morph_step *row)
 {
     const cm_surface_nodes *nd = mp->nodes;
     size_t nn = mp->mesh->n_nodes;
@@ -324,7 +326,7 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     for (size_t i = 0; i < nd->n; ++i)
         memcpy(xyz + 3 * nd->node[i], mp->bxyz + 3 * i, 3 * sizeof(double));
     memcpy(mp->work->xyz, xyz, 3 * nn * sizeof *xyz);
-    if (mp->opt.optimize) {
+    if (optimize) {
         cm_optimize_stats st;
         s = cm_mesh_optimize(ctx, mp->work, mp->fixed, &mp->opt.optimize_options, &st);
         if (s < 0) return s;
@@ -402,7 +404,8 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
         cm_progress(ctx, "morph", k - 1, n);
         cm_morph_step *row = new_row(ctx, mp);
         if (!row) return CM_ERR_NOMEM;
-        cm_status s = trial(ctx, mp, wo, (double)k / n, k == 1, xyz, mp->next, row);
+        cm_status s =
+            trial(ctx, mp, wo, (double)k / n, k == 1, mp->opt.optimize, xyz, mp->next, row);
         if (s < 0) return cm_error_prefix(ctx, s, "step %d of %d", k, n);
         memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
     }
@@ -416,14 +419,14 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
 {
     const cm_morph_options *o = &mp->opt;
     double done = 0, step = 1, min_step = o->min_fraction > 0 ? o->min_fraction : 1.0 / 256;
-    int easy = 0;
+    int easy = 0, optimize = o->optimize;
     while (done < 1) {
         double f = done + step;
         if (f > 1 - 1e-12) f = 1;
         cm_progress(ctx, "morph", done, 1);
         cm_morph_step *row = new_row(ctx, mp);
         if (!row) return CM_ERR_NOMEM;
-        cm_status s = trial(ctx, mp, wo, f, done == 0, xyz, mp->next, row);
+        cm_status s = trial(ctx, mp, wo, f, done == 0, optimize, xyz, mp->next, row);
         if (s < 0) return cm_error_prefix(ctx, s, "step to %.4g %%", 100 * f);
         double floor = o->min_sj;
         if (o->keep_fraction > 0 && step > min_step && o->keep_fraction * mp->min_sj0 > floor)
@@ -443,6 +446,17 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
             worst_cells(mp, row->note + w, sizeof row->note - (size_t)w);
         easy = 0;
         step /= 2;
+        if (step < min_step && !optimize && o->escalate) {
+            /* a cell that inverts at every step length is not one smaller steps can save (an
+             * interior cell squeezed by the whole motion): the optimiser may, from here on */
+            cm_log(ctx, CM_LOG_WARNING,
+                   "morph: from %.4g %% of the motion no step down to %.3g %% is valid without "
+                   "interior optimisation (worst: %s); the rest is morphed with it",
+                   100 * done, 100 * 2 * step, row->note);
+            optimize = 1;
+            step = 1;
+            continue;
+        }
         if (step < min_step) {
             char many[1024];
             worst_cells(mp, many, sizeof many);
@@ -451,7 +465,8 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
                             "leaves %zu cells at or below scaled Jacobian %.3g (worst: %s)%s",
                             100 * done, 100 * 2 * step, row->inverted > 0 ? row->inverted : 1,
                             floor, many,
-                            o->optimize ? "" : "; interior optimisation (--optimize) may lift them");
+                            optimize ? (o->optimize ? "" : ", also with interior optimisation")
+                                     : "; interior optimisation (--optimize) may lift them");
         }
     }
     cm_progress(ctx, "morph", 1, 1);

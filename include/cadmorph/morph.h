@@ -58,6 +58,10 @@ typedef struct cm_morph_options {
     double min_fraction;  /* auto: smallest step (default 1/256) */
     int optimize;         /* 1: optimise the interior (optimize.h) after every increment,
                              before it is judged; boundary nodes never move */
+    /* auto without optimize: 1 (default) = when no step down to min_fraction is valid, the
+     * rest of the motion is retried with interior optimisation (a warning says from where;
+     * the rows' optimized_moves show it); 0 = CM_ERR_REJECTED there */
+    int escalate;
     cm_optimize_options optimize_options;
     const char *cad_unit; /* target unit of STEP files read by cm_morph_run; NULL = "mm" */
     /* Samples of each model for the locators: h is a quarter of the shortest boundary edge,
