@@ -3,6 +3,8 @@
  * by a warp (section 3) whose factorisation depends only on M, kept per method. */
 #include "cadmorph/morph.h"
 
+#include "off_cad.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -61,6 +63,7 @@ void cm_morph_options_init(cm_morph_options *opt)
     cm_optimize_options_init(&opt->optimize_options);
     cm_classify_options_init(&opt->classify);
     cm_surface_morph_options_init(&opt->morph);
+    opt->off_cad = CM_OFF_CAD_REFUSE;
 }
 
 /* Warnings found before the mesh is known to lie on G are held back: a mesh in the wrong unit
@@ -106,8 +109,25 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
     }
     double t1 = cm_wtime();
     cm_surface_nodes_destroy(&mp->nodes);
+    mp->opt.classify.keep_off = mp->opt.off_cad == CM_OFF_CAD_FIXED;
     s = cm_surface_classify(ctx, mp->g, mp->loc, mp->mesh, mp->b, &mp->opt.classify, &mp->nodes);
+    if (s == CM_ERR_MISMATCH && mp->opt.off_cad == CM_OFF_CAD_REFUSE) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
+        return cm_error(ctx, s,
+                        "%s; if the rest of the boundary is not part of the model (a wind "
+                        "tunnel around the body), --off-cad fixed keeps it in place",
+                        msg);
+    }
     if (s < 0) return s;
+    s = cm_morph_off_cad_check(ctx, mp->mesh, mp->b, mp->nodes, &mp->info.off_cad_components);
+    if (s < 0) return s;
+    mp->info.off_cad_nodes = mp->nodes->n_off;
+    if (mp->nodes->n_off)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "classify: %zu of %zu boundary nodes are off the CAD model, in %zu boundary "
+               "components of their own: kept fixed (--off-cad fixed)",
+               mp->nodes->n_off, mp->b->n_nodes, mp->info.off_cad_components);
     for (int k = 0; k < 3; ++k)
         mp->info.counts[k] = mp->nodes->count[k];
     mp->info.class_dist = mp->nodes->max_dist;
@@ -204,7 +224,7 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
         mp->min_sj0 = q0.min;
     mp->info.nodes = nn;
     mp->info.cells = cm_mesh_count_dim(mp->mesh, 3);
-    mp->info.boundary_nodes = nb;
+    mp->info.boundary_nodes = mp->b->n_nodes; /* on G (nb) and off it */
     mp->info.components = mp->b->n_components;
     *morpher = mp;
     return release(ctx, &held);
@@ -320,9 +340,12 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     if (s < 0) return s;
     for (size_t i = 0; i < 3 * nn; ++i)
         xyz[i] = from[i] + mp->disp[i];
-    /* boundary nodes exactly where they were sent (no round-off from the increments) */
+    /* boundary nodes exactly where they were sent (no round-off from the increments), those
+     * off G exactly where they were (the warp's residual there is not zero) */
     for (size_t i = 0; i < nd->n; ++i)
         memcpy(xyz + 3 * nd->node[i], mp->bxyz + 3 * i, 3 * sizeof(double));
+    for (size_t i = 0; i < nd->n_off; ++i)
+        memcpy(xyz + 3 * nd->off[i], mp->mesh->xyz + 3 * nd->off[i], 3 * sizeof(double));
     memcpy(mp->work->xyz, xyz, 3 * nn * sizeof *xyz);
     if (mp->opt.optimize) {
         cm_optimize_stats st;
