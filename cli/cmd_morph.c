@@ -15,7 +15,7 @@ static const char *const usage_line =
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] "
     "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB --blend B] "
     "[--steps auto [--min-sj F] [--keep-partial]] [--optimize] [--report R.csv] "
-    "[--fail-on-inverted] [--cad-unit U] [--cad-tol F] [--off-cad refuse|fixed] [--threads N] "
+    "[--fail-on-inverted] [--cad-unit U] [--cad-tol F [--keep-offset]] [--off-cad refuse|fixed] [--threads N] "
     "[--verbose]";
 
 #define MORPH_MAX_VIA 256
@@ -152,6 +152,10 @@ static const cli_option options[] = {
      .hi = 1, .open = 1, .bad = "%s: expected a number in (0, 1], got '%s'", .label = "--cad-tol F",
      .help = "a boundary node is on G0 within F x its shortest boundary edge\n"
              "(default 1e-6; a snapped mesh, e.g. snappyHexMesh's, needs more)"},
+    {.name = "--keep-offset", .kind = CLI_FLAG, .dest = &args.opt.keep_offset,
+     .label = "--keep-offset",
+     .help = "boundary nodes keep their offset from G0 (move as their point on\n"
+             "G0 does) instead of landing on G1: for a mesh snapped near G0"},
     {.name = "--off-cad", .kind = CLI_ENUM, .dest = &args.opt.off_cad, .names = off_cad_names,
      .values = off_cad_values, .bad = "%.0sexpected refuse or fixed, got '%s'",
      .label = "--off-cad P",

@@ -37,6 +37,7 @@ struct cm_morpher {
     double *bnew;  /* #boundary x 3: the surface morph's positions on the target */
     double *bxyz;  /* #boundary x 3: the positions of the current increment */
     double *next;  /* #nodes x 3: the step being tried */
+    double *offset; /* keep_offset: #boundary x 3, each node minus its point on g */
     unsigned char *fixed; /* #nodes: the boundary nodes, which optimisation never moves */
     double min_sj0;       /* M's minimum scaled Jacobian (keep_fraction) */
     cm_morph_step *rows;  /* the last apply's steps */
@@ -96,6 +97,30 @@ static cm_status make_locator(cm_context *ctx, const cm_morpher *mp, const cm_ca
     return cm_cad_locator_create(ctx, g, &so, loc);
 }
 
+/* keep_offset: the surface morph of g onto itself puts every node on its point of g (the same
+ * parameters, evaluated): the offsets are the nodes minus those points. */
+static cm_status node_offsets(cm_context *ctx, cm_morpher *mp)
+{
+    const cm_surface_nodes *nd = mp->nodes;
+    free(mp->offset);
+    mp->offset = malloc(3 * (nd->n ? nd->n : 1) * sizeof *mp->offset);
+    if (!mp->offset) return cm_error(ctx, CM_ERR_NOMEM, "cm_morpher: out of memory for offsets");
+    cm_surface_morph_options mo = mp->opt.morph;
+    mo.method = mp->opt.method.surface;
+    cm_surface_morph_stats st;
+    memset(&st, 0, sizeof st);
+    cm_status s = cm_surface_morph(ctx, mp->g, mp->g, nd, &mo, mp->offset, &st);
+    if (s < 0) return cm_error_prefix(ctx, s, "the nodes' points on G (--keep-offset)");
+    double worst = 0;
+    for (size_t i = 0; i < 3 * nd->n; ++i) {
+        mp->offset[i] = nd->xyz[i] - mp->offset[i];
+        if (fabs(mp->offset[i]) > worst) worst = fabs(mp->offset[i]);
+    }
+    cm_log(ctx, CM_LOG_DEBUG, "keep-offset: largest offset component of a boundary node %.3g",
+           worst);
+    return CM_OK;
+}
+
 /* Samples g (once h is known) and classifies the boundary of mp->mesh on it. */
 static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
 {
@@ -131,6 +156,10 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
     for (int k = 0; k < 3; ++k)
         mp->info.counts[k] = mp->nodes->count[k];
     mp->info.class_dist = mp->nodes->max_dist;
+    if (mp->opt.keep_offset) {
+        s = node_offsets(ctx, mp);
+        if (s < 0) return s;
+    }
     double bb[6];
     cm_cad_bbox(mp->g, bb);
     mp->info.diagonal = cm_bbox_diagonal(bb);
@@ -166,6 +195,7 @@ void cm_morpher_destroy(cm_morpher **morpher)
     free(mp->bnew);
     free(mp->bxyz);
     free(mp->next);
+    free(mp->offset);
     free(mp->fixed);
     free(mp->rows);
     free(mp);
@@ -500,6 +530,9 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     memset(&mp->surface, 0, sizeof mp->surface);
     s = cm_surface_morph(ctx, mp->g, target, mp->nodes, &mo, mp->bnew, &mp->surface);
     if (s < 0) return s;
+    if (mp->opt.keep_offset)
+        for (size_t i = 0; i < 3 * mp->nodes->n; ++i)
+            mp->bnew[i] += mp->offset[i];
     double t_surface = cm_wtime() - t0;
     char warning[1024] = "";
     if (s == CM_WARNING) {

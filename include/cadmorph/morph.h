@@ -81,6 +81,11 @@ typedef struct cm_morph_options {
     cm_classify_options classify; /* its keep_off is set from off_cad */
     cm_surface_morph_options morph; /* its method field is replaced by method.surface */
     cm_off_cad off_cad;             /* default CM_OFF_CAD_REFUSE */
+    /* 1: each boundary node keeps its offset from G (its position minus its point on G, as
+     * classified): it moves by how its point on G moves, so a mesh snapped near G (e.g. by
+     * snappyHexMesh onto an STL of G, classified with a loose classify.rel_tol) keeps its
+     * cells, and G' = G changes nothing. 0 (default): the boundary lands on G'. */
+    int keep_offset;
 } cm_morph_options;
 
 CM_API void cm_morph_options_init(cm_morph_options *opt);

@@ -172,6 +172,22 @@ if rc == 0:
     far = max(body_nodes, key=lambda t: m0[t][0])
     check(abs(m1[far][0] - 1.1) < 1e-9, "fixed: the body's far end at x = 1.1: %r" % (m1[far],))
 
+# --keep-offset (for meshes snapped near G0, with a loose --cad-tol): G0 -> G0 changes nothing
+# beyond round-off, G0 -> G1 puts these exactly-on-G0 body nodes on G1 as before
+rc, out, err = run("--from", path("g0.step"), "--to", path("g0.step"), "--mesh", path("tunnel.msh"),
+                   "-o", path("identity.msh"), "--off-cad", "fixed", "--cad-tol", "0.3", "--keep-offset")
+check(rc == 0, "keep-offset identity: exit 0, got %d (%s)" % (rc, err.strip()[-600:]))
+if rc == 0:
+    mi = nodes("identity.msh")
+    worst = max(math.dist(mi[t], m0[t]) for t in m0)
+    print("keep-offset, G0 -> G0: largest node move %.3g" % worst)
+    check(worst < 1e-12, "keep-offset identity: a node moved by %.3g" % worst)
+rc, out, err = run("--from", path("g0.step"), "--to", path("g1.step"), "--mesh", path("tunnel.msh"),
+                   "-o", path("offset.msh"), "--off-cad", "fixed", "--keep-offset")
+check(rc == 0 and re.search(r"largest distance to G1: [0-9.e+-]+ \(([0-9.e+-]+) x diagonal", out)
+      and float(re.search(r"\(([0-9.e+-]+) x diagonal", out).group(1)) < 1e-9,
+      "keep-offset G0 -> G1: on G1 to 1e-9 x diagonal: %s %s" % (out, err.strip()[-300:]))
+
 # no node on G0: refused, also with fixed
 rc, out, err = run("--from", path("away.step"), "--to", path("away.step"), "--mesh", path("tunnel.msh"),
                    "-o", path("away.msh"), "--off-cad", "fixed")
