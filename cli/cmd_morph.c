@@ -177,9 +177,11 @@ static int print_help(void)
         "boundary nodes on CAD vertices go to the matching vertex, nodes on edges keep their\n"
         "arc length, nodes on faces are moved in the face's (u,v) by a 2D thin-plate RBF fitted\n"
         "on the face boundaries; the interior follows by an RBF space warp per component.\n"
-        "Writes M1 (.msh .vtu .vtk .mesh) with per-node 'displacement' and per-cell\n"
-        "'scaled_jacobian', then prints the quality summary line.\n\n"
-        "options:\n");
+        "Writes M1 with per-node 'displacement' and per-cell 'scaled_jacobian' (a polyMesh:\n"
+        "its points only), then prints the quality summary line. Mesh formats (M0 and M1):\n"
+        "  %s.\n\n"
+        "options:\n",
+        cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
            "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted or no\n"
