@@ -111,6 +111,11 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--leaf")) o.leaf_size = atoi(b), ++i;
         else if (!strcmp(a, "--local")) o.local_size = atoi(b), ++i;
         else if (!strcmp(a, "--coarse")) o.coarse_size = atoi(b), ++i;
+        else if (!strcmp(a, "--post")) o.coarse_post = atoi(b), ++i;
+        else if (!strcmp(a, "--overlap")) o.overlap = atof(b), ++i;
+        else if (!strcmp(a, "--local-max")) o.local_max = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-grow")) o.coarse_grow = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-max")) o.coarse_max = atoi(b), ++i;
         else if (!strcmp(a, "--restart")) o.restart = atoi(b), ++i;
         else if (!strcmp(a, "--tol")) o.tolerance = atof(b), ++i;
         else if (!strcmp(a, "--maxit")) o.max_iterations = atoi(b), ++i;
@@ -143,14 +148,16 @@ int main(int argc, char **argv)
         fit(ctx, &o, m, x, v, ne, p, &it);
         double exact = 0.0;
         for (size_t i = 0; i < 3 * m; ++i) exact = fmax(exact, fabs(it.out[i] - v[i]));
-        printf(" it_status=%d leaf=%d local=%d coarse=%d subdomains=%d it_setup_s=%.2f "
+        printf(" it_status=%d leaf=%d local=%d coarse=%d post=%d subdomains=%d it_setup_s=%.2f "
                "it_solve_s=%.2f it_eval_s=%.2f iterations=%d matvecs=%d it_residual=%.3g "
                "it_floor=%.3g at_floor=%d it_exact=%.3g it_mem_mb=%.1f it_rss_mb=%.0f "
-               "it_fit_cpu_s=%.1f it_eval_cpu_s=%.1f",
-               it.status, o.leaf_size, o.local_size, it.st.coarse_size, it.st.subdomains,
+               "it_fit_cpu_s=%.1f it_eval_cpu_s=%.1f overlap=%g local_max=%d",
+               it.status, o.leaf_size, o.local_size, it.st.coarse_size, o.coarse_post,
+               it.st.subdomains,
                it.st.setup_seconds, it.st.solve_seconds, it.eval_s, it.st.iterations,
                it.st.matvecs, it.st.residual, it.st.floor, it.st.floor_limited, exact / range,
-               (double)it.st.memory_bytes / 1e6, peak_rss_mb(), it.fit_cpu_s, it.eval_cpu_s);
+               (double)it.st.memory_bytes / 1e6, peak_rss_mb(), it.fit_cpu_s, it.eval_cpu_s,
+               o.overlap, o.local_max);
     }
     if (dense) {
         o.solver = CM_RBF_SOLVER_DENSE;

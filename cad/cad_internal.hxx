@@ -135,6 +135,20 @@ void seed_on_face(adaptors &a, int face, const gp_Pnt &p, double &u, double &v);
 // 1 if (u, v) is in the trimmed domain of face (or on its boundary).
 bool inside_face(adaptors &a, int face, double u, double v);
 
+// Trimming test along a row of the sampling grid (cad/scanline.cpp): the pcurves of a face
+// as a polyline, seg = x0 y0 x1 y1 per segment, within delta of the pcurves; ok = false
+// when the face is classified point by point.
+struct scanline {
+    bool ok = false;
+    double delta = 0;
+    std::vector<double> seg;
+};
+void scanline_build(const cm_cad_model *m, int face, scanline &s);
+// inside[i] for the candidates u_i = lo + (hi - lo) (i + 0.5) / nu on row v: as
+// inside_face, which decides those within delta of the polyline.
+void scanline_row(adaptors &a, int face, const scanline &s, double v, double lo, double hi,
+                  int nu, char *inside);
+
 }  // namespace cmcad
 
 #endif

@@ -171,10 +171,15 @@ void cm_cad_boundary_destroy(cm_cad_boundary **boundary)
     *boundary = nullptr;
 }
 
-cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model, int face,
-                               const int *per_edge, int count, cm_cad_boundary **boundary)
+}  // extern "C"
+
+namespace {
+
+// The samples of cm_cad_face_boundary; at_t (NULL: arc-length fractions) gives the edge
+// parameter of each sample instead (NaN: the arc-length one).
+cm_status face_boundary(cm_context *ctx, const cm_cad_model *model, int face, const int *per_edge,
+                        int count, const double *at_t, cm_cad_boundary **boundary, const char *fn)
 {
-    const char *fn = "cm_cad_face_boundary";
     if (!boundary) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: boundary is NULL", fn);
     *boundary = nullptr;
     cm_status st = cmcad::check_face(ctx, model, face, fn);
@@ -227,7 +232,8 @@ cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model, int f
                         const double *v = &model->vertex_xyz[3 * (size_t)std::max(ei.vertex[0], 0)];
                         p.SetCoord(v[0], v[1], v[2]);
                     } else {
-                        t = param_at(a.curve(e), s, ei.length);
+                        t = at_t && !std::isnan(at_t[j]) ? at_t[j]
+                                                         : param_at(a.curve(e), s, ei.length);
                         p = a.curve(e).Value(t);
                     }
                     gp_Pnt2d q = pc->Value(t);
@@ -245,6 +251,29 @@ cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model, int f
     }
     *boundary = b;
     return CM_OK;
+}
+
+}  // namespace
+
+extern "C" {
+
+cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model, int face,
+                               const int *per_edge, int count, cm_cad_boundary **boundary)
+{
+    return face_boundary(ctx, model, face, per_edge, count, nullptr, boundary,
+                         "cm_cad_face_boundary");
+}
+
+cm_status cm_cad_face_boundary_at(cm_context *ctx, const cm_cad_model *model, int face,
+                                  const int *per_edge, int count, const double *t,
+                                  cm_cad_boundary **boundary)
+{
+    if (!t) {
+        if (boundary) *boundary = nullptr;
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_cad_face_boundary_at: t is NULL");
+    }
+    return face_boundary(ctx, model, face, per_edge, count, t, boundary,
+                         "cm_cad_face_boundary_at");
 }
 
 }  // extern "C"

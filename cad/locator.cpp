@@ -132,11 +132,14 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     std::vector<char> keep(ncand, 0);
     cmcad::region_error err;
     cm_progress(ctx, "sample", 0, (double)rows.size());
+    std::vector<cmcad::scanline> scan((size_t)m->counts.faces);
+    for (int f = 0; f < m->counts.faces; ++f) cmcad::scanline_build(m, f, scan[(size_t)f]);
 #pragma omp parallel num_threads(cm_context_threads_for(ctx, ncand, 4096)) if (ncand > 4096)
     {
         cmcad::adaptors ta(m);
         const int nt = omp_get_num_threads();
         const bool master = omp_get_thread_num() == 0;
+        std::vector<char> in;
 #pragma omp for schedule(static)
         for (long r = 0; r < (long)rows.size(); ++r) {
             // the calling thread reports: with a static schedule it owns the first 1/nt rows
@@ -147,10 +150,13 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
                 const row &rw = rows[r];
                 const double *ur = m->face_info[rw.face].uv_range;
                 BRepAdaptor_Surface &S = ta.surface(rw.face);
+                in.resize((size_t)rw.nu);
+                cmcad::scanline_row(ta, rw.face, scan[(size_t)rw.face], rw.v, ur[0], ur[1], rw.nu,
+                                    in.data());
                 for (int i = 0; i < rw.nu; ++i) {
                     size_t c = rw.offset + (size_t)i;
                     double u = ur[0] + (ur[1] - ur[0]) * (i + 0.5) / rw.nu;
-                    if (!cmcad::inside_face(ta, rw.face, u, rw.v)) continue;
+                    if (!in[(size_t)i]) continue;
                     gp_Pnt p = S.Value(u, rw.v);
                     cxyz[3 * c] = p.X(), cxyz[3 * c + 1] = p.Y(), cxyz[3 * c + 2] = p.Z();
                     cuv[2 * c] = u, cuv[2 * c + 1] = rw.v;

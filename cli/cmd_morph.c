@@ -125,10 +125,12 @@ static const cli_option options[] = {
      .label = "--kernel K",
      .help = "triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)"},
     {.name = "--solver", .kind = CLI_ENUM, .dest = &args.opt.method.warp.solver, .names = cli_solver_names,
-     .values = cli_solver_values, .bad = "%.0sunknown solver '%s' (auto, dense, iterative)",
+     .values = cli_solver_values, .bad = "%.0sunknown solver '%s' (auto, dense, iterative, petsc)",
      .label = "--solver S",
      .help = "RBF warps: auto (default: dense below ~7,500 boundary nodes,\n"
-             "iterative above), dense or iterative (FGMRES + Schwarz)"},
+             "iterative above), dense, iterative (FGMRES + Schwarz) or petsc\n"
+             "(the same distributed over MPI ranks: mpirun -n K; builds\n"
+             "with -DCADMORPH_WITH_PETSC=ON)"},
     {.name = "--lattice", .kind = CLI_INT, .dest = &args.opt.method.warp.lattice, .lo = 4,
      .hi = 200, .bad = "%s: expected 4..200 control points per axis, got '%s'",
      .label = "--lattice N",
@@ -206,6 +208,7 @@ static int parse_args(int argc, char **argv, morph_args *a)
     if (!a->to) return cli_usage(cmd, usage_line, "--to is required");
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
+    if (cli_check_solver(cmd, usage_line, a->opt.method.warp.solver) >= 0) return CLI_EXIT_USAGE;
     if (a->keep_partial && a->opt.steps != CM_MORPH_STEPS_AUTO)
         return cli_usage(cmd, usage_line, "--keep-partial goes with --steps auto");
     if (a->n_via && !a->relative)
@@ -288,17 +291,19 @@ int cli_cmd_morph(int argc, char **argv)
                 last->inverted, last->min_sj, a.out);
         rc = CLI_EXIT_REJECTED;
     }
-    if (rc == CLI_EXIT_OK || (partial && a.keep_partial)) {
+    /* under mpirun (--solver petsc) every rank has the result; rank 0 writes it */
+    const int writer = cli_output_rank();
+    if (writer && (rc == CLI_EXIT_OK || (partial && a.keep_partial))) {
         double t = cm_wtime();
         s = cm_mesh_write(ctx, r->mesh, a.out, NULL);
         r->steps[r->n_steps - 1].t_write = cm_wtime() - t;
         if (s < 0) rc = cli_fail(ctx, "morph", s);
     }
-    if (a.report && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED)) {
+    if (writer && a.report && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED)) {
         s = write_report(ctx, a.report, r);
         if (s < 0) rc = cli_fail(ctx, "morph", s);
     }
-    if (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED) {
+    if (writer && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED)) {
         printf("boundary nodes: %zu on vertices, %zu on edges, %zu on faces; ", r->counts[0],
                r->counts[1], r->counts[2]);
         if (r->off_cad_nodes)

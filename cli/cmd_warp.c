@@ -48,10 +48,12 @@ static const cli_option options[] = {
      .help = "then optimise the other nodes (untangle, raise the worst cells;\n"
              "boundary and listed nodes stay where D.csv sends them)"},
     {.name = "--solver", .kind = CLI_ENUM, .dest = &args.solver, .names = cli_solver_names,
-     .values = cli_solver_values, .bad = "%.0sunknown solver '%s' (auto, dense, iterative)",
+     .values = cli_solver_values, .bad = "%.0sunknown solver '%s' (auto, dense, iterative, petsc)",
      .label = "--solver S",
      .help = "RBF warps: auto (default: dense below ~7,500 boundary nodes,\n"
-             "iterative above), dense or iterative (FGMRES + Schwarz)"},
+             "iterative above), dense, iterative (FGMRES + Schwarz) or petsc\n"
+             "(the same distributed over MPI ranks: mpirun -n K; builds\n"
+             "with -DCADMORPH_WITH_PETSC=ON)"},
     {.name = "--lattice", .kind = CLI_INT, .dest = &args.lattice, .lo = 4, .hi = 200,
      .bad = "%s: expected 4..200 control points per axis, got '%s'", .label = "--lattice N",
      .help = "dmffd: control points per axis of the B-spline lattice on the\n"
@@ -104,6 +106,7 @@ static int parse_args(int argc, char **argv, warp_args *a)
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->csv) return cli_usage(cmd, usage_line, "--displacements is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
+    if (cli_check_solver(cmd, usage_line, a->solver) >= 0) return CLI_EXIT_USAGE;
     const char *inputs[] = {a->mesh, a->csv};
     return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 2) ? CLI_EXIT_USAGE : -1;
 }
@@ -146,10 +149,12 @@ int cli_cmd_warp(int argc, char **argv)
                "apply %.3f s, residual at the constrained nodes %.3g",
                cm_warp_method_name(a.method), mesh->n_nodes, st.boundary_nodes, st.components,
                st.t_create, st.t_apply, st.residual);
-    if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
+    /* under mpirun (--solver petsc) every rank has the result; rank 0 writes it */
+    const int writer = cli_output_rank();
+    if (s >= 0 && writer) s = cm_mesh_write(ctx, mesh, a.out, NULL);
     /* the report only once the mesh is written: its last line is what scripts parse */
-    if (s >= 0) s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
-    if (s >= 0) cli_warn_inverted("warp", mesh, sj);
+    if (s >= 0 && writer) s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
+    if (s >= 0 && writer) cli_warn_inverted("warp", mesh, sj);
     rc = s < 0 ? cli_fail(ctx, "warp", s) : CLI_EXIT_OK;
     free(disp);
     free(listed);

@@ -24,11 +24,12 @@ void cli_constraints_help(void)
     printf(
         "  --constraint TYPE:SET     MLS only, repeatable: keep the nodes of SET on a shape of\n"
         "                            TYPE while deforming (Shape-Up, the MLS paper's section 6):\n"
-        "                            plane, circle, cylinder, line (similar copy: translation,\n"
-        "                            rotation, uniform scale) or rigid. SET: a node-list file\n"
-        "                            (header node), else a physical group of the mesh, else a\n"
-        "                            field NAME or NAME=VALUE (nodes where the node field, or of\n"
-        "                            the cells where the cell field, is nonzero / equals VALUE)\n"
+        "                            plane, circle, cylinder, cone, line (similar copy:\n"
+        "                            translation, rotation, uniform scale) or rigid. SET: a\n"
+        "                            node-list file (header node), else a physical group of the\n"
+        "                            mesh (gmsh; an OpenFOAM patch or cellZone), else a field\n"
+        "                            NAME or NAME=VALUE (nodes where the node field, or of the\n"
+        "                            cells where the cell field, is nonzero / equals VALUE)\n"
         "  --constraint-weight GC    gamma_c (default 10)\n"
         "  --constraint-iterations N cap on the alternations (default 10000)\n"
         "  --constraint-tolerance T  stop when no constrained node moves more than T x the\n"
@@ -41,10 +42,11 @@ void cli_constraints_help(void)
         "                            projections (the shapes then hold to rounding)\n"
         "  --constraints-from-cad G  volume meshes: constraints from the STEP model G of the\n"
         "                            mesh: the nodes of each planar face (with its edges and\n"
-        "                            vertices) a plane set, of each cylindrical face a cylinder\n"
-        "                            set, of each circular edge a circle set\n"
-        "  --cad-constraints LIST    which of them: plane, cylinder, circle, face:N, edge:N\n"
-        "                            (0-based ids as `cadmorph info` lists; default all types)\n");
+        "                            vertices) a plane set, of each cylindrical (conical) face\n"
+        "                            a cylinder (cone) set, of each circular edge a circle set\n"
+        "  --cad-constraints LIST    which of them: plane, cylinder, cone, circle, face:N,\n"
+        "                            edge:N (0-based ids as `cadmorph info` lists; default all\n"
+        "                            types)\n");
 }
 
 static int parse_number(const char *v, double *out)
@@ -92,7 +94,7 @@ int cli_constraints_option(int argc, char **argv, int *i, const char *cmd, const
         cm_shape_type t;
         if (cm_shape_type_parse(NULL, name, &t) < 0) {
             cli_usage(cmd, usage,
-                      "--constraint '%s': unknown type '%s' (plane|circle|cylinder|line|rigid)", v, name);
+                      "--constraint '%s': unknown type '%s' (plane|circle|cylinder|cone|line|rigid)", v, name);
             return -1;
         }
         if (c->n >= CLI_MAX_CONSTRAINTS) {

@@ -144,8 +144,42 @@ int cli_parse_size(const cli_parser *p, const cli_option *o, const char *v, void
 }
 
 const char *const cli_kernel_names[] = {"triharmonic", "biharmonic", NULL};
-const char *const cli_solver_names[] = {"auto", "dense", "iterative", NULL};
-const int cli_solver_values[] = {CM_RBF_SOLVER_AUTO, CM_RBF_SOLVER_DENSE, CM_RBF_SOLVER_ITERATIVE};
+const char *const cli_solver_names[] = {"auto", "dense", "iterative", "petsc", NULL};
+const int cli_solver_values[] = {CM_RBF_SOLVER_AUTO, CM_RBF_SOLVER_DENSE, CM_RBF_SOLVER_ITERATIVE,
+                                 CM_RBF_SOLVER_PETSC};
+
+int cli_check_solver(const char *cmd, const char *usage, int solver)
+{
+    if (solver == CM_RBF_SOLVER_PETSC && !cm_rbf_petsc_available())
+        return cli_usage(cmd, usage, "--solver petsc: this cadmorph was built without PETSc "
+                         "(configure with -DCADMORPH_WITH_PETSC=ON)");
+    return -1;
+}
+
+int cli_mpi_ranks(cm_context *ctx, const char *cmd, int *rank, int *ranks)
+{
+    *rank = 0;
+    *ranks = 1;
+    const char *v = getenv("OMPI_COMM_WORLD_SIZE");
+    if (!v) v = getenv("PMI_SIZE");
+    if (!v || atoi(v) <= 1) return 0;
+    if (!cm_rbf_petsc_available()) {
+        fprintf(stderr, "cadmorph %s: started by mpirun with %s ranks, but this cadmorph was "
+                "built without PETSc/MPI (configure with -DCADMORPH_WITH_PETSC=ON)\n", cmd, v);
+        return CLI_EXIT_USAGE;
+    }
+    cm_status s = cm_rbf_petsc_initialize(ctx);
+    if (s < 0) return cli_fail(ctx, cmd, s);
+    cm_rbf_petsc_rank(rank, ranks);
+    return 0;
+}
+
+int cli_output_rank(void)
+{
+    int rank;
+    cm_rbf_petsc_rank(&rank, NULL);
+    return rank == 0;
+}
 const int cli_kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};
 const char *const cli_study_mode_names[] = {"absolute", "relative", "both", NULL};
 const int cli_study_mode_values[] = {CM_STUDY_ABSOLUTE, CM_STUDY_RELATIVE, CM_STUDY_BOTH};

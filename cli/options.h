@@ -5,6 +5,8 @@
 #ifndef CADMORPH_CLI_OPTIONS_H
 #define CADMORPH_CLI_OPTIONS_H
 
+#include "cadmorph/core.h"
+
 #include <stdio.h>
 
 typedef enum cli_kind {
@@ -71,6 +73,16 @@ extern const char *const cli_kernel_names[];
 /* --solver of the RBF warps: auto, dense, iterative (cm_rbf_solver). */
 extern const char *const cli_solver_names[];
 extern const int cli_solver_values[];
+/* -1 if the --solver value can run in this build, else the usage exit code after saying why
+ * (petsc without PETSc). */
+int cli_check_solver(const char *cmd, const char *usage, int solver);
+/* 1 on the rank that writes outputs and prints reports: rank 0 under mpirun with --solver
+ * petsc (the other ranks compute the same result), and always without MPI. */
+int cli_output_rank(void);
+/* Under mpirun (OMPI_COMM_WORLD_SIZE or PMI_SIZE > 1): initialises MPI (PETSc builds) and
+ * returns this process's rank and the rank count; 1 rank otherwise. 0, or the exit code after
+ * a message (a build without PETSc). */
+int cli_mpi_ranks(cm_context *ctx, const char *cmd, int *rank, int *ranks);
 extern const int cli_kernel_methods[];
 /* --mode of study and sweep: absolute, relative, both (CM_STUDY_*). */
 extern const char *const cli_study_mode_names[];

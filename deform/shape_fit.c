@@ -1,8 +1,8 @@
 /* Shape-Up projections (paper section 6.2; Bouaziz et al. 2012): each projection is the
  * nearest point set of its kind, found through a least-squares fit of that kind: plane
  * (total least squares), circle (geometric fit in the plane), cylinder (Eberly's direction
- * search, then Levenberg-Marquardt on the geometric distances), similar/rigid match
- * (Kabsch/Umeyama). */
+ * search, then Levenberg-Marquardt on the geometric distances), cone (the same search on a
+ * cone's algebraic error, then Levenberg-Marquardt), similar/rigid match (Kabsch/Umeyama). */
 #include "cadmorph/shapeup.h"
 
 #include <lapacke.h>
@@ -412,6 +412,260 @@ cm_status cm_shape_project_cylinder(cm_context *ctx, size_t n, const double *x,
             p[3 * i + k] = pt[k] + h * w[k] + r * q[k] / d;
     }
     if (fit) memcpy(fit, pt, sizeof pt), memcpy(fit + 3, w, sizeof w), fit[6] = r;
+    return CM_OK;
+}
+
+/* ---- cone ---- */
+
+/* For a direction w, the points' coordinates (s, t) in the plane normal to w and their
+ * height h along it: the circles' common centre (a, b) from the linear least squares of
+ * s^2 + t^2 = 2 a s + 2 b t + k0 + k1 h + k2 h^2 (radius^2 any quadratic in h), then the
+ * radii r_i = |(s, t) - (a, b)| fitted by a line c + d h. Returns the geometric error of that
+ * line, sum (r_i - c - d h_i)^2 (a quadric of revolution that is no cone scores badly, unlike
+ * in the algebraic error), and the apex (c + d h = 0), the axis into the nappe (sign d w) and
+ * the half-angle atan |d|. */
+static double cone_direction_error(size_t n, const double *x, const double *mean,
+                                   const double w[3], double apex[3], double axis[3],
+                                   double *angle)
+{
+    double u[3], v[3], a[25] = {0}, b[5] = {0};
+    plane_basis(w, u, v);
+    double h2 = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double y[3] = {x[3 * i] - mean[0], x[3 * i + 1] - mean[1], x[3 * i + 2] - mean[2]};
+        double h = dot3(y, w);
+        h2 += h * h;
+    }
+    /* h scaled by its spread: the 5 x 5 normal equations stay balanced */
+    double hs = sqrt(h2 / (double)n);
+    if (!(hs > 0)) return INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        double y[3] = {x[3 * i] - mean[0], x[3 * i + 1] - mean[1], x[3 * i + 2] - mean[2]};
+        double s = dot3(y, u), t = dot3(y, v), h = dot3(y, w) / hs;
+        double row[5] = {2 * s, 2 * t, 1, h, h * h}, rhs = s * s + t * t;
+        for (int p = 0; p < 5; ++p) {
+            b[p] += row[p] * rhs;
+            for (int q = 0; q < 5; ++q)
+                a[5 * p + q] += row[p] * row[q];
+        }
+    }
+    if (!solve_small(5, a, b)) return INFINITY;
+    /* the radius line r = c + d h by least squares */
+    double sh = 0, sr = 0, shh = 0, shr = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double y[3] = {x[3 * i] - mean[0], x[3 * i + 1] - mean[1], x[3 * i + 2] - mean[2]};
+        double s = dot3(y, u) - b[0], t = dot3(y, v) - b[1], h = dot3(y, w);
+        double r = sqrt(s * s + t * t);
+        sh += h, sr += r, shh += h * h, shr += h * r;
+    }
+    double det = (double)n * shh - sh * sh;
+    if (!(det > 0)) return INFINITY;
+    double d = ((double)n * shr - sh * sr) / det, c = (sr - d * sh) / (double)n;
+    if (!(fabs(d) > 0)) return INFINITY; /* a cylinder */
+    double err = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double y[3] = {x[3 * i] - mean[0], x[3 * i + 1] - mean[1], x[3 * i + 2] - mean[2]};
+        double s = dot3(y, u) - b[0], t = dot3(y, v) - b[1], h = dot3(y, w);
+        double e = sqrt(s * s + t * t) - c - d * h;
+        err += e * e;
+    }
+    double h0 = -c / d;
+    for (int k = 0; k < 3; ++k) {
+        apex[k] = mean[k] + b[0] * u[k] + b[1] * v[k] + h0 * w[k];
+        axis[k] = d > 0 ? w[k] : -w[k];
+    }
+    *angle = atan(fabs(d));
+    return err;
+}
+
+/* Signed distances to the nappe (apex p[0..2], unit axis p[3..5], half-angle p[6]):
+ * r cos(angle) - h sin(angle) in the half-plane of the axis; the cost, res (may be NULL). */
+static double cone_cost(size_t n, const double *x, const double *p, double *res)
+{
+    double cost = 0, ca = cos(p[6]), sa = sin(p[6]);
+    for (size_t i = 0; i < n; ++i) {
+        double y[3] = {x[3 * i] - p[0], x[3 * i + 1] - p[1], x[3 * i + 2] - p[2]};
+        double h = dot3(y, p + 3), r2 = dot3(y, y) - h * h;
+        double r = sqrt(r2 > 0 ? r2 : 0), e = r * ca - h * sa;
+        /* a point behind the apex (foot beyond it): its distance to the apex */
+        if (h * ca + r * sa < 0) e = sqrt(dot3(y, y));
+        if (res) res[i] = e;
+        cost += e * e;
+    }
+    return cost;
+}
+
+/* p moved by t: apex + t0..2, axis tilted by t3, t4 in its normal plane, angle + t5. */
+static void cone_moved(const double *p, const double *t, double *q)
+{
+    double u[3], v[3];
+    plane_basis(p + 3, u, v);
+    for (int k = 0; k < 3; ++k)
+        q[k] = p[k] + t[k], q[3 + k] = p[3 + k] + t[3] * u[k] + t[4] * v[k];
+    double l = sqrt(dot3(q + 3, q + 3));
+    for (int k = 0; k < 3; ++k)
+        q[3 + k] /= l;
+    q[6] = p[6] + t[5];
+}
+
+/* The Jacobian of the signed distances with respect to the moves of cone_moved: apex
+ * shift, axis tilt along u and v (plane_basis of the axis), angle. jac: n x 6. */
+static void cone_jacobian(size_t n, const double *x, const double *p, double *jac)
+{
+    double ca = cos(p[6]), sa = sin(p[6]), u[3], v[3];
+    plane_basis(p + 3, u, v);
+    for (size_t i = 0; i < n; ++i) {
+        double y[3] = {x[3 * i] - p[0], x[3 * i + 1] - p[1], x[3 * i + 2] - p[2]};
+        double h = dot3(y, p + 3), q[3] = {y[0] - h * p[3], y[1] - h * p[4], y[2] - h * p[5]};
+        double r = sqrt(dot3(q, q)), *j = jac + 6 * i;
+        if (h * ca + r * sa < 0) { /* behind the apex: e = |y| */
+            double l = sqrt(dot3(y, y));
+            for (int k = 0; k < 3; ++k)
+                j[k] = l > 0 ? -y[k] / l : 0;
+            j[3] = j[4] = j[5] = 0;
+            continue;
+        }
+        if (r > 0)
+            for (int k = 0; k < 3; ++k)
+                q[k] /= r;
+        /* e = r cos - h sin: d e / d apex = -cos q^ + sin w; a tilt t along u changes h by
+         * t (y.u) and r by -h (q^.u) t; d e / d angle = -(r sin + h cos) */
+        for (int k = 0; k < 3; ++k)
+            j[k] = -ca * q[k] + sa * p[3 + k];
+        double g = h * ca + r * sa;
+        j[3] = -dot3(q, u) * g, j[4] = -dot3(q, v) * g, j[5] = -g;
+    }
+}
+
+/* Levenberg-Marquardt on the 6 parameters (scale: the points' spread, for the step size
+ * test). jac: n x 6, res, res2: n. */
+static void cone_refine(size_t n, const double *x, double *p, double scale, double *jac,
+                        double *res, double *res2)
+{
+    double cost = cone_cost(n, x, p, res), lambda = -1;
+    for (int it = 0; it < 200; ++it) {
+        cone_jacobian(n, x, p, jac);
+        double a[36] = {0}, g[6] = {0};
+        for (size_t i = 0; i < n; ++i)
+            for (int j = 0; j < 6; ++j) {
+                g[j] -= jac[6 * i + j] * res[i];
+                for (int l = 0; l < 6; ++l)
+                    a[6 * j + l] += jac[6 * i + j] * jac[6 * i + l];
+            }
+        if (lambda < 0) lambda = 1e-6 * (a[0] + a[7] + a[14] + a[21] + a[28] + a[35]) / 6;
+        int accepted = 0;
+        for (int tries = 0; tries < 20 && !accepted; ++tries) {
+            double aa[36], b[6], q[7];
+            memcpy(aa, a, sizeof aa);
+            memcpy(b, g, sizeof b);
+            for (int j = 0; j < 6; ++j)
+                aa[7 * j] += lambda * (a[7 * j] > 0 ? a[7 * j] : 1);
+            if (!solve_small(6, aa, b)) {
+                lambda *= 10;
+                continue;
+            }
+            cone_moved(p, b, q);
+            double step = (fabs(b[0]) + fabs(b[1]) + fabs(b[2])) / scale + fabs(b[3]) +
+                          fabs(b[4]) + fabs(b[5]);
+            if (!(q[6] > 0 && q[6] < 1.5707963267948966)) {
+                lambda *= 4;
+                continue;
+            }
+            double nc = cone_cost(n, x, q, res2);
+            /* steps below 1e-9 are taken on the gradient's word: the cost resolves the
+             * parameters only to sqrt(eps) near the minimum */
+            if (nc <= cost || step < 1e-9) {
+                memcpy(p, q, 7 * sizeof *p);
+                cost = nc;
+                memcpy(res, res2, n * sizeof *res);
+                lambda /= 3;
+                accepted = 1;
+                if (step <= 1e-14) return;
+            } else {
+                lambda *= 4;
+            }
+        }
+        if (!accepted) return;
+    }
+}
+
+cm_status cm_shape_project_cone(cm_context *ctx, size_t n, const double *x, const double *guess,
+                                double *p, double fit[7])
+{
+    const char *who = "cm_shape_project_cone";
+    cm_status st = check_points(ctx, who, n, 6, x, p);
+    if (st < 0) return st;
+    double mean[3], c[7], scale = 0;
+    centroid(n, x, mean);
+    for (size_t i = 0; i < n; ++i) {
+        double y[3] = {x[3 * i] - mean[0], x[3 * i + 1] - mean[1], x[3 * i + 2] - mean[2]};
+        scale = fmax(scale, sqrt(dot3(y, y)));
+    }
+    if (!(scale > 0)) return cm_error(ctx, CM_ERR_NUMERIC, "%s: %zu coincident points", who, n);
+    if (guess && finite_n(7, guess) && guess[6] > 0 && guess[6] < 1.5707963267948966 &&
+        dot3(guess + 3, guess + 3) > 0) {
+        memcpy(c, guess, sizeof c);
+        double l = sqrt(dot3(c + 3, c + 3));
+        for (int k = 3; k < 6; ++k)
+            c[k] /= l;
+    } else {
+        /* the direction search of the cylinder, on the cone's algebraic error */
+        double best = INFINITY, w[3] = {0, 0, 1};
+        const int nd = 600;
+        for (int i = 0; i < nd; ++i) {
+            double z = 1 - (i + 0.5) / nd, rho = sqrt(1 - z * z), phi = i * 2.399963229728653;
+            double d[3] = {rho * cos(phi), rho * sin(phi), z}, ap[3], ax[3], an;
+            double e = cone_direction_error(n, x, mean, d, ap, ax, &an);
+            if (e < best) best = e, memcpy(w, d, sizeof d), memcpy(c, ap, sizeof ap),
+                          memcpy(c + 3, ax, sizeof ax), c[6] = an;
+        }
+        for (double step = 0.1; step > 1e-7 && isfinite(best);) {
+            double u[3], v[3];
+            plane_basis(w, u, v);
+            int improved = 0;
+            for (int k = 0; k < 8; ++k) {
+                double ang = k * 0.7853981633974483, d[3], ap[3], ax[3], an;
+                for (int a = 0; a < 3; ++a)
+                    d[a] = w[a] + step * (cos(ang) * u[a] + sin(ang) * v[a]);
+                double l = sqrt(dot3(d, d));
+                for (int a = 0; a < 3; ++a)
+                    d[a] /= l;
+                double e = cone_direction_error(n, x, mean, d, ap, ax, &an);
+                if (e < best) {
+                    best = e, memcpy(w, d, sizeof d), memcpy(c, ap, sizeof ap);
+                    memcpy(c + 3, ax, sizeof ax), c[6] = an;
+                    improved = 1;
+                    break;
+                }
+            }
+            if (!improved) step /= 2;
+        }
+        if (!isfinite(best))
+            return cm_error(ctx, CM_ERR_NUMERIC, "%s: %zu points fit no cone", who, n);
+    }
+    double *buf = malloc(8 * n * sizeof *buf);
+    if (!buf) return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", who);
+    cone_refine(n, x, c, scale, buf, buf + 6 * n, buf + 7 * n);
+    free(buf);
+    if (!finite_n(7, c) || !(c[6] > 0 && c[6] < 1.5707963267948966))
+        return cm_error(ctx, CM_ERR_NUMERIC, "%s: the cone fit failed (half-angle %g)", who, c[6]);
+    /* the foot on the generator in the axis half-plane; behind the apex: the apex */
+    double ca = cos(c[6]), sa = sin(c[6]), u[3], v[3];
+    plane_basis(c + 3, u, v);
+    for (size_t i = 0; i < n; ++i) {
+        double y[3] = {x[3 * i] - c[0], x[3 * i + 1] - c[1], x[3 * i + 2] - c[2]};
+        double h = dot3(y, c + 3), q[3] = {y[0] - h * c[3], y[1] - h * c[4], y[2] - h * c[5]};
+        double r = sqrt(dot3(q, q));
+        if (!(r > 0)) memcpy(q, u, sizeof q), r = 0;
+        else
+            for (int k = 0; k < 3; ++k)
+                q[k] /= r;
+        double t = h * ca + r * sa; /* distance from the apex along the generator */
+        if (t < 0) t = 0;
+        for (int k = 0; k < 3; ++k)
+            p[3 * i + k] = c[k] + t * (ca * c[3 + k] + sa * q[k]);
+    }
+    if (fit) memcpy(fit, c, sizeof c);
     return CM_OK;
 }
 

@@ -42,13 +42,14 @@ const char *cm_shape_type_name(cm_shape_type t)
     case CM_SHAPE_CYLINDER: return "cylinder";
     case CM_SHAPE_LINE: return "line";
     case CM_SHAPE_RIGID: return "rigid";
+    case CM_SHAPE_CONE: return "cone";
     }
     return NULL;
 }
 
 cm_status cm_shape_type_parse(cm_context *ctx, const char *name, cm_shape_type *t)
 {
-    for (int i = CM_SHAPE_PLANE; i <= CM_SHAPE_RIGID; ++i)
+    for (int i = CM_SHAPE_PLANE; i <= CM_SHAPE_CONE; ++i)
         if (name && strcmp(name, cm_shape_type_name((cm_shape_type)i)) == 0) {
             *t = (cm_shape_type)i;
             return CM_OK;
@@ -84,7 +85,7 @@ void cm_shapeup_destroy(cm_shapeup **su)
 
 static size_t min_nodes(cm_shape_type t)
 {
-    return t == CM_SHAPE_CYLINDER ? 5 : (t == CM_SHAPE_LINE || t == CM_SHAPE_RIGID) ? 2 : 3;
+    return t == CM_SHAPE_CONE ? 6 : t == CM_SHAPE_CYLINDER ? 5 : (t == CM_SHAPE_LINE || t == CM_SHAPE_RIGID) ? 2 : 3;
 }
 
 /* A sparse column under construction: a dense accumulator over the k samples plus the list
@@ -566,6 +567,11 @@ static cm_status project_all(cm_context *ctx, cm_shapeup *s, const double *y, do
         case CM_SHAPE_CYLINDER:
             st = cm_shape_project_cylinder(ctx, n, yt, s->has_fit[t] ? s->fit + 7 * t : NULL, pt,
                                            s->fit + 7 * t);
+            if (st >= 0) s->has_fit[t] = 1;
+            break;
+        case CM_SHAPE_CONE:
+            st = cm_shape_project_cone(ctx, n, yt, s->has_fit[t] ? s->fit + 7 * t : NULL, pt,
+                                       s->fit + 7 * t);
             if (st >= 0) s->has_fit[t] = 1;
             break;
         case CM_SHAPE_LINE: st = cm_shape_project_similar(ctx, n, s->ref + 3 * o, yt, 1, pt); break;

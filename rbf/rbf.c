@@ -85,6 +85,7 @@ void cm_rbf_destroy(cm_rbf **rbf)
     free(r->chol);
     free(r->w);
     free(r->q);
+    cm_rbf_petsc_destroy(&r->petsc);
     cm_rbf_iterative_destroy(&r->iter);
     free(r);
     *rbf = NULL;
@@ -375,6 +376,7 @@ cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size
     r->stats.centres = r->m;
     if (st == CM_OK)
         st = solver == CM_RBF_SOLVER_ITERATIVE ? cm_rbf_iterative_setup(ctx, r, threads)
+             : solver == CM_RBF_SOLVER_PETSC   ? cm_rbf_petsc_setup(ctx, r, threads)
                                                : factor_projected(ctx, r, threads);
     if (st == CM_OK && solver == CM_RBF_SOLVER_DENSE)
         r->stats.memory_bytes = (r->m - (size_t)r->k) * (r->m - (size_t)r->k + 1) / 2 * 8;
@@ -527,8 +529,9 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
     const int saved_blas_threads = openblas_get_num_threads();
     blas_threads(1);
     const double t_start = cm_wtime();
-    st = rbf->iter ? cm_rbf_iterative_solve(ctx, rbf, nc, f, w, q, threads)
-                   : solve_pass(ctx, rbf, nc, f, w, q, aw, g, threads);
+    st = rbf->petsc  ? cm_rbf_petsc_solve(ctx, rbf, nc, f, w, q)
+         : rbf->iter ? cm_rbf_iterative_solve(ctx, rbf, nc, f, w, q, threads)
+                     : solve_pass(ctx, rbf, nc, f, w, q, aw, g, threads);
     /* Iterative refinement with the same factorisation: the cubic kernel's system is badly
      * conditioned for dense centres, and one or two cheap O(m^2) passes recover digits the
      * O(m^3) factorisation lost. Skipped when the first residual is already tiny. */
@@ -587,7 +590,9 @@ cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const do
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < dim; ++d)
             p[(size_t)d * n + i] = (points[i * (size_t)dim + (size_t)d] - rbf->shift[d]) * rbf->scale;
-    if (rbf->iter) /* compensated sums: see cm_rbf_iterative_evaluate */
+    if (rbf->petsc && cm_rbf_petsc_evaluate(rbf, n, p, out, cm_rbf_threads(ctx)))
+        ; /* collective: each rank its block of points */
+    else if (rbf->iter) /* compensated sums: see cm_rbf_iterative_evaluate */
         cm_rbf_iterative_evaluate(rbf, n, p, out, cm_rbf_threads(ctx));
     else
         kernel_sum_all(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx));

@@ -11,6 +11,7 @@
 #define CM_RBF_PARALLEL_MIN_PAIRS 200000.0
 
 typedef struct cm_rbf_iter cm_rbf_iter;
+typedef struct cm_rbf_petsc cm_rbf_petsc;
 
 struct cm_rbf {
     cm_rbf_kernel kernel;
@@ -33,6 +34,7 @@ struct cm_rbf {
     cm_rbf_options opt;
     cm_rbf_stats stats;
     cm_rbf_iter *iter; /* iterative solver state, NULL for dense (then chol is set) */
+    cm_rbf_petsc *petsc; /* PETSC solver (rbf_petsc.c): set with iter, NULL otherwise */
 };
 
 /* Threads for a leaf loop: the context's count, or all that OpenMP offers for 0. */
@@ -92,6 +94,11 @@ void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, doubl
 
 typedef struct cm_rbf_schwarz cm_rbf_schwarz;
 
+/* The iterative state's Q1 (m x k col-major, orthonormal basis of the polynomials at the
+ * centres) and preconditioner, for the PETSc bridge; NULL before cm_rbf_iterative_setup. */
+const double *cm_rbf_iterative_q1(const cm_rbf *r);
+const cm_rbf_schwarz *cm_rbf_iterative_pc(const cm_rbf *r);
+
 /* Two-level restricted additive Schwarz for the r^3 system on the centres of r. */
 cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
                                 cm_rbf_schwarz **pc);
@@ -100,8 +107,23 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc);
  * the restricted local solves. out is not projected onto the null space of P'. */
 void cm_rbf_schwarz_apply(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc, const double *in,
                           double *out, int threads);
+/* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
+ * at most m / 4). */
+size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);
 size_t cm_rbf_schwarz_bytes(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc);
+
+/* ---- the distributed solver (rbf_petsc.c; rbf_petsc_none.c without PETSc) ---- */
+
+/* cm_rbf_iterative_setup, then the PETSc objects on PETSC_COMM_WORLD (collective). */
+cm_status cm_rbf_petsc_setup(cm_context *ctx, cm_rbf *r, int threads);
+/* As cm_rbf_iterative_solve, rows split over the ranks; w and q complete on every rank. */
+cm_status cm_rbf_petsc_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f, double *w,
+                             double *q);
+void cm_rbf_petsc_destroy(cm_rbf_petsc **ps);
+/* With more than one rank: out (n x ncomp) as cm_rbf_iterative_evaluate, each rank summing
+ * its block of points, gathered to all; returns 1, or 0 if it did nothing (one rank). */
+int cm_rbf_petsc_evaluate(const cm_rbf *r, size_t n, const double *p, double *out, int threads);
 
 #endif

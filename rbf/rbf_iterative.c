@@ -42,6 +42,10 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->local_size = 1400;
     opt->coarse_size = 2000;
     opt->local_float = 0;
+    opt->coarse_grow = 1;
+    opt->coarse_max = 8000;
+    opt->overlap = 3.0;
+    opt->local_max = 2800;
 }
 
 void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
@@ -77,6 +81,10 @@ int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
     return 1;
 }
 
+const double *cm_rbf_iterative_q1(const cm_rbf *r) { return r->iter ? r->iter->q1 : NULL; }
+
+const cm_rbf_schwarz *cm_rbf_iterative_pc(const cm_rbf *r) { return r->iter ? r->iter->pc : NULL; }
+
 void cm_rbf_iterative_destroy(cm_rbf_iter **it)
 {
     if (!it || !*it) return;
@@ -94,12 +102,15 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
                         "cm_rbf_create: the iterative solver handles the 3D r^3 kernel only");
     if (!(o->tolerance > 0.0) || o->max_iterations < 1 || o->restart < 2 || o->leaf_size < 8 ||
-        o->local_size < o->leaf_size || o->coarse_size < 0)
+        o->local_size < o->leaf_size || o->coarse_size < 0 || o->coarse_post < 0 ||
+        o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0)
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
-                        "restart %d, leaf_size %d, local_size %d, coarse_size %d)",
+                        "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "
+                        "%d, overlap %g, local_max %d, coarse_max %d)",
                         o->tolerance, o->max_iterations, o->restart, o->leaf_size,
-                        o->local_size, o->coarse_size);
+                        o->local_size, o->coarse_size, o->coarse_post, o->overlap, o->local_max,
+                        o->coarse_max);
     cm_rbf_iter *it = calloc(1, sizeof *it);
     if (!it) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     it->q1 = malloc(m * k * sizeof *it->q1);
@@ -161,6 +172,8 @@ typedef struct krylov {
     double *h[4];   /* (R+1) x R col-major */
     double cs[4][64], sn[4][64], gv[4][65];
     double *soa, *rowm, *aux; /* g x m scratch */
+    double *wlo;    /* g x m: low parts of the weights (double-double accumulation) */
+    double *awlo;   /* g x m: A wlo */
 } krylov;
 
 /* out_c = A in_c for the components in list (n of them, in: pointers to m-vectors). */
@@ -214,6 +227,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
         ax[c] = aw + (size_t)c * m;
         memset(w + (size_t)c * m, 0, m * sizeof(double));
         memset(ax[c], 0, m * sizeof(double));
+        memset(kr->wlo + (size_t)c * m, 0, m * sizeof(double));
     }
     for (int cycle = 0;; ++cycle) {
         /* true residual Pi(f - A w) of every running component */
@@ -228,8 +242,17 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
             }
         if (n == 0) break;
         if (cycle > 0) {
+            /* A (w + wlo): the low parts carry what rounding w alone would lose */
+            double *lin[4], *lout[4];
+            for (int u = 0; u < n; ++u) {
+                lin[u] = kr->wlo + (size_t)list[u] * m;
+                lout[u] = kr->awlo + (size_t)u * m;
+            }
             matvec(r, kr, n, in, out, threads);
-            ++*matvecs;
+            matvec(r, kr, n, lin, lout, threads);
+            *matvecs += 2;
+            for (int u = 0; u < n; ++u)
+                for (size_t i = 0; i < m; ++i) out[u][i] += lout[u][i];
         }
         int nfl = 0, fl[4];
         double *absw[4], *afl[4];
@@ -345,10 +368,27 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                 for (int l = i + 1; l < jn[c]; ++l) s -= kr->h[c][(size_t)l * (size_t)(R + 1) + (size_t)i] * y[l];
                 y[i] = s / kr->h[c][(size_t)i * (size_t)(R + 1) + (size_t)i];
             }
-            for (int i = 0; i < jn[c]; ++i)
-                cblas_daxpy((int)m, y[i], kr->z[c] + (size_t)i * m, 1, w + (size_t)c * m, 1);
+            /* w += Z y in double-double: the terms y_i z_i are much larger than their sum
+             * (the preconditioned directions cancel), and the rounding of a plain daxpy
+             * then left the true residual of a cycle 10-100x above GMRES's estimate, which
+             * cost a whole restart cycle (bracket 59k: 7 of 21 iterations) */
+            double *wh = w + (size_t)c * m, *wl = kr->wlo + (size_t)c * m;
+            for (int i = 0; i < jn[c]; ++i) {
+                const double yi = y[i], *zi = kr->z[c] + (size_t)i * m;
+                for (size_t u = 0; u < m; ++u) {
+                    double p = yi * zi[u];
+                    double pe = fma(yi, zi[u], -p);
+                    double t = wh[u] + p, bv = t - wh[u];
+                    double te = (wh[u] - (t - bv)) + (p - bv);
+                    wh[u] = t;
+                    wl[u] += te + pe;
+                }
+            }
         }
     }
+    /* fold the low parts in; aw (= A(w + wlo) from the last true residual) stays */
+    for (int c = 0; c < g; ++c)
+        for (size_t u = 0; u < m; ++u) w[(size_t)c * m + u] += kr->wlo[(size_t)c * m + u];
     for (int c = 0; c < g; ++c) status[c] = state[c];
     return CM_OK;
 }
@@ -374,9 +414,11 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     kr.soa = malloc((size_t)gmax * m * sizeof(double));
     kr.rowm = malloc((size_t)gmax * m * sizeof(double));
     kr.aux = malloc((size_t)gmax * m * sizeof(double));
+    kr.wlo = malloc((size_t)gmax * m * sizeof(double));
+    kr.awlo = malloc((size_t)gmax * m * sizeof(double));
     double *aw = malloc(nc * m * sizeof *aw);
     cm_status st = CM_OK;
-    if (!ok || !kr.soa || !kr.rowm || !kr.aux || !aw) {
+    if (!ok || !kr.soa || !kr.rowm || !kr.aux || !kr.wlo || !kr.awlo || !aw) {
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_solve: out of memory for the Krylov basis "
                       "(%.3g GB)", (double)(2 * R + 1) * (double)m * gmax * 8e-9);
         goto done;
@@ -433,7 +475,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     r->stats.floor = floor_max;
     r->stats.floor_limited = floor_hit && worst > o->tolerance;
     r->stats.memory_bytes = cm_rbf_schwarz_bytes(r->iter->pc) + m * k * sizeof(double) +
-                            (size_t)gmax * (size_t)(2 * R + 4) * m * sizeof(double);
+                            (size_t)gmax * (size_t)(2 * R + 6) * m * sizeof(double);
     if (worst > o->tolerance && !r->stats.floor_limited)
         st = cm_error(ctx, CM_WARNING,
                       "cm_rbf_solve: the iterative solver %s after %d iterations at a relative "
@@ -442,6 +484,6 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                       maxit, worst, o->tolerance, floor_max);
 done:
     for (int c = 0; c < 4; ++c) free(kr.v[c]), free(kr.z[c]), free(kr.h[c]);
-    free(kr.soa), free(kr.rowm), free(kr.aux), free(aw);
+    free(kr.soa), free(kr.rowm), free(kr.aux), free(kr.wlo), free(kr.awlo), free(aw);
     return st;
 }

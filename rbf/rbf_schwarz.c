@@ -22,6 +22,8 @@
 #include <omp.h>
 #endif
 
+#define CM_RBF_COARSE_BASE_M 2e4
+
 struct cm_rbf_schwarz {
     size_t m;
     size_t nmax;      /* largest local set */
@@ -35,7 +37,13 @@ struct cm_rbf_schwarz {
     size_t nc;        /* coarse centres */
     size_t *c_idx;    /* nc */
     double *c_xyz;    /* 3 x nc SoA coordinates of the coarse centres */
-    double *gc;       /* nc x nc: full projected inverse of the coarse system */
+    double *gc;       /* nc*nc + 8nc: projected Cholesky factor of the coarse system
+                       * (projected_factor), solved at every application: forming the
+                       * inverse would cost 3x the factorisation */
+    int c_rk;
+    double c_tau[4];
+    int post;         /* 0: coarse then local; 1: coarse, local, coarse; 2: local, coarse */
+    double fill;      /* largest distance from a centre to its nearest coarse centre */
     size_t bytes;
 };
 
@@ -154,8 +162,8 @@ static int cmp_keyed(const void *a, const void *b)
 /* The local set of leaf l: its own centres, then the nloc - n_in centres nearest to its box
  * (leaves visited by box-box distance until no unvisited leaf can hold a nearer centre).
  * out: nloc indices. Scratch: lk (nleaves), cand (m). */
-static size_t grow_leaf(const tree_build *t, int l, size_t nloc, keyed *lk, keyed *cand,
-                        size_t *out)
+static size_t grow_leaf(const tree_build *t, int l, size_t nloc, size_t nmin, double reach2,
+                        keyed *lk, keyed *cand, size_t *out)
 {
     const leaf *L = &t->leaves[l];
     size_t nin = L->hi - L->lo, n = 0;
@@ -190,6 +198,10 @@ static size_t grow_leaf(const tree_build *t, int l, size_t nloc, keyed *lk, keye
         qsort(cand, nc, sizeof *cand, cmp_keyed);
         nc = need;
     }
+    /* nloc is the cap: keep at least nmin in all, beyond that only those within reach */
+    size_t keep = nmin > nin ? nmin - nin : 0;
+    while (keep < nc && cand[keep].key <= reach2) ++keep;
+    if (keep < nc) nc = keep;
     for (size_t u = 0; u < nc; ++u) out[n++] = cand[u].idx;
     return n;
 }
@@ -201,11 +213,14 @@ static size_t grow_leaf(const tree_build *t, int l, size_t nloc, keyed *lk, keye
  * symmetry are the leaf rows of the local inverse. The linear polynomial is rank-revealed
  * (dgeqp3), since a local set on one planar face is coplanar. work: n*n + 8n doubles.
  * Returns 0, or the failing Cholesky pivot (> 0), or -1 for a LAPACK argument error. */
-static int local_inverse(const double *cg, size_t m, const size_t *idx, size_t n, size_t n_in,
-                         double *work, double *g)
+/* The null-space projected Cholesky factor of the r^3 system on the n centres idx: in work
+ * (n*n + 8n doubles) a = Q' A Q with the Cholesky factor of its trailing n - rk block, and
+ * pq = the Householder vectors of P's rank-revealing QR (dgeqp3: a local set on one planar
+ * face is coplanar), rank in *rk, tau (4). Returns 0, the failing pivot (> 0), or -1. */
+static int projected_factor(const double *cg, size_t m, const size_t *idx, size_t n,
+                            double *work, int *rk_out, double *tau)
 {
     double *a = work, *xyz = a + n * n, *pq = xyz + 3 * n;
-    double tau[4];
     lapack_int jpvt[4] = {0, 0, 0, 0};
     for (int d = 0; d < 3; ++d)
         for (size_t i = 0; i < n; ++i) xyz[(size_t)d * n + i] = cg[(size_t)d * m + idx[i]];
@@ -225,30 +240,53 @@ static int local_inverse(const double *cg, size_t m, const size_t *idx, size_t n
     int rk = 0;
     const double r00 = fabs(pq[0]);
     while (rk < 4 && fabs(pq[(size_t)rk * n + (size_t)rk]) > 1e-9 * r00) ++rk;
+    *rk_out = rk;
     if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', ln, ln, rk, pq, ln, tau, a, ln) != 0 ||
         LAPACKE_dormqr(LAPACK_COL_MAJOR, 'R', 'N', ln, ln, rk, pq, ln, tau, a, ln) != 0)
         return -1;
     const lapack_int n2 = (lapack_int)(n - (size_t)rk);
-    double *b = a + (size_t)rk * n + (size_t)rk;
-    lapack_int info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', n2, b, ln);
-    if (info != 0) return (int)info;
-    memset(g, 0, n * n_in * sizeof *g);
-    for (size_t j = 0; j < n_in; ++j) g[j * n + j] = 1.0;
-    const lapack_int lin = (lapack_int)n_in;
-    if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', ln, lin, rk, pq, ln, tau, g, ln) != 0 ||
-        LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', n2, lin, b, ln, g + rk, ln) != 0)
+    lapack_int info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', n2, a + (size_t)rk * n + (size_t)rk, ln);
+    return info < 0 ? -1 : (int)info;
+}
+
+/* x (n x nrhs col-major, ld n) := Q2 (Q2' A Q2)^{-1} Q2' x with the factor of
+ * projected_factor: the weights of the interpolant of data x (linear part annihilated). */
+static int projected_solve(const double *work, size_t n, int rk, const double *tau, size_t nrhs,
+                           double *x)
+{
+    const double *a = work, *pq = work + n * n + 3 * n;
+    const lapack_int ln = (lapack_int)n, lr = (lapack_int)nrhs;
+    if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', ln, lr, rk, pq, ln, tau, x, ln) != 0 ||
+        LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', (lapack_int)(n - (size_t)rk), lr,
+                       a + (size_t)rk * n + (size_t)rk, ln, x + rk, ln) != 0)
         return -1;
-    for (size_t j = 0; j < n_in; ++j)
-        for (int i = 0; i < rk; ++i) g[j * n + (size_t)i] = 0.0;
-    if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'N', ln, lin, rk, pq, ln, tau, g, ln) != 0)
+    for (size_t j = 0; j < nrhs; ++j)
+        for (int i = 0; i < rk; ++i) x[j * n + (size_t)i] = 0.0;
+    if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'N', ln, lr, rk, pq, ln, tau, x, ln) != 0)
         return -1;
     return 0;
 }
 
+/* g (n x n_in col-major) = Q2 (Q2' A Q2)^{-1} Q2' E, E the first n_in columns of the
+ * identity: the weights of the local interpolant of unit data at each leaf centre, which by
+ * symmetry are the leaf rows of the local inverse. work: n*n + 8n doubles.
+ * Returns 0, or the failing Cholesky pivot (> 0), or -1 for a LAPACK argument error. */
+static int local_inverse(const double *cg, size_t m, const size_t *idx, size_t n, size_t n_in,
+                         double *work, double *g)
+{
+    double tau[4];
+    int rk = 0;
+    int info = projected_factor(cg, m, idx, n, work, &rk, tau);
+    if (info != 0) return info;
+    memset(g, 0, n * n_in * sizeof *g);
+    for (size_t j = 0; j < n_in; ++j) g[j * n + j] = 1.0;
+    return projected_solve(work, n, rk, tau, n_in, g);
+}
+
 /* Farthest-point sampling of nc centres (c: 3 x m SoA), starting at the centre nearest to
  * the centroid; spreads the coarse centres evenly over the whole set, every part included. */
-static void farthest_points(const double *c, size_t m, size_t nc, size_t *out, double *d2,
-                            int threads)
+static double farthest_points(const double *c, size_t m, size_t nc, size_t *out, double *d2,
+                              int threads)
 {
     double g[3] = {0, 0, 0};
     for (int d = 0; d < 3; ++d) {
@@ -265,6 +303,7 @@ static void farthest_points(const double *c, size_t m, size_t nc, size_t *out, d
         if (d2[i] > d2[next]) next = i;
     for (size_t i = 0; i < m; ++i) d2[i] = INFINITY;
     const int parallel = (double)m > 2e4 && threads > 1;
+    double fill2 = 0.0;
     for (size_t k = 0; k < nc; ++k) {
         out[k] = next;
         const double x = c[next], y = c[m + next], z = c[2 * m + next];
@@ -292,7 +331,22 @@ static void farthest_points(const double *c, size_t m, size_t nc, size_t *out, d
             }
         }
         next = best;
+        fill2 = bestd;
     }
+    return sqrt(fill2);
+}
+
+size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m)
+{
+    size_t nc = (size_t)o->coarse_size;
+    /* coarse_grow: coarse_size is the count at 2e4 centres, grown as sqrt(m) above, so that
+     * the coarse spacing keeps closer to the fixed-size subdomains' reach (which shrinks as
+     * m^-1/2) at O(m) memory for the coarse factor */
+    if (o->coarse_grow && (double)m > CM_RBF_COARSE_BASE_M)
+        nc = (size_t)((double)nc * sqrt((double)m / CM_RBF_COARSE_BASE_M));
+    if (o->coarse_max > 0 && nc > (size_t)o->coarse_max) nc = (size_t)o->coarse_max;
+    if (nc > m / 4) nc = m / 4; /* a coarse space as fine as the problem is no coarse space */
+    return nc;
 }
 
 void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
@@ -329,7 +383,13 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (kD-tree)");
         goto done;
     }
-    const size_t nloc = (size_t)o->local_size < m ? (size_t)o->local_size : m;
+    size_t nloc = (size_t)o->local_size < m ? (size_t)o->local_size : m;
+    const size_t nmin = nloc;
+    double reach2 = -1.0;
+    if (o->overlap > 0.0 && p->fill > 0.0 && o->local_max > o->local_size) {
+        nloc = (size_t)o->local_max < m ? (size_t)o->local_max : m;
+        reach2 = (o->overlap * p->fill) * (o->overlap * p->fill);
+    }
     p->nsub = t.nleaves;
     p->sub_ptr = malloc(((size_t)t.nleaves + 1) * sizeof *p->sub_ptr);
     p->n_in = malloc((size_t)t.nleaves * sizeof *p->n_in);
@@ -352,7 +412,8 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
                 fail = 1;
                 continue;
             }
-            cnt[l] = grow_leaf(&t, l, nloc, lk, cand, p->sub_idx + (size_t)l * stride);
+            cnt[l] = grow_leaf(&t, l, nloc, nmin, reach2, lk, cand,
+                               p->sub_idx + (size_t)l * stride);
         }
         free(lk);
         free(cand);
@@ -453,27 +514,25 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
 static cm_status build_coarse(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p, int threads)
 {
     const size_t m = r->m;
-    size_t nc = (size_t)r->opt.coarse_size;
-    if (nc > m / 4) nc = m / 4; /* a coarse space as fine as the problem is no coarse space */
+    size_t nc = cm_rbf_coarse_count(&r->opt, m); /* a coarse space as fine as the problem is no coarse space */
     if (nc < 16) return CM_OK;
     p->nc = nc;
     p->c_idx = malloc(nc * sizeof *p->c_idx);
     p->c_xyz = malloc(3 * nc * sizeof *p->c_xyz);
-    p->gc = malloc(nc * nc * sizeof *p->gc);
+    p->gc = malloc((nc * nc + 8 * nc) * sizeof *p->gc);
     double *d2 = malloc(m * sizeof *d2);
-    double *work = malloc((nc * nc + 8 * nc) * sizeof *work);
     cm_status st = CM_OK;
-    if (!p->c_idx || !p->c_xyz || !p->gc || !d2 || !work) {
+    if (!p->c_idx || !p->c_xyz || !p->gc || !d2) {
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (coarse space)");
         goto done;
     }
     p->bytes += nc * nc * 8 + nc * 32;
-    farthest_points(r->c, m, nc, p->c_idx, d2, threads);
+    p->fill = farthest_points(r->c, m, nc, p->c_idx, d2, threads);
     for (int d = 0; d < 3; ++d)
         for (size_t a = 0; a < nc; ++a) p->c_xyz[(size_t)d * nc + a] = r->c[(size_t)d * m + p->c_idx[a]];
     const int saved = openblas_get_num_threads();
     openblas_set_num_threads(threads);
-    int info = local_inverse(r->c, m, p->c_idx, nc, nc, work, p->gc);
+    int info = projected_factor(r->c, m, p->c_idx, nc, p->gc, &p->c_rk, p->c_tau);
     openblas_set_num_threads(saved);
     if (info != 0)
         st = cm_error(ctx, CM_ERR_NUMERIC,
@@ -482,7 +541,6 @@ static cm_status build_coarse(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *
                       nc, info);
 done:
     free(d2);
-    free(work);
     return st;
 }
 
@@ -493,10 +551,12 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
     cm_rbf_schwarz *p = calloc(1, sizeof *p);
     if (!p) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     p->m = r->m;
+    p->post = r->opt.coarse_post;
+    /* the coarse space first: its fill distance sets the overlap when measured in distance */
     double t0 = cm_wtime();
-    cm_status st = build_subdomains(ctx, r, p, threads);
+    cm_status st = build_coarse(ctx, r, p, threads);
     double t1 = cm_wtime();
-    if (st == CM_OK) st = build_coarse(ctx, r, p, threads);
+    if (st == CM_OK) st = build_subdomains(ctx, r, p, threads);
     double t2 = cm_wtime();
     if (st == CM_OK) st = build_local(ctx, r, p, threads);
     double t3 = cm_wtime();
@@ -506,10 +566,11 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
     }
     p->bytes += p->sub_ptr[p->nsub] * sizeof *p->sub_idx + (size_t)p->nsub * 24;
     cm_log(ctx, CM_LOG_DEBUG,
-           "cm_rbf_create: Schwarz: %d subdomains of <= %d centres (leaves <= %d), coarse %zu; "
-           "tree + overlap %.3f s, coarse %.3f s, local %.3f s, %.1f MB",
-           p->nsub, r->opt.local_size, r->opt.leaf_size, p->nc, t1 - t0, t2 - t1, t3 - t2,
-           (double)p->bytes / 1e6);
+           "cm_rbf_create: Schwarz: %d subdomains of <= %zu centres (mean %.0f, leaves <= %d), "
+           "coarse %zu (fill distance %.3g); coarse %.3f s, tree + overlap %.3f s, local %.3f "
+           "s, %.1f MB",
+           p->nsub, p->nmax, (double)p->sub_ptr[p->nsub] / (double)p->nsub, r->opt.leaf_size,
+           p->nc, p->fill, t1 - t0, t2 - t1, t3 - t2, (double)p->bytes / 1e6);
     *pc = p;
     return CM_OK;
 }
@@ -521,7 +582,10 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
     memset(out, 0, (size_t)nc * m * sizeof *out);
     const double *res = in;
     double *r1 = NULL, *rc = NULL, *ac = NULL;
-    if (ncs > 0) {
+    if (ncs > 0 && p->post == 2) { /* local solves first, coarse after them only */
+        rc = calloc(2 * ncs * (size_t)nc, sizeof *rc);
+        r1 = rc; /* marks the coarse correction below as possible */
+    } else if (ncs > 0) {
         rc = calloc(2 * ncs * (size_t)nc, sizeof *rc);
         ac = malloc(m * (size_t)nc * sizeof *ac);
         r1 = malloc(m * (size_t)nc * sizeof *r1);
@@ -532,8 +596,8 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
             double *wc = rc + ncs * (size_t)nc;
             for (int c = 0; c < nc; ++c)
                 for (size_t a = 0; a < ncs; ++a) rc[(size_t)c * ncs + a] = in[(size_t)c * m + p->c_idx[a]];
-            cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (int)ncs, nc, (int)ncs, 1.0,
-                        p->gc, (int)ncs, rc, (int)ncs, 0.0, wc, (int)ncs);
+            memcpy(wc, rc, ncs * (size_t)nc * sizeof *wc);
+            projected_solve(p->gc, ncs, p->c_rk, p->c_tau, (size_t)nc, wc);
             for (int c = 0; c < nc; ++c)
                 for (size_t a = 0; a < ncs; ++a) out[(size_t)c * m + p->c_idx[a]] = wc[(size_t)c * ncs + a];
             /* the local solves see the residual of the coarse interpolant; its polynomial
@@ -575,7 +639,27 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
         }
         free(loc);
     }
-    free(r1);
+    /* multiplicative coarse correction after the local solves: out += G_c (in - A out) at
+     * the coarse centres, so the coarse residual of the whole correction is zero */
+    if (r1 && p->post) {
+        double *wc = rc + ncs * (size_t)nc;
+        double *aout = malloc(ncs * (size_t)nc * sizeof *aout);
+        if (aout) {
+            cm_rbf_kernel_sum(r->kernel, 3, m, r->c, out, nc, ncs, p->c_xyz, ncs, aout,
+                              (size_t)nc, threads);
+            for (int c = 0; c < nc; ++c)
+                for (size_t a = 0; a < ncs; ++a)
+                    rc[(size_t)c * ncs + a] = in[(size_t)c * m + p->c_idx[a]] -
+                                              aout[a * (size_t)nc + (size_t)c];
+            memcpy(wc, rc, ncs * (size_t)nc * sizeof *wc);
+            projected_solve(p->gc, ncs, p->c_rk, p->c_tau, (size_t)nc, wc);
+            for (int c = 0; c < nc; ++c)
+                for (size_t a = 0; a < ncs; ++a)
+                    out[(size_t)c * m + p->c_idx[a]] += wc[(size_t)c * ncs + a];
+            free(aout);
+        }
+    }
+    if (r1 != rc) free(r1);
     free(rc);
     free(ac);
 }

@@ -13,6 +13,10 @@ packages=(
   python3-matplotlib  # imported by PyGeM, for tests/data/deform/make_pygem_fixture.py
   clang libclang-rt-14-dev  # make fuzz (libFuzzer); make check-asan uses gcc's sanitizers
 )
+# Optional, needed only for -DCADMORPH_WITH_PETSC=ON (the distributed solver, --solver petsc):
+# CADMORPH_WITH_PETSC=1 bash scripts/setup.sh. Not in the default list: with OpenMPI, hypre,
+# MUMPS, Trilinos, ScaLAPACK and gfortran it is ~340 packages for one optional solver.
+if [ "${CADMORPH_WITH_PETSC:-0}" = 1 ]; then packages+=(libpetsc-real-dev openmpi-bin); fi
 
 missing=()
 for p in "${packages[@]}"; do

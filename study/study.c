@@ -3,6 +3,7 @@
  * warp method for the whole family: the point of the design, DESIGN.md) and relatively
  * through one morpher per method re-based on each result. */
 #include "cadmorph/study.h"
+#include "cadmorph/rbf.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,6 +14,7 @@ void cm_study_options_init(cm_study_options *opt)
 {
     memset(opt, 0, sizeof *opt);
     opt->modes = CM_STUDY_BOTH;
+    opt->ranks = 1;
     cm_morph_options_init(&opt->morph);
 }
 
@@ -136,6 +138,47 @@ static cm_status morph(cm_context *ctx, study *w, series *se, cm_morpher *mp,
         if (e < 0) return e;
     }
     return s;
+}
+
+typedef struct row_key {
+    size_t variant, at;
+} row_key;
+
+static int cmp_key(const void *a, const void *b)
+{
+    const row_key *x = a, *y = b;
+    if (x->variant != y->variant) return x->variant < y->variant ? -1 : 1;
+    return x->at < y->at ? -1 : x->at > y->at;
+}
+
+/* A distributed study: every rank's rows into r, variant-major as a serial study has them
+ * (the rows of one variant come from one rank, in their order). */
+static cm_status gather_rows(cm_context *ctx, cm_study_result *r)
+{
+    void *all = NULL;
+    size_t n = 0;
+    cm_status s = cm_rbf_petsc_allgather(ctx, r->rows, r->n_rows, sizeof *r->rows, &all, &n);
+    if (s < 0) return s;
+    const cm_study_row *got = all;
+    row_key *key = malloc((n ? n : 1) * sizeof *key);
+    cm_study_row *rows = malloc((n ? n : 1) * sizeof *rows);
+    if (!key || !rows) {
+        free(all), free(key), free(rows);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_study_run: out of memory");
+    }
+    for (size_t i = 0; i < n; ++i) key[i] = (row_key){got[i].variant, i};
+    qsort(key, n, sizeof *key, cmp_key);
+    r->n_failed = 0;
+    for (size_t i = 0; i < n; ++i) {
+        rows[i] = got[key[i].at];
+        r->n_failed += rows[i].status < 0;
+    }
+    free(all);
+    free(key);
+    free(r->rows);
+    r->rows = rows;
+    r->n_rows = r->cap_rows = n;
+    return CM_OK;
 }
 
 /* Errors of a row that are not the method's or the variant's fault end the study. */
@@ -326,6 +369,12 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
     if (!(opt->modes & CM_STUDY_BOTH) || opt->morph.steps < 0 || (opt->methods && !opt->n_methods))
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_run: modes %d, steps %d, %zu methods",
                         opt->modes, opt->morph.steps, opt->n_methods);
+    const int ranks = opt->ranks > 1 ? opt->ranks : 1;
+    if (ranks > 1 && ((opt->modes & CM_STUDY_RELATIVE) || opt->rank < 0 || opt->rank >= ranks))
+        return cm_error(ctx, CM_ERR_ARGUMENT,
+                        "cm_study_run: over %d ranks only absolute studies (relative steps "
+                        "chain the variants); rank %d",
+                        ranks, opt->rank);
     if (opt->write_meshes == CM_STUDY_WRITE_LISTED && !opt->write_listed)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_run: listed meshes without a list");
     double t_start = cm_wtime();
@@ -360,6 +409,7 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
 
     cm_status s = setup(ctx, &w);
     for (size_t i = 0; i < family->n && s >= 0; ++i) {
+        if (ranks > 1 && (int)(i % (size_t)ranks) != opt->rank) continue; /* another rank's */
         cm_progress(ctx, "study", (double)i, (double)family->n);
         cm_cad_model *g = NULL;
         int abs_used = 0, rel_used = 0;
@@ -372,6 +422,11 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
     }
     if (s >= 0) cm_progress(ctx, "study", (double)family->n, (double)family->n);
     study_free(&w);
+    /* every rank gathers, also one that failed: the others would wait for it */
+    if (ranks > 1) {
+        cm_status g = gather_rows(ctx, w.r);
+        if (s >= 0 && g < 0) s = g;
+    }
     if (s < 0) {
         cm_study_result_destroy(&w.r);
         return s;

@@ -1,6 +1,7 @@
 /* The CAD-aware surface morph G -> G' (paper section 4): vertex nodes to the matching vertex,
  * edge nodes to the same arc length, face nodes by a 2D thin-plate warp of their (u,v) fitted
- * on corresponding boundary samples of f_k and f'_k; or, as a baseline, closest points. */
+ * on corresponding boundary samples of f_k and f'_k; or, as a baseline, closest points.
+ * Edges and faces that an affine edit maps onto G' take the affine image (affine.c). */
 #include "surface_internal.h"
 
 #include <math.h>
@@ -14,6 +15,7 @@ void cm_surface_morph_options_init(cm_surface_morph_options *opt)
     opt->spacing = 0;
     opt->min_per_edge = 8;
     opt->max_per_edge = 200;
+    opt->affine_tol = 1e-9;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -78,11 +80,88 @@ static void unwrap_runs(const cm_cad_boundary *a, cm_cad_boundary *b, const cm_c
     }
 }
 
+/* The affine images of G's boundary samples ba on face f of G': for each sample the
+ * parameter of its image on the edge of G' (NaN at the edge's ends, where the vertices match
+ * and a projection could pick either end of a closed edge), then the samples there. */
+static cm_status affine_boundary(cm_context *ctx, const cm_cad_model *g2, int f,
+                                 const int *per_edge, const cm_surface_affine *aff,
+                                 const cm_cad_boundary *ba, cm_cad_boundary **bb)
+{
+    double *t = malloc((ba->n ? ba->n : 1) * 4 * sizeof *t);
+    if (!t) return cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    double *y = t + ba->n;
+    cm_status r = CM_OK;
+    for (size_t i = 0; i < ba->n && r >= 0;) {
+        size_t j = i;
+        while (j < ba->n && ba->edge[j] == ba->edge[i] && ba->wire[j] == ba->wire[i])
+            ++j;
+        cm_cad_edge_info ei;
+        r = cm_cad_edge_get_info(ctx, g2, ba->edge[i], &ei);
+        for (size_t q = i; q < j && r >= 0; ++q)
+            cm_surface_affine_apply(aff, ba->xyz + 3 * q, y + 3 * (q - i));
+        if (r >= 0 && !ei.degenerate)
+            r = cm_cad_project_edge(ctx, g2, ba->edge[i], y, j - i, t + i, NULL);
+        for (size_t q = i; q < j; ++q)
+            if (ei.degenerate || ba->s[q] <= 0 || ba->s[q] >= 1) t[q] = NAN;
+        i = j;
+    }
+    if (r >= 0) r = cm_cad_face_boundary_at(ctx, g2, f, per_edge, 0, t, bb);
+    free(t);
+    return r < 0 ? r : CM_OK;
+}
+
+/* Face nodes of an affine face (surface/affine.c): the projection of A x + b onto f'_k, x
+ * the node's foot on f_k, seeded by the parameter warp's (u',v') (uv, updated), else by a
+ * grid search. 1 in *ok when every image lies on f'_k within the tolerance; nothing is
+ * written otherwise. */
+static cm_status affine_face(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2, int f,
+                             const cm_surface_affine *aff, const cm_surface_nodes *s,
+                             const size_t *idx, size_t k, double *uv, double *xyz, int *ok)
+{
+    *ok = 0;
+    double *w = malloc(k * 12 * sizeof *w);
+    if (!w) return cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    double *x = w, *y = x + 3 * k, *foot = y + 3 * k, *uv0 = foot + 3 * k, *dist = uv0 + 2 * k;
+    for (size_t j = 0; j < k; ++j)
+        memcpy(uv0 + 2 * j, s->param + 2 * idx[j], 2 * sizeof(double));
+    cm_status r = cm_cad_face_eval(ctx, g, f, uv0, k, x, NULL);
+    for (size_t j = 0; j < k && r >= 0; ++j)
+        cm_surface_affine_apply(aff, x + 3 * j, y + 3 * j);
+    double *uv1 = uv0; /* reused: the parameters of the feet */
+    if (r >= 0) r = cm_cad_project_face(ctx, g2, f, y, k, uv, uv1, dist, foot);
+    int all = r >= 0;
+    for (size_t j = 0; j < k && r >= 0; ++j) {
+        if (dist[j] <= aff->tol) continue;
+        /* the warp's seed led Newton elsewhere: search the face */
+        double u2[2], d2, f2[3];
+        r = cm_cad_project_face(ctx, g2, f, y + 3 * j, 1, NULL, u2, &d2, f2);
+        if (r >= 0 && d2 <= aff->tol) {
+            memcpy(uv1 + 2 * j, u2, sizeof u2);
+            memcpy(foot + 3 * j, f2, sizeof f2);
+        } else {
+            all = 0;
+            break;
+        }
+    }
+    if (r >= 0 && all) {
+        for (size_t j = 0; j < k; ++j) {
+            memcpy(xyz + 3 * idx[j], foot + 3 * j, 3 * sizeof(double));
+            memcpy(uv + 2 * j, uv1 + 2 * j, 2 * sizeof(double));
+        }
+        *ok = 1;
+    }
+    free(w);
+    return r < 0 ? r : CM_OK;
+}
+
 /* Face nodes idx[0..k) of face f: warp their (u,v), evaluate f'_k; those that left the
- * trimmed domain go to the closest point of f'_k. */
+ * trimmed domain go to the closest point of f'_k. When every edge of f is an affine image
+ * (affine: the edge flags, NULL if none), the warp is fitted on the images of G's boundary
+ * samples and the nodes go to the images of their feet if f is an affine image too. */
 static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2, int f,
                             const int *per_edge, const cm_surface_nodes *s, const size_t *idx,
-                            size_t k, double *xyz, cm_surface_morph_stats *st)
+                            size_t k, double *xyz, cm_surface_morph_stats *st,
+                            const cm_surface_affine *aff, const int *affine_edge)
 {
     cm_cad_boundary *ba = NULL, *bb = NULL;
     cm_rbf *rbf = NULL;
@@ -95,7 +174,12 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
     cm_cad_face_info fi;
     if (r == CM_OK) r = cm_cad_face_get_info(ctx, g2, f, &fi);
     if (r == CM_OK) r = cm_cad_face_boundary(ctx, g, f, per_edge, 0, &ba);
-    if (r == CM_OK) r = cm_cad_face_boundary(ctx, g2, f, per_edge, 0, &bb);
+    int candidate = affine_edge != NULL && r == CM_OK;
+    for (size_t j = 0; candidate && j < ba->n; ++j)
+        if (!affine_edge[ba->edge[j]]) candidate = 0;
+    if (r == CM_OK)
+        r = candidate ? affine_boundary(ctx, g2, f, per_edge, aff, ba, &bb)
+                      : cm_cad_face_boundary(ctx, g2, f, per_edge, 0, &bb);
     if (r == CM_OK && ba->n != bb->n)
         r = cm_error(ctx, CM_ERR_MISMATCH, "face %d: %zu boundary samples in G, %zu in G'", f,
                      ba->n, bb->n);
@@ -115,10 +199,15 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
     if (r >= 0) {
         for (size_t j = 0; j < 2 * k; ++j)
             uv[j] += d[j];
-        r = cm_cad_face_inside(ctx, g2, f, uv, k, inside);
     }
-    if (r >= 0) r = cm_cad_face_eval(ctx, g2, f, uv, k, p, NULL);
-    for (size_t j = 0; j < k && r >= 0; ++j) {
+    int done = 0;
+    if (r >= 0 && candidate) {
+        r = affine_face(ctx, g, g2, f, aff, s, idx, k, uv, xyz, &done);
+        st->faces_affine += (size_t)done;
+    }
+    if (r >= 0 && !done) r = cm_cad_face_inside(ctx, g2, f, uv, k, inside);
+    if (r >= 0 && !done) r = cm_cad_face_eval(ctx, g2, f, uv, k, p, NULL);
+    for (size_t j = 0; j < k && r >= 0 && !done; ++j) {
         memcpy(xyz + 3 * idx[j], p + 3 * j, 3 * sizeof(double));
         if (inside[j]) continue;
         double foot[3], dist;
@@ -142,15 +231,25 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
     return r;
 }
 
-/* Edge nodes: rbf keeps their arc length s, project takes the closest point on the edge. */
-static cm_status morph_edge(cm_context *ctx, const cm_cad_model *g2, int e, cm_surface_method m,
+/* Edge nodes: rbf keeps their arc length s, or on an edge that is an affine image (aff not
+ * NULL) takes the image A x + b of their foot x on G; project takes the closest point on the
+ * edge. */
+static cm_status morph_edge(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2, int e,
+                            cm_surface_method m, const cm_surface_affine *aff,
                             const cm_surface_nodes *s, const size_t *idx, size_t k, double *xyz)
 {
     double *t = malloc(k * sizeof *t), *q = malloc(3 * k * sizeof *q),
            *p = malloc(3 * k * sizeof *p);
     cm_status r =
         t && q && p ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
-    if (r == CM_OK && m == CM_SURFACE_RBF) {
+    if (r == CM_OK && m == CM_SURFACE_RBF && aff) {
+        for (size_t j = 0; j < k; ++j)
+            t[j] = s->param[2 * idx[j]];
+        r = cm_cad_edge_eval(ctx, g, e, t, k, p);
+        for (size_t j = 0; j < k && r >= 0; ++j)
+            cm_surface_affine_apply(aff, p + 3 * j, q + 3 * j);
+        if (r >= 0) r = cm_cad_project_edge(ctx, g2, e, q, k, t, NULL);
+    } else if (r == CM_OK && m == CM_SURFACE_RBF) {
         for (size_t j = 0; j < k; ++j)
             q[j] = s->param[2 * idx[j] + 1];
         r = cm_cad_edge_s_to_t(ctx, g2, e, q, k, t);
@@ -189,7 +288,7 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
                            double *xyz, cm_surface_morph_stats *stats)
 {
     const char *fn = "cm_surface_morph";
-    cm_surface_morph_stats st = {0, 0, 0, -1, 0};
+    cm_surface_morph_stats st = {0, 0, 0, -1, 0, 0, 0, 0, INFINITY};
     if (stats) *stats = st;
     if (!g || !g2 || !s || !xyz) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL input", fn);
     cm_surface_morph_options o;
@@ -210,6 +309,31 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
     for (int k = 0; k < 3 && r == CM_OK; ++k)
         r = cm_surface_group(ctx, s, (cm_surface_kind)k, count[k], &first[k], &idx[k]);
     if (r == CM_OK) r = samples_per_edge(ctx, g, s, &o, per_edge);
+    /* affine edits: the map from the vertices, then which edges it maps onto G' */
+    cm_surface_affine aff;
+    int *affine_edge = NULL;
+    memset(&aff, 0, sizeof aff);
+    if (r == CM_OK && o.method == CM_SURFACE_RBF && o.affine_tol > 0) {
+        double bb[6];
+        cm_cad_bbox(g2, bb);
+        r = cm_surface_affine_fit(ctx, g, g2, o.affine_tol * cm_bbox_diagonal(bb), &aff);
+        st.affine_residual = aff.residual;
+        st.affine = aff.valid;
+    }
+    if (r == CM_OK && aff.valid) {
+        affine_edge = calloc(c.edges > 0 ? (size_t)c.edges : 1, sizeof *affine_edge);
+        if (!affine_edge) r = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", fn);
+        for (int e = 0; e < c.edges && r == CM_OK; ++e) {
+            r = cm_surface_affine_edge(ctx, g, g2, &aff, e, per_edge[e] > 16 ? per_edge[e] : 16,
+                                       &affine_edge[e]);
+            st.edges_affine += (size_t)affine_edge[e];
+        }
+        if (r == CM_OK)
+            cm_log(ctx, CM_LOG_DEBUG,
+                   "surface morph: the edit is affine at the vertices (residual %.3g); %zu of %d "
+                   "edges are affine images",
+                   aff.residual, st.edges_affine, c.edges);
+    }
     for (int v = 0; v < c.vertices && r >= 0; ++v) {
         const size_t *in = idx[0] + first[0][v], k = first[0][v + 1] - first[0][v];
         double p[3];
@@ -219,7 +343,9 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
     }
     for (int e = 0; e < c.edges && r >= 0; ++e) {
         size_t k = first[1][e + 1] - first[1][e];
-        if (k) r = morph_edge(ctx, g2, e, o.method, s, idx[1] + first[1][e], k, xyz);
+        if (k)
+            r = morph_edge(ctx, g, g2, e, o.method, affine_edge && affine_edge[e] ? &aff : NULL,
+                           s, idx[1] + first[1][e], k, xyz);
     }
     for (int f = 0; f < c.faces && r >= 0; ++f) {
         cm_progress(ctx, "surface", f, c.faces);
@@ -230,7 +356,7 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
             continue;
         }
         if (o.method == CM_SURFACE_RBF) {
-            r = morph_face(ctx, g, g2, f, per_edge, s, in, k, xyz, &st);
+            r = morph_face(ctx, g, g2, f, per_edge, s, in, k, xyz, &st, &aff, affine_edge);
             st.faces_warped++;
         } else {
             r = project_face(ctx, g2, f, s, in, k, xyz);
@@ -242,6 +368,7 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
         free(idx[k]);
     }
     free(per_edge);
+    free(affine_edge);
     if (stats) *stats = st;
     if (r < 0) return r;
     if (st.outside)

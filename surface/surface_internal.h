@@ -10,4 +10,21 @@
 cm_status cm_surface_group(cm_context *ctx, const cm_surface_nodes *nodes, cm_surface_kind kind,
                            int n_entities, size_t **first, size_t **idx);
 
+/* An affine map x -> A x + b (surface/affine.c): m row-major 3 x 4, A then b. valid when the
+ * vertices of G map onto those of G' within tol (residual: the largest miss). */
+typedef struct cm_surface_affine {
+    double m[3][4];
+    double residual, tol;
+    int valid;
+} cm_surface_affine;
+
+void cm_surface_affine_apply(const cm_surface_affine *a, const double *x, double *y);
+/* Least-squares fit of G' vertices against G vertices (at least 4, not coplanar); a->valid
+ * says whether every vertex is reproduced within tol. Errors only for lack of memory. */
+cm_status cm_surface_affine_fit(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+                                double tol, cm_surface_affine *a);
+/* *is_image = 1 when n points spread over edge e of G map within a->tol of edge e of G'. */
+cm_status cm_surface_affine_edge(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+                                 const cm_surface_affine *a, int e, int n, int *is_image);
+
 #endif

@@ -29,22 +29,32 @@ typedef struct cm_rbf cm_rbf;
  *   kernel, m <= 60000.
  * ITERATIVE (3D r^3 only): restarted FGMRES in the null space of the polynomial block,
  *   right-preconditioned by two-level restricted additive Schwarz: kD-tree leaves of
- *   leaf_size/2..leaf_size centres, each grown to local_size centres and solved by the
- *   projected Cholesky of its own r^3 system, after a coarse solve on coarse_size
- *   farthest-point centres. Matvecs are direct sums with compensated accumulation (the
- *   preconditioned vectors cancel too much for plain sums; rbf_sum_acc.c). Memory about
- *   8 m local_size bytes (local_float: 4) plus the Krylov basis, 16 m restart bytes per
- *   component; time O(m local_size^2) to set up, O(m^2) per iteration.
+ *   leaf_size/2..leaf_size centres, each grown to local_size centres (more, up to
+ *   local_max, where centres within overlap x the coarse fill distance are left) and solved
+ *   by the projected Cholesky of its own r^3 system, after a coarse solve on coarse_size
+ *   farthest-point centres (grown as sqrt(m) above 2e4 centres). Matvecs are direct sums
+ *   with compensated accumulation (the preconditioned vectors cancel too much for plain
+ *   sums; rbf_sum_acc.c), the weights are accumulated in double-double. Memory about
+ *   8 m (mean subdomain size) bytes (local_float: 4) plus the coarse factor (8 coarse^2)
+ *   and the Krylov basis, 16 m restart bytes per component; time O(m local^2) to set up,
+ *   O(m^2) per iteration.
  * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
  *   crossover near 7,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
  *   iterative above; dense for the other kernels.
+ * PETSC: the ITERATIVE solver distributed over the MPI ranks of PETSC_COMM_WORLD through
+ *   PETSc (only in builds with -DCADMORPH_WITH_PETSC=ON; otherwise create fails with
+ *   CM_ERR_UNSUPPORTED): KSPFGMRES on a MatShell whose rows (the r^3 kernel sums) are split
+ *   over the ranks, the same Schwarz preconditioner as a PCSHELL. Create, solve and
+ *   evaluate are then collective: every rank calls them with the same centres and values
+ *   (each holds all centres and gets all weights); see cm_rbf_petsc_initialize.
  * cm_rbf_evaluate works for both; an iterative fit evaluates with compensated sums too
  * (about 2.8x the time of plain sums), so it reproduces the data at the centres to its
  * residual, where plain sums, as the dense path uses, stop at the floor in cm_rbf_stats. */
 typedef enum cm_rbf_solver {
     CM_RBF_SOLVER_AUTO = 0,
     CM_RBF_SOLVER_DENSE = 1,
-    CM_RBF_SOLVER_ITERATIVE = 2
+    CM_RBF_SOLVER_ITERATIVE = 2,
+    CM_RBF_SOLVER_PETSC = 3
 } cm_rbf_solver;
 
 /* Options of cm_rbf_create_opt; cm_rbf_options_init fills the defaults (in brackets).
@@ -61,18 +71,33 @@ typedef struct cm_rbf_options {
     int local_size;       /* [1400] centres per overlapping subdomain (the leaf plus the
                            * centres nearest to its box): the overlap is the knob that
                            * matters on thin walls */
-    int coarse_size;      /* [2000] farthest-point centres of the coarse space, 0: none */
+    int coarse_size;      /* [2000] farthest-point centres of the coarse space (at m <= 2e4,
+                           * see coarse_grow), 0: none */
     int local_float;      /* [0] store the local inverse rows in float: half the memory
                            * (4 instead of 8 bytes x m x local_size), but the r^3 inverses
                            * cancel so heavily that float rounding costs iterations (bracket
                            * m = 21k: 15 instead of 9, bore 22.6k: 12 instead of 10) */
+    int coarse_post;      /* [0] order of the coarse correction: 0 before the local solves,
+                           * 1 before and after them (symmetric multiplicative), 2 after
+                           * them only */
+    double overlap;       /* [3] overlap measured in distance: a subdomain also takes every
+                           * centre within overlap x H of its leaf's box (H: the coarse
+                           * space's fill distance), up to local_max centres; 0: by count
+                           * only. Grows the subdomains where the nodes are dense (edges,
+                           * thin features): bracket 59k, first cycle 9-10 iterations
+                           * instead of 12-13 at 1,501 centres on average instead of 1,400 */
+    int local_max;        /* [2800] cap on a subdomain's centres for overlap > 0 */
+    int coarse_grow;      /* [1] coarse_size is the count at 2e4 centres; above, it grows as
+                           * sqrt(m) (coarse factor 8 coarse^2 bytes, O(m)): bracket 59k,
+                           * 5,000 coarse centres: 17 iterations instead of 21 */
+    int coarse_max;       /* [8000] cap on the coarse centres (0: none but m/4) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
 
 /* Figures of the last create and solve (cm_rbf_stats). */
 typedef struct cm_rbf_stats {
-    cm_rbf_solver solver;  /* the one used: DENSE or ITERATIVE */
+    cm_rbf_solver solver;  /* the one used: DENSE, ITERATIVE or PETSC */
     size_t centres;        /* after merging duplicates */
     int subdomains;        /* iterative: Schwarz subdomains; 0 for dense */
     int coarse_size;       /* iterative: coarse centres */
@@ -82,7 +107,8 @@ typedef struct cm_rbf_stats {
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
     int matvecs;           /* last solve: direct-summation products with the m x m matrix
-                            * (one per iteration and restart, all components together) */
+                            * (one per iteration and restart, all components together;
+                            * PETSC: the components one after the other, each counted) */
     double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| over all components
                             * (exactness at the centres, by direct summation after the solve;
                             * iterative: with compensated sums) */
@@ -128,6 +154,27 @@ CM_API cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, c
 
 /* Centres after merging duplicates. */
 CM_API size_t cm_rbf_centre_count(const cm_rbf *rbf);
+
+/* ---- the distributed solver (CM_RBF_SOLVER_PETSC) ----
+ * 1 if this build has it (-DCADMORPH_WITH_PETSC=ON), else 0 and the calls below do nothing. */
+CM_API int cm_rbf_petsc_available(void);
+/* Initialises PETSc (and MPI) once per process, collectively over the ranks that mpirun
+ * started, unless the caller already did; PETSc's own options come from the PETSC_OPTIONS
+ * environment variable (prefix cm_: PETSC_OPTIONS=-cm_ksp_monitor). Called by cm_rbf_create
+ * for the PETSC solver by itself; a program calls it first when it needs the rank earlier.
+ * CM_ERR_UNSUPPORTED without PETSc. */
+CM_API cm_status cm_rbf_petsc_initialize(cm_context *ctx);
+/* This process's rank and the number of ranks (0 and 1 before initialisation or without
+ * PETSc); either pointer may be NULL. */
+CM_API void cm_rbf_petsc_rank(int *rank, int *size);
+/* Finalises PETSc (and MPI) if cm_rbf_petsc_initialize initialised it; collective, call it
+ * once before the program ends, after destroying every PETSC-solver cm_rbf. */
+CM_API void cm_rbf_petsc_finalize(void);
+/* Every rank's n records of `size` bytes (mine) to every rank: *all (malloc'd, free() it)
+ * gets them in rank order, *n_all their count; collective. On one rank, or without PETSc, a
+ * copy of mine. Plain-data records only (a study's rows: cm_study_run with ranks > 1). */
+CM_API cm_status cm_rbf_petsc_allgather(cm_context *ctx, const void *mine, size_t n, size_t size,
+                                        void **all, size_t *n_all);
 
 #ifdef __cplusplus
 }

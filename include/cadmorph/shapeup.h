@@ -35,6 +35,15 @@ CM_API cm_status cm_shape_project_circle(cm_context *ctx, size_t n, const double
 CM_API cm_status cm_shape_project_cylinder(cm_context *ctx, size_t n, const double *x,
                                            const double *guess, double *p, double fit[7]);
 
+/* The geometric least-squares cone (n >= 6; one nappe): the axis direction minimising the
+ * algebraic error of circles whose radius grows linearly along it (the cylinder's search),
+ * refined by Levenberg-Marquardt on the distances to the cone; points move to the nearest
+ * point of their generator (the apex for points behind it). guess: a previous fit (apex[3],
+ * unit axis[3] into the nappe, half-angle in (0, pi/2)) to start from, or NULL. fit (may be
+ * NULL) receives the same 7 numbers. */
+CM_API cm_status cm_shape_project_cone(cm_context *ctx, size_t n, const double *x,
+                                       const double *guess, double *p, double fit[7]);
+
 /* The least-squares match of a reference shape ref onto x (n >= 1, same order): a rotation
  * and a translation (scale = 0, rigid), plus a uniform scale (scale = 1, conformal: feature
  * lines); Kabsch/Umeyama with LAPACK's SVD, no reflection. p = s R (ref - mean ref) + mean x. */
@@ -48,10 +57,11 @@ typedef enum cm_shape_type {
     CM_SHAPE_CIRCLE,
     CM_SHAPE_CYLINDER,
     CM_SHAPE_LINE,  /* feature line: conformal match of the initial polyline */
-    CM_SHAPE_RIGID
+    CM_SHAPE_RIGID,
+    CM_SHAPE_CONE
 } cm_shape_type;
 
-/* "plane", "circle", "cylinder", "line", "rigid"; NULL for an unknown type. */
+/* "plane", "circle", "cylinder", "line", "rigid", "cone"; NULL for an unknown type. */
 CM_API const char *cm_shape_type_name(cm_shape_type t);
 /* The type of a name; CM_ERR_ARGUMENT for an unknown one. */
 CM_API cm_status cm_shape_type_parse(cm_context *ctx, const char *name, cm_shape_type *t);
@@ -86,7 +96,7 @@ typedef struct cm_shapeup cm_shapeup;
 
 /* Factors MLS normal equations + gamma_c Phi^T C^T C Phi once (from the MLS factor: see
  * reorder). mls and mesh (the one mls was built on) are borrowed and must outlive the
- * object; sets are copied. A set needs at least 3 nodes (5 for a cylinder). */
+ * object; sets are copied. A set needs at least 3 nodes (5 for a cylinder, 6 for a cone). */
 CM_API cm_status cm_shapeup_create(cm_context *ctx, cm_mls *mls, const cm_mesh *mesh,
                                    size_t n_sets, const cm_shape_set *sets,
                                    const cm_shapeup_options *opt, cm_shapeup **su);

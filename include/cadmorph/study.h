@@ -121,6 +121,11 @@ typedef struct cm_study_options {
                                per-cell scaled_jacobian and per-node displacement (from M0) */
     const char *model;      /* names for the CSV columns model and mesh and the plot title */
     const char *mesh;       /*   (NULL: "G0", "file") */
+    int rank, ranks;        /* distributed over MPI ranks (ranks > 1, absolute mode only;
+                               default 0, 1): this process runs variants i with
+                               i mod ranks = rank and writes their meshes; the result, on
+                               every rank, has all rows (cm_rbf_petsc_allgather). Every
+                               rank calls cm_study_run with the same inputs. */
 } cm_study_options;
 
 CM_API void cm_study_options_init(cm_study_options *opt);

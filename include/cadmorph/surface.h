@@ -2,7 +2,7 @@
  * model G (vertex | edge | face) and the CAD-aware surface morph G -> G' (paper section 4):
  * vertices go to the matching vertex, edge nodes keep their normalised arc length, face
  * nodes are moved in parameter space by a 2D thin-plate RBF fitted on the face's boundary
- * samples and evaluated on the matching face of G'.
+ * samples and evaluated on the matching face of G'; an affine edit is reproduced exactly.
  * Conventions: see core.h. Node indices are 0-based mesh node indices.
  */
 #ifndef CADMORPH_SURFACE_H
@@ -87,6 +87,12 @@ typedef struct cm_surface_morph_options {
      * bbox diagonal / 100. Defaults: 0, 8, 200. */
     double spacing;
     int min_per_edge, max_per_edge;
+    /* Affine edits (G' = A G + b) reproduced exactly: A, b are fitted on the vertices; when
+     * they reproduce every vertex within affine_tol x the bbox diagonal of G', each edge and
+     * face that they map onto G' (points spread over it land within that tolerance) sends
+     * its nodes to the images of their feet on G instead of equal arc length and the
+     * parameter warp. Default 1e-9; 0 turns it off. RBF method only. */
+    double affine_tol;
 } cm_surface_morph_options;
 
 CM_API void cm_surface_morph_options_init(cm_surface_morph_options *opt);
@@ -98,6 +104,11 @@ typedef struct cm_surface_morph_stats {
                                    they are put on the closest point of f'_k instead */
     int64_t worst_outside_node; /* mesh node, -1 if none */
     double worst_outside_dist;  /* how far f'_k(u',v') was from the trimmed face */
+    size_t edges_affine;        /* edges and faces (with nodes) moved as affine images */
+    size_t faces_affine;
+    int affine;                 /* 1 if the vertices moved by one affine map */
+    double affine_residual;     /* largest miss of that map at the vertices (INFINITY: no fit,
+                                   fewer than 4 or coplanar vertices) */
 } cm_surface_morph_stats;
 
 /* Morphs the classified nodes from G to G' (models that correspond: cm_cad_compare).
@@ -114,6 +125,47 @@ CM_API cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const 
 CM_API cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *locator,
                                          const double *xyz, size_t n, double *max_dist,
                                          size_t *worst);
+
+/* ---- constraint sets the CAD model knows (deformations with shape constraints) ---- */
+
+typedef enum cm_surface_set_type {
+    CM_SURFACE_SET_PLANE = 0,    /* the nodes of a planar face */
+    CM_SURFACE_SET_CYLINDER = 1, /* the nodes of a cylindrical face */
+    CM_SURFACE_SET_CIRCLE = 2,   /* the nodes of a circular edge */
+    CM_SURFACE_SET_CONE = 3      /* the nodes of a conical face */
+} cm_surface_set_type;
+
+/* Which entities become sets: every face/edge of a type whose flag is set, plus the listed
+ * ids (0-based) whatever the flags say. */
+typedef struct cm_surface_set_filter {
+    int plane, cylinder, circle, cone;
+    int n_faces, n_edges;
+    const int *faces, *edges;
+} cm_surface_set_filter;
+
+typedef struct cm_surface_set {
+    cm_surface_set_type type;
+    int entity;     /* the face (plane, cylinder, cone) or edge (circle) of G */
+    size_t n;       /* nodes, ascending */
+    int64_t *nodes; /* owned by the cm_surface_sets */
+} cm_surface_set;
+
+typedef struct cm_surface_sets {
+    size_t n;
+    cm_surface_set *set; /* faces first (ascending id), then edges */
+} cm_surface_sets;
+
+/* The constraint sets of a volume mesh lying on G: the boundary nodes are classified on G
+ * (cm_surface_classify, a locator of h = shortest boundary edge / 4); a planar, cylindrical
+ * or conical face's set holds the nodes on the face, on the edges of its wires and on
+ * their vertices; a circular edge's set the nodes on the edge and its end vertices, so a
+ * node may be in several sets. Sets with fewer nodes than their fit needs (3; cylinders 5)
+ * are left out (cones 6). filter NULL: all planes, cylinders, cones and circles. A listed
+ * face that is no plane, cylinder or cone, or edge that is no circle, is CM_ERR_UNSUPPORTED; an id out of range
+ * CM_ERR_MISMATCH; a mesh without volume cells CM_ERR_UNSUPPORTED. */
+CM_API cm_status cm_surface_cad_sets(cm_context *ctx, const cm_cad_model *g, const cm_mesh *mesh,
+                                     const cm_surface_set_filter *filter, cm_surface_sets **sets);
+CM_API void cm_surface_sets_destroy(cm_surface_sets **sets);
 
 #ifdef __cplusplus
 }

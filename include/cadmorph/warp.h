@@ -47,7 +47,8 @@ CM_API const char *cm_warp_method_list(void);
 typedef struct cm_warp_options {
     cm_warp_method method; /* default CM_WARP_RBF */
     /* RBF methods: CM_RBF_SOLVER_AUTO (0, default: dense below a measured size, the
-     * iterative solver above), DENSE or ITERATIVE (rbf.h) */
+     * iterative solver above), DENSE, ITERATIVE or PETSC (rbf.h; PETSC makes create and
+     * apply collective over the MPI ranks) */
     cm_rbf_solver solver;
     /* DM-FFD: control points per axis of the lattice whose domain is the mesh's bounding box
      * (grown by 1e-3 of its diagonal): 5, 10, 15, 25 in the paper; 0 = 10 */

@@ -2,6 +2,7 @@
  * in the hole of the box with a bore), counts follow area / h^2, and the cap on the count is
  * reported as a warning with h raised, never silently. */
 #include "cadmorph/cad.h"
+#include "test_rng.h"
 #include "test_util.h"
 
 #include <stdio.h>
@@ -48,6 +49,47 @@ static void check_on_faces(cm_context *ctx, const cm_cad_model *m, const cm_cad_
     free(p);
 }
 
+/* No part of a face is left out (the row-wise trimming test, cad/scanline.cpp, decides most
+ * candidates without the exact classifier): random points inside each face's trimming, by
+ * the exact classifier, have a sample of their face within 2 h. */
+static void check_complete(cm_context *ctx, const cm_cad_model *m, const cm_cad_locator *loc,
+                           double h, const char *name)
+{
+    const double *xyz;
+    const int *face;
+    size_t n = cm_cad_locator_samples(loc, &xyz, &face, NULL), far = 0, tried = 0;
+    cm_cad_counts c;
+    cm_cad_get_counts(m, &c);
+    uint64_t seed = 18;
+    double worst = 0;
+    for (int f = 0; f < c.faces; ++f) {
+        cm_cad_face_info fi;
+        CHECK(cm_cad_face_get_info(ctx, m, f, &fi) == CM_OK);
+        for (int k = 0; k < 200; ++k) {
+            double uv[2] = {test_rng_range(&seed, fi.uv_range[0], fi.uv_range[1]),
+                            test_rng_range(&seed, fi.uv_range[2], fi.uv_range[3])}, p[3];
+            int in = 0;
+            CHECK(cm_cad_face_inside(ctx, m, f, uv, 1, &in) == CM_OK);
+            if (!in) continue;
+            CHECK(cm_cad_face_eval(ctx, m, f, uv, 1, p, NULL) == CM_OK);
+            double best = INFINITY;
+            for (size_t i = 0; i < n; ++i) {
+                if (face[i] != f) continue;
+                double d = (p[0] - xyz[3 * i]) * (p[0] - xyz[3 * i]) +
+                           (p[1] - xyz[3 * i + 1]) * (p[1] - xyz[3 * i + 1]) +
+                           (p[2] - xyz[3 * i + 2]) * (p[2] - xyz[3 * i + 2]);
+                if (d < best) best = d;
+            }
+            best = sqrt(best);
+            if (best > worst) worst = best;
+            far += best > 2 * h;
+            ++tried;
+        }
+    }
+    CHECK_MSG(tried > 100 && far == 0, "%s: %zu of %zu points inside a face have no sample within "
+              "2 h (worst %.3g h)", name, far, tried, worst / h);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) return 2;
@@ -71,6 +113,7 @@ int main(int argc, char **argv)
         CHECK_MSG(in_hole == 0, "%zu samples in the hole", in_hole);
         CHECK(on_caps > 100);
         check_on_faces(ctx, m, loc, "holed");
+        check_complete(ctx, m, loc, 0.2, "holed");
         /* samples follow area / h^2: total area 2(80 + 40 + 32) - 2 pi 4 + 2 pi 2 4 */
         double area = 2 * (80 + 40 + 32) - 2 * 3.14159265358979 * 4 + 2 * 3.14159265358979 * 2 * 4;
         double ratio = n1 / (area / (0.2 * 0.2));
@@ -115,6 +158,7 @@ int main(int argc, char **argv)
         CHECK_MSG(ratio > 0.8 && ratio < 1.6, "%s: samples / (area / h^2) = %g", shapes[k].name,
                   ratio);
         check_on_faces(ctx, m, loc, shapes[k].name);
+        check_complete(ctx, m, loc, shapes[k].h, shapes[k].name);
         cm_cad_locator_destroy(&loc);
         cm_cad_destroy(&m);
     }

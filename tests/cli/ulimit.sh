@@ -8,6 +8,9 @@ set -u
 exe=$1 mesh=$2 disp=$3 work=$4
 # ASan reserves terabytes of address space: nothing to learn under ulimit -v there
 if ldd "$exe" 2>/dev/null | grep -q libasan; then echo "skip: ASan build"; exit 77; fi
+# a PETSc build (-DCADMORPH_WITH_PETSC=ON) loads ~340 libraries (MPI, hypre, MUMPS, ...): they
+# alone need more address space than the limits below, so the program cannot even start
+if ldd "$exe" 2>/dev/null | grep -q libpetsc; then echo "skip: PETSc build"; exit 77; fi
 fail=0
 # run LIMIT_KB EXPECT(0|4|0or4) ARGS...: within 30 s, the expected code, stderr as expected
 run() {

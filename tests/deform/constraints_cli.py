@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """`cadmorph deform --constraint TYPE:SET` end to end: a gmsh-built block with a bore (surface
 mesh, physical groups), bent by lifting one end: the bore stays a cylinder and the top face a
-plane far better than without; SET as a physical group, a node-list file and a VTK field;
+plane far better than without; a band of a sheared cone stays a cone; SET as a physical group, a node-list file and a VTK field;
 the error paths (exit 1 for usage, 2 for a set that is not there).
 usage: constraints_cli.py CADMORPH DATA_DIR WORK_DIR"""
 import os, re, subprocess, sys
@@ -149,6 +149,62 @@ meshio.write("block_field.vtu", mv)
 rc, out, err = run("--mesh", "block_field.vtu", *base[2:], "--constraint", "plane:flat=1",
                    "--constraint", "rigid:bore_nodes.csv", "-o", "con_field.vtu")
 check(rc == 0 and "plane:flat=1: %d nodes" % len(top) in out, "field set: %d %s %s" % (rc, out, err))
+
+# a cone: a quad mesh of a truncated cone (half-angle 0.35, distance 1..2.5 from the apex along
+# the generator), the bottom rows fixed, the top rows moved sideways; the middle band as a
+# cone set: scipy's least-squares cone of the band fits far better with the constraint
+A, na, nt = 0.35, 48, 30
+ang, tt = np.meshgrid(np.linspace(0, 2 * np.pi, na, endpoint=False), np.linspace(1, 2.5, nt + 1))
+cx = np.c_[(tt * np.sin(A) * np.cos(ang)).ravel(), (tt * np.sin(A) * np.sin(ang)).ravel(),
+           (tt * np.cos(A)).ravel()]
+quads = np.array([[j * na + i, j * na + (i + 1) % na, (j + 1) * na + (i + 1) % na, (j + 1) * na + i]
+                  for j in range(nt) for i in range(na)])
+meshio.write("cone.vtk", meshio.Mesh(cx, [("quad", quads)]), binary=False)
+h = cx[:, 2]
+with open("cone_F.csv", "w") as f:
+    f.write("node\n" + "".join("%d\n" % v for v in np.where(h < 1.1 * np.cos(A))[0]))
+with open("cone_H.csv", "w") as f:
+    f.write("node,dx,dy,dz\n" + "".join("%d,0.4,0,0.1\n" % v for v in np.where(h > 2.4 * np.cos(A))[0]))
+band = np.where((h > 1.5 * np.cos(A)) & (h < 2.0 * np.cos(A)))[0]
+with open("cone_band.csv", "w") as f:
+    f.write("node\n" + "".join("%d\n" % v for v in band))
+
+
+def cone_error(d):
+    from scipy.optimize import least_squares
+    y = cx[band] + d[band]
+
+    def res(p):
+        w = np.array([np.sin(p[0]) * np.cos(p[1]), np.sin(p[0]) * np.sin(p[1]), np.cos(p[0])])
+        q = y - p[2:5]
+        hh = q @ w
+        r = np.linalg.norm(q - np.outer(hh, w), axis=1)
+        return r * np.cos(p[5]) - hh * np.sin(p[5])
+
+    best = None
+    for th in (0.0, 0.2):
+        for ph in np.linspace(0, np.pi, 3, endpoint=False):
+            s = least_squares(res, [th, ph, 0, 0, 0, A], xtol=1e-14, ftol=1e-14)
+            if best is None or s.cost < best.cost:
+                best = s
+    return np.abs(best.fun).max()
+
+
+cbase = ["--mesh", "cone.vtk", "--handles", "cone_H.csv", "--fixed", "cone_F.csv", "--method", "mls",
+         "--stretch", "0"]
+rc, out, err = run(*cbase, "-o", "cone_free.vtu")
+check(rc == 0, "cone unconstrained: %d %s" % (rc, err))
+rc2, out2, err2 = run(*cbase, "--constraint", "cone:cone_band.csv", "--constraint-weight", "100",
+                      "--constraint-anderson", "5", "-o", "cone_con.vtu")
+check(rc2 == 0 and "constraint cone:cone_band.csv: %d nodes" % len(band) in out2,
+      "cone constrained: %d %s %s" % (rc2, out2, err2))
+if rc == 0 and rc2 == 0:
+    c0 = cone_error(meshio.read("cone_free.vtu").point_data["displacement"])
+    c1 = cone_error(meshio.read("cone_con.vtu").point_data["displacement"])
+    check(c0 > 1e-3 and c1 < 0.2 * c0, "cone band: scipy cone error %g -> %g" % (c0, c1))
+    m = re.search(r"constraint cone:\S+: \d+ nodes, residual before (\S+) after (\S+) ", out2)
+    check(m and abs(float(m.group(2)) - c1) < 0.5 * c1 + 1e-6,
+          "cone residual %s vs scipy %g" % (m.group(2) if m else None, c1))
 
 # error paths
 rc, out, err = run(*base, "--constraint", "sphere:bore", "-o", "x.vtu")

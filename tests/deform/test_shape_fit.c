@@ -156,6 +156,73 @@ static void test_cylinder(cm_context *ctx, uint64_t *seed)
     CHECK_MSG(max_diff(N, p2, want) < 1e-12, "cylinder from a guess: off by %g", max_diff(N, p2, want));
 }
 
+/* Points of a cone with apex 0, axis z, half-angle A in the local frame: angle a, distance
+ * t from the apex along the generator, offset e along the outward normal. */
+static void cone_point(double A, double a, double t, double e, double *x)
+{
+    double r = t * sin(A) + e * cos(A), h = t * cos(A) - e * sin(A);
+    x[0] = r * cos(a), x[1] = r * sin(a), x[2] = h;
+}
+
+static void test_cone(cm_context *ctx, uint64_t *seed)
+{
+    enum { NA = 12, NT = 5, N = NA * NT };
+    const double A = 0.45;
+    double x[3 * N], want[3 * N], p[3 * N], r[9], t[3], fit[7];
+    /* exact points on part of a cone (angles over 1.5 pi, uneven) stay put; the fit is the
+     * cone: apex t, axis r e_z, half-angle A */
+    for (int i = 0; i < NA; ++i)
+        for (int j = 0; j < NT; ++j)
+            cone_point(A, 1.5 * PI * i / (NA - 1) + 0.01 * i * i, 0.8 + 0.4 * j + 0.03 * i, 0,
+                       want + 3 * (NT * i + j));
+    random_frame(seed, r, t);
+    to_frame(r, t, N, want);
+    CHECK(cm_shape_project_cone(ctx, N, want, NULL, p, fit) == CM_OK);
+    CHECK_MSG(max_diff(N, p, want) < 1e-12, "cone: exact points moved %g", max_diff(N, p, want));
+    CHECK_NEAR(fit[6], A, 1e-12);
+    for (int k = 0; k < 3; ++k)
+        CHECK_NEAR(fit[k], t[k], 1e-11);
+    /* the axis into the nappe: r e_z (to_frame applies x -> r x + t) */
+    CHECK_NEAR(fit[3] * r[2] + fit[4] * r[5] + fit[5] * r[8], 1, 1e-12);
+    /* 12 full-circle angles, offsets +-eps along the normal alternately: by symmetry the
+     * least-squares cone is the true one and each point goes to its foot on the generator */
+    for (int i = 0; i < NA; ++i)
+        for (int j = 0; j < NT; ++j) {
+            int k = NT * i + j;
+            double a = 2 * PI * i / NA, tt = 0.8 + 0.4 * j, e = 0.04 * ((i & 1) ? -1 : 1);
+            cone_point(A, a, tt, e, x + 3 * k);
+            cone_point(A, a, tt, 0, want + 3 * k);
+        }
+    random_frame(seed, r, t);
+    to_frame(r, t, N, x);
+    to_frame(r, t, N, want);
+    CHECK(cm_shape_project_cone(ctx, N, x, NULL, p, fit) == CM_OK);
+    CHECK_MSG(max_diff(N, p, want) < 1e-12, "cone: noisy points off by %g", max_diff(N, p, want));
+    CHECK_NEAR(fit[6], A, 1e-12);
+    /* from a rough guess (the warm start of Shape-Up) the same cone */
+    double guess[7], p2[3 * N];
+    memcpy(guess, fit, sizeof guess);
+    guess[0] += 0.05, guess[4] += 0.05, guess[6] *= 1.1;
+    CHECK(cm_shape_project_cone(ctx, N, x, guess, p2, NULL) == CM_OK);
+    CHECK_MSG(max_diff(N, p2, want) < 1e-12, "cone from a guess: off by %g", max_diff(N, p2, want));
+    /* a point behind the fitted apex goes to the apex */
+    double y[3 * (N + 1)], q[3 * (N + 1)];
+    memcpy(y, want, sizeof want);
+    cone_point(A, 0.3, -0.1, 0, y + 3 * N); /* on the other nappe, near the apex */
+    to_frame(r, t, 1, y + 3 * N);
+    CHECK(cm_shape_project_cone(ctx, N + 1, y, NULL, q, fit) == CM_OK);
+    double yy[3] = {y[3 * N] - fit[0], y[3 * N + 1] - fit[1], y[3 * N + 2] - fit[2]};
+    double hh = yy[0] * fit[3] + yy[1] * fit[4] + yy[2] * fit[5];
+    double rr = sqrt(fmax(yy[0] * yy[0] + yy[1] * yy[1] + yy[2] * yy[2] - hh * hh, 0));
+    CHECK_MSG(hh * cos(fit[6]) + rr * sin(fit[6]) < 0, "the extra point is not behind the apex");
+    double da = 0;
+    for (int k = 0; k < 3; ++k)
+        da = fmax(da, fabs(q[3 * N + k] - fit[k]));
+    CHECK_MSG(da < 1e-12, "behind the apex: %g from it", da);
+    /* too few points */
+    CHECK(cm_shape_project_cone(ctx, 5, want, NULL, p, NULL) < 0);
+}
+
 static void test_similar(cm_context *ctx, uint64_t *seed)
 {
     enum { N = 20 };
@@ -208,6 +275,7 @@ int main(void)
         test_plane(ctx, &seed);
         test_circle(ctx, &seed);
         test_cylinder(ctx, &seed);
+        test_cone(ctx, &seed);
         test_similar(ctx, &seed);
     }
     cm_context_destroy(&ctx);

@@ -260,6 +260,8 @@ int main(void)
     test_shear(ctx);
     cm_shape_type t;
     CHECK(cm_shape_type_parse(ctx, "cylinder", &t) == CM_OK && t == CM_SHAPE_CYLINDER);
+    CHECK(cm_shape_type_parse(ctx, "cone", &t) == CM_OK && t == CM_SHAPE_CONE);
+    CHECK(!strcmp(cm_shape_type_name(CM_SHAPE_CONE), "cone"));
     CHECK(cm_shape_type_parse(ctx, "sphere", &t) == CM_ERR_ARGUMENT);
     cm_context_destroy(&ctx);
     return TEST_REPORT();

@@ -17,3 +17,21 @@ cm_add_unit_test(test_blas_core ${CMAKE_CURRENT_LIST_DIR}/test_blas_core.c
   LIBS cm_rbf LABELS rbf)
 # iterative solver vs dense on a box-with-bore boundary set, affine data, two bodies, threads
 cm_add_unit_test(test_rbf_iterative ${CMAKE_CURRENT_LIST_DIR}/test_rbf_iterative.c LIBS cm_rbf LABELS rbf)
+
+# the distributed solver (CADMORPH_WITH_PETSC only): against the serial iterative solver
+# under `mpirun -n 2` (--oversubscribe: the CI machine may have fewer slots; as root too), and
+# on one rank without mpirun
+if(CADMORPH_WITH_PETSC)
+  add_executable(test_rbf_petsc ${CMAKE_CURRENT_LIST_DIR}/test_rbf_petsc.c)
+  target_include_directories(test_rbf_petsc PRIVATE ${PROJECT_SOURCE_DIR}/tests/helpers
+    ${PROJECT_SOURCE_DIR})
+  target_link_libraries(test_rbf_petsc PRIVATE cm_rbf cm_core cm_warnings cm_posix)
+  set(CM_MPI_ENV "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1")
+  add_test(NAME test_rbf_petsc_2ranks
+    COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 --oversubscribe
+            $<TARGET_FILE:test_rbf_petsc> ${CM_TEST_DATA} ${CM_TEST_WORK} 2)
+  add_test(NAME test_rbf_petsc_1rank
+    COMMAND test_rbf_petsc ${CM_TEST_DATA} ${CM_TEST_WORK} 1)
+  set_tests_properties(test_rbf_petsc_2ranks test_rbf_petsc_1rank PROPERTIES
+    LABELS "unit;rbf;petsc" ENVIRONMENT "${CM_MPI_ENV}")
+endif()

@@ -83,14 +83,12 @@ static double max_diff(size_t n, const double *a, const double *b)
     return v;
 }
 
-/* Fits values on x with the given solver and evaluates at p (np points). */
-static cm_status fit_eval(cm_context *ctx, cm_rbf_solver solver, size_t m, const double *x,
-                          const double *val, size_t np, const double *p, double *out,
-                          cm_rbf_stats *stats)
+/* Fits values on x with the given options and evaluates at p (np points). */
+static cm_status fit_eval_opt(cm_context *ctx, const cm_rbf_options *opt, size_t m,
+                              const double *x, const double *val, size_t np, const double *p,
+                              double *out, cm_rbf_stats *stats)
 {
-    cm_rbf_options o;
-    cm_rbf_options_init(&o);
-    o.solver = solver;
+    cm_rbf_options o = *opt;
     cm_rbf *r = NULL;
     cm_status st = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r);
     if (st == CM_OK) st = cm_rbf_solve(ctx, r, 3, val);
@@ -98,6 +96,16 @@ static cm_status fit_eval(cm_context *ctx, cm_rbf_solver solver, size_t m, const
     if (r) cm_rbf_get_stats(r, stats);
     cm_rbf_destroy(&r);
     return st;
+}
+
+static cm_status fit_eval(cm_context *ctx, cm_rbf_solver solver, size_t m, const double *x,
+                          const double *val, size_t np, const double *p, double *out,
+                          cm_rbf_stats *stats)
+{
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = solver;
+    return fit_eval_opt(ctx, &o, m, x, val, np, p, out, stats);
 }
 
 /* Evaluation points: the centres and points inside the box. */
@@ -163,6 +171,32 @@ static void test_against_dense(cm_context *ctx)
            sti.iterations);
     CHECK(c == CM_OK);
     CHECK_MSG(dt <= 1e-9, "%.3g", dt);
+
+    /* the variants of the preconditioner converge to the same interpolant: the coarse
+     * correction before and after the local solves, after them only, and subdomains grown
+     * by a distance (twice the coarse fill distance, capped at 2000) with a sparser coarse
+     * space (300: then the distance reaches beyond the 1400 nearest) */
+    for (int v = 0; v < 3; ++v) {
+        cm_rbf_options o;
+        cm_rbf_options_init(&o);
+        o.solver = CM_RBF_SOLVER_ITERATIVE;
+        if (v == 0) o.coarse_post = 1;
+        if (v == 1) o.coarse_post = 2;
+        if (v == 2) {
+            o.overlap = 2.0;
+            o.local_max = 2000;
+            o.coarse_size = 300;
+        }
+        cm_rbf_stats sv;
+        cm_status e = fit_eval_opt(ctx, &o, m, x, d, np, p, s1, &sv);
+        double dv = max_diff(np * 3, s1, sd) / range;
+        printf("variant %d: %d iterations, coarse %d, residual %.3g, |variant - dense| = %.3g "
+               "of the range\n", v, sv.iterations, sv.coarse_size, sv.residual, dv);
+        CHECK_MSG(e == CM_OK, "variant %d: %s", v, cm_context_message(ctx));
+        CHECK_MSG(dv <= tol, "variant %d: %.3g > %.3g", v, dv, tol);
+        CHECK_MSG(sv.iterations >= 1 && sv.iterations <= 40, "variant %d: %d", v, sv.iterations);
+        if (v == 2) CHECK_MSG(sv.coarse_size == 300, "%d", sv.coarse_size);
+    }
     free(x), free(d), free(p), free(sd), free(si), free(s1);
 }
 
@@ -280,10 +314,25 @@ static void test_choice(cm_context *ctx)
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     o.local_size = 8; /* smaller than the leaves */
     CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    o.local_size = 1400;
+    o.coarse_post = 3;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    o.coarse_post = 0;
+    o.overlap = -1.0;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
     /* the cost model: dense at 5k, iterative at 20k (measured: 1.6x faster at 10k) */
     CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 5000) == 1);
     CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 20000) == 0);
     CHECK(cm_rbf_auto_dense(CM_RBF_BIHARMONIC, 20000) == 1);
+    /* the coarse space: 2000 up to 2e4 centres (m/4 below 8000), then grown as sqrt(m) up
+     * to coarse_max */
+    cm_rbf_options_init(&o);
+    CHECK(cm_rbf_coarse_count(&o, 20000) == 2000 && cm_rbf_coarse_count(&o, 6000) == 1500);
+    CHECK(cm_rbf_coarse_count(&o, 80000) == 4000 && cm_rbf_coarse_count(&o, 1000000) == 8000);
+    o.coarse_max = 3000;
+    CHECK(cm_rbf_coarse_count(&o, 80000) == 3000);
+    o.coarse_grow = 0;
+    CHECK(cm_rbf_coarse_count(&o, 150000) == 2000);
     free(x);
 }
 

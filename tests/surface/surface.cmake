@@ -9,3 +9,6 @@ set_tests_properties(surface_meshes_setup PROPERTIES FIXTURES_SETUP surface_mesh
 
 cm_add_unit_test(test_surface test_surface.c LIBS cm_surface LABELS cad)
 set_tests_properties(test_surface PROPERTIES FIXTURES_REQUIRED surface_meshes)
+
+cm_add_unit_test(test_cad_sets test_cad_sets.c LIBS cm_surface LABELS cad)
+set_tests_properties(test_cad_sets PROPERTIES FIXTURES_REQUIRED surface_meshes)

@@ -1,0 +1,171 @@
+/* The distributed solver (CM_RBF_SOLVER_PETSC) against the serial iterative one, run under
+ * `mpirun -n K`: same interpolant to 1e-9 of the data range, iteration counts within one,
+ * the preconditioner reused for a second right-hand side, the errors it must give.
+ * usage: test_rbf_petsc DATA WORK K (K: the ranks mpirun was asked for, checked). */
+#include "cadmorph/rbf.h"
+#include "test_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The box-with-bore boundary set of test_rbf_iterative.c (flat faces, a curved face, sharp
+ * edges, as on a tet mesh of bore_a.step), spaced about h. Returns the count. */
+static size_t box_with_bore(double a, double b, double c, double xc, double yc, double rad,
+                            double h, double *x)
+{
+    size_t n = 0;
+    const int na = (int)(a / h + 0.5), nb = (int)(b / h + 0.5), nz = (int)(c / h + 0.5);
+#define PUT(px, py, pz)                                                                         \
+    do {                                                                                       \
+        if (x) {                                                                               \
+            x[3 * n] = (px);                                                                   \
+            x[3 * n + 1] = (py);                                                               \
+            x[3 * n + 2] = (pz);                                                               \
+        }                                                                                      \
+        ++n;                                                                                   \
+    } while (0)
+    for (int i = 0; i <= na; ++i)
+        for (int j = 0; j <= nb; ++j) {
+            double px = a * i / na, py = b * j / nb;
+            if (hypot(px - xc, py - yc) < rad + 0.3 * h) continue;
+            PUT(px, py, 0.0);
+            PUT(px, py, c);
+        }
+    for (int k = 1; k < nz; ++k) {
+        double pz = c * k / nz;
+        for (int i = 0; i <= na; ++i) {
+            PUT(a * i / na, 0.0, pz);
+            PUT(a * i / na, b, pz);
+        }
+        for (int j = 1; j < nb; ++j) {
+            PUT(0.0, b * j / nb, pz);
+            PUT(a, b * j / nb, pz);
+        }
+    }
+    const int nt = (int)(6.283185307179586 * rad / h + 0.5);
+    for (int k = 0; k <= nz; ++k)
+        for (int t = 0; t < nt; ++t) {
+            double th = 6.283185307179586 * (t + 0.5 * (k % 2)) / nt;
+            PUT(xc + rad * cos(th), yc + rad * sin(th), c * k / nz);
+        }
+#undef PUT
+    return n;
+}
+
+static double range_of(size_t n, const double *v)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        lo = fmin(lo, v[i]);
+        hi = fmax(hi, v[i]);
+    }
+    return hi - lo;
+}
+
+static double max_diff(size_t n, const double *a, const double *b)
+{
+    double v = 0.0;
+    for (size_t i = 0; i < n; ++i) v = fmax(v, fabs(a[i] - b[i]));
+    return v;
+}
+
+int main(int argc, char **argv)
+{
+    const int want_ranks = argc > 3 ? atoi(argv[3]) : 1;
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return 1;
+    cm_context_set_threads(ctx, 1); /* one thread per rank: the ranks share the cores */
+    CHECK_MSG(cm_rbf_petsc_available(), "built without PETSc");
+    cm_status s0 = cm_rbf_petsc_initialize(ctx);
+    CHECK_MSG(s0 == CM_OK, "%s", cm_context_message(ctx));
+    int rank, size;
+    cm_rbf_petsc_rank(&rank, &size);
+    CHECK_MSG(size == want_ranks, "%d ranks, expected %d", size, want_ranks);
+
+    /* m ~ 5k boundary nodes, the bore's kind of motion, points inside */
+    const double h = 0.076;
+    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, NULL);
+    const size_t nin = 3000, np = m + nin;
+    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
+    double *p = malloc(np * 3 * sizeof *p);
+    double *ss = malloc(np * 3 * sizeof *ss), *sp = malloc(np * 3 * sizeof *sp);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, x);
+    for (size_t i = 0; i < m; ++i) {
+        const double *y = x + 3 * i;
+        double dx = y[0] - 2.0, dy = y[1] - 1.0, r = hypot(dx, dy) + 1e-12;
+        double sc = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
+        d[3 * i] = sc * dx / r + 0.01 * sin(y[2]);
+        d[3 * i + 1] = sc * dy / r;
+        d[3 * i + 2] = 0.02 * y[0] * y[0] / 16.0;
+    }
+    memcpy(p, x, m * 3 * sizeof *p);
+    for (size_t i = 0; i < nin; ++i) {
+        double t = (double)i / (double)nin;
+        p[3 * (m + i)] = 0.1 + 3.8 * t;
+        p[3 * (m + i) + 1] = 0.1 + 0.3 * fmod(7.0 * t, 1.0);
+        p[3 * (m + i) + 2] = 0.1 + 0.8 * fmod(13.0 * t, 1.0);
+    }
+
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    cm_rbf *rs = NULL, *rp = NULL;
+    cm_rbf_stats sts, stp;
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    cm_status a = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &rs);
+    if (a == CM_OK) a = cm_rbf_solve(ctx, rs, 3, d);
+    if (a == CM_OK) a = cm_rbf_evaluate(ctx, rs, np, p, ss);
+    CHECK_MSG(a == CM_OK, "serial: %s", cm_context_message(ctx));
+    cm_rbf_get_stats(rs, &sts);
+    o.solver = CM_RBF_SOLVER_PETSC;
+    cm_status b = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &rp);
+    if (b == CM_OK) b = cm_rbf_solve(ctx, rp, 3, d);
+    if (b == CM_OK) b = cm_rbf_evaluate(ctx, rp, np, p, sp);
+    CHECK_MSG(b == CM_OK, "petsc: %s", cm_context_message(ctx));
+    cm_rbf_get_stats(rp, &stp);
+    const double range = range_of(m * 3, d);
+    const double diff = max_diff(np * 3, ss, sp) / range;
+    const double exact = max_diff(m * 3, sp, d) / range;
+    if (rank == 0)
+        printf("box with bore: m = %zu on %d ranks: serial %d iterations (%d matvecs), PETSc %d "
+               "(%d), residual %.3g vs %.3g, |PETSc - serial| = %.3g of the range, exactness "
+               "at the centres %.3g\n",
+               m, size, sts.iterations, sts.matvecs, stp.iterations, stp.matvecs, sts.residual,
+               stp.residual, diff, exact);
+    CHECK(m > 4000 && m < 7000);
+    CHECK(stp.solver == CM_RBF_SOLVER_PETSC && sts.solver == CM_RBF_SOLVER_ITERATIVE);
+    CHECK_MSG(diff <= 1e-9, "%.3g", diff);
+    CHECK_MSG(exact <= 1e-9, "%.3g", exact);
+    CHECK_MSG(abs(stp.iterations - sts.iterations) <= 1, "%d vs %d iterations", stp.iterations,
+              sts.iterations);
+    CHECK_MSG(stp.residual <= o.tolerance, "%.3g", stp.residual);
+    CHECK(stp.subdomains == sts.subdomains && stp.coarse_size == sts.coarse_size);
+
+    /* a second right-hand side on the same preconditioner: affine data, reproduced exactly */
+    for (size_t i = 0; i < np; ++i)
+        for (int e = 0; e < 3; ++e) {
+            const double *y = p + 3 * i;
+            double v = 0.3 * e - 1.0 + (1.0 + e) * y[0] - 0.5 * y[1] + 2.0 * e * y[2];
+            ss[3 * i + e] = v;
+            if (i < m) d[3 * i + e] = v;
+        }
+    cm_status c = cm_rbf_solve(ctx, rp, 3, d);
+    if (c == CM_OK) c = cm_rbf_evaluate(ctx, rp, np, p, sp);
+    CHECK_MSG(c == CM_OK, "%s", cm_context_message(ctx));
+    const double aff = max_diff(np * 3, ss, sp) / range_of(np * 3, ss);
+    if (rank == 0) printf("affine data, same preconditioner: error %.3g\n", aff);
+    CHECK_MSG(aff <= 1e-13, "%.3g", aff);
+    cm_rbf_destroy(&rs);
+    cm_rbf_destroy(&rp);
+
+    /* the kernels it does not handle: a clear error, on every rank */
+    cm_rbf *rb = NULL;
+    cm_status e = cm_rbf_create_opt(ctx, CM_RBF_BIHARMONIC, 3, m, x, &o, &rb);
+    CHECK(e == CM_ERR_UNSUPPORTED && rb == NULL);
+    CHECK(strstr(cm_context_message(ctx), "r^3") != NULL);
+
+    free(x), free(d), free(p), free(ss), free(sp);
+    cm_context_destroy(&ctx);
+    cm_rbf_petsc_finalize();
+    return TEST_REPORT();
+}
