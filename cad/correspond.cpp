@@ -272,8 +272,14 @@ void match_darts(const topo &A, const topo &B, state &s, double diag)
                 }
                 if (perfect && cost < 1e-9) break;  // the same geometry: nothing nearer
             }
+            // How far the identity may be off: a parametric edit moves every entity (the ones
+            // matched so far show by how much), a renumbered file of the same shape none. A
+            // group that only geometry can place (a hole among equal holes) then follows the
+            // numbering of an edit that moved the rest as far, and the geometry of a file that
+            // moved nothing.
+            const double moved = s.ncost ? s.cost / (double)s.ncost / std::max(diag, 1e-300) : 0;
             if (ident_score >= 0 && ident_score == best_score &&
-                ident_cost <= 2 * best_cost + 0.01)
+                ident_cost <= 2 * best_cost + 2 * moved + 0.01)
                 best = std::move(ident);
             double keep_cost = s.cost;
             long keep_n = s.ncost;
@@ -688,6 +694,7 @@ cm_cad_correspondence *make_result(const cm_cad_model *g, const cm_cad_model *g2
     for (size_t e = 0; e < ne; ++e) c->edge[e] = s.e[e], c->edge_flipped[e] = s.eflip[e];
     for (size_t v = 0; v < nv; ++v) c->vertex[v] = s.v[v];
     c->renumbered = renumbered;
+    for (size_t w = 0; w < s.w.size(); ++w) c->wires_restarted += s.w[w] != (int)w || s.wrot[w] != 0;
     return c;
 }
 

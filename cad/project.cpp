@@ -213,6 +213,8 @@ void seed_on_face(adaptors &a, int face, const gp_Pnt &p, double &u, double &v)
         u = bu, v = bv;
 }
 
+void refine_on_surface(adaptors &a, int face, const gp_Pnt &p, double tol, foot &out);
+
 void project_on_face(adaptors &a, int face, const gp_Pnt &p, double u0, double v0, foot &out)
 {
     const cm_cad_model *m = a.model;
@@ -257,11 +259,13 @@ void project_on_face(adaptors &a, int face, const gp_Pnt &p, double u0, double v
     }
     double best = in ? d : std::numeric_limits<double>::infinity();
     if (in) out.u = u, out.v = v, out.dist = d, out.p = S.Value(u, v);
+    double tol = BRep_Tool::Tolerance(m->face(face));
     // The nearest point of the trimmed face lies on its boundary: try every boundary edge.
     int w0 = m->face_wire_offset[face], w1 = m->face_wire_offset[face + 1];
     for (int k = m->wire_offset[w0]; k < m->wire_offset[w1]; ++k) {
         int e = m->wire_edge[k];
         if (m->edge_info[e].degenerate) continue;
+        tol = std::max(tol, BRep_Tool::Tolerance(m->edge(e)));
         double t;
         gp_Pnt q;
         double de = project_on_edge(a, e, p, std::numeric_limits<double>::quiet_NaN(), t, q);
@@ -279,6 +283,41 @@ void project_on_face(adaptors &a, int face, const gp_Pnt &p, double u0, double v
     if (best == std::numeric_limits<double>::infinity()) {
         // no edge with a pcurve: keep the Newton result rather than nothing
         out.u = u, out.v = v, out.dist = d, out.p = S.Value(u, v);
+        return;
+    }
+    // the foot is on the trimming (an edge's 3D curve, or the parameter box it clamped to)
+    refine_on_surface(a, face, p, tol, out);
+}
+
+// An edge's 3D curve lies within the edge's tolerance of the surface, not on it (industrial
+// B-spline faces: up to 1e-4), and the parameter box of the face comes from the pcurves: so
+// the distance to a foot on the trimming is not the distance to the face, a point of the
+// surface just beyond the trimming curve would report the gap (or its distance to the box).
+// The final answer is a Newton projection onto the surface from the foot's (u,v), in a
+// parameter box widened by the tolerance tol (of the face and its edges), kept when its foot
+// stays within tol of the foot on the trimming (a point truly beyond the boundary slides
+// farther along the surface and keeps that foot).
+void refine_on_surface(adaptors &a, int face, const gp_Pnt &p, double tol, foot &out)
+{
+    const cm_cad_face_info &fi = a.model->face_info[face];
+    BRepAdaptor_Surface &S = a.surface(face);
+    gp_Pnt q;
+    gp_Vec su, sv;
+    S.D1(out.u, out.v, q, su, sv);
+    double box[4];
+    std::copy(fi.uv_range, fi.uv_range + 4, box);
+    const double gu = su.Magnitude(), gv = sv.Magnitude();
+    const double mu = gu > 0 ? std::min(4 * tol / gu, 0.01 * (box[1] - box[0])) : 0;
+    const double mv = gv > 0 ? std::min(4 * tol / gv, 0.01 * (box[3] - box[2])) : 0;
+    box[0] -= mu, box[1] += mu, box[2] -= mv, box[3] += mv;
+    double u = out.u, v = out.v;
+    bool clamped = false;
+    double d = newton_face(S, p, box, fi.periodic, u, v, clamped);
+    gp_Pnt f = S.Value(u, v);
+    if (d < out.dist && f.Distance(out.p) <= 2 * tol + 1e-12 * (1 + p.XYZ().Modulus())) {
+        u = wrap(u, fi.uv_range[0] - 1e-9 * fi.period[0], fi.period[0]);
+        v = wrap(v, fi.uv_range[2] - 1e-9 * fi.period[1], fi.period[1]);
+        out.u = u, out.v = v, out.dist = d, out.p = f;
     }
 }
 

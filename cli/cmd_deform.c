@@ -164,52 +164,6 @@ static int parse_args(int argc, char **argv, deform_args *a)
     return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 4) ? CLI_EXIT_USAGE : -1;
 }
 
-/* F.csv: header `node`, one 0-based index per line; blank lines and CRLF accepted. */
-static cm_status read_fixed(cm_context *ctx, const char *path, size_t n, unsigned char *fixed)
-{
-    char *data = NULL;
-    size_t size = 0;
-    cm_status s = cm_file_read(ctx, path, &data, &size);
-    if (s < 0) return s;
-    char *p = data;
-    long line = 0;
-    int header = 0;
-    while (p && *p) {
-        char *e = strchr(p, '\n');
-        if (e) *e = 0;
-        ++line;
-        size_t len = strlen(p);
-        while (len && (p[len - 1] == '\r' || p[len - 1] == ' ')) p[--len] = 0;
-        if (len) {
-            if (!header) {
-                if (strcmp(p, "node")) {
-                    s = cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: expected the header 'node'", path, line);
-                    break;
-                }
-                header = 1;
-            } else {
-                char *end;
-                errno = 0;
-                long long v = strtoll(p, &end, 10);
-                if (errno || *end || end == p) {
-                    s = cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: '%s' is not a node index", path, line, p);
-                    break;
-                }
-                if (v < 0 || (unsigned long long)v >= n) {
-                    s = cm_error(ctx, CM_ERR_MISMATCH, "%s:%ld: node %lld out of range (%zu nodes)",
-                                 path, line, v, n);
-                    break;
-                }
-                fixed[v] = 1;
-            }
-        }
-        p = e ? e + 1 : NULL;
-    }
-    if (s >= 0 && !header) s = cm_error(ctx, CM_ERR_FORMAT, "%s: empty (expected the header 'node')", path);
-    free(data);
-    return s;
-}
-
 int cli_cmd_deform(int argc, char **argv)
 {
     deform_args a;
@@ -235,7 +189,7 @@ int cli_cmd_deform(int argc, char **argv)
         if (!disp || !con || !fixed || !border || !H) s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
     }
     if (s >= 0) s = cm_warp_read_displacements(ctx, a.handles, n, disp, con);
-    if (s >= 0 && a.fixed) s = read_fixed(ctx, a.fixed, n, fixed);
+    if (s >= 0 && a.fixed) s = cm_mesh_read_node_list(ctx, a.fixed, n, fixed);
     if (s >= 0 && !volume) s = cm_mls_mean_curvature(ctx, mesh, H, border);
     if (s >= 0 && volume && a.fix_boundary) {
         s = cm_mesh_boundary_create(ctx, mesh, &b);

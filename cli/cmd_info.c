@@ -139,9 +139,10 @@ static void print_correspondence(const cm_cad_model *g, const cm_cad_model *g2,
     for (int e = 0; e < c->counts.edges; ++e) emoved += c->edge[e] != e, eflip += c->edge_flipped[e];
     for (int v = 0; v < c->counts.vertices; ++v) vmoved += c->vertex[v] != v;
     printf("correspondence: %d of %d faces, %d of %d edges, %d of %d vertices numbered otherwise "
-           "in G'; %d edges run the other way, %d faces have the opposite surface normal\n",
+           "in G'; %d edges run the other way, %d of %d wires start elsewhere, %d faces have the "
+           "opposite surface normal\n",
            fmoved, c->counts.faces, emoved, c->counts.edges, vmoved, c->counts.vertices, eflip,
-           frev);
+           c->wires_restarted, c->counts.wires, frev);
     printf("type changes: %d faces, %d edges\n", c->face_type_changes, c->edge_type_changes);
     int shown = 0;
     for (int f = 0; f < c->counts.faces && shown < 20; ++f)
@@ -152,8 +153,8 @@ static void print_correspondence(const cm_cad_model *g, const cm_cad_model *g2,
         }
     for (int e = 0; e < c->counts.edges && shown < 40; ++e)
         if (c->edge[e] != e || c->edge_flipped[e] || strcmp(edge_type(g, e), edge_type(g2, c->edge[e]))) {
-            printf("  edge %d -> %s%d (%s -> %s)\n", e, c->edge_flipped[e] ? "-" : "", c->edge[e],
-                   edge_type(g, e), edge_type(g2, c->edge[e]));
+            printf("  edge %d -> %d%s (%s -> %s)\n", e, c->edge[e],
+                   c->edge_flipped[e] ? " reversed" : "", edge_type(g, e), edge_type(g2, c->edge[e]));
             ++shown;
         }
     if (shown >= 20) printf("  ... (--map OUT.csv lists all)\n");

@@ -141,52 +141,6 @@ int cli_constraints_option(int argc, char **argv, int *i, const char *cmd, const
     return 0;
 }
 
-/* A node-list file: header `node`, one 0-based index per line. */
-static cm_status read_nodes(cm_context *ctx, const char *path, size_t n, unsigned char *mark)
-{
-    char *data = NULL;
-    size_t size = 0;
-    cm_status s = cm_file_read(ctx, path, &data, &size);
-    if (s < 0) return s;
-    char *p = data;
-    long line = 0;
-    int header = 0;
-    while (p && *p) {
-        char *e = strchr(p, '\n');
-        if (e) *e = 0;
-        ++line;
-        size_t len = strlen(p);
-        while (len && (p[len - 1] == '\r' || p[len - 1] == ' ')) p[--len] = 0;
-        if (len) {
-            if (!header) {
-                if (strcmp(p, "node")) {
-                    s = cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: expected the header 'node'", path, line);
-                    break;
-                }
-                header = 1;
-            } else {
-                char *end;
-                errno = 0;
-                long long v = strtoll(p, &end, 10);
-                if (errno || *end || end == p) {
-                    s = cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: '%s' is not a node index", path, line, p);
-                    break;
-                }
-                if (v < 0 || (unsigned long long)v >= n) {
-                    s = cm_error(ctx, CM_ERR_MISMATCH, "%s:%ld: node %lld out of range (%zu nodes)",
-                                 path, line, v, n);
-                    break;
-                }
-                mark[v] = 1;
-            }
-        }
-        p = e ? e + 1 : NULL;
-    }
-    if (s >= 0 && !header) s = cm_error(ctx, CM_ERR_FORMAT, "%s: empty (expected the header 'node')", path);
-    free(data);
-    return s;
-}
-
 static void mark_cell(const cm_mesh *m, size_t c, unsigned char *mark)
 {
     if (m->type[c] == CM_CELL_POLYHEDRON) {
@@ -274,7 +228,7 @@ cm_status cli_constraints_resolve(cm_context *ctx, const cm_mesh *mesh, cli_cons
         memset(mark, 0, n ? n : 1);
         struct stat st;
         if (stat(c->set[t], &st) == 0 && S_ISREG(st.st_mode))
-            s = read_nodes(ctx, c->set[t], n, mark);
+            s = cm_mesh_read_node_list(ctx, c->set[t], n, mark);
         else
             s = mesh_set(ctx, mesh, c->set[t], mark);
         if (s < 0) break;

@@ -144,6 +144,8 @@ typedef struct cm_cad_correspondence {
     int *vertex;              /* #vertices */
     int renumbered;           /* faces, edges, vertices or wire starts numbered otherwise, or
                                  edges flipped: cm_cad_match renumbers G' */
+    int wires_restarted;      /* wires of G whose counterpart is another wire of the face or
+                                 starts at another edge */
     int face_type_changes;    /* faces whose surface type differs (plane -> bspline, ...) */
     int edge_type_changes;    /* edges whose curve type differs */
 } cm_cad_correspondence;

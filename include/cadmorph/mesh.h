@@ -241,6 +241,13 @@ CM_API cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh)
 CM_API cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
                                const cm_mesh_write_options *opt);
 
+/* A node list (the fixed region of `cadmorph deform`, a constraint set): the header `node`,
+ * then one 0-based node index per line; blank lines, trailing blanks and CRLF accepted. Sets
+ * mark[i] = 1 for every listed node i < n_nodes (mark is not cleared first). Errors name the
+ * file and line: a missing header, a token that is not an index, an index out of range. */
+CM_API cm_status cm_mesh_read_node_list(cm_context *ctx, const char *path, size_t n_nodes,
+                                        unsigned char *mark);
+
 /* ---- boundary and components (volume cells only: dim 3) ---- */
 
 typedef struct cm_mesh_boundary {

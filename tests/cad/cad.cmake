@@ -13,6 +13,10 @@ foreach(t model project sample boundary)
   cm_add_unit_test(test_cad_${t} test_cad_${t}.c LIBS cm_cad LABELS cad)
   set_tests_properties(test_cad_${t} PROPERTIES FIXTURES_REQUIRED cad_shapes)
 endforeach()
+# the correspondence of G and G' as graphs, and a morph onto a renumbered identical G'
+cm_add_unit_test(test_cad_correspond test_cad_correspond.c LIBS cm_morph cm_cad LABELS cad)
+set_tests_properties(test_cad_correspond PROPERTIES FIXTURES_REQUIRED cad_shapes
+                     FIXTURES_SETUP cad_part_mesh)
 
 # cadmorph info: exit codes and one-line messages on real files (bad input: one stderr line).
 function(cm_cad_cli name code regex)
@@ -35,4 +39,36 @@ cm_cad_cli(cad_cli_no_solid 2 "^cadmorph info: .*no solid, shell or face" info $
 cm_cad_cli(cad_cli_broken 2 "^cadmorph info: .*broken.step: " info ${D}/broken.step)
 cm_cad_cli(cad_cli_usage 1 "usage" info)
 cm_cad_cli(cad_cli_bad_unit 1 "unknown length unit" info ${D}/bore_a.step --cad-unit parsec)
+# --compare: the correspondence (renumbered, flipped edges, type changes) and --map
+cm_cad_cli(cad_cli_compare_renumbered 0 "corresponds to .*numbered otherwise.*\ncorrespondence: [1-9][0-9]* of 6 faces" info ${CM_CAD_WORK}/block.step --compare ${CM_CAD_WORK}/block_rebuilt.step --map ${CM_CAD_WORK}/block_map.csv)
+cm_cad_cli(cad_cli_compare_types 0 "type changes: 9 faces" info ${CM_CAD_WORK}/part.step --compare ${CM_CAD_WORK}/part_gtrsf.step)
+add_test(NAME cad_cli_compare_verbose_types COMMAND ${CM_RUN_CLI} --exit 0 --stderr "face 6: torus in G, bspline in G'" --
+         $<TARGET_FILE:cadmorph> info ${CM_CAD_WORK}/part.step --compare ${CM_CAD_WORK}/part_nurbs.step --verbose)
+set_tests_properties(cad_cli_compare_verbose_types PROPERTIES LABELS "cad;cli" FIXTURES_REQUIRED cad_shapes)
+cm_cad_cli(cad_cli_compare_part_hole 2 "^cadmorph info: .*face [0-9]+ \\(plane, 5 edges, 1 hole\\) has no counterpart: G' has a hole there" info ${CM_CAD_WORK}/part.step --compare ${CM_CAD_WORK}/part_hole.step)
+cm_cad_cli(cad_cli_map_needs_compare 1 "--map needs --compare" info ${CM_CAD_WORK}/part.step --map ${CM_CAD_WORK}/x.csv)
 
+add_test(NAME cad_cli_compare_map_csv COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/check_map.py
+         ${CM_CAD_WORK}/block_map.csv 6 12 8)
+set_tests_properties(cad_cli_compare_map_csv PROPERTIES LABELS "cad;cli" DEPENDS cad_cli_compare_renumbered)
+# cadmorph morph renumbers G' (a re-sewn, reordered copy of G) and says so under --verbose
+add_test(NAME cad_cli_morph_renumbered COMMAND ${CM_RUN_CLI} --exit 0
+         --stderr "correspondence: G' is numbered otherwise than G: renumbered"
+         --stdout "inverted=0 cells=[1-9]" --
+         $<TARGET_FILE:cadmorph> morph --from ${CM_CAD_WORK}/part.step --to ${CM_CAD_WORK}/part_renumbered.step
+         --mesh ${CM_CAD_WORK}/part_m.vtu -o ${CM_CAD_WORK}/part_renumbered_m.vtu --verbose)
+set_tests_properties(cad_cli_morph_renumbered PROPERTIES LABELS "cad;cli"
+                     FIXTURES_REQUIRED "cad_shapes;cad_part_mesh")
+# NurbsConvert changes the parameterisation only: the morph must leave every node in place
+# (the surface morph finds the identity as an affine map; a (u,v) warp alone slid face nodes
+# by 1 % of the diagonal along G')
+add_test(NAME cad_cli_morph_nurbs COMMAND $<TARGET_FILE:cadmorph> morph
+         --from ${CM_CAD_WORK}/part.step --to ${CM_CAD_WORK}/part_nurbs.step
+         --mesh ${CM_CAD_WORK}/part_m.vtu -o ${CM_CAD_WORK}/part_nurbs_m.vtu)
+set_tests_properties(cad_cli_morph_nurbs PROPERTIES LABELS "cad;cli"
+                     FIXTURES_REQUIRED "cad_shapes;cad_part_mesh" FIXTURES_SETUP cad_part_nurbs_m)
+add_test(NAME cad_cli_morph_nurbs_in_place COMMAND ${CM_PYTHON}
+         ${PROJECT_SOURCE_DIR}/tests/cli/compare_moved.py ${CM_CAD_WORK}/part_m.vtu
+         ${CM_CAD_WORK}/part_nurbs_m.vtu 1e-9 diagonal)
+set_tests_properties(cad_cli_morph_nurbs_in_place PROPERTIES LABELS "cad;cli"
+                     FIXTURES_REQUIRED cad_part_nurbs_m)

@@ -3,6 +3,27 @@
 // with N the outward normal, so the foot point, (u,v) and distance are known by construction).
 // Also writes the bad inputs the CLI must refuse. The assertions live in the C tests.
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_Copy.hxx>
+#include <BRepBuilderAPI_GTransform.hxx>
+#include <BRepBuilderAPI_MakeSolid.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepBuilderAPI_NurbsConvert.hxx>
+#include <BRepBuilderAPI_Sewing.hxx>
+#include <Geom_Plane.hxx>
+#include <Geom_ToroidalSurface.hxx>
+#include <gp_Circ.hxx>
+#include <BRepTools_WireExplorer.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRep_Tool.hxx>
+#include <ShapeCustom.hxx>
+#include <ShapeFix_Face.hxx>
+#include <ShapeFix_Solid.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
+#include <GeomAPI_PointsToBSpline.hxx>
+#include <Geom_BSplineCurve.hxx>
+#include <TColgp_Array1OfPnt.hxx>
+#include <TopoDS_Vertex.hxx>
+#include <gp_GTrsf.hxx>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -22,14 +43,17 @@
 #include <Standard_Failure.hxx>
 #include <TColgp_Array2OfPnt.hxx>
 #include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Shell.hxx>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
+#include <vector>
 
 static bool write_step(const TopoDS_Shape &s, const std::string &path)
 {
@@ -75,6 +99,160 @@ static bool write_points(const TopoDS_Shape &s, const std::string &path, int n, 
         ++i;
     }
     return fclose(f) == 0;
+}
+
+// The correspondence pairs (test_cad_correspond): a part with planes, a bore (cylinder) and a
+// toroidal groove, then the same part after edits and re-exports that keep its topology.
+static TopoDS_Shape grooved_part(bool extra_hole)
+{
+    TopoDS_Shape block = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 10, 8, 4).Shape();
+    TopoDS_Shape bore =
+        BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(5, 4, -1), gp_Dir(0, 0, 1)), 1.5, 6).Shape();
+    TopoDS_Shape groove =
+        BRepPrimAPI_MakeTorus(gp_Ax2(gp_Pnt(5, 4, 4), gp_Dir(0, 0, 1)), 2.7, 0.6).Shape();
+    TopoDS_Shape part = BRepAlgoAPI_Cut(BRepAlgoAPI_Cut(block, bore).Shape(), groove).Shape();
+    if (extra_hole) {
+        TopoDS_Shape hole =
+            BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(1.5, 1.5, -1), gp_Dir(0, 0, 1)), 0.5, 6).Shape();
+        part = BRepAlgoAPI_Cut(part, hole).Shape();
+    }
+    return part;
+}
+
+// A plate with a row of n equal holes, stretched by sx about its centre: in G' (sx = 2.5) the
+// outer holes are nearer to other holes of G than to their own, and only the numbering
+// (kept by the edit) places them.
+static TopoDS_Shape hole_row(int n, double sx)
+{
+    TopoDS_Shape s = BRepPrimAPI_MakeBox(gp_Pnt(5.0 * n * (1 - sx), 0, 0), 10.0 * n * sx, 10, 4).Shape();
+    for (int i = 0; i < n; ++i) {
+        gp_Pnt c(5.0 * n + (5 + 10 * i - 5.0 * n) * sx, 5, -1);
+        s = BRepAlgoAPI_Cut(s, BRepPrimAPI_MakeCylinder(gp_Ax2(c, gp_Dir(0, 0, 1)), 2, 6).Shape()).Shape();
+    }
+    return s;
+}
+
+// Non-uniform scale and shear (planes, cylinders and tori become B-splines).
+static TopoDS_Shape gtransformed(const TopoDS_Shape &s)
+{
+    gp_GTrsf t;
+    t.SetValue(1, 1, 1.3), t.SetValue(1, 2, 0.2), t.SetValue(1, 3, 0.1);
+    t.SetValue(2, 1, 0.0), t.SetValue(2, 2, 0.8), t.SetValue(2, 3, 0.15);
+    t.SetValue(3, 1, 0.05), t.SetValue(3, 2, 0.0), t.SetValue(3, 3, 1.1);
+    t.SetTranslationPart(gp_XYZ(0.5, -0.3, 0.2));
+    return BRepBuilderAPI_GTransform(s, t, true).Shape();
+}
+
+// The same solid with its faces in another order and its edges rebuilt by sewing: faces,
+// edges and vertices are numbered otherwise, edges may run the other way.
+static TopoDS_Shape renumbered(const TopoDS_Shape &s, unsigned seed)
+{
+    TopTools_IndexedMapOfShape faces;
+    TopExp::MapShapes(s, TopAbs_FACE, faces);
+    std::vector<int> order(faces.Extent());
+    for (int i = 0; i < faces.Extent(); ++i) order[i] = i + 1;
+    std::mt19937 rng(seed);
+    std::shuffle(order.begin(), order.end(), rng);
+    BRepBuilderAPI_Sewing sew(1e-6);
+    for (int i : order) sew.Add(BRepBuilderAPI_Copy(faces(i)).Shape());
+    sew.Perform();
+    TopoDS_Shape shell = sew.SewedShape();
+    TopoDS_Shell sh;
+    for (TopExp_Explorer x(shell, TopAbs_SHELL); x.More(); x.Next()) sh = TopoDS::Shell(x.Current());
+    BRepBuilderAPI_MakeSolid ms(sh);
+    ShapeFix_Solid fix(ms.Solid());
+    fix.Perform();
+    return fix.Solid();
+}
+
+// A polyhedron rebuilt from its faces' corner points, polygon by polygon in a shuffled order
+// and sewn: every edge is made anew along the first face that uses it, so some run against
+// the original's.
+static TopoDS_Shape rebuilt_polyhedron(const TopoDS_Shape &s, unsigned seed)
+{
+    TopTools_IndexedMapOfShape faces;
+    TopExp::MapShapes(s, TopAbs_FACE, faces);
+    std::vector<int> order(faces.Extent());
+    for (int i = 0; i < faces.Extent(); ++i) order[i] = i + 1;
+    std::mt19937 rng(seed);
+    std::shuffle(order.begin(), order.end(), rng);
+    BRepBuilderAPI_Sewing sew(1e-6);
+    for (int i : order) {
+        TopoDS_Face f = TopoDS::Face(faces(i));
+        BRepBuilderAPI_MakePolygon poly;
+        std::vector<gp_Pnt> pts;
+        for (BRepTools_WireExplorer e(BRepTools::OuterWire(f), f); e.More(); e.Next())
+            pts.push_back(BRep_Tool::Pnt(e.CurrentVertex()));
+        // start the polygon elsewhere than the original wire
+        std::rotate(pts.begin(), pts.begin() + (i % pts.size()), pts.end());
+        for (const gp_Pnt &p : pts) poly.Add(p);
+        poly.Close();
+        sew.Add(BRepBuilderAPI_MakeFace(poly.Wire(), true).Face());
+    }
+    sew.Perform();
+    TopoDS_Shell sh;
+    for (TopExp_Explorer x(sew.SewedShape(), TopAbs_SHELL); x.More(); x.Next())
+        sh = TopoDS::Shell(x.Current());
+    ShapeFix_Solid fix(BRepBuilderAPI_MakeSolid(sh).Solid());
+    fix.Perform();
+    return fix.Solid();
+}
+
+// A B-spline face bounded by curves that lie 2e-5 off its surface, pcurves by projection (as
+// OpenCASCADE builds them for industrial STEP files without pcurves): the face's boundary is
+// only known to the edges' tolerance.
+static TopoDS_Shape loose_bspline_face(const Handle(Geom_BSplineSurface) & bs)
+{
+    double u0, u1, v0, v1;
+    bs->Bounds(u0, u1, v0, v1);
+    const double du = 0.1 * (u1 - u0), dv = 0.1 * (v1 - v0);
+    // a rectangle inside the surface's box, in uv, run counter-clockwise
+    const double cu[5] = {u0 + du, u1 - du, u1 - du, u0 + du, u0 + du};
+    const double cv[5] = {v0 + dv, v0 + dv, v1 - dv, v1 - dv, v0 + dv};
+    BRepBuilderAPI_MakeWire mw;
+    std::vector<TopoDS_Vertex> corner;
+    for (int k = 0; k < 4; ++k)
+        corner.push_back(BRepBuilderAPI_MakeVertex(bs->Value(cu[k], cv[k]).Translated(gp_Vec(0, 0, 2e-5))));
+    for (int k = 0; k < 4; ++k) {
+        TColgp_Array1OfPnt pts(1, 12);
+        for (int i = 1; i <= 12; ++i) {
+            double a = (i - 1) / 11.0;
+            gp_Pnt p = bs->Value(cu[k] + a * (cu[k + 1] - cu[k]), cv[k] + a * (cv[k + 1] - cv[k]));
+            pts(i) = p.Translated(gp_Vec(0, 0, 2e-5));
+        }
+        Handle(Geom_BSplineCurve) c = GeomAPI_PointsToBSpline(pts, 3, 8, GeomAbs_C2, 1e-9).Curve();
+        mw.Add(BRepBuilderAPI_MakeEdge(c, corner[k], corner[(k + 1) % 4]).Edge());
+    }
+    TopoDS_Face f = BRepBuilderAPI_MakeFace(bs, mw.Wire(), true).Face();
+    ShapeFix_Face fix(f);
+    fix.Perform();
+    TopoDS_Shell shell;
+    BRep_Builder bb;
+    bb.MakeShell(shell);
+    bb.Add(shell, fix.Face());
+    return shell;
+}
+
+// A spindle torus (minor radius 2 > major radius 1) closed by the plane z = -1.2: the
+// apple-shaped outer part of the torus (v from -asin 0.6 to 2 pi / 3, where it meets the
+// axis), sewn to a disc.
+static TopoDS_Shape spindle_part()
+{
+    Handle(Geom_ToroidalSurface) t = new Geom_ToroidalSurface(gp_Ax3(gp::Origin(), gp::DZ()), 1.0, 2.0);
+    TopoDS_Face side = BRepBuilderAPI_MakeFace(t, 0, 2 * M_PI, -std::asin(0.6), 2 * M_PI / 3, 1e-7).Face();
+    Handle(Geom_Plane) pl = new Geom_Plane(gp_Ax3(gp_Pnt(0, 0, -1.2), gp::DZ()));
+    TopoDS_Edge rim = BRepBuilderAPI_MakeEdge(gp_Circ(gp_Ax2(gp_Pnt(0, 0, -1.2), gp::DZ()), 2.6)).Edge();
+    TopoDS_Face disc = BRepBuilderAPI_MakeFace(pl, BRepBuilderAPI_MakeWire(rim).Wire()).Face();
+    BRepBuilderAPI_Sewing sew(1e-6);
+    sew.Add(side);
+    sew.Add(disc);
+    sew.Perform();
+    TopoDS_Shell sh;
+    for (TopExp_Explorer x(sew.SewedShape(), TopAbs_SHELL); x.More(); x.Next())
+        sh = TopoDS::Shell(x.Current());
+    ShapeFix_Solid fix(BRepBuilderAPI_MakeSolid(sh).Solid());
+    fix.Perform();
+    return fix.Solid();
 }
 
 int main(int argc, char **argv)
@@ -129,6 +307,27 @@ int main(int argc, char **argv)
                 return 1;
             }
         }
+        TopoDS_Shape part = grooved_part(false);
+        const struct {
+            const char *name;
+            TopoDS_Shape s;
+        } pairs[] = {{"part", part},
+                     {"part_hole", grooved_part(true)},
+                     {"part_gtrsf", gtransformed(part)},
+                     {"part_nurbs", BRepBuilderAPI_NurbsConvert(part, true).Shape()},
+                     {"part_renumbered", renumbered(part, 7)},
+                     {"part_revolution", ShapeCustom::ConvertToRevolution(part)},
+                     {"block", block},
+                     {"block_rebuilt", rebuilt_polyhedron(block, 3)},
+                     {"spindle", spindle_part()},
+                     {"loose_bspline", loose_bspline_face(bs)},
+                     {"row_a", hole_row(6, 1.0)},
+                     {"row_b", hole_row(6, 2.5)}};
+        for (auto &p : pairs)
+            if (!write_step(p.s, dir + "/" + p.name + ".step")) {
+                fprintf(stderr, "gen_shapes: cannot write %s\n", p.name);
+                return 1;
+            }
         // bad inputs: a STEP with only an edge (no solid, shell or face), a text file
         TopoDS_Shape edge = BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(1, 2, 3)).Shape();
         if (!write_step(edge, dir + "/edge_only.step")) return 1;

@@ -5,6 +5,7 @@
 #include "cadmorph/cad.h"
 #include "test_util.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -210,6 +211,62 @@ static void run_gmsh(cm_context *ctx, const char *data, const char *name)
     cm_cad_destroy(&m);
 }
 
+/* A B-spline face whose boundary curves lie 2e-5 off its surface (gen_shapes: pcurves by
+ * projection, tolerances up to ~1e-4, as in industrial STEP files): points of the surface just
+ * beyond the trimming curve, within the edges' tolerance, are on the face; their distance is
+ * that of the final Newton projection (~1e-16), not the gap to the edge curves. Points well
+ * beyond the tolerance keep their true distance to the trimmed face. */
+static void run_loose(cm_context *ctx, const char *work)
+{
+    char path[2048];
+    snprintf(path, sizeof path, "%s/cad/loose_bspline.step", work);
+    cm_cad_model *m = NULL;
+    cm_cad_locator *loc = NULL;
+    CHECK(cm_cad_read(ctx, path, NULL, &m) == CM_OK);
+    if (!m) return;
+    cm_cad_sample_options so;
+    cm_cad_sample_options_init(&so);
+    CHECK(cm_cad_locator_create(ctx, m, &so, &loc) >= 0);
+    cm_cad_boundary *b = NULL;
+    CHECK(cm_cad_face_boundary(ctx, m, 0, NULL, 40, &b) == CM_OK);
+    cm_cad_face_info fi;
+    CHECK(cm_cad_face_get_info(ctx, m, 0, &fi) == CM_OK);
+    if (!loc || !b) goto done;
+    const double cu = 0.5 * (fi.uv_range[0] + fi.uv_range[1]), cv = 0.5 * (fi.uv_range[2] + fi.uv_range[3]);
+    const double shifts[2] = {1e-6, 0.02}; /* x the parameter range, outward */
+    for (int k = 0; k < 2; ++k) {
+        size_t n = b->n;
+        double *uv = malloc(2 * n * sizeof *uv), *xyz = malloc(3 * n * sizeof *xyz);
+        double *d = malloc(n * sizeof *d), *dp = malloc(n * sizeof *dp);
+        for (size_t i = 0; uv && i < n; ++i) {
+            /* outward, across the nearer side of the rectangle of pcurves */
+            double u = b->uv[2 * i], v = b->uv[2 * i + 1];
+            double ru = (u - cu) / (fi.uv_range[1] - fi.uv_range[0]), rv = (v - cv) / (fi.uv_range[3] - fi.uv_range[2]);
+            if (fabs(ru) >= fabs(rv))
+                u += (ru > 0 ? 1 : -1) * shifts[k] * (fi.uv_range[1] - fi.uv_range[0]);
+            else
+                v += (rv > 0 ? 1 : -1) * shifts[k] * (fi.uv_range[3] - fi.uv_range[2]);
+            uv[2 * i] = u, uv[2 * i + 1] = v;
+        }
+        CHECK(cm_cad_face_eval(ctx, m, 0, uv, n, xyz, NULL) == CM_OK);
+        CHECK(cm_cad_locate_faces(ctx, loc, xyz, n, NULL, NULL, d, NULL) == CM_OK);
+        CHECK(cm_cad_project_face(ctx, m, 0, xyz, n, uv, NULL, dp, NULL) == CM_OK);
+        double worst = 0, least = INFINITY;
+        for (size_t i = 0; i < n; ++i) worst = fmax(worst, fmax(d[i], dp[i])), least = fmin(least, fmin(d[i], dp[i]));
+        printf("loose_bspline: %zu surface points %g x range beyond the trimming: distance %.3g .. %.3g\n",
+               n, shifts[k], least, worst);
+        if (k == 0)
+            CHECK_MSG(worst <= 1e-12, "within tolerance of the boundary: reported %g", worst);
+        else
+            CHECK_MSG(least > 1e-3, "beyond the tolerance: reported %g", least);
+        free(uv), free(xyz), free(d), free(dp);
+    }
+done:
+    cm_cad_boundary_destroy(&b);
+    cm_cad_locator_destroy(&loc);
+    cm_cad_destroy(&m);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) return 2;
@@ -219,6 +276,7 @@ int main(int argc, char **argv)
     run_gmsh(ctx, argv[1], "bore_b");
     const char *names[] = {"box", "cylinder", "sphere", "torus", "holed", "bspline"};
     for (size_t i = 0; i < sizeof names / sizeof *names; ++i) run(ctx, argv[2], names[i]);
+    run_loose(ctx, argv[2]);
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }
