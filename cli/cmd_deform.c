@@ -25,8 +25,9 @@ static void print_help(void)
 {
     printf("usage: %s\n\n", usage_line);
     printf(
-        "Deforms the mesh M (a surface mesh of triangles/quads, or a volume mesh; .msh .vtu\n"
-        ".vtk .mesh, surfaces also .obj .off .stl) by moving the handle nodes of H.csv, keeping the fixed nodes in place and\n"
+        "Deforms the mesh M (a surface mesh of triangles/quads, or a volume mesh;\n"
+        "%s;\n"
+        ".obj .off .stl are surfaces) by moving the handle nodes of H.csv, keeping the fixed nodes in place and\n"
         "letting every other node follow a space deformation. Writes M' with a per-node\n"
         "'displacement' field; surfaces also get 'mean_curvature' (H = |lap x|/2, cotangent\n"
         "Laplacian) and a mean-curvature summary, volume meshes the quality summary line.\n\n"
@@ -57,7 +58,8 @@ static void print_help(void)
         "                            the field's\n"
         "  -o, --output M'           output mesh (must not be an input)\n"
         "  --threads N               threads (default: all)\n"
-        "  --verbose                 timings and debug messages on stderr\n");
+        "  --verbose                 timings and debug messages on stderr\n",
+        cm_mesh_format_list());
     cli_constraints_help();
     printf("\nexit codes: 0 done, 1 usage, 2 bad input.\n");
 }

@@ -59,7 +59,8 @@ static int print_help(void)
     printf(
         "Free-form deformation: every node x of the mesh M inside the lattice moves by\n"
         "d(x) = sum_p dc_p N_p(u(x)); nodes outside it do not move (d = 0 exactly, counted).\n"
-        "Writes M1 (.msh .vtu .vtk .mesh) with per-node 'displacement' (and per-cell\n"
+        "Writes M1 (%s)\n"
+        "with per-node 'displacement' (and per-cell\n"
         "'scaled_jacobian'), prints the node counts, then the quality summary line.\n\n"
         "The lattice: a PyGeM parameter file (.prm) - [Box info] n control points, box length,\n"
         "box origin, rotation angle (degrees) per axis; [Parameters weights] lines 'i j k mu'.\n"
@@ -76,7 +77,8 @@ static int print_help(void)
         "  - displacement form: zero weights leave every node bit for bit where it was (PyGeM's\n"
         "    two least-squares affine fits move them by ~1e-15);\n"
         "  - a missing .prm file is an error (PyGeM writes a default one there).\n\n"
-        "options:\n");
+        "options:\n",
+        cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed .prm or CSV, a lattice that is not\n"
            "invertible).\n");

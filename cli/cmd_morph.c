@@ -15,7 +15,8 @@ static const char *const usage_line =
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] "
     "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB --blend B] "
     "[--steps auto [--min-sj F] [--keep-partial] [--no-escalate]] [--optimize] [--report R.csv] "
-    "[--fail-on-inverted] [--cad-unit U] [--threads N] [--verbose]";
+    "[--fail-on-inverted] [--cad-unit U] [--cad-tol F [--keep-offset]] [--off-cad refuse|fixed] "
+    "[--threads N] [--verbose]";
 
 #define MORPH_MAX_VIA 256
 
@@ -70,6 +71,9 @@ static int parse_steps(const cli_parser *p, const cli_option *o, const char *v, 
 
 static const char *const surface_names[] = {"rbf", "project", NULL};
 static const int surface_methods[] = {CM_SURFACE_RBF, CM_SURFACE_PROJECT};
+
+static const char *const off_cad_names[] = {"refuse", "fixed", NULL};
+static const int off_cad_values[] = {CM_OFF_CAD_REFUSE, CM_OFF_CAD_FIXED};
 
 static int print_help(void);
 
@@ -151,6 +155,20 @@ static const cli_option options[] = {
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &args.unit, .label = "--cad-unit U",
      .help = "unit of the mesh coordinates: the STEP files are converted to\n"
              "it (mm default; cm m in ft um ...)"},
+    {.name = "--cad-tol", .kind = CLI_DOUBLE, .dest = &args.opt.classify.rel_tol, .lo = 0,
+     .hi = 1, .open = 1, .bad = "%s: expected a number in (0, 1], got '%s'", .label = "--cad-tol F",
+     .help = "a boundary node is on G0 within F x its shortest boundary edge\n"
+             "(default 1e-6; a snapped mesh, e.g. snappyHexMesh's, needs more)"},
+    {.name = "--keep-offset", .kind = CLI_FLAG, .dest = &args.opt.keep_offset,
+     .label = "--keep-offset",
+     .help = "boundary nodes keep their offset from G0 (move as their point on\n"
+             "G0 does) instead of landing on G1: for a mesh snapped near G0"},
+    {.name = "--off-cad", .kind = CLI_ENUM, .dest = &args.opt.off_cad, .names = off_cad_names,
+     .values = off_cad_values, .bad = "%.0sexpected refuse or fixed, got '%s'",
+     .label = "--off-cad P",
+     .help = "boundary nodes not on G0: refuse (default: not a mesh of G0) or\n"
+             "fixed (kept where they are, e.g. a wind tunnel around the body;\n"
+             "only whole boundary components off G0, some node must be on it)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads,
      .bad = "%s: expected a positive integer, got '%s'", .label = "--threads N",
      .help = "threads (default: all)"},
@@ -166,9 +184,11 @@ static int print_help(void)
         "boundary nodes on CAD vertices go to the matching vertex, nodes on edges keep their\n"
         "arc length, nodes on faces are moved in the face's (u,v) by a 2D thin-plate RBF fitted\n"
         "on the face boundaries; the interior follows by an RBF space warp per component.\n"
-        "Writes M1 (.msh .vtu .vtk .mesh) with per-node 'displacement' and per-cell\n"
-        "'scaled_jacobian', then prints the quality summary line.\n\n"
-        "options:\n");
+        "Writes M1 with per-node 'displacement' and per-cell 'scaled_jacobian' (a polyMesh:\n"
+        "its points only), then prints the quality summary line. Mesh formats (M0 and M1):\n"
+        "  %s.\n\n"
+        "options:\n",
+        cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
            "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted or no\n"
@@ -290,9 +310,12 @@ int cli_cmd_morph(int argc, char **argv)
         if (s < 0) rc = cli_fail(ctx, "morph", s);
     }
     if (writer && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED)) {
-        printf("boundary nodes: %zu on vertices, %zu on edges, %zu on faces; "
-               "largest distance to G1: %.3g (%.3g x diagonal)\n",
-               r->counts[0], r->counts[1], r->counts[2], r->max_dist,
+        printf("boundary nodes: %zu on vertices, %zu on edges, %zu on faces; ", r->counts[0],
+               r->counts[1], r->counts[2]);
+        if (r->off_cad_nodes)
+            printf("%zu off G0 kept fixed (%zu boundary components); ", r->off_cad_nodes,
+                   r->off_cad_components);
+        printf("largest distance to G1: %.3g (%.3g x diagonal)\n", r->max_dist,
                r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
         s = cli_print_quality(ctx, r->mesh, r->sj, stdout, NULL);
         if (s < 0 && rc == CLI_EXIT_OK) rc = cli_fail(ctx, "morph", s);

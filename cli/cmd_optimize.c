@@ -42,10 +42,12 @@ static int print_help(void)
            "the worst ones, node by node (Knupp's inverse mean ratio of the corner Jacobians,\n"
            "regularised so that inverted corners can recover); a move that would lower the\n"
            "worst cell around a node is not made. Boundary nodes, and the nodes of cells other\n"
-           "than linear tets, hexes, wedges and pyramids, never move. Writes OUT (.msh .vtu .vtk\n"
-           ".mesh) with per-cell 'scaled_jacobian' and per-node 'displacement', prints the\n"
+           "than linear tets, hexes, wedges and pyramids, never move. Writes OUT\n"
+           "(%s)\n"
+           "with per-cell 'scaled_jacobian' and per-node 'displacement', prints the\n"
            "quality before and after and ends with the summary line of the result.\n\n"
-           "options:\n");
+           "options:\n",
+           cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input, 3 inverted cells remain.\n");
     return CLI_EXIT_OK;

@@ -78,12 +78,14 @@ static int print_help(void)
         "Moves the nodes of the volume mesh M0 by the displacements of D.csv and carries the\n"
         "boundary motion into the interior with an RBF space warp (phi = r^3 by default, plus a\n"
         "linear polynomial), one per connected component of volume cells. Writes M1 (format by\n"
-        "extension: .msh .vtu .vtk .mesh) with per-node 'displacement' and per-cell\n"
+        "its name: %s)\n"
+        "with per-node 'displacement' and per-cell\n"
         "'scaled_jacobian', then prints the quality summary line.\n\n"
         "D.csv: header node,dx,dy,dz; node is the 0-based index of the node in M0's file order.\n"
         "  Boundary nodes that are not listed stay where they are;\n"
         "  listed interior nodes are pinned to their displacement.\n\n"
-        "options:\n");
+        "options:\n",
+        cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed file, degenerate boundary).\n");
     return CLI_EXIT_OK;

@@ -12,6 +12,7 @@ void cm_classify_options_init(cm_classify_options *opt)
 {
     opt->rel_tol = 1e-6;
     opt->abs_tol = 1e-9;
+    opt->keep_off = 0;
 }
 
 void cm_surface_nodes_destroy(cm_surface_nodes **p)
@@ -25,6 +26,8 @@ void cm_surface_nodes_destroy(cm_surface_nodes **p)
     free(s->param);
     free(s->dist);
     free(s->h);
+    free(s->off);
+    free(s->off_dist);
     free(s);
     *p = NULL;
 }
@@ -182,6 +185,40 @@ static void take(cm_surface_nodes *s, const size_t *rest, size_t nr, const doubl
     }
 }
 
+/* keep_off: the nodes still unclassified after the face pass (rest[0..nr), their face
+ * distances in dist) move to s->off / s->off_dist, and the classified ones close up (the order,
+ * ascending node, is kept). */
+static cm_status set_aside_off(cm_context *ctx, cm_surface_nodes *s, const size_t *rest,
+                               size_t nr, const double *dist, size_t off)
+{
+    s->off = malloc(off * sizeof *s->off);
+    s->off_dist = malloc(off * sizeof *s->off_dist);
+    if (!s->off || !s->off_dist)
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_surface_classify: out of memory");
+    size_t k = 0;
+    for (size_t j = 0; j < nr; ++j) /* rest is ascending in i, so off is ascending in node */
+        if (s->kind[rest[j]] == 255) {
+            s->off[k] = s->node[rest[j]];
+            s->off_dist[k++] = dist[j];
+        }
+    s->n_off = off;
+    size_t m = 0;
+    for (size_t i = 0; i < s->n; ++i) {
+        if (s->kind[i] == 255) continue;
+        s->node[m] = s->node[i];
+        memcpy(s->xyz + 3 * m, s->xyz + 3 * i, 3 * sizeof *s->xyz);
+        s->kind[m] = s->kind[i];
+        s->entity[m] = s->entity[i];
+        s->param[2 * m] = s->param[2 * i];
+        s->param[2 * m + 1] = s->param[2 * i + 1];
+        s->dist[m] = s->dist[i];
+        s->h[m] = s->h[i];
+        ++m;
+    }
+    s->n = m;
+    return CM_OK;
+}
+
 cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_cad_locator *locator,
                               const cm_mesh *mesh, const cm_mesh_boundary *b,
                               const cm_classify_options *opt, cm_surface_nodes **out)
@@ -244,7 +281,10 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
                     ++off;
                     if (dist[j] > wd) wd = dist[j], worst = rest[j];
                 }
-            if (off) {
+            if (off && o.keep_off && off < n) {
+                st = set_aside_off(ctx, s, rest, nr, dist, off);
+                if (st < 0) goto done;
+            } else if (off) {
                 char hint[192];
                 unit_hint(s, g, hint, sizeof hint);
                 st = cm_error(ctx, CM_ERR_MISMATCH,
@@ -255,6 +295,7 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
                 goto done;
             }
         }
+        if (pass == 2) break; /* every node classified or set aside (rest is stale) */
         size_t k = 0;
         for (size_t j = 0; j < nr; ++j)
             if (s->kind[rest[j]] == 255) rest[k++] = rest[j];
@@ -263,7 +304,7 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
     cm_progress(ctx, "classify", 3, 3);
     st = edge_arc_lengths(ctx, g, s);
     if (st < 0) goto done;
-    for (size_t i = 0; i < n; ++i) {
+    for (size_t i = 0; i < s->n; ++i) {
         if (s->kind[i] == CM_SURFACE_ON_VERTEX) s->param[2 * i] = s->param[2 * i + 1] = 0;
         s->count[s->kind[i]]++;
         if (s->dist[i] > s->max_dist) s->max_dist = s->dist[i];

@@ -100,6 +100,8 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
         const cm_morpher_info *in = cm_morpher_get_info(mp);
         memcpy(r->counts, in->counts, sizeof r->counts);
         r->h = in->h;
+        r->off_cad_nodes = in->off_cad_nodes;
+        r->off_cad_components = in->off_cad_components;
         xyz = malloc(3 * (mesh->n_nodes ? mesh->n_nodes : 1) * sizeof *xyz);
         if (!xyz) s = cm_error(ctx, CM_ERR_NOMEM, "cm_morph_run: out of memory");
     }

@@ -3,6 +3,8 @@
  * by a warp (section 3) whose factorisation depends only on M, kept per method. */
 #include "cadmorph/morph.h"
 
+#include "off_cad.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -35,6 +37,7 @@ struct cm_morpher {
     double *bnew;  /* #boundary x 3: the surface morph's positions on the target */
     double *bxyz;  /* #boundary x 3: the positions of the current increment */
     double *next;  /* #nodes x 3: the step being tried */
+    double *offset; /* keep_offset: #boundary x 3, each node minus its point on g */
     unsigned char *fixed; /* #nodes: the boundary nodes, which optimisation never moves */
     double min_sj0;       /* M's minimum scaled Jacobian (keep_fraction) */
     cm_morph_step *rows;  /* the last apply's steps */
@@ -62,6 +65,7 @@ void cm_morph_options_init(cm_morph_options *opt)
     cm_optimize_options_init(&opt->optimize_options);
     cm_classify_options_init(&opt->classify);
     cm_surface_morph_options_init(&opt->morph);
+    opt->off_cad = CM_OFF_CAD_REFUSE;
 }
 
 /* Warnings found before the mesh is known to lie on G are held back: a mesh in the wrong unit
@@ -94,6 +98,30 @@ static cm_status make_locator(cm_context *ctx, const cm_morpher *mp, const cm_ca
     return cm_cad_locator_create(ctx, g, &so, loc);
 }
 
+/* keep_offset: the surface morph of g onto itself puts every node on its point of g (the same
+ * parameters, evaluated): the offsets are the nodes minus those points. */
+static cm_status node_offsets(cm_context *ctx, cm_morpher *mp)
+{
+    const cm_surface_nodes *nd = mp->nodes;
+    free(mp->offset);
+    mp->offset = malloc(3 * (nd->n ? nd->n : 1) * sizeof *mp->offset);
+    if (!mp->offset) return cm_error(ctx, CM_ERR_NOMEM, "cm_morpher: out of memory for offsets");
+    cm_surface_morph_options mo = mp->opt.morph;
+    mo.method = mp->opt.method.surface;
+    cm_surface_morph_stats st;
+    memset(&st, 0, sizeof st);
+    cm_status s = cm_surface_morph(ctx, mp->g, mp->g, nd, &mo, mp->offset, &st);
+    if (s < 0) return cm_error_prefix(ctx, s, "the nodes' points on G (--keep-offset)");
+    double worst = 0;
+    for (size_t i = 0; i < 3 * nd->n; ++i) {
+        mp->offset[i] = nd->xyz[i] - mp->offset[i];
+        if (fabs(mp->offset[i]) > worst) worst = fabs(mp->offset[i]);
+    }
+    cm_log(ctx, CM_LOG_DEBUG, "keep-offset: largest offset component of a boundary node %.3g",
+           worst);
+    return CM_OK;
+}
+
 /* Samples g (once h is known) and classifies the boundary of mp->mesh on it. */
 static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
 {
@@ -107,11 +135,32 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
     }
     double t1 = cm_wtime();
     cm_surface_nodes_destroy(&mp->nodes);
+    mp->opt.classify.keep_off = mp->opt.off_cad == CM_OFF_CAD_FIXED;
     s = cm_surface_classify(ctx, mp->g, mp->loc, mp->mesh, mp->b, &mp->opt.classify, &mp->nodes);
+    if (s == CM_ERR_MISMATCH && mp->opt.off_cad == CM_OFF_CAD_REFUSE) {
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", cm_context_message(ctx));
+        return cm_error(ctx, s,
+                        "%s; if the rest of the boundary is not part of the model (a wind "
+                        "tunnel around the body), --off-cad fixed keeps it in place",
+                        msg);
+    }
     if (s < 0) return s;
+    s = cm_morph_off_cad_check(ctx, mp->mesh, mp->b, mp->nodes, &mp->info.off_cad_components);
+    if (s < 0) return s;
+    mp->info.off_cad_nodes = mp->nodes->n_off;
+    if (mp->nodes->n_off)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "classify: %zu of %zu boundary nodes are off the CAD model, in %zu boundary "
+               "components of their own: kept fixed (--off-cad fixed)",
+               mp->nodes->n_off, mp->b->n_nodes, mp->info.off_cad_components);
     for (int k = 0; k < 3; ++k)
         mp->info.counts[k] = mp->nodes->count[k];
     mp->info.class_dist = mp->nodes->max_dist;
+    if (mp->opt.keep_offset) {
+        s = node_offsets(ctx, mp);
+        if (s < 0) return s;
+    }
     double bb[6];
     cm_cad_bbox(mp->g, bb);
     mp->info.diagonal = cm_bbox_diagonal(bb);
@@ -147,6 +196,7 @@ void cm_morpher_destroy(cm_morpher **morpher)
     free(mp->bnew);
     free(mp->bxyz);
     free(mp->next);
+    free(mp->offset);
     free(mp->fixed);
     free(mp->rows);
     free(mp);
@@ -205,7 +255,7 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
         mp->min_sj0 = q0.min;
     mp->info.nodes = nn;
     mp->info.cells = cm_mesh_count_dim(mp->mesh, 3);
-    mp->info.boundary_nodes = nb;
+    mp->info.boundary_nodes = mp->b->n_nodes; /* on G (nb) and off it */
     mp->info.components = mp->b->n_components;
     *morpher = mp;
     return release(ctx, &held);
@@ -322,9 +372,12 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     if (s < 0) return s;
     for (size_t i = 0; i < 3 * nn; ++i)
         xyz[i] = from[i] + mp->disp[i];
-    /* boundary nodes exactly where they were sent (no round-off from the increments) */
+    /* boundary nodes exactly where they were sent (no round-off from the increments), those
+     * off G exactly where they were (the warp's residual there is not zero) */
     for (size_t i = 0; i < nd->n; ++i)
         memcpy(xyz + 3 * nd->node[i], mp->bxyz + 3 * i, 3 * sizeof(double));
+    for (size_t i = 0; i < nd->n_off; ++i)
+        memcpy(xyz + 3 * nd->off[i], mp->mesh->xyz + 3 * nd->off[i], 3 * sizeof(double));
     memcpy(mp->work->xyz, xyz, 3 * nn * sizeof *xyz);
     if (optimize) {
         cm_optimize_stats st;
@@ -492,6 +545,9 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     memset(&mp->surface, 0, sizeof mp->surface);
     s = cm_surface_morph(ctx, mp->g, target, mp->nodes, &mo, mp->bnew, &mp->surface);
     if (s < 0) return s;
+    if (mp->opt.keep_offset)
+        for (size_t i = 0; i < 3 * mp->nodes->n; ++i)
+            mp->bnew[i] += mp->offset[i];
     double t_surface = cm_wtime() - t0;
     char warning[1024] = "";
     if (s == CM_WARNING) {

@@ -39,6 +39,15 @@ typedef struct cm_morph_method {
 
 CM_API void cm_morph_method_init(cm_morph_method *m);
 
+/* Boundary nodes that are not on G (cm_morph_options.off_cad). */
+typedef enum cm_off_cad {
+    CM_OFF_CAD_REFUSE = 0, /* default: a mesh with such nodes is not a mesh of G (MISMATCH) */
+    /* such nodes stay where they are (e.g. the wind tunnel around a body in a CFD mesh), when
+     * they form whole boundary components of their own (connected through boundary faces);
+     * a component partly on G and partly off it, or no node on G at all, is still refused */
+    CM_OFF_CAD_FIXED = 1
+} cm_off_cad;
+
 /* steps = CM_MORPH_STEPS_AUTO: adaptive steps (see cm_morph_options). */
 #define CM_MORPH_STEPS_AUTO 0
 
@@ -73,8 +82,14 @@ typedef struct cm_morph_options {
      * would cost more than the morph itself. A rebase onto a target sampled coarser samples
      * it again at the classification h. */
     double target_h_scale;
-    cm_classify_options classify;
+    cm_classify_options classify; /* its keep_off is set from off_cad */
     cm_surface_morph_options morph; /* its method field is replaced by method.surface */
+    cm_off_cad off_cad;             /* default CM_OFF_CAD_REFUSE */
+    /* 1: each boundary node keeps its offset from G (its position minus its point on G, as
+     * classified): it moves by how its point on G moves, so a mesh snapped near G (e.g. by
+     * snappyHexMesh onto an STL of G, classified with a loose classify.rel_tol) keeps its
+     * cells, and G' = G changes nothing. 0 (default): the boundary lands on G'. */
+    int keep_offset;
 } cm_morph_options;
 
 CM_API void cm_morph_options_init(cm_morph_options *opt);
@@ -110,11 +125,13 @@ typedef struct cm_morpher_info {
     double class_dist; /* largest distance of a boundary node to its entity of G */
     double diagonal;   /* bbox diagonal of G */
     double t_sample, t_classify;
+    size_t off_cad_nodes;      /* boundary nodes off G kept fixed (CM_OFF_CAD_FIXED) */
+    size_t off_cad_components; /* the boundary components they form */
 } cm_morpher_info;
 
 /* g: the geometry M lies on; mesh: M (copied). Errors: CM_ERR_UNSUPPORTED for a mesh without
  * volume cells, CM_ERR_MISMATCH when M is not a mesh of G (cm_surface_classify's message,
- * prefixed), CM_ERR_FORMAT when every boundary edge has zero length. Returns CM_WARNING
+ * prefixed; with CM_OFF_CAD_FIXED: no node on G, or a boundary component partly on it), CM_ERR_FORMAT when every boundary edge has zero length. Returns CM_WARNING
  * (after logging it) when the sampling hit its cap. opt may be NULL. */
 CM_API cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mesh *mesh,
                             const cm_morph_options *opt, cm_morpher **morpher);
@@ -168,6 +185,7 @@ typedef struct cm_morph_result {
     double max_dist; /* largest distance of the final boundary nodes to G' */
     double diagonal; /* bbox diagonal of G' (for relative tolerances) */
     double h;        /* sampling h actually used on G */
+    size_t off_cad_nodes, off_cad_components; /* kept fixed off G (CM_OFF_CAD_FIXED) */
 } cm_morph_result;
 
 /* Reads G (g0_path), G' (g1_path) and M, checks that they correspond, and morphs M onto G'.

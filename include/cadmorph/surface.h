@@ -29,6 +29,10 @@ typedef struct cm_classify_options {
      *   rel_tol x (shortest boundary edge at the node) + abs_tol x (model bbox diagonal).
      * Defaults 1e-6 and 1e-9. */
     double rel_tol, abs_tol;
+    /* 0 (default): a node off G is an error. 1: nodes off G are left out of the result and
+     * listed in its `off` (a mesh whose boundary is partly not on G, e.g. a wind tunnel
+     * around a body); it is still an error when no node is on G. */
+    int keep_off;
 } cm_classify_options;
 
 CM_API void cm_classify_options_init(cm_classify_options *opt);
@@ -45,6 +49,9 @@ typedef struct cm_surface_nodes {
     double *h;           /* n: shortest boundary edge at the node */
     size_t count[3];     /* nodes per kind */
     double max_dist;     /* largest dist */
+    size_t n_off;        /* with keep_off: boundary nodes off G (not among the n above) */
+    int64_t *off;        /* n_off: their mesh node indices, ascending */
+    double *off_dist;    /* n_off: their distance to G */
 } cm_surface_nodes;
 
 /* Shortest boundary-face edge at each boundary node: h_node (b->n_nodes, in the order of
@@ -54,7 +61,8 @@ CM_API cm_status cm_surface_edge_lengths(cm_context *ctx, const cm_mesh *mesh,
                                          const cm_mesh_boundary *b, double *h_node, double *h_min);
 
 /* Classifies the boundary nodes of b: vertex if within tolerance of a CAD vertex, else edge
- * if within tolerance of an edge (t from the projection, s its arc length), else face (u,v).
+ * if within tolerance of an edge (t from the projection, s its arc length), else face (u,v);
+ * with opt->keep_off the nodes off G are set aside in (n_off, off) instead of failing.
  * locator: built on g (its h about a quarter of the shortest boundary edge). A node farther
  * than the tolerance from every face is CM_ERR_MISMATCH; the message gives their count, the
  * worst distance and node, and suggests a unit mismatch when the mesh and model sizes differ
