@@ -49,6 +49,27 @@ cm_mesh_format cm_mesh_format_from_path(const char *path)
     return cm_foam_is_path(path) ? CM_FORMAT_FOAM : format_of_extension(path);
 }
 
+cm_status cm_mesh_read_whole(cm_context *ctx, const char *fn, const char *path,
+                             cm_mesh_parse_fn parse, cm_mesh **mesh)
+{
+    if (!mesh || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL argument", fn);
+    *mesh = NULL;
+    char *data = NULL;
+    size_t size = 0;
+    cm_status s = cm_file_read(ctx, path, &data, &size);
+    if (s != CM_OK) return s;
+    cm_mesh *m = NULL;
+    s = cm_mesh_create(ctx, &m);
+    if (s == CM_OK) s = parse(ctx, path, data, size, m);
+    free(data);
+    if (s != CM_OK) {
+        cm_mesh_destroy(&m);
+        return s;
+    }
+    *mesh = m;
+    return CM_OK;
+}
+
 const char *cm_mesh_format_list(void)
 {
     return ".msh .vtu .vtk .mesh .obj .off .stl, or an OpenFOAM case directory";

@@ -182,26 +182,17 @@ static cm_status read_body(cm_context *ctx, cm_text *t, cm_mesh *m)
     return s;
 }
 
-cm_status cm_mesh_read_medit(cm_context *ctx, const char *path, cm_mesh **mesh)
+static cm_status parse_medit(cm_context *ctx, const char *path, const char *data, size_t size,
+                             cm_mesh *m)
 {
-    if (!mesh || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_read_medit: NULL argument");
-    *mesh = NULL;
-    char *data = NULL;
-    size_t size = 0;
-    cm_status s = cm_file_read(ctx, path, &data, &size);
-    if (s != CM_OK) return s;
     cm_text t;
     cm_text_init(&t, path, data, size);
-    cm_mesh *m = NULL;
-    s = cm_mesh_create(ctx, &m);
-    if (s == CM_OK) s = read_body(ctx, &t, m);
-    free(data);
-    if (s != CM_OK) {
-        cm_mesh_destroy(&m);
-        return s;
-    }
-    *mesh = m;
-    return CM_OK;
+    return read_body(ctx, &t, m);
+}
+
+cm_status cm_mesh_read_medit(cm_context *ctx, const char *path, cm_mesh **mesh)
+{
+    return cm_mesh_read_whole(ctx, "cm_mesh_read_medit", path, parse_medit, mesh);
 }
 
 cm_status cm_mesh_write_medit(cm_context *ctx, const cm_mesh *mesh, const char *path,

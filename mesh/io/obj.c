@@ -165,22 +165,7 @@ static cm_status read_obj(cm_context *ctx, const char *path, const char *data, s
 
 cm_status cm_mesh_read_obj(cm_context *ctx, const char *path, cm_mesh **mesh)
 {
-    if (!mesh || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_read_obj: NULL argument");
-    *mesh = NULL;
-    char *data = NULL;
-    size_t size = 0;
-    cm_status s = cm_file_read(ctx, path, &data, &size);
-    if (s != CM_OK) return s;
-    cm_mesh *m = NULL;
-    s = cm_mesh_create(ctx, &m);
-    if (s == CM_OK) s = read_obj(ctx, path, data, size, m);
-    free(data);
-    if (s != CM_OK) {
-        cm_mesh_destroy(&m);
-        return s;
-    }
-    *mesh = m;
-    return CM_OK;
+    return cm_mesh_read_whole(ctx, "cm_mesh_read_obj", path, read_obj, mesh);
 }
 
 cm_status cm_mesh_write_obj(cm_context *ctx, const cm_mesh *mesh, const char *path,

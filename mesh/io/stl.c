@@ -224,36 +224,24 @@ static cm_status read_ascii(cm_context *ctx, cm_text *t, cm_mesh *m)
     return s;
 }
 
-cm_status cm_mesh_read_stl(cm_context *ctx, const char *path, cm_mesh **mesh)
+/* Binary if the size matches its count (binary headers may start with "solid" too). */
+static cm_status parse_stl(cm_context *ctx, const char *path, const char *data, size_t size,
+                           cm_mesh *m)
 {
-    if (!mesh || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_read_stl: NULL argument");
-    *mesh = NULL;
-    char *data = NULL;
-    size_t size = 0;
-    cm_status s = cm_file_read(ctx, path, &data, &size);
-    if (s != CM_OK) return s;
-    cm_mesh *m = NULL;
-    s = cm_mesh_create(ctx, &m);
-    /* binary if the size matches its count (binary headers may start with "solid" too) */
     const unsigned char *d = (const unsigned char *)data;
     size_t lead = 0;
     while (lead < size && (data[lead] == ' ' || data[lead] == '\t' || data[lead] == '\r' || data[lead] == '\n')) ++lead;
     int binary = size >= 84 && 84 + 50 * (uint64_t)le32(d + 80) == size;
     int ascii = !binary && size - lead >= 5 && !memcmp(data + lead, "solid", 5);
-    if (s == CM_OK && ascii) {
-        cm_text t;
-        cm_text_init(&t, path, data, size);
-        s = read_ascii(ctx, &t, m);
-    } else if (s == CM_OK) {
-        s = read_binary(ctx, path, d, size, m);
-    }
-    free(data);
-    if (s != CM_OK) {
-        cm_mesh_destroy(&m);
-        return s;
-    }
-    *mesh = m;
-    return CM_OK;
+    if (!ascii) return read_binary(ctx, path, d, size, m);
+    cm_text t;
+    cm_text_init(&t, path, data, size);
+    return read_ascii(ctx, &t, m);
+}
+
+cm_status cm_mesh_read_stl(cm_context *ctx, const char *path, cm_mesh **mesh)
+{
+    return cm_mesh_read_whole(ctx, "cm_mesh_read_stl", path, parse_stl, mesh);
 }
 
 static void put_le32(unsigned char *p, uint32_t u)

@@ -454,27 +454,18 @@ static cm_status read_body(legacy_reader *r, cm_mesh *mesh)
     return s;
 }
 
-cm_status cm_mesh_read_vtk(cm_context *ctx, const char *path, cm_mesh **mesh)
+static cm_status parse_vtk(cm_context *ctx, const char *path, const char *data, size_t size,
+                           cm_mesh *m)
 {
-    if (!mesh || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_read_vtk: NULL argument");
-    *mesh = NULL;
-    char *data = NULL;
-    size_t size = 0;
-    cm_status s = cm_file_read(ctx, path, &data, &size);
-    if (s != CM_OK) return s;
     legacy_reader r;
     memset(&r, 0, sizeof r);
     r.ctx = ctx;
     r.path = path;
     cm_text_init(&r.t, path, data, size);
-    cm_mesh *m = NULL;
-    s = cm_mesh_create(ctx, &m);
-    if (s == CM_OK) s = read_body(&r, m);
-    free(data);
-    if (s != CM_OK) {
-        cm_mesh_destroy(&m);
-        return s;
-    }
-    *mesh = m;
-    return CM_OK;
+    return read_body(&r, m);
+}
+
+cm_status cm_mesh_read_vtk(cm_context *ctx, const char *path, cm_mesh **mesh)
+{
+    return cm_mesh_read_whole(ctx, "cm_mesh_read_vtk", path, parse_vtk, mesh);
 }
