@@ -21,7 +21,7 @@ static const cli_command commands[] = {
     {"demo", cli_cmd_demo, "the embedded example: bore model, tet mesh, 10-step absolute sweep"},
     {"quality", cli_cmd_quality, "scaled Jacobian report of a mesh; --foam: OpenFOAM checkMesh's metrics"},
     {"deform", cli_cmd_deform, "handle-based deformation of a surface or volume mesh (RBF, MLS, DM-FFD, shell)"},
-    {"warp", cli_cmd_warp, "move interior nodes by a warp (RBF, FEMWARP, LBWARP, simplex, DM-FFD, MLS) of boundary displacements"},
+    {"warp", cli_cmd_warp, "move interior nodes by a warp of boundary displacements (RBF, FEMWARP, DM-FFD, ...)"},
     {"ffd", cli_cmd_ffd, "free-form deformation of a mesh by a control lattice (PyGeM .prm accepted)"},
     {"detect", cli_cmd_detect, "planes, cylinders, spheres, cones of a surface mesh (efficient RANSAC)"},
     {"mesh", cli_cmd_mesh, "tet mesh of a STEP solid (gmsh by default, or TetGen)"},
