@@ -6,7 +6,7 @@ and by `cadmorph quality --foam`: worst aspect ratio, non-orthogonality, skewnes
 oriented face pyramids, pass/fail by checkMesh's thresholds (aspect 1000, non-orthogonality
 70 degrees, skewness 4, no wrong pyramids). Also read/morph/write CPU times and peak memory of
 the polyMesh against the same mesh as .vtu.
-usage: morph_table.py CADMORPH CASE WORKDIR [--lift D]"""
+usage: morph_table.py CADMORPH CASE WORKDIR [--lift D] [--handles-only]"""
 import argparse
 import math
 import os
@@ -21,6 +21,7 @@ ap.add_argument("cadmorph")
 ap.add_argument("case")
 ap.add_argument("work")
 ap.add_argument("--lift", type=float, default=0.03)
+ap.add_argument("--handles-only", action="store_true", help="write handles.csv and fixed.csv only")
 a = ap.parse_args()
 ENV = dict(os.environ)
 ENV.setdefault("WM_PROJECT_DIR", "/usr/share/openfoam")
@@ -82,6 +83,8 @@ with open(H, "w") as f:
     f.write("node,dx,dy,dz\n" + "".join("%d,0,0,%.17g\n" % (i, d) for i, d in sorted(handles.items())))
 with open(F, "w") as f:
     f.write("node\n" + "".join("%d\n" % i for i in sorted(fixed)))
+if a.handles_only:
+    sys.exit(0)
 
 
 NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"

@@ -6,3 +6,8 @@ cm_add_unit_test(test_foam_io test_foam_io.c LIBS cm_mesh ZLIB::ZLIB LABELS foam
 add_test(NAME test_foam_crosscheck
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_foam_crosscheck.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
 set_tests_properties(test_foam_crosscheck PROPERTIES LABELS "foam;cli" SKIP_RETURN_CODE 77 TIMEOUT 300)
+# The polyhedral morph test at ~52k cells (benchmarks/foam/make_case.py; RBF roof warp and the
+# CAD-driven morph, checkMesh against quality --foam).
+add_test(NAME test_foam_car
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_foam_car.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
+set_tests_properties(test_foam_car PROPERTIES LABELS "foam;cli;slow" SKIP_RETURN_CODE 77 TIMEOUT 600)

@@ -19,7 +19,8 @@ import re
 import shutil
 import subprocess
 import sys
-import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 CADMORPH, WORK = sys.argv[1], os.path.join(sys.argv[2], "foam_cross")
 TOOLS = ["blockMesh", "snappyHexMesh", "checkMesh"]
@@ -32,23 +33,10 @@ ENV = dict(os.environ)
 # WM_PROJECT_DIR (no bashrc needs sourcing).
 if "WM_PROJECT_DIR" not in ENV:
     ENV["WM_PROJECT_DIR"] = "/usr/share/openfoam"
-failures = []
-foam_seconds = 0.0
+from foam_compare import FoamCompare, metrics  # noqa: E402  (this folder: shared with test_foam_car.py)
 
-
-def check(cond, msg):
-    if not cond:
-        failures.append(msg)
-        print("FAIL:", msg)
-
-
-def run(cmd, cwd=None, foam=False):
-    global foam_seconds
-    t = time.time()
-    p = subprocess.run(cmd, cwd=cwd, env=ENV, capture_output=True, text=True)
-    if foam:
-        foam_seconds += time.time() - t
-    return p
+FC = FoamCompare(CADMORPH, ENV)
+check, run, compare, failures = FC.check, FC.run, FC.compare, FC.failures
 
 
 HEADER = "FoamFile { version 2.0; format ascii; class dictionary; object %s; }\n"
@@ -85,80 +73,6 @@ def write_system(case, binary=False, compress=False):
                 "interpolationSchemes { default linear; } snGradSchemes { default corrected; }\n")
     with open(os.path.join(d, "fvSolution"), "w") as f:
         f.write(HEADER % "fvSolution")
-
-
-NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-
-
-def metrics(text):
-    """The numbers of checkMesh's mesh stats and geometry block, by name (same parser for
-    checkMesh's output and cadmorph's, which prints the same layout)."""
-    out = {}
-    for key in ["points", "faces", "internal faces", "cells", "boundary patches"]:
-        m = re.search(r"^\s+%s:\s+(%s)" % (key, NUM), text, re.M)
-        if m:
-            out[key] = m.group(1)
-    geo = text[text.find("Checking geometry..."):]
-    pats = {
-        "bbox": r"bounding box \((%s) (%s) (%s)\) \((%s) (%s) (%s)\)" % ((NUM,) * 6),
-        "boundary openness": r"Boundary openness \((%s) (%s) (%s)\)" % ((NUM,) * 3),
-        "max cell openness": r"Max cell openness = (%s)" % NUM,
-        "max aspect ratio": r"Max aspect ratio = (%s)" % NUM,
-        "face area": r"Minimum face area = (%s)\. Maximum face area = (%s)\." % (NUM, NUM),
-        "volume": r"Min volume = (%s)\. Max volume = (%s)\.  Total volume = (%s)\." % (NUM, NUM, NUM),
-        "non-orthogonality": r"Mesh non-orthogonality Max: (%s) average: (%s)" % (NUM, NUM),
-        "severe non-orthogonal faces": r"severely non-orthogonal \(> 70 degrees\) faces: (%s)" % NUM,
-        "max skewness": r"Max skewness = (%s)" % NUM,
-        "wrong pyramids": r"Error in face pyramids: (%s) faces" % NUM,
-        "failed checks": r"Failed (%s) mesh checks" % NUM,
-    }
-    for k, p in pats.items():
-        m = re.search(p, geo)
-        if m:
-            out[k] = m.groups()
-    out["pyramids OK"] = "Face pyramids OK." in geo
-    out["mesh OK"] = "\nMesh OK." in geo
-    return out
-
-
-def same_number(a, b):
-    if a == b:
-        return True
-    x, y = float(a), float(b)
-    if abs(x) < 1e-10 and abs(y) < 1e-10:  # round-off noise: summation order differs
-        return abs(x - y) < 1e-12
-    return False
-
-
-def compare(name, case):
-    p = run(["checkMesh", "-case", case], foam=True)
-    check(p.returncode == 0, "%s: checkMesh exit %d" % (name, p.returncode))
-    q = run([CADMORPH, "quality", case, "--foam"])
-    check(q.returncode == 0, "%s: cadmorph quality --foam exit %d: %s" % (name, q.returncode, q.stderr))
-    ref, ours = metrics(p.stdout), metrics(q.stdout)
-    check(len(ref) >= 14, "%s: parsed only %s from checkMesh" % (name, sorted(ref)))
-    n = 0
-    for k, v in ref.items():
-        if k not in ours:
-            check(False, "%s: cadmorph lacks '%s' (checkMesh: %s)" % (name, k, v))
-            continue
-        w = ours[k]
-        vs, ws = (v if isinstance(v, tuple) else (v,)), (w if isinstance(w, tuple) else (w,))
-        for a, b in zip(vs, ws):
-            if isinstance(a, bool):
-                check(a == b, "%s: %s: checkMesh %s, cadmorph %s" % (name, k, a, b))
-            else:
-                check(same_number(a, b), "%s: %s: checkMesh %s, cadmorph %s" % (name, k, a, b))
-            n += 1
-    for k in ours:
-        if k not in ref and k not in ("pyramids OK", "mesh OK"):
-            check(False, "%s: cadmorph reports '%s' = %s, checkMesh does not" % (name, k, ours[k]))
-    line = [l for l in q.stdout.splitlines() if l.startswith("max_aspect_ratio=")]
-    check(len(line) == 1, "%s: no summary line" % name)
-    print("%-10s %3d values equal to checkMesh's: non-orth max %s avg %s, skewness %s, aspect %s"
-          % (name, n, ref.get("non-orthogonality", ("-", "-"))[0], ref.get("non-orthogonality", ("-", "-"))[1],
-             ref.get("max skewness", ("-",))[0], ref.get("max aspect ratio", ("-",))[0]))
-    return ref, ours
 
 
 os.makedirs(WORK, exist_ok=True)
@@ -349,8 +263,8 @@ os.remove(os.path.join(bad, "constant", "polyMesh", "owner"))
 b = run([CADMORPH, "quality", bad, "--foam"])
 check(b.returncode == 2 and "polyMesh/owner" in b.stderr, "broken case: exit %d, %s" % (b.returncode, b.stderr))
 
-print("OpenFOAM tools ran %.1f s in total" % foam_seconds)
-check(foam_seconds < 60, "OpenFOAM runs took %.1f s (budget 60 s)" % foam_seconds)
+print("OpenFOAM tools ran %.1f s in total" % FC.foam_seconds)
+check(FC.foam_seconds < 60, "OpenFOAM runs took %.1f s (budget 60 s)" % FC.foam_seconds)
 if failures:
     print("%d failures" % len(failures))
     sys.exit(1)
