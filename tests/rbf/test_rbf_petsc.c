@@ -3,72 +3,12 @@
  * the preconditioner reused for a second right-hand side, the errors it must give.
  * usage: test_rbf_petsc DATA WORK K (K: the ranks mpirun was asked for, checked). */
 #include "cadmorph/rbf.h"
+#include "rbf_test_sets.h"
 #include "test_util.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* The box-with-bore boundary set of test_rbf_iterative.c (flat faces, a curved face, sharp
- * edges, as on a tet mesh of bore_a.step), spaced about h. Returns the count. */
-static size_t box_with_bore(double a, double b, double c, double xc, double yc, double rad,
-                            double h, double *x)
-{
-    size_t n = 0;
-    const int na = (int)(a / h + 0.5), nb = (int)(b / h + 0.5), nz = (int)(c / h + 0.5);
-#define PUT(px, py, pz)                                                                         \
-    do {                                                                                       \
-        if (x) {                                                                               \
-            x[3 * n] = (px);                                                                   \
-            x[3 * n + 1] = (py);                                                               \
-            x[3 * n + 2] = (pz);                                                               \
-        }                                                                                      \
-        ++n;                                                                                   \
-    } while (0)
-    for (int i = 0; i <= na; ++i)
-        for (int j = 0; j <= nb; ++j) {
-            double px = a * i / na, py = b * j / nb;
-            if (hypot(px - xc, py - yc) < rad + 0.3 * h) continue;
-            PUT(px, py, 0.0);
-            PUT(px, py, c);
-        }
-    for (int k = 1; k < nz; ++k) {
-        double pz = c * k / nz;
-        for (int i = 0; i <= na; ++i) {
-            PUT(a * i / na, 0.0, pz);
-            PUT(a * i / na, b, pz);
-        }
-        for (int j = 1; j < nb; ++j) {
-            PUT(0.0, b * j / nb, pz);
-            PUT(a, b * j / nb, pz);
-        }
-    }
-    const int nt = (int)(6.283185307179586 * rad / h + 0.5);
-    for (int k = 0; k <= nz; ++k)
-        for (int t = 0; t < nt; ++t) {
-            double th = 6.283185307179586 * (t + 0.5 * (k % 2)) / nt;
-            PUT(xc + rad * cos(th), yc + rad * sin(th), c * k / nz);
-        }
-#undef PUT
-    return n;
-}
-
-static double range_of(size_t n, const double *v)
-{
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < n; ++i) {
-        lo = fmin(lo, v[i]);
-        hi = fmax(hi, v[i]);
-    }
-    return hi - lo;
-}
-
-static double max_diff(size_t n, const double *a, const double *b)
-{
-    double v = 0.0;
-    for (size_t i = 0; i < n; ++i) v = fmax(v, fabs(a[i] - b[i]));
-    return v;
-}
 
 int main(int argc, char **argv)
 {
@@ -84,13 +24,13 @@ int main(int argc, char **argv)
     CHECK_MSG(size == want_ranks, "%d ranks, expected %d", size, want_ranks);
 
     /* m ~ 5k boundary nodes, the bore's kind of motion, points inside */
-    const double h = 0.076;
-    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, NULL);
+    const double h = 0.076, no_offset[3] = {0, 0, 0};
+    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, no_offset, NULL);
     const size_t nin = 3000, np = m + nin;
     double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
     double *p = malloc(np * 3 * sizeof *p);
     double *ss = malloc(np * 3 * sizeof *ss), *sp = malloc(np * 3 * sizeof *sp);
-    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, x);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, no_offset, x);
     for (size_t i = 0; i < m; ++i) {
         const double *y = x + 3 * i;
         double dx = y[0] - 2.0, dy = y[1] - 1.0, r = hypot(dx, dy) + 1e-12;

@@ -1,0 +1,71 @@
+/* Boundary point sets shared by the iterative and the distributed RBF tests (header-only,
+ * like test_mesh.h). */
+#ifndef CADMORPH_TEST_RBF_SETS_H
+#define CADMORPH_TEST_RBF_SETS_H
+
+#include <math.h>
+#include <stddef.h>
+
+/* Boundary nodes of a box [0,a] x [0,b] x [0,c] with a bore of radius rad along z through
+ * (xc, yc), spaced about h, shifted by off: the kind of set a tet mesh of bore_a.step has
+ * (flat faces, a curved face, sharp edges). Returns the count written into x (n x 3). */
+static size_t box_with_bore(double a, double b, double c, double xc, double yc, double rad,
+                            double h, const double *off, double *x)
+{
+    size_t n = 0;
+    const int na = (int)(a / h + 0.5), nb = (int)(b / h + 0.5), nz = (int)(c / h + 0.5);
+#define PUT(px, py, pz)                                                                         \
+    do {                                                                                       \
+        if (x) {                                                                               \
+            x[3 * n] = (px) + off[0];                                                          \
+            x[3 * n + 1] = (py) + off[1];                                                      \
+            x[3 * n + 2] = (pz) + off[2];                                                      \
+        }                                                                                      \
+        ++n;                                                                                   \
+    } while (0)
+    for (int i = 0; i <= na; ++i)
+        for (int j = 0; j <= nb; ++j) {
+            double px = a * i / na, py = b * j / nb;
+            if (hypot(px - xc, py - yc) < rad + 0.3 * h) continue; /* the hole */
+            PUT(px, py, 0.0);
+            PUT(px, py, c);
+        }
+    for (int k = 1; k < nz; ++k) {
+        double pz = c * k / nz;
+        for (int i = 0; i <= na; ++i) {
+            PUT(a * i / na, 0.0, pz);
+            PUT(a * i / na, b, pz);
+        }
+        for (int j = 1; j < nb; ++j) {
+            PUT(0.0, b * j / nb, pz);
+            PUT(a, b * j / nb, pz);
+        }
+    }
+    const int nt = (int)(6.283185307179586 * rad / h + 0.5);
+    for (int k = 0; k <= nz; ++k)
+        for (int t = 0; t < nt; ++t) {
+            double th = 6.283185307179586 * (t + 0.5 * (k % 2)) / nt;
+            PUT(xc + rad * cos(th), yc + rad * sin(th), c * k / nz);
+        }
+#undef PUT
+    return n;
+}
+
+static double range_of(size_t n, const double *v)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < n; ++i) {
+        lo = fmin(lo, v[i]);
+        hi = fmax(hi, v[i]);
+    }
+    return hi - lo;
+}
+
+static double max_diff(size_t n, const double *a, const double *b)
+{
+    double v = 0.0;
+    for (size_t i = 0; i < n; ++i) v = fmax(v, fabs(a[i] - b[i]));
+    return v;
+}
+
+#endif
