@@ -11,22 +11,10 @@ import gmsh
 import meshio
 from scipy.optimize import least_squares
 
-cad, work = sys.argv[1], os.path.join(sys.argv[3], "cad_constraints_cli")
-os.makedirs(work, exist_ok=True)
-os.chdir(work)
-fails = 0
+from cli_case import CliCase
 
-
-def check(cond, what):
-    global fails
-    if not cond:
-        fails += 1
-        print("FAILED:", what)
-
-
-def run(*args):
-    p = subprocess.run([cad, "deform", *args], capture_output=True, text=True)
-    return p.returncode, p.stdout, p.stderr
+case = CliCase("cad_constraints_cli", "deform")
+cad, work, check, run = case.cad, case.work, case.check, case.run
 
 
 gmsh.initialize()
@@ -120,5 +108,4 @@ rc, out, err = run(*base, "--constraints-from-cad", "missing.step", "-o", "x.vtu
 check(rc == 2, "missing STEP: %d %s" % (rc, err))
 check(not os.path.exists("x.vtu"), "no output after failures")
 
-print("%d passed, %d failed" % (1 if fails == 0 else 0, fails))
-sys.exit(1 if fails else 0)
+case.finish()

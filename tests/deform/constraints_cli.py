@@ -9,22 +9,10 @@ import numpy as np
 import gmsh
 import meshio
 
-cad, work = sys.argv[1], os.path.join(sys.argv[3], "constraints_cli")
-os.makedirs(work, exist_ok=True)
-os.chdir(work)
-fails = 0
+from cli_case import CliCase
 
-
-def check(cond, what):
-    global fails
-    if not cond:
-        fails += 1
-        print("FAILED:", what)
-
-
-def run(*args):
-    p = subprocess.run([cad, "deform", *args], capture_output=True, text=True)
-    return p.returncode, p.stdout, p.stderr
+case = CliCase("constraints_cli", "deform")
+cad, work, check, run = case.cad, case.work, case.check, case.run
 
 
 # the block [0,2]x[0,1]x[0,1] with a bore of radius 0.25 along z at (1, 0.5)
@@ -222,5 +210,4 @@ check(rc == 1 and "1..64" in err, "anderson 0: %d %s" % (rc, err))
 rc, out, err = run("--help")
 check(rc == 0 and "--constraint TYPE:SET" in out, "help")
 
-print("%d passed, %d failed" % (1 if fails == 0 else 0, fails))
-sys.exit(1 if fails else 0)
+case.finish()

@@ -7,20 +7,10 @@ import os, re, subprocess, sys
 import numpy as np
 import meshio
 
-cad, work = sys.argv[1], os.path.join(sys.argv[3], "deform_cli")
-os.makedirs(work, exist_ok=True)
-os.chdir(work)
-fails = 0
+from cli_case import CliCase
 
-def check(cond, what):
-    global fails
-    if not cond:
-        fails += 1
-        print("FAILED:", what)
-
-def run(*args):
-    p = subprocess.run([cad, "deform", *args], capture_output=True, text=True)
-    return p.returncode, p.stdout, p.stderr
+case = CliCase("deform_cli", "deform")
+cad, work, check, run = case.cad, case.work, case.check, case.run
 
 # plate: 21 x 21 vertices, quads; handle: the centre 3 x 3, lifted 0.1; the border fixed
 n = 21
@@ -241,5 +231,4 @@ for args, code, msg in (
     check(rc == code and re.search(msg, err), "%s: exit %d (want %d), %s" % (args, rc, code, err))
 rc, out, err = run("--help")
 check(rc == 0 and "usage: cadmorph deform" in out, "--help")
-print("deform_cli: %d failures" % fails)
-sys.exit(1 if fails else 0)
+case.finish()

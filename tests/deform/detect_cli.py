@@ -12,22 +12,10 @@ import numpy as np
 import gmsh
 import meshio
 
-cad, work = sys.argv[1], os.path.join(sys.argv[3], "detect_cli")
-os.makedirs(work, exist_ok=True)
-os.chdir(work)
-fails = 0
+from cli_case import CliCase
 
-
-def check(cond, what):
-    global fails
-    if not cond:
-        fails += 1
-        print("FAILED:", what)
-
-
-def run(*args):
-    p = subprocess.run([cad, "detect", *args], capture_output=True, text=True)
-    return p.returncode, p.stdout, p.stderr
+case = CliCase("detect_cli", "detect")
+cad, work, check, run = case.cad, case.work, case.check, case.run
 
 
 def build(name, make, size, dim=2):
@@ -141,5 +129,4 @@ check(rc == 2 and not os.path.exists("x.csv"), "missing mesh: %d %s" % (rc, err)
 rc, out, err = run("--help")
 check(rc == 0 and "Schnabel" in out, "help")
 
-print("%d passed, %d failed" % (1 if fails == 0 else 0, fails))
-sys.exit(1 if fails else 0)
+case.finish()
