@@ -12,6 +12,7 @@
  * iteration counts here are small, so the extra orthogonalisation is cheap. The components
  * of the data run in lock step, so one kernel-sum pass serves up to four of them. */
 #include "rbf_internal.h"
+#include "rbf_treecode.h"
 
 #include <cblas.h>
 #include <float.h>
@@ -25,9 +26,31 @@
  * error of a whole solve, observed, stays within this factor of that estimate. */
 #define CM_RBF_FLOOR_SLACK 10.0
 
+/* fast_sum = -1 (auto): treecode matvecs from this many centres, evaluation from this many
+ * point-centre pairs (RESULTS.md, "Fast summation": the treecode at fast_tol 1e-12 overtakes
+ * compensated direct sums near 3e4 centres on this machine kind). */
+#define CM_RBF_FAST_MIN_M 40000
+#define CM_RBF_FAST_EVAL_PAIRS 2e9
+/* an inner (fast-matvec) solve of a refinement step aims for this reduction of its own
+ * right-hand side, or the final tolerance if that is nearer: the treecode's operator
+ * differs from A by about fast_tol x (sum |w| phi / |A w|), 1e-8..1e-5 on real sets, so
+ * going further in one step would only polish the wrong operator */
+#define CM_RBF_REFINE_GAIN 1e-7
+/* samples for the a-posteriori error estimate of a fast evaluation, and the factor on the
+ * largest sampled error (the sampled max was within it of the true max on the real sets) */
+#define CM_RBF_FAST_SAMPLES 256
+#define CM_RBF_FAST_SAFETY 4.0
+
 struct cm_rbf_iter {
     cm_rbf_schwarz *pc;
     double *q1; /* m x k col-major, orthonormal basis of the polynomials at the centres */
+    cm_rbf_tree *tree; /* treecode on the centres, for the order below (NULL: none yet) */
+    int tree_order;
+    double tree_theta;
+    double fmax;       /* max |data| of the last solve: the scale of fast_eval_tol */
+    int eval_fast;     /* the last evaluation's choice and estimate (evaluation gets a
+                        * const cm_rbf, the iterative state is where it can leave them) */
+    double eval_error;
 };
 
 void cm_rbf_options_init(cm_rbf_options *opt)
@@ -46,6 +69,10 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->coarse_max = 8000;
     opt->overlap = 3.0;
     opt->local_max = 2800;
+    opt->fast_sum = -1;
+    opt->fast_tol = 1e-12;
+    opt->fast_refine = 3;
+    opt->fast_eval_tol = 1e-9;
 }
 
 void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
@@ -56,6 +83,10 @@ void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
         return;
     }
     *stats = rbf->stats;
+    if (rbf->iter) {
+        stats->eval_fast = rbf->iter->eval_fast;
+        stats->eval_error = rbf->iter->eval_error;
+    }
 }
 
 /* Cost model for AUTO, CPU seconds measured by benchmarks/bench_rbf_iterative on this
@@ -89,6 +120,7 @@ void cm_rbf_iterative_destroy(cm_rbf_iter **it)
 {
     if (!it || !*it) return;
     cm_rbf_schwarz_destroy(&(*it)->pc);
+    cm_rbf_tree_destroy(&(*it)->tree);
     free((*it)->q1);
     free(*it);
     *it = NULL;
@@ -103,14 +135,18 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
                         "cm_rbf_create: the iterative solver handles the 3D r^3 kernel only");
     if (!(o->tolerance > 0.0) || o->max_iterations < 1 || o->restart < 2 || o->leaf_size < 8 ||
         o->local_size < o->leaf_size || o->coarse_size < 0 || o->coarse_post < 0 ||
-        o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0)
+        o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0 ||
+        o->fast_sum < -1 || o->fast_sum > 1 || !(o->fast_tol > 0.0 && o->fast_tol <= 1e-3) ||
+        o->fast_refine < 0 || o->fast_refine > 10 || !(o->fast_eval_tol > 0.0))
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
                         "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "
-                        "%d, overlap %g, local_max %d, coarse_max %d)",
+                        "%d, overlap %g, local_max %d, coarse_max %d, fast_sum %d, fast_tol %g, "
+                        "fast_refine %d, fast_eval_tol %g)",
                         o->tolerance, o->max_iterations, o->restart, o->leaf_size,
                         o->local_size, o->coarse_size, o->coarse_post, o->overlap, o->local_max,
-                        o->coarse_max);
+                        o->coarse_max, o->fast_sum, o->fast_tol, o->fast_refine,
+                        o->fast_eval_tol);
     cm_rbf_iter *it = calloc(1, sizeof *it);
     if (!it) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     it->q1 = malloc(m * k * sizeof *it->q1);
@@ -141,9 +177,81 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
  * then reproduce the data at the centres only to eps sum |w_j phi_ij| (bracket, m = 59k:
  * 1e-7 of the range, although the residual is 6e-11). The dense path keeps plain sums: its
  * callers at m <= 7,500 do not see that floor, and it is 2.4x faster. */
+/* The treecode on the centres for (order, theta), made on first use and kept. */
+static cm_rbf_tree *tree_for(const cm_rbf *r, int order, double theta)
+{
+    cm_rbf_iter *it = r->iter;
+    if (it->tree && it->tree_order == order && it->tree_theta == theta) return it->tree;
+    cm_rbf_tree_destroy(&it->tree);
+    it->tree = cm_rbf_tree_create(r->m, r->c, order, theta);
+    it->tree_order = order;
+    it->tree_theta = theta;
+    return it->tree;
+}
+
+/* Evaluation by the treecode if its error can be shown to be within fast_eval_tol x max
+ * |data|: the order is chosen from sum_j |w_j| phi_ij at a few of the points (the scale of
+ * its bound, which the cancellation of the weights makes 1e4..1e7 x the result), then the
+ * fast result is checked against compensated direct sums at CM_RBF_FAST_SAMPLES points.
+ * 1 if out holds the accepted fast result; 0 (out undefined) if direct sums must do it. */
+static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads)
+{
+    cm_rbf_iter *it = r->iter;
+    const size_t m = r->m, nc = (size_t)r->ncomp;
+    const double target = r->opt.fast_eval_tol * it->fmax;
+    it->eval_fast = 0;
+    it->eval_error = 0.0;
+    if (!(target > 0.0)) return 0;
+    const size_t ns = n < 64 ? n : 64;
+    double *sp = malloc(3 * ns * sizeof *sp), *aw = malloc(nc * m * sizeof *aw);
+    double *ab = malloc(ns * nc * sizeof *ab);
+    int ok = sp && aw && ab;
+    double smax = 0.0;
+    if (ok) {
+        for (size_t k = 0; k < ns; ++k)
+            for (int d = 0; d < 3; ++d)
+                sp[(size_t)d * ns + k] = p[(size_t)d * n + (size_t)((double)k * (double)n / (double)ns)];
+        for (size_t j = 0; j < nc * m; ++j) aw[j] = fabs(r->w[j]);
+        for (size_t g = 0; g < nc; g += 4) {
+            int gc = nc - g < 4 ? (int)(nc - g) : 4;
+            cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw + g * m, gc, ns, sp, ns, ab + g,
+                              nc, threads);
+        }
+        for (size_t i = 0; i < ns * nc; ++i) smax = fmax(smax, ab[i]);
+    }
+    free(sp), free(aw), free(ab);
+    if (!ok) return 0;
+    /* the order that should meet the target with room for the estimate's factor */
+    const double tau = target / (smax * CM_RBF_FAST_SAFETY * 10.0);
+    if (tau < 1e-14) { /* beyond the finest order: record what it would reach, sum directly */
+        it->eval_error = 1e-14 * smax / it->fmax;
+        return 0;
+    }
+    int order;
+    double theta;
+    cm_rbf_tree_params(tau, &order, &theta);
+    const cm_rbf_tree *t = tree_for(r, order, theta);
+    if (!t) return 0;
+    double err = 0.0;
+    for (size_t g = 0; g < nc; g += 4) {
+        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+        if (cm_rbf_tree_sum(t, r->w + g * m, gc, n, p, n, out + g, nc, threads)) return 0;
+        double e, sabs;
+        cm_rbf_tree_check(t, r->w + g * m, gc, n, p, n, out + g, nc, CM_RBF_FAST_SAMPLES, &e,
+                          &sabs, threads);
+        err = fmax(err, e);
+    }
+    it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
+    it->eval_fast = CM_RBF_FAST_SAFETY * err <= target;
+    return it->eval_fast;
+}
+
 void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
                                int threads)
 {
+    const int fs = r->opt.fast_sum;
+    if (fs == 1 || (fs < 0 && (double)n * (double)r->m >= CM_RBF_FAST_EVAL_PAIRS))
+        if (evaluate_fast(r, n, p, out, threads)) return;
     for (int g = 0; g < r->ncomp; g += 4) {
         int nc = r->ncomp - g < 4 ? r->ncomp - g : 4;
         cm_rbf_kernel_sum_acc(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
@@ -174,6 +282,7 @@ typedef struct krylov {
     double *soa, *rowm, *aux; /* g x m scratch */
     double *wlo;    /* g x m: low parts of the weights (double-double accumulation) */
     double *awlo;   /* g x m: A wlo */
+    const cm_rbf_tree *tree; /* fast matvecs (treecode) if set, else compensated direct */
 } krylov;
 
 /* out_c = A in_c for the components in list (n of them, in: pointers to m-vectors). */
@@ -182,7 +291,8 @@ static void matvec(const cm_rbf *r, krylov *kr, int n, double *const *in, double
 {
     const size_t m = kr->m;
     for (int c = 0; c < n; ++c) memcpy(kr->soa + (size_t)c * m, in[c], m * sizeof(double));
-    cm_rbf_kernel_sum_acc(m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
+    if (!kr->tree || cm_rbf_tree_sum_self(kr->tree, kr->soa, n, kr->rowm, (size_t)n, threads))
+        cm_rbf_kernel_sum_acc(m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
     for (int c = 0; c < n; ++c)
         for (size_t i = 0; i < m; ++i) out[c][i] = kr->rowm[i * (size_t)n + (size_t)c];
 }
@@ -208,8 +318,8 @@ static double norm_inf(size_t m, const double *v)
 
 /* Solves components [c0, c0 + g) of f (nc x m SoA) into w. it/stop/floor per component. */
 static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
-                             double fmax_all, double *w, double *aw, int *iters, int *matvecs,
-                             double *floor_rel, int *status, int threads)
+                             double fmax_all, double tol, double *w, double *aw, int *iters,
+                             int *matvecs, double *floor_rel, int *status, int threads)
 {
     const size_t m = kr->m;
     const int g = kr->g, R = kr->R;
@@ -262,7 +372,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
             for (size_t i = 0; i < m; ++i) rv[i] = f[(size_t)c * m + i] - ax[c][i];
             project(r->iter->q1, m, r->k, rv);
             res[c] = fnorm[c] > 0.0 ? norm_inf(m, rv) / fnorm[c] : 0.0;
-            if (res[c] <= o->tolerance) state[c] = 1;
+            if (res[c] <= tol) state[c] = 1;
             else if (cycle > 0) {
                 fl[nfl] = c;
                 ++nfl;
@@ -304,7 +414,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
             if (state[c] != 0) continue;
             double *v0 = kr->v[c];
             double r2 = cblas_dnrm2((int)m, v0, 1), rinf = norm_inf(m, v0);
-            target[c] = 0.5 * o->tolerance * fnorm[c] * (r2 / rinf);
+            target[c] = 0.5 * tol * fnorm[c] * (r2 / rinf);
             cblas_dscal((int)m, 1.0 / r2, v0, 1);
             memset(kr->gv[c], 0, sizeof kr->gv[c]);
             kr->gv[c][0] = r2;
@@ -393,6 +503,89 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
     return CM_OK;
 }
 
+/* solve_group with fast (treecode) matvecs inside the Krylov loop, wrapped in iterative
+ * refinement on exact residuals: w += solve(f - A w) with A w summed directly and
+ * compensated (and A w_lo, the low parts, by the treecode: they are eps |w|). Why: the
+ * treecode's error is relative to sum |w| phi, which the cancelling RBF weights make 1e4..1e7
+ * x |A w|, so the first solve is exact only to fast_tol times that (measured: 1e-8..1e-5 on
+ * the real sets); each step multiplies the residual by about that factor again. The
+ * residual the caller sees is the exact one. steps: exact residuals formed; first: the
+ * residual after the first solve. */
+static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
+                              double fmax_all, double *w, double *aw, int *iters, int *matvecs,
+                              double *floor_rel, int *status, int *steps, double *first,
+                              int threads)
+{
+    const size_t m = kr->m;
+    const int g = kr->g;
+    const cm_rbf_options *o = &r->opt;
+    const size_t gm = (size_t)g * m;
+    double *rhs = malloc(gm * sizeof *rhs), *dw = malloc(gm * sizeof *dw);
+    double *adw = malloc(gm * sizeof *adw), *wl = calloc(gm, sizeof *wl);
+    double *soa = malloc(gm * sizeof *soa), *rowm = malloc(gm * sizeof *rowm);
+    if (!rhs || !dw || !adw || !wl || !soa || !rowm) {
+        free(rhs), free(dw), free(adw), free(wl), free(soa), free(rowm);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_solve: out of memory for the refinement");
+    }
+    memcpy(rhs, f, gm * sizeof *rhs);
+    memset(w, 0, gm * sizeof *w);
+    for (int c = 0; c < g; ++c) iters[c] = 0;
+    double prev[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
+    int done[4] = {0, 0, 0, 0};
+    for (int step = 0;; ++step) {
+        double rn = 0.0;
+        for (int c = 0; c < g; ++c)
+            if (!done[c]) rn = fmax(rn, norm_inf(m, rhs + (size_t)c * m));
+        double tol = o->fast_refine > 0 ? fmax(o->tolerance, CM_RBF_REFINE_GAIN * rn / fmax_all)
+                                        : o->tolerance;
+        int it[4], stt[4];
+        solve_group(ctx, r, kr, rhs, fmax_all, tol, dw, adw, it, matvecs, floor_rel, stt,
+                    threads);
+        for (size_t i = 0; i < gm; ++i) { /* w += dw in double-double (TwoSum) */
+            double t = w[i] + dw[i], bv = t - w[i];
+            wl[i] += (w[i] - (t - bv)) + (dw[i] - bv);
+            w[i] = t;
+        }
+        for (int c = 0; c < g; ++c) iters[c] += it[c];
+        if (o->fast_refine == 0) { /* the treecode's own residual: A w = A dw here */
+            memcpy(aw, adw, gm * sizeof *aw);
+            for (int c = 0; c < g; ++c) status[c] = stt[c];
+            break;
+        }
+        /* the exact residual f - A w_hi - A w_lo */
+        cm_rbf_kernel_sum_acc(m, r->c, w, g, m, r->c, m, rowm, (size_t)g, threads);
+        for (int c = 0; c < g; ++c)
+            for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] = rowm[i * (size_t)g + (size_t)c];
+        if (cm_rbf_tree_sum_self(kr->tree, wl, g, rowm, (size_t)g, threads) == 0)
+            for (int c = 0; c < g; ++c)
+                for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] += rowm[i * (size_t)g + (size_t)c];
+        *matvecs += 2;
+        ++*steps;
+        int running = 0;
+        for (int c = 0; c < g; ++c) {
+            double *rv = rhs + (size_t)c * m;
+            for (size_t i = 0; i < m; ++i) rv[i] = f[(size_t)c * m + i] - aw[(size_t)c * m + i];
+            project(r->iter->q1, m, r->k, rv);
+            const double res = norm_inf(m, rv) / fmax_all;
+            if (step == 0) *first = fmax(*first, res);
+            cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: component %d, refinement %d: %d "
+                   "iterations (fast matvecs), exact residual %.3g", c, step + 1, it[c], res);
+            if (done[c]) continue;
+            if (res <= o->tolerance) done[c] = 1, status[c] = 1;
+            else if (step + 1 >= o->fast_refine || res > 0.5 * prev[c])
+                done[c] = 1, status[c] = stt[c] == 1 ? 3 : stt[c];
+            prev[c] = res;
+            running += !done[c];
+        }
+        if (!running) break;
+        for (int c = 0; c < g; ++c) /* converged components: nothing more to add */
+            if (done[c]) memset(rhs + (size_t)c * m, 0, m * sizeof *rhs);
+    }
+    for (size_t i = 0; i < gm; ++i) w[i] += wl[i];
+    free(rhs), free(dw), free(adw), free(wl), free(soa), free(rowm);
+    return CM_OK;
+}
+
 cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
                                  double *w, double *q, int threads)
 {
@@ -424,14 +617,31 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         goto done;
     }
     const double fmax_all = norm_inf(nc * m, f);
-    int maxit = 0, mv = 0, floor_hit = 0, stagnated = 0, maxed = 0;
-    double floor_max = 0.0;
+    r->iter->fmax = fmax_all;
+    const int fast = o->fast_sum == 1 || (o->fast_sum < 0 && m >= CM_RBF_FAST_MIN_M);
+    if (fast) {
+        int order;
+        double theta;
+        cm_rbf_tree_params(o->fast_tol, &order, &theta);
+        kr.tree = tree_for(r, order, theta);
+        if (!kr.tree) {
+            st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_solve: out of memory for the treecode");
+            goto done;
+        }
+    }
+    int maxit = 0, mv = 0, floor_hit = 0, stagnated = 0, maxed = 0, steps = 0;
+    double floor_max = 0.0, first = 0.0;
     for (size_t c0 = 0; c0 < nc; c0 += 4) {
         kr.g = nc - c0 < 4 ? (int)(nc - c0) : 4;
         int iters[4], status[4];
         double fl[4];
-        solve_group(ctx, r, &kr, f + c0 * m, fmax_all, w + c0 * m, aw + c0 * m, iters, &mv, fl,
-                    status, threads);
+        if (fast)
+            st = refine_group(ctx, r, &kr, f + c0 * m, fmax_all, w + c0 * m, aw + c0 * m, iters,
+                              &mv, fl, status, &steps, &first, threads);
+        else
+            st = solve_group(ctx, r, &kr, f + c0 * m, fmax_all, o->tolerance, w + c0 * m,
+                             aw + c0 * m, iters, &mv, fl, status, threads);
+        if (st != CM_OK) goto done;
         for (int c = 0; c < kr.g; ++c) {
             if (iters[c] > maxit) maxit = iters[c];
             if (fl[c] > floor_max) floor_max = fl[c];
@@ -465,8 +675,10 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     for (size_t c0 = 0; c0 < nc; c0 += 4) {
         int g = nc - c0 < 4 ? (int)(nc - c0) : 4;
         for (size_t i = 0; i < (size_t)g * m; ++i) kr.soa[i] = fabs(w[c0 * m + i]);
-        cm_rbf_kernel_sum(r->kernel, 3, m, r->c, kr.soa, g, m, r->c, m, kr.rowm, (size_t)g,
-                          threads);
+        /* an estimate: the treecode's error on positive weights is fast_tol of the sum */
+        if (!kr.tree || cm_rbf_tree_sum_self(kr.tree, kr.soa, g, kr.rowm, (size_t)g, threads))
+            cm_rbf_kernel_sum(r->kernel, 3, m, r->c, kr.soa, g, m, r->c, m, kr.rowm, (size_t)g,
+                              threads);
         floor_max = fmax(floor_max, fmax_all > 0.0 ? DBL_EPSILON * norm_inf((size_t)g * m, kr.rowm) / fmax_all : 0.0);
     }
     r->stats.iterations = maxit;
@@ -474,8 +686,12 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     r->stats.residual = worst;
     r->stats.floor = floor_max;
     r->stats.floor_limited = floor_hit && worst > o->tolerance;
+    r->stats.fast_sum = fast;
+    r->stats.refinements = steps;
+    r->stats.fast_residual = fast ? first : 0.0;
     r->stats.memory_bytes = cm_rbf_schwarz_bytes(r->iter->pc) + m * k * sizeof(double) +
-                            (size_t)gmax * (size_t)(2 * R + 6) * m * sizeof(double);
+                            (size_t)gmax * (size_t)(2 * R + 6) * m * sizeof(double) +
+                            (fast ? cm_rbf_tree_bytes(kr.tree) + (size_t)gmax * 6 * m * sizeof(double) : 0);
     if (worst > o->tolerance && !r->stats.floor_limited)
         st = cm_error(ctx, CM_WARNING,
                       "cm_rbf_solve: the iterative solver %s after %d iterations at a relative "

@@ -91,6 +91,22 @@ typedef struct cm_rbf_options {
                            * sqrt(m) (coarse factor 8 coarse^2 bytes, O(m)): bracket 59k,
                            * 5,000 coarse centres: 17 iterations instead of 21 */
     int coarse_max;       /* [8000] cap on the coarse centres (0: none but m/4) */
+    int fast_sum;         /* [-1] fast summation (barycentric Lagrange treecode for r^3,
+                           * rbf_treecode.c) for the Krylov matvecs and for evaluation:
+                           * 0 never (direct sums), 1 always, -1 auto (matvecs at m >= 40,000;
+                           * evaluation when n x m >= 2e9 pairs and the treecode's
+                           * a-posteriori error estimate is within fast_eval_tol) */
+    double fast_tol;      /* [1e-12] treecode accuracy in the Krylov loop, relative to
+                           * sum_j |w_j| phi_ij (its error bound; measured on random weights).
+                           * RBF weights cancel (sum |w| phi is 1e4..1e7 x the result), so the
+                           * error relative to the result is that much larger: the solver
+                           * corrects it by refinement on exact residuals (fast_refine) */
+    int fast_refine;      /* [3] outer refinement steps on exact (compensated direct)
+                           * residuals around the fast-matvec Krylov solve; 0: none (the final
+                           * residual is then the treecode's, cheaper but not exact) */
+    double fast_eval_tol; /* [1e-9] evaluation takes the fast sum only if its estimated error
+                           * is at most fast_eval_tol x max |data| (else direct compensated
+                           * sums) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
@@ -119,6 +135,14 @@ typedef struct cm_rbf_stats {
                             * and on two bodies far apart it is 1e-9 .. 1e-8) */
     int floor_limited;     /* 1 if the solve stagnated above the tolerance but within 10x
                             * the floor: the attainable accuracy, not a failure */
+    int fast_sum;          /* iterative: 1 if the last solve's Krylov matvecs were fast sums */
+    int refinements;       /* last solve with fast sums: outer steps (each one Krylov solve
+                            * with fast matvecs, then one exact residual) */
+    double fast_residual;  /* last solve with fast sums: residual after the first Krylov
+                            * solve, by exact sums (what the treecode alone reached) */
+    int eval_fast;         /* last cm_rbf_evaluate: 1 if it used the fast sum */
+    double eval_error;     /* last cm_rbf_evaluate that tried the fast sum: its estimated
+                            * max error / max |data| (sampled against exact sums, x4) */
 } cm_rbf_stats;
 
 CM_API void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats);

@@ -35,3 +35,6 @@ if(CADMORPH_WITH_PETSC)
   set_tests_properties(test_rbf_petsc_2ranks test_rbf_petsc_1rank PROPERTIES
     LABELS "unit;rbf;petsc" ENVIRONMENT "${CM_MPI_ENV}")
 endif()
+# the r^3 treecode: its error bound on random and real weights; fits with fast matvecs
+# against direct ones and dense; affine data; the choice of the fast evaluation
+cm_add_unit_test(test_rbf_treecode ${CMAKE_CURRENT_LIST_DIR}/test_rbf_treecode.c LIBS cm_rbf LABELS rbf)

@@ -1,0 +1,189 @@
+/* The r^3 treecode (rbf/rbf_treecode.c) against direct summation on real RBF weights and on
+ * random ones, on the centres of a boundary set: error relative to sum_j |w_j| phi_ij (what
+ * the bound controls) and to the result (what cancellation costs), CPU time of one fast and
+ * one direct product.
+ * usage: bench_rbf_treecode PREFIX WEIGHTS [--threads N] [--orders n:theta,n:theta,...]
+ *        [--tol T,T,...]
+ * PREFIX.centres / .values as for bench_rbf_iterative; WEIGHTS: a cache of the solved
+ * weights (written by the first run, read afterwards). One key=value line per setting. */
+#include "cadmorph/rbf.h"
+#include "rbf/rbf_internal.h"
+#include "rbf/rbf_treecode.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+static double *read_raw(const char *path, size_t *bytes_out)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long bytes = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    double *x = malloc((size_t)bytes + 8);
+    size_t got = x ? fread(x, 1, (size_t)bytes, f) : 0;
+    fclose(f);
+    if (got != (size_t)bytes) {
+        free(x);
+        return NULL;
+    }
+    *bytes_out = (size_t)bytes;
+    return x;
+}
+
+static double cpu_s(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
+/* err_i / S_i (max over i), max err / max S, max err / max |exact| */
+static void compare(size_t m, const double *fast, const double *ex, const double *S,
+                    double *rel_s, double *rel_smax, double *rel_res)
+{
+    double e_s = 0.0, emax = 0.0, smax = 0.0, rmax = 0.0;
+    for (size_t i = 0; i < 3 * m; ++i) {
+        double e = fabs(fast[i] - ex[i]);
+        if (S[i] > 0.0) e_s = fmax(e_s, e / S[i]);
+        emax = fmax(emax, e);
+        smax = fmax(smax, S[i]);
+        rmax = fmax(rmax, fabs(ex[i]));
+    }
+    *rel_s = e_s;
+    *rel_smax = emax / smax;
+    *rel_res = emax / rmax;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 3) {
+        fprintf(stderr, "usage: bench_rbf_treecode PREFIX WEIGHTS [options], see the source\n");
+        return 1;
+    }
+    const char *prefix = argv[1], *wpath = argv[2];
+    int threads = 2;
+    const char *orders = "4:0.5,6:0.5,8:0.5,10:0.5,12:0.5,8:0.4,10:0.4,12:0.4,14:0.4";
+    const char *tols = NULL;
+    for (int i = 3; i < argc; ++i) {
+        const char *a = argv[i], *b = i + 1 < argc ? argv[i + 1] : "";
+        if (!strcmp(a, "--threads")) threads = atoi(b), ++i;
+        else if (!strcmp(a, "--orders")) orders = b, ++i;
+        else if (!strcmp(a, "--tol")) tols = b, ++i;
+        else {
+            fprintf(stderr, "unknown option %s\n", a);
+            return 1;
+        }
+    }
+    size_t bytes = 0, m = 0;
+    double *cw = read_raw(wpath, &bytes); /* 3 x m unit-box centres, then 3 x m weights */
+    if (cw) {
+        m = bytes / (6 * sizeof(double));
+    } else {
+        char path[4096];
+        snprintf(path, sizeof path, "%s.centres", prefix);
+        double *x = read_raw(path, &bytes);
+        size_t mx = bytes / 24;
+        snprintf(path, sizeof path, "%s.values", prefix);
+        double *v = read_raw(path, &bytes);
+        if (!x || !v || bytes / 24 != mx) {
+            fprintf(stderr, "cannot read %s.centres / .values\n", prefix);
+            return 1;
+        }
+        cm_context *ctx = NULL;
+        cm_context_create(&ctx);
+        cm_context_set_threads(ctx, threads);
+        cm_rbf_options o;
+        cm_rbf_options_init(&o);
+        o.solver = CM_RBF_SOLVER_ITERATIVE;
+        cm_rbf *r = NULL;
+        cm_status st = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, mx, x, &o, &r);
+        if (st >= 0) st = cm_rbf_solve(ctx, r, 3, v);
+        if (st < 0) {
+            fprintf(stderr, "fit: %s\n", cm_context_message(ctx));
+            return 1;
+        }
+        m = r->m;
+        cw = malloc(6 * m * sizeof *cw);
+        memcpy(cw, r->c, 3 * m * sizeof *cw);
+        memcpy(cw + 3 * m, r->w, 3 * m * sizeof *cw);
+        FILE *f = fopen(wpath, "wb");
+        if (f) fwrite(cw, sizeof *cw, 6 * m, f), fclose(f);
+        cm_rbf_destroy(&r);
+        cm_context_destroy(&ctx);
+        free(x), free(v);
+    }
+    const double *c = cw, *wreal = cw + 3 * m;
+    double *wrand = malloc(3 * m * sizeof *wrand), *aw = malloc(3 * m * sizeof *aw);
+    unsigned long long s = 12345;
+    for (size_t i = 0; i < 3 * m; ++i) {
+        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+        wrand[i] = (double)(s >> 11) / 9007199254740992.0 * 2.0 - 1.0;
+    }
+    /* exact products (compensated) and the scales sum |w| phi, for both weight sets */
+    double *ex[2], *S[2], *fast = malloc(3 * m * sizeof *fast);
+    const double *ws[2] = {wreal, wrand};
+    double direct_cpu = 0.0;
+    for (int k = 0; k < 2; ++k) {
+        ex[k] = malloc(3 * m * sizeof(double));
+        S[k] = malloc(3 * m * sizeof(double));
+        double c0 = cpu_s();
+        cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, ws[k], 3, m, c, m, fast, 3, threads);
+        if (k == 0) direct_cpu = cpu_s() - c0;
+        cm_rbf_kernel_sum_acc(m, c, ws[k], 3, m, c, m, ex[k], 3, threads);
+        for (size_t i = 0; i < 3 * m; ++i) aw[i] = fabs(ws[k][i]);
+        cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, aw, 3, m, c, m, S[k], 3, threads);
+    }
+    double kappa = 0.0, smax = 0.0, rmax = 0.0;
+    for (size_t i = 0; i < 3 * m; ++i) smax = fmax(smax, S[0][i]), rmax = fmax(rmax, fabs(ex[0][i]));
+    kappa = smax / rmax;
+    /* plain direct sums against compensated ones: the rounding floor */
+    double pr_s, pr_smax, pr_res;
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, wreal, 3, m, c, m, fast, 3, threads);
+    compare(m, fast, ex[0], S[0], &pr_s, &pr_smax, &pr_res);
+    printf("set=%s m=%zu threads=%d direct_cpu_s=%.3f cancellation=%.3g plain_err_rel_S=%.3g "
+           "plain_err_rel_result=%.3g\n", prefix, m, threads, direct_cpu, kappa, pr_smax, pr_res);
+    /* settings: explicit n:theta pairs, or tolerances through cm_rbf_tree_params */
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", tols ? tols : orders);
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        int n;
+        double th, tol = 0.0;
+        if (tols) {
+            tol = atof(tok);
+            cm_rbf_tree_params(tol, &n, &th);
+        } else if (sscanf(tok, "%d:%lf", &n, &th) != 2) continue;
+        double c0 = cpu_s();
+        cm_rbf_tree *t = cm_rbf_tree_create(m, c, n, th);
+        double build = cpu_s() - c0;
+        if (!t) return 1;
+        double res[2][3], tcpu[2];
+        for (int k = 0; k < 2; ++k) {
+            c0 = cpu_s();
+            cm_rbf_tree_sum_self(t, ws[k], 3, fast, 3, threads);
+            tcpu[k] = cpu_s() - c0;
+            compare(m, fast, ex[k], S[k], &res[k][0], &res[k][1], &res[k][2]);
+        }
+        double est_err, est_s;
+        double true_max = 0.0;
+        cm_rbf_tree_sum_self(t, wreal, 3, fast, 3, threads);
+        cm_rbf_tree_check(t, wreal, 3, m, c, m, fast, 3, 256, &est_err, &est_s, threads);
+        (void)est_s;
+        for (size_t i = 0; i < 3 * m; ++i) true_max = fmax(true_max, fabs(fast[i] - ex[0][i]));
+        printf("tol=%.0e order=%d theta=%.2f build_cpu_s=%.3f fast_cpu_s=%.3f speedup=%.2f "
+               "rand_err_S=%.3g rand_errmax_Smax=%.3g rand_err_result=%.3g "
+               "real_err_S=%.3g real_errmax_Smax=%.3g real_err_result=%.3g digits_lost=%.2f "
+               "sample_est/true=%.3g tree_mb=%.1f\n",
+               tol, n, th, build, tcpu[0], direct_cpu / tcpu[0], res[1][0], res[1][1],
+               res[1][2], res[0][0], res[0][1], res[0][2],
+               log10(res[0][2] / res[1][2]), est_err / true_max,
+               (double)cm_rbf_tree_bytes(t) / 1e6);
+        fflush(stdout);
+        cm_rbf_tree_destroy(&t);
+    }
+    return 0;
+}

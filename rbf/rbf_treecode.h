@@ -1,0 +1,39 @@
+/* Fast summation of r^3 kernel sums: a barycentric Lagrange treecode (rbf_treecode.c).
+ * Not a public header. */
+#ifndef CADMORPH_RBF_TREECODE_H
+#define CADMORPH_RBF_TREECODE_H
+
+#include <stddef.h>
+
+typedef struct cm_rbf_tree cm_rbf_tree;
+
+/* Parameters for a requested accuracy: order n (n + 1 Chebyshev points per axis and
+ * cluster) and opening angle theta such that, measured on random weights, the error of
+ * every sum is at most tol x sum_j |w_j| phi_ij (rbf_treecode.c has the table and the bound).
+ * tol is clamped to [1e-14, 1e-3]. */
+void cm_rbf_tree_params(double tol, int *order, double *theta);
+
+/* Source tree over the m centres c (3 x m SoA, stride m; kept by pointer, must outlive the
+ * tree) for order (2..14) and theta (0.1..0.9). Also orders the centres themselves as target
+ * batches, for cm_rbf_tree_sum_self. NULL on allocation failure. */
+cm_rbf_tree *cm_rbf_tree_create(size_t m, const double *c, int order, double theta);
+void cm_rbf_tree_destroy(cm_rbf_tree **t);
+size_t cm_rbf_tree_bytes(const cm_rbf_tree *t);
+
+/* out[i * ldo + q] ~ sum_j phi(|p_i - c_j|) w[q * m + j] for q < nc (1..4), i < n; p: 3 x n
+ * SoA with stride ldp. 0 on success, -1 on allocation failure (out untouched). */
+int cm_rbf_tree_sum(const cm_rbf_tree *t, const double *w, int nc, size_t n, const double *p,
+                    size_t ldp, double *out, size_t ldo, int threads);
+/* The same with the targets = the centres of the tree (their batches are cached). */
+int cm_rbf_tree_sum_self(const cm_rbf_tree *t, const double *w, int nc, double *out,
+                         size_t ldo, int threads);
+
+/* A posteriori check of a fast sum: at `samples` targets spread over p (indices i = k n /
+ * samples), the largest |out - exact| with exact by compensated direct summation, and the
+ * largest sum_j |w_j| phi_ij there (the scale the error bound is relative to), both over
+ * the nc components. */
+void cm_rbf_tree_check(const cm_rbf_tree *t, const double *w, int nc, size_t n,
+                       const double *p, size_t ldp, const double *out, size_t ldo,
+                       size_t samples, double *max_err, double *max_abs_sum, int threads);
+
+#endif

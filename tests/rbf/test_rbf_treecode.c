@@ -1,0 +1,327 @@
+/* Tests of the r^3 treecode (rbf/rbf_treecode.c) and of the iterative solver with fast
+ * matvecs: the error bound |fast_i - exact_i| <= tol sum_j |w_j| phi_ij on random and on real
+ * RBF weights, at the centres and elsewhere; fits with fast_sum on against direct matvecs
+ * and the dense solver; affine data; the choice of the fast evaluation. */
+#include "cadmorph/rbf.h"
+#include "rbf/rbf_internal.h"
+#include "rbf/rbf_treecode.h"
+#include "rbf_test_sets.h"
+#include "test_rng.h"
+#include "test_util.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static void bore_motion(size_t n, const double *x, double *d)
+{
+    for (size_t i = 0; i < n; ++i) {
+        double dx = x[3 * i] - 2.0, dy = x[3 * i + 1] - 1.0, r = hypot(dx, dy) + 1e-12;
+        double s = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
+        d[3 * i] = s * dx / r + 0.01 * sin(x[3 * i + 2]);
+        d[3 * i + 1] = s * dy / r;
+        d[3 * i + 2] = 0.02 * x[3 * i] * x[3 * i] / 16.0;
+    }
+}
+
+static double *bore_set(double h, size_t *m)
+{
+    const double off[3] = {0.0, 0.0, 0.0};
+    *m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, off, NULL);
+    double *x = malloc(*m * 3 * sizeof *x);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, off, x);
+    return x;
+}
+
+/* max_i |fast_i - exact_i| / S_i with S_i = sum_j |w_j| phi_ij, over nc components; exact by
+ * compensated sums. c: 3 x m SoA, p: 3 x n SoA. Also the cancellation max S / max |exact|. */
+static double bound_ratio(const cm_rbf_tree *t, size_t m, const double *c, const double *w,
+                          int nc, size_t n, const double *p, int self, double *cancel)
+{
+    double *fast = malloc(n * (size_t)nc * sizeof *fast), *ex = malloc(n * (size_t)nc * sizeof *ex);
+    double *S = malloc(n * (size_t)nc * sizeof *S), *aw = malloc(m * (size_t)nc * sizeof *aw);
+    int st = self ? cm_rbf_tree_sum_self(t, w, nc, fast, (size_t)nc, 2)
+                  : cm_rbf_tree_sum(t, w, nc, n, p, n, fast, (size_t)nc, 2);
+    CHECK(st == 0);
+    cm_rbf_kernel_sum_acc(m, c, w, nc, n, p, n, ex, (size_t)nc, 2);
+    for (size_t j = 0; j < m * (size_t)nc; ++j) aw[j] = fabs(w[j]);
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, aw, nc, n, p, n, S, (size_t)nc, 2);
+    double worst = 0.0, smax = 0.0, emax = 0.0;
+    for (size_t i = 0; i < n * (size_t)nc; ++i) {
+        worst = fmax(worst, fabs(fast[i] - ex[i]) / S[i]);
+        smax = fmax(smax, S[i]);
+        emax = fmax(emax, fabs(ex[i]));
+    }
+    if (cancel) *cancel = smax / emax;
+    free(fast), free(ex), free(S), free(aw);
+    return worst;
+}
+
+/* The bound on random weights, for the tolerances of the table, at the centres (the
+ * solver's use) and at points inside the box (evaluation), for 1..4 components. */
+static void test_bound_random(void)
+{
+    size_t m;
+    double *x = bore_set(0.05, &m); /* ~12k centres */
+    double *c = malloc(3 * m * sizeof *c), *w = malloc(4 * m * sizeof *w);
+    for (size_t i = 0; i < m; ++i)
+        for (int d = 0; d < 3; ++d) c[(size_t)d * m + i] = x[3 * i + d] / 4.0;
+    uint64_t rng = 7;
+    for (size_t i = 0; i < 4 * m; ++i) w[i] = test_rng_range(&rng, -1.0, 1.0);
+    const size_t n = 3000;
+    double *p = malloc(3 * n * sizeof *p);
+    for (size_t i = 0; i < n; ++i) {
+        p[i] = test_rng_range(&rng, 0.0, 1.0);
+        p[n + i] = test_rng_range(&rng, 0.0, 0.5);
+        p[2 * n + i] = test_rng_range(&rng, 0.0, 0.25);
+    }
+    const double tols[] = {1e-4, 1e-7, 1e-10, 1e-12};
+    for (int k = 0; k < 4; ++k) {
+        int order;
+        double theta;
+        cm_rbf_tree_params(tols[k], &order, &theta);
+        cm_rbf_tree *t = cm_rbf_tree_create(m, c, order, theta);
+        CHECK(t != NULL);
+        if (!t) continue;
+        int nc = 1 + k % 4;
+        double rs = bound_ratio(t, m, c, w, nc, m, c, 1, NULL);
+        double ro = bound_ratio(t, m, c, w, nc, n, p, 0, NULL);
+        printf("random weights, m = %zu, tol %.0e (order %d, theta %.2f), %d components: "
+               "max err / sum|w|phi = %.3g at the centres, %.3g inside\n",
+               m, tols[k], order, theta, nc, rs, ro);
+        CHECK_MSG(rs <= tols[k] && ro <= tols[k], "%.3g %.3g > %.3g", rs, ro, tols[k]);
+        /* and not trivially: the far field was used (a direct sum would be at 1e-16) */
+        if (k < 2) CHECK_MSG(rs > 1e-3 * tols[k], "%.3g: far field unused?", rs);
+        cm_rbf_tree_destroy(&t);
+    }
+    /* fewer centres than one proxy grid: all direct, exact to rounding */
+    cm_rbf_tree *t = cm_rbf_tree_create(300, c, 8, 0.5);
+    CHECK(t && bound_ratio(t, 300, c, w, 3, 300, c, 0, NULL) <= 1e-14);
+    cm_rbf_tree_destroy(&t);
+    free(x), free(c), free(w), free(p);
+}
+
+/* Real weights (an RBF fit of the bore motion): the bound holds all the same, relative to
+ * sum |w| phi, and the cancellation makes the error relative to the result that much
+ * larger. */
+static void test_bound_real(cm_context *ctx)
+{
+    size_t m;
+    double *x = bore_set(0.076, &m); /* ~5k centres */
+    double *d = malloc(m * 3 * sizeof *d);
+    bore_motion(m, x, d);
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_DENSE;
+    cm_rbf *r = NULL;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_OK);
+    CHECK(cm_rbf_solve(ctx, r, 3, d) == CM_OK);
+    const double tols[] = {1e-6, 1e-10};
+    for (int k = 0; k < 2; ++k) {
+        int order;
+        double theta, cancel;
+        cm_rbf_tree_params(tols[k], &order, &theta);
+        cm_rbf_tree *t = cm_rbf_tree_create(r->m, r->c, order, theta);
+        double rs = bound_ratio(t, r->m, r->c, r->w, 3, r->m, r->c, 1, &cancel);
+        printf("real weights, m = %zu, tol %.0e: max err / sum|w|phi = %.3g, cancellation "
+               "(max sum|w|phi / max|A w|) %.3g\n", r->m, tols[k], rs, cancel);
+        CHECK_MSG(rs <= tols[k], "%.3g > %.3g", rs, tols[k]);
+        CHECK_MSG(cancel > 10.0, "%.3g", cancel); /* the weights do cancel */
+        cm_rbf_tree_destroy(&t);
+    }
+    cm_rbf_destroy(&r);
+    free(x), free(d);
+}
+
+static cm_status fit_eval(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
+                          const double *d, size_t np, const double *p, double *out,
+                          cm_rbf_stats *st)
+{
+    cm_rbf *r = NULL;
+    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &r);
+    if (s == CM_OK) s = cm_rbf_solve(ctx, r, 3, d);
+    if (s == CM_OK) s = cm_rbf_evaluate(ctx, r, np, p, out);
+    if (r) cm_rbf_get_stats(r, st);
+    cm_rbf_destroy(&r);
+    return s;
+}
+
+/* Iterative fits with fast matvecs (and refinement) against direct matvecs and dense. */
+static void test_fit(cm_context *ctx)
+{
+    size_t m;
+    double *x = bore_set(0.076, &m);
+    double *d = malloc(m * 3 * sizeof *d);
+    bore_motion(m, x, d);
+    const size_t nin = 4000, np = m + nin;
+    double *p = malloc(np * 3 * sizeof *p);
+    memcpy(p, x, m * 3 * sizeof *p);
+    uint64_t rng = 11;
+    for (size_t i = 0; i < nin; ++i) {
+        p[3 * (m + i)] = test_rng_range(&rng, 0.1, 3.9);
+        p[3 * (m + i) + 1] = test_rng_range(&rng, 0.1, 0.5);
+        p[3 * (m + i) + 2] = test_rng_range(&rng, 0.1, 0.9);
+    }
+    double *sf = malloc(np * 3 * sizeof *sf), *sd = malloc(np * 3 * sizeof *sd);
+    double *sn = malloc(np * 3 * sizeof *sn);
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.fast_sum = 0;
+    cm_rbf_stats a, b, dn;
+    cm_status s0 = fit_eval(ctx, &o, m, x, d, np, p, sd, &a);
+    o.fast_sum = 1;
+    cm_status s1 = fit_eval(ctx, &o, m, x, d, np, p, sf, &b);
+    o.solver = CM_RBF_SOLVER_DENSE;
+    cm_status s2 = fit_eval(ctx, &o, m, x, d, np, p, sn, &dn);
+    CHECK_MSG(s0 == CM_OK && s1 == CM_OK && s2 == CM_OK, "%d %d %d: %s", s0, s1, s2,
+              cm_context_message(ctx));
+    const double range = range_of(m * 3, d);
+    double agree = max_diff(np * 3, sf, sd) / range, vsd = max_diff(np * 3, sf, sn) / range;
+    double exact = max_diff(m * 3, sf, d) / range;
+    printf("fit m = %zu: fast %d iterations, %d refinements, residual after the first solve "
+           "%.3g, final %.3g; direct %d iterations; |fast - direct| = %.3g, |fast - dense| = "
+           "%.3g (dense residual %.3g), exact at the centres %.3g of the range\n",
+           m, b.iterations, b.refinements, b.fast_residual, b.residual, a.iterations, agree,
+           vsd, dn.residual, exact);
+    CHECK(b.fast_sum == 1 && a.fast_sum == 0);
+    CHECK_MSG(b.refinements >= 1 && b.refinements <= 3, "%d", b.refinements);
+    CHECK_MSG(b.residual <= 1e-10, "%.3g", b.residual);
+    CHECK_MSG(agree <= 1e-9, "%.3g", agree);
+    CHECK_MSG(vsd <= fmax(1e-9, 3.0 * dn.residual), "%.3g", vsd);
+    CHECK_MSG(exact <= 1e-9, "%.3g", exact);
+    /* no refinement: the treecode's own residual, looser but reported as such */
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.fast_refine = 0;
+    o.fast_tol = 1e-6;
+    cm_rbf_stats c;
+    cm_status s3 = fit_eval(ctx, &o, m, x, d, np, p, sf, &c);
+    printf("fast_tol 1e-6 without refinement: residual %.3g, |fast - direct| = %.3g\n",
+           c.residual, max_diff(np * 3, sf, sd) / range);
+    CHECK(s3 >= CM_OK && c.refinements == 0);
+    CHECK_MSG(max_diff(np * 3, sf, sd) / range <= 1e-2, "%.3g", max_diff(np * 3, sf, sd) / range);
+    free(x), free(d), free(p), free(sf), free(sd), free(sn);
+}
+
+/* Affine data: reproduced exactly with fast matvecs (the weights are zero). */
+static void test_affine(cm_context *ctx)
+{
+    size_t m;
+    double *x = bore_set(0.076, &m);
+    double *d = malloc(m * 3 * sizeof *d), *out = malloc(m * 3 * sizeof *out);
+    for (size_t i = 0; i < m; ++i) {
+        d[3 * i] = 1.0 + 0.5 * x[3 * i] - 0.25 * x[3 * i + 2];
+        d[3 * i + 1] = -2.0 + x[3 * i + 1];
+        d[3 * i + 2] = 0.125 * x[3 * i] + 0.375 * x[3 * i + 1];
+    }
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.fast_sum = 1;
+    cm_rbf_stats st;
+    cm_status s = fit_eval(ctx, &o, m, x, d, m, x, out, &st);
+    double err = max_diff(m * 3, out, d);
+    printf("affine data with fast sums: max error %.3g\n", err);
+    CHECK(s == CM_OK);
+    CHECK_MSG(err <= 1e-12, "%.3g", err);
+    free(x), free(d), free(out);
+}
+
+/* Evaluation: fast when its estimated error is within fast_eval_tol x max |data|, else
+ * direct; the result within that tolerance of the direct one either way. Widely spaced
+ * centres with a smooth field cancel little (fast accepted), the bore set cancels more. */
+static void test_evaluation(cm_context *ctx)
+{
+    uint64_t rng = 5;
+    for (int set = 0; set < 2; ++set) {
+        size_t m;
+        double *x, *d;
+        if (set == 0) {
+            m = 6000;
+            x = malloc(m * 3 * sizeof *x);
+            for (size_t i = 0; i < 3 * m; ++i) x[i] = test_rng_range(&rng, 0.0, 1.0);
+        } else {
+            x = bore_set(0.076, &m);
+        }
+        d = malloc(m * 3 * sizeof *d);
+        for (size_t i = 0; i < m; ++i)
+            for (int e = 0; e < 3; ++e)
+                d[3 * i + e] = 0.01 * sin(1.0 + e + x[3 * i]) * cos(x[3 * i + 1] - 0.5 * x[3 * i + 2]);
+        if (set == 1) bore_motion(m, x, d);
+        const size_t n = 20000;
+        double *p = malloc(n * 3 * sizeof *p), *a = malloc(n * 3 * sizeof *a);
+        double *b = malloc(n * 3 * sizeof *b);
+        for (size_t i = 0; i < n; ++i)
+            for (int e = 0; e < 3; ++e) p[3 * i + e] = x[3 * (i % m) + e] * 0.97 + 0.01;
+        cm_rbf_options o;
+        cm_rbf_options_init(&o);
+        o.solver = CM_RBF_SOLVER_ITERATIVE;
+        o.fast_sum = 0;
+        cm_rbf_stats sa, sb;
+        cm_status s0 = fit_eval(ctx, &o, m, x, d, n, p, a, &sa);
+        o.fast_sum = 1;
+        cm_status s1 = fit_eval(ctx, &o, m, x, d, n, p, b, &sb);
+        double dmax = 0.0;
+        for (size_t i = 0; i < 3 * m; ++i) dmax = fmax(dmax, fabs(d[i]));
+        double diff = max_diff(n * 3, a, b) / dmax;
+        printf("evaluation, %s set, m = %zu: fast %s (estimated error %.3g of max |d|), "
+               "|fast - direct| = %.3g of max |d|\n", set ? "bore" : "random", m,
+               sb.eval_fast ? "accepted" : "refused", sb.eval_error, diff);
+        CHECK(s0 == CM_OK && s1 == CM_OK && sa.eval_fast == 0);
+        CHECK_MSG(diff <= 1e-9 + 3e-10, "%.3g", diff); /* + the two solves' difference */
+        if (sb.eval_fast) CHECK_MSG(sb.eval_error <= 1e-9, "%.3g", sb.eval_error);
+        if (set == 0) CHECK_MSG(sb.eval_fast == 1, "smooth set: fast refused (%.3g)", sb.eval_error);
+        free(x), free(d), free(p), free(a), free(b);
+    }
+}
+
+static void test_options(cm_context *ctx)
+{
+    size_t m;
+    double *x = bore_set(0.2, &m);
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    CHECK(o.fast_sum == -1 && o.fast_tol == 1e-12 && o.fast_refine == 3 && o.fast_eval_tol == 1e-9);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    cm_rbf *r = NULL;
+    o.fast_tol = 0.0;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.fast_sum = 2;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    CHECK(r == NULL);
+    /* the table: finer tolerances never give a lower order or a wider angle */
+    int prev_n = 0;
+    double prev_t = 1.0;
+    for (double tol = 1e-3; tol >= 1e-14; tol *= 0.1) {
+        int n;
+        double th;
+        cm_rbf_tree_params(tol, &n, &th);
+        CHECK(n >= prev_n && th <= prev_t);
+        prev_n = n, prev_t = th;
+    }
+    free(x);
+}
+
+static void log_stderr(void *user, cm_log_level level, const char *message)
+{
+    (void)user;
+    (void)level;
+    fprintf(stderr, "%s\n", message);
+}
+
+int main(void)
+{
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return 1;
+    if (getenv("CM_TEST_VERBOSE")) cm_context_set_log(ctx, log_stderr, NULL);
+    cm_context_set_threads(ctx, 2);
+    test_bound_random();
+    test_bound_real(ctx);
+    test_fit(ctx);
+    test_affine(ctx);
+    test_evaluation(ctx);
+    test_options(ctx);
+    cm_context_destroy(&ctx);
+    return TEST_REPORT();
+}
