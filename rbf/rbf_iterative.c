@@ -222,9 +222,9 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
     free(sp), free(aw), free(ab);
     if (!ok) return 0;
     /* the order that should meet the target with room for the estimate's factor */
-    const double tau = target / (smax * CM_RBF_FAST_SAFETY * 10.0);
-    if (tau < 1e-14) { /* beyond the finest order: record what it would reach, sum directly */
-        it->eval_error = 1e-14 * smax / it->fmax;
+    double tau = target / (smax * CM_RBF_FAST_SAFETY);
+    if (tau < 1e-15) { /* below the finest order's rounding: record that, sum directly */
+        it->eval_error = 1e-15 * smax / it->fmax;
         return 0;
     }
     int order;
@@ -689,6 +689,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     r->stats.fast_sum = fast;
     r->stats.refinements = steps;
     r->stats.fast_residual = fast ? first : 0.0;
+    r->stats.fast_bound = fast ? o->fast_tol * floor_max / DBL_EPSILON : 0.0;
     r->stats.memory_bytes = cm_rbf_schwarz_bytes(r->iter->pc) + m * k * sizeof(double) +
                             (size_t)gmax * (size_t)(2 * R + 6) * m * sizeof(double) +
                             (fast ? cm_rbf_tree_bytes(kr.tree) + (size_t)gmax * 6 * m * sizeof(double) : 0);

@@ -138,8 +138,13 @@ typedef struct cm_rbf_stats {
     int fast_sum;          /* iterative: 1 if the last solve's Krylov matvecs were fast sums */
     int refinements;       /* last solve with fast sums: outer steps (each one Krylov solve
                             * with fast matvecs, then one exact residual) */
-    double fast_residual;  /* last solve with fast sums: residual after the first Krylov
-                            * solve, by exact sums (what the treecode alone reached) */
+    double fast_residual;  /* last solve with fast sums and fast_refine > 0: residual after
+                            * the first Krylov solve, by exact sums (what the treecode alone
+                            * reached). With fast_refine = 0, residual above is the
+                            * treecode's own (of its operator), and this bound is the guide: */
+    double fast_bound;     /* last solve with fast sums: fast_tol x max_i sum_j |w_j| phi_ij /
+                            * max |data|, the treecode's error bound on a product with these
+                            * weights relative to the data */
     int eval_fast;         /* last cm_rbf_evaluate: 1 if it used the fast sum */
     double eval_error;     /* last cm_rbf_evaluate that tried the fast sum: its estimated
                             * max error / max |data| (sampled against exact sums, x4) */

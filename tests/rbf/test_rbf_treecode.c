@@ -56,12 +56,23 @@ static double bound_ratio(const cm_rbf_tree *t, size_t m, const double *c, const
     return worst;
 }
 
-/* The bound on random weights, for the tolerances of the table, at the centres (the
- * solver's use) and at points inside the box (evaluation), for 1..4 components. */
+/* max_i |fast_i - ex_i| / S_i over the first nc of 4 components (ex, S: n x 4) */
+static double ratio4(const double *fast, int nc, size_t n, const double *ex, const double *S)
+{
+    double worst = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        for (int q = 0; q < nc; ++q)
+            worst = fmax(worst, fabs(fast[i * (size_t)nc + (size_t)q] - ex[4 * i + (size_t)q]) /
+                                    S[4 * i + (size_t)q]);
+    return worst;
+}
+
+/* The bound on random weights, for tolerances of the table, at the centres (the solver's
+ * use) and at points inside the box (evaluation), for 1..4 components. */
 static void test_bound_random(void)
 {
     size_t m;
-    double *x = bore_set(0.05, &m); /* ~12k centres */
+    double *x = bore_set(0.06, &m); /* ~8k centres */
     double *c = malloc(3 * m * sizeof *c), *w = malloc(4 * m * sizeof *w);
     for (size_t i = 0; i < m; ++i)
         for (int d = 0; d < 3; ++d) c[(size_t)d * m + i] = x[3 * i + d] / 4.0;
@@ -74,6 +85,15 @@ static void test_bound_random(void)
         p[n + i] = test_rng_range(&rng, 0.0, 0.5);
         p[2 * n + i] = test_rng_range(&rng, 0.0, 0.25);
     }
+    /* exact sums (compensated) and the scales S = sum |w| phi, at the centres and at p */
+    double *exc = malloc(4 * m * sizeof *exc), *Sc = malloc(4 * m * sizeof *Sc);
+    double *exp_ = malloc(4 * n * sizeof *exp_), *Sp = malloc(4 * n * sizeof *Sp);
+    double *aw = malloc(4 * m * sizeof *aw), *fast = malloc(4 * m * sizeof *fast);
+    for (size_t j = 0; j < 4 * m; ++j) aw[j] = fabs(w[j]);
+    cm_rbf_kernel_sum_acc(m, c, w, 4, m, c, m, exc, 4, 2);
+    cm_rbf_kernel_sum_acc(m, c, w, 4, n, p, n, exp_, 4, 2);
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, aw, 4, m, c, m, Sc, 4, 2);
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, aw, 4, n, p, n, Sp, 4, 2);
     const double tols[] = {1e-4, 1e-7, 1e-10, 1e-12};
     for (int k = 0; k < 4; ++k) {
         int order;
@@ -82,22 +102,42 @@ static void test_bound_random(void)
         cm_rbf_tree *t = cm_rbf_tree_create(m, c, order, theta);
         CHECK(t != NULL);
         if (!t) continue;
-        int nc = 1 + k % 4;
-        double rs = bound_ratio(t, m, c, w, nc, m, c, 1, NULL);
-        double ro = bound_ratio(t, m, c, w, nc, n, p, 0, NULL);
+        int nc = 1 + k;
+        CHECK(cm_rbf_tree_sum_self(t, w, nc, fast, (size_t)nc, 2) == 0);
+        double rs = ratio4(fast, nc, m, exc, Sc);
+        CHECK(cm_rbf_tree_sum(t, w, nc, n, p, n, fast, (size_t)nc, 2) == 0);
+        double ro = ratio4(fast, nc, n, exp_, Sp);
         printf("random weights, m = %zu, tol %.0e (order %d, theta %.2f), %d components: "
                "max err / sum|w|phi = %.3g at the centres, %.3g inside\n",
                m, tols[k], order, theta, nc, rs, ro);
         CHECK_MSG(rs <= tols[k] && ro <= tols[k], "%.3g %.3g > %.3g", rs, ro, tols[k]);
         /* and not trivially: the far field was used (a direct sum would be at 1e-16) */
         if (k < 2) CHECK_MSG(rs > 1e-3 * tols[k], "%.3g: far field unused?", rs);
+        /* the a-posteriori check sees an error of the same order as the true one */
+        if (k == 1) {
+            double e, sabs;
+            cm_rbf_tree_check(t, w, nc, n, p, n, fast, (size_t)nc, 256, &e, &sabs, 2);
+            double etrue = 0.0;
+            for (size_t i = 0; i < n; ++i)
+                for (int q = 0; q < nc; ++q)
+                    etrue = fmax(etrue, fabs(fast[i * (size_t)nc + (size_t)q] - exp_[4 * i + (size_t)q]));
+            printf("sampled error %.3g, true max error %.3g\n", e, etrue);
+            CHECK_MSG(e <= etrue * (1 + 1e-6) && 4.0 * e >= etrue, "%.3g vs %.3g", e, etrue);
+        }
         cm_rbf_tree_destroy(&t);
     }
     /* fewer centres than one proxy grid: all direct, exact to rounding */
     cm_rbf_tree *t = cm_rbf_tree_create(300, c, 8, 0.5);
-    CHECK(t && bound_ratio(t, 300, c, w, 3, 300, c, 0, NULL) <= 1e-14);
+    double *ex3 = malloc(3 * 300 * sizeof *ex3), *w3 = malloc(3 * 300 * sizeof *w3);
+    for (int q = 0; q < 3; ++q) memcpy(w3 + q * 300, w + (size_t)q * m, 300 * sizeof *w3);
+    CHECK(t && cm_rbf_tree_sum_self(t, w3, 3, fast, 3, 2) == 0);
+    cm_rbf_kernel_sum_acc(300, c, w3, 3, 300, c, 300, ex3, 3, 2);
+    double e300 = 0.0, s300 = 0.0;
+    for (size_t i = 0; i < 900; ++i) e300 = fmax(e300, fabs(fast[i] - ex3[i])), s300 = fmax(s300, fabs(ex3[i]));
+    CHECK_MSG(e300 <= 1e-13 * s300, "%.3g", e300 / s300);
     cm_rbf_tree_destroy(&t);
-    free(x), free(c), free(w), free(p);
+    free(x), free(c), free(w), free(p), free(exc), free(Sc), free(exp_), free(Sp), free(aw);
+    free(fast), free(ex3), free(w3);
 }
 
 /* Real weights (an RBF fit of the bore motion): the bound holds all the same, relative to
@@ -206,7 +246,7 @@ static void test_fit(cm_context *ctx)
 static void test_affine(cm_context *ctx)
 {
     size_t m;
-    double *x = bore_set(0.076, &m);
+    double *x = bore_set(0.1, &m);
     double *d = malloc(m * 3 * sizeof *d), *out = malloc(m * 3 * sizeof *out);
     for (size_t i = 0; i < m; ++i) {
         d[3 * i] = 1.0 + 0.5 * x[3 * i] - 0.25 * x[3 * i + 2];
@@ -236,18 +276,18 @@ static void test_evaluation(cm_context *ctx)
         size_t m;
         double *x, *d;
         if (set == 0) {
-            m = 6000;
+            m = 3000;
             x = malloc(m * 3 * sizeof *x);
             for (size_t i = 0; i < 3 * m; ++i) x[i] = test_rng_range(&rng, 0.0, 1.0);
         } else {
-            x = bore_set(0.076, &m);
+            x = bore_set(0.1, &m);
         }
         d = malloc(m * 3 * sizeof *d);
         for (size_t i = 0; i < m; ++i)
             for (int e = 0; e < 3; ++e)
                 d[3 * i + e] = 0.01 * sin(1.0 + e + x[3 * i]) * cos(x[3 * i + 1] - 0.5 * x[3 * i + 2]);
         if (set == 1) bore_motion(m, x, d);
-        const size_t n = 20000;
+        const size_t n = 10000;
         double *p = malloc(n * 3 * sizeof *p), *a = malloc(n * 3 * sizeof *a);
         double *b = malloc(n * 3 * sizeof *b);
         for (size_t i = 0; i < n; ++i)
@@ -270,6 +310,15 @@ static void test_evaluation(cm_context *ctx)
         CHECK_MSG(diff <= 1e-9 + 3e-10, "%.3g", diff); /* + the two solves' difference */
         if (sb.eval_fast) CHECK_MSG(sb.eval_error <= 1e-9, "%.3g", sb.eval_error);
         if (set == 0) CHECK_MSG(sb.eval_fast == 1, "smooth set: fast refused (%.3g)", sb.eval_error);
+        if (set == 1) { /* a tolerance no fast sum can meet: refused, the direct result */
+            o.fast_eval_tol = 1e-16;
+            cm_status s2 = fit_eval(ctx, &o, m, x, d, n, p, b, &sb);
+            double d2 = max_diff(n * 3, a, b) / dmax;
+            printf("fast_eval_tol 1e-16: fast %s (estimate %.3g), |result - direct| = %.3g\n",
+                   sb.eval_fast ? "accepted" : "refused", sb.eval_error, d2);
+            CHECK(s2 == CM_OK && sb.eval_fast == 0 && sb.eval_error > 1e-16);
+            CHECK_MSG(d2 <= 3e-10, "%.3g", d2);
+        }
         free(x), free(d), free(p), free(a), free(b);
     }
 }
