@@ -37,7 +37,12 @@ typedef struct cm_rbf cm_rbf;
  *   sums; rbf_sum_acc.c), the weights are accumulated in double-double. Memory about
  *   8 m (mean subdomain size) bytes (local_float: 4) plus the coarse factor (8 coarse^2)
  *   and the Krylov basis, 16 m restart bytes per component; time O(m local^2) to set up,
- *   O(m^2) per iteration.
+ *   O(m^2) per iteration. From 40,000 centres (fast_sum) the Krylov matvecs are fast sums
+ *   instead (a barycentric Lagrange treecode for r^3, O(m log m), error at most fast_tol x
+ *   sum_j |w_j| phi_ij), wrapped in 1..fast_refine refinement steps on exact (compensated
+ *   direct) residuals, so the residual reported is still the exact one; evaluation of
+ *   large n x m uses the treecode where a sampled check shows its error within
+ *   fast_eval_tol x max |data|, direct sums otherwise (stats: eval_fast, eval_error).
  * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
  *   crossover near 7,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
  *   iterative above; dense for the other kernels.
@@ -124,7 +129,9 @@ typedef struct cm_rbf_stats {
                             * dense: refinement steps */
     int matvecs;           /* last solve: direct-summation products with the m x m matrix
                             * (one per iteration and restart, all components together;
-                            * PETSC: the components one after the other, each counted) */
+                            * PETSC: the components one after the other, each counted;
+                            * fast_sum: the treecode's products plus two exact ones per
+                            * refinement step) */
     double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| over all components
                             * (exactness at the centres, by direct summation after the solve;
                             * iterative: with compensated sums) */
