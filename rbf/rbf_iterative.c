@@ -1,6 +1,8 @@
 /* Iterative solver for the r^3 + linear RBF system: restarted FGMRES in the null space of
  * the polynomial block, right-preconditioned by two-level restricted Schwarz
- * (rbf_schwarz.c), with direct-summation matvecs (rbf_sum.c).
+ * (rbf_schwarz.c), with compensated direct-summation matvecs (rbf_sum_acc.c) or, for large
+ * m, fast ones (the r^3 treecode, rbf_treecode.c) inside an outer refinement on exact
+ * residuals (refine_group says why).
  *
  * Why the null space: with Pi = I - Q1 Q1' (Q1 an orthonormal basis of the polynomials at
  * the centres), the weights are the solution of Pi A w = Pi f with Pi w = w, and Pi A Pi is
