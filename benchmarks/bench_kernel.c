@@ -138,6 +138,19 @@ int main(int argc, char **argv)
             fflush(stdout);
         }
     }
+    /* what AUTO's cost model sees in this process (one thread, as cm_rbf_create sets it) */
+    cm_rbf_blas_threads(NULL, "bench_kernel", 1, NULL);
+    double g, kp, ka;
+    cm_rbf_auto_rates(&g, &kp, &ka);
+    printf("auto_probe dgemm_gflops=%.1f plain_pairs_per_s=%.3g compensated_pairs_per_s=%.3g\n",
+           g * 1e-9, kp, ka);
+    for (size_t m = 2500; m <= 40000; m *= 2) {
+        double d, it;
+        int measured = cm_rbf_auto_costs(m, &d, &it);
+        printf("auto_model m=%zu dense_s=%.2f iterative_s=%.2f choice=%s rates=%s\n", m, d, it,
+               cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, m) ? "dense" : "iterative",
+               measured ? "measured" : "fallback");
+    }
     free(c), free(w), free(p), free(out), free(ref), free(absum);
     return 0;
 }

@@ -107,6 +107,13 @@ cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *g
 
 /* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */
 int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m);
+/* dgemm flops per second and r^3 kernel-sum pairs per second (plain, compensated; 3 weight
+ * vectors) of one thread, timed once per process (rbf_auto_probe.c); 0 if the probe could
+ * not allocate its 3.6 MB. cm_rbf_create calls it with one BLAS thread set. */
+void cm_rbf_auto_rates(double *gemm, double *plain, double *acc);
+/* The model's seconds (of one thread) for m centres, dense and iterative; returns 1 if they
+ * come from the measured rates, 0 from the fixed fallback constants. */
+int cm_rbf_auto_costs(size_t m, double *dense, double *iter);
 
 /* Builds r->iter (preconditioner) for the centres in r (placed, P factored). */
 cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads);
