@@ -1,12 +1,13 @@
 /* Hand-written AVX-512 blocks of the r^3 kernel sums (plain and compensated), chosen at run
  * time by rbf_sum.c and rbf_sum_acc.c on CPUs with AVX-512 F/DQ/VL; other CPUs keep the
- * compiler-vectorised loops there. Why by hand: GCC's vectorisation of the generic loop
- * reached 0.9e9 pairs per CPU-second on Zen 5, 4x below what the sqrt unit allows, and it
- * cannot balance the sqrt unit against the FMA pipes.
+ * compiler-vectorised loops there. Why by hand: the compiler cannot balance the sqrt unit
+ * against the FMA pipes (plain sums), and the compensated sums need a different algorithm
+ * (the fixed binade below). Measured on Zen 5 (benchmarks/bench_kernel.c, RESULTS.md issue
+ * 10): plain 3.3e9 -> 3.8-4.0e9, compensated 1.2e9 -> 2.4-2.6e9 pairs per CPU-second.
  *
- * The square root is the bottleneck (one vsqrtpd zmm every ~8 cycles on Zen 5, while the
- * rest of a pair takes ~1 cycle per vector on the FMA/add pipes). So of every four vectors
- * of points, three take vsqrtpd and one computes sqrt on the FMA pipes instead: rsqrt14
+ * The square root is the bottleneck of the plain sum (in a register-resident test: all
+ * vsqrtpd 3.46e9 pairs/s, all rsqrt14 + Newton 2.37e9). So of every four vectors of
+ * points, three take vsqrtpd and one computes sqrt on the FMA pipes instead: rsqrt14
  * (14 bits), two Goldschmidt steps and a final Newton correction with an FMA residual
  * (Markstein's scheme). In a test of 1.6e7 arguments over 40 binades that sequence returned
  * the correctly rounded sqrt every time (one Goldschmidt step fewer errs by 1 ulp in 0.6 %),
@@ -178,9 +179,9 @@ CM_AVX512 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, con
  * w f - (T - S), the rounding error (|.| <= u/2), is formed by one more FMA with a relative
  * error of eps. Those remainders are summed plainly into E. So S - big + E has the error
  * eps |result| + about eps u m^(1/2..1) (u ~ eps 4 bound), second order like TwoSum's, at
- * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the add pipes were the
- * bottleneck: 0.4x the plain sum's throughput). This is the binned summation of the
- * reproducible BLAS literature (Demmel and Nguyen) with a single bin. */
+ * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the vector operation
+ * count was the limit: TwoSum ran at 0.4x the plain sum's throughput). This is the binned
+ * summation of the reproducible-BLAS literature (Demmel and Nguyen) with a single bin. */
 CM_AVX512 CM_INLINE void tile_accf(const int nc, const double *c, size_t ldc, const double *w,
                                    size_t ldw, size_t jn, const double *pt, double *hi,
                                    double *lo)
