@@ -18,7 +18,7 @@
 static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
     "[--method rbf|mls|dmffd|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
-    "[--cubature N] [--cover S] [--lattice N] [--clamp E] [--exact-constraints] "
+    "[--cubature N] [--cover S] [--graded G] [--lattice N] [--clamp E] [--exact-constraints] "
     "[--constraint TYPE:SET ...] [--threads N] [--verbose]";
 
 static void print_help(void)
@@ -51,6 +51,9 @@ static void print_help(void)
         "  --samples K               MLS samples (default 2%% of the nodes, at least 500)\n"
         "  --cubature N              MLS cubature points (default 4 K)\n"
         "  --cover S                 MLS: samples covering every point (default 5)\n"
+        "  --graded G                MLS: samples and cubature points follow the mesh's\n"
+        "                            resolution: 0 uniform by volume and area (default),\n"
+        "                            1 each cell alike (a CFD mesh refined around a body)\n"
         "  --lattice N               DM-FFD control points per axis (4..200, default 10)\n"
         "  --clamp E                 DM-FFD: singular values <= E x the largest dropped\n"
         "                            (default 1e-10)\n"
@@ -67,7 +70,7 @@ static void print_help(void)
 typedef struct deform_args {
     const char *mesh, *handles, *fixed, *out;
     int fix_boundary, mls, shell, dmffd, exact, threads, verbose, cover, lattice;
-    double stretch, bend, fix, clamp;
+    double stretch, bend, fix, clamp, graded;
     size_t samples, cubature;
     cli_constraints cons; /* --constraint and its options (deform_constraints.c) */
 } deform_args;
@@ -140,6 +143,10 @@ static int parse_args(int argc, char **argv, deform_args *a)
             if (number(v, &d) || d < lo || d > hi || d != floor(d))
                 return cli_usage(cmd, usage_line, "%s: '%s' is not an integer in %g..%g", o, v, lo, hi);
             *(o[2] == 'c' ? &a->cover : &a->lattice) = (int)d;
+        } else if (!strcmp(o, "--graded")) {
+            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
+            if (number(v, &a->graded) || !(a->graded <= 1))
+                return cli_usage(cmd, usage_line, "--graded: expected a number in 0..1, got '%s'", v);
         } else if (!strcmp(o, "--clamp")) {
             if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
             if (number(v, &a->clamp) || !(a->clamp > 0 && a->clamp < 1))
@@ -223,7 +230,7 @@ int cli_cmd_deform(int argc, char **argv)
         cm_mls_options o;
         cm_mls_options_init(&o);
         o.stretch = a.stretch, o.bend = a.bend, o.fix = a.fix, o.samples = a.samples;
-        o.cubature = a.cubature, o.cover = a.cover;
+        o.cubature = a.cubature, o.cover = a.cover, o.graded = a.graded;
         o.keep_constrained = a.exact;
         cm_mls *mls = NULL;
         cm_shape_set sets[CLI_MAX_CONSTRAINTS];
