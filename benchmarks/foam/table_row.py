@@ -52,7 +52,13 @@ def judge(text):
     g = metrics(text)
     f = lambda k, i=0: float(g[k][i]) if k in g else float("nan")  # noqa: E731
     pyr = int(g["wrong pyramids"][0]) if "wrong pyramids" in g else 0
-    return g, (f("max aspect ratio"), f("non-orthogonality"), f("non-orthogonality", 1), f("max skewness"), pyr)
+    ar = f("max aspect ratio")
+    m = re.search(r"High aspect ratio cells found, Max aspect ratio: (\S+),", text)
+    if m:  # above the threshold checkMesh words it differently
+        ar = float(m.group(1))
+    m = re.search(r"Max skewness = (\S+),", text)  # likewise ("***High skewness: ...")
+    sk = float(m.group(1)) if m and "max skewness" not in g else f("max skewness")
+    return g, (ar, f("non-orthogonality"), f("non-orthogonality", 1), sk, pyr)
 
 
 def verdict(ar, no, sk, pyr):
@@ -75,8 +81,8 @@ else:
     p, cpu, rss, wall = timed([CM] + cmd + ["-o", out])
     open(os.path.join(WORK, ROW + ".log"), "w").write(" ".join(cmd) + "\n" + p.stdout + p.stderr)
     if p.returncode != 0:
-        row = "| %s | - | - | - | - | exit %d: %s | - | %.1f | %.0f |" % (
-            ROW, p.returncode, p.stderr.strip().splitlines()[-2 if len(p.stderr.strip().splitlines()) > 1 else -1][:200], cpu, rss)
+        msg = [ln for ln in p.stderr.splitlines() if ln.startswith("cadmorph")] or p.stderr.strip().splitlines()[-1:]
+        row = "| %s | - | - | - | - | exit %d: %s | - | %.1f | %.0f |" % (ROW, p.returncode, msg[-1][:300], cpu, rss)
         print(row)
         open(os.path.join(WORK, "rows.md"), "a").write(row + "\n")
         sys.exit(0)
