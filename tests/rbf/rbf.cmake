@@ -38,3 +38,8 @@ endif()
 # the r^3 treecode: its error bound on random and real weights; fits with fast matvecs
 # against direct ones and dense; affine data; the choice of the fast evaluation
 cm_add_unit_test(test_rbf_treecode ${CMAKE_CURRENT_LIST_DIR}/test_rbf_treecode.c LIBS cm_rbf LABELS rbf)
+# the kernel sums per instruction set (generic, AVX2, AVX-512 compiled and by hand) against
+# each other and a long-double reference: plain and compensated, tails, threads
+cm_add_unit_test(test_rbf_sum ${CMAKE_CURRENT_LIST_DIR}/test_rbf_sum.c LIBS cm_rbf LABELS rbf)
+# AUTO's cost model: probe rates, growth of the costs, one crossover
+cm_add_unit_test(test_rbf_auto ${CMAKE_CURRENT_LIST_DIR}/test_rbf_auto.c LIBS cm_rbf LABELS rbf)
