@@ -9,7 +9,12 @@
  * m * local_size numbers over all leaves instead of sum local_size^2 for the factors, and
  * one application is one small matrix-vector product per leaf. A coarse space of
  * farthest-point centres is solved exactly first (multiplicative), so the local solves see
- * only the residual of the smooth, global part. */
+ * only the residual of the smooth, global part.
+ * Storage (local_float): the rows can be kept in float at half the memory without costing
+ * iterations, because the local linear fit is taken out of the data before the product
+ * (G_l annihilates it in exact arithmetic, while its float rounding would multiply it).
+ * Split set-up (rbf_petsc.c): a part builds and applies only its run of subdomains; the
+ * parts' corrections add up to the whole one. */
 #include "rbf_internal.h"
 
 #include <cblas.h>
@@ -17,7 +22,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <stdio.h> /* TEMP */
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -41,6 +45,10 @@ struct cm_rbf_schwarz {
     float *g32;
     double *g64;
     int l0, l1;       /* the subdomains this part owns (all: 0, nsub) */
+    double *lq;       /* with float rows: nsub x nmax x 4, orthonormal basis of the linear
+                       * polynomials on each own local set (idx order; zero columns past its
+                       * rank), see cm_rbf_schwarz_apply_sum */
+    size_t *q_ptr;    /* nsub + 1: offsets into lq */
     size_t nc;        /* coarse centres */
     size_t *c_idx;    /* nc */
     double *c_xyz;    /* 3 x nc SoA coordinates of the coarse centres */
@@ -473,6 +481,8 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
     free(p->n_in);
     free(p->d_ptr);
     free(p->f_ptr);
+    free(p->lq);
+    free(p->q_ptr);
     free(p->hd);
     free(p->g32);
     free(p->g64);
@@ -556,6 +566,28 @@ done:
 
 /* Rows of the local inverse kept in double for a subdomain of n centres, n_in of its own:
  * local_float 0 all, 1 none, 2 the leaf's own rows (mixed: the overlap rows in float). */
+/* q (n x 4 col-major) = orthonormal basis of the linear polynomials on the n centres idx
+ * (the same rank-revealing QR as local_inverse; columns past the rank zero). work: 8n. */
+static int local_poly_basis(const double *cg, size_t m, const size_t *idx, size_t n,
+                            double *work, double *q)
+{
+    double *pq = work;
+    lapack_int jpvt[4] = {0, 0, 0, 0};
+    double tau[4];
+    for (size_t i = 0; i < n; ++i) pq[i] = 1.0;
+    for (int d = 0; d < 3; ++d)
+        for (size_t i = 0; i < n; ++i) pq[(size_t)(d + 1) * n + i] = cg[(size_t)d * m + idx[i]];
+    const lapack_int ln = (lapack_int)n;
+    if (LAPACKE_dgeqp3(LAPACK_COL_MAJOR, ln, 4, pq, ln, jpvt, tau) != 0) return -1;
+    int rk = 0;
+    const double r00 = fabs(pq[0]);
+    while (rk < 4 && fabs(pq[(size_t)rk * n + (size_t)rk]) > 1e-9 * r00) ++rk;
+    if (LAPACKE_dorgqr(LAPACK_COL_MAJOR, ln, rk, rk, pq, ln, tau) != 0) return -1;
+    memset(q, 0, 4 * n * sizeof *q);
+    memcpy(q, pq, (size_t)rk * n * sizeof *q);
+    return 0;
+}
+
 static int double_rows(int local_float, size_t n, size_t n_in)
 {
     return local_float == 1 ? 0 : local_float == 2 ? (int)n_in : (int)n;
@@ -620,6 +652,18 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
                         "cm_rbf_create: out of memory for the local solves (%.3g GB)",
                         ((double)nd * 8.0 + (double)nf * 4.0) / 1e9);
     p->bytes += nd * 8 + nf * 4;
+    if (nf > 0) { /* float rows: the local polynomial bases, see cm_rbf_schwarz_apply_sum */
+        p->q_ptr = malloc(((size_t)p->nsub + 1) * sizeof *p->q_ptr);
+        if (!p->q_ptr) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+        p->q_ptr[0] = 0;
+        for (int l = 0; l < p->nsub; ++l) {
+            int own = l >= p->l0 && l < p->l1;
+            p->q_ptr[l + 1] = p->q_ptr[l] + (own ? 4 * (p->sub_ptr[l + 1] - p->sub_ptr[l]) : 0);
+        }
+        p->lq = malloc((p->q_ptr[p->nsub] ? p->q_ptr[p->nsub] : 1) * sizeof *p->lq);
+        if (!p->lq) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+        p->bytes += p->q_ptr[p->nsub] * 8;
+    }
     /* one subdomain per thread with single-threaded BLAS: the local problems are too small
      * for threaded LAPACK to pay off */
     const int saved = openblas_get_num_threads();
@@ -639,8 +683,17 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
             }
             size_t n = p->sub_ptr[l + 1] - p->sub_ptr[l], nin = (size_t)p->n_in[l];
             const size_t *idx = p->sub_idx + p->sub_ptr[l];
-            int info = getenv("CM_LOCAL_OLD") ? -2 : local_inverse_fast(r->c, m, idx, n, nin, work, g); /* TEMP */
+            int info = local_inverse_fast(r->c, m, idx, n, nin, work, g);
             if (info == -2) info = local_inverse(r->c, m, idx, n, nin, work, g);
+            if (info != 0) {
+#pragma omp critical
+                {
+                    bad = l + 1;
+                    bad_info = info;
+                }
+                continue;
+            }
+            if (p->lq && info == 0) info = local_poly_basis(r->c, m, idx, n, work, p->lq + p->q_ptr[l]);
             if (info != 0) {
 #pragma omp critical
                 {
@@ -795,6 +848,22 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
             if (!x) continue; /* out of memory: a weaker preconditioner, not a wrong result */
             for (int c = 0; c < nc; ++c)
                 for (size_t i = 0; i < n; ++i) x[(size_t)c * n + i] = res[(size_t)c * m + idx[i]];
+            if (p->lq) {
+                /* float rows: the local inverse annihilates linear data, so taking the local
+                 * linear fit out first changes nothing in exact arithmetic, but the float
+                 * rounding of G (about 6e-8 |G|) then multiplies only what is left, not the
+                 * linear part, which on a small set dominates the data */
+                const double *q = p->lq + p->q_ptr[l];
+                for (int c = 0; c < nc; ++c) {
+                    double *xc = x + (size_t)c * n;
+                    for (int a = 0; a < 4; ++a) {
+                        const double *qa = q + (size_t)a * n;
+                        double t = 0.0;
+                        for (size_t i = 0; i < n; ++i) t += qa[i] * xc[i];
+                        for (size_t i = 0; i < n; ++i) xc[i] -= t * qa[i];
+                    }
+                }
+            }
             for (size_t j = 0; j < nin; ++j) {
                 const double *gd = p->g64 + p->d_ptr[l] + j * hd;
                 const float *gf = p->g32 + p->f_ptr[l] + j * hf;
