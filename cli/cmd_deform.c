@@ -9,7 +9,6 @@
 #include "cadmorph/mls.h"
 #include "cadmorph/warp.h"
 
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,10 +17,71 @@
 static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
     "[--method rbf|mls|dmffd|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
-    "[--cubature N] [--cover S] [--lattice N] [--clamp E] [--exact-constraints] "
+    "[--cubature N] [--cover S] [--blend B] [--lattice N] [--clamp E] [--exact-constraints] "
     "[--constraint TYPE:SET ...] [--threads N] [--verbose]";
 
-static void print_help(void)
+enum { METHOD_RBF, METHOD_MLS, METHOD_SHELL, METHOD_DMFFD };
+
+typedef struct deform_args {
+    const char *mesh, *handles, *fixed, *out;
+    int method, fix_boundary, exact, threads, verbose, lattice;
+    double clamp;
+    cm_mls_options mls;   /* stretch, bend, fix also weigh the shell */
+    cli_constraints cons; /* --constraint and its options (deform_constraints.c) */
+} deform_args;
+
+static deform_args args;
+static int print_help(void);
+
+static const char *const method_names[] = {"rbf", "mls", "shell", "dmffd", NULL};
+static const int method_values[] = {METHOD_RBF, METHOD_MLS, METHOD_SHELL, METHOD_DMFFD};
+
+static const cli_option options[] = {
+    {.name = "--help", .alias = "-h", .kind = CLI_HELP},
+    {.name = "--mesh", .kind = CLI_STRING, .dest = &args.mesh, .label = "--mesh M",
+     .help = "input mesh"},
+    {.name = "--handles", .kind = CLI_STRING, .dest = &args.handles, .label = "--handles H.csv",
+     .help = "the handle region and its displacement"},
+    {.name = "--fixed", .kind = CLI_STRING, .dest = &args.fixed, .label = "--fixed F.csv",
+     .help = "the fixed region"},
+    {.name = "--fix-unlisted-boundary", .kind = CLI_FLAG, .dest = &args.fix_boundary,
+     .label = "--fix-unlisted-boundary",
+     .help = "fix every boundary node not in H.csv (volume: the\n"
+             "boundary surface; surface: its border edges)"},
+    {.name = "--method", .kind = CLI_ENUM, .dest = &args.method, .names = method_names,
+     .values = method_values, .bad = "%.0sunknown method '%s' (rbf|mls|dmffd|shell)",
+     .label = "--method M",
+     .help = "rbf (triharmonic, exact at H and F), mls (constrained\n"
+             "MLS, approximate; default), dmffd (DM-FFD on a cubic\n"
+             "B-spline lattice enclosing M, least squares: H and F keep\n"
+             "their motion, the residual is the lattice's miss) or\n"
+             "shell (surfaces: the mesh-based shell of the paper's eq. 10,\n"
+             "the ground truth; weights per unit area, not normalised)"},
+    CLI_MLS_OPTIONS(args.mls),
+    {.name = "--fix", .kind = CLI_DOUBLE, .dest = &args.mls.fix, .lo = 0, .hi = NAN, .open = 1,
+     .bad = "%s: '%s' is not a number > 0", .label = "--fix GF",
+     .help = "mls / shell: constraint weight gamma_f (default 1000);\n"
+             "--stretch and --bend weigh the shell's energies too"},
+    {.name = "--exact-constraints", .kind = CLI_FLAG, .dest = &args.exact,
+     .label = "--exact-constraints",
+     .help = "mls: H and F nodes get their prescribed value instead of\n"
+             "the field's (its miss blended over --blend)"},
+    {.name = "--lattice", .kind = CLI_INT, .dest = &args.lattice, .lo = 4, .hi = 200,
+     .bad = "%s: '%s' is not an integer in 4..200", .label = "--lattice N",
+     .help = "dmffd: control points per axis (4..200, default 10)"},
+    {.name = "--clamp", .kind = CLI_DOUBLE, .dest = &args.clamp, .lo = 0, .hi = 1, .open = 3,
+     .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--clamp E",
+     .help = "dmffd: singular values <= E x the largest dropped\n(default 1e-10)"},
+    CLI_CONSTRAINT_OPTIONS(args.cons),
+    {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
+     .label = "-o, --output M'", .help = "output mesh (must not be an input)"},
+    {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
+     .help = "threads (default: all)"},
+    {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
+     .label = "--verbose", .help = "timings and debug messages on stderr"},
+    {0}};
+
+static int print_help(void)
 {
     printf("usage: %s\n\n", usage_line);
     printf(
@@ -33,132 +93,35 @@ static void print_help(void)
         "Laplacian) and a mean-curvature summary, volume meshes the quality summary line.\n\n"
         "H.csv: header node,dx,dy,dz (0-based node index in M's file order).\n"
         "F.csv: header node, then one node index per line.\n\n"
-        "options:\n"
-        "  --mesh M                  input mesh\n"
-        "  --handles H.csv           the handle region and its displacement\n"
-        "  --fixed F.csv             the fixed region\n"
-        "  --fix-unlisted-boundary   fix every boundary node not in H.csv (volume: the\n"
-        "                            boundary surface; surface: its border edges)\n"
-        "  --method M                rbf (triharmonic, exact at H and F), mls (constrained\n"
-        "                            MLS, approximate; default), dmffd (DM-FFD on a cubic\n"
-        "                            B-spline lattice enclosing M, least squares: H and F keep\n"
-        "                            their motion, the residual is the lattice's miss) or\n"
-        "                            shell (surfaces: the\n"
-        "                            mesh-based shell of the paper's eq. 10, the ground truth;\n"
-        "                            weights per unit area, not normalised)\n"
-        "  --stretch GS, --bend GB   MLS / shell energy weights (default 1, 1)\n"
-        "  --fix GF                  MLS / shell constraint weight (default 1000)\n"
-        "  --samples K               MLS samples (default 2%% of the nodes, at least 500)\n"
-        "  --cubature N              MLS cubature points (default 4 K)\n"
-        "  --cover S                 MLS: samples covering every point (default 5)\n"
-        "  --lattice N               DM-FFD control points per axis (4..200, default 10)\n"
-        "  --clamp E                 DM-FFD: singular values <= E x the largest dropped\n"
-        "                            (default 1e-10)\n"
-        "  --exact-constraints       MLS: H and F nodes get their prescribed value instead of\n"
-        "                            the field's\n"
-        "  -o, --output M'           output mesh (must not be an input)\n"
-        "  --threads N               threads (default: all)\n"
-        "  --verbose                 timings and debug messages on stderr\n",
+        "options:\n",
         cm_mesh_format_list());
-    cli_constraints_help();
+    cli_print_options(stdout, options, 26);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input.\n");
+    return CLI_EXIT_OK;
 }
 
-typedef struct deform_args {
-    const char *mesh, *handles, *fixed, *out;
-    int fix_boundary, mls, shell, dmffd, exact, threads, verbose, cover, lattice;
-    double stretch, bend, fix, clamp;
-    size_t samples, cubature;
-    cli_constraints cons; /* --constraint and its options (deform_constraints.c) */
-} deform_args;
-
-static int number(const char *v, double *out)
-{
-    char *end;
-    errno = 0;
-    double d = strtod(v, &end);
-    if (errno || *end || end == v || !isfinite(d) || d < 0) return -1;
-    *out = d;
-    return 0;
-}
-
+/* Returns -1 to go on, else the exit code. */
 static int parse_args(int argc, char **argv, deform_args *a)
 {
     static const char *cmd = "deform";
-    memset(a, 0, sizeof *a);
-    a->mls = 1;
-    a->stretch = 1, a->bend = 1, a->fix = 1000, a->cover = 5, a->lattice = 10;
-    cli_constraints_init(&a->cons);
-    for (int i = 1; i < argc; ++i) {
-        const char *o = argv[i], *v;
-        int r = cli_constraints_option(argc, argv, &i, cmd, usage_line, &a->cons);
-        if (r < 0) return CLI_EXIT_USAGE;
-        if (r > 0) continue;
-        if (!strcmp(o, "-h") || !strcmp(o, "--help")) {
-            print_help();
-            return CLI_EXIT_OK;
-        } else if (!strcmp(o, "--verbose") || !strcmp(o, "-v")) {
-            a->verbose = 1;
-        } else if (!strcmp(o, "--fix-unlisted-boundary")) {
-            a->fix_boundary = 1;
-        } else if (!strcmp(o, "--exact-constraints")) {
-            a->exact = 1;
-        } else if (!strcmp(o, "--mesh")) {
-            if (!(a->mesh = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--handles")) {
-            if (!(a->handles = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--fixed")) {
-            if (!(a->fixed = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "-o") || !strcmp(o, "--output")) {
-            if (!(a->out = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-        } else if (!strcmp(o, "--method")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (!strcmp(v, "rbf"))
-                a->mls = 0;
-            else if (!strcmp(v, "mls"))
-                a->mls = 1;
-            else if (!strcmp(v, "shell"))
-                a->mls = 0, a->shell = 1;
-            else if (!strcmp(v, "dmffd"))
-                a->mls = 0, a->dmffd = 1;
-            else
-                return cli_usage(cmd, usage_line, "unknown method '%s' (rbf|mls|dmffd|shell)", v);
-        } else if (!strcmp(o, "--stretch") || !strcmp(o, "--bend") || !strcmp(o, "--fix")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            double *dst = o[2] == 's' ? &a->stretch : o[2] == 'b' ? &a->bend : &a->fix;
-            if (number(v, dst))
-                return cli_usage(cmd, usage_line, "%s: '%s' is not a number >= 0", o, v);
-        } else if (!strcmp(o, "--samples") || !strcmp(o, "--cubature")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            double d;
-            if (number(v, &d) || d < 4 || d > 1e8 || d != floor(d))
-                return cli_usage(cmd, usage_line, "%s: '%s' is not an integer >= 4", o, v);
-            *(o[2] == 's' ? &a->samples : &a->cubature) = (size_t)d;
-        } else if (!strcmp(o, "--cover") || !strcmp(o, "--lattice")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            double d, lo = o[2] == 'c' ? 1 : 4, hi = o[2] == 'c' ? 64 : 200;
-            if (number(v, &d) || d < lo || d > hi || d != floor(d))
-                return cli_usage(cmd, usage_line, "%s: '%s' is not an integer in %g..%g", o, v, lo, hi);
-            *(o[2] == 'c' ? &a->cover : &a->lattice) = (int)d;
-        } else if (!strcmp(o, "--clamp")) {
-            if (!(v = cli_value(argc, argv, &i, cmd, usage_line))) return CLI_EXIT_USAGE;
-            if (number(v, &a->clamp) || !(a->clamp > 0 && a->clamp < 1))
-                return cli_usage(cmd, usage_line, "--clamp: expected a number in (0, 1), got '%s'", v);
-        } else if (!strcmp(o, "--threads")) {
-            if (cli_threads_value(argc, argv, &i, cmd, usage_line, &a->threads))
-                return CLI_EXIT_USAGE;
-        } else {
-            return cli_usage(cmd, usage_line, "unknown argument '%s'", o);
-        }
-    }
+    memset(&args, 0, sizeof args);
+    args.method = METHOD_MLS, args.lattice = 10;
+    cm_mls_options_init(&args.mls);
+    cli_constraints_init(&args.cons);
+    cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
+                    .unknown = "unknown argument '%s'"};
+    const int parsed = cli_parse(&p, argc, argv);
+    *a = args;
+    if (parsed >= 0) return parsed;
+    a->mls.keep_constrained = a->exact;
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->handles) return cli_usage(cmd, usage_line, "--handles is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
     if (a->fixed && a->fix_boundary)
         return cli_usage(cmd, usage_line, "--fixed and --fix-unlisted-boundary exclude each other");
-    if ((a->mls || a->shell) && (a->fix <= 0 || a->stretch + a->bend <= 0))
-        return cli_usage(cmd, usage_line, "--fix must be > 0 and --stretch + --bend > 0");
-    if (cli_constraints_any(&a->cons) && !a->mls)
+    if ((a->method == METHOD_MLS || a->method == METHOD_SHELL) && a->mls.stretch + a->mls.bend <= 0)
+        return cli_usage(cmd, usage_line, "--stretch + --bend must be > 0");
+    if (cli_constraints_any(&a->cons) && a->method != METHOD_MLS)
         return cli_usage(cmd, usage_line, "--constraint needs --method mls");
     const char *inputs[] = {a->mesh, a->handles, a->fixed, a->cons.cad};
     return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 4) ? CLI_EXIT_USAGE : -1;
@@ -213,22 +176,18 @@ int cli_cmd_deform(int argc, char **argv)
     }
     if (s >= 0 && nh == 0) s = cm_error(ctx, CM_ERR_ARGUMENT, "%s: no handle node", a.handles);
     double residual = 0, t0 = cm_wtime();
-    if (s >= 0 && a.shell && volume)
+    if (s >= 0 && a.method == METHOD_SHELL && volume)
         s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: --method shell deforms surface meshes only", a.mesh);
-    if (s >= 0 && a.shell) s = cm_mls_shell(ctx, mesh, con, a.stretch, a.bend, a.fix, disp);
-    if (s >= 0 && !a.mls && !a.shell && !a.dmffd) s = cm_deform_rbf(ctx, mesh->n_nodes, mesh->xyz, con, disp);
-    if (s >= 0 && a.dmffd)
+    if (s >= 0 && a.method == METHOD_SHELL)
+        s = cm_mls_shell(ctx, mesh, con, a.mls.stretch, a.mls.bend, a.mls.fix, disp);
+    if (s >= 0 && a.method == METHOD_RBF) s = cm_deform_rbf(ctx, mesh->n_nodes, mesh->xyz, con, disp);
+    if (s >= 0 && a.method == METHOD_DMFFD)
         s = cm_deform_dmffd(ctx, mesh->n_nodes, mesh->xyz, con, a.lattice, a.clamp, disp, &residual);
-    if (s >= 0 && a.mls) {
-        cm_mls_options o;
-        cm_mls_options_init(&o);
-        o.stretch = a.stretch, o.bend = a.bend, o.fix = a.fix, o.samples = a.samples;
-        o.cubature = a.cubature, o.cover = a.cover;
-        o.keep_constrained = a.exact;
+    if (s >= 0 && a.method == METHOD_MLS) {
         cm_mls *mls = NULL;
         cm_shape_set sets[CLI_MAX_CONSTRAINTS];
         s = cli_constraints_resolve(ctx, mesh, &a.cons, sets);
-        if (s >= 0) s = cm_mls_create(ctx, mesh, con, &o, &mls);
+        if (s >= 0) s = cm_mls_create(ctx, mesh, con, &a.mls, &mls);
         if (s >= 0 && cli_constraints_any(&a.cons))
             s = cli_constraints_run(ctx, mls, mesh, &a.cons, sets, disp, &residual);
         else if (s >= 0)
@@ -271,7 +230,7 @@ int cli_cmd_deform(int argc, char **argv)
             if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
             if (s >= 0) {
                 printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                       a.mls ? "mls" : a.shell ? "shell" : a.dmffd ? "dmffd" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                       method_names[a.method], nh, nf, n - nh - nf, t1 - t0, residual);
                 printf("mean_curvature (interior vertices): before min=%.6g mean=%.6g max=%.6g; "
                        "after min=%.6g mean=%.6g max=%.6g\n",
                        h_before[0], h_before[1], h_before[2], cnt ? mn : 0,
@@ -285,7 +244,7 @@ int cli_cmd_deform(int argc, char **argv)
         if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
         if (s >= 0) {
             printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                   a.mls ? "mls" : a.shell ? "shell" : a.dmffd ? "dmffd" : "rbf", nh, nf, n - nh - nf, t1 - t0, residual);
+                   method_names[a.method], nh, nf, n - nh - nf, t1 - t0, residual);
             s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
         }
     }

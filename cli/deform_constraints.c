@@ -19,34 +19,34 @@ void cli_constraints_init(cli_constraints *c)
     cm_shapeup_options_init(&c->opt);
 }
 
-void cli_constraints_help(void)
+int cli_parse_constraint(const cli_parser *p, const cli_option *o, const char *v, void *dest)
 {
-    printf(
-        "  --constraint TYPE:SET     MLS only, repeatable: keep the nodes of SET on a shape of\n"
-        "                            TYPE while deforming (Shape-Up, the MLS paper's section 6):\n"
-        "                            plane, circle, cylinder, cone, line (similar copy:\n"
-        "                            translation, rotation, uniform scale) or rigid. SET: a\n"
-        "                            node-list file (header node), else a physical group of the\n"
-        "                            mesh (gmsh; an OpenFOAM patch or cellZone), else a field\n"
-        "                            NAME or NAME=VALUE (nodes where the node field, or of the\n"
-        "                            cells where the cell field, is nonzero / equals VALUE)\n"
-        "  --constraint-weight GC    gamma_c (default 10)\n"
-        "  --constraint-iterations N cap on the alternations (default 10000)\n"
-        "  --constraint-tolerance T  stop when no constrained node moves more than T x the\n"
-        "                            bounding-box diagonal in one alternation (default 1e-9)\n"
-        "  --dense-constraints       mean-centred C (dense per set) instead of subtracting one\n"
-        "                            point (section 6.1, the default)\n"
-        "  --constraint-anderson M   Anderson acceleration over the last M iterates (1..64;\n"
-        "                            default off: the paper's plain alternation)\n"
-        "  --constraint-snap         after the alternation, put the constrained nodes on their\n"
-        "                            projections (the shapes then hold to rounding)\n"
-        "  --constraints-from-cad G  volume meshes: constraints from the STEP model G of the\n"
-        "                            mesh: the nodes of each planar face (with its edges and\n"
-        "                            vertices) a plane set, of each cylindrical (conical) face\n"
-        "                            a cylinder (cone) set, of each circular edge a circle set\n"
-        "  --cad-constraints LIST    which of them: plane, cylinder, cone, circle, face:N,\n"
-        "                            edge:N (0-based ids as `cadmorph info` lists; default all\n"
-        "                            types)\n");
+    (void)o;
+    cli_constraints *c = dest;
+    const char *colon = strchr(v, ':');
+    char name[16];
+    size_t len = colon ? (size_t)(colon - v) : 0;
+    if (!colon || len == 0 || len >= sizeof name || !colon[1])
+        return cli_usage(p->cmd, p->usage, "--constraint '%s': expected TYPE:SET", v);
+    memcpy(name, v, len);
+    name[len] = 0;
+    cm_shape_type t;
+    if (cm_shape_type_parse(NULL, name, &t) < 0)
+        return cli_usage(p->cmd, p->usage,
+                         "--constraint '%s': unknown type '%s' (plane|circle|cylinder|cone|line|rigid)",
+                         v, name);
+    if (c->n >= CLI_MAX_CONSTRAINTS)
+        return cli_usage(p->cmd, p->usage, "more than %d --constraint options", CLI_MAX_CONSTRAINTS);
+    c->type[c->n] = t;
+    c->set[c->n++] = colon + 1;
+    return 0;
+}
+
+int cli_parse_dense_constraints(const cli_parser *p, const cli_option *o, const char *v, void *dest)
+{
+    (void)p, (void)o, (void)v;
+    ((cli_constraints *)dest)->opt.sparse = 0;
+    return 0;
 }
 
 static int parse_number(const char *v, double *out)
@@ -56,88 +56,6 @@ static int parse_number(const char *v, double *out)
     double d = strtod(v, &end);
     if (errno || *end || end == v || !isfinite(d)) return -1;
     *out = d;
-    return 0;
-}
-
-int cli_constraints_option(int argc, char **argv, int *i, const char *cmd, const char *usage,
-                           cli_constraints *c)
-{
-    const char *o = argv[*i], *v;
-    double d;
-    if (!strcmp(o, "--dense-constraints")) {
-        c->opt.sparse = 0;
-        return 1;
-    }
-    if (!strcmp(o, "--constraint-snap")) {
-        c->opt.snap = 1;
-        return 1;
-    }
-    if (!strcmp(o, "--constraints-from-cad") || !strcmp(o, "--cad-constraints")) {
-        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
-        if (o[2] == 'c' && o[3] == 'o')
-            c->cad = v;
-        else
-            c->cad_filter = v;
-        return 1;
-    }
-    if (!strcmp(o, "--constraint")) {
-        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
-        const char *colon = strchr(v, ':');
-        char name[16];
-        size_t len = colon ? (size_t)(colon - v) : 0;
-        if (!colon || len == 0 || len >= sizeof name || !colon[1]) {
-            cli_usage(cmd, usage, "--constraint '%s': expected TYPE:SET", v);
-            return -1;
-        }
-        memcpy(name, v, len);
-        name[len] = 0;
-        cm_shape_type t;
-        if (cm_shape_type_parse(NULL, name, &t) < 0) {
-            cli_usage(cmd, usage,
-                      "--constraint '%s': unknown type '%s' (plane|circle|cylinder|cone|line|rigid)", v, name);
-            return -1;
-        }
-        if (c->n >= CLI_MAX_CONSTRAINTS) {
-            cli_usage(cmd, usage, "more than %d --constraint options", CLI_MAX_CONSTRAINTS);
-            return -1;
-        }
-        c->type[c->n] = t;
-        c->set[c->n++] = colon + 1;
-        return 1;
-    }
-    if (!strcmp(o, "--constraint-anderson")) {
-        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
-        if (parse_number(v, &d) || d < 1 || d > 64 || d != floor(d)) {
-            cli_usage(cmd, usage, "%s: '%s' is not an integer in 1..64", o, v);
-            return -1;
-        }
-        c->opt.anderson = (int)d;
-        return 1;
-    }
-    if (!strcmp(o, "--constraint-weight") || !strcmp(o, "--constraint-tolerance") ||
-        !strcmp(o, "--constraint-iterations")) {
-        if (!(v = cli_value(argc, argv, i, cmd, usage))) return -1;
-        if (parse_number(v, &d) || d < 0) {
-            cli_usage(cmd, usage, "%s: '%s' is not a number >= 0", o, v);
-            return -1;
-        }
-        if (o[13] == 'w') {
-            if (!(d > 0)) {
-                cli_usage(cmd, usage, "%s: must be > 0", o);
-                return -1;
-            }
-            c->opt.weight = d;
-        } else if (o[13] == 't') {
-            c->opt.tolerance = d;
-        } else {
-            if (d != floor(d) || d > 1e9) {
-                cli_usage(cmd, usage, "%s: '%s' is not an integer", o, v);
-                return -1;
-            }
-            c->opt.max_iterations = (int)d;
-        }
-        return 1;
-    }
     return 0;
 }
 

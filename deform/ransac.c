@@ -299,125 +299,6 @@ static int make_cone(const rs *s, const size_t f[3], cand *k)
 
 /* ---- refits (the forward search's fits) ---- */
 
-/* The parameters of a cone moved by t: apex + t0..2, axis tilted by t3, t4 in its normal
- * plane, half-angle + t5. */
-static void cone_moved(const double *p, const double *t, double *q)
-{
-    double ax[3] = {p[3], p[4], p[5]}, u[3], v[3], tmp[3] = {1, 0, 0};
-    if (fabs(ax[0]) > 0.9) tmp[0] = 0, tmp[1] = 1;
-    cross3(ax, tmp, u);
-    normalize(u);
-    cross3(ax, u, v);
-    for (int i = 0; i < 3; ++i)
-        q[i] = p[i] + t[i], q[3 + i] = ax[i] + t[3] * u[i] + t[4] * v[i];
-    normalize(q + 3);
-    q[6] = p[6] + t[5];
-}
-
-static double cone_cost(const double *p, size_t m, const double *x, double *res)
-{
-    cand k = {CM_PRIMITIVE_CONE, {0}, 0};
-    memcpy(k.p, p, sizeof k.p);
-    double c = 0, nv[3];
-    for (size_t i = 0; i < m; ++i) {
-        /* signed distance: the geometric one, with its side */
-        double d = prim_distance(&k, x + 3 * i, nv);
-        double v[3] = {x[3 * i] - p[0], x[3 * i + 1] - p[1], x[3 * i + 2] - p[2]};
-        double h = dot3(v, p + 3), rho2 = dot3(v, v) - h * h;
-        double phi = atan2(sqrt(rho2 > 0 ? rho2 : 0), h);
-        if (phi < p[6]) d = -d;
-        if (res) res[i] = d;
-        c += d * d;
-    }
-    return c;
-}
-
-/* Levenberg-Marquardt on the 6 cone parameters with a forward-difference Jacobian (the
- * minimal set's cone as the start). jac: m x 6 scratch, res, res2: m. */
-static void cone_refit(size_t m, const double *x, double *p, double *jac, double *res, double *res2,
-                       double scale)
-{
-    double cost = cone_cost(p, m, x, res), lambda = -1;
-    for (int it = 0; it < 50; ++it) {
-        const double hstep[6] = {1e-7 * scale, 1e-7 * scale, 1e-7 * scale, 1e-7, 1e-7, 1e-7};
-        for (int j = 0; j < 6; ++j) {
-            double t[6] = {0, 0, 0, 0, 0, 0}, q[7];
-            t[j] = hstep[j];
-            cone_moved(p, t, q);
-            cone_cost(q, m, x, res2);
-            for (size_t i = 0; i < m; ++i)
-                jac[6 * i + j] = (res2[i] - res[i]) / hstep[j];
-        }
-        double a[36] = {0}, g[6] = {0};
-        for (size_t i = 0; i < m; ++i)
-            for (int j = 0; j < 6; ++j) {
-                g[j] -= jac[6 * i + j] * res[i];
-                for (int l = 0; l < 6; ++l)
-                    a[6 * j + l] += jac[6 * i + j] * jac[6 * i + l];
-            }
-        if (lambda < 0) lambda = 1e-6 * (a[0] + a[7] + a[14] + a[21] + a[28] + a[35]) / 6;
-        int accepted = 0;
-        for (int tries = 0; tries < 12 && !accepted; ++tries) {
-            double aa[36], b[6], q[7];
-            memcpy(aa, a, sizeof aa);
-            memcpy(b, g, sizeof b);
-            for (int j = 0; j < 6; ++j)
-                aa[7 * j] += lambda * (a[7 * j] > 0 ? a[7 * j] : 1);
-            /* Gaussian elimination, 6 x 6 */
-            int ok = 1;
-            for (int c = 0; c < 6 && ok; ++c) {
-                int piv = c;
-                for (int r = c + 1; r < 6; ++r)
-                    if (fabs(aa[6 * r + c]) > fabs(aa[6 * piv + c])) piv = r;
-                if (!(fabs(aa[6 * piv + c]) > 0)) {
-                    ok = 0;
-                    break;
-                }
-                for (int j = 0; j < 6; ++j) {
-                    double tt = aa[6 * c + j];
-                    aa[6 * c + j] = aa[6 * piv + j], aa[6 * piv + j] = tt;
-                }
-                double tt = b[c];
-                b[c] = b[piv], b[piv] = tt;
-                for (int r = c + 1; r < 6; ++r) {
-                    double f = aa[6 * r + c] / aa[6 * c + c];
-                    for (int j = c; j < 6; ++j)
-                        aa[6 * r + j] -= f * aa[6 * c + j];
-                    b[r] -= f * b[c];
-                }
-            }
-            if (!ok) {
-                lambda *= 10;
-                continue;
-            }
-            for (int c = 5; c >= 0; --c) {
-                double v = b[c];
-                for (int j = c + 1; j < 6; ++j)
-                    v -= aa[6 * c + j] * b[j];
-                b[c] = v / aa[6 * c + c];
-            }
-            cone_moved(p, b, q);
-            if (!(q[6] > 0.01 && q[6] < 1.5)) {
-                lambda *= 4;
-                continue;
-            }
-            double nc = cone_cost(q, m, x, res2);
-            if (nc < cost) {
-                double step = (fabs(b[0]) + fabs(b[1]) + fabs(b[2])) / scale + fabs(b[3]) + fabs(b[4]) + fabs(b[5]);
-                memcpy(p, q, 7 * sizeof *p);
-                cost = nc;
-                memcpy(res, res2, m * sizeof *res);
-                lambda /= 3;
-                accepted = 1;
-                if (step < 1e-12) return;
-            } else {
-                lambda *= 4;
-            }
-        }
-        if (!accepted) return;
-    }
-}
-
 static int refit(cm_context *ctx, rs *s, cand *k, size_t m, const int32_t *list, double *buf,
                  double *tmp)
 {
@@ -478,15 +359,12 @@ static int refit(cm_context *ctx, rs *s, cand *k, size_t m, const int32_t *list,
         k->p[3] = sqrt(r2);
         return k->p[3] < s->diag;
     }
-    case CM_PRIMITIVE_CONE: {
-        if (m < 7) return 0;
-        /* scratch: the m x 6 Jacobian and two residual vectors */
-        double *jac = malloc(m * 8 * sizeof *jac);
-        if (!jac) return 0;
-        cone_refit(m, buf, k->p, jac, jac + 6 * m, jac + 7 * m, s->diag);
-        free(jac);
+    case CM_PRIMITIVE_CONE:
+        /* nearly flat or nearly cylindrical cones are the other primitives */
+        if (m < 7 || cm_shape_project_cone(ctx, m, buf, k->p, tmp, fit) < 0) return 0;
+        if (!(fit[6] > 0.01 && fit[6] < 1.5)) return 0;
+        memcpy(k->p, fit, 7 * sizeof *fit);
         return 1;
-    }
     }
     return 0;
 }

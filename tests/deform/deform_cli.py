@@ -224,7 +224,7 @@ for args, code, msg in (
         (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "--method", "dmffd", "--lattice", "3", "-o", "x.vtu"], 1,
          "--lattice: '3' is not an integer in 4..200"),
         (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "--cover", "0", "-o", "x.vtu"], 1,
-         "--cover: '0' is not an integer"),
+         "--cover: expected 1..64 samples covering every point, got .0."),
         (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "-o", "x.ply"], 1, "unknown mesh extension"),
         (["--mesh", "plate.vtk", "--handles", "plate_H.csv", "-o", "plate.vtk"], 1, "is an input")):
     rc, out, err = run(*args)
