@@ -44,7 +44,8 @@ typedef struct cm_rbf cm_rbf;
  * PETSC: the ITERATIVE solver distributed over the MPI ranks of PETSC_COMM_WORLD through
  *   PETSc (only in builds with -DCADMORPH_WITH_PETSC=ON; otherwise create fails with
  *   CM_ERR_UNSUPPORTED): KSPFGMRES on a MatShell whose rows (the r^3 kernel sums) are split
- *   over the ranks, the same Schwarz preconditioner as a PCSHELL. Create, solve and
+ *   over the ranks, the same Schwarz preconditioner as a PCSHELL (each rank factorises
+ *   and applies only its share of the subdomains, the coarse solve on all). Create, solve and
  *   evaluate are then collective: every rank calls them with the same centres and values
  *   (each holds all centres and gets all weights); see cm_rbf_petsc_initialize.
  * cm_rbf_evaluate works for both; an iterative fit evaluates with compensated sums too
