@@ -17,7 +17,7 @@
 static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
     "[--method rbf|mls|dmffd|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
-    "[--cubature N] [--cover S] [--blend B] [--lattice N] [--clamp E] [--exact-constraints] "
+    "[--cubature N] [--cover S] [--blend B] [--graded G] [--lattice N] [--clamp E] [--exact-constraints] "
     "[--constraint TYPE:SET ...] [--threads N] [--verbose]";
 
 enum { METHOD_RBF, METHOD_MLS, METHOD_SHELL, METHOD_DMFFD };

@@ -92,7 +92,8 @@ extern const int cli_study_mode_values[];
 int cli_parse_size(const cli_parser *p, const cli_option *o, const char *value, void *dest);
 
 /* The MLS options of warp, morph and deform (m: a cm_mls_options lvalue, set to its defaults
- * before parsing): --samples K, --cubature N, --cover S, --stretch GS, --bend GB, --blend B. */
+ * before parsing): --samples K, --cubature N, --cover S, --stretch GS, --bend GB, --blend B,
+ * --graded G. */
 #define CLI_MLS_OPTIONS(m)                                                                        \
     {.name = "--samples", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_size,          \
      .dest = &(m).samples, .label = "--samples K",                                                \
@@ -111,7 +112,12 @@ int cli_parse_size(const cli_parser *p, const cli_option *o, const char *value, 
     {.name = "--blend", .kind = CLI_DOUBLE, .dest = &(m).blend, .lo = 0, .hi = NAN,               \
      .bad = "%s: '%s' is not a number >= 0", .label = "--blend B",                               \
      .help = "mls: the field's miss at the boundary decays into the interior over\n"             \
-             "B x the mean support radius (default 1.5; 0: the first cell layer takes it)"}
+             "B x the mean support radius (default 1.5; 0: the first cell layer takes it)"},      \
+    {.name = "--graded", .kind = CLI_DOUBLE, .dest = &(m).graded, .lo = 0, .hi = 1,               \
+     .bad = "%s: '%s' is not a number in 0..1", .label = "--graded G",                           \
+     .help = "mls: samples follow the mesh's resolution: 0 uniform by\n"                        \
+             "volume and area (default), 1 each cell alike (a CFD mesh\n"                      \
+             "refined around a body: the 1M-cell car case needs it)"}
 
 /* Parses argv[1..argc). Returns -1 when the command should run, or the exit code: 0 after
  * --help, CLI_EXIT_USAGE after a message on stderr. */

@@ -52,6 +52,7 @@ void cm_mls_options_init(cm_mls_options *opt)
     opt->keep_constrained = 1;
     opt->blend = 1.5;
     opt->seed = 1;
+    opt->graded = 0;
 }
 
 void cm_mls_destroy(cm_mls **mls)
@@ -111,7 +112,7 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
     size_t ns = 20 * ks + (n3 ? 0 : 5 * N), nv = n3 ? (20 * kv > 5 * N ? 20 * kv : 5 * N) : 0;
     mls_dense d;
     double t0 = cm_wtime();
-    cm_status s = mls_dense_create(ctx, mesh, ns, nv, o->seed, &d);
+    cm_status s = mls_dense_create(ctx, mesh, ns, nv, o->graded, o->seed, &d);
     double t1 = cm_wtime();
     if (s < 0) return s;
     if (d.n_s == 0) kv = kk, ks = 0; /* no surface of positive area */
@@ -122,8 +123,17 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_mls_create: out of memory");
         goto fail;
     }
-    if (ks) s = mls_farthest(ctx, d.xyz, d.n_s, ks, o->seed, c);
-    if (s >= 0 && kv) s = mls_farthest(ctx, d.xyz + 3 * d.n_s, d.n_v, kv, o->seed + 1, c + 3 * ks);
+    if (o->graded > 0) {
+        /* graded: the dense points follow the mesh's resolution, and so should the samples; a
+         * farthest-point subset would spread them evenly again, so take the first ones (the
+         * dense points are drawn at random: a random subset), Lloyd evens them out locally */
+        memcpy(c, d.xyz, ks * 3 * sizeof *c);
+        memcpy(c + 3 * ks, d.xyz + 3 * d.n_s, kv * 3 * sizeof *c);
+    } else {
+        if (ks) s = mls_farthest(ctx, d.xyz, d.n_s, ks, o->seed, c);
+        if (s >= 0 && kv)
+            s = mls_farthest(ctx, d.xyz + 3 * d.n_s, d.n_v, kv, o->seed + 1, c + 3 * ks);
+    }
     for (size_t i = 0; i < d.n_s + d.n_v; ++i)
         w[i] = i < d.n_s ? o->surface_weight : 1;
     double t2 = cm_wtime();
@@ -141,13 +151,18 @@ static cm_status place_points(cm_context *ctx, const cm_mesh *mesh, const cm_mls
             memcpy(qq + 3 * i, dom + 3 * (i * (nd / N)), 3 * sizeof *qq);
     }
     s = mls_lloyd(ctx, dom, NULL, nd, o->lloyd, N, qq, mass);
+    /* graded dense points are not uniform: each cubature point's volume is the measure its
+     * closest dense points stand for (the positions still follow the points' density) */
+    const double *dm = d.n_v ? d.measure + d.n_s : d.measure;
+    if (s >= 0 && o->graded > 0) s = mls_lloyd(ctx, dom, dm, nd, 0, N, qq, mass);
     if (s < 0) goto fail;
     cm_log(ctx, CM_LOG_DEBUG,
            "cm_mls: sampling: %zu + %zu dense points %.3f s, farthest points %.3f s, Lloyd of the "
            "samples %.3f s, Lloyd of the %zu cubature points %.3f s",
            d.n_s, d.n_v, t1 - t0, t2 - t1, t3 - t2, N, cm_wtime() - t3);
-    for (size_t i = 0; i < N; ++i)
-        mass[i] *= measure / (double)nd;
+    if (!(o->graded > 0))
+        for (size_t i = 0; i < N; ++i)
+            mass[i] *= measure / (double)nd;
     mls_dense_free(&d);
     free(w);
     *k = kk;
@@ -304,6 +319,8 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
         o = *opt;
     else
         cm_mls_options_init(&o);
+    if (!(o.graded >= 0 && o.graded <= 1))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mls_create: graded %g: need 0..1", o.graded);
     if (!(o.blend >= 0))
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mls_create: blend %g: need >= 0", o.blend);
     if (!(o.stretch >= 0) || !(o.bend >= 0) || !(o.fix > 0) || o.stretch + o.bend <= 0)

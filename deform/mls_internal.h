@@ -49,11 +49,16 @@ int mls_basis_eval(const cm_mls_basis *b, const double x[3], int32_t *idx, doubl
 typedef struct mls_dense {
     size_t n_s, n_v;      /* surface, volume points */
     double *xyz;          /* (n_s + n_v) x 3: surface points first */
+    double *measure;      /* n_s + n_v: the area / volume each point stands for (their sum
+                             is about the total); uniform (total / count) when graded = 0 */
     double area, volume;  /* total measures */
 } mls_dense;
 
+/* graded in [0, 1]: a face / cell piece is drawn with probability proportional to
+ * measure^(1 - graded): 0 uniform by measure (the paper's), 1 each mesh simplex alike (the
+ * points follow the mesh's resolution). */
 cm_status mls_dense_create(cm_context *ctx, const cm_mesh *mesh, size_t n_surface,
-                           size_t n_volume, uint64_t seed, mls_dense *d);
+                           size_t n_volume, double graded, uint64_t seed, mls_dense *d);
 void mls_dense_free(mls_dense *d);
 
 /* k points out of dense points [first, first + n): farthest-point subset (from a seeded

@@ -22,6 +22,7 @@ static double rng_uniform(uint64_t *s) { return (double)(rng_next(s) >> 11) * 0x
 void mls_dense_free(mls_dense *d)
 {
     free(d->xyz);
+    free(d->measure);
     memset(d, 0, sizeof *d);
 }
 
@@ -103,20 +104,35 @@ static int push_cell_tets(simplex_list *l, const double *xyz, cm_cell_type lin, 
     return 0;
 }
 
-static void sample_list(const simplex_list *l, const double *xyz, size_t m, uint64_t *rng,
-                        double *out)
+/* m points drawn from the simplices of l, each simplex with probability proportional to
+ * measure^power (cdf: scratch of l->n entries, used when power != 1); measure[i]: the share
+ * of the total measure point i stands for, measure_s / (m p_s), so that the sum over the
+ * points estimates the total for any power. */
+static void sample_list(const simplex_list *l, const double *xyz, size_t m, double power,
+                        double *cdf, uint64_t *rng, double *out, double *measure)
 {
-    double total = l->cdf[l->n - 1];
+    const double *c = l->cdf;
+    if (power != 1) {
+        for (size_t i = 0; i < l->n; ++i) {
+            double mi = l->cdf[i] - (i ? l->cdf[i - 1] : 0);
+            cdf[i] = (i ? cdf[i - 1] : 0) + (mi > 0 ? pow(mi, power) : 0);
+        }
+        c = cdf;
+    }
+    double total = c[l->n - 1], whole = l->cdf[l->n - 1];
     for (size_t i = 0; i < m; ++i) {
         double t = rng_uniform(rng) * total;
         size_t lo = 0, hi = l->n - 1;
         while (lo < hi) {
             size_t mid = (lo + hi) / 2;
-            if (l->cdf[mid] < t)
+            if (c[mid] < t)
                 lo = mid + 1;
             else
                 hi = mid;
         }
+        double ps = (c[lo] - (lo ? c[lo - 1] : 0)) / total;
+        double ms = l->cdf[lo] - (lo ? l->cdf[lo - 1] : 0);
+        measure[i] = power == 1 || !(ps > 0) ? whole / (double)m : ms / ((double)m * ps);
         const int64_t *v = l->v + lo * (size_t)l->nv;
         double b[4];
         if (l->nv == 3) {
@@ -140,8 +156,9 @@ static void sample_list(const simplex_list *l, const double *xyz, size_t m, uint
 }
 
 cm_status mls_dense_create(cm_context *ctx, const cm_mesh *mesh, size_t n_surface,
-                           size_t n_volume, uint64_t seed, mls_dense *d)
+                           size_t n_volume, double graded, uint64_t seed, mls_dense *d)
 {
+    double *cdf = NULL;
     memset(d, 0, sizeof *d);
     simplex_list tri = {0, 0, 3, NULL, NULL}, tet = {0, 0, 4, NULL, NULL};
     cm_mesh_boundary *bnd = NULL;
@@ -180,16 +197,22 @@ cm_status mls_dense_create(cm_context *ctx, const cm_mesh *mesh, size_t n_surfac
         goto done;
     }
     d->xyz = malloc((n_surface + n_volume) * 3 * sizeof *d->xyz);
-    if (!d->xyz) {
+    d->measure = malloc((n_surface + n_volume) * sizeof *d->measure);
+    if (graded > 0) cdf = malloc((tri.n > tet.n ? tri.n : tet.n) * sizeof *cdf);
+    if (!d->xyz || !d->measure || (graded > 0 && !cdf)) {
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_mls: out of memory (sampling)");
         goto done;
     }
     uint64_t rng = seed * 0x9E3779B97F4A7C15ull + 1;
-    if (n_surface) sample_list(&tri, mesh->xyz, n_surface, &rng, d->xyz);
-    if (n_volume) sample_list(&tet, mesh->xyz, n_volume, &rng, d->xyz + 3 * n_surface);
+    double power = 1 - (graded > 1 ? 1 : graded > 0 ? graded : 0);
+    if (n_surface) sample_list(&tri, mesh->xyz, n_surface, power, cdf, &rng, d->xyz, d->measure);
+    if (n_volume)
+        sample_list(&tet, mesh->xyz, n_volume, power, cdf, &rng, d->xyz + 3 * n_surface,
+                    d->measure + n_surface);
     d->n_s = n_surface;
     d->n_v = n_volume;
 done:
+    free(cdf);
     cm_mesh_boundary_destroy(&bnd);
     free(tri.v);
     free(tri.cdf);

@@ -123,7 +123,7 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
         size_t n_leg = 0;
         const cm_morph_step *leg = cm_morpher_steps(mp, &n_leg);
         cm_morph_step *grown = n_leg ? realloc(rows, (n_rows + n_leg) * sizeof *rows) : rows;
-        if (!grown) {
+        if (!grown && n_leg) { /* no rows (apply failed before its first step): keep its error */
             s = cm_error(ctx, CM_ERR_NOMEM, "cm_morph_run: out of memory");
             break;
         }

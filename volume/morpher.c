@@ -39,6 +39,7 @@ struct cm_morpher {
     double *next;  /* #nodes x 3: the step being tried */
     double *offset; /* keep_offset: #boundary x 3, each node minus its point on g */
     unsigned char *fixed; /* #nodes: the boundary nodes, which optimisation never moves */
+    cm_off_cad_contact contact; /* off_cad fixed: nodes on G touching the fixed surface */
     double min_sj0;       /* M's minimum scaled Jacobian (keep_fraction) */
     cm_morph_step *rows;  /* the last apply's steps */
     size_t n_rows, cap_rows;
@@ -146,8 +147,16 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
                         msg);
     }
     if (s < 0) return s;
-    s = cm_morph_off_cad_check(ctx, mp->mesh, mp->b, mp->nodes, &mp->info.off_cad_components);
+    cm_off_cad_contact_free(&mp->contact);
+    size_t partial = 0;
+    s = cm_morph_off_cad_check(ctx, mp->mesh, mp->b, mp->nodes, &mp->info.off_cad_components,
+                               &partial, &mp->contact);
     if (s < 0) return s;
+    if (partial)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "classify: %zu boundary components partly on the CAD model: %zu nodes on it touch "
+               "the fixed surface (they may slide along it where it is flat)",
+               partial, mp->contact.n);
     mp->info.off_cad_nodes = mp->nodes->n_off;
     if (mp->nodes->n_off)
         cm_log(ctx, CM_LOG_DEBUG,
@@ -198,6 +207,7 @@ void cm_morpher_destroy(cm_morpher **morpher)
     free(mp->next);
     free(mp->offset);
     free(mp->fixed);
+    cm_off_cad_contact_free(&mp->contact);
     free(mp->rows);
     free(mp);
     *morpher = NULL;
@@ -367,6 +377,7 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     }
     double t1 = cm_wtime();
     if (s >= 0) s = cm_warp_apply(ctx, w, mp->disp);
+    double t_apply = cm_wtime() - t1;
     row->residual = cm_warp_residual(w);
     cm_warp_destroy(&own);
     if (s < 0) return s;
@@ -390,6 +401,9 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     s = cm_mesh_quality(ctx, mp->work, mp->sj);
     if (s >= 0) s = cm_quality_summarize(ctx, mp->work, mp->sj, NULL, &all);
     row->t_evaluation = cm_wtime() - t1;
+    /* t_evaluation holds the warp's apply (for an iterative RBF its Krylov solve too) */
+    cm_log(ctx, CM_LOG_DEBUG, "morph: warp apply %.3f s, optimisation and quality %.3f s",
+           t_apply, row->t_evaluation - t_apply);
     double t2 = cm_wtime();
     if (s >= 0)
         s = cm_surface_max_distance(ctx, mp->target_loc, mp->bxyz, nd->n, &row->max_dist, NULL);
@@ -548,6 +562,10 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     if (mp->opt.keep_offset)
         for (size_t i = 0; i < 3 * mp->nodes->n; ++i)
             mp->bnew[i] += mp->offset[i];
+    if (s >= 0 && mp->contact.n) {
+        cm_status c = cm_morph_off_cad_contact_check(ctx, mp->mesh, mp->nodes, &mp->contact, mp->bnew);
+        if (c < 0) return c;
+    }
     double t_surface = cm_wtime() - t0;
     char warning[1024] = "";
     if (s == CM_WARNING) {

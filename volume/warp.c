@@ -69,6 +69,9 @@ cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_bou
     if ((int)opt->method < 0 || opt->method >= CM_WARP_N_METHODS)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_create: unknown method %d",
                         (int)opt->method);
+    if (!(opt->tolerance >= 0 && opt->tolerance < 1))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_create: tolerance %g: need 0 <= t < 1",
+                        opt->tolerance);
     if (b->n_components == 0)
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_warp_create: the mesh has no volume cells");
     cm_warp *w = calloc(1, sizeof *w);

@@ -115,7 +115,7 @@ static cm_status split_component(cm_context *ctx, const cm_mesh *mesh,
 /* The RBF of component k; its errors (coplanar centres, failed factorisation) get the
  * component number in front. */
 static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel,
-                               cm_rbf_solver solver, size_t k,
+                               cm_rbf_solver solver, double tolerance, size_t k,
                                warp_component *wc)
 {
     if (wc->n_free == 0) return CM_OK; /* nothing to interpolate: every node is prescribed */
@@ -130,6 +130,7 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
     cm_rbf_options ro;
     cm_rbf_options_init(&ro);
     ro.solver = solver;
+    if (tolerance > 0) ro.tolerance = tolerance;
     cm_status s = cm_rbf_create_opt(ctx, kernel, 3, wc->n_fixed, centres, &ro, &wc->rbf);
     free(centres);
     if (s < 0)
@@ -142,7 +143,7 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
  * one pass per component with a stamp array deduplicates its nodes. */
 static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                                   const unsigned char *constrained, cm_rbf_kernel kernel,
-                                  cm_rbf_solver solver,
+                                  cm_rbf_solver solver, double tolerance,
                                   rbf_warp *w, size_t *n_shared_free)
 {
     size_t nc = b->n_components, nn = mesh->n_nodes;
@@ -186,7 +187,7 @@ static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm
         s = split_component(ctx, mesh, constrained, (int)k, list, vis.n, owner, &w->comp[k],
                             n_shared_free);
         if (s < 0) goto done;
-        s = fit_component(ctx, mesh, kernel, solver, k, &w->comp[k]);
+        s = fit_component(ctx, mesh, kernel, solver, tolerance, k, &w->comp[k]);
         if (s < 0) goto done;
         cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc);
     }
@@ -212,7 +213,7 @@ done:
 
 static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                             const unsigned char *constrained, cm_rbf_kernel kernel,
-                            cm_rbf_solver solver, void **state)
+                            cm_rbf_solver solver, double tolerance, void **state)
 {
     if (b->n_components > (size_t)(~0u >> 1))
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_warp_create: too many components");
@@ -227,7 +228,7 @@ static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
         goto fail;
     }
     size_t n_shared_free = 0;
-    s = build_components(ctx, mesh, b, constrained, kernel, solver, w, &n_shared_free);
+    s = build_components(ctx, mesh, b, constrained, kernel, solver, tolerance, w, &n_shared_free);
     if (s < 0) goto fail;
     if (n_shared_free)
         cm_log(ctx, CM_LOG_WARNING,
@@ -262,9 +263,21 @@ static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *r
         if (!wc->rbf) continue;
         for (size_t i = 0; i < wc->n_fixed; ++i)
             memcpy(warp->values + 3 * i, disp + 3 * wc->fixed[i], 3 * sizeof(double));
+        double t0 = cm_wtime();
         cm_status s = cm_rbf_solve(ctx, wc->rbf, 3, warp->values);
+        double t1 = cm_wtime();
         if (s >= 0) s = cm_rbf_evaluate(ctx, wc->rbf, wc->n_free, wc->free_xyz, warp->out);
         if (s < 0) return cm_error_prefix(ctx, s, "cm_warp_apply: component %zu", k);
+        /* the split that says where a large warp's time goes: an iterative fit's solve (its
+         * Krylov matvecs, m^2 kernel pairs each) or the evaluation (n_free x m pairs) */
+        cm_rbf_stats st;
+        cm_rbf_get_stats(wc->rbf, &st);
+        cm_log(ctx, CM_LOG_DEBUG,
+               "cm_warp_apply: component %zu: %zu centres, solve %.3f s (%s, %d iterations), "
+               "evaluation at %zu nodes %.3f s",
+               k, wc->n_fixed, t1 - t0,
+               st.solver == CM_RBF_SOLVER_DENSE ? "dense" : "iterative", st.iterations, wc->n_free,
+               cm_wtime() - t1);
         for (size_t i = 0; i < wc->n_free; ++i)
             memcpy(disp + 3 * wc->free_nodes[i], warp->out + 3 * i, 3 * sizeof(double));
         cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components);
@@ -276,14 +289,16 @@ static cm_status triharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                     const cm_mesh_boundary *b, const unsigned char *constrained,
                                     const cm_warp_options *opt, void **state)
 {
-    return rbf_create(ctx, mesh, b, constrained, CM_RBF_TRIHARMONIC, opt->solver, state);
+    return rbf_create(ctx, mesh, b, constrained, CM_RBF_TRIHARMONIC, opt->solver, opt->tolerance,
+                      state);
 }
 
 static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                    const cm_mesh_boundary *b, const unsigned char *constrained,
                                    const cm_warp_options *opt, void **state)
 {
-    return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, opt->solver, state);
+    return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, opt->solver, opt->tolerance,
+                      state);
 }
 
 const cm_warp_method_ops cm_warp_rbf_triharmonic = {"rbf", triharmonic_create, rbf_apply,

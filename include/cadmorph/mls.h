@@ -60,6 +60,12 @@ typedef struct cm_mls_options {
                               the mean support radius (1.5; 0: off, the miss stays in the
                               first cell layer) */
     uint64_t seed;         /* random sampling (1) */
+    double graded;         /* how the samples and cubature points follow the mesh's own
+                              resolution: a face / cell piece is drawn with probability
+                              proportional to measure^(1 - graded); 0 (default): uniform by
+                              measure, farthest points (the paper's); 1: each piece alike,
+                              so a mesh refined around a body (a CFD mesh in a wind
+                              tunnel) gets its samples where its cells are small (0) */
 } cm_mls_options;
 
 CM_API void cm_mls_options_init(cm_mls_options *opt);

@@ -50,6 +50,12 @@ typedef struct cm_warp_options {
      * iterative solver above), DENSE, ITERATIVE or PETSC (rbf.h; PETSC makes create and
      * apply collective over the MPI ranks) */
     cm_rbf_solver solver;
+    /* RBF methods, iterative solvers: stop when the largest miss at the centres is
+     * <= tolerance x the largest prescribed displacement; 0 = the RBF's default (1e-10,
+     * the exact interpolant). The warp puts the constrained nodes at their prescribed values
+     * anyway, so a looser tolerance only perturbs the interior by about tolerance x the
+     * motion: 1e-6 of a 0.02 motion is 2e-8, far below any cell. */
+    double tolerance;
     /* DM-FFD: control points per axis of the lattice whose domain is the mesh's bounding box
      * (grown by 1e-3 of its diagonal): 5, 10, 15, 25 in the paper; 0 = 10 */
     int lattice;

@@ -451,6 +451,74 @@ static void test_blend(cm_context *ctx)
     cm_mesh_destroy(&m);
 }
 
+/* --graded: on a box whose cells shrink towards x = 0 (x -> x^3), graded 1 puts the samples
+ * where the cells are (46 % of them lie in x < 0.1, 10 % of the volume), graded 0 by volume;
+ * the dense points' measures still add up to the volume and the area (unbiased weights), and
+ * an affine motion stays exact under bending. */
+static void test_graded(cm_context *ctx)
+{
+    cm_mesh *m = NULL;
+    cm_mesh_create(ctx, &m);
+    add_box(ctx, m, 12, 0);
+    size_t n = m->n_nodes;
+    for (size_t i = 0; i < n; ++i)
+        m->xyz[3 * i] = m->xyz[3 * i] * m->xyz[3 * i] * m->xyz[3 * i];
+    for (int g = 0; g <= 1; ++g) {
+        mls_dense d;
+        CHECK(mls_dense_create(ctx, m, 20000, 20000, g, 7, &d) == CM_OK);
+        double area = 0, vol = 0;
+        for (size_t i = 0; i < d.n_s; ++i)
+            area += d.measure[i];
+        for (size_t i = d.n_s; i < d.n_s + d.n_v; ++i)
+            vol += d.measure[i];
+        CHECK_MSG(fabs(area - 6) < 0.03 * 6 && fabs(vol - 1) < 0.03,
+                  "graded %d: dense measures add up to area %g (6), volume %g (1)", g, area, vol);
+        mls_dense_free(&d);
+    }
+    unsigned char *con = calloc(n, 1);
+    double *dsp = calloc(3 * n, sizeof *dsp);
+    for (size_t i = 0; i < n; ++i)
+        con[i] = m->xyz[3 * i] < 1e-9 || m->xyz[3 * i] > 1 - 1e-9;
+    double share[2] = {0, 0};
+    for (int g = 0; g <= 1; ++g) {
+        cm_mls_options o;
+        cm_mls_options_init(&o);
+        o.samples = 300;
+        o.stretch = 0;
+        o.graded = g;
+        cm_mls *mls = NULL;
+        CHECK(cm_mls_create(ctx, m, con, &o, &mls) == CM_OK);
+        if (!mls) break;
+        size_t k = 0;
+        const double *c = cm_mls_samples(mls, &k);
+        for (size_t j = 0; j < k; ++j)
+            share[g] += c[3 * j] < 0.1 ? 1.0 / (double)k : 0;
+        for (size_t i = 0; i < n; ++i)
+            if (con[i]) affine(m->xyz + 3 * i, dsp + 3 * i);
+        double res = -1, worst = 0;
+        CHECK(cm_mls_apply(ctx, mls, dsp, &res) == CM_OK);
+        for (size_t i = 0; i < n; ++i) {
+            double e[3];
+            affine(m->xyz + 3 * i, e);
+            for (int a = 0; a < 3; ++a)
+                worst = fmax(worst, fabs(dsp[3 * i + a] - e[a]));
+        }
+        CHECK_MSG(worst <= 1e-8 && res <= 1e-8, "graded %d, affine: %g off, residual %g", g, worst, res);
+        cm_mls_destroy(&mls);
+    }
+    printf("graded box: samples in x < 0.1 (10 %% of the volume, 46 %% of the cells): graded 0 "
+           "%.2f, graded 1 %.2f\n", share[0], share[1]);
+    CHECK_MSG(share[0] < 0.25 && share[1] > 0.35 && share[1] > 2 * share[0],
+              "samples in x < 0.1: graded 0 %.2f, graded 1 %.2f", share[0], share[1]);
+    cm_mls_options o;
+    cm_mls_options_init(&o);
+    o.graded = 1.5;
+    cm_mls *bad = NULL;
+    CHECK(cm_mls_create(ctx, m, con, &o, &bad) == CM_ERR_ARGUMENT && bad == NULL);
+    free(con), free(dsp);
+    cm_mesh_destroy(&m);
+}
+
 int main(void)
 {
     cm_context *ctx = NULL;
@@ -462,6 +530,7 @@ int main(void)
     test_deform(ctx);
     test_two_components(ctx);
     test_plate(ctx);
+    test_graded(ctx);
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }

@@ -9,8 +9,13 @@ the box minus the body, tets, physical groups).
     node is on G1 to 1e-9 x G1's diagonal (closest points by gmsh's OpenCASCADE on G1's
     faces), every box node has exactly its input coordinates, no inverted cell;
   * still refused with fixed: no node on G0 (the body's STEP moved away from the mesh), and a
-    boundary component partly on G0 (a block mesh taller than the STEP's block: its top is off
-    G0, its sides partly on).
+    boundary component partly on G0 whose contact nodes the edit moves off the fixed surface
+    (a block mesh taller than the STEP's block: its top is off G0, its sides partly on, and
+    the edit makes the block longer);
+  * a body touching the fixed surface (a block standing on the box's floor: one boundary
+    component, partly on G0): the block 10 % taller morphs, the floor's nodes unmoved bit for
+    bit, the block's nodes on G1, no inverted cell; the block lifted off the floor is refused
+    (the contact nodes would leave the floor's plane).
 usage: test_off_cad.py CADMORPH WORKDIR"""
 import math
 import os
@@ -79,6 +84,34 @@ def write_tunnel_mesh(name):
     gmsh.write(path(name))
     gmsh.model.remove()
     return len(tunnel)
+
+
+def write_step_box(name, length, width, height, dz=0.0):
+    gmsh.model.add(name)
+    gmsh.model.occ.addBox(0, 0, dz, length, width, height)
+    gmsh.model.occ.synchronize()
+    gmsh.write(path(name))
+    gmsh.model.remove()
+
+
+def write_floor_mesh(name):
+    """The box [-1.5, 2.5] x [-1.2, 1.8] x [0, 1.5] minus a block 1 x 0.6 x 0.4 standing on its
+    floor (z = 0): the block's faces and the floor meet along the block's bottom edges."""
+    gmsh.model.add(name)
+    occ = gmsh.model.occ
+    box = occ.addBox(-1.5, -1.2, 0, 4, 3, 1.5)
+    blk = occ.addBox(0, 0, 0, 1, 0.6, 0.4)
+    occ.cut([(3, box)], [(3, blk)])
+    occ.synchronize()
+    physical(3, [t for _, t in gmsh.model.getEntities(3)], 1, "fluid")
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.3)
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.model.mesh.setSize([(0, t) for _, t in gmsh.model.getEntities(0)
+                             if max(abs(c) for c in gmsh.model.getValue(0, t, [])[:2]) < 1.2], 0.08)
+    gmsh.model.mesh.generate(3)
+    gmsh.write(path(name))
+    gmsh.model.remove()
 
 
 def write_block_mesh(name, height):
@@ -211,11 +244,43 @@ check(rc == 2 and "boundary nodes are off the CAD model" in err,
 
 # a component partly on G0: a block 0.5 high against the STEP's filleted block 0.4 high
 write_block_mesh("tall.msh", 0.5)
-rc, out, err = run("--from", path("g0.step"), "--to", path("g0.step"), "--mesh", path("tall.msh"),
+rc, out, err = run("--from", path("g0.step"), "--to", path("g1.step"), "--mesh", path("tall.msh"),
                    "-o", path("tall_out.msh"), "--off-cad", "fixed")
-check(rc == 2 and "is partly on the CAD model" in err,
+check(rc == 2 and "touches the fixed surface off it" in err,
       "partly matched component: exit 2 with the message, got %d (%s)" % (rc, err.strip()))
 check(not os.path.exists(path("tall_out.msh")), "partly matched: nothing written")
+
+# a body standing on the fixed floor: the block 10 % taller follows the CAD, the floor stays
+write_step_box("b0.step", 1, 0.6, 0.4)
+write_step_box("b1.step", 1, 0.6, 0.44)
+write_step_box("lifted.step", 1, 0.6, 0.4, dz=0.02)
+write_floor_mesh("floor.msh")
+rc, out, err = run("--from", path("b0.step"), "--to", path("b1.step"), "--mesh", path("floor.msh"),
+                   "-o", path("floor_out.msh"), "--off-cad", "fixed", "--verbose")
+check(rc == 0, "block on the floor: exit 0, got %d (%s)" % (rc, err.strip()[-600:]))
+check(re.search(r"1 boundary components partly on the CAD model: \d+ nodes on it touch", err) is not None,
+      "block on the floor: --verbose names the contact nodes: %s" % err[-600:])
+check(" inverted=0 " in out, "block on the floor: no inverted cell: %s" % out)
+if rc == 0:
+    f0, f1 = nodes("floor.msh"), nodes("floor_out.msh")
+    blk = [t for t, p in f0.items() if -1e-12 <= p[0] <= 1 + 1e-12 and -1e-12 <= p[1] <= 0.6 + 1e-12
+           and p[2] <= 0.4 + 1e-12 and (min(p[0], 1 - p[0], p[1], 0.6 - p[1], 0.4 - p[2]) < 1e-12)]
+    box = [t for t, p in f0.items() if t not in blk and (min(p[0] + 1.5, 2.5 - p[0], p[1] + 1.2, 1.8 - p[1],
+                                                        p[2], 1.5 - p[2]) < 1e-12)]
+    moved = [t for t in box if f1[t] != f0[t]]
+    check(len(box) > 100 and not moved, "block on the floor: %d of %d box nodes moved" % (len(moved), len(box)))
+    contact = [t for t in blk if abs(f0[t][2]) < 1e-12]
+    off = max(abs(f1[t][2] - 0.44 * f0[t][2] / 0.4) for t in blk)
+    same = max(math.dist(f1[t], f0[t]) for t in contact)
+    print("block on the floor: %d block nodes (%d on the floor), largest miss of z' = 1.1 z %.3g, "
+          "contact nodes moved by %.3g; %d box nodes unmoved" % (len(blk), len(contact), off, same, len(box)))
+    check(len(contact) > 10 and same < 1e-12, "block on the floor: contact nodes stay: %.3g" % same)
+    check(off < 1e-9, "block on the floor: the block's nodes at z' = 1.1 z (G1): %.3g" % off)
+rc, out, err = run("--from", path("b0.step"), "--to", path("lifted.step"), "--mesh", path("floor.msh"),
+                   "-o", path("lifted_out.msh"), "--off-cad", "fixed")
+check(rc == 2 and "touches the fixed surface off it" in err and "off that surface's plane" in err,
+      "block lifted off the floor: exit 2 with the message, got %d (%s)" % (rc, err.strip()))
+check(not os.path.exists(path("lifted_out.msh")), "lifted: nothing written")
 gmsh.finalize()
 
 if failures:
