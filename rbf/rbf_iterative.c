@@ -41,7 +41,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->leaf_size = 256;
     opt->local_size = 1400;
     opt->coarse_size = 2000;
-    opt->local_float = 0;
+    opt->local_float = 1;
     opt->coarse_grow = 1;
     opt->coarse_max = 8000;
     opt->overlap = 3.0;
@@ -132,7 +132,8 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
                         "cm_rbf_create: the iterative solver handles the 3D r^3 kernel only");
     if (!(o->tolerance > 0.0) || o->max_iterations < 1 || o->restart < 2 || o->leaf_size < 8 ||
         o->local_size < o->leaf_size || o->coarse_size < 0 || o->coarse_post < 0 ||
-        o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0)
+        o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0 ||
+        o->local_float < 0 || o->local_float > 2)
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
                         "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "
