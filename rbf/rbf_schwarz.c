@@ -260,7 +260,7 @@ static int projected_factor(const double *cg, size_t m, const size_t *idx, size_
         LAPACKE_dormqr(LAPACK_COL_MAJOR, 'R', 'N', ln, ln, rk, pq, ln, tau, a, ln) != 0)
         return -1;
     const lapack_int n2 = (lapack_int)(n - (size_t)rk);
-    lapack_int info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', n2, a + (size_t)rk * n + (size_t)rk, ln);
+    lapack_int info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n2, a + (size_t)rk * n + (size_t)rk, ln);
     return info < 0 ? -1 : (int)info;
 }
 
@@ -272,7 +272,7 @@ static int projected_solve(const double *work, size_t n, int rk, const double *t
     const double *a = work, *pq = work + n * n + 3 * n;
     const lapack_int ln = (lapack_int)n, lr = (lapack_int)nrhs;
     if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', ln, lr, rk, pq, ln, tau, x, ln) != 0 ||
-        LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', (lapack_int)(n - (size_t)rk), lr,
+        LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', (lapack_int)(n - (size_t)rk), lr,
                        a + (size_t)rk * n + (size_t)rk, ln, x + rk, ln) != 0)
         return -1;
     for (size_t j = 0; j < nrhs; ++j)
@@ -340,7 +340,7 @@ static int local_inverse_fast(const double *cg, size_t m, const size_t *idx, siz
     for (int c = 0; c < rk; ++c)
         for (size_t i = 0; i < n; ++i)
             vx[(size_t)c * n + i] = i < (size_t)c ? 0.0 : i == (size_t)c ? 1.0 : pq[(size_t)c * n + i];
-    if (LAPACKE_dlarft(LAPACK_COL_MAJOR, 'F', 'C', ln, rk, vx, ln, tau, t, rk) != 0) return -1;
+    if (LAPACKE_dlarft_work(LAPACK_COL_MAJOR, 'F', 'C', ln, rk, vx, ln, tau, t, rk) != 0) return -1;
     /* Q'AQ = A - V Z' - Z V', Z = A V T - V (T'V'A V T) / 2 */
     cblas_dsymm(CblasColMajor, CblasLeft, CblasLower, (int)n, rk, 1.0, a, (int)n, vx, (int)n,
                 0.0, y, (int)n);
@@ -355,7 +355,7 @@ static int local_inverse_fast(const double *cg, size_t m, const size_t *idx, siz
     cblas_dsyr2k(CblasColMajor, CblasLower, CblasNoTrans, (int)n, rk, -1.0, vx, (int)n, y,
                  (int)n, 1.0, a, (int)n);
     double *L = a + (size_t)rk * n + (size_t)rk; /* S = L L', leading dimension n */
-    lapack_int info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', (lapack_int)nn, L, ln);
+    lapack_int info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', (lapack_int)nn, L, ln);
     if (info != 0) return info < 0 ? -1 : (int)info;
     /* Q2'E = E2 - V2 xs: E2 the unit columns at rows s.. of S's space, V2 = rows rk.. of V,
      * xs = T' V_leaf' (rk x n_in) */
@@ -375,7 +375,7 @@ static int local_inverse_fast(const double *cg, size_t m, const size_t *idx, siz
     double *gx = g + rk, *x2 = g + no, *L22 = L + s * n + s;
     for (size_t j = 0; j < n_in; ++j)
         for (size_t i = j; i < n_in; ++i) x2[j * n + i] = L22[j * n + i];
-    info = LAPACKE_dpotri(LAPACK_COL_MAJOR, 'L', (lapack_int)n_in, x2, ln);
+    info = LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', (lapack_int)n_in, x2, ln);
     if (info != 0) return info < 0 ? -1 : (int)(s + (size_t)info);
     for (size_t j = 0; j < n_in; ++j)
         for (size_t i = 0; i < j; ++i) x2[j * n + i] = x2[i * n + j];
