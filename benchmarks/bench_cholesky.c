@@ -2,7 +2,10 @@
  * Cholesky (rbf/cholesky_blocked.c) on the same SPD matrix, alternating in one process, at
  * the OpenBLAS core and thread count of this run; with the Cholesky bound n^3/3 at the best
  * dgemm rate measured in the same process.
- * usage: bench_cholesky THREADS REPS N...   (one line of key=value per n) */
+ * usage: bench_cholesky THREADS REPS N...   (one line of key=value per n)
+ * BLOCKS=b1,b2,... (environment): also the panel-by-panel factorisation with these blocks;
+ * FULL=1: also dpotrf on full storage, unpacked from and packed back into RFP (dtfttr,
+ * dtrttf; timed with the copies and without), the alternative for small n. */
 #include "rbf/rbf_internal.h"
 
 #include <cblas.h>
@@ -57,6 +60,19 @@ int main(int argc, char **argv)
         const size_t len = (size_t)n * (n + 1) / 2;
         double *a = malloc(len * sizeof *a), *b = malloc(len * sizeof *b);
         if (!a || !b) return 2;
+        long blocks[8];
+        int nblocks = 0;
+        for (const char *e = getenv("BLOCKS"); e && *e && nblocks < 8;) {
+            char *end;
+            blocks[nblocks++] = strtol(e, &end, 10);
+            e = *end == ',' ? end + 1 : end;
+            if (end == e && *e) break;
+        }
+        const int full = getenv("FULL") && atoi(getenv("FULL"));
+        double best_b[8], best_full = INFINITY, best_full_only = INFINITY;
+        for (int q = 0; q < 8; ++q) best_b[q] = INFINITY;
+        double *f = full ? malloc((size_t)n * n * sizeof *f) : NULL;
+        if (full && !f) return 2;
         double rate = 0.0, best_ref = INFINITY, best_blk = INFINITY;
         int info_ref = 0, info_blk = 0;
         for (int r = 0; r < reps; ++r) {
@@ -71,6 +87,24 @@ int main(int argc, char **argv)
             double t3 = cm_wtime();
             best_ref = fmin(best_ref, t1 - t0);
             best_blk = fmin(best_blk, t3 - t2);
+            for (int q = 0; q < nblocks; ++q) {
+                fill_rfp(n, b);
+                double s0 = cm_wtime();
+                cm_rbf_cholesky_rfp(NULL, n, b, (int)blocks[q]);
+                best_b[q] = fmin(best_b[q], cm_wtime() - s0);
+            }
+            if (full) {
+                fill_rfp(n, b);
+                double s0 = cm_wtime();
+                LAPACKE_dtfttr_work(LAPACK_COL_MAJOR, 'N', 'L', n, b, f, n);
+                double s1 = cm_wtime();
+                LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, f, n);
+                double s2 = cm_wtime();
+                LAPACKE_dtrttf_work(LAPACK_COL_MAJOR, 'N', 'L', n, f, n, b);
+                double s3 = cm_wtime();
+                best_full = fmin(best_full, s3 - s0);
+                best_full_only = fmin(best_full_only, s2 - s1);
+            }
         }
         rate = fmax(rate, dgemm_rate());
         double diff = 0.0, big = 0.0;
@@ -85,8 +119,15 @@ int main(int argc, char **argv)
                n, openblas_get_corename(), got, reps, rate * 1e-9, bound, best_ref,
                best_ref / bound, best_blk, best_blk / bound, best_blk / best_ref, diff / big,
                info_ref, info_blk);
+        for (int q = 0; q < nblocks; ++q)
+            printf("n=%d block=%ld blocked_s=%.3f blocked_over_bound=%.3f\n", n, blocks[q],
+                   best_b[q], best_b[q] / bound);
+        if (full)
+            printf("n=%d full_dpotrf_s=%.3f full_over_bound=%.3f with_copies_s=%.3f "
+                   "with_copies_over_bound=%.3f\n",
+                   n, best_full_only, best_full_only / bound, best_full, best_full / bound);
         fflush(stdout);
-        free(a), free(b);
+        free(a), free(b), free(f);
     }
     return 0;
 }

@@ -3,6 +3,8 @@
 # usage: benchmarks/bench_rbf.sh BUILD_DIR [THREADS] [M...]
 #   SCIPY_MAX=M  largest m also run through scipy (default 10000)
 #   REPS=R       repetitions per m, best times reported (default 3; 1 for m > 10000)
+#   SOLVER=S     auto (default: cm_rbf_create's choice, iterative above its crossover), dense
+#                or iterative (fit / Cholesky bound is a dense figure: use SOLVER=dense)
 #   WARM_GB=G    touch G GB of memory first (default 0 = off). The Firecracker VM we run on
 #                backs guest memory on first touch and reclaims freed memory, so fresh memory
 #                costs ~1-5 s/GB in every process (ours and scipy's alike); warming did not
@@ -24,7 +26,7 @@ echo "# $(date -u '+%Y-%m-%d %H:%M UTC')  $(lscpu | sed -n 's/^Model name: *//p'
 for m in $sizes; do
     reps=${REPS:-3}
     [ -n "${REPS:-}" ] || [ "$m" -le 10000 ] || reps=1
-    "$bench" "$m" "$work" "$threads" "$reps"
+    "$bench" "$m" "$work" "$threads" "$reps" "${SOLVER:-auto}"
     if [ "$m" -le "$scipy_max" ]; then
         OPENBLAS_NUM_THREADS=$scipy_threads /usr/bin/python3 "$here/bench_rbf_scipy.py" "$m" "$work" "$reps"
     fi

@@ -8,3 +8,8 @@ target_link_libraries(bench_cholesky PRIVATE cm_rbf cm_core cm_lapack cm_warning
 # Iterative vs dense solver on real boundary node sets (see RESULTS.md; not a test).
 add_executable(bench_rbf_iterative ${CMAKE_CURRENT_LIST_DIR}/bench_rbf_iterative.c)
 target_link_libraries(bench_rbf_iterative PRIVATE cm_rbf cm_core cm_warnings cm_posix)
+# Pairs per CPU-second of the r^3 kernel sums, plain and compensated, per instruction set
+# (before/after the hand-written AVX-512 blocks side by side; see RESULTS.md, issue 10)
+add_executable(bench_kernel ${CMAKE_CURRENT_LIST_DIR}/bench_kernel.c)
+target_include_directories(bench_kernel PRIVATE ${PROJECT_SOURCE_DIR})
+target_link_libraries(bench_kernel PRIVATE cm_rbf cm_core cm_warnings cm_posix)

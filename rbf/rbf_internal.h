@@ -52,6 +52,32 @@ void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
 void cm_rbf_kernel_sum_acc(size_t m, const double *c, const double *w, int nc, size_t n,
                            const double *p, size_t ldp, double *out, size_t ldo, int threads);
 
+/* Which code runs the kernel sums. The library passes AUTO (the fastest this CPU runs);
+ * tests and benchmarks name one to compare them: GENERIC (baseline x86-64 or any CPU), AVX2
+ * (AVX2 + FMA, compiler-vectorised), AVX512_AUTOVEC (the generic loops compiled for AVX-512,
+ * the kernel before the hand-written one), AVX512 (rbf_sum_avx512.c for r^3 in 3D; the other
+ * kernels as AVX512_AUTOVEC). */
+typedef enum cm_rbf_isa {
+    CM_RBF_ISA_AUTO = 0,
+    CM_RBF_ISA_GENERIC,
+    CM_RBF_ISA_AVX2,
+    CM_RBF_ISA_AVX512_AUTOVEC,
+    CM_RBF_ISA_AVX512
+} cm_rbf_isa;
+
+/* 1 if this CPU runs isa (AUTO and GENERIC always do). */
+int cm_rbf_isa_supported(cm_rbf_isa isa);
+/* The ISA that AUTO resolves to here. */
+cm_rbf_isa cm_rbf_isa_auto(void);
+/* cm_rbf_kernel_sum and cm_rbf_kernel_sum_acc through the code of isa (which must be
+ * supported: cm_rbf_isa_supported). */
+void cm_rbf_kernel_sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m,
+                           const double *c, const double *w, int nc, size_t n, const double *p,
+                           size_t ldp, double *out, size_t ldo, int threads);
+void cm_rbf_kernel_sum_acc_isa(cm_rbf_isa isa, size_t m, const double *c, const double *w,
+                               int nc, size_t n, const double *p, size_t ldp, double *out,
+                               size_t ldo, int threads);
+
 /* Lower triangle of B = sign * (A - V Z' - Z V') restricted to rows/columns k..m-1, into
  * rfp (n = m - k; n(n+1)/2 doubles, LAPACK rectangular full packed, TRANSR 'N', UPLO 'L').
  * A_ij = phi(|c_i - c_j|); v and z: m x k col-major. */
@@ -81,6 +107,13 @@ cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *g
 
 /* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */
 int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m);
+/* dgemm flops per second and r^3 kernel-sum pairs per second (plain, compensated; 3 weight
+ * vectors) of one thread, timed once per process (rbf_auto_probe.c); 0 if the probe could
+ * not allocate its 3.6 MB. cm_rbf_create calls it with one BLAS thread set. */
+void cm_rbf_auto_rates(double *gemm, double *plain, double *acc);
+/* The model's seconds (of one thread) for m centres, dense and iterative; returns 1 if they
+ * come from the measured rates, 0 from the fixed fallback constants. */
+int cm_rbf_auto_costs(size_t m, double *dense, double *iter);
 
 /* Builds r->iter (preconditioner) for the centres in r (placed, P factored). */
 cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads);

@@ -58,27 +58,56 @@ void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
     *stats = rbf->stats;
 }
 
-/* Cost model for AUTO, CPU seconds measured by benchmarks/bench_rbf_iterative on this
- * machine kind (RESULTS.md, bore m = 9,960: dense 7.8 s, iterative 4.8 s, 7 iterations; 2
- * threads, OpenBLAS Haswell kernels): dense ~ a m^3 (dpftrf), iterative ~ b m (local
- * factorisations: m / 190 subdomains of 1400 centres) + c m^2 (about 8 compensated matvecs
- * of 3 components). They cross near m = 7,500. Dense is also refused when its factor
- * (4 m^2 bytes) would take more than half the physical memory. A faster BLAS core makes
- * the dense path relatively cheaper: the crossover then moves up, by the cube root of the
- * speed-up. */
+/* Cost model for AUTO, in seconds of one thread, from rates timed in this process
+ * (cm_rbf_auto_rates: G dgemm flops/s, Kp and Ka plain and compensated kernel pairs/s):
+ *   dense     ~ m^3/3 / (E G) + D m^2 / Kp: the Cholesky factorisation at E times the dgemm
+ *               rate, assembly and the refinement's kernel sums;
+ *   iterative ~ S m / G + N m^2 / Ka: the Schwarz set-up (local and coarse factorisations,
+ *               S flops per centre at the dgemm rate) and N compensated sums of m^2 pairs
+ *               (FGMRES matvecs, the final residual, evaluation at the centres).
+ * E, S and N were fitted to bench_rbf runs of both solvers at m = 5k, 10k, 20k in one
+ * window (RESULTS.md, issue 10, "Kernel throughput and the dense path on a quiet machine").
+ * Why rates and not seconds: the old constants (crossover ~7,500 centres) came from
+ * Haswell kernels under load; with the AVX-512 dgemm the dense path is 2x faster and with the
+ * hand-written AVX-512 sums the iterative one too, and the crossover follows their ratio.
+ * Without rates (the probe could not allocate) the old constants stand. Dense is also
+ * refused when its factor (4 m^2 bytes) would take more than half the physical memory.
+ * Below 1,000 centres dense always wins and above 60,000 its factorisation alone takes
+ * minutes and 7 GB, so those skip the probe. */
+#define CM_RBF_AUTO_E 1.0
+#define CM_RBF_AUTO_D 3.0
+#define CM_RBF_AUTO_S 1.9e7
+#define CM_RBF_AUTO_N 12.0
 #define CM_RBF_COST_DENSE_M3 7.9e-12
 #define CM_RBF_COST_ITER_M 3.5e-4
 #define CM_RBF_COST_ITER_M2 1.3e-8
+
+int cm_rbf_auto_costs(size_t m, double *dense, double *iter)
+{
+    const double x = (double)m;
+    double g, kp, ka;
+    cm_rbf_auto_rates(&g, &kp, &ka);
+    if (g > 0.0 && kp > 0.0 && ka > 0.0) {
+        *dense = x * x * x / 3.0 / (CM_RBF_AUTO_E * g) + CM_RBF_AUTO_D * x * x / kp;
+        *iter = CM_RBF_AUTO_S * x / g + CM_RBF_AUTO_N * x * x / ka;
+        return 1;
+    }
+    *dense = CM_RBF_COST_DENSE_M3 * x * x * x;
+    *iter = CM_RBF_COST_ITER_M * x + CM_RBF_COST_ITER_M2 * x * x;
+    return 0;
+}
 
 int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
 {
     if (kernel != CM_RBF_TRIHARMONIC) return 1;
     const double x = (double)m;
-    if (CM_RBF_COST_DENSE_M3 * x * x * x > CM_RBF_COST_ITER_M * x + CM_RBF_COST_ITER_M2 * x * x)
-        return 0;
     long pages = sysconf(_SC_PHYS_PAGES), psize = sysconf(_SC_PAGESIZE);
     if (pages > 0 && psize > 0 && 4.0 * x * x > 0.5 * (double)pages * (double)psize) return 0;
-    return 1;
+    if (m < 1000) return 1;
+    if (m > 60000) return 0;
+    double dense, iter;
+    cm_rbf_auto_costs(m, &dense, &iter);
+    return dense <= iter;
 }
 
 const double *cm_rbf_iterative_q1(const cm_rbf *r) { return r->iter ? r->iter->q1 : NULL; }

@@ -3,6 +3,7 @@
  * them at -O3 (points in the inner loop, no reductions), and both are compiled for AVX-512,
  * AVX2+FMA and baseline x86-64, chosen at run time: no global -march flag is needed. */
 #include "rbf_internal.h"
+#include "rbf_sum_isa.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -10,7 +11,7 @@
 
 
 #define NB 16      /* points held in registers while streaming the centres */
-#define PB 128     /* points per parallel work item (a multiple of NB) */
+#define PB CM_RBF_SUM_PB /* points per parallel work item (a multiple of NB) */
 #define TILE 512   /* centres per tile: 7 x 512 doubles stay in L1 */
 
 /* log(r2 + tiny) keeps phi(0) = 0 without a branch: r2 = 0 gives 0 * (-690); merged
@@ -148,16 +149,40 @@ block_avx512(int kern, int nc, size_t m, const double *c, const double *w, const
     CM_BLOCK_DISPATCH
 }
 
-static block_fn pick_block(void)
+/* AVX-512 blocks for r^3 in 3D by hand (rbf_sum_avx512.c), the other kernels as compiled */
+static void block_avx512_hand(int kern, int nc, size_t m, const double *c, const double *w,
+                              const double *pt, double *acc)
 {
-#if defined(__x86_64__) && defined(__GNUC__)
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-        __builtin_cpu_supports("avx512vl"))
-        return block_avx512;
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return block_avx2;
-#endif
-    return block_generic;
+    if (kern == (int)CM_RBF_TRIHARMONIC) cm_rbf_r3_block_avx512(nc, m, c, w, pt, acc);
+    else block_avx512(kern, nc, m, c, w, pt, acc);
+}
+
+int cm_rbf_isa_supported(cm_rbf_isa isa)
+{
+    switch (isa) {
+    case CM_RBF_ISA_AUTO:
+    case CM_RBF_ISA_GENERIC: return 1;
+    case CM_RBF_ISA_AVX2: return cm_rbf_cpu_avx2();
+    default: return cm_rbf_cpu_avx512();
+    }
+}
+
+cm_rbf_isa cm_rbf_isa_auto(void)
+{
+    if (cm_rbf_cpu_avx512()) return CM_RBF_ISA_AVX512;
+    if (cm_rbf_cpu_avx2()) return CM_RBF_ISA_AVX2;
+    return CM_RBF_ISA_GENERIC;
+}
+
+static block_fn pick_block(cm_rbf_isa isa)
+{
+    if (isa == CM_RBF_ISA_AUTO) isa = cm_rbf_isa_auto();
+    switch (isa) {
+    case CM_RBF_ISA_AVX512: return block_avx512_hand;
+    case CM_RBF_ISA_AVX512_AUTOVEC: return block_avx512;
+    case CM_RBF_ISA_AVX2: return block_avx2;
+    default: return block_generic;
+    }
 }
 
 int cm_rbf_threads(const cm_context *ctx)
@@ -170,7 +195,15 @@ void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                        const double *w, int nc, size_t n, const double *p, size_t ldp,
                        double *out, size_t ldo, int threads)
 {
-    const block_fn fn = pick_block();
+    cm_rbf_kernel_sum_isa(CM_RBF_ISA_AUTO, kernel, dim, m, c, w, nc, n, p, ldp, out, ldo,
+                          threads);
+}
+
+void cm_rbf_kernel_sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m,
+                           const double *c, const double *w, int nc, size_t n, const double *p,
+                           size_t ldp, double *out, size_t ldo, int threads)
+{
+    const block_fn fn = pick_block(isa);
     const long nblocks = (long)((n + PB - 1) / PB);
     const int kern = (int)kernel;
     const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;

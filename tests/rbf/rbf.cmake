@@ -35,3 +35,8 @@ if(CADMORPH_WITH_PETSC)
   set_tests_properties(test_rbf_petsc_2ranks test_rbf_petsc_1rank PROPERTIES
     LABELS "unit;rbf;petsc" ENVIRONMENT "${CM_MPI_ENV}")
 endif()
+# the kernel sums per instruction set (generic, AVX2, AVX-512 compiled and by hand) against
+# each other and a long-double reference: plain and compensated, tails, threads
+cm_add_unit_test(test_rbf_sum ${CMAKE_CURRENT_LIST_DIR}/test_rbf_sum.c LIBS cm_rbf LABELS rbf)
+# AUTO's cost model: probe rates, growth of the costs, one crossover
+cm_add_unit_test(test_rbf_auto ${CMAKE_CURRENT_LIST_DIR}/test_rbf_auto.c LIBS cm_rbf LABELS rbf)

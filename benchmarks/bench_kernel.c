@@ -1,0 +1,156 @@
+/* Throughput of the r^3 kernel sums (rbf/rbf_sum.c plain, rbf/rbf_sum_acc.c compensated) in
+ * pairs per CPU-second (getrusage: user + system of the process, so 2 threads count both),
+ * each instruction-set variant side by side in one process, alternating, on the same data:
+ * m random centres in the unit cube, n random points, 3 weight vectors uniform in [-1, 1].
+ * Accuracy against a long-double reference on the first 64 points: max |out - ref| over
+ * sum_j |w_j phi_ij| (what the plain sum can promise) and over |ref| (what the compensated
+ * sum should reach).
+ * usage: bench_kernel N REPS THREADS,... M,...      e.g. bench_kernel 10000 3 1,2 10000,100000
+ * (one line of key=value per m, threads, variant and sum) */
+#include "rbf/rbf_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+static unsigned long long rng = 0x9E3779B97F4A7C15ULL;
+static double urand(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static double cpu_seconds(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
+#define NREF 64
+#define NC 3
+
+static const struct {
+    cm_rbf_isa isa;
+    const char *name;
+} variants[] = {
+    {CM_RBF_ISA_AVX512_AUTOVEC, "avx512_autovec"}, /* before: GCC's vectorisation */
+    {CM_RBF_ISA_AVX512, "avx512"},                 /* after: rbf_sum_avx512.c */
+    {CM_RBF_ISA_AVX2, "avx2"},
+};
+#define NVAR (int)(sizeof variants / sizeof variants[0])
+
+static int parse_list(const char *s, long *out, int max)
+{
+    int k = 0;
+    while (*s && k < max) {
+        char *end;
+        out[k++] = strtol(s, &end, 10);
+        s = *end == ',' ? end + 1 : end;
+        if (end == s && *s) return -1;
+    }
+    return k;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 5) {
+        fprintf(stderr, "usage: %s N REPS THREADS,... M,...\n", argv[0]);
+        return 1;
+    }
+    const size_t n = strtoul(argv[1], NULL, 10);
+    const int reps = atoi(argv[2]) > 0 ? atoi(argv[2]) : 1;
+    long th[8], ms[16];
+    const int nth = parse_list(argv[3], th, 8), nm = parse_list(argv[4], ms, 16);
+    if (n < NREF || nth < 1 || nm < 1) return 1;
+    size_t mmax = 0;
+    for (int k = 0; k < nm; ++k) mmax = (size_t)ms[k] > mmax ? (size_t)ms[k] : mmax;
+    double *c = malloc(3 * mmax * sizeof *c), *w = malloc(NC * mmax * sizeof *w);
+    double *p = malloc(3 * n * sizeof *p), *out = malloc(NC * n * sizeof *out);
+    long double *ref = malloc(NC * NREF * sizeof *ref), *absum = malloc(NC * NREF * sizeof *absum);
+    if (!c || !w || !p || !out || !ref || !absum) return 2;
+    for (size_t i = 0; i < 3 * n; ++i) p[i] = urand();
+
+    printf("# bench_kernel: n=%zu points, %d weight vectors, reps=%d (best of), AUTO=%d\n", n,
+           NC, reps, (int)cm_rbf_isa_auto());
+    for (int km = 0; km < nm; ++km) {
+        const size_t m = (size_t)ms[km];
+        for (size_t i = 0; i < 3 * m; ++i) c[i] = urand();
+        for (size_t i = 0; i < NC * m; ++i) w[i] = 2.0 * urand() - 1.0;
+        for (int i = 0; i < NREF; ++i)
+            for (int q = 0; q < NC; ++q) {
+                long double s = 0.0L, a = 0.0L;
+                for (size_t j = 0; j < m; ++j) {
+                    long double dx = (long double)p[i] - c[j];
+                    long double dy = (long double)p[n + i] - c[m + j];
+                    long double dz = (long double)p[2 * n + i] - c[2 * m + j];
+                    long double r2 = dx * dx + dy * dy + dz * dz, f = r2 * sqrtl(r2);
+                    s += f * w[q * m + j];
+                    a += fabsl(f * w[q * m + j]);
+                }
+                ref[q * NREF + i] = s;
+                absum[q * NREF + i] = a;
+            }
+        for (int kt = 0; kt < nth; ++kt) {
+            const int threads = (int)th[kt];
+            double best[NVAR][2], wall[NVAR][2], err_abs[NVAR][2], err_rel[NVAR][2];
+            for (int v = 0; v < NVAR; ++v)
+                for (int s = 0; s < 2; ++s) best[v][s] = INFINITY;
+            /* alternate the variants rep by rep so that a change of load hits all of them */
+            for (int r = 0; r < reps; ++r)
+                for (int v = 0; v < NVAR; ++v) {
+                    if (!cm_rbf_isa_supported(variants[v].isa)) continue;
+                    for (int s = 0; s < 2; ++s) {
+                        double t0 = cpu_seconds(), w0 = cm_wtime();
+                        if (s == 0)
+                            cm_rbf_kernel_sum_isa(variants[v].isa, CM_RBF_TRIHARMONIC, 3, m, c,
+                                                  w, NC, n, p, n, out, NC, threads);
+                        else
+                            cm_rbf_kernel_sum_acc_isa(variants[v].isa, m, c, w, NC, n, p, n,
+                                                      out, NC, threads);
+                        double t = cpu_seconds() - t0, tw = cm_wtime() - w0;
+                        if (t < best[v][s]) best[v][s] = t, wall[v][s] = tw;
+                        double ea = 0.0, er = 0.0;
+                        for (int i = 0; i < NREF; ++i)
+                            for (int q = 0; q < NC; ++q) {
+                                long double d = fabsl((long double)out[i * NC + q] - ref[q * NREF + i]);
+                                ea = fmax(ea, (double)(d / absum[q * NREF + i]));
+                                er = fmax(er, (double)(d / fabsl(ref[q * NREF + i])));
+                            }
+                        err_abs[v][s] = ea, err_rel[v][s] = er;
+                    }
+                }
+            for (int v = 0; v < NVAR; ++v)
+                for (int s = 0; s < 2; ++s) {
+                    if (!cm_rbf_isa_supported(variants[v].isa)) continue;
+                    printf("m=%zu n=%zu threads=%d variant=%s sum=%s cpu_s=%.3f wall_s=%.3f "
+                           "pairs_per_cpu_s=%.3g pairs_per_s=%.3g err_over_sum_abs=%.2g "
+                           "err_over_ref=%.2g\n",
+                           m, n, threads, variants[v].name, s ? "compensated" : "plain",
+                           best[v][s], wall[v][s], (double)n * (double)m / best[v][s],
+                           (double)n * (double)m / wall[v][s], err_abs[v][s], err_rel[v][s]);
+                }
+            fflush(stdout);
+        }
+    }
+    /* what AUTO's cost model sees in this process (one thread, as cm_rbf_create sets it) */
+    cm_rbf_blas_threads(NULL, "bench_kernel", 1, NULL);
+    double g, kp, ka;
+    cm_rbf_auto_rates(&g, &kp, &ka);
+    printf("auto_probe dgemm_gflops=%.1f plain_pairs_per_s=%.3g compensated_pairs_per_s=%.3g\n",
+           g * 1e-9, kp, ka);
+    for (size_t m = 2500; m <= 40000; m *= 2) {
+        double d, it;
+        int measured = cm_rbf_auto_costs(m, &d, &it);
+        printf("auto_model m=%zu dense_s=%.2f iterative_s=%.2f choice=%s rates=%s\n", m, d, it,
+               cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, m) ? "dense" : "iterative",
+               measured ? "measured" : "fallback");
+    }
+    free(c), free(w), free(p), free(out), free(ref), free(absum);
+    return 0;
+}

@@ -1,0 +1,279 @@
+/* Hand-written AVX-512 blocks of the r^3 kernel sums (plain and compensated), chosen at run
+ * time by rbf_sum.c and rbf_sum_acc.c on CPUs with AVX-512 F/DQ/VL; other CPUs keep the
+ * compiler-vectorised loops there. Why by hand: the compiler cannot balance the sqrt unit
+ * against the FMA pipes (plain sums), and the compensated sums need a different algorithm
+ * (the fixed binade below). Measured on Zen 5 (benchmarks/bench_kernel.c, RESULTS.md issue
+ * 10): plain 3.3e9 -> 3.8-4.0e9, compensated 1.2e9 -> 2.4-2.6e9 pairs per CPU-second.
+ *
+ * The square root is the bottleneck of the plain sum (in a register-resident test: all
+ * vsqrtpd 3.46e9 pairs/s, all rsqrt14 + Newton 2.37e9). So of every four vectors of
+ * points, three take vsqrtpd and one computes sqrt on the FMA pipes instead: rsqrt14
+ * (14 bits), two Goldschmidt steps and a final Newton correction with an FMA residual
+ * (Markstein's scheme). In a test of 1.6e7 arguments over 40 binades that sequence returned
+ * the correctly rounded sqrt every time (one Goldschmidt step fewer errs by 1 ulp in 0.6 %),
+ * so the entries phi_ij are the same whichever unit computed them, as the "fixed matrix"
+ * argument of rbf_sum_acc.c needs. The mixture is 1.15x the all-vsqrtpd kernel.
+ *
+ * Built with -ffp-contract=off: the error-free transformations of the compensated block
+ * need every rounding where it is written. */
+#include "rbf_sum_isa.h"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+
+#define CM_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma")))
+#define CM_INLINE static inline __attribute__((always_inline))
+
+#define NV 4       /* vectors of 8 points held in registers */
+#define NSQRT 3    /* of them through vsqrtpd, the rest through rsqrt14 + Newton */
+#define TILE 512   /* centres per tile: 3 + 4 rows of 512 doubles stay in L1 */
+#define ACC_NV 2   /* compensated: vectors of points held in registers (2 accumulators each) */
+#define ACCF_NV 2  /* the same for the fixed-binade compensated sums */
+
+/* sqrt(x) for x >= 0 without the sqrt unit. x = 0 (a point on a centre) would give
+ * rsqrt14 = inf and 0 * inf = NaN, so the seed is taken at max(x, 1e-300): then s = x * y
+ * = 0 and every step keeps 0; for 0 < x < 1e-300 the result is wrong, but x^(3/2) < 1e-450
+ * underflows to 0 anyway, and that is all the callers use it for. */
+CM_AVX512 CM_INLINE __m512d sqrt_fma(__m512d x)
+{
+    const __m512d half = _mm512_set1_pd(0.5);
+    __m512d y = _mm512_rsqrt14_pd(_mm512_max_pd(x, _mm512_set1_pd(1e-300)));
+    __m512d s = _mm512_mul_pd(x, y), h = _mm512_mul_pd(half, y); /* s ~ sqrt x, h ~ 1/(2 s) */
+    __m512d r = _mm512_fnmadd_pd(s, h, half);
+    s = _mm512_fmadd_pd(s, r, s);
+    h = _mm512_fmadd_pd(h, r, h);
+    r = _mm512_fnmadd_pd(s, h, half);
+    s = _mm512_fmadd_pd(s, r, s);
+    h = _mm512_fmadd_pd(h, r, h);
+    __m512d d = _mm512_fnmadd_pd(s, s, x); /* x - s^2, exact by the FMA */
+    return _mm512_fmadd_pd(d, h, s);
+}
+
+/* |p - c_j|^3 for vector v of a register block (which unit by v, see above) */
+CM_AVX512 CM_INLINE __m512d r3_of(int v, __m512d x, __m512d y, __m512d z, __m512d xj,
+                                  __m512d yj, __m512d zj)
+{
+    __m512d dx = _mm512_sub_pd(x, xj), dy = _mm512_sub_pd(y, yj), dz = _mm512_sub_pd(z, zj);
+    __m512d r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
+    __m512d r = v < NSQRT ? _mm512_sqrt_pd(r2) : sqrt_fma(r2);
+    return _mm512_mul_pd(r2, r);
+}
+
+/* Centres [0, jn) of a tile against NV * 8 points at pt (stride CM_RBF_SUM_PB). */
+CM_AVX512 CM_INLINE void tile_plain(const int nc, const double *c, size_t ldc, const double *w,
+                                    size_t ldw, size_t jn, const double *pt, double *acc)
+{
+    const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
+    __m512d x[NV], y[NV], z[NV], a[4][NV];
+    for (int v = 0; v < NV; ++v) {
+        x[v] = _mm512_loadu_pd(pt + 8 * v);
+        y[v] = _mm512_loadu_pd(pt + CM_RBF_SUM_PB + 8 * v);
+        z[v] = _mm512_loadu_pd(pt + 2 * CM_RBF_SUM_PB + 8 * v);
+        for (int q = 0; q < nc; ++q) a[q][v] = _mm512_loadu_pd(acc + q * CM_RBF_SUM_PB + 8 * v);
+    }
+    for (size_t j = 0; j < jn; ++j) {
+        const __m512d xj = _mm512_set1_pd(cx[j]), yj = _mm512_set1_pd(cy[j]);
+        const __m512d zj = _mm512_set1_pd(cz[j]);
+        __m512d wj[4];
+        for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
+        for (int v = 0; v < NV; ++v) {
+            const __m512d f = r3_of(v, x[v], y[v], z[v], xj, yj, zj);
+            for (int q = 0; q < nc; ++q) a[q][v] = _mm512_fmadd_pd(wj[q], f, a[q][v]);
+        }
+    }
+    for (int v = 0; v < NV; ++v)
+        for (int q = 0; q < nc; ++q) _mm512_storeu_pd(acc + q * CM_RBF_SUM_PB + 8 * v, a[q][v]);
+}
+
+CM_AVX512 CM_INLINE void block_plain(const int nc, size_t m, const double *c, const double *w,
+                                     const double *pt, double *acc)
+{
+    for (size_t t0 = 0; t0 < m; t0 += TILE) {
+        const size_t jn = m - t0 < TILE ? m - t0 : TILE;
+        for (int b = 0; b < CM_RBF_SUM_PB; b += 8 * NV)
+            tile_plain(nc, c + t0, m, w + t0, m, jn, pt + b, acc + b);
+    }
+}
+
+CM_AVX512 void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
+                                      const double *pt, double *acc)
+{
+    switch (nc) {
+    case 1: block_plain(1, m, c, w, pt, acc); break;
+    case 2: block_plain(2, m, c, w, pt, acc); break;
+    case 3: block_plain(3, m, c, w, pt, acc); break;
+    default: block_plain(4, m, c, w, pt, acc); break;
+    }
+}
+
+/* ---- compensated: s + e += w * f exactly to first order (TwoProd by FMA, TwoSum) ---- */
+
+CM_AVX512 CM_INLINE void tile_acc(const int nc, const double *c, size_t ldc, const double *w,
+                                  size_t ldw, size_t jn, const double *pt, double *hi,
+                                  double *lo)
+{
+    const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
+    __m512d x[ACC_NV], y[ACC_NV], z[ACC_NV], s[4][ACC_NV], e[4][ACC_NV];
+    for (int v = 0; v < ACC_NV; ++v) {
+        x[v] = _mm512_loadu_pd(pt + 8 * v);
+        y[v] = _mm512_loadu_pd(pt + CM_RBF_ACC_PB + 8 * v);
+        z[v] = _mm512_loadu_pd(pt + 2 * CM_RBF_ACC_PB + 8 * v);
+        for (int q = 0; q < nc; ++q) {
+            s[q][v] = _mm512_loadu_pd(hi + q * CM_RBF_ACC_PB + 8 * v);
+            e[q][v] = _mm512_loadu_pd(lo + q * CM_RBF_ACC_PB + 8 * v);
+        }
+    }
+    for (size_t j = 0; j < jn; ++j) {
+        const __m512d xj = _mm512_set1_pd(cx[j]), yj = _mm512_set1_pd(cy[j]);
+        const __m512d zj = _mm512_set1_pd(cz[j]);
+        __m512d wj[4];
+        for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
+        for (int v = 0; v < ACC_NV; ++v) {
+            /* the add pipes are busy with TwoSum here, so every vector takes vsqrtpd
+             * (v = 0 < NSQRT) */
+            const __m512d f = r3_of(0, x[v], y[v], z[v], xj, yj, zj);
+            for (int q = 0; q < nc; ++q) {
+                const __m512d p = _mm512_mul_pd(wj[q], f);
+                const __m512d pe = _mm512_fmsub_pd(wj[q], f, p); /* p + pe = w f exactly */
+                const __m512d t = _mm512_add_pd(s[q][v], p);
+                const __m512d bv = _mm512_sub_pd(t, s[q][v]);
+                const __m512d te = _mm512_add_pd(_mm512_sub_pd(s[q][v], _mm512_sub_pd(t, bv)),
+                                                 _mm512_sub_pd(p, bv));
+                s[q][v] = t;
+                e[q][v] = _mm512_add_pd(e[q][v], _mm512_add_pd(te, pe));
+            }
+        }
+    }
+    for (int v = 0; v < ACC_NV; ++v)
+        for (int q = 0; q < nc; ++q) {
+            _mm512_storeu_pd(hi + q * CM_RBF_ACC_PB + 8 * v, s[q][v]);
+            _mm512_storeu_pd(lo + q * CM_RBF_ACC_PB + 8 * v, e[q][v]);
+        }
+}
+
+CM_AVX512 CM_INLINE void block_acc(const int nc, size_t m, const double *c, const double *w,
+                                   const double *pt, double *hi, double *lo)
+{
+    for (size_t t0 = 0; t0 < m; t0 += TILE) {
+        const size_t jn = m - t0 < TILE ? m - t0 : TILE;
+        for (int b = 0; b < CM_RBF_ACC_PB; b += 8 * ACC_NV)
+            tile_acc(nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
+    }
+}
+
+CM_AVX512 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
+                                          const double *pt, double *hi, double *lo)
+{
+    switch (nc) {
+    case 1: block_acc(1, m, c, w, pt, hi, lo); break;
+    case 2: block_acc(2, m, c, w, pt, hi, lo); break;
+    case 3: block_acc(3, m, c, w, pt, hi, lo); break;
+    default: block_acc(4, m, c, w, pt, hi, lo); break;
+    }
+}
+
+/* ---- compensated with a fixed binade: 4 operations per product instead of 10 ----
+ * The running sum S = big + partial sum stays in one binade [2^k, 2^(k+1)) when big = 1.5 2^k
+ * and 2^k >= 4 max |partial sum| (the caller's bound), so all its values are multiples of
+ * one ulp u: T = fma(w, f, S) rounds w f + S once, T - S is exact (Sterbenz), and
+ * w f - (T - S), the rounding error (|.| <= u/2), is formed by one more FMA with a relative
+ * error of eps. Those remainders are summed plainly into E. So S - big + E has the error
+ * eps |result| + about eps u m^(1/2..1) (u ~ eps 4 bound), second order like TwoSum's, at
+ * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the vector operation
+ * count was the limit: TwoSum ran at 0.4x the plain sum's throughput). This is the binned
+ * summation of the reproducible-BLAS literature (Demmel and Nguyen) with a single bin. */
+CM_AVX512 CM_INLINE void tile_accf(const int nc, const double *c, size_t ldc, const double *w,
+                                   size_t ldw, size_t jn, const double *pt, double *hi,
+                                   double *lo)
+{
+    const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
+    __m512d x[ACCF_NV], y[ACCF_NV], z[ACCF_NV], s[4][ACCF_NV], e[4][ACCF_NV];
+    for (int v = 0; v < ACCF_NV; ++v) {
+        x[v] = _mm512_loadu_pd(pt + 8 * v);
+        y[v] = _mm512_loadu_pd(pt + CM_RBF_ACC_PB + 8 * v);
+        z[v] = _mm512_loadu_pd(pt + 2 * CM_RBF_ACC_PB + 8 * v);
+        for (int q = 0; q < nc; ++q) {
+            s[q][v] = _mm512_loadu_pd(hi + q * CM_RBF_ACC_PB + 8 * v);
+            e[q][v] = _mm512_loadu_pd(lo + q * CM_RBF_ACC_PB + 8 * v);
+        }
+    }
+    for (size_t j = 0; j < jn; ++j) {
+        const __m512d xj = _mm512_set1_pd(cx[j]), yj = _mm512_set1_pd(cy[j]);
+        const __m512d zj = _mm512_set1_pd(cz[j]);
+        __m512d wj[4];
+        for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
+        for (int v = 0; v < ACCF_NV; ++v) {
+            const __m512d f = r3_of(v, x[v], y[v], z[v], xj, yj, zj);
+            for (int q = 0; q < nc; ++q) {
+                const __m512d t = _mm512_fmadd_pd(wj[q], f, s[q][v]);
+                const __m512d d = _mm512_sub_pd(t, s[q][v]); /* exact: same binade */
+                e[q][v] = _mm512_add_pd(e[q][v], _mm512_fmsub_pd(wj[q], f, d));
+                s[q][v] = t;
+            }
+        }
+    }
+    for (int v = 0; v < ACCF_NV; ++v)
+        for (int q = 0; q < nc; ++q) {
+            _mm512_storeu_pd(hi + q * CM_RBF_ACC_PB + 8 * v, s[q][v]);
+            _mm512_storeu_pd(lo + q * CM_RBF_ACC_PB + 8 * v, e[q][v]);
+        }
+}
+
+CM_AVX512 CM_INLINE void block_accf(const int nc, size_t m, const double *c, const double *w,
+                                    const double *pt, double *hi, double *lo)
+{
+    for (size_t t0 = 0; t0 < m; t0 += TILE) {
+        const size_t jn = m - t0 < TILE ? m - t0 : TILE;
+        for (int b = 0; b < CM_RBF_ACC_PB; b += 8 * ACCF_NV)
+            tile_accf(nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
+    }
+}
+
+CM_AVX512 void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
+                                           const double *pt, double *hi, double *lo)
+{
+    switch (nc) {
+    case 1: block_accf(1, m, c, w, pt, hi, lo); break;
+    case 2: block_accf(2, m, c, w, pt, hi, lo); break;
+    case 3: block_accf(3, m, c, w, pt, hi, lo); break;
+    default: block_accf(4, m, c, w, pt, hi, lo); break;
+    }
+}
+
+int cm_rbf_cpu_avx512(void)
+{
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+           __builtin_cpu_supports("avx512vl");
+}
+
+int cm_rbf_cpu_avx2(void)
+{
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+
+#else /* not x86-64 GCC/Clang: the generic loops only */
+
+void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
+                            const double *pt, double *acc)
+{
+    (void)nc, (void)m, (void)c, (void)w, (void)pt, (void)acc;
+}
+
+void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
+                                const double *pt, double *hi, double *lo)
+{
+    (void)nc, (void)m, (void)c, (void)w, (void)pt, (void)hi, (void)lo;
+}
+
+void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
+                                 const double *pt, double *hi, double *lo)
+{
+    (void)nc, (void)m, (void)c, (void)w, (void)pt, (void)hi, (void)lo;
+}
+
+int cm_rbf_cpu_avx512(void) { return 0; }
+int cm_rbf_cpu_avx2(void) { return 0; }
+
+#endif

@@ -1,0 +1,34 @@
+/* The instruction-set variants of the kernel sums (rbf_sum.c, rbf_sum_acc.c) and the
+ * hand-written AVX-512 r^3 blocks (rbf_sum_avx512.c) they dispatch to. Not a public header. */
+#ifndef CADMORPH_RBF_SUM_ISA_H
+#define CADMORPH_RBF_SUM_ISA_H
+
+#include <stddef.h>
+
+/* Points per work item of the plain and of the compensated sums: the drivers pack that many
+ * points (3 x PB SoA) and the blocks add all centres' contributions to them. */
+#define CM_RBF_SUM_PB 128
+#define CM_RBF_ACC_PB 64
+
+/* acc[q * CM_RBF_SUM_PB + l] += sum_j |pt_l - c_j|^3 w[q * m + j], q < nc (1..4), in the
+ * order j = 0, 1, ..., m - 1 for every point. c: 3 x m SoA (stride m), pt: 3 x PB SoA. */
+void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
+                            const double *pt, double *acc);
+
+/* The same with compensated accumulation: (hi, lo)[q * CM_RBF_ACC_PB + l] is a double-double
+ * running sum, each product split exactly (FMA) and added by TwoSum. */
+void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
+                                const double *pt, double *hi, double *lo);
+
+/* The same with a fixed-binade running sum (rbf_sum_avx512.c says why it is exact enough):
+ * hi[q * CM_RBF_ACC_PB + l] must start at big_q = 1.5 * 2^k with 2^k >= 4 * (a bound of
+ * every partial sum |sum_{j<=J} w_qj phi_lj|), and the result is (hi - big_q) + lo. */
+void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
+                                 const double *pt, double *hi, double *lo);
+
+/* 1 if this CPU and OS run AVX-512 F/DQ/VL code (cpuid, as GCC's __builtin_cpu_supports). */
+int cm_rbf_cpu_avx512(void);
+/* 1 if they run AVX2 + FMA code. */
+int cm_rbf_cpu_avx2(void);
+
+#endif
