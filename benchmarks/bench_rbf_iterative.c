@@ -2,9 +2,9 @@
  * writes them from `cadmorph morph` output): set-up, solve, evaluation at the interior
  * nodes, iterations, peak memory, and agreement with the dense solver in the same run.
  * usage: bench_rbf_iterative PREFIX [--dense] [--no-iterative] [--threads N] [--leaf N]
- *        [--local N] [--coarse N] [--float] [--tol T] [--maxit N] [--restart N] [--eval N]
- *        [--verbose] [--fast 0|1|-1] [--fast-tol T] [--fast-refine N] [--fast-eval-tol T]
- *        [--no-centres]
+ *        [--local N] [--coarse N] [--float | --local-float 0|1|2] [--tol T] [--maxit N]
+ *        [--restart N] [--eval N] [--verbose] [--fast 0|1|-1] [--fast-tol T]
+ *        [--fast-refine N] [--fast-eval-tol T] [--no-centres]
  * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
 #include "cadmorph/rbf.h"
 
@@ -62,6 +62,9 @@ typedef struct run {
     cm_rbf_stats st;
     double eval_s;
     double fit_cpu_s; /* create + solve */
+    double setup_cpu_s; /* create alone */
+    double centres_cpu_s; /* evaluation at the m centres: one direct matvec of 3 components
+                           * (compensated for iterative fits), the unit of the fit's cost */
     double eval_cpu_s;
     cm_status status;
     double *out; /* (m + ne) x 3: at the centres, then the interior sample */
@@ -80,6 +83,7 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
     r->out = malloc((m + ne) * 3 * sizeof *r->out);
     double c0 = cpu_s();
     r->status = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &rbf);
+    r->setup_cpu_s = cpu_s() - c0;
     if (r->status >= 0) r->status = cm_rbf_solve(ctx, rbf, 3, v);
     r->fit_cpu_s = cpu_s() - c0;
     if (r->status >= 0) {
@@ -98,7 +102,9 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
             cm_rbf_destroy(&rbf);
             return;
         }
+        c0 = cpu_s();
         if (r->status >= 0) r->status = cm_rbf_evaluate(ctx, rbf, m, x, r->out);
+        r->centres_cpu_s = cpu_s() - c0;
         if (r->status == CM_OK) r->status = solved;
     }
     if (r->status < 0) fprintf(stderr, "error: %s\n", cm_context_message(ctx));
@@ -122,6 +128,7 @@ int main(int argc, char **argv)
         if (!strcmp(a, "--dense")) dense = 1;
         else if (!strcmp(a, "--no-iterative")) iterative = 0;
         else if (!strcmp(a, "--float")) o.local_float = 1;
+        else if (!strcmp(a, "--local-float")) o.local_float = atoi(b), ++i;
         else if (!strcmp(a, "--verbose")) verbose = 1;
         else if (!strcmp(a, "--no-centres")) skip_centres = 1;
         else if (!strcmp(a, "--threads")) threads = atoi(b), ++i;
@@ -172,13 +179,15 @@ int main(int argc, char **argv)
         printf(" it_status=%d leaf=%d local=%d coarse=%d post=%d subdomains=%d it_setup_s=%.2f "
                "it_solve_s=%.2f it_eval_s=%.2f iterations=%d matvecs=%d it_residual=%.3g "
                "it_floor=%.3g at_floor=%d it_exact=%.3g it_mem_mb=%.1f it_rss_mb=%.0f "
-               "it_fit_cpu_s=%.1f it_eval_cpu_s=%.1f overlap=%g local_max=%d",
+               "it_fit_cpu_s=%.1f it_eval_cpu_s=%.1f overlap=%g local_max=%d it_setup_cpu_s=%.1f "
+               "matvec_cpu_s=%.2f fit_in_matvecs=%.1f local_float=%d",
                it.status, o.leaf_size, o.local_size, it.st.coarse_size, o.coarse_post,
                it.st.subdomains,
                it.st.setup_seconds, it.st.solve_seconds, it.eval_s, it.st.iterations,
                it.st.matvecs, it.st.residual, it.st.floor, it.st.floor_limited, exact / range,
                (double)it.st.memory_bytes / 1e6, peak_rss_mb(), it.fit_cpu_s, it.eval_cpu_s,
-               o.overlap, o.local_max);
+               o.overlap, o.local_max, it.setup_cpu_s, it.centres_cpu_s,
+               it.centres_cpu_s > 0.0 ? it.fit_cpu_s / it.centres_cpu_s : 0.0, o.local_float);
         printf(" fast_sum=%d fast_tol=%g refinements=%d fast_residual=%.3g fast_bound=%.3g "
                "eval_fast=%d eval_error=%.3g", it.st.fast_sum, o.fast_tol, it.st.refinements,
                it.st.fast_residual, it.st.fast_bound, it.eval_fast, it.eval_error);

@@ -5,7 +5,9 @@
 # thread. Rows: wall and CPU seconds (the child's user + sys), warp create (set-up) and apply
 # (solve + evaluation) seconds, joint iterations, max node difference to the serial result
 # over the displacement range. usage: bench_rbf_petsc.sh BUILD_DIR MESH D.csv [WORK] [THREADS]
-# (D.csv: benchmarks/bench_warp_scipy.py --csv MESH MORPHED D.csv)
+# (D.csv: benchmarks/bench_warp_scipy.py --csv MESH MORPHED D.csv). RUNS (environment) picks
+# the rows, "solver ranks threads" separated by ';' (default: the three above); the serial
+# reference for "vs serial" is WORK/iterative_1xTHREADS.vtu, from this or an earlier run.
 set -eu
 build=${1:?usage: bench_rbf_petsc.sh BUILD_DIR MESH D.csv [WORK] [THREADS]}
 mesh=${2:?mesh}
@@ -18,7 +20,10 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OPENBLAS_VERBOS
 echo "# $(date -u '+%Y-%m-%d %H:%M UTC')  $(lscpu | sed -n 's/^Model name: *//p')  nproc=$(nproc)  load=$(cut -d' ' -f1-3 /proc/loadavg)  OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE:--}"
 echo "| solver | ranks x threads | wall s | CPU s | create s | apply s | iterations | BLAS core | vs serial |"
 echo "|---|---|---|---|---|---|---|---|---|"
-for run in "iterative 1 $threads" "petsc 1 $threads" "petsc 2 1"; do
+runs=${RUNS:-"iterative 1 $threads;petsc 1 $threads;petsc 2 1"}
+IFS=';'
+for run in $runs; do
+    IFS=' '
     set -- $run
     out="$work/${1}_$2x$3.vtu"
     launch=""

@@ -35,6 +35,8 @@ struct cm_rbf {
     cm_rbf_stats stats;
     cm_rbf_iter *iter; /* iterative solver state, NULL for dense (then chol is set) */
     cm_rbf_petsc *petsc; /* PETSC solver (rbf_petsc.c): set with iter, NULL otherwise */
+    int pc_part, pc_parts; /* Schwarz set-up split over ranks (rbf_petsc.c): this part of
+                            * pc_parts builds only its subdomains; 0, 0: all */
 };
 
 /* Threads for a leaf loop: the context's count, or all that OpenMP offers for 0. */
@@ -140,6 +142,16 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc);
  * the restricted local solves. out is not projected onto the null space of P'. */
 void cm_rbf_schwarz_apply(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc, const double *in,
                           double *out, int threads);
+/* Adds the other parts' local corrections into out (n doubles) in place, as MPI_Allreduce
+ * with MPI_SUM: 0, or nonzero on failure. */
+typedef int (*cm_rbf_schwarz_sum)(void *arg, double *out, size_t n);
+/* cm_rbf_schwarz_apply for a preconditioner built for one part of several (r->pc_parts):
+ * the local solves of its own subdomains, then sum() (called by every part, once per
+ * application), then the coarse terms; out is then the whole M in on every part, bit for
+ * bit the single-part result. sum NULL: as cm_rbf_schwarz_apply. 0, or -1 if sum failed. */
+int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc,
+                             const double *in, double *out, int threads, cm_rbf_schwarz_sum sum,
+                             void *arg);
 /* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
  * at most m / 4). */
 size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);

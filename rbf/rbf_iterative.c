@@ -66,7 +66,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->leaf_size = 256;
     opt->local_size = 1400;
     opt->coarse_size = 2000;
-    opt->local_float = 0;
+    opt->local_float = 1;
     opt->coarse_grow = 1;
     opt->coarse_max = 8000;
     opt->overlap = 3.0;
@@ -167,8 +167,9 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
     if (!(o->tolerance > 0.0) || o->max_iterations < 1 || o->restart < 2 || o->leaf_size < 8 ||
         o->local_size < o->leaf_size || o->coarse_size < 0 || o->coarse_post < 0 ||
         o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0 ||
-        o->fast_sum < -1 || o->fast_sum > 1 || !(o->fast_tol > 0.0 && o->fast_tol <= 1e-3) ||
-        o->fast_refine < 0 || o->fast_refine > 10 || !(o->fast_eval_tol > 0.0))
+        o->local_float < 0 || o->local_float > 2 || o->fast_sum < -1 || o->fast_sum > 1 ||
+        !(o->fast_tol > 0.0 && o->fast_tol <= 1e-3) || o->fast_refine < 0 ||
+        o->fast_refine > 10 || !(o->fast_eval_tol > 0.0))
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
                         "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "

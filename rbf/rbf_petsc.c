@@ -17,12 +17,17 @@
  *
  * Distribution: every rank holds all centres (3 m doubles: replicated data is cheap beside
  * m^2 kernel pairs) and owns a block of rows; a matvec gathers x to all ranks and each sums
- * its rows, so the O(m^2) work is divided by the ranks. The preconditioner is replicated
- * (each rank builds and applies all of it and keeps its rows): its application costs a few
- * per cent of a matvec, but its set-up is not divided. For many nodes the design is to
- * number the rows by Schwarz leaves so that each rank builds and owns whole subdomains
- * (local solves without communication, the coarse solve replicated) and to replace the
- * gather by a treecode's far field; see README. */
+ * its rows, so the O(m^2) work is divided by the ranks. The preconditioner is split by
+ * subdomains: every rank builds the kD-tree, the local sets and the coarse factor (cheap,
+ * and identical on all ranks), but the local factorisations - most of the set-up - only of
+ * its own run of subdomains (contiguous leaves of about equal cost, r->pc_parts); an
+ * application does the coarse solve on every rank, the own local solves, and one
+ * MPI_Allreduce of the g m corrections, which gives every rank the whole M x bit for bit
+ * as one rank computes it (each leaf centre gets one term; rbf_schwarz.c). The rows of the
+ * matvec stay in the centres' order, so the reduction moves the whole vector (g m doubles,
+ * as the gather does): fine on one node. For many nodes the design is to number the rows
+ * by Schwarz leaves, so that a rank's rows are its subdomains' leaves and the reduction
+ * shrinks to the overlap halo, and to replace the gather by a treecode's far field. */
 #include "rbf_internal.h"
 
 #include <float.h>
@@ -222,7 +227,17 @@ static PetscErrorCode shell_mult(Mat A, Vec x, Vec y)
     return apply_a(ps, x, y, 1, 0);
 }
 
-/* y = Pi M x: the whole preconditioner on every rank, each keeps its rows. */
+/* The other ranks' local corrections, summed into out on every rank. */
+static int sum_ranks(void *arg, double *out, size_t n)
+{
+    (void)arg;
+    if (n > (size_t)0x7fffffff) return -1;
+    return MPI_Allreduce(MPI_IN_PLACE, out, (int)n, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD) !=
+           MPI_SUCCESS;
+}
+
+/* y = Pi M x: the coarse solve and this rank's subdomains, the local corrections summed
+ * over the ranks; each rank keeps its rows. */
 static PetscErrorCode shell_pc(PC pc, Vec x, Vec y)
 {
     cm_rbf_petsc *ps;
@@ -230,8 +245,12 @@ static PetscErrorCode shell_pc(PC pc, Vec x, Vec y)
     const size_t m = ps->r->m, g = (size_t)ps->cur->g;
     PetscScalar *ya;
     PetscCall(gather(ps, x, ps->soa_in));
-    cm_rbf_schwarz_apply(cm_rbf_iterative_pc(ps->r), ps->r, (int)g, ps->soa_in, ps->soa_out,
-                         ps->threads);
+    int ranks = 1;
+    cm_rbf_petsc_rank(NULL, &ranks);
+    if (cm_rbf_schwarz_apply_sum(cm_rbf_iterative_pc(ps->r), ps->r, (int)g, ps->soa_in,
+                                 ps->soa_out, ps->threads, ranks > 1 ? sum_ranks : NULL,
+                                 NULL) != 0)
+        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "MPI_Allreduce of the Schwarz corrections failed");
     PetscCall(VecGetArray(y, &ya));
     for (size_t i = 0; i < (size_t)(ps->hi - ps->lo); ++i)
         for (size_t c = 0; c < g; ++c) ya[i * g + c] = ps->soa_out[c * m + (size_t)ps->lo + i];
@@ -329,7 +348,11 @@ cm_status cm_rbf_petsc_setup(cm_context *ctx, cm_rbf *r, int threads)
     if ((size_t)(PetscInt)(4 * r->m) != 4 * r->m)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
                         "cm_rbf_create: %zu centres exceed PETSc's index type", r->m);
-    /* the Schwarz preconditioner and Q1, on every rank (replicated) */
+    /* Q1 on every rank, the Schwarz preconditioner's subdomains split over the ranks */
+    int rank0 = 0, size0 = 1;
+    cm_rbf_petsc_rank(&rank0, &size0);
+    r->pc_part = rank0;
+    r->pc_parts = size0;
     st = cm_rbf_iterative_setup(ctx, r, threads);
     if (st != CM_OK) return st;
     cm_rbf_petsc *ps = calloc(1, sizeof *ps);

@@ -9,7 +9,12 @@
  * m * local_size numbers over all leaves instead of sum local_size^2 for the factors, and
  * one application is one small matrix-vector product per leaf. A coarse space of
  * farthest-point centres is solved exactly first (multiplicative), so the local solves see
- * only the residual of the smooth, global part. */
+ * only the residual of the smooth, global part.
+ * Storage (local_float): the rows can be kept in float at half the memory without costing
+ * iterations, because the local linear fit is taken out of the data before the product
+ * (G_l annihilates it in exact arithmetic, while its float rounding would multiply it).
+ * Split set-up (rbf_petsc.c): a part builds and applies only its run of subdomains; the
+ * parts' corrections add up to the whole one. */
 #include "rbf_internal.h"
 
 #include <cblas.h>
@@ -31,9 +36,19 @@ struct cm_rbf_schwarz {
     size_t *sub_ptr;  /* nsub + 1: offsets into sub_idx */
     size_t *sub_idx;  /* centre indices of each local set, its n_in leaf centres first */
     int *n_in;        /* nsub: leaf centres of each local set */
-    size_t *g_ptr;    /* nsub + 1: offsets into g32/g64 (local x n_in, col-major) */
-    float *g32;       /* local inverse rows, float storage */
-    double *g64;      /* or double storage */
+    /* local inverse rows of subdomain l, col-major local x n_in: the first hd[l] rows (its
+     * own leaf's centres come first) in g64 + d_ptr[l], the rest in g32 + f_ptr[l] (float:
+     * see store_local); only the subdomains of this part (l0 <= l < l1) are built */
+    size_t *d_ptr;    /* nsub + 1 */
+    size_t *f_ptr;    /* nsub + 1 */
+    int *hd;          /* nsub */
+    float *g32;
+    double *g64;
+    int l0, l1;       /* the subdomains this part owns (all: 0, nsub) */
+    double *lq;       /* with float rows: nsub x nmax x 4, orthonormal basis of the linear
+                       * polynomials on each own local set (idx order; zero columns past its
+                       * rank), see cm_rbf_schwarz_apply_sum */
+    size_t *q_ptr;    /* nsub + 1: offsets into lq */
     size_t nc;        /* coarse centres */
     size_t *c_idx;    /* nc */
     double *c_xyz;    /* 3 x nc SoA coordinates of the coarse centres */
@@ -245,7 +260,7 @@ static int projected_factor(const double *cg, size_t m, const size_t *idx, size_
         LAPACKE_dormqr(LAPACK_COL_MAJOR, 'R', 'N', ln, ln, rk, pq, ln, tau, a, ln) != 0)
         return -1;
     const lapack_int n2 = (lapack_int)(n - (size_t)rk);
-    lapack_int info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', n2, a + (size_t)rk * n + (size_t)rk, ln);
+    lapack_int info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n2, a + (size_t)rk * n + (size_t)rk, ln);
     return info < 0 ? -1 : (int)info;
 }
 
@@ -257,7 +272,7 @@ static int projected_solve(const double *work, size_t n, int rk, const double *t
     const double *a = work, *pq = work + n * n + 3 * n;
     const lapack_int ln = (lapack_int)n, lr = (lapack_int)nrhs;
     if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', ln, lr, rk, pq, ln, tau, x, ln) != 0 ||
-        LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', (lapack_int)(n - (size_t)rk), lr,
+        LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', (lapack_int)(n - (size_t)rk), lr,
                        a + (size_t)rk * n + (size_t)rk, ln, x + rk, ln) != 0)
         return -1;
     for (size_t j = 0; j < nrhs; ++j)
@@ -283,6 +298,114 @@ static int local_inverse(const double *cg, size_t m, const size_t *idx, size_t n
     return projected_solve(work, n, rk, tau, n_in, g);
 }
 
+/* local_inverse at about 0.6x the flops, for a local set with more overlap centres than
+ * polynomial terms (else -2: use local_inverse). Why it is cheaper: the projection is rank
+ * rk <= 4, so with the leaf ordered last, Q2'E is the trailing identity block plus a rank-rk
+ * term, and S^{-1} [0; I] (S = Q2' A Q2 = L L') needs only the inverse of L's trailing leaf
+ * block (dpotri) and one triangular solve with the overlap block L11, instead of dpotrs on
+ * n_in full columns; the two-sided projection is one rank-2rk update of the lower triangle
+ * (dsyr2k, Q = I - V T V') instead of two dormqr passes over the whole matrix. Same matrix
+ * as local_inverse up to rounding. work: n*n + 24n doubles; g as local_inverse. */
+static int local_inverse_fast(const double *cg, size_t m, const size_t *idx, size_t n,
+                              size_t n_in, double *work, double *g)
+{
+    const size_t no = n - n_in; /* overlap centres: first in this order, the leaf last */
+    double *a = work, *xyz = a + n * n, *pq = xyz + 3 * n, *vx = pq + 4 * n, *y = vx + 4 * n;
+    double *wv = y + 4 * n, *xs = wv + 4 * n;
+    for (int d = 0; d < 3; ++d)
+        for (size_t i = 0; i < n; ++i) {
+            size_t c = i < no ? idx[n_in + i] : idx[i - no];
+            xyz[(size_t)d * n + i] = cg[(size_t)d * m + c];
+        }
+    for (size_t j = 0; j < n; ++j) { /* lower triangle only */
+        const double xj = xyz[j], yj = xyz[n + j], zj = xyz[2 * n + j];
+        double *col = a + j * n;
+        for (size_t i = j; i < n; ++i) {
+            double dx = xyz[i] - xj, dy = xyz[n + i] - yj, dz = xyz[2 * n + i] - zj;
+            double r2 = dx * dx + dy * dy + dz * dz;
+            col[i] = r2 * sqrt(r2);
+        }
+    }
+    for (size_t i = 0; i < n; ++i) pq[i] = 1.0;
+    memcpy(pq + n, xyz, 3 * n * sizeof *pq);
+    lapack_int jpvt[4] = {0, 0, 0, 0};
+    double tau[4], t[16], mx[16];
+    const lapack_int ln = (lapack_int)n;
+    if (LAPACKE_dgeqp3(LAPACK_COL_MAJOR, ln, 4, pq, ln, jpvt, tau) != 0) return -1;
+    int rk = 0;
+    const double r00 = fabs(pq[0]);
+    while (rk < 4 && fabs(pq[(size_t)rk * n + (size_t)rk]) > 1e-9 * r00) ++rk;
+    if (no < (size_t)rk + 1 || n_in == 0) return -2;
+    const size_t nn = n - (size_t)rk, s = no - (size_t)rk; /* S is nn x nn: s overlap, n_in leaf */
+    for (int c = 0; c < rk; ++c)
+        for (size_t i = 0; i < n; ++i)
+            vx[(size_t)c * n + i] = i < (size_t)c ? 0.0 : i == (size_t)c ? 1.0 : pq[(size_t)c * n + i];
+    if (LAPACKE_dlarft_work(LAPACK_COL_MAJOR, 'F', 'C', ln, rk, vx, ln, tau, t, rk) != 0) return -1;
+    /* Q'AQ = A - V Z' - Z V', Z = A V T - V (T'V'A V T) / 2 */
+    cblas_dsymm(CblasColMajor, CblasLeft, CblasLower, (int)n, rk, 1.0, a, (int)n, vx, (int)n,
+                0.0, y, (int)n);
+    cblas_dtrmm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, (int)n, rk,
+                1.0, t, rk, y, (int)n);
+    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, rk, rk, (int)n, 1.0, vx, (int)n, y,
+                (int)n, 0.0, mx, rk);
+    cblas_dtrmm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, rk, rk, 1.0, t,
+                rk, mx, rk);
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (int)n, rk, rk, -0.5, vx, (int)n, mx,
+                rk, 1.0, y, (int)n);
+    cblas_dsyr2k(CblasColMajor, CblasLower, CblasNoTrans, (int)n, rk, -1.0, vx, (int)n, y,
+                 (int)n, 1.0, a, (int)n);
+    double *L = a + (size_t)rk * n + (size_t)rk; /* S = L L', leading dimension n */
+    lapack_int info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', (lapack_int)nn, L, ln);
+    if (info != 0) return info < 0 ? -1 : (int)info;
+    /* Q2'E = E2 - V2 xs: E2 the unit columns at rows s.. of S's space, V2 = rows rk.. of V,
+     * xs = T' V_leaf' (rk x n_in) */
+    for (size_t j = 0; j < n_in; ++j)
+        for (int c = 0; c < rk; ++c) xs[(size_t)c + (size_t)rk * j] = vx[(size_t)c * n + no + j];
+    cblas_dtrmm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, rk, (int)n_in,
+                1.0, t, rk, xs, rk);
+    /* wv = S^{-1} V2 */
+    for (int c = 0; c < rk; ++c)
+        memcpy(wv + (size_t)c * n, vx + (size_t)c * n + rk, nn * sizeof *wv);
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, (int)nn, rk,
+                1.0, L, (int)n, wv, (int)n);
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasTrans, CblasNonUnit, (int)nn, rk, 1.0,
+                L, (int)n, wv, (int)n);
+    /* X = S^{-1} E2 - wv xs into rows rk.. of g: S^{-1} E2 = [-L11^{-T} L21' x2; x2] with
+     * x2 = (L22 L22')^{-1} */
+    double *gx = g + rk, *x2 = g + no, *L22 = L + s * n + s;
+    for (size_t j = 0; j < n_in; ++j)
+        for (size_t i = j; i < n_in; ++i) x2[j * n + i] = L22[j * n + i];
+    info = LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', (lapack_int)n_in, x2, ln);
+    if (info != 0) return info < 0 ? -1 : (int)(s + (size_t)info);
+    for (size_t j = 0; j < n_in; ++j)
+        for (size_t i = 0; i < j; ++i) x2[j * n + i] = x2[i * n + j];
+    if (s > 0) {
+        cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)s, (int)n_in, (int)n_in, -1.0,
+                    L + s, (int)n, x2, (int)n, 0.0, gx, (int)n);
+        cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasTrans, CblasNonUnit, (int)s,
+                    (int)n_in, 1.0, L, (int)n, gx, (int)n);
+    }
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (int)nn, (int)n_in, rk, -1.0, wv,
+                (int)n, xs, rk, 1.0, gx, (int)n);
+    /* G E = Q [0; X] = g - V T (V' g) */
+    for (size_t j = 0; j < n_in; ++j)
+        for (int i = 0; i < rk; ++i) g[j * n + (size_t)i] = 0.0;
+    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, rk, (int)n_in, (int)n, 1.0, vx, (int)n,
+                g, (int)n, 0.0, xs, rk);
+    cblas_dtrmm(CblasColMajor, CblasLeft, CblasUpper, CblasNoTrans, CblasNonUnit, rk, (int)n_in,
+                1.0, t, rk, xs, rk);
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (int)n, (int)n_in, rk, -1.0, vx,
+                (int)n, xs, rk, 1.0, g, (int)n);
+    /* back to idx order (leaf first): rotate every column by n_in */
+    for (size_t j = 0; j < n_in; ++j) {
+        double *col = g + j * n;
+        memcpy(y, col, no * sizeof *y);
+        memmove(col, col + no, n_in * sizeof *col);
+        memcpy(col + n_in, y, no * sizeof *col);
+    }
+    return 0;
+}
+
 /* Farthest-point sampling of nc centres (c: 3 x m SoA), starting at the centre nearest to
  * the centroid; spreads the coarse centres evenly over the whole set, every part included. */
 static double farthest_points(const double *c, size_t m, size_t nc, size_t *out, double *d2,
@@ -302,7 +425,10 @@ static double farthest_points(const double *c, size_t m, size_t nc, size_t *out,
     for (size_t i = 1; i < m; ++i)
         if (d2[i] > d2[next]) next = i;
     for (size_t i = 0; i < m; ++i) d2[i] = INFINITY;
-    const int parallel = (double)m > 2e4 && threads > 1;
+    /* one parallel region per pick: below ~2e5 centres a pick is ~0.1 ms of work, less than
+     * a fork and join costs on a loaded machine (bore 20.6k, 2,031 picks: 9.7 s wall in
+     * parallel, 0.17 s serial with the coarse factorisation) */
+    const int parallel = (double)m > 2e5 && threads > 1;
     double fill2 = 0.0;
     for (size_t k = 0; k < nc; ++k) {
         out[k] = next;
@@ -356,7 +482,11 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
     free(p->sub_ptr);
     free(p->sub_idx);
     free(p->n_in);
-    free(p->g_ptr);
+    free(p->d_ptr);
+    free(p->f_ptr);
+    free(p->lq);
+    free(p->q_ptr);
+    free(p->hd);
     free(p->g32);
     free(p->g64);
     free(p->c_idx);
@@ -437,46 +567,127 @@ done:
     return st;
 }
 
+/* Rows of the local inverse kept in double for a subdomain of n centres, n_in of its own:
+ * local_float 0 all, 1 none, 2 the leaf's own rows (mixed: the overlap rows in float). */
+/* q (n x 4 col-major) = orthonormal basis of the linear polynomials on the n centres idx
+ * (the same rank-revealing QR as local_inverse; columns past the rank zero). work: 8n. */
+static int local_poly_basis(const double *cg, size_t m, const size_t *idx, size_t n,
+                            double *work, double *q)
+{
+    double *pq = work;
+    lapack_int jpvt[4] = {0, 0, 0, 0};
+    double tau[4];
+    for (size_t i = 0; i < n; ++i) pq[i] = 1.0;
+    for (int d = 0; d < 3; ++d)
+        for (size_t i = 0; i < n; ++i) pq[(size_t)(d + 1) * n + i] = cg[(size_t)d * m + idx[i]];
+    const lapack_int ln = (lapack_int)n;
+    if (LAPACKE_dgeqp3(LAPACK_COL_MAJOR, ln, 4, pq, ln, jpvt, tau) != 0) return -1;
+    int rk = 0;
+    const double r00 = fabs(pq[0]);
+    while (rk < 4 && fabs(pq[(size_t)rk * n + (size_t)rk]) > 1e-9 * r00) ++rk;
+    if (LAPACKE_dorgqr(LAPACK_COL_MAJOR, ln, rk, rk, pq, ln, tau) != 0) return -1;
+    memset(q, 0, 4 * n * sizeof *q);
+    memcpy(q, pq, (size_t)rk * n * sizeof *q);
+    return 0;
+}
+
+static int double_rows(int local_float, size_t n, size_t n_in)
+{
+    return local_float == 1 ? 0 : local_float == 2 ? (int)n_in : (int)n;
+}
+
+/* The owned subdomains [l0, l1) of part `part` of `parts`: contiguous runs of kD-tree
+ * leaves (so a part is a compact region) of about equal set-up cost, n^3 per subdomain. */
+static void split_parts(cm_rbf_schwarz *p, int part, int parts)
+{
+    p->l0 = 0;
+    p->l1 = p->nsub;
+    if (parts <= 1 || part < 0 || part >= parts) return;
+    double total = 0.0;
+    for (int l = 0; l < p->nsub; ++l) {
+        double n = (double)(p->sub_ptr[l + 1] - p->sub_ptr[l]);
+        total += n * n * n;
+    }
+    double acc = 0.0;
+    int l0 = -1, l1 = p->nsub;
+    for (int l = 0; l < p->nsub; ++l) {
+        /* subdomain l goes to the part its cost's midpoint falls in */
+        double n = (double)(p->sub_ptr[l + 1] - p->sub_ptr[l]), c = n * n * n;
+        int q = (int)((acc + 0.5 * c) / total * parts);
+        if (q > parts - 1) q = parts - 1;
+        if (q == part && l0 < 0) l0 = l;
+        if (q > part) {
+            l1 = l;
+            break;
+        }
+        acc += c;
+    }
+    p->l0 = l0 < 0 ? l1 : l0;
+    p->l1 = l0 < 0 ? l1 : l1;
+}
+
 static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p, int threads)
 {
     const size_t m = r->m;
-    p->g_ptr = malloc(((size_t)p->nsub + 1) * sizeof *p->g_ptr);
-    if (!p->g_ptr) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+    const int mode = r->opt.local_float;
+    p->d_ptr = malloc(((size_t)p->nsub + 1) * sizeof *p->d_ptr);
+    p->f_ptr = malloc(((size_t)p->nsub + 1) * sizeof *p->f_ptr);
+    p->hd = malloc(((size_t)p->nsub + 1) * sizeof *p->hd);
+    if (!p->d_ptr || !p->f_ptr || !p->hd)
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     size_t nmax = 0, inmax = 0;
-    p->g_ptr[0] = 0;
+    p->d_ptr[0] = p->f_ptr[0] = 0;
     for (int l = 0; l < p->nsub; ++l) {
-        size_t n = p->sub_ptr[l + 1] - p->sub_ptr[l];
-        p->g_ptr[l + 1] = p->g_ptr[l] + n * (size_t)p->n_in[l];
+        size_t n = p->sub_ptr[l + 1] - p->sub_ptr[l], nin = (size_t)p->n_in[l];
+        int own = l >= p->l0 && l < p->l1;
+        p->hd[l] = double_rows(mode, n, nin);
+        p->d_ptr[l + 1] = p->d_ptr[l] + (own ? (size_t)p->hd[l] * nin : 0);
+        p->f_ptr[l + 1] = p->f_ptr[l] + (own ? (n - (size_t)p->hd[l]) * nin : 0);
         if (n > nmax) nmax = n;
-        if ((size_t)p->n_in[l] > inmax) inmax = (size_t)p->n_in[l];
+        if (nin > inmax) inmax = nin;
     }
-    const size_t total = p->g_ptr[p->nsub];
+    const size_t nd = p->d_ptr[p->nsub], nf = p->f_ptr[p->nsub];
     p->nmax = nmax;
-    if (r->opt.local_float) p->g32 = malloc(total * sizeof *p->g32);
-    else p->g64 = malloc(total * sizeof *p->g64);
-    if (!p->g32 && !p->g64)
+    p->g64 = malloc((nd ? nd : 1) * sizeof *p->g64);
+    p->g32 = malloc((nf ? nf : 1) * sizeof *p->g32);
+    if (!p->g32 || !p->g64)
         return cm_error(ctx, CM_ERR_NOMEM,
                         "cm_rbf_create: out of memory for the local solves (%.3g GB)",
-                        (double)total * (r->opt.local_float ? 4.0 : 8.0) / 1e9);
-    p->bytes += total * (r->opt.local_float ? 4 : 8);
+                        ((double)nd * 8.0 + (double)nf * 4.0) / 1e9);
+    p->bytes += nd * 8 + nf * 4;
+    if (nf > 0) { /* float rows: the local polynomial bases, see cm_rbf_schwarz_apply_sum */
+        p->q_ptr = malloc(((size_t)p->nsub + 1) * sizeof *p->q_ptr);
+        if (!p->q_ptr) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+        p->q_ptr[0] = 0;
+        for (int l = 0; l < p->nsub; ++l) {
+            int own = l >= p->l0 && l < p->l1;
+            p->q_ptr[l + 1] = p->q_ptr[l] + (own ? 4 * (p->sub_ptr[l + 1] - p->sub_ptr[l]) : 0);
+        }
+        p->lq = malloc((p->q_ptr[p->nsub] ? p->q_ptr[p->nsub] : 1) * sizeof *p->lq);
+        if (!p->lq) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
+        p->bytes += p->q_ptr[p->nsub] * 8;
+    }
     /* one subdomain per thread with single-threaded BLAS: the local problems are too small
      * for threaded LAPACK to pay off */
     const int saved = openblas_get_num_threads();
     openblas_set_num_threads(1);
     int bad = 0, bad_info = 0, done = 0;
+    const int nown = p->l1 - p->l0;
 #pragma omp parallel num_threads(threads) if (threads > 1)
     {
-        double *work = malloc((nmax * nmax + 8 * nmax) * sizeof *work);
+        double *work = malloc((nmax * nmax + 24 * nmax) * sizeof *work);
         double *g = malloc(nmax * inmax * sizeof *g);
 #pragma omp for schedule(dynamic, 1)
-        for (int l = 0; l < p->nsub; ++l) {
+        for (int l = p->l0; l < p->l1; ++l) {
             if (!work || !g) {
 #pragma omp atomic write
                 bad = -1;
                 continue;
             }
             size_t n = p->sub_ptr[l + 1] - p->sub_ptr[l], nin = (size_t)p->n_in[l];
-            int info = local_inverse(r->c, m, p->sub_idx + p->sub_ptr[l], n, nin, work, g);
+            const size_t *idx = p->sub_idx + p->sub_ptr[l];
+            int info = local_inverse_fast(r->c, m, idx, n, nin, work, g);
+            if (info == -2) info = local_inverse(r->c, m, idx, n, nin, work, g);
             if (info != 0) {
 #pragma omp critical
                 {
@@ -485,18 +696,31 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
                 }
                 continue;
             }
-            size_t off = p->g_ptr[l];
-            if (p->g32)
-                for (size_t i = 0; i < n * nin; ++i) p->g32[off + i] = (float)g[i];
-            else
-                memcpy(p->g64 + off, g, n * nin * sizeof *g);
+            if (p->lq && info == 0) info = local_poly_basis(r->c, m, idx, n, work, p->lq + p->q_ptr[l]);
+            if (info != 0) {
+#pragma omp critical
+                {
+                    bad = l + 1;
+                    bad_info = info;
+                }
+                continue;
+            }
+            /* column j: rows [0, hd) in double, [hd, n) in float */
+            const size_t hd = (size_t)p->hd[l], hf = n - hd;
+            double *gd = p->g64 + p->d_ptr[l];
+            float *gf = p->g32 + p->f_ptr[l];
+            for (size_t j = 0; j < nin; ++j) {
+                const double *col = g + j * n;
+                memcpy(gd + j * hd, col, hd * sizeof *col);
+                for (size_t i = 0; i < hf; ++i) gf[j * hf + i] = (float)col[hd + i];
+            }
             int d;
 #pragma omp atomic capture
             d = ++done;
 #ifdef _OPENMP
             if (omp_get_thread_num() == 0) /* the caller's thread: callbacks need not be reentrant */
 #endif
-                cm_progress(ctx, "rbf local solves", (double)d, (double)p->nsub);
+                cm_progress(ctx, "rbf local solves", (double)d, (double)nown);
         }
         free(work);
         free(g);
@@ -557,6 +781,7 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
     cm_status st = build_coarse(ctx, r, p, threads);
     double t1 = cm_wtime();
     if (st == CM_OK) st = build_subdomains(ctx, r, p, threads);
+    if (st == CM_OK) split_parts(p, r->pc_part, r->pc_parts);
     double t2 = cm_wtime();
     if (st == CM_OK) st = build_local(ctx, r, p, threads);
     double t3 = cm_wtime();
@@ -568,20 +793,22 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
     cm_log(ctx, CM_LOG_DEBUG,
            "cm_rbf_create: Schwarz: %d subdomains of <= %zu centres (mean %.0f, leaves <= %d), "
            "coarse %zu (fill distance %.3g); coarse %.3f s, tree + overlap %.3f s, local %.3f "
-           "s, %.1f MB",
+           "s (%d subdomains built here), %.1f MB",
            p->nsub, p->nmax, (double)p->sub_ptr[p->nsub] / (double)p->nsub, r->opt.leaf_size,
-           p->nc, p->fill, t1 - t0, t2 - t1, t3 - t2, (double)p->bytes / 1e6);
+           p->nc, p->fill, t1 - t0, t2 - t1, t3 - t2, p->l1 - p->l0, (double)p->bytes / 1e6);
     *pc = p;
     return CM_OK;
 }
 
-void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, const double *in,
-                          double *out, int threads)
+int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
+                             const double *in, double *out, int threads, cm_rbf_schwarz_sum sum,
+                             void *arg)
 {
     const size_t m = r->m, ncs = p->nc;
     memset(out, 0, (size_t)nc * m * sizeof *out);
     const double *res = in;
-    double *r1 = NULL, *rc = NULL, *ac = NULL;
+    double *r1 = NULL, *rc = NULL, *ac = NULL, *wc = NULL;
+    int failed = 0;
     if (ncs > 0 && p->post == 2) { /* local solves first, coarse after them only */
         rc = calloc(2 * ncs * (size_t)nc, sizeof *rc);
         r1 = rc; /* marks the coarse correction below as possible */
@@ -593,13 +820,11 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
             free(rc), free(ac), free(r1);
             r1 = rc = ac = NULL;
         } else {
-            double *wc = rc + ncs * (size_t)nc;
+            wc = rc + ncs * (size_t)nc;
             for (int c = 0; c < nc; ++c)
                 for (size_t a = 0; a < ncs; ++a) rc[(size_t)c * ncs + a] = in[(size_t)c * m + p->c_idx[a]];
             memcpy(wc, rc, ncs * (size_t)nc * sizeof *wc);
             projected_solve(p->gc, ncs, p->c_rk, p->c_tau, (size_t)nc, wc);
-            for (int c = 0; c < nc; ++c)
-                for (size_t a = 0; a < ncs; ++a) out[(size_t)c * m + p->c_idx[a]] = wc[(size_t)c * ncs + a];
             /* the local solves see the residual of the coarse interpolant; its polynomial
              * part is left in, as the local solves annihilate linear functions exactly */
             cm_rbf_kernel_sum(r->kernel, 3, ncs, p->c_xyz, wc, nc, m, r->c, m, ac, (size_t)nc,
@@ -610,39 +835,60 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
             res = r1;
         }
     }
-    /* leaves are disjoint, so the scatter into out needs no synchronisation */
-#pragma omp parallel num_threads(threads) if (threads > 1 && p->nsub > 1)
+    /* leaves are disjoint, so the scatter into out needs no synchronisation; each leaf
+     * centre receives exactly one sum (and a coarse centre its coarse weight below, in
+     * either order the same two numbers), so the parts of a split preconditioner added
+     * together give this one bit for bit */
+#pragma omp parallel num_threads(threads) if (threads > 1 && p->l1 - p->l0 > 1)
     {
         double *loc = malloc(p->nmax * (size_t)nc * sizeof *loc);
 #pragma omp for schedule(dynamic, 4)
-        for (int l = 0; l < p->nsub; ++l) {
+        for (int l = p->l0; l < p->l1; ++l) {
             const size_t *idx = p->sub_idx + p->sub_ptr[l];
             const size_t n = p->sub_ptr[l + 1] - p->sub_ptr[l], nin = (size_t)p->n_in[l];
+            const size_t hd = (size_t)p->hd[l], hf = n - hd;
             double *x = loc;
             if (!x) continue; /* out of memory: a weaker preconditioner, not a wrong result */
             for (int c = 0; c < nc; ++c)
                 for (size_t i = 0; i < n; ++i) x[(size_t)c * n + i] = res[(size_t)c * m + idx[i]];
+            if (p->lq) {
+                /* float rows: the local inverse annihilates linear data, so taking the local
+                 * linear fit out first changes nothing in exact arithmetic, but the float
+                 * rounding of G (about 6e-8 |G|) then multiplies only what is left, not the
+                 * linear part, which on a small set dominates the data */
+                const double *q = p->lq + p->q_ptr[l];
+                for (int c = 0; c < nc; ++c) {
+                    double *xc = x + (size_t)c * n;
+                    for (int a = 0; a < 4; ++a) {
+                        const double *qa = q + (size_t)a * n;
+                        double t = 0.0;
+                        for (size_t i = 0; i < n; ++i) t += qa[i] * xc[i];
+                        for (size_t i = 0; i < n; ++i) xc[i] -= t * qa[i];
+                    }
+                }
+            }
             for (size_t j = 0; j < nin; ++j) {
+                const double *gd = p->g64 + p->d_ptr[l] + j * hd;
+                const float *gf = p->g32 + p->f_ptr[l] + j * hf;
                 for (int c = 0; c < nc; ++c) {
                     const double *xc = x + (size_t)c * n;
                     double acc = 0.0;
-                    if (p->g32) {
-                        const float *g = p->g32 + p->g_ptr[l] + j * n;
-                        for (size_t i = 0; i < n; ++i) acc += (double)g[i] * xc[i];
-                    } else {
-                        const double *g = p->g64 + p->g_ptr[l] + j * n;
-                        for (size_t i = 0; i < n; ++i) acc += g[i] * xc[i];
-                    }
+                    for (size_t i = 0; i < hd; ++i) acc += gd[i] * xc[i];
+                    for (size_t i = 0; i < hf; ++i) acc += (double)gf[i] * xc[hd + i];
                     out[(size_t)c * m + idx[j]] += acc;
                 }
             }
         }
         free(loc);
     }
+    if (sum && sum(arg, out, (size_t)nc * m) != 0) failed = 1;
+    if (wc)
+        for (int c = 0; c < nc; ++c)
+            for (size_t a = 0; a < ncs; ++a) out[(size_t)c * m + p->c_idx[a]] += wc[(size_t)c * ncs + a];
     /* multiplicative coarse correction after the local solves: out += G_c (in - A out) at
      * the coarse centres, so the coarse residual of the whole correction is zero */
     if (r1 && p->post) {
-        double *wc = rc + ncs * (size_t)nc;
+        wc = rc + ncs * (size_t)nc;
         double *aout = malloc(ncs * (size_t)nc * sizeof *aout);
         if (aout) {
             cm_rbf_kernel_sum(r->kernel, 3, m, r->c, out, nc, ncs, p->c_xyz, ncs, aout,
@@ -662,4 +908,11 @@ void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, cons
     if (r1 != rc) free(r1);
     free(rc);
     free(ac);
+    return failed ? -1 : 0;
+}
+
+void cm_rbf_schwarz_apply(const cm_rbf_schwarz *p, const cm_rbf *r, int nc, const double *in,
+                          double *out, int threads)
+{
+    cm_rbf_schwarz_apply_sum(p, r, nc, in, out, threads, NULL, NULL);
 }

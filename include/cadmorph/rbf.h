@@ -35,7 +35,7 @@ typedef struct cm_rbf cm_rbf;
  *   farthest-point centres (grown as sqrt(m) above 2e4 centres). Matvecs are direct sums
  *   with compensated accumulation (the preconditioned vectors cancel too much for plain
  *   sums; rbf_sum_acc.c), the weights are accumulated in double-double. Memory about
- *   8 m (mean subdomain size) bytes (local_float: 4) plus the coarse factor (8 coarse^2)
+ *   4 m (mean subdomain size) bytes (local_float 0: 8) plus the coarse factor (8 coarse^2)
  *   and the Krylov basis, 16 m restart bytes per component; time O(m local^2) to set up,
  *   O(m^2) per iteration. From 40,000 centres (fast_sum) the Krylov matvecs are fast sums
  *   instead (a barycentric Lagrange treecode for r^3, O(m log m), error at most fast_tol x
@@ -49,11 +49,12 @@ typedef struct cm_rbf cm_rbf;
  * PETSC: the ITERATIVE solver distributed over the MPI ranks of PETSC_COMM_WORLD through
  *   PETSc (only in builds with -DCADMORPH_WITH_PETSC=ON; otherwise create fails with
  *   CM_ERR_UNSUPPORTED): KSPFGMRES on a MatShell whose rows (the r^3 kernel sums) are split
- *   over the ranks, the same Schwarz preconditioner as a PCSHELL. Create, solve and
+ *   over the ranks, the same Schwarz preconditioner as a PCSHELL (each rank factorises
+ *   and applies only its share of the subdomains, the coarse solve on all). Create, solve and
  *   evaluate are then collective: every rank calls them with the same centres and values
  *   (each holds all centres and gets all weights); see cm_rbf_petsc_initialize.
  * cm_rbf_evaluate works for both; an iterative fit evaluates with compensated sums too
- * (about 2.8x the time of plain sums), so it reproduces the data at the centres to its
+ * (about 1.5x the time of plain sums with the AVX-512 kernels), so it reproduces the data at the centres to its
  * residual, where plain sums, as the dense path uses, stop at the floor in cm_rbf_stats. */
 typedef enum cm_rbf_solver {
     CM_RBF_SOLVER_AUTO = 0,
@@ -78,10 +79,11 @@ typedef struct cm_rbf_options {
                            * matters on thin walls */
     int coarse_size;      /* [2000] farthest-point centres of the coarse space (at m <= 2e4,
                            * see coarse_grow), 0: none */
-    int local_float;      /* [0] store the local inverse rows in float: half the memory
-                           * (4 instead of 8 bytes x m x local_size), but the r^3 inverses
-                           * cancel so heavily that float rounding costs iterations (bracket
-                           * m = 21k: 15 instead of 9, bore 22.6k: 12 instead of 10) */
+    int local_float;      /* [1] storage of the local inverse rows: 1 float (4 instead of
+                           * 8 bytes x m x local_size; the local linear fit is taken out of
+                           * the data first, so float rounding costs no iterations: bracket
+                           * 21k / 59k and bore 22.6k take the same counts as in double),
+                           * 0 double, 2 the leaf's own rows in double, the overlap in float */
     int coarse_post;      /* [0] order of the coarse correction: 0 before the local solves,
                            * 1 before and after them (symmetric multiplicative), 2 after
                            * them only */

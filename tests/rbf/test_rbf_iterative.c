@@ -165,6 +165,49 @@ static void test_affine(cm_context *ctx)
     free(x), free(d), free(p), free(ref), free(out);
 }
 
+/* The storage of the local inverse rows (local_float 0 double, 1 float, 2 mixed): the same
+ * interpolant to 1e-9 of the range, iterations within one, float smaller. */
+static void test_storage(cm_context *ctx)
+{
+    const double off[3] = {0.0, 0.0, 0.0};
+    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.09, off, NULL);
+    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.09, off, x);
+    bore_motion(m, x, 2.0, 1.0, d);
+    size_t np;
+    double *p = eval_points(m, x, 500, &np);
+    double *out[3];
+    cm_rbf_stats st[3];
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    const double range = range_of(m * 3, d);
+    for (int f = 0; f < 3; ++f) {
+        out[f] = malloc(np * 3 * sizeof *out[f]);
+        o.local_float = f;
+        cm_status s = fit_eval_opt(ctx, &o, m, x, d, np, p, out[f], &st[f]);
+        CHECK_MSG(s == CM_OK, "local_float %d: %s", f, cm_context_message(ctx));
+        CHECK_MSG(st[f].residual <= o.tolerance, "local_float %d: %.3g", f, st[f].residual);
+    }
+    for (int f = 1; f < 3; ++f) {
+        double diff = max_diff(np * 3, out[f], out[0]) / range;
+        printf("storage: m = %zu, local_float %d vs double: %.3g of the range, %d vs %d "
+               "iterations, %.1f vs %.1f MB\n",
+               m, f, diff, st[f].iterations, st[0].iterations, st[f].memory_bytes / 1e6,
+               st[0].memory_bytes / 1e6);
+        CHECK_MSG(diff <= 1e-9, "local_float %d: %.3g", f, diff);
+        CHECK(abs(st[f].iterations - st[0].iterations) <= 1);
+        CHECK(st[f].memory_bytes < st[0].memory_bytes);
+        free(out[f]);
+    }
+    free(out[0]);
+    o.local_float = 3;
+    cm_rbf *bad = NULL;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &bad) == CM_ERR_ARGUMENT);
+    CHECK(bad == NULL);
+    free(x), free(d), free(p);
+}
+
 /* Two parts far apart (10 part sizes): the coarse space and the subdomains must not couple
  * them wrongly, and the null space is that of the whole set. */
 static void test_two_bodies(cm_context *ctx)
@@ -291,6 +334,7 @@ int main(void)
     cm_context_set_threads(ctx, 2);
     test_against_dense(ctx);
     test_affine(ctx);
+    test_storage(ctx);
     test_two_bodies(ctx);
     test_choice(ctx);
     cm_context_destroy(&ctx);
