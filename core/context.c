@@ -10,6 +10,7 @@
 #include <string.h>
 #include <sys/resource.h>
 #include <time.h>
+#include <unistd.h>
 
 #define CM_MESSAGE_MAX 2048
 
@@ -200,6 +201,12 @@ void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
 void cm_progress(cm_context *ctx, const char *stage, double done, double total)
 {
     if (ctx && ctx->progress) ctx->progress(ctx->progress_user, stage, done, total);
+}
+
+double cm_memory_budget(void)
+{
+    const long pages = sysconf(_SC_PHYS_PAGES), psize = sysconf(_SC_PAGESIZE);
+    return pages > 0 && psize > 0 ? 0.5 * (double)pages * (double)psize : 0.0;
 }
 
 double cm_wtime(void)

@@ -22,7 +22,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 /* The rounding error of one direct sum A w is at most about eps sum_j |w_j phi_ij|; the
  * error of a whole solve, observed, stays within this factor of that estimate. */
@@ -134,8 +133,8 @@ int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
 {
     if (kernel != CM_RBF_TRIHARMONIC) return 1;
     const double x = (double)m;
-    long pages = sysconf(_SC_PHYS_PAGES), psize = sysconf(_SC_PAGESIZE);
-    if (pages > 0 && psize > 0 && 4.0 * x * x > 0.5 * (double)pages * (double)psize) return 0;
+    const double budget = cm_memory_budget();
+    if (budget > 0 && 4.0 * x * x > budget) return 0;
     if (m < 1000) return 1;
     if (m > 60000) return 0;
     double dense, iter;

@@ -118,6 +118,11 @@ CM_API double cm_bbox_diagonal(const double bb[6]);
 /* Wall clock in seconds (monotonic), for stage timings in reports and benchmarks. */
 CM_API double cm_wtime(void);
 
+/* Bytes a single dense working set may take: half the machine's physical memory (the dense
+ * RBF factor, DM-FFD's SVD), so that a request that cannot fit is refused with its size
+ * instead of thrashing. 0 if the system does not say. */
+CM_API double cm_memory_budget(void);
+
 /* ---- files ---- */
 
 /* Reads a whole regular file into *data (NUL-terminated; *size excludes the NUL). The caller
