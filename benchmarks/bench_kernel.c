@@ -13,24 +13,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
+#include "bench_util.h"
 
-static unsigned long long rng = 0x9E3779B97F4A7C15ULL;
-static double urand(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
-}
 
-static double cpu_seconds(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
-}
 
 #define NREF 64
 #define NC 3
@@ -74,14 +59,14 @@ int main(int argc, char **argv)
     double *p = malloc(3 * n * sizeof *p), *out = malloc(NC * n * sizeof *out);
     long double *ref = malloc(NC * NREF * sizeof *ref), *absum = malloc(NC * NREF * sizeof *absum);
     if (!c || !w || !p || !out || !ref || !absum) return 2;
-    for (size_t i = 0; i < 3 * n; ++i) p[i] = urand();
+    for (size_t i = 0; i < 3 * n; ++i) p[i] = bench_urand();
 
     printf("# bench_kernel: n=%zu points, %d weight vectors, reps=%d (best of), AUTO=%d\n", n,
            NC, reps, (int)cm_rbf_isa_auto());
     for (int km = 0; km < nm; ++km) {
         const size_t m = (size_t)ms[km];
-        for (size_t i = 0; i < 3 * m; ++i) c[i] = urand();
-        for (size_t i = 0; i < NC * m; ++i) w[i] = 2.0 * urand() - 1.0;
+        for (size_t i = 0; i < 3 * m; ++i) c[i] = bench_urand();
+        for (size_t i = 0; i < NC * m; ++i) w[i] = 2.0 * bench_urand() - 1.0;
         for (int i = 0; i < NREF; ++i)
             for (int q = 0; q < NC; ++q) {
                 long double s = 0.0L, a = 0.0L;
@@ -106,14 +91,14 @@ int main(int argc, char **argv)
                 for (int v = 0; v < NVAR; ++v) {
                     if (!cm_rbf_isa_supported(variants[v].isa)) continue;
                     for (int s = 0; s < 2; ++s) {
-                        double t0 = cpu_seconds(), w0 = cm_wtime();
+                        double t0 = bench_cpu_seconds(), w0 = cm_wtime();
                         if (s == 0)
                             cm_rbf_kernel_sum_isa(variants[v].isa, CM_RBF_TRIHARMONIC, 3, m, c,
                                                   w, NC, n, p, n, out, NC, threads);
                         else
                             cm_rbf_kernel_sum_acc_isa(variants[v].isa, m, c, w, NC, n, p, n,
                                                       out, NC, threads);
-                        double t = cpu_seconds() - t0, tw = cm_wtime() - w0;
+                        double t = bench_cpu_seconds() - t0, tw = cm_wtime() - w0;
                         if (t < best[v][s]) best[v][s] = t, wall[v][s] = tw;
                         double ea = 0.0, er = 0.0;
                         for (int i = 0; i < NREF; ++i)

@@ -16,25 +16,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
+#include "bench_util.h"
 #include <time.h>
 
-static double cpu_seconds(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
-}
 
-static unsigned long long rng = 0x9E3779B97F4A7C15ULL;
-static double urand(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0);
-}
 
 #define TORUS_R 1.0
 #define TORUS_A 0.4
@@ -44,10 +29,10 @@ static void torus_point(int inside, double *x)
 {
     const double two_pi = 6.283185307179586;
     for (;;) {
-        double u = two_pi * urand(), v = two_pi * urand();
-        double rho = inside ? 0.95 * TORUS_A * sqrt(urand()) : TORUS_A;
+        double u = two_pi * bench_urand(), v = two_pi * bench_urand();
+        double rho = inside ? 0.95 * TORUS_A * sqrt(bench_urand()) : TORUS_A;
         double ring = TORUS_R + rho * cos(v);
-        if (urand() * (TORUS_R + TORUS_A) > ring) continue;
+        if (bench_urand() * (TORUS_R + TORUS_A) > ring) continue;
         x[0] = ring * cos(u);
         x[1] = ring * sin(u);
         x[2] = rho * sin(v);
@@ -88,7 +73,7 @@ static double dgemm_rate(void)
     const int n = 2000;
     double *a = malloc(sizeof(double) * n * n), *b = malloc(sizeof(double) * n * n);
     double *c = malloc(sizeof(double) * n * n);
-    for (long i = 0; i < (long)n * n; ++i) a[i] = urand(), b[i] = urand(), c[i] = 0.0;
+    for (long i = 0; i < (long)n * n; ++i) a[i] = bench_urand(), b[i] = bench_urand(), c[i] = 0.0;
     double best = 0.0;
     for (int r = 0; r < 3; ++r) {
         double t = cm_wtime();
@@ -157,13 +142,13 @@ int main(int argc, char **argv)
         /* OpenBLAS workers spin ~0.1 s after the dgemm probe; let them settle */
         struct timespec ts = {0, 300000000};
         nanosleep(&ts, NULL);
-        double t0 = cm_wtime(), c0 = cpu_seconds();
+        double t0 = cm_wtime(), c0 = bench_cpu_seconds();
         cm_status st = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, c, &opt, &rbf);
         double t1 = cm_wtime();
         if (st == CM_OK) st = cm_rbf_solve(ctx, rbf, 3, v);
-        double t2 = cm_wtime(), c2 = cpu_seconds();
+        double t2 = cm_wtime(), c2 = bench_cpu_seconds();
         if (st == CM_OK) st = cm_rbf_evaluate(ctx, rbf, n, p, out);
-        double t3 = cm_wtime(), c3 = cpu_seconds();
+        double t3 = cm_wtime(), c3 = bench_cpu_seconds();
         best_fit_cpu = fmin(best_fit_cpu, c2 - c0);
         best_eval_cpu = fmin(best_eval_cpu, c3 - c2);
         if (st != CM_OK) {

@@ -12,43 +12,20 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
+#include "bench_util.h"
 
+
+
+
+/* PREFIX.ext as n x 3 doubles */
 static double *read_raw(const char *prefix, const char *ext, size_t *n)
 {
     char path[4096];
+    size_t bytes = 0;
     snprintf(path, sizeof path, "%s.%s", prefix, ext);
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long bytes = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    double *x = malloc((size_t)bytes + 8);
-    size_t got = x ? fread(x, 1, (size_t)bytes, f) : 0;
-    fclose(f);
-    if (got != (size_t)bytes) {
-        free(x);
-        return NULL;
-    }
-    *n = (size_t)bytes / (3 * sizeof(double));
+    double *x = bench_read_raw(path, &bytes);
+    *n = bytes / (3 * sizeof(double));
     return x;
-}
-
-static double peak_rss_mb(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_maxrss / 1024.0;
-}
-
-/* CPU seconds of the process (user + system): on a shared machine the figure that the
- * other jobs disturb least. */
-static double cpu_s(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
 }
 
 static void log_stderr(void *user, cm_log_level level, const char *message)
@@ -81,18 +58,18 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
 {
     cm_rbf *rbf = NULL;
     r->out = malloc((m + ne) * 3 * sizeof *r->out);
-    double c0 = cpu_s();
+    double c0 = bench_cpu_seconds();
     r->status = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &rbf);
-    r->setup_cpu_s = cpu_s() - c0;
+    r->setup_cpu_s = bench_cpu_seconds() - c0;
     if (r->status >= 0) r->status = cm_rbf_solve(ctx, rbf, 3, v);
-    r->fit_cpu_s = cpu_s() - c0;
+    r->fit_cpu_s = bench_cpu_seconds() - c0;
     if (r->status >= 0) {
         double t0 = cm_wtime();
-        c0 = cpu_s();
+        c0 = bench_cpu_seconds();
         cm_status solved = r->status; /* keep a solve's warning (stagnation, max_iterations) */
         r->status = cm_rbf_evaluate(ctx, rbf, ne, p, r->out + m * 3);
         r->eval_s = cm_wtime() - t0;
-        r->eval_cpu_s = cpu_s() - c0;
+        r->eval_cpu_s = bench_cpu_seconds() - c0;
         cm_rbf_stats es;
         cm_rbf_get_stats(rbf, &es);
         r->eval_fast = es.eval_fast;
@@ -102,9 +79,9 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
             cm_rbf_destroy(&rbf);
             return;
         }
-        c0 = cpu_s();
+        c0 = bench_cpu_seconds();
         if (r->status >= 0) r->status = cm_rbf_evaluate(ctx, rbf, m, x, r->out);
-        r->centres_cpu_s = cpu_s() - c0;
+        r->centres_cpu_s = bench_cpu_seconds() - c0;
         if (r->status == CM_OK) r->status = solved;
     }
     if (r->status < 0) fprintf(stderr, "error: %s\n", cm_context_message(ctx));
@@ -185,7 +162,7 @@ int main(int argc, char **argv)
                it.st.subdomains,
                it.st.setup_seconds, it.st.solve_seconds, it.eval_s, it.st.iterations,
                it.st.matvecs, it.st.residual, it.st.floor, it.st.floor_limited, exact / range,
-               (double)it.st.memory_bytes / 1e6, peak_rss_mb(), it.fit_cpu_s, it.eval_cpu_s,
+               (double)it.st.memory_bytes / 1e6, bench_peak_rss_mb(), it.fit_cpu_s, it.eval_cpu_s,
                o.overlap, o.local_max, it.setup_cpu_s, it.centres_cpu_s,
                it.centres_cpu_s > 0.0 ? it.fit_cpu_s / it.centres_cpu_s : 0.0, o.local_float);
         printf(" fast_sum=%d fast_tol=%g refinements=%d fast_residual=%.3g fast_bound=%.3g "
@@ -200,7 +177,7 @@ int main(int argc, char **argv)
         printf(" dense_status=%d dense_setup_s=%.2f dense_solve_s=%.2f dense_eval_s=%.2f "
                "dense_residual=%.3g dense_exact=%.3g dense_rss_mb=%.0f dense_fit_cpu_s=%.1f",
                dn.status, dn.st.setup_seconds, dn.st.solve_seconds, dn.eval_s, dn.st.residual,
-               dex / range, peak_rss_mb(), dn.fit_cpu_s);
+               dex / range, bench_peak_rss_mb(), dn.fit_cpu_s);
         if (iterative && it.status >= 0 && dn.status >= 0) {
             double d = 0.0;
             for (size_t i = 0; i < 3 * (m + ne); ++i) d = fmax(d, fabs(it.out[i] - dn.out[i]));

@@ -14,33 +14,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
+#include "bench_util.h"
 
-static double *read_raw(const char *path, size_t *bytes_out)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long bytes = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    double *x = malloc((size_t)bytes + 8);
-    size_t got = x ? fread(x, 1, (size_t)bytes, f) : 0;
-    fclose(f);
-    if (got != (size_t)bytes) {
-        free(x);
-        return NULL;
-    }
-    *bytes_out = (size_t)bytes;
-    return x;
-}
 
-static double cpu_s(void)
-{
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
-    return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-           (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
-}
 
 /* err_i / S_i (max over i), max err / max S, max err / max |exact| */
 static void compare(size_t m, const double *fast, const double *ex, const double *S,
@@ -67,7 +43,7 @@ static int random_only(const char *prefix, const char *orders, const char *tols,
     char path[4096];
     size_t bytes = 0;
     snprintf(path, sizeof path, "%s.centres", prefix);
-    double *x = read_raw(path, &bytes);
+    double *x = bench_read_raw(path, &bytes);
     if (!x) return 1;
     const size_t m = bytes / 24;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, ext = 0.0;
@@ -88,12 +64,12 @@ static int random_only(const char *prefix, const char *orders, const char *tols,
     double *sp = malloc(3 * ns * sizeof *sp), *so = malloc(3 * ns * sizeof *so);
     for (size_t k = 0; k < ns; ++k)
         for (int d = 0; d < 3; ++d) sp[(size_t)d * ns + k] = c[(size_t)d * m + k * (m / ns)];
-    double c0 = cpu_s();
+    double c0 = bench_cpu_seconds();
     cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, w, 3, ns, sp, ns, so, 3, threads);
-    const double direct = (cpu_s() - c0) * (double)m / (double)ns;
-    c0 = cpu_s();
+    const double direct = (bench_cpu_seconds() - c0) * (double)m / (double)ns;
+    c0 = bench_cpu_seconds();
     cm_rbf_kernel_sum_acc(m, c, w, 3, ns, sp, ns, so, 3, threads);
-    const double acc = (cpu_s() - c0) * (double)m / (double)ns;
+    const double acc = (bench_cpu_seconds() - c0) * (double)m / (double)ns;
     printf("set=%s m=%zu threads=%d random weights: direct_cpu_s=%.1f compensated_cpu_s=%.1f "
            "(scaled from %zu targets; %.3g pairs per CPU-s plain, 3 components)\n", prefix, m,
            threads, direct, acc, ns, (double)m * (double)m / direct);
@@ -106,14 +82,14 @@ static int random_only(const char *prefix, const char *orders, const char *tols,
             tol = atof(tok);
             cm_rbf_tree_params(tol, &n, &th);
         } else if (sscanf(tok, "%d:%lf", &n, &th) != 2) continue;
-        c0 = cpu_s();
+        c0 = bench_cpu_seconds();
         cm_rbf_tree *t = cm_rbf_tree_create(m, c, n, th);
-        double build = cpu_s() - c0;
+        double build = bench_cpu_seconds() - c0;
         if (!t) return 1;
-        c0 = cpu_s();
+        c0 = bench_cpu_seconds();
         double w0 = cm_wtime();
         cm_rbf_tree_sum_self(t, w, 3, out, 3, threads);
-        double fast = cpu_s() - c0, fast_wall = cm_wtime() - w0;
+        double fast = bench_cpu_seconds() - c0, fast_wall = cm_wtime() - w0;
         double e, sabs;
         cm_rbf_tree_check(t, w, 3, m, c, m, out, 3, 512, &e, &sabs, threads);
         printf("tol=%.0e order=%d theta=%.2f build_cpu_s=%.2f fast_cpu_s=%.2f fast_wall_s=%.2f "
@@ -149,16 +125,16 @@ int main(int argc, char **argv)
     }
     size_t bytes = 0, m = 0;
     if (!strcmp(wpath, "-")) return random_only(prefix, orders, tols, threads);
-    double *cw = read_raw(wpath, &bytes); /* 3 x m unit-box centres, then 3 x m weights */
+    double *cw = bench_read_raw(wpath, &bytes); /* 3 x m unit-box centres, then 3 x m weights */
     if (cw) {
         m = bytes / (6 * sizeof(double));
     } else {
         char path[4096];
         snprintf(path, sizeof path, "%s.centres", prefix);
-        double *x = read_raw(path, &bytes);
+        double *x = bench_read_raw(path, &bytes);
         size_t mx = bytes / 24;
         snprintf(path, sizeof path, "%s.values", prefix);
-        double *v = read_raw(path, &bytes);
+        double *v = bench_read_raw(path, &bytes);
         if (!x || !v || bytes / 24 != mx) {
             fprintf(stderr, "cannot read %s.centres / .values\n", prefix);
             return 1;
@@ -200,12 +176,12 @@ int main(int argc, char **argv)
     for (int k = 0; k < 2; ++k) {
         ex[k] = malloc(3 * m * sizeof(double));
         S[k] = malloc(3 * m * sizeof(double));
-        double c0 = cpu_s();
+        double c0 = bench_cpu_seconds();
         cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, ws[k], 3, m, c, m, fast, 3, threads);
-        if (k == 0) direct_cpu = cpu_s() - c0;
-        c0 = cpu_s();
+        if (k == 0) direct_cpu = bench_cpu_seconds() - c0;
+        c0 = bench_cpu_seconds();
         cm_rbf_kernel_sum_acc(m, c, ws[k], 3, m, c, m, ex[k], 3, threads);
-        if (k == 0) acc_cpu = cpu_s() - c0;
+        if (k == 0) acc_cpu = bench_cpu_seconds() - c0;
         for (size_t i = 0; i < 3 * m; ++i) aw[i] = fabs(ws[k][i]);
         cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, aw, 3, m, c, m, S[k], 3, threads);
     }
@@ -229,15 +205,15 @@ int main(int argc, char **argv)
             tol = atof(tok);
             cm_rbf_tree_params(tol, &n, &th);
         } else if (sscanf(tok, "%d:%lf", &n, &th) != 2) continue;
-        double c0 = cpu_s();
+        double c0 = bench_cpu_seconds();
         cm_rbf_tree *t = cm_rbf_tree_create(m, c, n, th);
-        double build = cpu_s() - c0;
+        double build = bench_cpu_seconds() - c0;
         if (!t) return 1;
         double res[2][3], tcpu[2];
         for (int k = 0; k < 2; ++k) {
-            c0 = cpu_s();
+            c0 = bench_cpu_seconds();
             cm_rbf_tree_sum_self(t, ws[k], 3, fast, 3, threads);
-            tcpu[k] = cpu_s() - c0;
+            tcpu[k] = bench_cpu_seconds() - c0;
             compare(m, fast, ex[k], S[k], &res[k][0], &res[k][1], &res[k][2]);
         }
         double est_err, est_s;
