@@ -28,9 +28,13 @@
 #define CM_RBF_FLOOR_SLACK 10.0
 
 /* fast_sum = -1 (auto): treecode matvecs from this many centres, evaluation from this many
- * point-centre pairs (RESULTS.md, "Fast summation": the treecode at fast_tol 1e-12 overtakes
- * compensated direct sums near 3e4 centres on this machine kind). */
-#define CM_RBF_FAST_MIN_M 40000
+ * point-centre pairs. With the old compensated sums the treecode fit overtook direct matvecs
+ * near 3e4 centres; against the AVX-512 fixed-binade sums (twice as fast) whole fits gained
+ * nothing at 59k and 103k (bracket, quiet machine: 41.3 vs 38.5 and 127.0 vs 125.4 CPU s,
+ * the refinements' exact residuals eat the cheaper inner matvecs), while one product is 5x
+ * faster at 479k (RESULTS.md, "Quiet-machine reruns" and "Fast summation"). 2e5 lies between
+ * the measured points; the crossover itself was not measured. */
+#define CM_RBF_FAST_MIN_M 200000
 #define CM_RBF_FAST_EVAL_PAIRS 2e9
 /* an inner (fast-matvec) solve of a refinement step aims for this reduction of its own
  * right-hand side, or the final tolerance if that is nearer: the treecode's operator
