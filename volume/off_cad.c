@@ -140,7 +140,8 @@ cm_status cm_morph_off_cad_contact_check(cm_context *ctx, const cm_mesh *mesh,
                             "node %lld is on the CAD model and touches the fixed surface off it "
                             "(%zu such contact nodes), and the edit moves it %s by %.6g (allowed "
                             "%.3g): --off-cad fixed lets a body touching the fixed surface slide "
-                            "only along it where it is flat",
+                            "only along it where it is flat (if the nodes off the model are the "
+                            "body's own, e.g. a mesh snapped onto an STL, raise --cad-tol)",
                             (long long)v, c->n, flat ? "off that surface's plane" : "(that surface is not flat there)",
                             off, c->tol[s]);
     }
