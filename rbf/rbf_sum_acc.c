@@ -28,11 +28,15 @@
 #define PB CM_RBF_ACC_PB
 #define TILE 512
 
-static inline __attribute__((always_inline)) void tile_acc(const int nc, const double *c,
-                                                           size_t ldc, const double *w,
-                                                           size_t ldw, size_t jn,
-                                                           const double *pt, double *hi,
-                                                           double *lo)
+/* One tile of compensated sums, rounding errors of the products and of the running sums kept
+ * in lo. fixed (a constant after inlining): 0 TwoProd + TwoSum, 10 operations per product; 1
+ * the fixed-binade compensation of rbf_sum_avx512.c (which says why it is exact enough), 4
+ * operations, hi must start at the binade offsets. */
+static inline __attribute__((always_inline)) void tile_acc(const int fixed, const int nc,
+                                                           const double *c, size_t ldc,
+                                                           const double *w, size_t ldw,
+                                                           size_t jn, const double *pt,
+                                                           double *hi, double *lo)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     double x[NB], y[NB], z[NB], s[4][NB], e[4][NB];
@@ -54,13 +58,20 @@ static inline __attribute__((always_inline)) void tile_acc(const int nc, const d
             double r2 = dx * dx + dy * dy + dz * dz;
             double f = r2 * sqrt(r2);
             for (int q = 0; q < nc; ++q) {
-                double p = wj[q] * f;
-                double pe = fma(wj[q], f, -p); /* exact: p + pe = wj f */
-                double t = s[q][l] + p;        /* TwoSum(s, p) */
-                double bv = t - s[q][l];
-                double te = (s[q][l] - (t - bv)) + (p - bv);
-                s[q][l] = t;
-                e[q][l] += te + pe;
+                if (fixed) {
+                    double t = fma(wj[q], f, s[q][l]);
+                    double d = t - s[q][l]; /* exact: one binade */
+                    e[q][l] += fma(wj[q], f, -d);
+                    s[q][l] = t;
+                } else {
+                    double p = wj[q] * f;
+                    double pe = fma(wj[q], f, -p); /* exact: p + pe = wj f */
+                    double t = s[q][l] + p;        /* TwoSum(s, p) */
+                    double bv = t - s[q][l];
+                    double te = (s[q][l] - (t - bv)) + (p - bv);
+                    s[q][l] = t;
+                    e[q][l] += te + pe;
+                }
             }
         }
     }
@@ -71,91 +82,33 @@ static inline __attribute__((always_inline)) void tile_acc(const int nc, const d
         }
 }
 
-static inline __attribute__((always_inline)) void block_acc(const int nc, size_t m,
-                                                            const double *c, const double *w,
-                                                            const double *pt, double *hi,
-                                                            double *lo)
+static inline __attribute__((always_inline)) void block_acc(const int fixed, const int nc,
+                                                            size_t m, const double *c,
+                                                            const double *w, const double *pt,
+                                                            double *hi, double *lo)
 {
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         size_t jn = m - t0 < TILE ? m - t0 : TILE;
         for (int b = 0; b < PB; b += NB)
-            tile_acc(nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
+            tile_acc(fixed, nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
     }
 }
 
-/* The fixed-binade compensation of rbf_sum_avx512.c (which says why it is exact enough) for
- * the compiled AVX2 path: 4 operations per product; hi must start at the binade offsets. */
-static inline __attribute__((always_inline)) void tile_accf(const int nc, const double *c,
-                                                            size_t ldc, const double *w,
-                                                            size_t ldw, size_t jn,
-                                                            const double *pt, double *hi,
-                                                            double *lo)
-{
-    const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
-    double x[NB], y[NB], z[NB], s[4][NB], e[4][NB];
-    for (int l = 0; l < NB; ++l) {
-        x[l] = pt[l];
-        y[l] = pt[PB + l];
-        z[l] = pt[2 * PB + l];
-        for (int q = 0; q < nc; ++q) {
-            s[q][l] = hi[q * PB + l];
-            e[q][l] = lo[q * PB + l];
-        }
+/* block_acc for nc = 1..4 as constants */
+#define CM_ACC_DISPATCH(fixed)                                                                 \
+    switch (nc) {                                                                              \
+    case 1: block_acc(fixed, 1, m, c, w, pt, hi, lo); break;                                   \
+    case 2: block_acc(fixed, 2, m, c, w, pt, hi, lo); break;                                   \
+    case 3: block_acc(fixed, 3, m, c, w, pt, hi, lo); break;                                   \
+    default: block_acc(fixed, 4, m, c, w, pt, hi, lo); break;                                  \
     }
-    for (size_t j = 0; j < jn; ++j) {
-        const double xj = cx[j], yj = cy[j], zj = cz[j];
-        double wj[4];
-        for (int q = 0; q < nc; ++q) wj[q] = w[q * ldw + j];
-        for (int l = 0; l < NB; ++l) {
-            double dx = x[l] - xj, dy = y[l] - yj, dz = z[l] - zj;
-            double r2 = dx * dx + dy * dy + dz * dz;
-            double f = r2 * sqrt(r2);
-            for (int q = 0; q < nc; ++q) {
-                double t = fma(wj[q], f, s[q][l]);
-                double d = t - s[q][l]; /* exact: one binade */
-                e[q][l] += fma(wj[q], f, -d);
-                s[q][l] = t;
-            }
-        }
-    }
-    for (int l = 0; l < NB; ++l)
-        for (int q = 0; q < nc; ++q) {
-            hi[q * PB + l] = s[q][l];
-            lo[q * PB + l] = e[q][l];
-        }
-}
-
-static inline __attribute__((always_inline)) void block_accf(const int nc, size_t m,
-                                                             const double *c, const double *w,
-                                                             const double *pt, double *hi,
-                                                             double *lo)
-{
-    for (size_t t0 = 0; t0 < m; t0 += TILE) {
-        size_t jn = m - t0 < TILE ? m - t0 : TILE;
-        for (int b = 0; b < PB; b += NB)
-            tile_accf(nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
-    }
-}
 
 __attribute__((target("avx2,fma"))) static void accf_avx2(int nc, size_t m, const double *c,
                                                            const double *w, const double *pt,
                                                            double *hi, double *lo)
 {
-    switch (nc) {
-    case 1: block_accf(1, m, c, w, pt, hi, lo); break;
-    case 2: block_accf(2, m, c, w, pt, hi, lo); break;
-    case 3: block_accf(3, m, c, w, pt, hi, lo); break;
-    default: block_accf(4, m, c, w, pt, hi, lo); break;
-    }
+    CM_ACC_DISPATCH(1)
 }
-
-#define CM_ACC_DISPATCH                                                                        \
-    switch (nc) {                                                                              \
-    case 1: block_acc(1, m, c, w, pt, hi, lo); break;                                          \
-    case 2: block_acc(2, m, c, w, pt, hi, lo); break;                                          \
-    case 3: block_acc(3, m, c, w, pt, hi, lo); break;                                          \
-    default: block_acc(4, m, c, w, pt, hi, lo); break;                                         \
-    }
 
 typedef void (*acc_fn)(int nc, size_t m, const double *c, const double *w, const double *pt,
                        double *hi, double *lo);
@@ -163,21 +116,21 @@ typedef void (*acc_fn)(int nc, size_t m, const double *c, const double *w, const
 static void acc_generic(int nc, size_t m, const double *c, const double *w, const double *pt,
                         double *hi, double *lo)
 {
-    CM_ACC_DISPATCH
+    CM_ACC_DISPATCH(0)
 }
 
 __attribute__((target("avx2,fma"))) static void acc_avx2(int nc, size_t m, const double *c,
                                                           const double *w, const double *pt,
                                                           double *hi, double *lo)
 {
-    CM_ACC_DISPATCH
+    CM_ACC_DISPATCH(0)
 }
 
 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) static void
 acc_avx512(int nc, size_t m, const double *c, const double *w, const double *pt, double *hi,
            double *lo)
 {
-    CM_ACC_DISPATCH
+    CM_ACC_DISPATCH(0)
 }
 
 static acc_fn pick_acc(cm_rbf_isa isa)
