@@ -27,8 +27,7 @@
 #define NV 4       /* vectors of 8 points held in registers */
 #define NSQRT 3    /* of them through vsqrtpd, the rest through rsqrt14 + Newton */
 #define TILE 512   /* centres per tile: 3 + 4 rows of 512 doubles stay in L1 */
-#define ACC_NV 2   /* compensated: vectors of points held in registers (2 accumulators each) */
-#define ACCF_NV 2  /* the same for the fixed-binade compensated sums */
+#define ACC_NV 2   /* compensated (both kinds): vectors of points held in registers (2 accumulators each) */
 
 /* sqrt(x) for x >= 0 without the sqrt unit. x = 0 (a point on a centre) would give
  * rsqrt14 = inf and 0 * inf = NaN, so the seed is taken at max(x, 1e-300): then s = x * y
@@ -106,11 +105,22 @@ CM_AVX512 void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const d
     }
 }
 
-/* ---- compensated: s + e += w * f exactly to first order (TwoProd by FMA, TwoSum) ---- */
-
-CM_AVX512 CM_INLINE void tile_acc(const int nc, const double *c, size_t ldc, const double *w,
-                                  size_t ldw, size_t jn, const double *pt, double *hi,
-                                  double *lo)
+/* ---- compensated sums: s + e += w * f exactly to first order ----
+ * fixed = 0: TwoProd by FMA and TwoSum, 10 operations per product (the add pipes are busy
+ * with TwoSum, so every vector takes vsqrtpd). fixed = 1: the fixed binade below. fixed is a
+ * constant after inlining, so each exported block has one inner loop.
+ * The fixed binade (4 operations per product instead of 10): the running sum S = big + partial sum stays in one binade [2^k, 2^(k+1)) when big = 1.5 2^k
+ * and 2^k >= 4 max |partial sum| (the caller's bound), so all its values are multiples of
+ * one ulp u: T = fma(w, f, S) rounds w f + S once, T - S is exact (Sterbenz), and
+ * w f - (T - S), the rounding error (|.| <= u/2), is formed by one more FMA with a relative
+ * error of eps. Those remainders are summed plainly into E. So S - big + E has the error
+ * eps |result| + about eps u m^(1/2..1) (u ~ eps 4 bound), second order like TwoSum's, at
+ * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the vector operation
+ * count was the limit: TwoSum ran at 0.4x the plain sum's throughput). This is the binned
+ * summation of the reproducible-BLAS literature (Demmel and Nguyen) with a single bin. */
+CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nc, const double *c, size_t ldc,
+                                  const double *w, size_t ldw, size_t jn, const double *pt,
+                                  double *hi, double *lo)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     __m512d x[ACC_NV], y[ACC_NV], z[ACC_NV], s[4][ACC_NV], e[4][ACC_NV];
@@ -129,18 +139,23 @@ CM_AVX512 CM_INLINE void tile_acc(const int nc, const double *c, size_t ldc, con
         __m512d wj[4];
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
         for (int v = 0; v < ACC_NV; ++v) {
-            /* the add pipes are busy with TwoSum here, so every vector takes vsqrtpd
-             * (v = 0 < NSQRT) */
-            const __m512d f = r3_of(0, x[v], y[v], z[v], xj, yj, zj);
+            const __m512d f = r3_of(fixed ? v : 0, x[v], y[v], z[v], xj, yj, zj);
             for (int q = 0; q < nc; ++q) {
-                const __m512d p = _mm512_mul_pd(wj[q], f);
-                const __m512d pe = _mm512_fmsub_pd(wj[q], f, p); /* p + pe = w f exactly */
-                const __m512d t = _mm512_add_pd(s[q][v], p);
-                const __m512d bv = _mm512_sub_pd(t, s[q][v]);
-                const __m512d te = _mm512_add_pd(_mm512_sub_pd(s[q][v], _mm512_sub_pd(t, bv)),
-                                                 _mm512_sub_pd(p, bv));
-                s[q][v] = t;
-                e[q][v] = _mm512_add_pd(e[q][v], _mm512_add_pd(te, pe));
+                if (fixed) {
+                    const __m512d t = _mm512_fmadd_pd(wj[q], f, s[q][v]);
+                    const __m512d d = _mm512_sub_pd(t, s[q][v]); /* exact: same binade */
+                    e[q][v] = _mm512_add_pd(e[q][v], _mm512_fmsub_pd(wj[q], f, d));
+                    s[q][v] = t;
+                } else {
+                    const __m512d p = _mm512_mul_pd(wj[q], f);
+                    const __m512d pe = _mm512_fmsub_pd(wj[q], f, p); /* p + pe = w f exactly */
+                    const __m512d t = _mm512_add_pd(s[q][v], p);
+                    const __m512d bv = _mm512_sub_pd(t, s[q][v]);
+                    const __m512d te = _mm512_add_pd(
+                        _mm512_sub_pd(s[q][v], _mm512_sub_pd(t, bv)), _mm512_sub_pd(p, bv));
+                    s[q][v] = t;
+                    e[q][v] = _mm512_add_pd(e[q][v], _mm512_add_pd(te, pe));
+                }
             }
         }
     }
@@ -151,93 +166,37 @@ CM_AVX512 CM_INLINE void tile_acc(const int nc, const double *c, size_t ldc, con
         }
 }
 
-CM_AVX512 CM_INLINE void block_acc(const int nc, size_t m, const double *c, const double *w,
-                                   const double *pt, double *hi, double *lo)
+CM_AVX512 CM_INLINE void block_acc(const int fixed, const int nc, size_t m, const double *c,
+                                   const double *w, const double *pt, double *hi, double *lo)
 {
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         const size_t jn = m - t0 < TILE ? m - t0 : TILE;
         for (int b = 0; b < CM_RBF_ACC_PB; b += 8 * ACC_NV)
-            tile_acc(nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
+            tile_acc(fixed, nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
+    }
+}
+
+CM_AVX512 CM_INLINE void dispatch_acc(const int fixed, int nc, size_t m, const double *c,
+                                      const double *w, const double *pt, double *hi, double *lo)
+{
+    switch (nc) {
+    case 1: block_acc(fixed, 1, m, c, w, pt, hi, lo); break;
+    case 2: block_acc(fixed, 2, m, c, w, pt, hi, lo); break;
+    case 3: block_acc(fixed, 3, m, c, w, pt, hi, lo); break;
+    default: block_acc(fixed, 4, m, c, w, pt, hi, lo); break;
     }
 }
 
 CM_AVX512 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
                                           const double *pt, double *hi, double *lo)
 {
-    switch (nc) {
-    case 1: block_acc(1, m, c, w, pt, hi, lo); break;
-    case 2: block_acc(2, m, c, w, pt, hi, lo); break;
-    case 3: block_acc(3, m, c, w, pt, hi, lo); break;
-    default: block_acc(4, m, c, w, pt, hi, lo); break;
-    }
-}
-
-/* ---- compensated with a fixed binade: 4 operations per product instead of 10 ----
- * The running sum S = big + partial sum stays in one binade [2^k, 2^(k+1)) when big = 1.5 2^k
- * and 2^k >= 4 max |partial sum| (the caller's bound), so all its values are multiples of
- * one ulp u: T = fma(w, f, S) rounds w f + S once, T - S is exact (Sterbenz), and
- * w f - (T - S), the rounding error (|.| <= u/2), is formed by one more FMA with a relative
- * error of eps. Those remainders are summed plainly into E. So S - big + E has the error
- * eps |result| + about eps u m^(1/2..1) (u ~ eps 4 bound), second order like TwoSum's, at
- * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the vector operation
- * count was the limit: TwoSum ran at 0.4x the plain sum's throughput). This is the binned
- * summation of the reproducible-BLAS literature (Demmel and Nguyen) with a single bin. */
-CM_AVX512 CM_INLINE void tile_accf(const int nc, const double *c, size_t ldc, const double *w,
-                                   size_t ldw, size_t jn, const double *pt, double *hi,
-                                   double *lo)
-{
-    const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
-    __m512d x[ACCF_NV], y[ACCF_NV], z[ACCF_NV], s[4][ACCF_NV], e[4][ACCF_NV];
-    for (int v = 0; v < ACCF_NV; ++v) {
-        x[v] = _mm512_loadu_pd(pt + 8 * v);
-        y[v] = _mm512_loadu_pd(pt + CM_RBF_ACC_PB + 8 * v);
-        z[v] = _mm512_loadu_pd(pt + 2 * CM_RBF_ACC_PB + 8 * v);
-        for (int q = 0; q < nc; ++q) {
-            s[q][v] = _mm512_loadu_pd(hi + q * CM_RBF_ACC_PB + 8 * v);
-            e[q][v] = _mm512_loadu_pd(lo + q * CM_RBF_ACC_PB + 8 * v);
-        }
-    }
-    for (size_t j = 0; j < jn; ++j) {
-        const __m512d xj = _mm512_set1_pd(cx[j]), yj = _mm512_set1_pd(cy[j]);
-        const __m512d zj = _mm512_set1_pd(cz[j]);
-        __m512d wj[4];
-        for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
-        for (int v = 0; v < ACCF_NV; ++v) {
-            const __m512d f = r3_of(v, x[v], y[v], z[v], xj, yj, zj);
-            for (int q = 0; q < nc; ++q) {
-                const __m512d t = _mm512_fmadd_pd(wj[q], f, s[q][v]);
-                const __m512d d = _mm512_sub_pd(t, s[q][v]); /* exact: same binade */
-                e[q][v] = _mm512_add_pd(e[q][v], _mm512_fmsub_pd(wj[q], f, d));
-                s[q][v] = t;
-            }
-        }
-    }
-    for (int v = 0; v < ACCF_NV; ++v)
-        for (int q = 0; q < nc; ++q) {
-            _mm512_storeu_pd(hi + q * CM_RBF_ACC_PB + 8 * v, s[q][v]);
-            _mm512_storeu_pd(lo + q * CM_RBF_ACC_PB + 8 * v, e[q][v]);
-        }
-}
-
-CM_AVX512 CM_INLINE void block_accf(const int nc, size_t m, const double *c, const double *w,
-                                    const double *pt, double *hi, double *lo)
-{
-    for (size_t t0 = 0; t0 < m; t0 += TILE) {
-        const size_t jn = m - t0 < TILE ? m - t0 : TILE;
-        for (int b = 0; b < CM_RBF_ACC_PB; b += 8 * ACCF_NV)
-            tile_accf(nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
-    }
+    dispatch_acc(0, nc, m, c, w, pt, hi, lo);
 }
 
 CM_AVX512 void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
                                            const double *pt, double *hi, double *lo)
 {
-    switch (nc) {
-    case 1: block_accf(1, m, c, w, pt, hi, lo); break;
-    case 2: block_accf(2, m, c, w, pt, hi, lo); break;
-    case 3: block_accf(3, m, c, w, pt, hi, lo); break;
-    default: block_accf(4, m, c, w, pt, hi, lo); break;
-    }
+    dispatch_acc(1, nc, m, c, w, pt, hi, lo);
 }
 
 int cm_rbf_cpu_avx512(void)
