@@ -1,9 +1,12 @@
 /* The dense factorisation alone: LAPACK's dpftrf against cadmorph's panel-by-panel RFP
- * Cholesky (rbf/cholesky_blocked.c) on the same SPD matrix, alternating in one process, at
- * the OpenBLAS core and thread count of this run; with the Cholesky bound n^3/3 at the best
- * dgemm rate measured in the same process.
- * usage: bench_cholesky THREADS REPS N...   (one line of key=value per n)
+ * Cholesky (rbf/cholesky_blocked.c) and its look-ahead variant on THREADS OpenMP threads of
+ * one-thread BLAS (rbf/cholesky_lookahead.c) on the same SPD matrix, alternating in one
+ * process, at the OpenBLAS core and thread count of this run; with the Cholesky bound n^3/3
+ * at the best dgemm rate measured in the same process.
+ * usage: bench_cholesky THREADS REPS N...   (one line of key=value per n; `blocked` is the
+ * panel-by-panel path, `lookahead` the other, `chosen` says which cm_rbf_cholesky_rfp takes)
  * BLOCKS=b1,b2,... (environment): also the panel-by-panel factorisation with these blocks;
+ * LA_BLOCKS=b1,b2,...: also the look-ahead factorisation with these blocks;
  * FULL=1: also dpotrf on full storage, unpacked from and packed back into RFP (dtfttr,
  * dtrttf; timed with the copies and without), the alternative for small n. */
 #include "rbf/rbf_internal.h"
@@ -14,6 +17,20 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* b1,b2,... from the environment variable `name` into out (at most 8) */
+static int parse_blocks(const char *name, long *out)
+{
+    int count = 0;
+    for (const char *e = getenv(name); e && *e && count < 8;) {
+        char *end;
+        long v = strtol(e, &end, 10);
+        if (end == e) break;
+        out[count++] = v;
+        e = *end == ',' ? end + 1 : end;
+    }
+    return count;
+}
 
 /* A_ij = 1 / (1 + |i - j|) + n [i = j]: diagonally dominant, so SPD, and cheap to fill. */
 static void fill_rfp(int n, double *a)
@@ -59,22 +76,20 @@ int main(int argc, char **argv)
         const int n = atoi(argv[k]);
         const size_t len = (size_t)n * (n + 1) / 2;
         double *a = malloc(len * sizeof *a), *b = malloc(len * sizeof *b);
-        if (!a || !b) return 2;
-        long blocks[8];
-        int nblocks = 0;
-        for (const char *e = getenv("BLOCKS"); e && *e && nblocks < 8;) {
-            char *end;
-            blocks[nblocks++] = strtol(e, &end, 10);
-            e = *end == ',' ? end + 1 : end;
-            if (end == e && *e) break;
-        }
+        double *l = malloc(len * sizeof *l);
+        if (!a || !b || !l) return 2;
+        long blocks[8], la_blocks[8];
+        const int nblocks = parse_blocks("BLOCKS", blocks);
+        const int nla = parse_blocks("LA_BLOCKS", la_blocks);
+        double best_la_b[8];
+        for (int q = 0; q < 8; ++q) best_la_b[q] = INFINITY;
         const int full = getenv("FULL") && atoi(getenv("FULL"));
         double best_b[8], best_full = INFINITY, best_full_only = INFINITY;
         for (int q = 0; q < 8; ++q) best_b[q] = INFINITY;
         double *f = full ? malloc((size_t)n * n * sizeof *f) : NULL;
         if (full && !f) return 2;
-        double rate = 0.0, best_ref = INFINITY, best_blk = INFINITY;
-        int info_ref = 0, info_blk = 0;
+        double rate = 0.0, best_ref = INFINITY, best_blk = INFINITY, best_la = INFINITY;
+        int info_ref = 0, info_blk = 0, info_la = 0;
         for (int r = 0; r < reps; ++r) {
             rate = fmax(rate, dgemm_rate());
             fill_rfp(n, a);
@@ -83,15 +98,26 @@ int main(int argc, char **argv)
             double t1 = cm_wtime();
             fill_rfp(n, b);
             double t2 = cm_wtime();
-            info_blk = cm_rbf_cholesky_rfp(NULL, n, b, 0);
+            info_blk = cm_rbf_cholesky_rfp_panels(NULL, n, b, 0);
             double t3 = cm_wtime();
+            fill_rfp(n, l);
+            double t4 = cm_wtime();
+            info_la = cm_rbf_cholesky_rfp_lookahead(NULL, n, l, 0, got);
+            double t5 = cm_wtime();
             best_ref = fmin(best_ref, t1 - t0);
             best_blk = fmin(best_blk, t3 - t2);
+            best_la = fmin(best_la, t5 - t4);
             for (int q = 0; q < nblocks; ++q) {
                 fill_rfp(n, b);
                 double s0 = cm_wtime();
-                cm_rbf_cholesky_rfp(NULL, n, b, (int)blocks[q]);
+                cm_rbf_cholesky_rfp_panels(NULL, n, b, (int)blocks[q]);
                 best_b[q] = fmin(best_b[q], cm_wtime() - s0);
+            }
+            for (int q = 0; q < nla; ++q) {
+                fill_rfp(n, l);
+                double s0 = cm_wtime();
+                cm_rbf_cholesky_rfp_lookahead(NULL, n, l, (int)la_blocks[q], got);
+                best_la_b[q] = fmin(best_la_b[q], cm_wtime() - s0);
             }
             if (full) {
                 fill_rfp(n, b);
@@ -107,27 +133,44 @@ int main(int argc, char **argv)
             }
         }
         rate = fmax(rate, dgemm_rate());
-        double diff = 0.0, big = 0.0;
+        char load[64] = "?";
+        FILE *lf = fopen("/proc/loadavg", "r");
+        if (lf) {
+            if (!fgets(load, sizeof load, lf)) load[0] = '\0';
+            fclose(lf);
+            for (char *s = load, *sp = NULL; *s; ++s) /* the 1-minute average only */
+                if (*s == ' ' || *s == '\n') { sp = s; *sp = '\0'; break; }
+        }
+        double diff = 0.0, diff_la = 0.0, big = 0.0;
         for (size_t i = 0; i < len; ++i) {
             diff = fmax(diff, fabs(a[i] - b[i]));
+            diff_la = fmax(diff_la, fabs(a[i] - l[i]));
             big = fmax(big, fabs(a[i]));
         }
         const double bound = (double)n * n * n / 3.0 / rate;
         printf("n=%d core=%s blas_threads=%d reps=%d dgemm_gflops=%.1f bound_s=%.3f "
                "dpftrf_s=%.3f dpftrf_over_bound=%.3f blocked_s=%.3f blocked_over_bound=%.3f "
-               "blocked_over_dpftrf=%.3f max_diff_rel=%.2g info=%d/%d\n",
+               "blocked_over_dpftrf=%.3f lookahead_s=%.3f lookahead_over_bound=%.3f "
+               "lookahead_over_dpftrf=%.3f chosen=%s max_diff_rel=%.2g/%.2g info=%d/%d/%d "
+               "load=%s\n",
                n, openblas_get_corename(), got, reps, rate * 1e-9, bound, best_ref,
-               best_ref / bound, best_blk, best_blk / bound, best_blk / best_ref, diff / big,
-               info_ref, info_blk);
+               best_ref / bound, best_blk, best_blk / bound, best_blk / best_ref, best_la,
+               best_la / bound, best_la / best_ref,
+               got > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N ? "lookahead"
+                                                                            : "blocked",
+               diff / big, diff_la / big, info_ref, info_blk, info_la, load);
         for (int q = 0; q < nblocks; ++q)
             printf("n=%d block=%ld blocked_s=%.3f blocked_over_bound=%.3f\n", n, blocks[q],
                    best_b[q], best_b[q] / bound);
+        for (int q = 0; q < nla; ++q)
+            printf("n=%d la_block=%ld lookahead_s=%.3f lookahead_over_bound=%.3f\n", n,
+                   la_blocks[q], best_la_b[q], best_la_b[q] / bound);
         if (full)
             printf("n=%d full_dpotrf_s=%.3f full_over_bound=%.3f with_copies_s=%.3f "
                    "with_copies_over_bound=%.3f\n",
                    n, best_full_only, best_full_only / bound, best_full, best_full / bound);
         fflush(stdout);
-        free(a), free(b), free(f);
+        free(a), free(b), free(l), free(f);
     }
     return 0;
 }

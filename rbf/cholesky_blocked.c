@@ -17,6 +17,7 @@
 
 #include <cblas.h>
 #include <lapacke.h>
+#include <omp.h>
 
 #define CM_CHOLESKY_BLOCK 256
 
@@ -32,7 +33,7 @@ static void report(progress *p, double flops)
     cm_progress(p->ctx, "rbf factor", p->done, p->total);
 }
 
-int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
+int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
 {
     if (n < 0 || !a) return -1;
     if (n == 0) return 0;
@@ -103,4 +104,17 @@ int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
     }
     cm_progress(ctx, "rbf factor", pr.total, pr.total);
     return 0;
+}
+
+/* Which of the two runs: on T > 1 BLAS threads, the look-ahead factorisation
+ * (cholesky_lookahead.c) for n up to CM_LOOKAHEAD_MAX_N, where OpenBLAS's threaded panels
+ * leave a core idle; above it the panels are a vanishing part of the work and the threaded
+ * BLAS calls do as well. Inside a parallel region (local factorisations run side by side)
+ * the BLAS-threaded path runs, on whatever count the caller set. */
+int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
+{
+    const int threads = openblas_get_num_threads();
+    if (threads > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N && !omp_in_parallel())
+        return cm_rbf_cholesky_rfp_lookahead(ctx, n, a, block, threads);
+    return cm_rbf_cholesky_rfp_panels(ctx, n, a, block);
 }

@@ -97,8 +97,22 @@ long cm_rbf_merge_duplicates(int dim, size_t m_in, const double *c, double tol, 
  * UPLO 'L', as dpftrf), in place, panel by panel of `block` columns (0: the default), with
  * cm_progress(ctx, "rbf factor", done, total) after every panel (done in flops, monotonic).
  * Returns dpftrf's info: 0, or i > 0 if the leading minor of order i is not positive definite.
- * BLAS threads: as the caller set them (cm_rbf_blas_threads). */
+ * BLAS threads: as the caller set them (cm_rbf_blas_threads); on T > 1 of them and n in
+ * [CM_LOOKAHEAD_MIN_N, CM_LOOKAHEAD_MAX_N] outside a parallel region, the look-ahead path
+ * below on T OpenMP threads, else the panel-by-panel one (both: the same factor to rounding,
+ * the same info and progress). */
 int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
+/* The two paths, for benchmarks and tests. panels (cholesky_blocked.c): one panel after the
+ * other, each BLAS call on the caller's BLAS threads. lookahead (cholesky_lookahead.c):
+ * `threads` OpenMP threads each calling one-thread BLAS (OpenBLAS's count is set to 1 during
+ * the call and restored), the next panel factored while the others update; block 0: its
+ * own default. */
+int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block);
+int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, int threads);
+/* measured crossovers of cm_rbf_cholesky_rfp (benchmarks/RESULTS.md, issue 10 fourth
+ * session) */
+#define CM_LOOKAHEAD_MIN_N 1
+#define CM_LOOKAHEAD_MAX_N 1000000
 
 /* Sets OpenBLAS's thread count for the calls that follow to `want`, or fewer if the
  * address-space limit cannot back their 128 MB buffers (blas.h, point 2); got (may be NULL)
