@@ -24,6 +24,10 @@
 #include <omp.h>
 
 #define CM_LOOKAHEAD_BLOCK 192
+#ifndef CM_LOOKAHEAD_MIN_CHUNK
+#define CM_LOOKAHEAD_MIN_CHUNK 256
+#endif
+#define CM_LOOKAHEAD_MAX_CHUNKS 64
 
 /* The logical n x n lower triangle in RFP (TRANSR 'N', UPLO 'L'): columns j < n1 stored
  * down column j of t (element (i, j) at t[i + j ld], i >= j, rows to n-1), columns j >= n1
@@ -75,32 +79,35 @@ static int factor_block(const rfp *r, int q)
     return info > 0 ? c0 + (int)info : (int)info;
 }
 
-/* Block q -= (panel k) (panel k)' restricted to block q's columns, k < q. */
-static void update_block(const rfp *r, int k, int q)
+/* Columns c0..c1-1 (right of panel k; may straddle n1) -= (panel k) (panel k)' restricted to
+ * them: dsyrk on the diagonal block, dgemm below (tall part) or right of it (A22's rows). */
+static void update_range(const rfp *r, int k, int c0, int c1)
 {
-    int p0, p1, c0, c1;
+    int p0, p1;
     block_range(r, k, &p0, &p1);
-    block_range(r, q, &c0, &c1);
-    const int bk = p1 - p0, bw = c1 - c0, rest = r->n - c1, ld = r->ld;
-    if (k < r->nb1) {
-        const double *x = at_t(r, c0, p0); /* L(c0..c1-1, panel) */
-        const double *y = at_t(r, c1, p0); /* L(c1..n-1, panel) */
-        if (q < r->nb1) { /* a column block of the tall part: down its columns */
-            cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, bw, bk, -1.0, x, ld, 1.0,
-                        at_t(r, c0, c0), ld);
-            if (rest > 0)
-                cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, rest, bw, bk, -1.0, y, ld, x,
-                            ld, 1.0, at_t(r, c1, c0), ld);
-        } else { /* columns of A22 = rows of u */
-            const int s0 = c0 - r->n1, s1 = c1 - r->n1;
-            cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, bw, bk, -1.0, x, ld, 1.0,
-                        at_u(r, s0, s0), ld);
-            if (rest > 0)
-                cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, bw, rest, bk, -1.0, x, ld, y,
-                            ld, 1.0, at_u(r, s0, s1), ld);
-        }
-    } else { /* a panel of A22 (rows k of u) applied to rows q of u */
-        const int k0 = p0 - r->n1, s0 = c0 - r->n1, s1 = c1 - r->n1;
+    const int bk = p1 - p0, ld = r->ld;
+    if (k < r->nb1 && c0 < r->n1) { /* columns of the tall part: down the columns */
+        const int e = c1 < r->n1 ? c1 : r->n1, bw = e - c0, rest = r->n - e;
+        const double *x = at_t(r, c0, p0); /* L(c0..e-1, panel) */
+        cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, bw, bk, -1.0, x, ld, 1.0,
+                    at_t(r, c0, c0), ld);
+        if (rest > 0)
+            cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, rest, bw, bk, -1.0,
+                        at_t(r, e, p0), ld, x, ld, 1.0, at_t(r, e, c0), ld);
+        c0 = e;
+    }
+    if (c0 >= c1) return;
+    /* columns of A22 = rows s0..s1-1 of u, and everything right of them */
+    const int s0 = c0 - r->n1, s1 = c1 - r->n1, bw = c1 - c0, rest = r->n - c1;
+    if (k < r->nb1) { /* L(c0.., panel) down the tall part's panel columns */
+        const double *x = at_t(r, c0, p0);
+        cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, bw, bk, -1.0, x, ld, 1.0,
+                    at_u(r, s0, s0), ld);
+        if (rest > 0)
+            cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, bw, rest, bk, -1.0, x, ld,
+                        at_t(r, c1, p0), ld, 1.0, at_u(r, s0, s1), ld);
+    } else { /* a panel of A22: rows k0.. of u */
+        const int k0 = p0 - r->n1;
         const double *x = at_u(r, k0, s0);
         cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, bw, bk, -1.0, x, ld, 1.0,
                     at_u(r, s0, s0), ld);
@@ -108,6 +115,46 @@ static void update_block(const rfp *r, int k, int q)
             cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, bw, rest, bk, -1.0, x, ld,
                         at_u(r, k0, s1), ld, 1.0, at_u(r, s0, s1), ld);
     }
+}
+
+static void update_block(const rfp *r, int k, int q)
+{
+    int c0, c1;
+    block_range(r, q, &c0, &c1);
+    update_range(r, k, c0, c1);
+}
+
+/* Work of updating columns c..e-1 (each column j: n - j entries, bk flops each) */
+static double col_work(int n, int c, int e)
+{
+    return (double)(e - c) * n - ((double)e * (e - 1) - (double)c * (c - 1)) / 2.0;
+}
+
+/* Cuts the columns s..n-1 of a step's update into chunks, widest work first: each a
+ * quarter of the work left (guided), at least CM_LOOKAHEAD_MIN_CHUNK columns. Why not one
+ * block per task: a dgemm of N = 192 columns repacks its tall operand for every call and
+ * ran ~8 % slower than N >= 768; why not T equal parts: the thread that factors the next
+ * panel has less time left, and the small last chunks even the threads out whatever the
+ * panel cost. The cuts depend on n and s only, not on T or timing, so the factor does not
+ * depend on the thread count. Returns the count; cut[0] = s, cut[count] = n. */
+static int chunks(int n, int s, int *cut, int max)
+{
+    int count = 0;
+    cut[0] = s;
+    while (s < n && count < max - 1) {
+        const double want = col_work(n, s, n) / 4.0;
+        int lo = s + 1, hi = n; /* smallest e with col_work(s, e) >= want */
+        while (lo < hi) {
+            int mid = lo + (hi - lo) / 2;
+            if (col_work(n, s, mid) >= want) hi = mid;
+            else lo = mid + 1;
+        }
+        int e = lo < s + CM_LOOKAHEAD_MIN_CHUNK ? s + CM_LOOKAHEAD_MIN_CHUNK : lo;
+        if (e > n - CM_LOOKAHEAD_MIN_CHUNK / 2 || count == max - 2) e = n;
+        cut[++count] = e;
+        s = e;
+    }
+    return count;
 }
 
 /* Flops of step k: factoring panel k and applying it to every block on its right (the
@@ -175,9 +222,15 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
                     failed = 1;
                 }
             }
+            int cut[CM_LOOKAHEAD_MAX_CHUNKS + 1], count = 0;
+            if (k + 2 < r.nblocks) {
+                int s0, s1;
+                block_range(&r, k + 2, &s0, &s1);
+                count = chunks(n, s0, cut, CM_LOOKAHEAD_MAX_CHUNKS);
+            }
 #pragma omp for schedule(dynamic, 1)
-            for (int q = k + 2; q < r.nblocks; ++q)
-                if (!stop) update_block(&r, k, q);
+            for (int q = 0; q < count; ++q)
+                if (!stop) update_range(&r, k, cut[q], cut[q + 1]);
             /* the barrier above ends step k: panel k+1 is factored, every block updated */
 #pragma omp master
             if (!stop) {
