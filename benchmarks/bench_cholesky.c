@@ -7,9 +7,11 @@
  * panel-by-panel path, `lookahead` the other, `chosen` says which cm_rbf_cholesky_rfp takes)
  * BLOCKS=b1,b2,... (environment): also the panel-by-panel factorisation with these blocks;
  * LA_BLOCKS=b1,b2,...: also the look-ahead factorisation with these blocks;
+ * cpu_s: best CPU seconds of the process (dpftrf/blocked/lookahead; spinning workers count);
  * FULL=1: also dpotrf on full storage, unpacked from and packed back into RFP (dtfttr,
  * dtrttf; timed with the copies and without), the alternative for small n. */
 #include "rbf/rbf_internal.h"
+#include "bench_util.h"
 
 #include <cblas.h>
 #include <lapacke.h>
@@ -89,21 +91,25 @@ int main(int argc, char **argv)
         double *f = full ? malloc((size_t)n * n * sizeof *f) : NULL;
         if (full && !f) return 2;
         double rate = 0.0, best_ref = INFINITY, best_blk = INFINITY, best_la = INFINITY;
+        double cpu_ref = INFINITY, cpu_blk = INFINITY, cpu_la = INFINITY;
         int info_ref = 0, info_blk = 0, info_la = 0;
         for (int r = 0; r < reps; ++r) {
             rate = fmax(rate, dgemm_rate());
             fill_rfp(n, a);
-            double t0 = cm_wtime();
+            double t0 = cm_wtime(), u0 = bench_cpu_seconds();
             info_ref = LAPACKE_dpftrf_work(LAPACK_COL_MAJOR, 'N', 'L', n, a);
-            double t1 = cm_wtime();
+            double t1 = cm_wtime(), u1 = bench_cpu_seconds();
             fill_rfp(n, b);
-            double t2 = cm_wtime();
+            double t2 = cm_wtime(), u2 = bench_cpu_seconds();
             info_blk = cm_rbf_cholesky_rfp_panels(NULL, n, b, 0);
-            double t3 = cm_wtime();
+            double t3 = cm_wtime(), u3 = bench_cpu_seconds();
             fill_rfp(n, l);
-            double t4 = cm_wtime();
+            double t4 = cm_wtime(), u4 = bench_cpu_seconds();
             info_la = cm_rbf_cholesky_rfp_lookahead(NULL, n, l, 0, got);
-            double t5 = cm_wtime();
+            double t5 = cm_wtime(), u5 = bench_cpu_seconds();
+            cpu_ref = fmin(cpu_ref, u1 - u0);
+            cpu_blk = fmin(cpu_blk, u3 - u2);
+            cpu_la = fmin(cpu_la, u5 - u4);
             best_ref = fmin(best_ref, t1 - t0);
             best_blk = fmin(best_blk, t3 - t2);
             best_la = fmin(best_la, t5 - t4);
@@ -151,11 +157,11 @@ int main(int argc, char **argv)
         printf("n=%d core=%s blas_threads=%d reps=%d dgemm_gflops=%.1f bound_s=%.3f "
                "dpftrf_s=%.3f dpftrf_over_bound=%.3f blocked_s=%.3f blocked_over_bound=%.3f "
                "blocked_over_dpftrf=%.3f lookahead_s=%.3f lookahead_over_bound=%.3f "
-               "lookahead_over_dpftrf=%.3f chosen=%s max_diff_rel=%.2g/%.2g info=%d/%d/%d "
-               "load=%s\n",
+               "lookahead_over_dpftrf=%.3f cpu_s=%.3f/%.3f/%.3f chosen=%s max_diff_rel=%.2g/%.2g "
+               "info=%d/%d/%d load=%s\n",
                n, openblas_get_corename(), got, reps, rate * 1e-9, bound, best_ref,
                best_ref / bound, best_blk, best_blk / bound, best_blk / best_ref, best_la,
-               best_la / bound, best_la / best_ref,
+               best_la / bound, best_la / best_ref, cpu_ref, cpu_blk, cpu_la,
                got > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N ? "lookahead"
                                                                             : "blocked",
                diff / big, diff_la / big, info_ref, info_blk, info_la, load);
