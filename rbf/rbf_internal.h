@@ -109,6 +109,11 @@ int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
  * own default. */
 int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block);
 int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, int threads);
+/* dpftrs (TRANSR 'N', UPLO 'L') on `threads` OpenMP threads of one-thread BLAS
+ * (cholesky_solve.c): b (n x nrhs col-major, leading dimension ldb) is overwritten by
+ * A^-1 b for the factor a of cm_rbf_cholesky_rfp. Below its size threshold, or on one
+ * thread, dpftrs itself. Returns 0, or < 0 for a bad argument. */
+int cm_rbf_rfp_solve(int n, int nrhs, const double *a, double *b, int ldb, int threads);
 /* measured crossovers of cm_rbf_cholesky_rfp (benchmarks/RESULTS.md, issue 10 fourth
  * session) */
 #define CM_LOOKAHEAD_MIN_N 1
