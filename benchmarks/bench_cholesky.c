@@ -7,6 +7,7 @@
  * panel-by-panel path, `lookahead` the other, `chosen` says which cm_rbf_cholesky_rfp takes)
  * BLOCKS=b1,b2,... (environment): also the panel-by-panel factorisation with these blocks;
  * LA_BLOCKS=b1,b2,...: also the look-ahead factorisation with these blocks;
+ * MODEL=1 [MODEL_BLOCK=b]: the look-ahead's schedule model (below);
  * cpu_s: best CPU seconds of the process (dpftrf/blocked/lookahead; spinning workers count);
  * FULL=1: also dpotrf on full storage, unpacked from and packed back into RFP (dtfttr,
  * dtrttf; timed with the copies and without), the alternative for small n. */
@@ -19,6 +20,102 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+
+/* MODEL=1: the look-ahead factorisation once more per repetition, compiled here with its
+ * tasks timed by their thread's CPU clock (cholesky_lookahead.c, CM_LOOKAHEAD_TRACE), and its
+ * schedule replayed on THREADS idle cores: each step's look-ahead task on one thread, its
+ * chunks in order on whichever thread is free first (the dynamic schedule), a barrier per
+ * step. On a machine that other jobs load, wall time says how busy the machine was; this
+ * says what the schedule costs, against the bound at THREADS x the one-thread dgemm rate
+ * by the same CPU clock. */
+#define CM_LOOKAHEAD_TRACE
+#define cm_rbf_cholesky_rfp_lookahead traced_lookahead
+int traced_lookahead(cm_context *ctx, int n, double *a, int block, int threads);
+#include "../rbf/cholesky_lookahead.c"
+#undef cm_rbf_cholesky_rfp_lookahead
+
+typedef struct trace_rec {
+    int step, kind;
+    double s;
+} trace_rec;
+#define TRACE_MAX (1 << 18)
+static trace_rec trace_recs[TRACE_MAX];
+static int trace_count;
+
+void cm_lookahead_trace(int step, int kind, double cpu_seconds)
+{
+    int i = __atomic_fetch_add(&trace_count, 1, __ATOMIC_RELAXED);
+    if (i < TRACE_MAX) trace_recs[i] = (trace_rec){step, kind, cpu_seconds};
+}
+
+/* The replayed makespan on `threads` cores and the sum of the task times (one core). */
+static double trace_la; /* of the last model: the look-ahead tasks' share of busy */
+static void trace_model(int threads, double *makespan, double *busy)
+{
+    const int count = trace_count < TRACE_MAX ? trace_count : TRACE_MAX;
+    int steps = 0;
+    for (int i = 0; i < count; ++i)
+        if (trace_recs[i].step + 1 > steps) steps = trace_recs[i].step + 1;
+    *makespan = *busy = trace_la = 0.0;
+    for (int i = 0; i < count; ++i) {
+        *busy += trace_recs[i].s;
+        if (trace_recs[i].kind == 0) trace_la += trace_recs[i].s;
+        if (trace_recs[i].step < 0) *makespan += trace_recs[i].s;
+    }
+    double *chunk = malloc((CM_LOOKAHEAD_MAX_CHUNKS + 1) * sizeof *chunk);
+    for (int k = 0; k < steps; ++k) {
+        double la = 0.0, free_at[64] = {0};
+        int nchunks = 0;
+        for (int q = 0; q <= CM_LOOKAHEAD_MAX_CHUNKS; ++q) chunk[q] = -1.0;
+        for (int i = 0; i < count; ++i) {
+            if (trace_recs[i].step != k) continue;
+            if (trace_recs[i].kind == 0) la = trace_recs[i].s;
+            else if (trace_recs[i].kind - 1 <= CM_LOOKAHEAD_MAX_CHUNKS) {
+                chunk[trace_recs[i].kind - 1] = trace_recs[i].s;
+                if (trace_recs[i].kind > nchunks) nchunks = trace_recs[i].kind;
+            }
+        }
+        const int t = threads < 64 ? threads : 64;
+        free_at[0] = la;
+        for (int q = 0; q < nchunks; ++q) {
+            int best = 0;
+            for (int j = 1; j < t; ++j)
+                if (free_at[j] < free_at[best]) best = j;
+            free_at[best] += chunk[q] > 0.0 ? chunk[q] : 0.0;
+        }
+        double end = 0.0;
+        for (int j = 0; j < t; ++j) end = fmax(end, free_at[j]);
+        *makespan += end;
+    }
+    free(chunk);
+}
+
+static double thread_cpu(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* one-thread dgemm flops per CPU-second of the calling thread (OpenBLAS's count restored) */
+static double dgemm_cpu_rate1(void)
+{
+    const int n = 2000, saved = openblas_get_num_threads();
+    openblas_set_num_threads(1);
+    double *a = malloc(sizeof(double) * n * n), *b = malloc(sizeof(double) * n * n);
+    double *c = malloc(sizeof(double) * n * n);
+    for (long i = 0; i < (long)n * n; ++i) a[i] = 1.0 / (1 + i % 7), b[i] = 0.5, c[i] = 0.0;
+    double best = 0.0;
+    for (int r = 0; r < 3; ++r) {
+        double t = thread_cpu();
+        cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, n, n, n, 1.0, a, n, b, n, 0.0, c, n);
+        best = fmax(best, 2.0 * n * (double)n * n / (thread_cpu() - t));
+    }
+    free(a), free(b), free(c);
+    openblas_set_num_threads(saved);
+    return best;
+}
 
 /* b1,b2,... from the environment variable `name` into out (at most 8) */
 static int parse_blocks(const char *name, long *out)
@@ -92,6 +189,9 @@ int main(int argc, char **argv)
         if (full && !f) return 2;
         double rate = 0.0, best_ref = INFINITY, best_blk = INFINITY, best_la = INFINITY;
         double cpu_ref = INFINITY, cpu_blk = INFINITY, cpu_la = INFINITY;
+        const int model = getenv("MODEL") && atoi(getenv("MODEL"));
+        const int model_block = getenv("MODEL_BLOCK") ? atoi(getenv("MODEL_BLOCK")) : 0;
+        double rate1 = 0.0, best_model = INFINITY, best_busy = INFINITY, best_la_cpu = 0.0;
         int info_ref = 0, info_blk = 0, info_la = 0;
         for (int r = 0; r < reps; ++r) {
             rate = fmax(rate, dgemm_rate());
@@ -113,6 +213,16 @@ int main(int argc, char **argv)
             best_ref = fmin(best_ref, t1 - t0);
             best_blk = fmin(best_blk, t3 - t2);
             best_la = fmin(best_la, t5 - t4);
+            if (model) {
+                rate1 = fmax(rate1, dgemm_cpu_rate1());
+                fill_rfp(n, l);
+                trace_count = 0;
+                traced_lookahead(NULL, n, l, model_block, got);
+                double ms, busy;
+                trace_model(got, &ms, &busy);
+                best_model = fmin(best_model, ms);
+                if (busy < best_busy) best_busy = busy, best_la_cpu = trace_la;
+            }
             for (int q = 0; q < nblocks; ++q) {
                 fill_rfp(n, b);
                 double s0 = cm_wtime();
@@ -165,6 +275,14 @@ int main(int argc, char **argv)
                got > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N ? "lookahead"
                                                                             : "blocked",
                diff / big, diff_la / big, info_ref, info_blk, info_la, load);
+        if (model) {
+            const double mbound = (double)n * n * n / 3.0 / (rate1 * got);
+            printf("n=%d model threads=%d block=%d dgemm1_cpu_gflops=%.1f model_bound_s=%.3f "
+                   "model_s=%.3f model_over_bound=%.3f busy_cpu_s=%.3f busy_over_1thread_bound=%.3f "
+                   "lookahead_tasks_cpu_s=%.3f\n",
+                   n, got, model_block, rate1 * 1e-9, mbound, best_model, best_model / mbound,
+                   best_busy, best_busy / (mbound * got), best_la_cpu);
+        }
         for (int q = 0; q < nblocks; ++q)
             printf("n=%d block=%ld blocked_s=%.3f blocked_over_bound=%.3f\n", n, blocks[q],
                    best_b[q], best_b[q] / bound);
