@@ -106,11 +106,11 @@ int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
     return 0;
 }
 
-/* Which of the two runs: on T > 1 BLAS threads, the look-ahead factorisation
- * (cholesky_lookahead.c) for n up to CM_LOOKAHEAD_MAX_N, where OpenBLAS's threaded panels
- * leave a core idle; above it the panels are a vanishing part of the work and the threaded
- * BLAS calls do as well. Inside a parallel region (local factorisations run side by side)
- * the BLAS-threaded path runs, on whatever count the caller set. */
+/* Which of the two runs: on T > 1 BLAS threads and n from CM_LOOKAHEAD_MIN_N, the look-ahead
+ * factorisation (cholesky_lookahead.c), which keeps the T cores busy while a panel is
+ * factored instead of leaving all but one idle; on one thread, for small n, and inside a
+ * parallel region (local factorisations side by side, where the team would be one thread
+ * and OpenBLAS's count is the caller's business) the panel-by-panel path. */
 int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
 {
     const int threads = openblas_get_num_threads();

@@ -6,17 +6,19 @@
  * 1.25 x the bound n^3/3 at the dgemm rate, against 1.15 on one thread: every panel step
  * (dpotrf of b x b, dtrsm of the column below) runs while the second core waits, and the
  * trailing updates are too small for OpenBLAS to split well. Here the columns are cut into
- * the same blocks as in cholesky_blocked.c (the first n1 columns, then the n2 of A22, in
- * widths of `block`), and step k applies the factored panel k to every block on its right:
- * one thread first updates block k+1 and factors it (dpotrf + dtrsm), the next panel, while
- * the other threads take the remaining blocks' updates one at a time (dynamic schedule), and
- * that thread joins them when its panel is done. So the panel work of step k+1 hides behind
- * the updates of step k, and no thread waits except at the one barrier per step.
+ * the same kind of blocks as in cholesky_blocked.c (the first n1 columns, then the n2 of
+ * A22, in widths of `block`), and step k applies the factored panel k to everything on its
+ * right: one thread first updates block k+1 and factors it (dpotrf + dtrsm), the next
+ * panel, while the other threads take the rest of the update in tasks of a few hundred
+ * columns (dynamic schedule, see make_tasks), and that thread joins them when its panel is
+ * done. So the panel work of step k+1 hides behind the updates of step k, and no thread
+ * waits except at the one barrier per step.
  *
- * Same arithmetic as dpftrf in another order (every update is panel k applied to one block,
- * by dsyrk on its diagonal block and dgemm below or right of it), same storage, and the
- * result does not depend on which thread ran which block: a BLAS call on one thread computes
- * the same bits whoever calls it, so the factor is the same for every T. */
+ * Same arithmetic as dpftrf in another order (every update is panel k applied to a set of
+ * columns, by dsyrk on the diagonal and dgemm off it), same storage, and the result does not
+ * depend on which thread ran which task: the tasks are cut from n, the block and the step
+ * alone, and a one-thread BLAS call computes the same bits whoever makes it, so the factor is
+ * the same on every T. */
 #include "rbf_internal.h"
 
 #include <cblas.h>

@@ -114,10 +114,12 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
  * A^-1 b for the factor a of cm_rbf_cholesky_rfp. Below its size threshold, or on one
  * thread, dpftrs itself. Returns 0, or < 0 for a bad argument. */
 int cm_rbf_rfp_solve(int n, int nrhs, const double *a, double *b, int ldb, int threads);
-/* measured crossovers of cm_rbf_cholesky_rfp (benchmarks/RESULTS.md, issue 10 fourth
- * session) */
-#define CM_LOOKAHEAD_MIN_N 1
-#define CM_LOOKAHEAD_MAX_N 1000000
+/* cm_rbf_cholesky_rfp's range for the look-ahead path (benchmarks/RESULTS.md, "The dense
+ * factorisation on 2 threads at small m"): its schedule replayed from per-task CPU times
+ * beat the threaded panels from 3k to 20k; below 2k both take milliseconds and the
+ * look-ahead's barriers are its largest cost on a loaded machine. */
+#define CM_LOOKAHEAD_MIN_N 2000
+#define CM_LOOKAHEAD_MAX_N 60000
 
 /* Sets OpenBLAS's thread count for the calls that follow to `want`, or fewer if the
  * address-space limit cannot back their 128 MB buffers (blas.h, point 2); got (may be NULL)
