@@ -7,8 +7,6 @@
  * panel-by-panel path, `lookahead` the other, `chosen` says which cm_rbf_cholesky_rfp takes)
  * BLOCKS=b1,b2,... (environment): also the panel-by-panel factorisation with these blocks;
  * LA_BLOCKS=b1,b2,...: also the look-ahead factorisation with these blocks;
- * SOLVE=1: also dpftrs (one thread, as cm_rbf_solve ran it) against cm_rbf_rfp_solve on
- * THREADS, with dpftrf's factor and 3 right-hand sides;
  * MODEL=1 [MODEL_BLOCK=b]: the look-ahead's schedule model (below);
  * cpu_s: best CPU seconds of the process (dpftrf/blocked/lookahead; spinning workers count);
  * FULL=1: also dpotrf on full storage, unpacked from and packed back into RFP (dtfttr,
@@ -277,37 +275,6 @@ int main(int argc, char **argv)
                got > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N ? "lookahead"
                                                                             : "blocked",
                diff / big, diff_la / big, info_ref, info_blk, info_la, load);
-        if (getenv("SOLVE") && atoi(getenv("SOLVE"))) {
-            /* the dense solve's triangular solves with this factor: 3 right-hand sides */
-            const int nrhs = 3;
-            double *rhs = malloc((size_t)n * nrhs * sizeof *rhs), *x = malloc((size_t)n * nrhs * sizeof *x);
-            if (!rhs || !x) return 2;
-            for (size_t i = 0; i < (size_t)n * nrhs; ++i) rhs[i] = 1.0 / (1.0 + (double)(i % 11));
-            double best_p = INFINITY, best_o = INFINITY, diff_s = 0.0, big_s = 0.0;
-            for (int r = 0; r < 5 * reps; ++r) {
-                memcpy(x, rhs, (size_t)n * nrhs * sizeof *x);
-                openblas_set_num_threads(1);
-                double s0 = cm_wtime();
-                LAPACKE_dpftrs_work(LAPACK_COL_MAJOR, 'N', 'L', n, nrhs, a, x, n);
-                double s1 = cm_wtime();
-                openblas_set_num_threads(got);
-                best_p = fmin(best_p, s1 - s0);
-                double *y = malloc((size_t)n * nrhs * sizeof *y);
-                memcpy(y, rhs, (size_t)n * nrhs * sizeof *y);
-                double s2 = cm_wtime();
-                cm_rbf_rfp_solve(n, nrhs, a, y, n, got);
-                best_o = fmin(best_o, cm_wtime() - s2);
-                for (size_t i = 0; i < (size_t)n * nrhs; ++i) {
-                    diff_s = fmax(diff_s, fabs(x[i] - y[i]));
-                    big_s = fmax(big_s, fabs(x[i]));
-                }
-                free(y);
-            }
-            printf("n=%d solve nrhs=%d dpftrs_1thread_s=%.4f rfp_solve_s=%.4f threads=%d "
-                   "rfp_solve_over_dpftrs=%.3f max_diff_rel=%.2g\n",
-                   n, nrhs, best_p, best_o, got, best_o / best_p, diff_s / big_s);
-            free(rhs), free(x);
-        }
         if (model) {
             const double mbound = (double)n * n * n / 3.0 / (rate1 * got);
             printf("n=%d model threads=%d block=%d dgemm1_cpu_gflops=%.1f model_bound_s=%.3f "

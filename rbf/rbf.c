@@ -443,7 +443,8 @@ static cm_status solve_pass(cm_context *ctx, const cm_rbf *r, size_t nc, const d
     lapack_int info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', (lapack_int)m, (lapack_int)nc,
                                      k, r->qr, (lapack_int)m, r->tau, w, (lapack_int)m);
     if (info == 0 && n2 > 0)
-        info = cm_rbf_rfp_solve((int)n2, (int)nc, r->chol, w + k, (int)m, threads);
+        info = LAPACKE_dpftrs_work(LAPACK_COL_MAJOR, 'N', 'L', (lapack_int)n2, (lapack_int)nc,
+                                   r->chol, w + k, (lapack_int)m);
     /* w = Q [0; sign z] */
     for (size_t c = 0; c < nc && info == 0; ++c) {
         for (int i = 0; i < k; ++i) w[c * m + (size_t)i] = 0.0;

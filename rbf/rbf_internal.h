@@ -109,16 +109,12 @@ int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
  * own default. */
 int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block);
 int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, int threads);
-/* dpftrs (TRANSR 'N', UPLO 'L') on `threads` OpenMP threads of one-thread BLAS
- * (cholesky_solve.c): b (n x nrhs col-major, leading dimension ldb) is overwritten by
- * A^-1 b for the factor a of cm_rbf_cholesky_rfp. Below its size threshold, or on one
- * thread, dpftrs itself. Returns 0, or < 0 for a bad argument. */
-int cm_rbf_rfp_solve(int n, int nrhs, const double *a, double *b, int ldb, int threads);
 /* cm_rbf_cholesky_rfp's range for the look-ahead path (benchmarks/RESULTS.md, "The dense
- * factorisation on 2 threads at small m"): its schedule replayed from per-task CPU times
- * beat the threaded panels from 3k to 20k; below 2k both take milliseconds and the
- * look-ahead's barriers are its largest cost on a loaded machine. */
-#define CM_LOOKAHEAD_MIN_N 2000
+ * factorisation on 2 threads at small m"): its schedule, replayed from per-task CPU times,
+ * beats the threaded panels from 5k to 20k; below 4k a factorisation takes < 0.15 s, and on
+ * a loaded machine, where each of its barriers can wait a time slice for a preempted
+ * thread, it lost to them (3k: 1.28 x their time, 2k: 1.9 x). */
+#define CM_LOOKAHEAD_MIN_N 4000
 #define CM_LOOKAHEAD_MAX_N 60000
 
 /* Sets OpenBLAS's thread count for the calls that follow to `want`, or fewer if the
