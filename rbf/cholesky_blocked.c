@@ -113,8 +113,11 @@ int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
  * and OpenBLAS's count is the caller's business) the panel-by-panel path. */
 int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
 {
-    const int threads = openblas_get_num_threads();
+    int threads = openblas_get_num_threads();
+    /* under ulimit -v, as many callers as have room for their buffers (blas_threads.c) */
     if (threads > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N && !omp_in_parallel())
-        return cm_rbf_cholesky_rfp_lookahead(ctx, n, a, block, threads);
+        threads = cm_rbf_blas_callers(threads);
+    else threads = 1;
+    if (threads > 1) return cm_rbf_cholesky_rfp_lookahead(ctx, n, a, block, threads);
     return cm_rbf_cholesky_rfp_panels(ctx, n, a, block);
 }

@@ -122,6 +122,9 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
  * receives the count. CM_ERR_NOMEM, with a message starting with who, if not even the
  * calling thread's buffer fits: OpenBLAS would spin forever trying to allocate it. */
 cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *got);
+/* How many of `want` threads can call one-thread BLAS at the same time (each needs its own
+ * OpenBLAS buffer) under the address-space limit: want if there is none, at least 1. */
+int cm_rbf_blas_callers(int want);
 /* ---- iterative solver (rbf_iterative.c, rbf_schwarz.c) ---- */
 
 /* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */

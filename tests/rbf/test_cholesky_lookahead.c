@@ -4,8 +4,15 @@
  * layout, many update chunks per step; the failing pivot of an indefinite matrix (info as
  * dpftrf's); progress monotonic up to its total; OpenBLAS's thread count restored; and which
  * path cm_rbf_cholesky_rfp takes. */
+#if defined(__linux__) && !defined(_DEFAULT_SOURCE)
+#define _DEFAULT_SOURCE /* fork, waitpid, setrlimit */
+#endif
 #include "rbf/rbf_internal.h"
 #include "test_util.h"
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cblas.h>
 #include <lapacke.h>
@@ -182,6 +189,33 @@ static void check_dispatch(int n)
     free(full), free(orig), free(a), free(b);
 }
 
+/* Under an address-space limit with no room for a second OpenBLAS buffer the look-ahead is
+ * not taken (its second thread's first BLAS call would spin forever in OpenBLAS's
+ * allocation): cm_rbf_blas_callers says 1. In a child, which the limit must not outlive. */
+static void check_ulimit(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    unsigned long pages = 0;
+    if (!f || fscanf(f, "%lu", &pages) != 1) {
+        if (f) fclose(f);
+        return; /* not Linux: nothing to check */
+    }
+    fclose(f);
+    CHECK(cm_rbf_blas_callers(2) == 2); /* no limit here */
+    pid_t pid = fork();
+    if (pid == 0) {
+        /* 100 MB more than mapped now: less than one more 128 MB buffer */
+        struct rlimit rl;
+        getrlimit(RLIMIT_AS, &rl);
+        rl.rlim_cur = (rlim_t)pages * 4096u + ((rlim_t)100 << 20);
+        if (setrlimit(RLIMIT_AS, &rl) != 0) _exit(4);
+        _exit(cm_rbf_blas_callers(2) == 1 ? 0 : 5);
+    }
+    int status = 0;
+    CHECK(pid > 0 && waitpid(pid, &status, 0) == pid);
+    CHECK_MSG(WIFEXITED(status) && WEXITSTATUS(status) == 0, "child: status %d", status);
+}
+
 int main(void)
 {
     const int sizes[] = {1, 2, 3, 7, 16, 33, 64, 65, 100, 129, 301, 513};
@@ -204,5 +238,6 @@ int main(void)
     CHECK(cm_rbf_cholesky_rfp_lookahead(NULL, -1, &(double){1.0}, 0, 2) < 0);
     check_dispatch(CM_LOOKAHEAD_MIN_N - 1);
     check_dispatch(CM_LOOKAHEAD_MIN_N);
+    check_ulimit();
     return TEST_REPORT();
 }
