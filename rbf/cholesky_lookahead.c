@@ -73,9 +73,15 @@ static void block_range(const rfp *r, int q, int *c0, int *c1)
     }
 }
 
-static double *at_t(const rfp *r, int i, int j) { return r->t + (size_t)i + (size_t)j * r->ld; }
+static double *at_t(const rfp *r, int i, int j)
+{
+    return r->t + (size_t)i + (size_t)j * r->ld;
+}
 /* u's element (p, q) in A22's own numbering */
-static double *at_u(const rfp *r, int p, int q) { return r->u + (size_t)p + (size_t)q * r->ld; }
+static double *at_u(const rfp *r, int p, int q)
+{
+    return r->u + (size_t)p + (size_t)q * r->ld;
+}
 
 /* B (m x nb) := B L^-T, L lower nb x nb: the dtrsm of a tall panel, split in halves down to
  * CM_LOOKAHEAD_TRSM_LEAF columns so that most of it runs as dgemm. Why: one-thread dtrsm of
@@ -84,8 +90,8 @@ static double *at_u(const rfp *r, int p, int q) { return r->u + (size_t)p + (siz
 static void trsm_rlt(int m, int nb, const double *l, int ldl, double *b, int ldb)
 {
     if (nb <= CM_LOOKAHEAD_TRSM_LEAF) {
-        cblas_dtrsm(CblasColMajor, CblasRight, CblasLower, CblasTrans, CblasNonUnit, m, nb, 1.0,
-                    l, ldl, b, ldb);
+        cblas_dtrsm(CblasColMajor, CblasRight, CblasLower, CblasTrans, CblasNonUnit, m, nb, 1.0, l,
+                    ldl, b, ldb);
         return;
     }
     const int h = (nb / 2 + 7) / 8 * 8; /* halves on multiples of 8: the kernels' unroll */
@@ -100,14 +106,14 @@ static void trsm_rlt(int m, int nb, const double *l, int ldl, double *b, int ldb
 static void trsm_lut(int nb, int m, const double *u, int ldu, double *b, int ldb)
 {
     if (nb <= CM_LOOKAHEAD_TRSM_LEAF) {
-        cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, nb, m, 1.0,
-                    u, ldu, b, ldb);
+        cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, nb, m, 1.0, u,
+                    ldu, b, ldb);
         return;
     }
     const int h = (nb / 2 + 7) / 8 * 8;
     trsm_lut(h, m, u, ldu, b, ldb);
-    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, nb - h, m, h, -1.0,
-                u + (size_t)h * ldu, ldu, b, ldb, 1.0, b + h, ldb);
+    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, nb - h, m, h, -1.0, u + (size_t)h * ldu,
+                ldu, b, ldb, 1.0, b + h, ldb);
     trsm_lut(nb - h, m, u + h + (size_t)h * ldu, ldu, b + h, ldb);
 }
 
@@ -123,14 +129,12 @@ static int factor_block(const rfp *r, int q)
     if (q < r->nb1) {
         double *d = at_t(r, c0, c0);
         info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', bw, d, r->ld);
-        if (info == 0 && rest > 0)
-            trsm_rlt(rest, bw, d, r->ld, d + bw, r->ld);
+        if (info == 0 && rest > 0) trsm_rlt(rest, bw, d, r->ld, d + bw, r->ld);
     } else {
         const int p0 = c0 - r->n1;
         double *d = at_u(r, p0, p0);
         info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'U', bw, d, r->ld);
-        if (info == 0 && rest > 0)
-            trsm_lut(bw, rest, d, r->ld, d + (size_t)bw * r->ld, r->ld);
+        if (info == 0 && rest > 0) trsm_lut(bw, rest, d, r->ld, d + (size_t)bw * r->ld, r->ld);
     }
     return info > 0 ? c0 + (int)info : (int)info;
 }
@@ -148,8 +152,8 @@ static void update_range(const rfp *r, int k, int c0, int c1)
         cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, bw, bk, -1.0, x, ld, 1.0,
                     at_t(r, c0, c0), ld);
         if (rest > 0)
-            cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, rest, bw, bk, -1.0,
-                        at_t(r, e, p0), ld, x, ld, 1.0, at_t(r, e, c0), ld);
+            cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, rest, bw, bk, -1.0, at_t(r, e, p0),
+                        ld, x, ld, 1.0, at_t(r, e, c0), ld);
         c0 = e;
     }
     if (c0 >= c1) return;
@@ -200,11 +204,11 @@ static void update_a22_cols(const rfp *r, int k, int s, int j0, int j1)
     } else { /* L(n1 + q, panel) = u(k0.., q) */
         const int k0 = p0 - n1;
         const double *y = at_u(r, k0, j0);
-        cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, w, bk, -1.0, y, ld, 1.0,
-                    at_u(r, j0, j0), ld);
+        cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, w, bk, -1.0, y, ld, 1.0, at_u(r, j0, j0),
+                    ld);
         if (above > 0)
-            cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, above, w, bk, -1.0,
-                        at_u(r, k0, s), ld, y, ld, 1.0, at_u(r, s, j0), ld);
+            cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, above, w, bk, -1.0, at_u(r, k0, s),
+                        ld, y, ld, 1.0, at_u(r, s, j0), ld);
     }
 }
 
@@ -242,8 +246,10 @@ static int make_tasks(int n, int n1, int a, int s, task *out, int max)
         int lo = a + 1, hi = n1; /* smallest e with tall_work(a, e) >= want */
         while (lo < hi) {
             int mid = lo + (hi - lo) / 2;
-            if (tall_work(n, a, mid) >= want) hi = mid;
-            else lo = mid + 1;
+            if (tall_work(n, a, mid) >= want)
+                hi = mid;
+            else
+                lo = mid + 1;
         }
         int e = lo < a + mc ? a + mc : lo;
         if (e > n1 - mc / 2 || count == max / 2 - 1) e = n1;
@@ -256,8 +262,10 @@ static int make_tasks(int n, int n1, int a, int s, task *out, int max)
         int lo = s, hi = b - 1; /* largest e with a22_work(e, b) >= want */
         while (lo < hi) {
             int mid = lo + (hi - lo + 1) / 2;
-            if (a22_work(s, mid, b) >= want) lo = mid;
-            else hi = mid - 1;
+            if (a22_work(s, mid, b) >= want)
+                lo = mid;
+            else
+                hi = mid - 1;
         }
         int e = lo > b - mc ? b - mc : lo;
         if (e < s + mc / 2 || count == max - 1) e = s;
@@ -269,8 +277,10 @@ static int make_tasks(int n, int n1, int a, int s, task *out, int max)
 
 static void run_task(const rfp *r, int k, const task *t)
 {
-    if (t->kind == 0) update_range(r, k, t->a, t->b);
-    else update_a22_cols(r, k, t->s, t->a, t->b);
+    if (t->kind == 0)
+        update_range(r, k, t->a, t->b);
+    else
+        update_a22_cols(r, k, t->s, t->a, t->b);
 }
 
 /* Flops of step k: factoring panel k and applying it to every block on its right (the
@@ -357,7 +367,7 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
                     run_task(&r, k, &tasks[q]);
                     TRACE_END(k, 1 + q);
                 }
-            /* the barrier above ends step k: panel k+1 is factored, every block updated */
+                /* the barrier above ends step k: panel k+1 is factored, every block updated */
 #pragma omp master
             if (!stop) {
                 done += step_flops(&r, k);

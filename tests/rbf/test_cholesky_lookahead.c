@@ -49,12 +49,14 @@ static void on_progress(void *user, const char *stage, double done, double total
 static double *spd(int n, int bad)
 {
     double *b = malloc((size_t)n * n * sizeof *b), *a = calloc((size_t)n * n, sizeof *a);
-    for (size_t i = 0; i < (size_t)n * n; ++i) b[i] = urand();
+    for (size_t i = 0; i < (size_t)n * n; ++i)
+        b[i] = urand();
     openblas_set_num_threads(1);
     cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, n, n, 1.0 / n, b, n, 0.0, a, n);
     for (int j = 0; j < n; ++j) {
         a[j + (size_t)j * n] += 1.0;
-        for (int i = j + 1; i < n; ++i) a[j + (size_t)i * n] = a[i + (size_t)j * n];
+        for (int i = j + 1; i < n; ++i)
+            a[j + (size_t)i * n] = a[i + (size_t)j * n];
     }
     if (bad >= 0) a[bad + (size_t)bad * n] = -1e3;
     free(b);
@@ -67,7 +69,8 @@ static double residual(int n, const double *full, const double *f)
     double *l = calloc((size_t)n * n, sizeof *l), *r = malloc((size_t)n * n * sizeof *r);
     LAPACKE_dtfttr(LAPACK_COL_MAJOR, 'N', 'L', n, f, l, n);
     for (int j = 0; j < n; ++j) /* dtfttr leaves the strict upper part alone: zero it */
-        for (int i = 0; i < j; ++i) l[i + (size_t)j * n] = 0.0;
+        for (int i = 0; i < j; ++i)
+            l[i + (size_t)j * n] = 0.0;
     memcpy(r, full, (size_t)n * n * sizeof *r);
     cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, n, n, -1.0, l, n, 1.0, r, n);
     double worst = 0.0, big = 0.0;
@@ -114,15 +117,16 @@ static void check_size(int n, int block)
                   threads, openblas_get_num_threads());
         /* the same arithmetic in another order: round-off of a well-conditioned factor */
         double d = max_rel_diff(len, got, ref);
-        CHECK_MSG(d <= 1e-12, "n %d block %d threads %d: factor differs from dpftrf's by %.3g",
-                  n, block, threads, d);
+        CHECK_MSG(d <= 1e-12, "n %d block %d threads %d: factor differs from dpftrf's by %.3g", n,
+                  block, threads, d);
         double res = residual(n, full, got);
         CHECK_MSG(res <= 1e-13 && res <= 10.0 * res_ref + 1e-15,
-                  "n %d block %d threads %d: |A - LL'| %.3g (dpftrf %.3g)", n, block, threads,
-                  res, res_ref);
+                  "n %d block %d threads %d: |A - LL'| %.3g (dpftrf %.3g)", n, block, threads, res,
+                  res_ref);
         /* the cuts of every step depend on n and the block only: the same factor on any
          * thread count, up to the round-off OpenBLAS might add (none seen) */
-        if (threads == 1) memcpy(one, got, len * sizeof *one);
+        if (threads == 1)
+            memcpy(one, got, len * sizeof *one);
         else {
             double dt = max_rel_diff(len, got, one);
             CHECK_MSG(dt <= 1e-15, "n %d block %d: %d threads vs 1 differ by %.3g", n, block,
@@ -130,8 +134,8 @@ static void check_size(int n, int block)
         }
         const int bs = block > 0 ? block : 192; /* cholesky_lookahead.c's default */
         const int blocks = (n - n / 2 + bs - 1) / bs + (n / 2 + bs - 1) / bs;
-        CHECK_MSG(c.count >= blocks + 1, "n %d block %d: %d progress calls, %d blocks", n,
-                  block, c.count, blocks);
+        CHECK_MSG(c.count >= blocks + 1, "n %d block %d: %d progress calls, %d blocks", n, block,
+                  c.count, blocks);
         CHECK(c.monotonic && c.stage_ok);
         CHECK_NEAR(c.last, c.total, 0.0);
         CHECK(c.total > 0.0);
@@ -154,8 +158,8 @@ static void check_pivot(int n, int bad, int block)
     for (int threads = 1; threads <= 2; ++threads) {
         memcpy(got, orig, len * sizeof *got);
         int info = cm_rbf_cholesky_rfp_lookahead(NULL, n, got, block, threads);
-        CHECK_MSG(info == want, "n %d bad %d block %d threads %d: dpftrf %d, look-ahead %d", n,
-                  bad, block, threads, want, info);
+        CHECK_MSG(info == want, "n %d bad %d block %d threads %d: dpftrf %d, look-ahead %d", n, bad,
+                  block, threads, want, info);
     }
     free(full), free(ref), free(got), free(orig);
 }
@@ -180,11 +184,13 @@ static void check_dispatch(int n)
         openblas_set_num_threads(threads);
         CHECK(cm_rbf_cholesky_rfp(NULL, n, a, 0) == 0);
         CHECK(openblas_get_num_threads() == threads);
-        if (threads > 1 && in_range) cm_rbf_cholesky_rfp_lookahead(NULL, n, b, 0, threads);
-        else cm_rbf_cholesky_rfp_panels(NULL, n, b, 0);
+        if (threads > 1 && in_range)
+            cm_rbf_cholesky_rfp_lookahead(NULL, n, b, 0, threads);
+        else
+            cm_rbf_cholesky_rfp_panels(NULL, n, b, 0);
         CHECK(openblas_get_num_threads() == threads);
-        CHECK_MSG(memcmp(a, b, len * sizeof *a) == 0, "n %d threads %d: not the expected path",
-                  n, threads);
+        CHECK_MSG(memcmp(a, b, len * sizeof *a) == 0, "n %d threads %d: not the expected path", n,
+                  threads);
     }
     free(full), free(orig), free(a), free(b);
 }
@@ -226,7 +232,7 @@ int main(void)
     check_size(150, 0);  /* n below the default block: one block a half */
     check_size(1200, 0); /* default block; steps with several chunks of >= 256 columns */
     check_size(1201, 48);
-    check_size(997, 100); /* the last block of each half narrower */
+    check_size(997, 100);      /* the last block of each half narrower */
     check_pivot(200, 0, 16);   /* first column */
     check_pivot(200, 37, 16);  /* inside the first half */
     check_pivot(200, 48, 16);  /* first column of a block (the look-ahead's panel) */
