@@ -33,6 +33,7 @@
 #include "rbf_treecode.h"
 
 #include "rbf_internal.h"
+#include "rbf_sum_isa.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -74,6 +75,7 @@ struct cm_rbf_tree {
     double *pxyz;   /* 3 x (nprox P) SoA: proxy points */
     double cheb[CM_TREE_MAXN + 1], bw[CM_TREE_MAXN + 1];
     int *depth_start; /* proxies sorted by depth: [depth_start[d], depth_start[d + 1]) */
+    cm_rbf_isa isa;   /* code of the downward products (AUTO unless a test names one) */
 };
 
 /* (n, theta) measured to keep max_i err_i / sum_j |w_j| phi_ij below tol, with a margin of
@@ -386,8 +388,8 @@ static void upward(const cm_rbf_tree *t, const double *ws, int nc, double *W, in
 /* ---- downward: batches against clusters ---- */
 
 typedef struct seg {
-    const double *x, *y, *z, *w; /* w: component q at w + q * ldw */
-    size_t ldw, n;
+    const double *x, *y, *z, *w; /* w: component q at w + q * ldw; y = x + ldc, z = y + ldc */
+    size_t ldc, ldw, n;
     int direct; /* centres (1) or proxies (0) */
 } seg;
 
@@ -453,16 +455,35 @@ block_avx512(int nc, const seg *s, int ns, const double *tx, const double *ty, c
     CM_TREE_DISPATCH
 }
 
-static block_fn pick_block(void)
+static block_fn pick_block(cm_rbf_isa isa)
 {
-#if defined(__x86_64__) && defined(__GNUC__)
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-        __builtin_cpu_supports("avx512vl"))
-        return block_avx512;
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return block_avx2;
-#endif
-    return block_generic;
+    if (isa == CM_RBF_ISA_AUTO) isa = cm_rbf_isa_auto();
+    switch (isa) {
+    case CM_RBF_ISA_AVX512_AUTOVEC: return block_avx512;
+    case CM_RBF_ISA_AVX2: return block_avx2;
+    case CM_RBF_ISA_AVX512: return NULL; /* the hand-written block, batch-wise (batch_avx512) */
+    default: return block_generic;
+    }
+}
+
+/* A whole batch (cnt targets, 3 x CM_TREE_BATCH SoA in pt, padded to a multiple of 8 with
+ * its last target) against every segment, by the AVX-512 block of the direct sums
+ * (rbf_sum_avx512.c): per segment the 32 targets in registers stream its centres or
+ * proxies tile by tile, so a segment (<= 512 per tile, 3 + nc rows) stays in L1 while the
+ * batch's groups pass over it. Each target adds the segments in the same order as the
+ * compiled loops do. acc: nc x CM_TREE_BATCH. */
+static void batch_avx512(int nc, const seg *s, int ns, size_t cnt, const double *pt,
+                         double *acc)
+{
+    memset(acc, 0, (size_t)nc * CM_TREE_BATCH * sizeof *acc);
+    for (int g = 0; g < ns; ++g)
+        cm_rbf_r3_strided_avx512(nc, s[g].n, s[g].x, s[g].ldc, s[g].w, s[g].ldw, cnt, pt,
+                                 CM_TREE_BATCH, acc);
+}
+
+void cm_rbf_tree_set_isa(cm_rbf_tree *t, cm_rbf_isa isa)
+{
+    if (t) t->isa = isa;
 }
 
 /* the whole sum for targets ordered by tg (batches = its leaves) */
@@ -479,7 +500,7 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
     for (int q = 0; q < nc; ++q)
         for (size_t j = 0; j < m; ++j) ws[(size_t)q * m + j] = w[(size_t)q * m + t->src.perm[j]];
     upward(t, ws, nc, W, threads);
-    const block_fn fn = pick_block();
+    const block_fn fn = pick_block(t->isa);
     const double *px = t->pxyz, *py = px + np * P, *pz = py + np * P;
     const double *xs = t->xs, *ys = xs + m, *zs = ys + m;
     int failed = 0;
@@ -489,7 +510,7 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
         seg *sg = malloc((size_t)cap * sizeof *sg);
         int stack[512];
         double tx[CM_TREE_BATCH + NB], ty[CM_TREE_BATCH + NB], tz[CM_TREE_BATCH + NB];
-        double acc[4 * NB];
+        double acc[4 * NB], pt[3 * CM_TREE_BATCH], bacc[4 * CM_TREE_BATCH];
         if (!sg) {
 #pragma omp atomic write
             failed = 1;
@@ -527,13 +548,13 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
                 }
                 if (far) {
                     const size_t o0 = (size_t)u->proxy * P;
-                    sg[ns++] = (seg){px + o0, py + o0, pz + o0, W + o0, np * P, P, 0};
+                    sg[ns++] = (seg){px + o0, py + o0, pz + o0, W + o0, np * P, np * P, P, 0};
                 } else if (ns > 0 && sg[ns - 1].direct &&
                            sg[ns - 1].x + sg[ns - 1].n == xs + u->begin) {
                     sg[ns - 1].n += u->end - u->begin; /* adjacent centres: one stretch */
                 } else {
                     const size_t o0 = u->begin;
-                    sg[ns++] = (seg){xs + o0, ys + o0, zs + o0, ws + o0, m, u->end - u->begin, 1};
+                    sg[ns++] = (seg){xs + o0, ys + o0, zs + o0, ws + o0, m, m, u->end - u->begin, 1};
                 }
             }
             for (size_t l = 0; l < cnt + NB; ++l) {
@@ -541,6 +562,20 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
                 tx[l] = p[i];
                 ty[l] = p[ldp + i];
                 tz[l] = p[2 * ldp + i];
+            }
+            if (!fn) {
+                for (size_t l = 0; l < CM_TREE_BATCH; ++l) {
+                    pt[l] = tx[l < cnt ? l : cnt - 1];
+                    pt[CM_TREE_BATCH + l] = ty[l < cnt ? l : cnt - 1];
+                    pt[2 * CM_TREE_BATCH + l] = tz[l < cnt ? l : cnt - 1];
+                }
+                batch_avx512(nc, sg, ns, cnt, pt, bacc);
+                for (size_t l = 0; l < cnt; ++l) {
+                    size_t i = tg->perm[b->begin + l];
+                    for (int q = 0; q < nc; ++q)
+                        out[i * ldo + (size_t)q] = bacc[(size_t)q * CM_TREE_BATCH + l];
+                }
+                continue;
             }
             for (size_t l0 = 0; l0 < cnt; l0 += NB) {
                 fn(nc, sg, ns, tx + l0, ty + l0, tz + l0, acc);
