@@ -149,19 +149,19 @@ CM_AVX512 void cm_rbf_r3_strided_avx512(int nc, size_t m, const double *c, size_
  * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the vector operation
  * count was the limit: TwoSum ran at 0.4x the plain sum's throughput). This is the binned
  * summation of the reproducible-BLAS literature (Demmel and Nguyen) with a single bin. */
-CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nc, const double *c, size_t ldc,
-                                  const double *w, size_t ldw, size_t jn, const double *pt,
-                                  double *hi, double *lo)
+CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nv, const int nc, const double *c,
+                                  size_t ldc, const double *w, size_t ldw, size_t jn,
+                                  const double *pt, size_t ldp, double *hi, double *lo)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     __m512d x[ACC_NV], y[ACC_NV], z[ACC_NV], s[4][ACC_NV], e[4][ACC_NV];
-    for (int v = 0; v < ACC_NV; ++v) {
+    for (int v = 0; v < nv; ++v) {
         x[v] = _mm512_loadu_pd(pt + 8 * v);
-        y[v] = _mm512_loadu_pd(pt + CM_RBF_ACC_PB + 8 * v);
-        z[v] = _mm512_loadu_pd(pt + 2 * CM_RBF_ACC_PB + 8 * v);
+        y[v] = _mm512_loadu_pd(pt + ldp + 8 * v);
+        z[v] = _mm512_loadu_pd(pt + 2 * ldp + 8 * v);
         for (int q = 0; q < nc; ++q) {
-            s[q][v] = _mm512_loadu_pd(hi + q * CM_RBF_ACC_PB + 8 * v);
-            e[q][v] = _mm512_loadu_pd(lo + q * CM_RBF_ACC_PB + 8 * v);
+            s[q][v] = _mm512_loadu_pd(hi + q * ldp + 8 * v);
+            e[q][v] = _mm512_loadu_pd(lo + q * ldp + 8 * v);
         }
     }
     for (size_t j = 0; j < jn; ++j) {
@@ -169,7 +169,7 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nc, const double *c
         const __m512d zj = _mm512_set1_pd(cz[j]);
         __m512d wj[4];
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
-        for (int v = 0; v < ACC_NV; ++v) {
+        for (int v = 0; v < nv; ++v) {
             const __m512d f = r3_of(fixed ? v : 0, x[v], y[v], z[v], xj, yj, zj);
             for (int q = 0; q < nc; ++q) {
                 if (fixed) {
@@ -190,44 +190,61 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nc, const double *c
             }
         }
     }
-    for (int v = 0; v < ACC_NV; ++v)
+    for (int v = 0; v < nv; ++v)
         for (int q = 0; q < nc; ++q) {
-            _mm512_storeu_pd(hi + q * CM_RBF_ACC_PB + 8 * v, s[q][v]);
-            _mm512_storeu_pd(lo + q * CM_RBF_ACC_PB + 8 * v, e[q][v]);
+            _mm512_storeu_pd(hi + q * ldp + 8 * v, s[q][v]);
+            _mm512_storeu_pd(lo + q * ldp + 8 * v, e[q][v]);
         }
 }
 
+/* as block_plain: one body for the direct sums (npt = ldp = CM_RBF_ACC_PB) and the
+ * treecode's compensated products (any strides; a tail of one vector) */
 CM_AVX512 CM_INLINE void block_acc(const int fixed, const int nc, size_t m, const double *c,
-                                   const double *w, const double *pt, double *hi, double *lo)
+                                   size_t ldc, const double *w, size_t ldw, size_t npt,
+                                   const double *pt, size_t ldp, double *hi, double *lo)
 {
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         const size_t jn = m - t0 < TILE ? m - t0 : TILE;
-        for (int b = 0; b < CM_RBF_ACC_PB; b += 8 * ACC_NV)
-            tile_acc(fixed, nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
+        for (size_t b = 0; b < npt; b += 8 * ACC_NV) {
+            if (npt - b > 8 * (ACC_NV - 1))
+                tile_acc(fixed, ACC_NV, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp, hi + b,
+                         lo + b);
+            else
+                tile_acc(fixed, 1, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp, hi + b, lo + b);
+        }
     }
 }
 
 CM_AVX512 CM_INLINE void dispatch_acc(const int fixed, int nc, size_t m, const double *c,
-                                      const double *w, const double *pt, double *hi, double *lo)
+                                      size_t ldc, const double *w, size_t ldw, size_t npt,
+                                      const double *pt, size_t ldp, double *hi, double *lo)
 {
     switch (nc) {
-    case 1: block_acc(fixed, 1, m, c, w, pt, hi, lo); break;
-    case 2: block_acc(fixed, 2, m, c, w, pt, hi, lo); break;
-    case 3: block_acc(fixed, 3, m, c, w, pt, hi, lo); break;
-    default: block_acc(fixed, 4, m, c, w, pt, hi, lo); break;
+    case 1: block_acc(fixed, 1, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 2: block_acc(fixed, 2, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 3: block_acc(fixed, 3, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    default: block_acc(fixed, 4, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
     }
 }
 
 CM_AVX512 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
                                           const double *pt, double *hi, double *lo)
 {
-    dispatch_acc(0, nc, m, c, w, pt, hi, lo);
+    dispatch_acc(0, nc, m, c, m, w, m, CM_RBF_ACC_PB, pt, CM_RBF_ACC_PB, hi, lo);
+}
+
+CM_AVX512 void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
+                                            const double *w, size_t ldw, size_t npt,
+                                            const double *pt, size_t ldp, double *hi,
+                                            double *lo)
+{
+    dispatch_acc(0, nc, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo);
 }
 
 CM_AVX512 void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
                                            const double *pt, double *hi, double *lo)
 {
-    dispatch_acc(1, nc, m, c, w, pt, hi, lo);
+    dispatch_acc(1, nc, m, c, m, w, m, CM_RBF_ACC_PB, pt, CM_RBF_ACC_PB, hi, lo);
 }
 
 int cm_rbf_cpu_avx512(void)
@@ -268,6 +285,14 @@ void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double
                                  const double *pt, double *hi, double *lo)
 {
     (void)nc, (void)m, (void)c, (void)w, (void)pt, (void)hi, (void)lo;
+}
+
+void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
+                                  const double *w, size_t ldw, size_t npt, const double *pt,
+                                  size_t ldp, double *hi, double *lo)
+{
+    (void)nc, (void)m, (void)c, (void)ldc, (void)w, (void)ldw, (void)npt, (void)pt;
+    (void)ldp, (void)hi, (void)lo;
 }
 
 int cm_rbf_cpu_avx512(void) { return 0; }

@@ -30,6 +30,13 @@ void cm_rbf_r3_strided_avx512(int nc, size_t m, const double *c, size_t ldc, con
 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
                                 const double *pt, double *hi, double *lo);
 
+/* The compensated (TwoSum) block with strides, for the treecode's compensated products:
+ * (hi, lo)[q * ldp + l] as cm_rbf_r3_acc_block_avx512, targets and strides as
+ * cm_rbf_r3_strided_avx512 (npt rounded up to a multiple of 8). */
+void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
+                                  const double *w, size_t ldw, size_t npt, const double *pt,
+                                  size_t ldp, double *hi, double *lo);
+
 /* The same with a fixed-binade running sum (rbf_sum_avx512.c says why it is exact enough):
  * hi[q * CM_RBF_ACC_PB + l] must start at big_q = 1.5 * 2^k with 2^k >= 4 * (a bound of
  * every partial sum |sum_{j<=J} w_qj phi_lj|), and the result is (hi - big_q) + lo. */

@@ -144,6 +144,65 @@ static void test_bound_random(void)
 /* Real weights (an RBF fit of the bore motion): the bound holds all the same, relative to
  * sum |w| phi, and the cancellation makes the error relative to the result that much
  * larger. */
+/* The compensated levels (cm_rbf_tree_set_compensated) on real, cancelling weights: each
+ * within the bound, the levels the same sums to rounding of sum |w| phi; with all sums
+ * direct (order 14: no cluster but the root has proxies, and the centres never see the
+ * root as far) level 1 is the compensated direct sum, to a relative 1e-13 of the result,
+ * where plain accumulation errs by more. */
+static void test_compensated(const cm_rbf *r)
+{
+    if (!cm_rbf_isa_supported(CM_RBF_ISA_AVX512)) {
+        printf("no AVX-512 here: compensated tree sums not run (they fall back to plain)\n");
+        return;
+    }
+    const size_t m = r->m;
+    double *out[3], *ex = malloc(3 * m * sizeof *ex), *S = malloc(3 * m * sizeof *S);
+    double *aw = malloc(3 * m * sizeof *aw);
+    for (int k = 0; k < 3; ++k) out[k] = malloc(3 * m * sizeof(double));
+    cm_rbf_kernel_sum_acc(m, r->c, r->w, 3, m, r->c, m, ex, 3, 2);
+    for (size_t j = 0; j < 3 * m; ++j) aw[j] = fabs(r->w[j]);
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw, 3, m, r->c, m, S, 3, 2);
+    double smax = 0.0, emax = 0.0;
+    for (size_t i = 0; i < 3 * m; ++i) smax = fmax(smax, S[i]), emax = fmax(emax, fabs(ex[i]));
+    for (int pass = 0; pass < 2; ++pass) {
+        const double tol = pass == 0 ? 1e-6 : 1e-14;
+        int order = 14;
+        double theta = 0.35;
+        if (pass == 0) cm_rbf_tree_params(tol, &order, &theta);
+        cm_rbf_tree *t = cm_rbf_tree_create(m, r->c, order, theta);
+        CHECK(t != NULL);
+        if (!t) break;
+        double err[3], dev = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            cm_rbf_tree_set_compensated(t, k);
+            CHECK(cm_rbf_tree_sum_self(t, r->w, 3, out[k], 3, 2) == 0);
+            err[k] = 0.0;
+            for (size_t i = 0; i < 3 * m; ++i) {
+                err[k] = fmax(err[k], fabs(out[k][i] - ex[i]) / S[i]);
+                if (k) dev = fmax(dev, fabs(out[k][i] - out[0][i]));
+            }
+        }
+        double e1 = 0.0, e0 = 0.0;
+        for (size_t i = 0; i < 3 * m; ++i) {
+            e0 = fmax(e0, fabs(out[0][i] - ex[i]));
+            e1 = fmax(e1, fabs(out[1][i] - ex[i]));
+        }
+        printf("compensated levels, order %d theta %.2f: err / sum|w|phi %.3g %.3g %.3g, "
+               "levels vs plain %.3g of max sum|w|phi; err / max result plain %.3g, "
+               "level 1 %.3g\n", order, theta, err[0], err[1], err[2], dev / smax, e0 / emax,
+               e1 / emax);
+        for (int k = 0; k < 3; ++k) CHECK_MSG(err[k] <= (pass ? 1e-14 : tol), "%.3g", err[k]);
+        CHECK_MSG(dev <= 1e-13 * smax, "%.3g", dev / smax);
+        if (pass == 1) {
+            CHECK_MSG(e1 <= 1e-13 * emax, "%.3g", e1 / emax);
+            CHECK_MSG(e1 < e0, "%.3g vs %.3g", e1, e0);
+        }
+        cm_rbf_tree_destroy(&t);
+    }
+    for (int k = 0; k < 3; ++k) free(out[k]);
+    free(ex), free(S), free(aw);
+}
+
 static void test_bound_real(cm_context *ctx)
 {
     size_t m;
@@ -169,6 +228,7 @@ static void test_bound_real(cm_context *ctx)
         CHECK_MSG(cancel > 10.0, "%.3g", cancel); /* the weights do cancel */
         cm_rbf_tree_destroy(&t);
     }
+    test_compensated(r);
     cm_rbf_destroy(&r);
     free(x), free(d);
 }
