@@ -1,5 +1,6 @@
 /* Hand-written AVX-512 blocks of the r^3 kernel sums (plain and compensated), chosen at run
- * time by rbf_sum.c and rbf_sum_acc.c on CPUs with AVX-512 F/DQ/VL; other CPUs keep the
+ * time by rbf_sum.c and rbf_sum_acc.c on CPUs with AVX-512 F/DQ/VL (and, through the strided
+ * entry points, by the treecode's products in rbf_treecode.c); other CPUs keep the
  * compiler-vectorised loops there. Why by hand: the compiler cannot balance the sqrt unit
  * against the FMA pipes (plain sums), and the compensated sums need a different algorithm
  * (the fixed binade below). Measured on Zen 5 (benchmarks/bench_kernel.c, RESULTS.md issue
