@@ -46,6 +46,26 @@
 #define CM_RBF_FAST_SAMPLES 256
 #define CM_RBF_FAST_SAFETY 4.0
 
+/* Relaxed products (opt.relax). Inexact Krylov (Simoncini & Szyld 2003, van den Eshof &
+ * Sleijpen 2004): with E_j = (A~ - A) z_j the error of the j-th product, the true residual
+ * differs from the one GMRES sees by E y = sum_j y_j E_j, and |y_j| is about the GMRES
+ * residual before step j (the preconditioned operator is well conditioned). So step j may
+ * err by share x target / |r_{j-1}|, growing as the residual falls. The error of a sum is
+ * bounded through S(z) = max_i sum_j |z_j| phi_ij <= diam^3 sum_j |z_j| (safe, a few times
+ * too large): plain sums err by at most CM_RBF_PLAIN_ERR x S (measured 1.2e-14..1.4e-14 x S
+ * with 3 weight vectors on the bracket and the two bodies, RESULTS.md "Fast summation"),
+ * the treecode at tol by tol x S (its bound, margin 3-30), compensated ones by eps |A z|.
+ * Every product's bound enters a gap bound sum |y_j| err_j, logged after each cycle; the
+ * exact residual at the cycle's end decides as before. */
+#define CM_RBF_RELAX_SHARE 0.02
+#define CM_RBF_PLAIN_ERR 1e-13
+/* loose treecode products from this many centres (below, one plain direct product costs
+ * about what the treecode at 1e-9 does: 59k, 0.52 vs ~0.9 CPU s, 22.6k 0.2 vs 0.08) */
+#define CM_RBF_RELAX_TREE_M 50000
+static const double relax_tree_tol[2] = {1e-6, 1e-9};
+
+enum { MV_COMP = 0, MV_PLAIN = 1, MV_FAST = 2 };
+
 struct cm_rbf_iter {
     cm_rbf_schwarz *pc;
     double *q1; /* m x k col-major, orthonormal basis of the polynomials at the centres */
@@ -56,6 +76,7 @@ struct cm_rbf_iter {
     int eval_fast;     /* the last evaluation's choice and estimate (evaluation gets a
                         * const cm_rbf, the iterative state is where it can leave them) */
     double eval_error;
+    cm_rbf_tree *rtree[2]; /* loose treecodes for relaxed products (relax_tree_tol) */
 };
 
 void cm_rbf_options_init(cm_rbf_options *opt)
@@ -78,6 +99,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->fast_tol = 1e-12;
     opt->fast_refine = 3;
     opt->fast_eval_tol = 1e-9;
+    opt->relax = 1;
 }
 
 void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
@@ -155,6 +177,8 @@ void cm_rbf_iterative_destroy(cm_rbf_iter **it)
     if (!it || !*it) return;
     cm_rbf_schwarz_destroy(&(*it)->pc);
     cm_rbf_tree_destroy(&(*it)->tree);
+    cm_rbf_tree_destroy(&(*it)->rtree[0]);
+    cm_rbf_tree_destroy(&(*it)->rtree[1]);
     free((*it)->q1);
     free(*it);
     *it = NULL;
@@ -172,16 +196,16 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
         o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0 ||
         o->local_float < 0 || o->local_float > 2 || o->fast_sum < -1 || o->fast_sum > 1 ||
         !(o->fast_tol > 0.0 && o->fast_tol <= 1e-3) || o->fast_refine < 0 ||
-        o->fast_refine > 10 || !(o->fast_eval_tol > 0.0))
+        o->fast_refine > 10 || !(o->fast_eval_tol > 0.0) || o->relax < 0 || o->relax > 2)
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
                         "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "
                         "%d, overlap %g, local_max %d, coarse_max %d, fast_sum %d, fast_tol %g, "
-                        "fast_refine %d, fast_eval_tol %g)",
+                        "fast_refine %d, fast_eval_tol %g, relax %d)",
                         o->tolerance, o->max_iterations, o->restart, o->leaf_size,
                         o->local_size, o->coarse_size, o->coarse_post, o->overlap, o->local_max,
                         o->coarse_max, o->fast_sum, o->fast_tol, o->fast_refine,
-                        o->fast_eval_tol);
+                        o->fast_eval_tol, o->relax);
     cm_rbf_iter *it = calloc(1, sizeof *it);
     if (!it) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     it->q1 = malloc(m * k * sizeof *it->q1);
@@ -321,6 +345,12 @@ typedef struct krylov {
     double *wlo;    /* g x m: low parts of the weights (double-double accumulation) */
     double *awlo;   /* g x m: A wlo */
     const cm_rbf_tree *tree; /* fast matvecs (treecode) if set, else compensated direct */
+    int relax;      /* relaxed products (direct-matvec solves only) */
+    int relax_tree; /* the loose treecodes may serve them */
+    double diam3;   /* diam^3 of the centres: S(z) <= diam3 sum |z| */
+    double eb[4][64]; /* bound on the error of each product of the cycle (max-norm) */
+    double gv0[4][64];
+    int *mv;        /* products by kind (MV_COMP, MV_PLAIN, MV_FAST) */
 } krylov;
 
 /* out_c = A in_c for the components in list (n of them, in: pointers to m-vectors). */
@@ -333,6 +363,38 @@ static void matvec(const cm_rbf *r, krylov *kr, int n, double *const *in, double
         cm_rbf_kernel_sum_acc(m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
     for (int c = 0; c < n; ++c)
         for (size_t i = 0; i < m; ++i) out[c][i] = kr->rowm[i * (size_t)n + (size_t)c];
+    ++kr->mv[kr->tree ? MV_FAST : MV_COMP];
+}
+
+/* The same by a named kind: compensated or plain direct sums, or the loose treecode lev.
+ * The treecode falls back to plain sums if it cannot be made (kept in r->iter: studies solve
+ * again on the same centres). Returns the kind used. */
+static int matvec_kind(const cm_rbf *r, krylov *kr, int kind, int lev, int n,
+                       double *const *in, double *const *out, int threads)
+{
+    const size_t m = kr->m;
+    cm_rbf_iter *it = r->iter;
+    for (int c = 0; c < n; ++c) memcpy(kr->soa + (size_t)c * m, in[c], m * sizeof(double));
+    if (kind == MV_FAST) {
+        if (!it->rtree[lev]) {
+            int order;
+            double theta;
+            cm_rbf_tree_params(relax_tree_tol[lev], &order, &theta);
+            it->rtree[lev] = cm_rbf_tree_create(m, r->c, order, theta);
+        }
+        if (!it->rtree[lev] ||
+            cm_rbf_tree_sum_self(it->rtree[lev], kr->soa, n, kr->rowm, (size_t)n, threads))
+            kind = MV_PLAIN;
+    }
+    if (kind == MV_PLAIN)
+        cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, kr->soa, n, m, r->c, m, kr->rowm,
+                          (size_t)n, threads);
+    else if (kind == MV_COMP)
+        cm_rbf_kernel_sum_acc(m, r->c, kr->soa, n, m, r->c, m, kr->rowm, (size_t)n, threads);
+    for (int c = 0; c < n; ++c)
+        for (size_t i = 0; i < m; ++i) out[c][i] = kr->rowm[i * (size_t)n + (size_t)c];
+    ++kr->mv[kind];
+    return kind;
 }
 
 static void precondition(const cm_rbf *r, krylov *kr, int n, double *const *in,
@@ -357,7 +419,7 @@ static double norm_inf(size_t m, const double *v)
 /* Solves components [c0, c0 + g) of f (nc x m SoA) into w. it/stop/floor per component. */
 static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
                              double fmax_all, double tol, double *w, double *aw, int *iters,
-                             int *matvecs, double *floor_rel, int *status, int threads)
+                             double *floor_rel, int *status, int threads)
 {
     const size_t m = kr->m;
     const int g = kr->g, R = kr->R;
@@ -396,9 +458,14 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                 lin[u] = kr->wlo + (size_t)list[u] * m;
                 lout[u] = kr->awlo + (size_t)u * m;
             }
-            matvec(r, kr, n, in, out, threads);
-            matvec(r, kr, n, lin, lout, threads);
-            *matvecs += 2;
+            /* A w exactly (this is the check); A wlo, eps |w| small, by plain sums */
+            if (kr->tree) {
+                matvec(r, kr, n, in, out, threads);
+                matvec(r, kr, n, lin, lout, threads);
+            } else {
+                matvec_kind(r, kr, MV_COMP, 0, n, in, out, threads);
+                matvec_kind(r, kr, MV_PLAIN, 0, n, lin, lout, threads);
+            }
             for (int u = 0; u < n; ++u)
                 for (size_t i = 0; i < m; ++i) out[u][i] += lout[u][i];
         }
@@ -424,8 +491,9 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                 afl[u] = kr->z[c] + m;
                 for (size_t i = 0; i < m; ++i) absw[u][i] = fabs(w[(size_t)c * m + i]);
             }
-            matvec(r, kr, nfl, absw, afl, threads);
-            ++*matvecs;
+            /* positive weights: plain sums are exact to ~1e-14 of the result */
+            if (kr->tree) matvec(r, kr, nfl, absw, afl, threads);
+            else matvec_kind(r, kr, MV_PLAIN, 0, nfl, absw, afl, threads);
             for (int u = 0; u < nfl; ++u) {
                 int c = fl[u];
                 floor_rel[c] = DBL_EPSILON * norm_inf(m, afl[u]) / fnorm[c];
@@ -468,8 +536,33 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                 wo[u] = kr->v[c] + (size_t)(j + 1) * m;
             }
             precondition(r, kr, na, vi, zo, threads);
-            matvec(r, kr, na, zo, wo, threads);
-            ++*matvecs;
+            if (!kr->relax) matvec(r, kr, na, zo, wo, threads);
+            else {
+                /* the loosest kind whose error bound every component allows */
+                double tau = INFINITY, sz[4];
+                for (int u = 0; u < na; ++u) {
+                    int c = act[u];
+                    sz[u] = kr->diam3 * cblas_dasum((int)m, zo[u], 1);
+                    double rj = fabs(kr->gv[c][j]);
+                    kr->gv0[c][j] = rj;
+                    double allow = CM_RBF_RELAX_SHARE * tol * fnorm[c] / (rj > 0.0 ? rj : 1.0);
+                    tau = fmin(tau, sz[u] > 0.0 ? allow / sz[u] : INFINITY);
+                }
+                int kind = MV_COMP, lev = 0;
+                if (kr->relax_tree && tau >= relax_tree_tol[0]) kind = MV_FAST, lev = 0;
+                else if (kr->relax_tree && tau >= relax_tree_tol[1]) kind = MV_FAST, lev = 1;
+                else if (tau >= CM_RBF_PLAIN_ERR) kind = MV_PLAIN;
+                kind = matvec_kind(r, kr, kind, lev, na, zo, wo, threads);
+                cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: cycle %d, step %d: %s product (error "
+                       "allowed %.3g x diam^3 sum |z|)", cycle, j + 1,
+                       kind == MV_COMP ? "compensated" : kind == MV_PLAIN ? "plain" : "treecode",
+                       tau);
+                const double rel = kind == MV_FAST ? relax_tree_tol[lev]
+                                   : kind == MV_PLAIN ? CM_RBF_PLAIN_ERR : 0.0;
+                for (int u = 0; u < na; ++u)
+                    kr->eb[act[u]][j] = kind == MV_COMP ? DBL_EPSILON * norm_inf(m, wo[u])
+                                                        : rel * sz[u];
+            }
             int keep = 0;
             for (int u = 0; u < na; ++u) {
                 int c = act[u];
@@ -520,6 +613,15 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
              * (the preconditioned directions cancel), and the rounding of a plain daxpy
              * then left the true residual of a cycle 10-100x above GMRES's estimate, which
              * cost a whole restart cycle (bracket 59k: 7 of 21 iterations) */
+            if (kr->relax) { /* the bound on what the inexact products moved the residual */
+                double gap = 0.0, pred = 0.0;
+                for (int i = 0; i < jn[c]; ++i) gap += fabs(y[i]) * kr->eb[c][i];
+                for (int i = 0; i < jn[c]; ++i) pred += fabs(kr->gv0[c][i]) * kr->eb[c][i];
+                cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: component %d: predicted gap %.3g",
+                       c, pred / fnorm[c]);
+                cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: component %d, cycle %d: gap bound of "
+                       "the relaxed products %.3g (target %.3g)", c, cycle, gap / fnorm[c], tol);
+            }
             double *wh = w + (size_t)c * m, *wl = kr->wlo + (size_t)c * m;
             for (int i = 0; i < jn[c]; ++i) {
                 const double yi = y[i], *zi = kr->z[c] + (size_t)i * m;
@@ -550,7 +652,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
  * residual the caller sees is the exact one. steps: exact residuals formed; first: the
  * residual after the first solve. */
 static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
-                              double fmax_all, double *w, double *aw, int *iters, int *matvecs,
+                              double fmax_all, double *w, double *aw, int *iters,
                               double *floor_rel, int *status, int *steps, double *first,
                               int threads)
 {
@@ -577,8 +679,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
         double tol = o->fast_refine > 0 ? fmax(o->tolerance, CM_RBF_REFINE_GAIN * rn / fmax_all)
                                         : o->tolerance;
         int it[4], stt[4];
-        solve_group(ctx, r, kr, rhs, fmax_all, tol, dw, adw, it, matvecs, floor_rel, stt,
-                    threads);
+        solve_group(ctx, r, kr, rhs, fmax_all, tol, dw, adw, it, floor_rel, stt, threads);
         for (size_t i = 0; i < gm; ++i) { /* w += dw in double-double (TwoSum) */
             double t = w[i] + dw[i], bv = t - w[i];
             wl[i] += (w[i] - (t - bv)) + (dw[i] - bv);
@@ -597,7 +698,8 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
         if (cm_rbf_tree_sum_self(kr->tree, wl, g, rowm, (size_t)g, threads) == 0)
             for (int c = 0; c < g; ++c)
                 for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] += rowm[i * (size_t)g + (size_t)c];
-        *matvecs += 2;
+        ++kr->mv[MV_COMP];
+        ++kr->mv[MV_FAST];
         ++*steps;
         int running = 0;
         for (int c = 0; c < g; ++c) {
@@ -667,7 +769,24 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             goto done;
         }
     }
-    int maxit = 0, mv = 0, floor_hit = 0, stagnated = 0, maxed = 0, steps = 0;
+    int mvk[3] = {0, 0, 0};
+    kr.mv = mvk;
+    /* relaxed products in the direct-matvec solve (the fast one refines on its own) */
+    kr.relax = o->relax && !fast;
+    kr.relax_tree = o->fast_sum != 0 && (m >= CM_RBF_RELAX_TREE_M || o->relax == 2);
+    {
+        double d2 = 0.0;
+        for (int d = 0; d < 3; ++d) {
+            double lo = INFINITY, hi = -INFINITY;
+            for (size_t i = 0; i < m; ++i) {
+                lo = fmin(lo, r->c[(size_t)d * m + i]);
+                hi = fmax(hi, r->c[(size_t)d * m + i]);
+            }
+            d2 += (hi - lo) * (hi - lo);
+        }
+        kr.diam3 = d2 * sqrt(d2);
+    }
+    int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, steps = 0;
     double floor_max = 0.0, first = 0.0;
     for (size_t c0 = 0; c0 < nc; c0 += 4) {
         kr.g = nc - c0 < 4 ? (int)(nc - c0) : 4;
@@ -675,10 +794,10 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         double fl[4];
         if (fast)
             st = refine_group(ctx, r, &kr, f + c0 * m, fmax_all, w + c0 * m, aw + c0 * m, iters,
-                              &mv, fl, status, &steps, &first, threads);
+                              fl, status, &steps, &first, threads);
         else
             st = solve_group(ctx, r, &kr, f + c0 * m, fmax_all, o->tolerance, w + c0 * m,
-                             aw + c0 * m, iters, &mv, fl, status, threads);
+                             aw + c0 * m, iters, fl, status, threads);
         if (st != CM_OK) goto done;
         for (int c = 0; c < kr.g; ++c) {
             if (iters[c] > maxit) maxit = iters[c];
@@ -720,7 +839,10 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         floor_max = fmax(floor_max, fmax_all > 0.0 ? DBL_EPSILON * norm_inf((size_t)g * m, kr.rowm) / fmax_all : 0.0);
     }
     r->stats.iterations = maxit;
-    r->stats.matvecs = mv;
+    r->stats.matvecs = mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST];
+    r->stats.matvecs_compensated = mvk[MV_COMP];
+    r->stats.matvecs_plain = mvk[MV_PLAIN];
+    r->stats.matvecs_fast = mvk[MV_FAST];
     r->stats.residual = worst;
     r->stats.floor = floor_max;
     /* with fast sums the stop at the floor is seen on the exact residuals, after the loop */
@@ -732,7 +854,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     r->stats.fast_bound = fast ? o->fast_tol * floor_max / DBL_EPSILON : 0.0;
     r->stats.memory_bytes = cm_rbf_schwarz_bytes(r->iter->pc) + m * k * sizeof(double) +
                             (size_t)gmax * (size_t)(2 * R + 6) * m * sizeof(double) +
-                            (fast ? cm_rbf_tree_bytes(kr.tree) + (size_t)gmax * 6 * m * sizeof(double) : 0);
+                            (fast ? cm_rbf_tree_bytes(kr.tree) + (size_t)gmax * 6 * m * sizeof(double) : 0) +
+                            cm_rbf_tree_bytes(r->iter->rtree[0]) + cm_rbf_tree_bytes(r->iter->rtree[1]);
     if (worst > o->tolerance && !r->stats.floor_limited)
         st = cm_error(ctx, CM_WARNING,
                       "cm_rbf_solve: the iterative solver %s after %d iterations at a relative "

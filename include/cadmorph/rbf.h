@@ -114,6 +114,14 @@ typedef struct cm_rbf_options {
     double fast_eval_tol; /* [1e-9] evaluation takes the fast sum only if its estimated error
                            * is at most fast_eval_tol x max |data| (else direct compensated
                            * sums) */
+    int relax;            /* [1] relaxed-accuracy Krylov products (direct-matvec solves):
+                           * compensated sums while the residual is large, then plain sums and,
+                           * from 5e4 centres unless fast_sum = 0, loose treecode sums, as the
+                           * GMRES residual falls (an error of about tolerance / residual in a
+                           * product is harmless: inexact Krylov); the residual is still
+                           * checked exactly at the end, and a restart follows if it fails.
+                           * 0: every Krylov product compensated; 2: as 1 with the treecode at
+                           * any m (for tests) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
@@ -157,6 +165,9 @@ typedef struct cm_rbf_stats {
     int eval_fast;         /* last cm_rbf_evaluate: 1 if it used the fast sum */
     double eval_error;     /* last cm_rbf_evaluate that tried the fast sum: its estimated
                             * max error / max |data| (sampled against exact sums, x4) */
+    int matvecs_compensated; /* last iterative solve: matvecs split by kind (they add up to */
+    int matvecs_plain;       /* matvecs): compensated direct sums (~1.45x a plain one), plain */
+    int matvecs_fast;        /* direct sums, treecode sums (a loose one: ~0.1-0.3x) */
 } cm_rbf_stats;
 
 CM_API void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats);
