@@ -55,14 +55,21 @@
  * too large): plain sums err by at most CM_RBF_PLAIN_ERR x S (measured 1.2e-14..1.4e-14 x S
  * with 3 weight vectors on the bracket and the two bodies, RESULTS.md "Fast summation"),
  * the treecode at tol by tol x S (its bound, margin 3-30), compensated ones by eps |A z|.
- * Every product's bound enters a gap bound sum |y_j| err_j, logged after each cycle; the
- * exact residual at the cycle's end decides as before. */
-#define CM_RBF_RELAX_SHARE 0.02
+ * Each step may take half of what is left of a budget of CM_RBF_RELAX_BUDGET x target for
+ * sum_j |y_j| err_j (so the sum stays within it; |y_j| of the coming step guessed as |r_{j-1}|
+ * times the largest |y_i| / |r_{i-1}| so far), the inner loop stopping at 0.5 x target. Every product's bound enters a gap bound sum |y_j| err_j, logged after each
+ * cycle; the exact residual at the cycle's end decides as before. */
+#define CM_RBF_RELAX_BUDGET 0.5
+/* the safe bound diam^3 sum |z| was 3.2-3.8 x S(z) on the bore (22.6k) */
+#define CM_RBF_S_SLACK 5.0
 #define CM_RBF_PLAIN_ERR 1e-13
 /* loose treecode products from this many centres (below, one plain direct product costs
- * about what the treecode at 1e-9 does: 59k, 0.52 vs ~0.9 CPU s, 22.6k 0.2 vs 0.08) */
+ * about what the treecode at 1e-9 does: 59k, 0.52 vs ~0.9 CPU s, 22.6k 0.2 vs 0.08), and at
+ * 1e-11 from the second count (119k: 1.9 vs ~3.6 CPU s; 59k: 0.82 vs ~0.9) */
 #define CM_RBF_RELAX_TREE_M 50000
-static const double relax_tree_tol[2] = {1e-6, 1e-9};
+#define CM_RBF_RELAX_TREE11_M 80000
+#define CM_RBF_RELAX_LEVELS 3
+static const double relax_tree_tol[CM_RBF_RELAX_LEVELS] = {1e-6, 1e-9, 1e-11};
 
 enum { MV_COMP = 0, MV_PLAIN = 1, MV_FAST = 2 };
 
@@ -76,7 +83,7 @@ struct cm_rbf_iter {
     int eval_fast;     /* the last evaluation's choice and estimate (evaluation gets a
                         * const cm_rbf, the iterative state is where it can leave them) */
     double eval_error;
-    cm_rbf_tree *rtree[2]; /* loose treecodes for relaxed products (relax_tree_tol) */
+    cm_rbf_tree *rtree[3]; /* loose treecodes for relaxed products (relax_tree_tol) */
 };
 
 void cm_rbf_options_init(cm_rbf_options *opt)
@@ -179,6 +186,7 @@ void cm_rbf_iterative_destroy(cm_rbf_iter **it)
     cm_rbf_tree_destroy(&(*it)->tree);
     cm_rbf_tree_destroy(&(*it)->rtree[0]);
     cm_rbf_tree_destroy(&(*it)->rtree[1]);
+    cm_rbf_tree_destroy(&(*it)->rtree[2]);
     free((*it)->q1);
     free(*it);
     *it = NULL;
@@ -346,10 +354,10 @@ typedef struct krylov {
     double *awlo;   /* g x m: A wlo */
     const cm_rbf_tree *tree; /* fast matvecs (treecode) if set, else compensated direct */
     int relax;      /* relaxed products (direct-matvec solves only) */
-    int relax_tree; /* the loose treecodes may serve them */
+    int relax_tree; /* the loose treecodes 0..relax_tree-1 may serve them */
     double diam3;   /* diam^3 of the centres: S(z) <= diam3 sum |z| */
     double eb[4][64]; /* bound on the error of each product of the cycle (max-norm) */
-    double gv0[4][64];
+    double gv0[4][64]; /* |GMRES residual| before each step */
     int *mv;        /* products by kind (MV_COMP, MV_PLAIN, MV_FAST) */
 } krylov;
 
@@ -416,6 +424,30 @@ static double norm_inf(size_t m, const double *v)
     return s;
 }
 
+/* The cheapest product kind whose error bound, relative to S(z), is within tau. */
+static int relax_pick(const krylov *kr, double tau, int *lev)
+{
+    *lev = 0;
+    for (int l = 0; l < kr->relax_tree; ++l)
+        if (tau >= relax_tree_tol[l]) {
+            *lev = l;
+            return MV_FAST;
+        }
+    return tau >= CM_RBF_PLAIN_ERR ? MV_PLAIN : MV_COMP;
+}
+
+/* y = R^-1 g of component c over its first n steps (R, g: H and the right-hand side after
+ * the rotations): the coefficients of the current FGMRES solution. */
+static void ls_solve(const krylov *kr, int c, int n, double *y)
+{
+    const size_t ld = (size_t)(kr->R + 1);
+    for (int i = n - 1; i >= 0; --i) {
+        double s = kr->gv[c][i];
+        for (int l = i + 1; l < n; ++l) s -= kr->h[c][(size_t)l * ld + (size_t)i] * y[l];
+        y[i] = s / kr->h[c][(size_t)i * ld + (size_t)i];
+    }
+}
+
 /* Solves components [c0, c0 + g) of f (nc x m SoA) into w. it/stop/floor per component. */
 static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
                              double fmax_all, double tol, double *w, double *aw, int *iters,
@@ -458,13 +490,14 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                 lin[u] = kr->wlo + (size_t)list[u] * m;
                 lout[u] = kr->awlo + (size_t)u * m;
             }
-            /* A w exactly (this is the check); A wlo, eps |w| small, by plain sums */
+            /* A w exactly (this is the check); A wlo, eps |w| small, by plain sums or the
+             * loosest treecode (its error, 1e-6 S(wlo), is 1e-22 S(w)) */
             if (kr->tree) {
                 matvec(r, kr, n, in, out, threads);
                 matvec(r, kr, n, lin, lout, threads);
             } else {
                 matvec_kind(r, kr, MV_COMP, 0, n, in, out, threads);
-                matvec_kind(r, kr, MV_PLAIN, 0, n, lin, lout, threads);
+                matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, n, lin, lout, threads);
             }
             for (int u = 0; u < n; ++u)
                 for (size_t i = 0; i < m; ++i) out[u][i] += lout[u][i];
@@ -491,9 +524,11 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                 afl[u] = kr->z[c] + m;
                 for (size_t i = 0; i < m; ++i) absw[u][i] = fabs(w[(size_t)c * m + i]);
             }
-            /* positive weights: plain sums are exact to ~1e-14 of the result */
+            /* positive weights: plain sums are exact to ~1e-14 of the result, the loosest
+             * treecode to 1e-6, enough for an estimate */
             if (kr->tree) matvec(r, kr, nfl, absw, afl, threads);
-            else matvec_kind(r, kr, MV_PLAIN, 0, nfl, absw, afl, threads);
+            else matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, nfl, absw, afl,
+                             threads);
             for (int u = 0; u < nfl; ++u) {
                 int c = fl[u];
                 floor_rel[c] = DBL_EPSILON * norm_inf(m, afl[u]) / fnorm[c];
@@ -539,19 +574,45 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
             if (!kr->relax) matvec(r, kr, na, zo, wo, threads);
             else {
                 /* the loosest kind whose error bound every component allows */
-                double tau = INFINITY, sz[4];
+                double tau = INFINITY, sz[4], allow[4];
                 for (int u = 0; u < na; ++u) {
                     int c = act[u];
                     sz[u] = kr->diam3 * cblas_dasum((int)m, zo[u], 1);
-                    double rj = fabs(kr->gv[c][j]);
+                    /* what the products so far cost of the budget, with the coefficients
+                     * y of the current solution, and how far |y_i| exceeded |r_{i-1}| (the
+                     * guess for the coming y_j): 1 when the preconditioned operator is well
+                     * conditioned, 1e2 and more on the bracket's y component at 103k */
+                    double rj = fabs(kr->gv[c][j]), used = 0.0, grow = 1.0, y[64];
                     kr->gv0[c][j] = rj;
-                    double allow = CM_RBF_RELAX_SHARE * tol * fnorm[c] / (rj > 0.0 ? rj : 1.0);
-                    tau = fmin(tau, sz[u] > 0.0 ? allow / sz[u] : INFINITY);
+                    ls_solve(kr, c, j, y);
+                    for (int i = 0; i < j; ++i) {
+                        used += fabs(y[i]) * kr->eb[c][i];
+                        if (kr->gv0[c][i] > 0.0) grow = fmax(grow, fabs(y[i]) / kr->gv0[c][i]);
+                    }
+                    double left = fmax(0.0, CM_RBF_RELAX_BUDGET * tol * fnorm[c] - used);
+                    allow[u] = 0.5 * left / (grow * (rj > 0.0 ? rj : 1.0));
+                    tau = fmin(tau, sz[u] > 0.0 ? allow[u] / sz[u] : INFINITY);
                 }
-                int kind = MV_COMP, lev = 0;
-                if (kr->relax_tree && tau >= relax_tree_tol[0]) kind = MV_FAST, lev = 0;
-                else if (kr->relax_tree && tau >= relax_tree_tol[1]) kind = MV_FAST, lev = 1;
-                else if (tau >= CM_RBF_PLAIN_ERR) kind = MV_PLAIN;
+                int lev, kind = relax_pick(kr, tau, &lev), lev2;
+                if (kr->relax_tree && !(kind == MV_FAST && lev == 0) &&
+                    relax_pick(kr, tau * CM_RBF_S_SLACK, &lev2) != kind) {
+                    /* the safe bound on S is a few times too large and a cheaper kind is
+                     * within that: S itself, by the loosest treecode (positive weights, so
+                     * exact to 1e-6 of the result), cheaper than the products it saves */
+                    double *ab[4], *ao[4];
+                    for (int u = 0; u < na; ++u) {
+                        ab[u] = kr->aux + (size_t)u * m;
+                        ao[u] = kr->awlo + (size_t)u * m;
+                        for (size_t i = 0; i < m; ++i) ab[u][i] = fabs(zo[u][i]);
+                    }
+                    matvec_kind(r, kr, MV_FAST, 0, na, ab, ao, threads);
+                    tau = INFINITY;
+                    for (int u = 0; u < na; ++u) {
+                        sz[u] = fmin(sz[u], 1.01 * norm_inf(m, ao[u]));
+                        tau = fmin(tau, sz[u] > 0.0 ? allow[u] / sz[u] : INFINITY);
+                    }
+                    kind = relax_pick(kr, tau, &lev);
+                }
                 kind = matvec_kind(r, kr, kind, lev, na, zo, wo, threads);
                 cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: cycle %d, step %d: %s product (error "
                        "allowed %.3g x diam^3 sum |z|)", cycle, j + 1,
@@ -604,11 +665,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
         for (int c = 0; c < g; ++c) {
             if (jn[c] == 0) continue;
             double y[64];
-            for (int i = jn[c] - 1; i >= 0; --i) {
-                double s = kr->gv[c][i];
-                for (int l = i + 1; l < jn[c]; ++l) s -= kr->h[c][(size_t)l * (size_t)(R + 1) + (size_t)i] * y[l];
-                y[i] = s / kr->h[c][(size_t)i * (size_t)(R + 1) + (size_t)i];
-            }
+            ls_solve(kr, c, jn[c], y);
             /* w += Z y in double-double: the terms y_i z_i are much larger than their sum
              * (the preconditioned directions cancel), and the rounding of a plain daxpy
              * then left the true residual of a cycle 10-100x above GMRES's estimate, which
@@ -773,7 +830,9 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     kr.mv = mvk;
     /* relaxed products in the direct-matvec solve (the fast one refines on its own) */
     kr.relax = o->relax && !fast;
-    kr.relax_tree = o->fast_sum != 0 && (m >= CM_RBF_RELAX_TREE_M || o->relax == 2);
+    kr.relax_tree = o->fast_sum == 0 || !kr.relax ? 0
+                    : m >= CM_RBF_RELAX_TREE11_M || o->relax == 2 ? 3
+                    : m >= CM_RBF_RELAX_TREE_M ? 2 : 0;
     {
         double d2 = 0.0;
         for (int d = 0; d < 3; ++d) {
@@ -855,7 +914,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     r->stats.memory_bytes = cm_rbf_schwarz_bytes(r->iter->pc) + m * k * sizeof(double) +
                             (size_t)gmax * (size_t)(2 * R + 6) * m * sizeof(double) +
                             (fast ? cm_rbf_tree_bytes(kr.tree) + (size_t)gmax * 6 * m * sizeof(double) : 0) +
-                            cm_rbf_tree_bytes(r->iter->rtree[0]) + cm_rbf_tree_bytes(r->iter->rtree[1]);
+                            cm_rbf_tree_bytes(r->iter->rtree[0]) + cm_rbf_tree_bytes(r->iter->rtree[1]) +
+                            cm_rbf_tree_bytes(r->iter->rtree[2]);
     if (worst > o->tolerance && !r->stats.floor_limited)
         st = cm_error(ctx, CM_WARNING,
                       "cm_rbf_solve: the iterative solver %s after %d iterations at a relative "
