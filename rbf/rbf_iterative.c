@@ -12,7 +12,10 @@
  * restricted Schwarz preconditioner is not symmetric (and is stored in float), so CG's
  * short recurrence does not hold; GMRES needs one matvec per iteration like CG, and the
  * iteration counts here are small, so the extra orthogonalisation is cheap. The components
- * of the data run in lock step, so one kernel-sum pass serves up to four of them. */
+ * of the data run in lock step, so one kernel-sum pass serves up to four of them (and a
+ * converged one leaves the pass). The Krylov products are relaxed (opt.relax, see
+ * CM_RBF_RELAX_BUDGET): compensated while the residual is large, plain or loose treecode
+ * sums as it falls; the exact residual at the end of a cycle decides. */
 #include "rbf_internal.h"
 #include "rbf_treecode.h"
 
@@ -890,12 +893,17 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
      * gives at the centres): eps max_i sum_j |w_j| phi_ij, for all components at once */
     for (size_t c0 = 0; c0 < nc; c0 += 4) {
         int g = nc - c0 < 4 ? (int)(nc - c0) : 4;
-        for (size_t i = 0; i < (size_t)g * m; ++i) kr.soa[i] = fabs(w[c0 * m + i]);
-        /* an estimate: the treecode's error on positive weights is fast_tol of the sum */
-        if (!kr.tree || cm_rbf_tree_sum_self(kr.tree, kr.soa, g, kr.rowm, (size_t)g, threads))
-            cm_rbf_kernel_sum(r->kernel, 3, m, r->c, kr.soa, g, m, r->c, m, kr.rowm, (size_t)g,
-                              threads);
-        floor_max = fmax(floor_max, fmax_all > 0.0 ? DBL_EPSILON * norm_inf((size_t)g * m, kr.rowm) / fmax_all : 0.0);
+        /* an estimate: the treecode's error on positive weights is fast_tol (or, the loosest
+         * relaxed one, 1e-6) of the sum; counted with the products */
+        double *ab[4], *ao[4];
+        for (int u = 0; u < g; ++u) {
+            ab[u] = kr.aux + (size_t)u * m;
+            ao[u] = kr.awlo + (size_t)u * m;
+            for (size_t i = 0; i < m; ++i) ab[u][i] = fabs(w[(c0 + (size_t)u) * m + i]);
+        }
+        if (kr.tree) matvec(r, &kr, g, ab, ao, threads);
+        else matvec_kind(r, &kr, kr.relax_tree ? MV_FAST : MV_PLAIN, 0, g, ab, ao, threads);
+        floor_max = fmax(floor_max, fmax_all > 0.0 ? DBL_EPSILON * norm_inf((size_t)g * m, kr.awlo) / fmax_all : 0.0);
     }
     r->stats.iterations = maxit;
     r->stats.matvecs = mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST];

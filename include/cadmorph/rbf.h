@@ -137,11 +137,13 @@ typedef struct cm_rbf_stats {
     size_t memory_bytes;   /* factor or preconditioner + Krylov storage of the last solve */
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
-    int matvecs;           /* last solve: direct-summation products with the m x m matrix
-                            * (one per iteration and restart, all components together;
-                            * PETSC: the components one after the other, each counted;
-                            * fast_sum: the treecode's products plus two exact ones per
-                            * refinement step) */
+    int matvecs;           /* last solve: kernel-sum passes over the m x m matrix of every
+                            * kind (one per iteration, two at a restart plus one for the
+                            * floor estimate, all running components together; PETSC: the
+                            * components one after the other, each counted; fast_sum: the
+                            * treecode's products plus two exact ones per refinement step;
+                            * relax: also the S(z) estimates); the split by kind and so the
+                            * cost is in matvecs_compensated/plain/fast below */
     double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| over all components
                             * (exactness at the centres, by direct summation after the solve;
                             * iterative: with compensated sums) */
