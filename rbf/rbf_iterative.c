@@ -361,6 +361,9 @@ typedef struct krylov {
     double diam3;   /* diam^3 of the centres: S(z) <= diam3 sum |z| */
     double eb[4][64]; /* bound on the error of each product of the cycle (max-norm) */
     double gv0[4][64]; /* |GMRES residual| before each step */
+    double grow[4];   /* largest |y_i| / |r_{i-1}| of the solve so far, per component */
+    int exact[4];     /* 1: the component's products stay compensated (a cycle's gap bound
+                       * exceeded the budget: its Krylov space needs huge coefficients) */
     int *mv;        /* products by kind (MV_COMP, MV_PLAIN, MV_FAST) */
 } krylov;
 
@@ -473,6 +476,8 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
         memset(w + (size_t)c * m, 0, m * sizeof(double));
         memset(ax[c], 0, m * sizeof(double));
         memset(kr->wlo + (size_t)c * m, 0, m * sizeof(double));
+        kr->grow[c] = 1.0;
+        kr->exact[c] = 0;
     }
     for (int cycle = 0;; ++cycle) {
         /* true residual Pi(f - A w) of every running component */
@@ -585,15 +590,17 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                      * y of the current solution, and how far |y_i| exceeded |r_{i-1}| (the
                      * guess for the coming y_j): 1 when the preconditioned operator is well
                      * conditioned, 1e2 and more on the bracket's y component at 103k */
-                    double rj = fabs(kr->gv[c][j]), used = 0.0, grow = 1.0, y[64];
+                    double rj = fabs(kr->gv[c][j]), used = 0.0, y[64];
                     kr->gv0[c][j] = rj;
                     ls_solve(kr, c, j, y);
                     for (int i = 0; i < j; ++i) {
                         used += fabs(y[i]) * kr->eb[c][i];
-                        if (kr->gv0[c][i] > 0.0) grow = fmax(grow, fabs(y[i]) / kr->gv0[c][i]);
+                        if (kr->gv0[c][i] > 0.0)
+                            kr->grow[c] = fmax(kr->grow[c], fabs(y[i]) / kr->gv0[c][i]);
                     }
                     double left = fmax(0.0, CM_RBF_RELAX_BUDGET * tol * fnorm[c] - used);
-                    allow[u] = 0.5 * left / (grow * (rj > 0.0 ? rj : 1.0));
+                    if (kr->exact[c]) left = 0.0;
+                    allow[u] = 0.5 * left / (kr->grow[c] * (rj > 0.0 ? rj : 1.0));
                     tau = fmin(tau, sz[u] > 0.0 ? allow[u] / sz[u] : INFINITY);
                 }
                 int lev, kind = relax_pick(kr, tau, &lev), lev2;
@@ -675,7 +682,14 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
              * cost a whole restart cycle (bracket 59k: 7 of 21 iterations) */
             if (kr->relax) { /* the bound on what the inexact products moved the residual */
                 double gap = 0.0, pred = 0.0;
-                for (int i = 0; i < jn[c]; ++i) gap += fabs(y[i]) * kr->eb[c][i];
+                for (int i = 0; i < jn[c]; ++i) {
+                    gap += fabs(y[i]) * kr->eb[c][i];
+                    if (kr->gv0[c][i] > 0.0)
+                        kr->grow[c] = fmax(kr->grow[c], fabs(y[i]) / kr->gv0[c][i]);
+                }
+                /* past the budget (bracket 103k, y component: the compensated products'
+                 * own rounding, eps |A z_j| x huge y_j, already was): no more relaxing */
+                if (gap > CM_RBF_RELAX_BUDGET * tol * fnorm[c]) kr->exact[c] = 1;
                 for (int i = 0; i < jn[c]; ++i) pred += fabs(kr->gv0[c][i]) * kr->eb[c][i];
                 cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: component %d: predicted gap %.3g",
                        c, pred / fnorm[c]);
