@@ -4,7 +4,7 @@
  * usage: bench_rbf_iterative PREFIX [--dense] [--no-iterative] [--threads N] [--leaf N]
  *        [--local N] [--coarse N] [--float | --local-float 0|1|2] [--tol T] [--maxit N]
  *        [--restart N] [--eval N] [--verbose] [--fast 0|1|-1] [--fast-tol T]
- *        [--fast-refine N] [--fast-eval-tol T] [--no-centres]
+ *        [--fast-refine N] [--fast-eval-tol T] [--no-centres] [--relax 0|1]
  * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
 #include "cadmorph/rbf.h"
 
@@ -125,6 +125,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--fast-tol")) o.fast_tol = atof(b), ++i;
         else if (!strcmp(a, "--fast-refine")) o.fast_refine = atoi(b), ++i;
         else if (!strcmp(a, "--fast-eval-tol")) o.fast_eval_tol = atof(b), ++i;
+        else if (!strcmp(a, "--relax")) o.relax = atoi(b), ++i;
         else {
             fprintf(stderr, "unknown option %s\n", a);
             return 1;
@@ -168,6 +169,8 @@ int main(int argc, char **argv)
         printf(" fast_sum=%d fast_tol=%g refinements=%d fast_residual=%.3g fast_bound=%.3g "
                "eval_fast=%d eval_error=%.3g", it.st.fast_sum, o.fast_tol, it.st.refinements,
                it.st.fast_residual, it.st.fast_bound, it.eval_fast, it.eval_error);
+        printf(" relax=%d mv_comp=%d mv_plain=%d mv_fast=%d", o.relax, it.st.matvecs_compensated,
+               it.st.matvecs_plain, it.st.matvecs_fast);
     }
     if (dense) {
         o.solver = CM_RBF_SOLVER_DENSE;

@@ -114,6 +114,14 @@ typedef struct cm_rbf_options {
     double fast_eval_tol; /* [1e-9] evaluation takes the fast sum only if its estimated error
                            * is at most fast_eval_tol x max |data| (else direct compensated
                            * sums) */
+    int relax;            /* [1] relaxed-accuracy Krylov products (direct-matvec solves):
+                           * compensated sums while the residual is large, then plain sums and,
+                           * from 5e4 centres unless fast_sum = 0, loose treecode sums, as the
+                           * GMRES residual falls (an error of about tolerance / residual in a
+                           * product is harmless: inexact Krylov); the residual is still
+                           * checked exactly at the end, and a restart follows if it fails.
+                           * 0: every Krylov product compensated; 2: as 1 with the treecode at
+                           * any m (for tests) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
@@ -129,11 +137,13 @@ typedef struct cm_rbf_stats {
     size_t memory_bytes;   /* factor or preconditioner + Krylov storage of the last solve */
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
-    int matvecs;           /* last solve: direct-summation products with the m x m matrix
-                            * (one per iteration and restart, all components together;
-                            * PETSC: the components one after the other, each counted;
-                            * fast_sum: the treecode's products plus two exact ones per
-                            * refinement step) */
+    int matvecs;           /* last solve: kernel-sum passes over the m x m matrix of every
+                            * kind (one per iteration, two at a restart plus one for the
+                            * floor estimate, all running components together; PETSC: the
+                            * components one after the other, each counted; fast_sum: the
+                            * treecode's products plus two exact ones per refinement step;
+                            * relax: also the S(z) estimates); the split by kind and so the
+                            * cost is in matvecs_compensated/plain/fast below */
     double residual;       /* last solve: max_i |f_i - s(c_i)| / max |f| over all components
                             * (exactness at the centres, by direct summation after the solve;
                             * iterative: with compensated sums) */
@@ -157,6 +167,9 @@ typedef struct cm_rbf_stats {
     int eval_fast;         /* last cm_rbf_evaluate: 1 if it used the fast sum */
     double eval_error;     /* last cm_rbf_evaluate that tried the fast sum: its estimated
                             * max error / max |data| (sampled against exact sums, x4) */
+    int matvecs_compensated; /* last iterative solve: matvecs split by kind (they add up to */
+    int matvecs_plain;       /* matvecs): compensated direct sums (~1.45x a plain one), plain */
+    int matvecs_fast;        /* direct sums, treecode sums (a loose one: ~0.1-0.3x) */
 } cm_rbf_stats;
 
 CM_API void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats);

@@ -101,6 +101,47 @@ static void test_against_dense(cm_context *ctx)
     CHECK_MSG(sti.iterations >= 1 && sti.iterations <= 25, "%d iterations", sti.iterations);
     CHECK(sti.subdomains > 10 && sti.memory_bytes > 0 && sti.matvecs >= sti.iterations);
 
+    /* relaxed products (the default, relax = 1: plain sums as the residual falls; 2: the
+     * loose treecode too, which the default uses from 5e4 centres) against none: the same
+     * interpolant, the exact residual within the tolerance, fewer compensated products */
+    {
+        cm_rbf_stats sr[2];
+        double *sx = malloc(np * 3 * sizeof *sx);
+        cm_status sts[2];
+        for (int v = 0; v < 2; ++v) {
+            cm_rbf_options o;
+            cm_rbf_options_init(&o);
+            o.solver = CM_RBF_SOLVER_ITERATIVE;
+            o.relax = v == 0 ? 0 : 2;
+            sts[v] = fit_eval_opt(ctx, &o, m, x, d, np, p, v == 0 ? s1 : sx, &sr[v]);
+        }
+        double d0 = max_diff(np * 3, s1, sd) / range, d2 = max_diff(np * 3, sx, sd) / range;
+        printf("relax 0: %d iterations, %d compensated + %d plain + %d fast products, residual "
+               "%.3g, |. - dense| %.3g; relax 1: %d + %d + %d; relax 2: %d iterations, "
+               "%d + %d + %d, residual %.3g, |. - dense| %.3g\n", sr[0].iterations,
+               sr[0].matvecs_compensated, sr[0].matvecs_plain, sr[0].matvecs_fast,
+               sr[0].residual, d0, sti.matvecs_compensated, sti.matvecs_plain, sti.matvecs_fast,
+               sr[1].iterations, sr[1].matvecs_compensated, sr[1].matvecs_plain,
+               sr[1].matvecs_fast, sr[1].residual, d2);
+        CHECK(sts[0] == CM_OK && sts[1] == CM_OK);
+        CHECK_MSG(d0 <= tol && d2 <= tol, "%.3g %.3g > %.3g", d0, d2, tol);
+        CHECK_MSG(sr[1].residual <= 1e-10 && sti.residual <= 1e-10, "%.3g %.3g",
+                  sr[1].residual, sti.residual);
+        for (int v = 0; v < 2; ++v)
+            CHECK(sr[v].matvecs == sr[v].matvecs_compensated + sr[v].matvecs_plain +
+                                   sr[v].matvecs_fast);
+        CHECK(sti.matvecs == sti.matvecs_compensated + sti.matvecs_plain + sti.matvecs_fast);
+        /* without relaxation only the cycle ends' low-part and floor sums are plain */
+        CHECK(sr[0].matvecs_fast == 0 && sr[0].matvecs_compensated >= sr[0].iterations);
+        CHECK_MSG(sti.matvecs_compensated < sr[0].matvecs_compensated && sti.matvecs_fast == 0,
+                  "relax 1: %d compensated, relax 0: %d", sti.matvecs_compensated,
+                  sr[0].matvecs_compensated);
+        CHECK_MSG(sr[1].matvecs_fast >= 1 &&
+                  sr[1].matvecs_compensated < sr[0].matvecs_compensated, "relax 2: %d fast",
+                  sr[1].matvecs_fast);
+        free(sx);
+    }
+
     /* one thread: same result within the tolerance */
     cm_context_set_threads(ctx, 1);
     cm_status c = fit_eval(ctx, CM_RBF_SOLVER_ITERATIVE, m, x, d, np, p, s1, &st1);
@@ -301,6 +342,9 @@ static void test_choice(cm_context *ctx)
     CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
     o.coarse_post = 0;
     o.overlap = -1.0;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    o.overlap = 3.0;
+    o.relax = 3;
     CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
     /* the cost model: dense at 5k, iterative at 20k (measured: 1.6x faster at 10k) */
     CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 5000) == 1);
