@@ -114,6 +114,30 @@ cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *g
     return CM_OK;
 }
 
+/* OpenMP threads that call one-thread BLAS side by side (cholesky_lookahead.c): besides
+ * OpenBLAS's own workers, each such thread gets its own 128 MB buffer on its first call,
+ * and keeps it (libgomp's threads live on). Granted once, a count stays granted. */
+static int callers_held; /* threads besides the calling one known to hold a buffer */
+
+int cm_rbf_blas_callers(int want)
+{
+    if (want <= 1) return want < 1 ? 1 : want;
+    struct rlimit rl;
+    if (getrlimit(RLIMIT_AS, &rl) != 0 || rl.rlim_cur == RLIM_INFINITY) return want;
+    pthread_mutex_lock(&lock);
+    int t = want;
+    while (t > 1 + callers_held) {
+        size_t need = (size_t)(t - 1 - callers_held) *
+                          (CM_BLAS_BUFFER_BYTES + CM_BLAS_ARENA_BYTES + stack_bytes()) +
+                      CM_BLAS_MARGIN_BYTES;
+        if (fits(need)) break;
+        --t;
+    }
+    if (t - 1 > callers_held) callers_held = t - 1;
+    pthread_mutex_unlock(&lock);
+    return t;
+}
+
 cm_status cm_blas_reserve(cm_context *ctx, const char *who)
 {
     return cm_rbf_blas_threads(ctx, who ? who : "cm_blas_reserve", openblas_get_num_threads(),

@@ -17,6 +17,7 @@
 
 #include <cblas.h>
 #include <lapacke.h>
+#include <omp.h>
 
 #define CM_CHOLESKY_BLOCK 256
 
@@ -32,7 +33,7 @@ static void report(progress *p, double flops)
     cm_progress(p->ctx, "rbf factor", p->done, p->total);
 }
 
-int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
+int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
 {
     if (n < 0 || !a) return -1;
     if (n == 0) return 0;
@@ -103,4 +104,20 @@ int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
     }
     cm_progress(ctx, "rbf factor", pr.total, pr.total);
     return 0;
+}
+
+/* Which of the two runs: on T > 1 BLAS threads and n from CM_LOOKAHEAD_MIN_N, the look-ahead
+ * factorisation (cholesky_lookahead.c), which keeps the T cores busy while a panel is
+ * factored instead of leaving all but one idle; on one thread, for small n, and inside a
+ * parallel region (local factorisations side by side, where the team would be one thread
+ * and OpenBLAS's count is the caller's business) the panel-by-panel path. */
+int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
+{
+    int threads = openblas_get_num_threads();
+    /* under ulimit -v, as many callers as have room for their buffers (blas_threads.c) */
+    if (threads > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N && !omp_in_parallel())
+        threads = cm_rbf_blas_callers(threads);
+    else threads = 1;
+    if (threads > 1) return cm_rbf_cholesky_rfp_lookahead(ctx, n, a, block, threads);
+    return cm_rbf_cholesky_rfp_panels(ctx, n, a, block);
 }

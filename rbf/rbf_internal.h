@@ -97,14 +97,34 @@ long cm_rbf_merge_duplicates(int dim, size_t m_in, const double *c, double tol, 
  * UPLO 'L', as dpftrf), in place, panel by panel of `block` columns (0: the default), with
  * cm_progress(ctx, "rbf factor", done, total) after every panel (done in flops, monotonic).
  * Returns dpftrf's info: 0, or i > 0 if the leading minor of order i is not positive definite.
- * BLAS threads: as the caller set them (cm_rbf_blas_threads). */
+ * BLAS threads: as the caller set them (cm_rbf_blas_threads); on T > 1 of them and n in
+ * [CM_LOOKAHEAD_MIN_N, CM_LOOKAHEAD_MAX_N] outside a parallel region, the look-ahead path
+ * below on T OpenMP threads, else the panel-by-panel one (both: the same factor to rounding,
+ * the same info and progress). */
 int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
+/* The two paths, for benchmarks and tests. panels (cholesky_blocked.c): one panel after the
+ * other, each BLAS call on the caller's BLAS threads. lookahead (cholesky_lookahead.c):
+ * `threads` OpenMP threads each calling one-thread BLAS (OpenBLAS's count is set to 1 during
+ * the call and restored), the next panel factored while the others update; block 0: its
+ * own default. */
+int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block);
+int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, int threads);
+/* cm_rbf_cholesky_rfp's range for the look-ahead path (benchmarks/RESULTS.md, "The dense
+ * factorisation on 2 threads at small m"): its schedule, replayed from per-task CPU times,
+ * beats the threaded panels from 5k to 20k; below 4k a factorisation takes < 0.15 s, and on
+ * a loaded machine, where each of its barriers can wait a time slice for a preempted
+ * thread, it lost to them (3k: 1.28 x their time, 2k: 1.9 x). */
+#define CM_LOOKAHEAD_MIN_N 4000
+#define CM_LOOKAHEAD_MAX_N 60000
 
 /* Sets OpenBLAS's thread count for the calls that follow to `want`, or fewer if the
  * address-space limit cannot back their 128 MB buffers (blas.h, point 2); got (may be NULL)
  * receives the count. CM_ERR_NOMEM, with a message starting with who, if not even the
  * calling thread's buffer fits: OpenBLAS would spin forever trying to allocate it. */
 cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *got);
+/* How many of `want` threads can call one-thread BLAS at the same time (each needs its own
+ * OpenBLAS buffer) under the address-space limit: want if there is none, at least 1. */
+int cm_rbf_blas_callers(int want);
 /* ---- iterative solver (rbf_iterative.c, rbf_schwarz.c) ---- */
 
 /* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */

@@ -12,6 +12,10 @@ set_tests_properties(rbf_scipy_check PROPERTIES LABELS "unit;rbf" FIXTURES_REQUI
 # the panel-by-panel RFP Cholesky against dpftrf (round-off), pivots, progress
 cm_add_unit_test(test_cholesky_blocked ${CMAKE_CURRENT_LIST_DIR}/test_cholesky_blocked.c
   LIBS cm_rbf cm_lapack LABELS rbf)
+# the look-ahead RFP Cholesky on 1-3 threads against dpftrf (round-off, A - LL'), pivots,
+# progress, the path cm_rbf_cholesky_rfp takes
+cm_add_unit_test(test_cholesky_lookahead ${CMAKE_CURRENT_LIST_DIR}/test_cholesky_lookahead.c
+  LIBS cm_rbf cm_lapack LABELS rbf)
 # the BLAS-core decision table (cpuid flags and core names in, decision out), cm_blas_info
 cm_add_unit_test(test_blas_core ${CMAKE_CURRENT_LIST_DIR}/test_blas_core.c
   LIBS cm_rbf LABELS rbf)
