@@ -42,7 +42,8 @@ typedef struct cm_rbf cm_rbf;
  *   sum_j |w_j| phi_ij), wrapped in 1..fast_refine refinement steps on exact (compensated
  *   direct) residuals, so the residual reported is still the exact one; evaluation of
  *   large n x m uses the treecode where a sampled check shows its error within
- *   fast_eval_tol x max |data|, direct sums otherwise (stats: eval_fast, eval_error).
+ *   fast_eval_tol x max |data| (or within the direct sums' own rounding, if that is
+ *   larger), direct sums otherwise (stats: eval_fast, eval_error).
  * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
  *   crossover near 7,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
  *   iterative above; dense for the other kernels.
@@ -112,7 +113,8 @@ typedef struct cm_rbf_options {
                            * residuals around the fast-matvec Krylov solve; 0: none (the final
                            * residual is then the treecode's, cheaper but not exact) */
     double fast_eval_tol; /* [1e-9] evaluation takes the fast sum only if its estimated error
-                           * is at most fast_eval_tol x max |data| (else direct compensated
+                           * is at most fast_eval_tol x max |data|, or at most the rounding
+                           * that direct sums have too (eval_error; else direct compensated
                            * sums) */
     int relax;            /* [1] relaxed-accuracy Krylov products (direct-matvec solves):
                            * compensated sums while the residual is large, then plain sums and,
@@ -166,7 +168,11 @@ typedef struct cm_rbf_stats {
                             * weights relative to the data */
     int eval_fast;         /* last cm_rbf_evaluate: 1 if it used the fast sum */
     double eval_error;     /* last cm_rbf_evaluate that tried the fast sum: its estimated
-                            * max error / max |data| (sampled against exact sums, x4) */
+                            * max error / max |data| (sampled against compensated direct
+                            * sums, x4). The fast sum is taken if this is within
+                            * fast_eval_tol or within the direct sums' own rounding (about
+                            * 4 eps sum_j |w_j| phi_ij / max |data|: weights that cancel
+                            * 1e8-fold leave 1e-8 there, for any summation in doubles) */
     int matvecs_compensated; /* last iterative solve: matvecs split by kind (they add up to */
     int matvecs_plain;       /* matvecs): compensated direct sums (~1.45x a plain one), plain */
     int matvecs_fast;        /* direct sums, treecode sums (a loose one: ~0.1-0.3x) */

@@ -371,13 +371,17 @@ static void test_evaluation(cm_context *ctx)
         CHECK_MSG(diff <= 1e-9 + 3e-10, "%.3g", diff); /* + the two solves' difference */
         if (sb.eval_fast) CHECK_MSG(sb.eval_error <= 1e-9, "%.3g", sb.eval_error);
         if (set == 0) CHECK_MSG(sb.eval_fast == 1, "smooth set: fast refused (%.3g)", sb.eval_error);
-        if (set == 1) { /* a tolerance no fast sum can meet: refused, the direct result */
+        if (set == 1) {
+            /* a tolerance below what any sum in doubles reaches: the fast sum is taken only
+             * within the direct sums' own rounding (about 4 eps sum |w| phi, 1e-12 of max
+             * |d| here with the weights' 2e4-fold cancellation), else refused */
             o.fast_eval_tol = 1e-17;
             cm_status s2 = fit_eval(ctx, &o, m, x, d, n, p, b, &sb);
             double d2 = max_diff(n * 3, a, b) / dmax;
             printf("fast_eval_tol 1e-17: fast %s (estimate %.3g), |result - direct| = %.3g\n",
                    sb.eval_fast ? "accepted" : "refused", sb.eval_error, d2);
-            CHECK(s2 == CM_OK && sb.eval_fast == 0 && sb.eval_error > 1e-17);
+            CHECK(s2 == CM_OK && sb.eval_error > 1e-17);
+            CHECK_MSG(sb.eval_fast == 0 || sb.eval_error <= 1e-11, "%.3g", sb.eval_error);
             CHECK_MSG(d2 <= 3e-10, "%.3g", d2);
         }
         free(x), free(d), free(p), free(a), free(b);
