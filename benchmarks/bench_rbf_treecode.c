@@ -3,7 +3,13 @@
  * the bound controls) and to the result (what cancellation costs), CPU time of one fast and
  * one direct product.
  * usage: bench_rbf_treecode PREFIX WEIGHTS [--threads N] [--orders n:theta,n:theta,...]
- *        [--tol T,T,...]
+ *        [--tol T,T,...] [--isa avx512,autovec,avx2,generic] [--points FILE [--comp 0,1,2]]
+ * --isa: the products' code, each in turn on the same tree (side by side in one run; autovec
+ * is the compiled loop the treecode had before the hand-written block); default the
+ * library's choice. --points: with the weights cache, evaluate at FILE (n x 3 raw float64 in
+ * the coordinates of PREFIX.centres, e.g. PREFIX.interior) and check 2,048 of them against
+ * compensated sums, the error relative to max |PREFIX.values| (what fast_eval_tol bounds);
+ * --comp: the rounding levels of cm_rbf_tree_set_compensated, each in turn.
  * PREFIX.centres / .values as for bench_rbf_iterative; WEIGHTS: a cache of the solved
  * weights (written by the first run, read afterwards). One key=value line per setting. */
 #include "cadmorph/rbf.h"
@@ -15,6 +21,34 @@
 #include <stdlib.h>
 #include <string.h>
 #include "bench_util.h"
+
+static const struct { const char *name; cm_rbf_isa isa; } isa_names[] = {
+    {"auto", CM_RBF_ISA_AUTO}, {"avx512", CM_RBF_ISA_AVX512},
+    {"autovec", CM_RBF_ISA_AVX512_AUTOVEC}, {"avx2", CM_RBF_ISA_AVX2},
+    {"generic", CM_RBF_ISA_GENERIC}};
+
+/* "a,b,c" -> up to 8 ISAs; 0 on an unknown or unsupported name */
+static int parse_isas(const char *list, cm_rbf_isa *isa, const char **name)
+{
+    char buf[256];
+    int k = 0;
+    snprintf(buf, sizeof buf, "%s", list ? list : "auto");
+    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok && k < 8;
+         tok = strtok_r(NULL, ",", &save)) {
+        int found = 0;
+        for (size_t i = 0; i < sizeof isa_names / sizeof isa_names[0]; ++i)
+            if (!strcmp(tok, isa_names[i].name) && cm_rbf_isa_supported(isa_names[i].isa)) {
+                isa[k] = isa_names[i].isa;
+                name[k++] = isa_names[i].name;
+                found = 1;
+            }
+        if (!found) {
+            fprintf(stderr, "isa %s unknown or not supported here\n", tok);
+            return 0;
+        }
+    }
+    return k;
+}
 
 
 
@@ -36,10 +70,15 @@ static void compare(size_t m, const double *fast, const double *ex, const double
 }
 
 /* WEIGHTS "-": random weights on the centres of PREFIX, for sets too large to solve or to
- * sum directly in full: the direct products are timed on 2,000 of the targets and scaled
+ * sum directly in full: the direct products are timed on 20,000 of the targets and scaled
  * to m, the error is the sampled check (512 targets against compensated sums). */
-static int random_only(const char *prefix, const char *orders, const char *tols, int threads)
+static int random_only(const char *prefix, const char *orders, const char *tols, int threads,
+                       const char *isas)
 {
+    cm_rbf_isa isa[8];
+    const char *iname[8];
+    const int nisa = parse_isas(isas, isa, iname);
+    if (!nisa) return 1;
     char path[4096];
     size_t bytes = 0;
     snprintf(path, sizeof path, "%s.centres", prefix);
@@ -60,7 +99,7 @@ static int random_only(const char *prefix, const char *orders, const char *tols,
         s = s * 6364136223846793005ULL + 1442695040888963407ULL;
         w[i] = (double)(s >> 11) / 9007199254740992.0 * 2.0 - 1.0;
     }
-    const size_t ns = 2000;
+    const size_t ns = m < 20000 ? m : 20000;
     double *sp = malloc(3 * ns * sizeof *sp), *so = malloc(3 * ns * sizeof *so);
     for (size_t k = 0; k < ns; ++k)
         for (int d = 0; d < 3; ++d) sp[(size_t)d * ns + k] = c[(size_t)d * m + k * (m / ns)];
@@ -86,20 +125,146 @@ static int random_only(const char *prefix, const char *orders, const char *tols,
         cm_rbf_tree *t = cm_rbf_tree_create(m, c, n, th);
         double build = bench_cpu_seconds() - c0;
         if (!t) return 1;
-        c0 = bench_cpu_seconds();
-        double w0 = cm_wtime();
-        cm_rbf_tree_sum_self(t, w, 3, out, 3, threads);
-        double fast = bench_cpu_seconds() - c0, fast_wall = cm_wtime() - w0;
-        double e, sabs;
-        cm_rbf_tree_check(t, w, 3, m, c, m, out, 3, 512, &e, &sabs, threads);
-        printf("tol=%.0e order=%d theta=%.2f build_cpu_s=%.2f fast_cpu_s=%.2f fast_wall_s=%.2f "
-               "speedup=%.1f speedup_vs_compensated=%.1f sampled_err_Smax=%.3g tree_mb=%.1f\n",
-               tol, n, th, build, fast, fast_wall, direct / fast, acc / fast, e / sabs,
-               (double)cm_rbf_tree_bytes(t) / 1e6);
-        fflush(stdout);
+        for (int k = 0; k < nisa; ++k) {
+            cm_rbf_tree_set_isa(t, isa[k]);
+            c0 = bench_cpu_seconds();
+            double w0 = cm_wtime();
+            cm_rbf_tree_sum_self(t, w, 3, out, 3, threads);
+            double fast = bench_cpu_seconds() - c0, fast_wall = cm_wtime() - w0;
+            double e, sabs;
+            cm_rbf_tree_check(t, w, 3, m, c, m, out, 3, 512, &e, &sabs, threads);
+            printf("tol=%.0e order=%d theta=%.2f isa=%s build_cpu_s=%.2f fast_cpu_s=%.2f "
+                   "fast_wall_s=%.2f speedup=%.1f speedup_vs_compensated=%.1f "
+                   "sampled_err_Smax=%.3g tree_mb=%.1f\n",
+                   tol, n, th, iname[k], build, fast, fast_wall, direct / fast, acc / fast,
+                   e / sabs, (double)cm_rbf_tree_bytes(t) / 1e6);
+            fflush(stdout);
+        }
         cm_rbf_tree_destroy(&t);
     }
     free(x), free(c), free(w), free(out), free(sp), free(so);
+    return 0;
+}
+
+/* --points: the real weights evaluated at the points of a file, as the iterative solver's
+ * evaluation does (cm_rbf_tree_sum, then a sampled check), per setting and ISA: CPU s, the
+ * sampled error relative to max |data| and to the sampled sum |w| phi, against the CPU s of
+ * compensated direct sums (timed on 20,000 of the points, scaled). */
+static int at_points(const char *prefix, const char *file, size_t m, const double *c,
+                     const double *w, const char *orders, const char *tols, int threads,
+                     const char *isas, const char *comps)
+{
+    int comp[3], ncomp = 0;
+    char cb[64];
+    snprintf(cb, sizeof cb, "%s", comps ? comps : "0");
+    for (char *save = NULL, *tok = strtok_r(cb, ",", &save); tok && ncomp < 3;
+         tok = strtok_r(NULL, ",", &save))
+        comp[ncomp++] = atoi(tok);
+    cm_rbf_isa isa[8];
+    const char *iname[8];
+    const int nisa = parse_isas(isas, isa, iname);
+    if (!nisa) return 1;
+    char path[4096];
+    size_t bytes = 0;
+    snprintf(path, sizeof path, "%s.centres", prefix);
+    double *x = bench_read_raw(path, &bytes);
+    const size_t mx = bytes / 24;
+    snprintf(path, sizeof path, "%s.values", prefix);
+    double *v = bench_read_raw(path, &bytes);
+    double *pr = bench_read_raw(file, &bytes);
+    const size_t n = bytes / 24;
+    if (!x || !v || !pr || n == 0) {
+        fprintf(stderr, "cannot read %s.centres / .values or %s\n", prefix, file);
+        return 1;
+    }
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double ext = 0.0, dmax = 0.0;
+    for (size_t i = 0; i < mx; ++i)
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = fmin(lo[d], x[3 * i + d]);
+            hi[d] = fmax(hi[d], x[3 * i + d]);
+            dmax = fmax(dmax, fabs(v[3 * i + d]));
+        }
+    for (int d = 0; d < 3; ++d) ext = fmax(ext, hi[d] - lo[d]);
+    double *p = malloc(3 * n * sizeof *p), *out = malloc(3 * n * sizeof *out);
+    for (size_t i = 0; i < n; ++i)
+        for (int d = 0; d < 3; ++d) p[(size_t)d * n + i] = (pr[3 * i + d] - lo[d]) / ext;
+    const size_t ns = n < 20000 ? n : 20000;
+    double *sp = malloc(3 * ns * sizeof *sp), *so = malloc(3 * ns * sizeof *so);
+    for (size_t k = 0; k < ns; ++k)
+        for (int d = 0; d < 3; ++d) sp[(size_t)d * ns + k] = p[(size_t)d * n + k * (n / ns)];
+    double c0 = bench_cpu_seconds();
+    cm_rbf_kernel_sum_acc(m, c, w, 3, ns, sp, ns, so, 3, threads);
+    const double acc = (bench_cpu_seconds() - c0) * (double)n / (double)ns;
+    c0 = bench_cpu_seconds();
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, w, 3, ns, sp, ns, so, 3, threads);
+    const double direct = (bench_cpu_seconds() - c0) * (double)n / (double)ns;
+    /* a third reference at the check's samples: every entry in long double (64-bit
+     * mantissa), summed by TwoSum in long double, to see how far the compensated double sums (whose entries phi_ij
+     * are rounded doubles) are from the exact sum of these weights */
+    const size_t nsr = 2048 < n ? 2048 : n;
+    long double *ld = malloc(3 * nsr * sizeof *ld);
+    double *sx = malloc(3 * nsr * sizeof *sx), *sa = malloc(3 * nsr * sizeof *sa);
+    for (size_t k = 0; k < nsr; ++k) {
+        const size_t i = (size_t)((double)k * (double)n / (double)nsr);
+        long double a[3] = {0, 0, 0}, ae[3] = {0, 0, 0};
+        for (size_t j = 0; j < m; ++j) {
+            long double dx = (long double)p[i] - c[j], dy = (long double)p[n + i] - c[m + j];
+            long double dz = (long double)p[2 * n + i] - c[2 * m + j];
+            long double r2 = dx * dx + dy * dy + dz * dz, f = r2 * sqrtl(r2);
+            for (int q = 0; q < 3; ++q) { /* TwoSum in long double: the sum's rounding out too */
+                long double t = f * w[(size_t)q * m + j], s1 = a[q] + t, bv = s1 - a[q];
+                ae[q] += (a[q] - (s1 - bv)) + (t - bv);
+                a[q] = s1;
+            }
+        }
+        for (int q = 0; q < 3; ++q) ld[3 * k + (size_t)q] = a[q] + ae[q];
+        for (int d = 0; d < 3; ++d) sx[(size_t)d * nsr + k] = p[(size_t)d * n + i];
+    }
+    cm_rbf_kernel_sum_acc(m, c, w, 3, nsr, sx, nsr, sa, 3, threads);
+    double acc_ld = 0.0;
+    for (size_t k = 0; k < 3 * nsr; ++k) acc_ld = fmax(acc_ld, fabs((double)(sa[k] - ld[k])));
+    printf("reference check at %zu points: max |compensated - long double| / max|data| = %.3g\n",
+           nsr, acc_ld / dmax);
+    printf("set=%s m=%zu points=%s n=%zu threads=%d max_data=%.6g: direct_cpu_s=%.1f "
+           "compensated_cpu_s=%.1f (scaled from %zu points)\n", prefix, m, file, n, threads,
+           dmax, direct, acc, ns);
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", tols ? tols : orders);
+    for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        int order;
+        double th, tol = 0.0;
+        if (tols) {
+            tol = atof(tok);
+            cm_rbf_tree_params(tol, &order, &th);
+        } else if (sscanf(tok, "%d:%lf", &order, &th) != 2) continue;
+        cm_rbf_tree *t = cm_rbf_tree_create(m, c, order, th);
+        if (!t) return 1;
+        for (int k = 0; k < nisa * ncomp; ++k) {
+            cm_rbf_tree_set_isa(t, isa[k / ncomp]);
+            cm_rbf_tree_set_compensated(t, comp[k % ncomp]);
+            c0 = bench_cpu_seconds();
+            if (cm_rbf_tree_sum(t, w, 3, n, p, n, out, 3, threads)) return 1;
+            const double fast = bench_cpu_seconds() - c0;
+            double e, sabs;
+            cm_rbf_tree_check(t, w, 3, n, p, n, out, 3, 2048, &e, &sabs, threads);
+            double eld = 0.0;
+            for (size_t kk = 0; kk < nsr; ++kk) {
+                const size_t i = (size_t)((double)kk * (double)n / (double)nsr);
+                for (int q = 0; q < 3; ++q)
+                    eld = fmax(eld, fabs((double)(out[3 * i + (size_t)q] - ld[3 * kk + (size_t)q])));
+            }
+            printf("order=%d theta=%.2f isa=%s comp=%d fast_cpu_s=%.2f x_plain=%.2f "
+                   "x_compensated=%.2f sampled_err_data=%.3g sampled_err_Smax=%.3g "
+                   "Smax_data=%.3g err_vs_long_double_data=%.3g\n", order, th, iname[k / ncomp],
+                   comp[k % ncomp], fast, direct / fast, acc / fast, e / dmax, e / sabs,
+                   sabs / dmax, eld / dmax);
+            fflush(stdout);
+        }
+        cm_rbf_tree_destroy(&t);
+    }
+    free(x), free(v), free(pr), free(p), free(out), free(sp), free(so), free(ld), free(sx);
+    free(sa);
     return 0;
 }
 
@@ -112,19 +277,22 @@ int main(int argc, char **argv)
     const char *prefix = argv[1], *wpath = argv[2];
     int threads = 2;
     const char *orders = "4:0.5,6:0.5,8:0.5,10:0.5,12:0.5,8:0.4,10:0.4,12:0.4,14:0.4";
-    const char *tols = NULL;
+    const char *tols = NULL, *isas = NULL, *points = NULL, *comps = NULL;
     for (int i = 3; i < argc; ++i) {
         const char *a = argv[i], *b = i + 1 < argc ? argv[i + 1] : "";
         if (!strcmp(a, "--threads")) threads = atoi(b), ++i;
         else if (!strcmp(a, "--orders")) orders = b, ++i;
         else if (!strcmp(a, "--tol")) tols = b, ++i;
+        else if (!strcmp(a, "--isa")) isas = b, ++i;
+        else if (!strcmp(a, "--points")) points = b, ++i;
+        else if (!strcmp(a, "--comp")) comps = b, ++i;
         else {
             fprintf(stderr, "unknown option %s\n", a);
             return 1;
         }
     }
     size_t bytes = 0, m = 0;
-    if (!strcmp(wpath, "-")) return random_only(prefix, orders, tols, threads);
+    if (!strcmp(wpath, "-")) return random_only(prefix, orders, tols, threads, isas);
     double *cw = bench_read_raw(wpath, &bytes); /* 3 x m unit-box centres, then 3 x m weights */
     if (cw) {
         m = bytes / (6 * sizeof(double));
@@ -163,6 +331,7 @@ int main(int argc, char **argv)
         free(x), free(v);
     }
     const double *c = cw, *wreal = cw + 3 * m;
+    if (points) return at_points(prefix, points, m, c, wreal, orders, tols, threads, isas, comps);
     double *wrand = malloc(3 * m * sizeof *wrand), *aw = malloc(3 * m * sizeof *aw);
     unsigned long long s = 12345;
     for (size_t i = 0; i < 3 * m; ++i) {

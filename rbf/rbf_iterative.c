@@ -28,13 +28,14 @@
 #define CM_RBF_FLOOR_SLACK 10.0
 
 /* fast_sum = -1 (auto): treecode matvecs from this many centres, evaluation from this many
- * point-centre pairs. With the old compensated sums the treecode fit overtook direct matvecs
- * near 3e4 centres; against the AVX-512 fixed-binade sums (twice as fast) whole fits gained
- * nothing at 59k and 103k (bracket, quiet machine: 41.3 vs 38.5 and 127.0 vs 125.4 CPU s,
- * the refinements' exact residuals eat the cheaper inner matvecs), while one product is 5x
- * faster at 479k (RESULTS.md, "Quiet-machine reruns" and "Fast summation"). 2e5 lies between
- * the measured points; the crossover itself was not measured. */
-#define CM_RBF_FAST_MIN_M 200000
+ * point-centre pairs. A fast fit costs about 22 treecode products + 4 exact (compensated)
+ * residuals where direct matvecs take 12 compensated products (bracket 59k; RESULTS.md
+ * "Fast summation"), so it pays once one compensated product costs more than 22 / (12 - 4)
+ * = 2.75 treecode products at fast_tol 1e-12. Measured with the treecode on the AVX-512
+ * block (RESULTS.md, issue 10, fourth session; bracket sets, one product, CPU s): 1.9 at
+ * 59k, 2.6 at 103k, 3.6 at 201k, 6.6 at 479k; 2.75 falls near 1.15e5. Below that the fits
+ * measured no gain (59k, 103k: within 2 %, set-up dominates either way). */
+#define CM_RBF_FAST_MIN_M 120000
 #define CM_RBF_FAST_EVAL_PAIRS 2e9
 /* an inner (fast-matvec) solve of a refinement step aims for this reduction of its own
  * right-hand side, or the final tolerance if that is nearer: the treecode's operator

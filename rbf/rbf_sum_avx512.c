@@ -1,5 +1,6 @@
 /* Hand-written AVX-512 blocks of the r^3 kernel sums (plain and compensated), chosen at run
- * time by rbf_sum.c and rbf_sum_acc.c on CPUs with AVX-512 F/DQ/VL; other CPUs keep the
+ * time by rbf_sum.c and rbf_sum_acc.c on CPUs with AVX-512 F/DQ/VL (and, through the strided
+ * entry points, by the treecode's products in rbf_treecode.c); other CPUs keep the
  * compiler-vectorised loops there. Why by hand: the compiler cannot balance the sqrt unit
  * against the FMA pipes (plain sums), and the compensated sums need a different algorithm
  * (the fixed binade below). Measured on Zen 5 (benchmarks/bench_kernel.c, RESULTS.md issue
@@ -58,50 +59,81 @@ CM_AVX512 CM_INLINE __m512d r3_of(int v, __m512d x, __m512d y, __m512d z, __m512
     return _mm512_mul_pd(r2, r);
 }
 
-/* Centres [0, jn) of a tile against NV * 8 points at pt (stride CM_RBF_SUM_PB). */
-CM_AVX512 CM_INLINE void tile_plain(const int nc, const double *c, size_t ldc, const double *w,
-                                    size_t ldw, size_t jn, const double *pt, double *acc)
+/* Centres [0, jn) of a tile (coordinate d at c + d * ldc, component q's weights at
+ * w + q * ldw) against nv * 8 points at pt (coordinate d at pt + d * ldp, sums at acc + q *
+ * ldp). nv = NV in the direct sums; the treecode's batches end with a tail of nv < NV
+ * vectors, all through vsqrtpd. nv, nc and (in the direct sums) the strides are constants
+ * after inlining. */
+CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nc, const double *c, size_t ldc,
+                                    const double *w, size_t ldw, size_t jn, const double *pt,
+                                    size_t ldp, double *acc)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     __m512d x[NV], y[NV], z[NV], a[4][NV];
-    for (int v = 0; v < NV; ++v) {
+    for (int v = 0; v < nv; ++v) {
         x[v] = _mm512_loadu_pd(pt + 8 * v);
-        y[v] = _mm512_loadu_pd(pt + CM_RBF_SUM_PB + 8 * v);
-        z[v] = _mm512_loadu_pd(pt + 2 * CM_RBF_SUM_PB + 8 * v);
-        for (int q = 0; q < nc; ++q) a[q][v] = _mm512_loadu_pd(acc + q * CM_RBF_SUM_PB + 8 * v);
+        y[v] = _mm512_loadu_pd(pt + ldp + 8 * v);
+        z[v] = _mm512_loadu_pd(pt + 2 * ldp + 8 * v);
+        for (int q = 0; q < nc; ++q) a[q][v] = _mm512_loadu_pd(acc + q * ldp + 8 * v);
     }
     for (size_t j = 0; j < jn; ++j) {
         const __m512d xj = _mm512_set1_pd(cx[j]), yj = _mm512_set1_pd(cy[j]);
         const __m512d zj = _mm512_set1_pd(cz[j]);
         __m512d wj[4];
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
-        for (int v = 0; v < NV; ++v) {
-            const __m512d f = r3_of(v, x[v], y[v], z[v], xj, yj, zj);
+        for (int v = 0; v < nv; ++v) {
+            const __m512d f = r3_of(nv == NV ? v : 0, x[v], y[v], z[v], xj, yj, zj);
             for (int q = 0; q < nc; ++q) a[q][v] = _mm512_fmadd_pd(wj[q], f, a[q][v]);
         }
     }
-    for (int v = 0; v < NV; ++v)
-        for (int q = 0; q < nc; ++q) _mm512_storeu_pd(acc + q * CM_RBF_SUM_PB + 8 * v, a[q][v]);
+    for (int v = 0; v < nv; ++v)
+        for (int q = 0; q < nc; ++q) _mm512_storeu_pd(acc + q * ldp + 8 * v, a[q][v]);
 }
 
-CM_AVX512 CM_INLINE void block_plain(const int nc, size_t m, const double *c, const double *w,
-                                     const double *pt, double *acc)
+/* All m centres, tile by tile, against npt points (rounded up to a multiple of 8: pt and
+ * acc must hold that many). One body for the direct sums (npt = ldp = CM_RBF_SUM_PB,
+ * ldc = ldw = m) and the treecode (any strides), so both run the same kernel. */
+CM_AVX512 CM_INLINE void block_plain(const int nc, size_t m, const double *c, size_t ldc,
+                                     const double *w, size_t ldw, size_t npt, const double *pt,
+                                     size_t ldp, double *acc)
 {
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         const size_t jn = m - t0 < TILE ? m - t0 : TILE;
-        for (int b = 0; b < CM_RBF_SUM_PB; b += 8 * NV)
-            tile_plain(nc, c + t0, m, w + t0, m, jn, pt + b, acc + b);
+        for (size_t b = 0; b < npt; b += 8 * NV) {
+            const size_t left = (npt - b + 7) / 8;
+            const double *cb = c + t0, *wb = w + t0, *pb = pt + b;
+            double *ab = acc + b;
+            switch (left >= NV ? NV : (int)left) {
+            case 1: tile_plain(1, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            case 2: tile_plain(2, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            case 3: tile_plain(3, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            default: tile_plain(NV, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            }
+        }
     }
 }
 
 CM_AVX512 void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
                                       const double *pt, double *acc)
 {
+    const size_t PB = CM_RBF_SUM_PB;
     switch (nc) {
-    case 1: block_plain(1, m, c, w, pt, acc); break;
-    case 2: block_plain(2, m, c, w, pt, acc); break;
-    case 3: block_plain(3, m, c, w, pt, acc); break;
-    default: block_plain(4, m, c, w, pt, acc); break;
+    case 1: block_plain(1, m, c, m, w, m, PB, pt, PB, acc); break;
+    case 2: block_plain(2, m, c, m, w, m, PB, pt, PB, acc); break;
+    case 3: block_plain(3, m, c, m, w, m, PB, pt, PB, acc); break;
+    default: block_plain(4, m, c, m, w, m, PB, pt, PB, acc); break;
+    }
+}
+
+CM_AVX512 void cm_rbf_r3_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
+                                        const double *w, size_t ldw, size_t npt,
+                                        const double *pt, size_t ldp, double *acc)
+{
+    switch (nc) {
+    case 1: block_plain(1, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 2: block_plain(2, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 3: block_plain(3, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    default: block_plain(4, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
     }
 }
 
@@ -118,19 +150,19 @@ CM_AVX512 void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const d
  * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the vector operation
  * count was the limit: TwoSum ran at 0.4x the plain sum's throughput). This is the binned
  * summation of the reproducible-BLAS literature (Demmel and Nguyen) with a single bin. */
-CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nc, const double *c, size_t ldc,
-                                  const double *w, size_t ldw, size_t jn, const double *pt,
-                                  double *hi, double *lo)
+CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nv, const int nc, const double *c,
+                                  size_t ldc, const double *w, size_t ldw, size_t jn,
+                                  const double *pt, size_t ldp, double *hi, double *lo)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     __m512d x[ACC_NV], y[ACC_NV], z[ACC_NV], s[4][ACC_NV], e[4][ACC_NV];
-    for (int v = 0; v < ACC_NV; ++v) {
+    for (int v = 0; v < nv; ++v) {
         x[v] = _mm512_loadu_pd(pt + 8 * v);
-        y[v] = _mm512_loadu_pd(pt + CM_RBF_ACC_PB + 8 * v);
-        z[v] = _mm512_loadu_pd(pt + 2 * CM_RBF_ACC_PB + 8 * v);
+        y[v] = _mm512_loadu_pd(pt + ldp + 8 * v);
+        z[v] = _mm512_loadu_pd(pt + 2 * ldp + 8 * v);
         for (int q = 0; q < nc; ++q) {
-            s[q][v] = _mm512_loadu_pd(hi + q * CM_RBF_ACC_PB + 8 * v);
-            e[q][v] = _mm512_loadu_pd(lo + q * CM_RBF_ACC_PB + 8 * v);
+            s[q][v] = _mm512_loadu_pd(hi + q * ldp + 8 * v);
+            e[q][v] = _mm512_loadu_pd(lo + q * ldp + 8 * v);
         }
     }
     for (size_t j = 0; j < jn; ++j) {
@@ -138,7 +170,7 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nc, const double *c
         const __m512d zj = _mm512_set1_pd(cz[j]);
         __m512d wj[4];
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
-        for (int v = 0; v < ACC_NV; ++v) {
+        for (int v = 0; v < nv; ++v) {
             const __m512d f = r3_of(fixed ? v : 0, x[v], y[v], z[v], xj, yj, zj);
             for (int q = 0; q < nc; ++q) {
                 if (fixed) {
@@ -159,44 +191,61 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nc, const double *c
             }
         }
     }
-    for (int v = 0; v < ACC_NV; ++v)
+    for (int v = 0; v < nv; ++v)
         for (int q = 0; q < nc; ++q) {
-            _mm512_storeu_pd(hi + q * CM_RBF_ACC_PB + 8 * v, s[q][v]);
-            _mm512_storeu_pd(lo + q * CM_RBF_ACC_PB + 8 * v, e[q][v]);
+            _mm512_storeu_pd(hi + q * ldp + 8 * v, s[q][v]);
+            _mm512_storeu_pd(lo + q * ldp + 8 * v, e[q][v]);
         }
 }
 
+/* as block_plain: one body for the direct sums (npt = ldp = CM_RBF_ACC_PB) and the
+ * treecode's compensated products (any strides; a tail of one vector) */
 CM_AVX512 CM_INLINE void block_acc(const int fixed, const int nc, size_t m, const double *c,
-                                   const double *w, const double *pt, double *hi, double *lo)
+                                   size_t ldc, const double *w, size_t ldw, size_t npt,
+                                   const double *pt, size_t ldp, double *hi, double *lo)
 {
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         const size_t jn = m - t0 < TILE ? m - t0 : TILE;
-        for (int b = 0; b < CM_RBF_ACC_PB; b += 8 * ACC_NV)
-            tile_acc(fixed, nc, c + t0, m, w + t0, m, jn, pt + b, hi + b, lo + b);
+        for (size_t b = 0; b < npt; b += 8 * ACC_NV) {
+            if (npt - b > 8 * (ACC_NV - 1))
+                tile_acc(fixed, ACC_NV, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp, hi + b,
+                         lo + b);
+            else
+                tile_acc(fixed, 1, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp, hi + b, lo + b);
+        }
     }
 }
 
 CM_AVX512 CM_INLINE void dispatch_acc(const int fixed, int nc, size_t m, const double *c,
-                                      const double *w, const double *pt, double *hi, double *lo)
+                                      size_t ldc, const double *w, size_t ldw, size_t npt,
+                                      const double *pt, size_t ldp, double *hi, double *lo)
 {
     switch (nc) {
-    case 1: block_acc(fixed, 1, m, c, w, pt, hi, lo); break;
-    case 2: block_acc(fixed, 2, m, c, w, pt, hi, lo); break;
-    case 3: block_acc(fixed, 3, m, c, w, pt, hi, lo); break;
-    default: block_acc(fixed, 4, m, c, w, pt, hi, lo); break;
+    case 1: block_acc(fixed, 1, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 2: block_acc(fixed, 2, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 3: block_acc(fixed, 3, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    default: block_acc(fixed, 4, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
     }
 }
 
 CM_AVX512 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
                                           const double *pt, double *hi, double *lo)
 {
-    dispatch_acc(0, nc, m, c, w, pt, hi, lo);
+    dispatch_acc(0, nc, m, c, m, w, m, CM_RBF_ACC_PB, pt, CM_RBF_ACC_PB, hi, lo);
+}
+
+CM_AVX512 void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
+                                            const double *w, size_t ldw, size_t npt,
+                                            const double *pt, size_t ldp, double *hi,
+                                            double *lo)
+{
+    dispatch_acc(0, nc, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo);
 }
 
 CM_AVX512 void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
                                            const double *pt, double *hi, double *lo)
 {
-    dispatch_acc(1, nc, m, c, w, pt, hi, lo);
+    dispatch_acc(1, nc, m, c, m, w, m, CM_RBF_ACC_PB, pt, CM_RBF_ACC_PB, hi, lo);
 }
 
 int cm_rbf_cpu_avx512(void)
@@ -220,6 +269,13 @@ void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
     (void)nc, (void)m, (void)c, (void)w, (void)pt, (void)acc;
 }
 
+void cm_rbf_r3_strided_avx512(int nc, size_t m, const double *c, size_t ldc, const double *w,
+                              size_t ldw, size_t npt, const double *pt, size_t ldp, double *acc)
+{
+    (void)nc, (void)m, (void)c, (void)ldc, (void)w, (void)ldw, (void)npt, (void)pt, (void)ldp;
+    (void)acc;
+}
+
 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
                                 const double *pt, double *hi, double *lo)
 {
@@ -230,6 +286,14 @@ void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double
                                  const double *pt, double *hi, double *lo)
 {
     (void)nc, (void)m, (void)c, (void)w, (void)pt, (void)hi, (void)lo;
+}
+
+void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
+                                  const double *w, size_t ldw, size_t npt, const double *pt,
+                                  size_t ldp, double *hi, double *lo)
+{
+    (void)nc, (void)m, (void)c, (void)ldc, (void)w, (void)ldw, (void)npt, (void)pt;
+    (void)ldp, (void)hi, (void)lo;
 }
 
 int cm_rbf_cpu_avx512(void) { return 0; }

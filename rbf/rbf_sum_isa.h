@@ -1,5 +1,6 @@
-/* The instruction-set variants of the kernel sums (rbf_sum.c, rbf_sum_acc.c) and the
- * hand-written AVX-512 r^3 blocks (rbf_sum_avx512.c) they dispatch to. Not a public header. */
+/* The instruction-set variants of the kernel sums (rbf_sum.c, rbf_sum_acc.c, and the
+ * treecode's products in rbf_treecode.c) and the hand-written AVX-512 r^3 blocks
+ * (rbf_sum_avx512.c) they dispatch to. Not a public header. */
 #ifndef CADMORPH_RBF_SUM_ISA_H
 #define CADMORPH_RBF_SUM_ISA_H
 
@@ -15,10 +16,26 @@
 void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
                             const double *pt, double *acc);
 
+/* The same block with strides, for the treecode (rbf_treecode.c: a batch of targets against
+ * proxies or centres): acc[q * ldp + l] += sum_j |pt_l - c_j|^3 w[q * ldw + j], q < nc,
+ * l < npt rounded up to a multiple of 8 (pt and acc must hold that many; pad with a copy
+ * of a real point), c_j = (c[j], c[ldc + j], c[2 ldc + j]), pt: 3 x ldp SoA. Same
+ * arithmetic (and results) as cm_rbf_r3_block_avx512, which is this with npt = ldp =
+ * CM_RBF_SUM_PB, ldc = ldw = m. */
+void cm_rbf_r3_strided_avx512(int nc, size_t m, const double *c, size_t ldc, const double *w,
+                              size_t ldw, size_t npt, const double *pt, size_t ldp, double *acc);
+
 /* The same with compensated accumulation: (hi, lo)[q * CM_RBF_ACC_PB + l] is a double-double
  * running sum, each product split exactly (FMA) and added by TwoSum. */
 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
                                 const double *pt, double *hi, double *lo);
+
+/* The compensated (TwoSum) block with strides, for the treecode's compensated products:
+ * (hi, lo)[q * ldp + l] as cm_rbf_r3_acc_block_avx512, targets and strides as
+ * cm_rbf_r3_strided_avx512 (npt rounded up to a multiple of 8). */
+void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
+                                  const double *w, size_t ldw, size_t npt, const double *pt,
+                                  size_t ldp, double *hi, double *lo);
 
 /* The same with a fixed-binade running sum (rbf_sum_avx512.c says why it is exact enough):
  * hi[q * CM_RBF_ACC_PB + l] must start at big_q = 1.5 * 2^k with 2^k >= 4 * (a bound of

@@ -11,7 +11,9 @@
  * half-diagonal r_c and the distance D between the centres of batch and cluster satisfy
  * r_c / (D - r_b) <= theta (r_b: the batch's half-diagonal), and otherwise opens it, down to
  * direct sums with the leaves' centres. Every product then is a plain r^3 kernel sum, over
- * proxies or centres, with the targets of the batch in registers.
+ * proxies or centres, with the targets of the batch in registers: on AVX-512 the direct
+ * sums' hand-written block (rbf_sum_avx512.c, 1.2-1.4x the compiled loop at fast_tol
+ * 1e-9..1e-12), elsewhere the compiled loops below.
  *
  * Why the upward pass is exact: a parent's proxy weights are computed from its children's
  * (W^P_K = sum_k L^P_K(y_k) W_k), and a child's interpolation reproduces every tensor
@@ -33,6 +35,7 @@
 #include "rbf_treecode.h"
 
 #include "rbf_internal.h"
+#include "rbf_sum_isa.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -74,6 +77,8 @@ struct cm_rbf_tree {
     double *pxyz;   /* 3 x (nprox P) SoA: proxy points */
     double cheb[CM_TREE_MAXN + 1], bw[CM_TREE_MAXN + 1];
     int *depth_start; /* proxies sorted by depth: [depth_start[d], depth_start[d + 1]) */
+    cm_rbf_isa isa;   /* code of the downward products (AUTO unless a test names one) */
+    int comp;         /* 0 plain; 1 compensated products; 2 also double-double proxy weights */
 };
 
 /* (n, theta) measured to keep max_i err_i / sum_j |w_j| phi_ij below tol, with a margin of
@@ -359,8 +364,93 @@ static void m2m(const cm_rbf_tree *t, const tnode *par, const tnode *ch, const d
     free(t1);
 }
 
-/* proxy weights of every cluster: nc x (nprox P) */
-static void upward(const cm_rbf_tree *t, const double *ws, int nc, double *W, int threads)
+/* ---- double-double proxy weights (cm_rbf_tree_set_compensated level 2) ----
+ * The plain upward pass rounds every accumulation: W_k errs by about eps sum_j |L_k(c_j)
+ * w_j|, i.e. eps x sum |w| over the cluster, where the weights cancel to a much smaller
+ * W_k. Here every accumulation is a TwoSum into (hi, lo); the products are rounded once
+ * (a relative eps per term, which does not accumulate). No contraction in these: TwoSum
+ * needs every rounding where it is written (this file is built with -ffp-contract=fast). */
+#define CM_DD __attribute__((optimize("fp-contract=off")))
+
+/* (*h, *l) += a * (bh + bl) */
+CM_DD static inline void dd_madd(double *h, double *l, double a, double bh, double bl)
+{
+    const double p = a * bh, pe = fma(a, bh, -p);
+    const double s = *h + p, bv = s - *h;
+    const double e = (*h - (s - bv)) + (p - bv);
+    *h = s;
+    *l += e + pe + a * bl;
+}
+
+CM_DD static void p2m_dd(const cm_rbf_tree *t, const tnode *u, const double *ws, int nc,
+                         size_t b, size_t e, double *W, double *Wl, size_t ldW)
+{
+    const int n1 = t->n + 1;
+    const size_t m = t->m;
+    double lx[CM_TREE_MAXN + 1], ly[CM_TREE_MAXN + 1], lz[CM_TREE_MAXN + 1];
+    double lyz[(CM_TREE_MAXN + 1) * (CM_TREE_MAXN + 1)];
+    for (size_t j = b; j < e; ++j) {
+        lagrange(t, (t->xs[j] - u->mid[0]) / u->half[0], lx);
+        lagrange(t, (t->xs[m + j] - u->mid[1]) / u->half[1], ly);
+        lagrange(t, (t->xs[2 * m + j] - u->mid[2]) / u->half[2], lz);
+        for (int bb = 0; bb < n1; ++bb)
+            for (int g = 0; g < n1; ++g) lyz[bb * n1 + g] = ly[bb] * lz[g];
+        for (int q = 0; q < nc; ++q) {
+            const double wq = ws[(size_t)q * m + j];
+            double *Wq = W + (size_t)q * ldW, *Lq = Wl + (size_t)q * ldW;
+            for (int a = 0; a < n1; ++a) {
+                const double f = wq * lx[a];
+                const size_t o = (size_t)a * (size_t)(n1 * n1);
+                for (int k = 0; k < n1 * n1; ++k) dd_madd(Wq + o + k, Lq + o + k, f, lyz[k], 0.0);
+            }
+        }
+    }
+}
+
+CM_DD static void m2m_dd(const cm_rbf_tree *t, const tnode *par, const tnode *ch,
+                         const double *Wc, const double *Wcl, int nc, double *W, double *Wl,
+                         size_t ldW)
+{
+    const int n1 = t->n + 1, P = t->P;
+    double L[3][(CM_TREE_MAXN + 1) * (CM_TREE_MAXN + 1)];
+    double l[CM_TREE_MAXN + 1];
+    for (int d = 0; d < 3; ++d)
+        for (int a = 0; a < n1; ++a) {
+            double x = ch->mid[d] + ch->half[d] * t->cheb[a];
+            lagrange(t, (x - par->mid[d]) / par->half[d], l);
+            for (int A = 0; A < n1; ++A) L[d][A * n1 + a] = l[A];
+        }
+    double *t1 = malloc(4 * (size_t)P * sizeof *t1);
+    if (!t1) return; /* never with P <= 3375 */
+    double *t1l = t1 + P, *t2 = t1l + P, *t2l = t2 + P;
+    for (int q = 0; q < nc; ++q) {
+        const double *w = Wc + (size_t)q * ldW, *wl = Wcl + (size_t)q * ldW;
+        memset(t1, 0, 4 * (size_t)P * sizeof *t1);
+        for (int A = 0; A < n1; ++A)
+            for (int a = 0; a < n1; ++a)
+                for (int k = 0; k < n1 * n1; ++k)
+                    dd_madd(t1 + A * n1 * n1 + k, t1l + A * n1 * n1 + k, L[0][A * n1 + a],
+                            w[a * n1 * n1 + k], wl[a * n1 * n1 + k]);
+        for (int A = 0; A < n1; ++A)
+            for (int B = 0; B < n1; ++B)
+                for (int b = 0; b < n1; ++b)
+                    for (int g = 0; g < n1; ++g) {
+                        const int src = (A * n1 + b) * n1 + g, dst = (A * n1 + B) * n1 + g;
+                        dd_madd(t2 + dst, t2l + dst, L[1][B * n1 + b], t1[src], t1l[src]);
+                    }
+        double *Wq = W + (size_t)q * ldW, *Lq = Wl + (size_t)q * ldW;
+        for (int AB = 0; AB < n1 * n1; ++AB)
+            for (int G = 0; G < n1; ++G)
+                for (int g = 0; g < n1; ++g)
+                    dd_madd(Wq + AB * n1 + G, Lq + AB * n1 + G, L[2][G * n1 + g],
+                            t2[AB * n1 + g], t2l[AB * n1 + g]);
+    }
+    free(t1);
+}
+
+/* proxy weights of every cluster: nc x (nprox P); with Wl (not NULL) in double-double */
+static void upward(const cm_rbf_tree *t, const double *ws, int nc, double *W, double *Wl,
+                   int threads)
 {
     const size_t P = (size_t)t->P, ldW = (size_t)t->nprox * P;
     for (int d = t->src.maxdepth; d >= 0; --d) {
@@ -368,16 +458,23 @@ static void upward(const cm_rbf_tree *t, const double *ws, int nc, double *W, in
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (e - b > 1 && threads > 1)
         for (long x = b; x < e; ++x) {
             const tnode *u = &t->src.node[t->prox_node[x]];
-            double *Wx = W + (size_t)x * P;
-            for (int q = 0; q < nc; ++q) memset(Wx + (size_t)q * ldW, 0, P * sizeof *Wx);
-            if (u->child[0] < 0) {
-                p2m(t, u, ws, nc, u->begin, u->end, Wx, ldW);
-                continue;
+            double *Wx = W + (size_t)x * P, *Lx = Wl ? Wl + (size_t)x * P : NULL;
+            for (int q = 0; q < nc; ++q) {
+                memset(Wx + (size_t)q * ldW, 0, P * sizeof *Wx);
+                if (Lx) memset(Lx + (size_t)q * ldW, 0, P * sizeof *Lx);
             }
             for (int s = 0; s < 2; ++s) {
-                const tnode *ch = &t->src.node[u->child[s]];
-                if (ch->proxy >= 0) m2m(t, u, ch, W + (size_t)ch->proxy * P, nc, Wx, ldW);
-                else p2m(t, u, ws, nc, ch->begin, ch->end, Wx, ldW);
+                const tnode *ch = u->child[0] < 0 ? u : &t->src.node[u->child[s]];
+                if (ch != u && ch->proxy >= 0) {
+                    const size_t o = (size_t)ch->proxy * P;
+                    if (Lx) m2m_dd(t, u, ch, W + o, Wl + o, nc, Wx, Lx, ldW);
+                    else m2m(t, u, ch, W + o, nc, Wx, ldW);
+                } else if (Lx) {
+                    p2m_dd(t, u, ws, nc, ch->begin, ch->end, Wx, Lx, ldW);
+                } else {
+                    p2m(t, u, ws, nc, ch->begin, ch->end, Wx, ldW);
+                }
+                if (ch == u) break; /* a leaf with proxies: its own centres, once */
             }
         }
     }
@@ -386,8 +483,8 @@ static void upward(const cm_rbf_tree *t, const double *ws, int nc, double *W, in
 /* ---- downward: batches against clusters ---- */
 
 typedef struct seg {
-    const double *x, *y, *z, *w; /* w: component q at w + q * ldw */
-    size_t ldw, n;
+    const double *x, *y, *z, *w; /* w: component q at w + q * ldw; y = x + ldc, z = y + ldc */
+    size_t ldc, ldw, n;
     int direct; /* centres (1) or proxies (0) */
 } seg;
 
@@ -453,16 +550,52 @@ block_avx512(int nc, const seg *s, int ns, const double *tx, const double *ty, c
     CM_TREE_DISPATCH
 }
 
-static block_fn pick_block(void)
+static block_fn pick_block(cm_rbf_isa isa)
 {
-#if defined(__x86_64__) && defined(__GNUC__)
-    __builtin_cpu_init();
-    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-        __builtin_cpu_supports("avx512vl"))
-        return block_avx512;
-    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return block_avx2;
-#endif
-    return block_generic;
+    if (isa == CM_RBF_ISA_AUTO) isa = cm_rbf_isa_auto();
+    switch (isa) {
+    case CM_RBF_ISA_AVX512_AUTOVEC: return block_avx512;
+    case CM_RBF_ISA_AVX2: return block_avx2;
+    case CM_RBF_ISA_AVX512: return NULL; /* the hand-written block, batch-wise (batch_avx512) */
+    default: return block_generic;
+    }
+}
+
+/* A whole batch (cnt targets, 3 x CM_TREE_BATCH SoA in pt, padded to a multiple of 8 with
+ * its last target) against every segment, by the AVX-512 block of the direct sums
+ * (rbf_sum_avx512.c): per segment the 32 targets in registers stream its centres or
+ * proxies tile by tile, so a segment (<= 512 per tile, 3 + nc rows) stays in L1 while the
+ * batch's groups pass over it. Each target adds the segments in the same order as the
+ * compiled loops do. acc: nc x CM_TREE_BATCH. */
+static void batch_avx512(int nc, const seg *s, int ns, size_t cnt, const double *pt,
+                         double *acc)
+{
+    memset(acc, 0, (size_t)nc * CM_TREE_BATCH * sizeof *acc);
+    for (int g = 0; g < ns; ++g)
+        cm_rbf_r3_strided_avx512(nc, s[g].n, s[g].x, s[g].ldc, s[g].w, s[g].ldw, cnt, pt,
+                                 CM_TREE_BATCH, acc);
+}
+
+/* The same with compensated (TwoSum) accumulation: hi, lo nc x CM_TREE_BATCH */
+static void batch_acc_avx512(int nc, const seg *s, int ns, size_t cnt, const double *pt,
+                             double *hi, double *lo)
+{
+    memset(hi, 0, (size_t)nc * CM_TREE_BATCH * sizeof *hi);
+    memset(lo, 0, (size_t)nc * CM_TREE_BATCH * sizeof *lo);
+    for (int g = 0; g < ns; ++g)
+        cm_rbf_r3_acc_strided_avx512(nc, s[g].n, s[g].x, s[g].ldc, s[g].w, s[g].ldw, cnt, pt,
+                                     CM_TREE_BATCH, hi, lo);
+    for (size_t i = 0; i < (size_t)nc * CM_TREE_BATCH; ++i) hi[i] += lo[i];
+}
+
+void cm_rbf_tree_set_compensated(cm_rbf_tree *t, int level)
+{
+    if (t) t->comp = level < 0 ? 0 : level > 2 ? 2 : level;
+}
+
+void cm_rbf_tree_set_isa(cm_rbf_tree *t, cm_rbf_isa isa)
+{
+    if (t) t->isa = isa;
 }
 
 /* the whole sum for targets ordered by tg (batches = its leaves) */
@@ -471,15 +604,19 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
 {
     const size_t m = t->m, P = (size_t)t->P, np = (size_t)t->nprox;
     double *ws = malloc((size_t)nc * (m ? m : 1) * sizeof *ws);
-    double *W = malloc((size_t)nc * (np ? np : 1) * P * sizeof *W);
+    /* compensated products only by the AVX-512 block; elsewhere the plain ones (callers
+     * check the error of what they get) */
+    const int comp = t->comp > 0 && !pick_block(t->isa) ? t->comp : 0;
+    double *W = malloc((comp == 2 ? 2 : 1) * (size_t)nc * (np ? np : 1) * P * sizeof *W);
+    double *Wl = comp == 2 ? W + (size_t)nc * (np ? np : 1) * P : NULL;
     if (!ws || !W) {
         free(ws), free(W);
         return -1;
     }
     for (int q = 0; q < nc; ++q)
         for (size_t j = 0; j < m; ++j) ws[(size_t)q * m + j] = w[(size_t)q * m + t->src.perm[j]];
-    upward(t, ws, nc, W, threads);
-    const block_fn fn = pick_block();
+    upward(t, ws, nc, W, Wl, threads);
+    const block_fn fn = pick_block(t->isa);
     const double *px = t->pxyz, *py = px + np * P, *pz = py + np * P;
     const double *xs = t->xs, *ys = xs + m, *zs = ys + m;
     int failed = 0;
@@ -489,7 +626,8 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
         seg *sg = malloc((size_t)cap * sizeof *sg);
         int stack[512];
         double tx[CM_TREE_BATCH + NB], ty[CM_TREE_BATCH + NB], tz[CM_TREE_BATCH + NB];
-        double acc[4 * NB];
+        double acc[4 * NB], pt[3 * CM_TREE_BATCH], bacc[4 * CM_TREE_BATCH];
+        double blo[4 * CM_TREE_BATCH];
         if (!sg) {
 #pragma omp atomic write
             failed = 1;
@@ -515,7 +653,7 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
                     stack[sp++] = u->child[0];
                     continue;
                 }
-                if (ns == cap) {
+                if (ns + 2 > cap) { /* room for two: proxies and their low parts */
                     seg *nsg = realloc(sg, 2 * (size_t)cap * sizeof *nsg);
                     if (!nsg) {
 #pragma omp atomic write
@@ -527,13 +665,15 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
                 }
                 if (far) {
                     const size_t o0 = (size_t)u->proxy * P;
-                    sg[ns++] = (seg){px + o0, py + o0, pz + o0, W + o0, np * P, P, 0};
+                    sg[ns++] = (seg){px + o0, py + o0, pz + o0, W + o0, np * P, np * P, P, 0};
+                    if (Wl) /* the low parts: the same proxies once more */
+                        sg[ns++] = (seg){px + o0, py + o0, pz + o0, Wl + o0, np * P, np * P, P, 0};
                 } else if (ns > 0 && sg[ns - 1].direct &&
                            sg[ns - 1].x + sg[ns - 1].n == xs + u->begin) {
                     sg[ns - 1].n += u->end - u->begin; /* adjacent centres: one stretch */
                 } else {
                     const size_t o0 = u->begin;
-                    sg[ns++] = (seg){xs + o0, ys + o0, zs + o0, ws + o0, m, u->end - u->begin, 1};
+                    sg[ns++] = (seg){xs + o0, ys + o0, zs + o0, ws + o0, m, m, u->end - u->begin, 1};
                 }
             }
             for (size_t l = 0; l < cnt + NB; ++l) {
@@ -541,6 +681,21 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
                 tx[l] = p[i];
                 ty[l] = p[ldp + i];
                 tz[l] = p[2 * ldp + i];
+            }
+            if (!fn) {
+                for (size_t l = 0; l < CM_TREE_BATCH; ++l) {
+                    pt[l] = tx[l < cnt ? l : cnt - 1];
+                    pt[CM_TREE_BATCH + l] = ty[l < cnt ? l : cnt - 1];
+                    pt[2 * CM_TREE_BATCH + l] = tz[l < cnt ? l : cnt - 1];
+                }
+                if (comp) batch_acc_avx512(nc, sg, ns, cnt, pt, bacc, blo);
+                else batch_avx512(nc, sg, ns, cnt, pt, bacc);
+                for (size_t l = 0; l < cnt; ++l) {
+                    size_t i = tg->perm[b->begin + l];
+                    for (int q = 0; q < nc; ++q)
+                        out[i * ldo + (size_t)q] = bacc[(size_t)q * CM_TREE_BATCH + l];
+                }
+                continue;
             }
             for (size_t l0 = 0; l0 < cnt; l0 += NB) {
                 fn(nc, sg, ns, tx + l0, ty + l0, tz + l0, acc);

@@ -3,6 +3,8 @@
 #ifndef CADMORPH_RBF_TREECODE_H
 #define CADMORPH_RBF_TREECODE_H
 
+#include "rbf_internal.h"
+
 #include <stddef.h>
 
 typedef struct cm_rbf_tree cm_rbf_tree;
@@ -19,6 +21,20 @@ void cm_rbf_tree_params(double tol, int *order, double *theta);
 cm_rbf_tree *cm_rbf_tree_create(size_t m, const double *c, int order, double theta);
 void cm_rbf_tree_destroy(cm_rbf_tree **t);
 size_t cm_rbf_tree_bytes(const cm_rbf_tree *t);
+
+/* The code of the products against proxies and centres: AUTO (the default: the
+ * hand-written AVX-512 block of the direct sums where the CPU has it, else the compiled
+ * AVX2 or baseline loops), or a named one, which must be supported (cm_rbf_isa_supported):
+ * for tests and benchmarks. AVX512_AUTOVEC is the compiled loop built for AVX-512. */
+void cm_rbf_tree_set_isa(cm_rbf_tree *t, cm_rbf_isa isa);
+
+/* Rounding of the sums (default 0: plain accumulation, an error of about eps x sum |w|
+ * phi besides the approximation). 1: the products against proxies and centres accumulate
+ * by TwoSum (the compensated block of the direct sums); 2: also the proxy weights in
+ * double-double. Only where the AVX-512 block runs (the isa above); elsewhere plain. For
+ * evaluations whose weights cancel far more than the approximation error leaves room for
+ * (RESULTS.md, issue 10, fourth session, says what it buys). */
+void cm_rbf_tree_set_compensated(cm_rbf_tree *t, int level);
 
 /* out[i * ldo + q] ~ sum_j phi(|p_i - c_j|) w[q * m + j] for q < nc (1..4), i < n; p: 3 x n
  * SoA with stride ldp. 0 on success, -1 on allocation failure (out untouched). */

@@ -1,7 +1,8 @@
 /* Tests of the r^3 treecode (rbf/rbf_treecode.c) and of the iterative solver with fast
  * matvecs: the error bound |fast_i - exact_i| <= tol sum_j |w_j| phi_ij on random and on real
  * RBF weights, at the centres and elsewhere; fits with fast_sum on against direct matvecs
- * and the dense solver; affine data; the choice of the fast evaluation. */
+ * and the dense solver; affine data; the choice of the fast evaluation; the hand-written
+ * AVX-512 products against the compiled fallbacks. */
 #include "cadmorph/rbf.h"
 #include "rbf/rbf_internal.h"
 #include "rbf/rbf_treecode.h"
@@ -143,6 +144,65 @@ static void test_bound_random(void)
 /* Real weights (an RBF fit of the bore motion): the bound holds all the same, relative to
  * sum |w| phi, and the cancellation makes the error relative to the result that much
  * larger. */
+/* The compensated levels (cm_rbf_tree_set_compensated) on real, cancelling weights: each
+ * within the bound, the levels the same sums to rounding of sum |w| phi; with all sums
+ * direct (order 14: no cluster but the root has proxies, and the centres never see the
+ * root as far) level 1 is the compensated direct sum, to a relative 1e-13 of the result,
+ * where plain accumulation errs by more. */
+static void test_compensated(const cm_rbf *r)
+{
+    if (!cm_rbf_isa_supported(CM_RBF_ISA_AVX512)) {
+        printf("no AVX-512 here: compensated tree sums not run (they fall back to plain)\n");
+        return;
+    }
+    const size_t m = r->m;
+    double *out[3], *ex = malloc(3 * m * sizeof *ex), *S = malloc(3 * m * sizeof *S);
+    double *aw = malloc(3 * m * sizeof *aw);
+    for (int k = 0; k < 3; ++k) out[k] = malloc(3 * m * sizeof(double));
+    cm_rbf_kernel_sum_acc(m, r->c, r->w, 3, m, r->c, m, ex, 3, 2);
+    for (size_t j = 0; j < 3 * m; ++j) aw[j] = fabs(r->w[j]);
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw, 3, m, r->c, m, S, 3, 2);
+    double smax = 0.0, emax = 0.0;
+    for (size_t i = 0; i < 3 * m; ++i) smax = fmax(smax, S[i]), emax = fmax(emax, fabs(ex[i]));
+    for (int pass = 0; pass < 2; ++pass) {
+        const double tol = pass == 0 ? 1e-6 : 1e-14;
+        int order = 14;
+        double theta = 0.35;
+        if (pass == 0) cm_rbf_tree_params(tol, &order, &theta);
+        cm_rbf_tree *t = cm_rbf_tree_create(m, r->c, order, theta);
+        CHECK(t != NULL);
+        if (!t) break;
+        double err[3], dev = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            cm_rbf_tree_set_compensated(t, k);
+            CHECK(cm_rbf_tree_sum_self(t, r->w, 3, out[k], 3, 2) == 0);
+            err[k] = 0.0;
+            for (size_t i = 0; i < 3 * m; ++i) {
+                err[k] = fmax(err[k], fabs(out[k][i] - ex[i]) / S[i]);
+                if (k) dev = fmax(dev, fabs(out[k][i] - out[0][i]));
+            }
+        }
+        double e1 = 0.0, e0 = 0.0;
+        for (size_t i = 0; i < 3 * m; ++i) {
+            e0 = fmax(e0, fabs(out[0][i] - ex[i]));
+            e1 = fmax(e1, fabs(out[1][i] - ex[i]));
+        }
+        printf("compensated levels, order %d theta %.2f: err / sum|w|phi %.3g %.3g %.3g, "
+               "levels vs plain %.3g of max sum|w|phi; err / max result plain %.3g, "
+               "level 1 %.3g\n", order, theta, err[0], err[1], err[2], dev / smax, e0 / emax,
+               e1 / emax);
+        for (int k = 0; k < 3; ++k) CHECK_MSG(err[k] <= (pass ? 1e-14 : tol), "%.3g", err[k]);
+        CHECK_MSG(dev <= 1e-13 * smax, "%.3g", dev / smax);
+        if (pass == 1) {
+            CHECK_MSG(e1 <= 1e-13 * emax, "%.3g", e1 / emax);
+            CHECK_MSG(e1 < e0, "%.3g vs %.3g", e1, e0);
+        }
+        cm_rbf_tree_destroy(&t);
+    }
+    for (int k = 0; k < 3; ++k) free(out[k]);
+    free(ex), free(S), free(aw);
+}
+
 static void test_bound_real(cm_context *ctx)
 {
     size_t m;
@@ -168,6 +228,7 @@ static void test_bound_real(cm_context *ctx)
         CHECK_MSG(cancel > 10.0, "%.3g", cancel); /* the weights do cancel */
         cm_rbf_tree_destroy(&t);
     }
+    test_compensated(r);
     cm_rbf_destroy(&r);
     free(x), free(d);
 }
@@ -352,6 +413,82 @@ static void test_options(cm_context *ctx)
     free(x);
 }
 
+/* The products' code: every ISA this CPU runs (the hand-written AVX-512 block of the direct
+ * sums, its compiled predecessor, AVX2, baseline) gives the same sums to rounding on the
+ * same tree, and each is within the bound; targets not a multiple of the register block
+ * (batches end in a tail of 1..3 vectors) and 1..4 components. */
+static void test_isa(void)
+{
+    size_t m;
+    double *x = bore_set(0.08, &m); /* ~4.5k centres */
+    double *c = malloc(3 * m * sizeof *c), *w = malloc(4 * m * sizeof *w);
+    for (size_t i = 0; i < m; ++i)
+        for (int d = 0; d < 3; ++d) c[(size_t)d * m + i] = x[3 * i + d] / 4.0;
+    uint64_t rng = 11;
+    for (size_t i = 0; i < 4 * m; ++i) w[i] = test_rng_range(&rng, -1.0, 1.0);
+    const size_t n = 1001;
+    double *p = malloc(3 * n * sizeof *p);
+    for (size_t i = 0; i < n; ++i) {
+        p[i] = test_rng_range(&rng, 0.0, 1.0);
+        p[n + i] = test_rng_range(&rng, 0.0, 0.5);
+        p[2 * n + i] = test_rng_range(&rng, 0.0, 0.25);
+    }
+    double *ex = malloc(4 * n * sizeof *ex), *S = malloc(4 * n * sizeof *S);
+    double *aw = malloc(4 * m * sizeof *aw), *ref = malloc(4 * n * sizeof *ref);
+    double *out = malloc(4 * (m > n ? m : n) * sizeof *out), *refs = malloc(4 * m * sizeof *refs);
+    for (size_t j = 0; j < 4 * m; ++j) aw[j] = fabs(w[j]);
+    cm_rbf_kernel_sum_acc(m, c, w, 4, n, p, n, ex, 4, 2);
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, aw, 4, n, p, n, S, 4, 2);
+    double smax = 0.0;
+    for (size_t i = 0; i < 4 * n; ++i) smax = fmax(smax, S[i]);
+    const cm_rbf_isa isas[] = {CM_RBF_ISA_GENERIC, CM_RBF_ISA_AVX2, CM_RBF_ISA_AVX512_AUTOVEC,
+                               CM_RBF_ISA_AVX512};
+    const double tol = 1e-6; /* order 5: proxies for clusters of > 216 centres */
+    int order;
+    double theta;
+    cm_rbf_tree_params(tol, &order, &theta);
+    cm_rbf_tree *t = cm_rbf_tree_create(m, c, order, theta);
+    CHECK(t != NULL);
+    int ran = 0;
+    for (int nc = 1; t && nc <= 4; nc += 3) {
+        for (int k = 0; k < 4; ++k) {
+            if (!cm_rbf_isa_supported(isas[k])) continue;
+            cm_rbf_tree_set_isa(t, isas[k]);
+            CHECK(cm_rbf_tree_sum(t, w, nc, n, p, n, out, (size_t)nc, 2) == 0);
+            double rs = ratio4(out, nc, n, ex, S), dev = 0.0;
+            if (k == 0) memcpy(ref, out, n * (size_t)nc * sizeof *ref);
+            for (size_t i = 0; i < n * (size_t)nc; ++i) dev = fmax(dev, fabs(out[i] - ref[i]));
+            CHECK(cm_rbf_tree_sum_self(t, w, nc, out, (size_t)nc, 2) == 0);
+            if (k == 0) memcpy(refs, out, m * (size_t)nc * sizeof *refs);
+            for (size_t i = 0; i < m * (size_t)nc; ++i) dev = fmax(dev, fabs(out[i] - refs[i]));
+            printf("isa %d, %d components: max err / sum|w|phi = %.3g, vs baseline %.3g of "
+                   "max sum|w|phi\n", (int)isas[k], nc, rs, dev / smax);
+            CHECK_MSG(rs <= tol, "isa %d: %.3g > %.3g", (int)isas[k], rs, tol);
+            CHECK_MSG(rs > 1e-3 * tol, "isa %d: %.3g: far field unused?", (int)isas[k], rs);
+            /* the same terms in the same order: only the last bits of each product differ
+             * (FMA contraction, which sqrt unit) */
+            CHECK_MSG(dev <= 1e-14 * smax, "isa %d: %.3g", (int)isas[k], dev / smax);
+            ran += k == 3;
+        }
+    }
+    /* AUTO is the hand-written block where the CPU has AVX-512 */
+    if (t && cm_rbf_isa_supported(CM_RBF_ISA_AVX512)) {
+        double *o2 = malloc(4 * n * sizeof *o2);
+        cm_rbf_tree_set_isa(t, CM_RBF_ISA_AVX512);
+        CHECK(cm_rbf_tree_sum(t, w, 4, n, p, n, out, 4, 2) == 0);
+        cm_rbf_tree_set_isa(t, CM_RBF_ISA_AUTO);
+        CHECK(cm_rbf_tree_sum(t, w, 4, n, p, n, o2, 4, 2) == 0);
+        CHECK(memcmp(out, o2, 4 * n * sizeof *o2) == 0);
+        free(o2);
+        CHECK(ran == 2);
+    } else {
+        printf("no AVX-512 here: the hand-written path was not run\n");
+    }
+    cm_rbf_tree_destroy(&t);
+    free(x), free(c), free(w), free(p), free(ex), free(S), free(aw), free(ref), free(out);
+    free(refs);
+}
+
 static void log_stderr(void *user, cm_log_level level, const char *message)
 {
     (void)user;
@@ -366,6 +503,7 @@ int main(void)
     if (getenv("CM_TEST_VERBOSE")) cm_context_set_log(ctx, log_stderr, NULL);
     cm_context_set_threads(ctx, 2);
     test_bound_random();
+    test_isa();
     test_bound_real(ctx);
     test_fit(ctx);
     test_affine(ctx);
