@@ -5,8 +5,10 @@
  *        [--local N] [--coarse N] [--float | --local-float 0|1|2] [--tol T] [--maxit N]
  *        [--restart N] [--eval N] [--verbose] [--fast 0|1|-1] [--fast-tol T]
  *        [--fast-refine N] [--fast-eval-tol T] [--no-centres] [--relax 0|1]
+ *        [--coarse-inner N] [--coarse-inner-tol T]
  * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
 #include "cadmorph/rbf.h"
+#include "rbf/rbf_internal.h" /* the inner coarse solver's counts */
 
 #include <math.h>
 #include <stdio.h>
@@ -52,6 +54,14 @@ typedef struct run {
 /* --no-centres: skip the evaluation at the centres (the exactness check), which at m = 1e6
  * is a full direct product */
 static int skip_centres = 0;
+/* coarse_inner > 0: inner coarse solves and their iterations in all, of the last fit */
+static long inner_solves = 0, inner_its = 0;
+
+static void inner_counts(const cm_rbf *rbf)
+{
+    const cm_rbf_coarse_inner *ci = cm_rbf_schwarz_inner(cm_rbf_iterative_pc(rbf));
+    cm_rbf_coarse_inner_stats(ci, &inner_solves, &inner_its);
+}
 
 static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
                 const double *v, size_t ne, const double *p, run *r)
@@ -76,6 +86,7 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
         r->eval_error = es.eval_error;
         if (r->status >= 0 && skip_centres) {
             cm_rbf_get_stats(rbf, &r->st);
+            inner_counts(rbf);
             cm_rbf_destroy(&rbf);
             return;
         }
@@ -86,6 +97,7 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
     }
     if (r->status < 0) fprintf(stderr, "error: %s\n", cm_context_message(ctx));
     cm_rbf_get_stats(rbf, &r->st);
+    if (rbf) inner_counts(rbf);
     cm_rbf_destroy(&rbf);
 }
 
@@ -126,6 +138,8 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--fast-refine")) o.fast_refine = atoi(b), ++i;
         else if (!strcmp(a, "--fast-eval-tol")) o.fast_eval_tol = atof(b), ++i;
         else if (!strcmp(a, "--relax")) o.relax = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-inner")) o.coarse_inner = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-inner-tol")) o.coarse_inner_tol = atof(b), ++i;
         else {
             fprintf(stderr, "unknown option %s\n", a);
             return 1;
@@ -171,6 +185,8 @@ int main(int argc, char **argv)
                it.st.fast_residual, it.st.fast_bound, it.eval_fast, it.eval_error);
         printf(" relax=%d mv_comp=%d mv_plain=%d mv_fast=%d", o.relax, it.st.matvecs_compensated,
                it.st.matvecs_plain, it.st.matvecs_fast);
+        printf(" coarse_inner=%d coarse_inner_tol=%g inner_solves=%ld inner_its=%ld",
+               o.coarse_inner, o.coarse_inner_tol, inner_solves, inner_its);
     }
     if (dense) {
         o.solver = CM_RBF_SOLVER_DENSE;

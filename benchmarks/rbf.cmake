@@ -9,6 +9,7 @@ target_link_libraries(bench_cholesky PRIVATE cm_rbf cm_core cm_lapack cm_warning
 # Iterative vs dense solver on real boundary node sets (see RESULTS.md; not a test).
 add_executable(bench_rbf_iterative ${CMAKE_CURRENT_LIST_DIR}/bench_rbf_iterative.c)
 target_link_libraries(bench_rbf_iterative PRIVATE cm_rbf cm_core cm_warnings cm_posix)
+target_include_directories(bench_rbf_iterative PRIVATE ${PROJECT_SOURCE_DIR})
 # The r^3 treecode against direct sums on real and random weights (RESULTS.md, fast summation)
 add_executable(bench_rbf_treecode ${CMAKE_CURRENT_LIST_DIR}/bench_rbf_treecode.c)
 target_include_directories(bench_rbf_treecode PRIVATE ${PROJECT_SOURCE_DIR})

@@ -175,6 +175,27 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc,
 /* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
  * at most m / 4). */
 size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);
+/* The coarse problem solved inexactly (rbf_schwarz_coarse.c, options coarse_inner and
+ * coarse_inner_tol): an inner FGMRES on the nc coarse centres (c_xyz: 3 x nc SoA; m_fine:
+ * the outer centres, for the choice of the coarse-to-fine product) preconditioned by a
+ * two-level Schwarz of their own. */
+typedef struct cm_rbf_coarse_inner cm_rbf_coarse_inner;
+cm_status cm_rbf_coarse_inner_create(cm_context *ctx, const cm_rbf *r, size_t nc,
+                                     const double *c_xyz, size_t m_fine, int threads,
+                                     cm_rbf_coarse_inner **out);
+void cm_rbf_coarse_inner_destroy(cm_rbf_coarse_inner **ci);
+/* x (ncomp x nc SoA): the coarse data in, approximate projected weights out; 0 or -1 */
+int cm_rbf_coarse_inner_solve(const cm_rbf_coarse_inner *ci, int ncomp, double *x, int threads);
+/* out[i * ncomp + q] ~ sum_a phi(|c_i - coarse_a|) w[q * nc + a] by the treecode (c: 3 x m
+ * SoA): 0, or 1 if the direct sum is to be used instead */
+int cm_rbf_coarse_inner_to_fine(const cm_rbf_coarse_inner *ci, int ncomp, const double *w,
+                                size_t m, const double *c, double *out, int threads);
+size_t cm_rbf_coarse_inner_bytes(const cm_rbf_coarse_inner *ci);
+const cm_rbf_schwarz *cm_rbf_coarse_inner_pc(const cm_rbf_coarse_inner *ci);
+/* inner solves so far and their iterations in all */
+void cm_rbf_coarse_inner_stats(const cm_rbf_coarse_inner *ci, long *solves, long *iterations);
+/* The preconditioner's inner coarse solver, NULL if its coarse problem is factored densely */
+const cm_rbf_coarse_inner *cm_rbf_schwarz_inner(const cm_rbf_schwarz *pc);
 size_t cm_rbf_schwarz_bytes(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc);

@@ -57,6 +57,8 @@ struct cm_rbf_schwarz {
                        * inverse would cost 3x the factorisation */
     int c_rk;
     double c_tau[4];
+    cm_rbf_coarse_inner *inner; /* coarse_inner > 0: the coarse problem solved by an inner
+                       * Krylov method (rbf_schwarz_coarse.c) instead of gc */
     int post;         /* 0: coarse then local; 1: coarse, local, coarse; 2: local, coarse */
     double fill;      /* largest distance from a centre to its nearest coarse centre */
     size_t bytes;
@@ -492,6 +494,7 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
     free(p->c_idx);
     free(p->c_xyz);
     free(p->gc);
+    cm_rbf_coarse_inner_destroy(&p->inner);
     free(p);
     *pc = NULL;
 }
@@ -743,17 +746,24 @@ static cm_status build_coarse(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *
     p->nc = nc;
     p->c_idx = malloc(nc * sizeof *p->c_idx);
     p->c_xyz = malloc(3 * nc * sizeof *p->c_xyz);
-    p->gc = malloc((nc * nc + 8 * nc) * sizeof *p->gc);
+    const int inner = r->opt.coarse_inner > 0;
+    p->gc = inner ? NULL : malloc((nc * nc + 8 * nc) * sizeof *p->gc);
     double *d2 = malloc(m * sizeof *d2);
     cm_status st = CM_OK;
-    if (!p->c_idx || !p->c_xyz || !p->gc || !d2) {
-        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (coarse space)");
+    if (!p->c_idx || !p->c_xyz || (!inner && !p->gc) || !d2) {
+        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (coarse space: %zu centres%s)",
+                      nc, inner ? "" : ", dense factor");
         goto done;
     }
-    p->bytes += nc * nc * 8 + nc * 32;
+    p->bytes += (inner ? 0 : nc * nc * 8) + nc * 32;
     p->fill = farthest_points(r->c, m, nc, p->c_idx, d2, threads);
     for (int d = 0; d < 3; ++d)
         for (size_t a = 0; a < nc; ++a) p->c_xyz[(size_t)d * nc + a] = r->c[(size_t)d * m + p->c_idx[a]];
+    if (inner) {
+        st = cm_rbf_coarse_inner_create(ctx, r, nc, p->c_xyz, m, threads, &p->inner);
+        if (st == CM_OK) p->bytes += cm_rbf_coarse_inner_bytes(p->inner);
+        goto done;
+    }
     const int saved = openblas_get_num_threads();
     openblas_set_num_threads(threads);
     int info = projected_factor(r->c, m, p->c_idx, nc, p->gc, &p->c_rk, p->c_tau);
@@ -776,6 +786,14 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
     if (!p) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     p->m = r->m;
     p->post = r->opt.coarse_post;
+    if (r->opt.coarse_inner < 0 || r->opt.coarse_inner > 200 ||
+        (r->opt.coarse_inner > 0 && !(r->opt.coarse_inner_tol > 0.0 && r->opt.coarse_inner_tol < 1.0))) {
+        free(p);
+        return cm_error(ctx, CM_ERR_ARGUMENT,
+                        "cm_rbf_create: bad coarse_inner %d / coarse_inner_tol %g (expected "
+                        "0..200 iterations and a tolerance in (0, 1))",
+                        r->opt.coarse_inner, r->opt.coarse_inner_tol);
+    }
     /* the coarse space first: its fill distance sets the overlap when measured in distance */
     double t0 = cm_wtime();
     cm_status st = build_coarse(ctx, r, p, threads);
@@ -790,6 +808,16 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
         return st;
     }
     p->bytes += p->sub_ptr[p->nsub] * sizeof *p->sub_idx + (size_t)p->nsub * 24;
+    if (p->inner) {
+        const cm_rbf_schwarz *q = cm_rbf_coarse_inner_pc(p->inner);
+        cm_log(ctx, CM_LOG_DEBUG,
+               "cm_rbf_create: Schwarz coarse level: %zu centres solved by <= %d inner FGMRES "
+               "iterations (to %g) with %d subdomains (mean %.0f) and a dense coarse of %zu, "
+               "%.1f MB",
+               p->nc, r->opt.coarse_inner, r->opt.coarse_inner_tol, q->nsub,
+               (double)q->sub_ptr[q->nsub] / (double)q->nsub, q->nc,
+               (double)cm_rbf_coarse_inner_bytes(p->inner) / 1e6);
+    }
     cm_log(ctx, CM_LOG_DEBUG,
            "cm_rbf_create: Schwarz: %d subdomains of <= %zu centres (mean %.0f, leaves <= %d), "
            "coarse %zu (fill distance %.3g); coarse %.3f s, tree + overlap %.3f s, local %.3f "
@@ -798,6 +826,19 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
            p->nc, p->fill, t1 - t0, t2 - t1, t3 - t2, p->l1 - p->l0, (double)p->bytes / 1e6);
     *pc = p;
     return CM_OK;
+}
+
+/* wc (nc x ncs SoA): coarse data in, coarse weights out, exactly (dense factor) or by the
+ * inner Krylov solve */
+static void coarse_solve(const cm_rbf_schwarz *p, int nc, double *wc, int threads)
+{
+    if (p->inner) cm_rbf_coarse_inner_solve(p->inner, nc, wc, threads);
+    else projected_solve(p->gc, p->nc, p->c_rk, p->c_tau, (size_t)nc, wc);
+}
+
+const cm_rbf_coarse_inner *cm_rbf_schwarz_inner(const cm_rbf_schwarz *pc)
+{
+    return pc ? pc->inner : NULL;
 }
 
 int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
@@ -824,11 +865,12 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
             for (int c = 0; c < nc; ++c)
                 for (size_t a = 0; a < ncs; ++a) rc[(size_t)c * ncs + a] = in[(size_t)c * m + p->c_idx[a]];
             memcpy(wc, rc, ncs * (size_t)nc * sizeof *wc);
-            projected_solve(p->gc, ncs, p->c_rk, p->c_tau, (size_t)nc, wc);
+            coarse_solve(p, nc, wc, threads);
             /* the local solves see the residual of the coarse interpolant; its polynomial
              * part is left in, as the local solves annihilate linear functions exactly */
-            cm_rbf_kernel_sum(r->kernel, 3, ncs, p->c_xyz, wc, nc, m, r->c, m, ac, (size_t)nc,
-                              threads);
+            if (cm_rbf_coarse_inner_to_fine(p->inner, nc, wc, m, r->c, ac, threads) != 0)
+                cm_rbf_kernel_sum(r->kernel, 3, ncs, p->c_xyz, wc, nc, m, r->c, m, ac,
+                                  (size_t)nc, threads);
             for (int c = 0; c < nc; ++c)
                 for (size_t i = 0; i < m; ++i)
                     r1[(size_t)c * m + i] = in[(size_t)c * m + i] - ac[i * (size_t)nc + (size_t)c];
@@ -898,7 +940,7 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
                     rc[(size_t)c * ncs + a] = in[(size_t)c * m + p->c_idx[a]] -
                                               aout[a * (size_t)nc + (size_t)c];
             memcpy(wc, rc, ncs * (size_t)nc * sizeof *wc);
-            projected_solve(p->gc, ncs, p->c_rk, p->c_tau, (size_t)nc, wc);
+            coarse_solve(p, nc, wc, threads);
             for (int c = 0; c < nc; ++c)
                 for (size_t a = 0; a < ncs; ++a)
                     out[(size_t)c * m + p->c_idx[a]] += wc[(size_t)c * ncs + a];

@@ -99,6 +99,14 @@ typedef struct cm_rbf_options {
                            * sqrt(m) (coarse factor 8 coarse^2 bytes, O(m)): bracket 59k,
                            * 5,000 coarse centres: 17 iterations instead of 21 */
     int coarse_max;       /* [8000] cap on the coarse centres (0: none but m/4) */
+    int coarse_inner;     /* [0] 0: the coarse problem is solved exactly by its dense
+                           * projected Cholesky factor (8 coarse^2 bytes, so coarse_max
+                           * stays near 8,000-16,000); N > 0: by at most N iterations of an
+                           * inner FGMRES preconditioned by a two-level Schwarz of its own on
+                           * the coarse centres (O(coarse) memory, so the coarse space can
+                           * grow with m: set coarse_size / coarse_grow / coarse_max) */
+    double coarse_inner_tol; /* [1e-2] the inner solve stops when the coarse residual's
+                           * 2-norm is reduced by this factor (or after coarse_inner steps) */
     int fast_sum;         /* [-1] fast summation (barycentric Lagrange treecode for r^3,
                            * rbf_treecode.c) for the Krylov matvecs and for evaluation:
                            * 0 never (direct sums), 1 always, -1 auto (matvecs at m >= 120,000;

@@ -21,6 +21,8 @@ cm_add_unit_test(test_blas_core ${CMAKE_CURRENT_LIST_DIR}/test_blas_core.c
   LIBS cm_rbf LABELS rbf)
 # iterative solver vs dense on a box-with-bore boundary set, affine data, two bodies, threads
 cm_add_unit_test(test_rbf_iterative ${CMAKE_CURRENT_LIST_DIR}/test_rbf_iterative.c LIBS cm_rbf LABELS rbf)
+# the Schwarz coarse problem by an inner Krylov solve (multilevel) against dense
+cm_add_unit_test(test_rbf_schwarz_inner ${CMAKE_CURRENT_LIST_DIR}/test_rbf_schwarz_inner.c LIBS cm_rbf LABELS rbf)
 
 # the distributed solver (CADMORPH_WITH_PETSC only): against the serial iterative solver
 # under `mpirun -n 2` (--oversubscribe: the CI machine may have fewer slots; as root too), and

@@ -1,0 +1,130 @@
+/* The Schwarz preconditioner with its coarse problem solved by an inner Krylov method
+ * (coarse_inner > 0, rbf_schwarz_coarse.c): the fit agrees with the dense solver and with
+ * the dense-coarse preconditioner, the inner solver really ran (and the preconditioner with
+ * a tight inner tolerance takes the dense coarse factor's iterations), and bad options are
+ * refused. Small subdomains (leaves of <= 128 grown to 500-700), so that the inner Schwarz
+ * on the coarse centres is a real one (with the default 1,400 its subdomains would be the
+ * whole coarse set). */
+#include "cadmorph/rbf.h"
+#include "rbf/rbf_internal.h"
+#include "rbf_test_sets.h"
+#include "test_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void motion(size_t n, const double *x, double *d)
+{
+    for (size_t i = 0; i < n; ++i) {
+        double dx = x[3 * i] - 2.0, dy = x[3 * i + 1] - 1.0, r = hypot(dx, dy) + 1e-12;
+        double s = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
+        d[3 * i] = s * dx / r + 0.01 * sin(x[3 * i + 2]);
+        d[3 * i + 1] = s * dy / r;
+        d[3 * i + 2] = 0.02 * x[3 * i] * x[3 * i] / 16.0;
+    }
+}
+
+/* fit, evaluate at the np points p; inner solves / iterations of the preconditioner */
+static cm_status fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
+                     const double *d, size_t np, const double *p, double *out,
+                     cm_rbf_stats *st, long *solves, long *its)
+{
+    cm_rbf *r = NULL;
+    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &r);
+    if (s == CM_OK) s = cm_rbf_solve(ctx, r, 3, d);
+    if (s == CM_OK) s = cm_rbf_evaluate(ctx, r, np, p, out);
+    if (r) {
+        cm_rbf_get_stats(r, st);
+        if (solves)
+            cm_rbf_coarse_inner_stats(cm_rbf_schwarz_inner(cm_rbf_iterative_pc(r)), solves, its);
+    }
+    cm_rbf_destroy(&r);
+    return s;
+}
+
+static void test_inner(cm_context *ctx)
+{
+    const double off[3] = {0.0, 0.0, 0.0};
+    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, NULL);
+    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
+    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, x);
+    motion(m, x, d);
+    const size_t nin = 1500, np = m + nin;
+    double *p = malloc(np * 3 * sizeof *p);
+    memcpy(p, x, m * 3 * sizeof *p);
+    for (size_t i = 0; i < nin; ++i) {
+        double t = (double)i / (double)nin;
+        p[3 * (m + i)] = 0.1 + 3.8 * t;
+        p[3 * (m + i) + 1] = 0.1 + 1.8 * fmod(7.0 * t, 1.0);
+        p[3 * (m + i) + 2] = 0.1 + 0.8 * fmod(13.0 * t, 1.0);
+    }
+    double *sd = malloc(np * 3 * sizeof *sd), *s0 = malloc(np * 3 * sizeof *s0);
+    double *s1 = malloc(np * 3 * sizeof *s1);
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_DENSE;
+    cm_rbf_stats std, st0, st1;
+    cm_status a = fit(ctx, &o, m, x, d, np, p, sd, &std, NULL, NULL);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.leaf_size = 128;
+    o.local_size = 500;
+    o.local_max = 700;
+    long n0 = -1, i0 = -1, n1 = 0, i1 = 0;
+    cm_status b = fit(ctx, &o, m, x, d, np, p, s0, &st0, &n0, &i0);
+    /* the same coarse space (m/4: the most the rule allows) solved inexactly */
+    o.coarse_inner = 20;
+    cm_status c = fit(ctx, &o, m, x, d, np, p, s1, &st1, &n1, &i1);
+    CHECK_MSG(a == CM_OK && b == CM_OK && c == CM_OK, "%d %d %d: %s", a, b, c,
+              cm_context_message(ctx));
+    const double range = fmax(range_of(m * 3, d), 1e-300);
+    const double tol = fmax(1e-9, 3.0 * std.residual);
+    double d1 = max_diff(np * 3, s1, sd) / range, d0 = max_diff(np * 3, s0, sd) / range;
+    printf("m = %zu: dense-coarse %d iterations (coarse %d), inner-coarse %d iterations "
+           "(coarse %d; %ld inner solves, %ld inner iterations), residual %.3g, "
+           "|inner - dense| = %.3g, |dense-coarse - dense| = %.3g of the range\n",
+           m, st0.iterations, st0.coarse_size, st1.iterations, st1.coarse_size, n1, i1,
+           st1.residual, d1, d0);
+    CHECK(n0 == 0 && i0 == 0);       /* the default has no inner solver */
+    CHECK(st1.coarse_size == (int)(m / 4));
+    CHECK_MSG(n1 >= st1.iterations && i1 >= n1, "%ld solves, %ld iterations", n1, i1);
+    CHECK_MSG(i1 <= 20 * n1, "%ld > 20 x %ld", i1, n1);
+    CHECK_MSG(d1 <= tol, "%.3g > %.3g", d1, tol);
+    CHECK_MSG(st1.residual <= fmax(1e-10, st1.floor), "%.3g", st1.residual);
+    CHECK_MSG(max_diff(m * 3, s1, d) / range <= 1e-9, "%.3g", max_diff(m * 3, s1, d) / range);
+    CHECK_MSG(st1.iterations >= 1 && st1.iterations <= 30, "%d iterations", st1.iterations);
+
+    /* a tight inner tolerance is the exact coarse solve in all but rounding: the same
+     * iteration count as the dense coarse factor of the same coarse space */
+    cm_rbf_stats st2;
+    o.coarse_inner = 60;
+    o.coarse_inner_tol = 1e-9;
+    cm_status e = fit(ctx, &o, m, x, d, np, p, s1, &st2, &n1, &i1);
+    printf("inner to 1e-9: %d iterations (dense coarse: %d), %ld inner iterations\n",
+           st2.iterations, st0.iterations, i1);
+    CHECK(e == CM_OK);
+    CHECK_MSG(abs(st2.iterations - st0.iterations) <= 1, "%d vs %d", st2.iterations,
+              st0.iterations);
+    CHECK_MSG(max_diff(np * 3, s1, sd) / range <= tol, "%.3g", max_diff(np * 3, s1, sd) / range);
+
+    /* refused: negative counts and tolerances outside (0, 1) */
+    cm_rbf *r = NULL;
+    o.coarse_inner = -1;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT && !r);
+    o.coarse_inner = 5;
+    o.coarse_inner_tol = 1.5;
+    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT && !r);
+    CHECK(strstr(cm_context_message(ctx), "coarse_inner") != NULL);
+    free(x), free(d), free(p), free(sd), free(s0), free(s1);
+}
+
+int main(void)
+{
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return 1;
+    cm_context_set_threads(ctx, 2);
+    test_inner(ctx);
+    cm_context_destroy(&ctx);
+    return TEST_REPORT();
+}
