@@ -36,15 +36,24 @@
  * "Fast summation"), so it pays once one compensated product costs more than 22 / (12 - 4)
  * = 2.75 treecode products at fast_tol 1e-12. Measured with the treecode on the AVX-512
  * block (RESULTS.md, issue 10, fourth session; bracket sets, one product, CPU s): 1.9 at
- * 59k, 2.6 at 103k, 3.6 at 201k, 6.6 at 479k; 2.75 falls near 1.15e5. Below that the fits
- * measured no gain (59k, 103k: within 2 %, set-up dominates either way). */
-#define CM_RBF_FAST_MIN_M 120000
+ * 59k, 2.6 at 103k, 3.6 at 201k, 6.6 at 479k; 2.75 falls near 1.15e5. But on real data the
+ * refinement costs more than at 59k: bracket 148k (real displacements), fast 46 iterations,
+ * 65 products, 253 CPU s; direct 16 iterations, 22 products, 221 CPU s (RESULTS.md, "Quiet
+ * reruns after the fourth session"). So 2e5, above the largest real set measured. */
+#define CM_RBF_FAST_MIN_M 200000
 #define CM_RBF_FAST_EVAL_PAIRS 2e9
 /* an inner (fast-matvec) solve of a refinement step aims for this reduction of its own
  * right-hand side, or the final tolerance if that is nearer: the treecode's operator
  * differs from A by about fast_tol x (sum |w| phi / |A w|), 1e-8..1e-5 on real sets, so
  * going further in one step would only polish the wrong operator */
 #define CM_RBF_REFINE_GAIN 1e-7
+/* a restart cycle also ends once GMRES's estimate has fallen this far below the cycle's
+ * start, so that the true residual is formed again: on real data the estimate and the true
+ * residual part in long cycles (bracket 148k, y: after 40 iterations estimate 3e-7, true
+ * 3e-6 in the 2-norm; 48 iterations in all), and a fresh start costs the refinement-free
+ * two products plus the floor's. With it: 16 iterations there, 13 instead of 16 at 103k,
+ * 18 instead of 17 on two bodies 119k, the same below 1e5 (RESULTS.md, fourth session) */
+#define CM_RBF_CYCLE_GAIN 1e-6
 /* samples for the a-posteriori error estimate of a fast evaluation, and the factor on the
  * largest sampled error (the sampled max was within it of the true max on the real sets) */
 #define CM_RBF_FAST_SAMPLES 256
@@ -473,7 +482,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
     const size_t m = kr->m;
     const int g = kr->g, R = kr->R;
     const cm_rbf_options *o = &r->opt;
-    double fnorm[4], prev[4], res[4], target[4], est[4] = {0, 0, 0, 0};
+    double fnorm[4], prev[4], res[4], target[4], est[4] = {0, 0, 0, 0}, cycle0[4];
     double *res_v[4], *ax[4];
     int state[4]; /* 0 running, 1 converged, 2 floor, 3 stagnated, 4 max iterations */
     for (int c = 0; c < g; ++c) {
@@ -578,6 +587,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
             cblas_dscal((int)m, 1.0 / r2, v0, 1);
             memset(kr->gv[c], 0, sizeof kr->gv[c]);
             kr->gv[c][0] = r2;
+            cycle0[c] = r2;
             act[na++] = c;
         }
         int jn[4] = {0, 0, 0, 0};
@@ -677,6 +687,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                 est[c] = fabs(kr->gv[c][j + 1]);
                 ++iters[c];
                 int done = fabs(kr->gv[c][j + 1]) <= target[c] || hn == 0.0 ||
+                           fabs(kr->gv[c][j + 1]) <= CM_RBF_CYCLE_GAIN * cycle0[c] ||
                            iters[c] >= o->max_iterations;
                 if (!done) act[keep++] = c;
             }
