@@ -49,6 +49,7 @@ typedef struct run {
     double *out; /* (m + ne) x 3: at the centres, then the interior sample */
     int eval_fast;
     double eval_error;
+    int centres_fast; /* the evaluation at the centres (it_exact) took the treecode */
 } run;
 
 /* --no-centres: skip the evaluation at the centres (the exactness check), which at m = 1e6
@@ -91,6 +92,8 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
             return;
         }
         if (r->status >= 0) r->status = cm_rbf_evaluate(ctx, rbf, m, x, r->out);
+        cm_rbf_get_stats(rbf, &es);
+        r->centres_fast = es.eval_fast;
         /* the unit of fit_in_matvecs: one compensated direct product with the weights, timed
          * by itself (the evaluation above may take the treecode since it accepts the direct
          * sums' own rounding) */
@@ -189,8 +192,9 @@ int main(int argc, char **argv)
                o.overlap, o.local_max, it.setup_cpu_s, it.centres_cpu_s,
                it.centres_cpu_s > 0.0 ? it.fit_cpu_s / it.centres_cpu_s : 0.0, o.local_float);
         printf(" fast_sum=%d fast_tol=%g refinements=%d fast_residual=%.3g fast_bound=%.3g "
-               "eval_fast=%d eval_error=%.3g", it.st.fast_sum, o.fast_tol, it.st.refinements,
-               it.st.fast_residual, it.st.fast_bound, it.eval_fast, it.eval_error);
+               "eval_fast=%d eval_error=%.3g centres_fast=%d", it.st.fast_sum, o.fast_tol,
+               it.st.refinements, it.st.fast_residual, it.st.fast_bound, it.eval_fast,
+               it.eval_error, it.centres_fast);
         printf(" relax=%d mv_comp=%d mv_plain=%d mv_fast=%d", o.relax, it.st.matvecs_compensated,
                it.st.matvecs_plain, it.st.matvecs_fast);
         printf(" coarse_inner=%d coarse_inner_tol=%g inner_solves=%ld inner_its=%ld",
