@@ -2,41 +2,20 @@
  * SPD matrices: odd and even n, n below, at and off multiples of the block; the pivot of an
  * indefinite matrix; progress monotonic up to its total. */
 #include "rbf/rbf_internal.h"
+#include "cholesky_test_util.h"
 #include "test_util.h"
 
 #include <lapacke.h>
 #include <stdlib.h>
 #include <string.h>
 
-static unsigned long long rng = 0x2545F4914F6CDD1DULL;
-static double urand(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0) - 0.5;
-}
-
-typedef struct calls {
-    int count, monotonic, stage_ok;
-    double last, total;
-} calls;
-
-static void on_progress(void *user, const char *stage, double done, double total)
-{
-    calls *c = user;
-    if (c->count > 0 && (done < c->last || total != c->total)) c->monotonic = 0;
-    if (strcmp(stage, "rbf factor") != 0) c->stage_ok = 0;
-    c->last = done;
-    c->total = total;
-    ++c->count;
-}
+static uint64_t rng = 0x2545F4914F6CDD1DULL;
 
 /* Full n x n col-major SPD matrix B B'/n + I (+ shift on the diagonal at `bad`, if >= 0). */
 static double *spd(int n, int bad)
 {
     double *b = malloc((size_t)n * n * sizeof *b), *a = calloc((size_t)n * n, sizeof *a);
-    for (size_t i = 0; i < (size_t)n * n; ++i) b[i] = urand();
+    for (size_t i = 0; i < (size_t)n * n; ++i) b[i] = chol_urand(&rng);
     for (int j = 0; j < n; ++j)
         for (int i = j; i < n; ++i) {
             double s = 0.0;
@@ -103,7 +82,7 @@ static void check_create(void)
 {
     const size_t m = 1500;
     double *c = malloc(m * 3 * sizeof *c);
-    for (size_t i = 0; i < 3 * m; ++i) c[i] = urand();
+    for (size_t i = 0; i < 3 * m; ++i) c[i] = chol_urand(&rng);
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
     calls k = {0, 1, 1, 0.0, 0.0};

@@ -8,6 +8,7 @@
 #define _DEFAULT_SOURCE /* fork, waitpid, setrlimit */
 #endif
 #include "rbf/rbf_internal.h"
+#include "cholesky_test_util.h"
 #include "test_util.h"
 
 #include <sys/resource.h>
@@ -19,29 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static unsigned long long rng = 0x9E3779B97F4A7C15ULL;
-static double urand(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) * (1.0 / 9007199254740992.0) - 0.5;
-}
-
-typedef struct calls {
-    int count, monotonic, stage_ok;
-    double last, total;
-} calls;
-
-static void on_progress(void *user, const char *stage, double done, double total)
-{
-    calls *c = user;
-    if (c->count > 0 && (done < c->last || total != c->total)) c->monotonic = 0;
-    if (strcmp(stage, "rbf factor") != 0) c->stage_ok = 0;
-    c->last = done;
-    c->total = total;
-    ++c->count;
-}
+static uint64_t rng = 0x9E3779B97F4A7C15ULL;
 
 /* Full n x n col-major SPD B B'/n + I (by dsyrk: the large sizes stay fast), with -1e3 on the
  * diagonal at `bad` if >= 0, so that the leading minor of order bad + 1 is the first that
@@ -50,7 +29,7 @@ static double *spd(int n, int bad)
 {
     double *b = malloc((size_t)n * n * sizeof *b), *a = calloc((size_t)n * n, sizeof *a);
     for (size_t i = 0; i < (size_t)n * n; ++i)
-        b[i] = urand();
+        b[i] = chol_urand(&rng);
     openblas_set_num_threads(1);
     cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, n, n, 1.0 / n, b, n, 0.0, a, n);
     for (int j = 0; j < n; ++j) {
