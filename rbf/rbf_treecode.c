@@ -290,20 +290,28 @@ static void lagrange(const cm_rbf_tree *t, double u, double *l)
     for (int k = 0; k <= n; ++k) l[k] /= s;
 }
 
+/* The Lagrange basis of node u at tree position j: lx along x, lyz[b n1 + g] = L_b(y) L_g(z) */
+static void point_basis(const cm_rbf_tree *t, const tnode *u, size_t j, double *lx, double *lyz)
+{
+    const int n1 = t->n + 1;
+    const size_t m = t->m;
+    double ly[CM_TREE_MAXN + 1], lz[CM_TREE_MAXN + 1];
+    lagrange(t, (t->xs[j] - u->mid[0]) / u->half[0], lx);
+    lagrange(t, (t->xs[m + j] - u->mid[1]) / u->half[1], ly);
+    lagrange(t, (t->xs[2 * m + j] - u->mid[2]) / u->half[2], lz);
+    for (int bb = 0; bb < n1; ++bb)
+        for (int g = 0; g < n1; ++g) lyz[bb * n1 + g] = ly[bb] * lz[g];
+}
+
 /* W (nc x P, stride ldW) += the weights ws (stride m) of tree positions [b, e) */
 static void p2m(const cm_rbf_tree *t, const tnode *u, const double *ws, int nc, size_t b,
                 size_t e, double *W, size_t ldW)
 {
     const int n1 = t->n + 1;
     const size_t m = t->m;
-    double lx[CM_TREE_MAXN + 1], ly[CM_TREE_MAXN + 1], lz[CM_TREE_MAXN + 1];
-    double lyz[(CM_TREE_MAXN + 1) * (CM_TREE_MAXN + 1)];
+    double lx[CM_TREE_MAXN + 1], lyz[(CM_TREE_MAXN + 1) * (CM_TREE_MAXN + 1)];
     for (size_t j = b; j < e; ++j) {
-        lagrange(t, (t->xs[j] - u->mid[0]) / u->half[0], lx);
-        lagrange(t, (t->xs[m + j] - u->mid[1]) / u->half[1], ly);
-        lagrange(t, (t->xs[2 * m + j] - u->mid[2]) / u->half[2], lz);
-        for (int bb = 0; bb < n1; ++bb)
-            for (int g = 0; g < n1; ++g) lyz[bb * n1 + g] = ly[bb] * lz[g];
+        point_basis(t, u, j, lx, lyz);
         for (int q = 0; q < nc; ++q) {
             const double wq = ws[(size_t)q * m + j];
             double *Wq = W + (size_t)q * ldW;
@@ -387,14 +395,9 @@ CM_DD static void p2m_dd(const cm_rbf_tree *t, const tnode *u, const double *ws,
 {
     const int n1 = t->n + 1;
     const size_t m = t->m;
-    double lx[CM_TREE_MAXN + 1], ly[CM_TREE_MAXN + 1], lz[CM_TREE_MAXN + 1];
-    double lyz[(CM_TREE_MAXN + 1) * (CM_TREE_MAXN + 1)];
+    double lx[CM_TREE_MAXN + 1], lyz[(CM_TREE_MAXN + 1) * (CM_TREE_MAXN + 1)];
     for (size_t j = b; j < e; ++j) {
-        lagrange(t, (t->xs[j] - u->mid[0]) / u->half[0], lx);
-        lagrange(t, (t->xs[m + j] - u->mid[1]) / u->half[1], ly);
-        lagrange(t, (t->xs[2 * m + j] - u->mid[2]) / u->half[2], lz);
-        for (int bb = 0; bb < n1; ++bb)
-            for (int g = 0; g < n1; ++g) lyz[bb * n1 + g] = ly[bb] * lz[g];
+        point_basis(t, u, j, lx, lyz);
         for (int q = 0; q < nc; ++q) {
             const double wq = ws[(size_t)q * m + j];
             double *Wq = W + (size_t)q * ldW, *Lq = Wl + (size_t)q * ldW;
