@@ -51,6 +51,19 @@ static size_t box_with_bore(double a, double b, double c, double xc, double yc, 
     return n;
 }
 
+/* A displacement like the bore's edit: the bore face (axis through (xc, yc)) moves
+ * radially, the rest follows smoothly, plus a global bend. */
+static void bore_motion(size_t n, const double *x, double xc, double yc, double *d)
+{
+    for (size_t i = 0; i < n; ++i) {
+        double dx = x[3 * i] - xc, dy = x[3 * i + 1] - yc, r = hypot(dx, dy) + 1e-12;
+        double s = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
+        d[3 * i] = s * dx / r + 0.01 * sin(x[3 * i + 2]);
+        d[3 * i + 1] = s * dy / r;
+        d[3 * i + 2] = 0.02 * x[3 * i] * x[3 * i] / 16.0;
+    }
+}
+
 static double range_of(size_t n, const double *v)
 {
     double lo = INFINITY, hi = -INFINITY;

@@ -9,19 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A displacement like the bore's edit: the bore face moves radially, the rest follows
- * smoothly, plus a global bend. */
-static void bore_motion(size_t n, const double *x, double xc, double yc, double *d)
-{
-    for (size_t i = 0; i < n; ++i) {
-        double dx = x[3 * i] - xc, dy = x[3 * i + 1] - yc, r = hypot(dx, dy) + 1e-12;
-        double s = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
-        d[3 * i] = s * dx / r + 0.01 * sin(x[3 * i + 2]);
-        d[3 * i + 1] = s * dy / r;
-        d[3 * i + 2] = 0.02 * x[3 * i] * x[3 * i] / 16.0;
-    }
-}
-
 /* Fits values on x with the given options and evaluates at p (np points). */
 static cm_status fit_eval_opt(cm_context *ctx, const cm_rbf_options *opt, size_t m,
                               const double *x, const double *val, size_t np, const double *p,

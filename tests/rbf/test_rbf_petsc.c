@@ -32,14 +32,7 @@ int main(int argc, char **argv)
     double *p = malloc(np * 3 * sizeof *p);
     double *ss = malloc(np * 3 * sizeof *ss), *sp = malloc(np * 3 * sizeof *sp);
     box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, no_offset, x);
-    for (size_t i = 0; i < m; ++i) {
-        const double *y = x + 3 * i;
-        double dx = y[0] - 2.0, dy = y[1] - 1.0, r = hypot(dx, dy) + 1e-12;
-        double sc = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
-        d[3 * i] = sc * dx / r + 0.01 * sin(y[2]);
-        d[3 * i + 1] = sc * dy / r;
-        d[3 * i + 2] = 0.02 * y[0] * y[0] / 16.0;
-    }
+    bore_motion(m, x, 2.0, 1.0, d);
     memcpy(p, x, m * 3 * sizeof *p);
     for (size_t i = 0; i < nin; ++i) {
         double t = (double)i / (double)nin;

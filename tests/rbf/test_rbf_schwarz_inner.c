@@ -15,17 +15,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void motion(size_t n, const double *x, double *d)
-{
-    for (size_t i = 0; i < n; ++i) {
-        double dx = x[3 * i] - 2.0, dy = x[3 * i + 1] - 1.0, r = hypot(dx, dy) + 1e-12;
-        double s = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
-        d[3 * i] = s * dx / r + 0.01 * sin(x[3 * i + 2]);
-        d[3 * i + 1] = s * dy / r;
-        d[3 * i + 2] = 0.02 * x[3 * i] * x[3 * i] / 16.0;
-    }
-}
-
 /* fit, evaluate at the np points p; inner solves / iterations of the preconditioner */
 static cm_status fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
                      const double *d, size_t np, const double *p, double *out,
@@ -50,7 +39,7 @@ static void test_inner(cm_context *ctx)
     size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, NULL);
     double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
     box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, x);
-    motion(m, x, d);
+    bore_motion(m, x, 2.0, 1.0, d);
     const size_t nin = 1500, np = m + nin;
     double *p = malloc(np * 3 * sizeof *p);
     memcpy(p, x, m * 3 * sizeof *p);

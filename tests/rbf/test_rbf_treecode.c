@@ -13,17 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void bore_motion(size_t n, const double *x, double *d)
-{
-    for (size_t i = 0; i < n; ++i) {
-        double dx = x[3 * i] - 2.0, dy = x[3 * i + 1] - 1.0, r = hypot(dx, dy) + 1e-12;
-        double s = 0.05 * exp(-2.0 * (r - 0.4) * (r - 0.4));
-        d[3 * i] = s * dx / r + 0.01 * sin(x[3 * i + 2]);
-        d[3 * i + 1] = s * dy / r;
-        d[3 * i + 2] = 0.02 * x[3 * i] * x[3 * i] / 16.0;
-    }
-}
-
 static double *bore_set(double h, size_t *m)
 {
     const double off[3] = {0.0, 0.0, 0.0};
@@ -208,7 +197,7 @@ static void test_bound_real(cm_context *ctx)
     size_t m;
     double *x = bore_set(0.076, &m); /* ~5k centres */
     double *d = malloc(m * 3 * sizeof *d);
-    bore_motion(m, x, d);
+    bore_motion(m, x, 2.0, 1.0, d);
     cm_rbf_options o;
     cm_rbf_options_init(&o);
     o.solver = CM_RBF_SOLVER_DENSE;
@@ -252,7 +241,7 @@ static void test_fit(cm_context *ctx)
     size_t m;
     double *x = bore_set(0.076, &m);
     double *d = malloc(m * 3 * sizeof *d);
-    bore_motion(m, x, d);
+    bore_motion(m, x, 2.0, 1.0, d);
     const size_t nin = 4000, np = m + nin;
     double *p = malloc(np * 3 * sizeof *p);
     memcpy(p, x, m * 3 * sizeof *p);
@@ -347,7 +336,7 @@ static void test_evaluation(cm_context *ctx)
         for (size_t i = 0; i < m; ++i)
             for (int e = 0; e < 3; ++e)
                 d[3 * i + e] = 0.01 * sin(1.0 + e + x[3 * i]) * cos(x[3 * i + 1] - 0.5 * x[3 * i + 2]);
-        if (set == 1) bore_motion(m, x, d);
+        if (set == 1) bore_motion(m, x, 2.0, 1.0, d);
         const size_t n = 10000;
         double *p = malloc(n * 3 * sizeof *p), *a = malloc(n * 3 * sizeof *a);
         double *b = malloc(n * 3 * sizeof *b);
