@@ -33,6 +33,22 @@ static void face_normal(const cm_mesh *mesh, const cm_mesh_boundary *b, size_t f
     }
 }
 
+/* 1 if boundary face f has a node off G (state 2) */
+static int face_has_off(const cm_mesh_boundary *b, const unsigned char *state, size_t f)
+{
+    for (int64_t k = b->face_offset[f]; k < b->face_offset[f + 1]; ++k)
+        if ((state[b->face_nodes[k]] & 3) == 2) return 1;
+    return 0;
+}
+
+/* distance of nodes v and w */
+static double node_dist(const cm_mesh *mesh, int64_t v, int64_t w)
+{
+    const double *p = mesh->xyz + 3 * v, *q = mesh->xyz + 3 * w;
+    return sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                (p[2] - q[2]) * (p[2] - q[2]));
+}
+
 /* The contact nodes and the fixed surface around each (state: 1 on G, 2 off G, per node;
  * at: index into nodes->node, per node). */
 static cm_status find_contact(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
@@ -46,9 +62,8 @@ static cm_status find_contact(cm_context *ctx, const cm_mesh *mesh, const cm_mes
         slot[i] = -1;
     /* faces with a node off G and one on G: their on nodes are contact nodes */
     for (size_t f = 0; f < b->n_faces; ++f) {
-        int64_t a = b->face_offset[f], e = b->face_offset[f + 1], has_off = 0;
-        for (int64_t k = a; k < e; ++k)
-            has_off |= (state[b->face_nodes[k]] & 3) == 2;
+        int64_t a = b->face_offset[f], e = b->face_offset[f + 1];
+        const int has_off = face_has_off(b, state, f);
         if (!has_off) continue;
         for (int64_t k = a; k < e; ++k) {
             int64_t v = b->face_nodes[k];
@@ -69,24 +84,20 @@ static cm_status find_contact(cm_context *ctx, const cm_mesh *mesh, const cm_mes
     /* pass 1: the area-weighted normal of the faces with an off node around each contact node,
      * and its shortest boundary edge */
     for (size_t f = 0; f < b->n_faces; ++f) {
-        int64_t a = b->face_offset[f], e = b->face_offset[f + 1], has_off = 0;
-        for (int64_t k = a; k < e; ++k)
-            has_off |= (state[b->face_nodes[k]] & 3) == 2;
+        int64_t a = b->face_offset[f], e = b->face_offset[f + 1];
+        const int has_off = face_has_off(b, state, f);
         double n[3] = {0, 0, 0};
         if (has_off) face_normal(mesh, b, f, n);
         for (int64_t k = a; k < e; ++k) {
             int64_t v = b->face_nodes[k], s = slot[v];
             if (s < 0) continue;
-            int64_t w = b->face_nodes[k + 1 < e ? k + 1 : a];
-            const double *p = mesh->xyz + 3 * v, *q = mesh->xyz + 3 * w;
-            double len = sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                              (p[2] - q[2]) * (p[2] - q[2]));
-            if (len > 0 && 1e-3 * len < c->tol[s]) c->tol[s] = 1e-3 * len;
-            int64_t u = b->face_nodes[k > a ? k - 1 : e - 1];
-            const double *r = mesh->xyz + 3 * u;
-            len = sqrt((p[0] - r[0]) * (p[0] - r[0]) + (p[1] - r[1]) * (p[1] - r[1]) +
-                       (p[2] - r[2]) * (p[2] - r[2]));
-            if (len > 0 && 1e-3 * len < c->tol[s]) c->tol[s] = 1e-3 * len;
+            /* the shorter of its two edges in this face */
+            const int64_t nb[2] = {b->face_nodes[k + 1 < e ? k + 1 : a],
+                                   b->face_nodes[k > a ? k - 1 : e - 1]};
+            for (int t = 0; t < 2; ++t) {
+                const double len = node_dist(mesh, v, nb[t]);
+                if (len > 0 && 1e-3 * len < c->tol[s]) c->tol[s] = 1e-3 * len;
+            }
             if (has_off)
                 for (int d = 0; d < 3; ++d)
                     c->normal[3 * s + d] += n[d];
@@ -102,9 +113,8 @@ static cm_status find_contact(cm_context *ctx, const cm_mesh *mesh, const cm_mes
     }
     /* pass 2: flat means every node of those faces within tol of the plane */
     for (size_t f = 0; f < b->n_faces; ++f) {
-        int64_t a = b->face_offset[f], e = b->face_offset[f + 1], has_off = 0;
-        for (int64_t k = a; k < e; ++k)
-            has_off |= (state[b->face_nodes[k]] & 3) == 2;
+        int64_t a = b->face_offset[f], e = b->face_offset[f + 1];
+        const int has_off = face_has_off(b, state, f);
         if (!has_off) continue;
         for (int64_t k = a; k < e; ++k) {
             int64_t v = b->face_nodes[k], s = slot[v];
