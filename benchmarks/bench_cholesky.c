@@ -11,6 +11,7 @@
  * cpu_s: best CPU seconds of the process (dpftrf/blocked/lookahead; spinning workers count);
  * FULL=1: also dpotrf on full storage, unpacked from and packed back into RFP (dtfttr,
  * dtrttf; timed with the copies and without), the alternative for small n. */
+#include "cli/blas_reexec.h"
 #include "rbf/rbf_internal.h"
 #include "bench_util.h"
 
@@ -163,6 +164,7 @@ static double dgemm_rate(void)
 
 int main(int argc, char **argv)
 {
+    cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
     if (argc < 4) {
         fprintf(stderr, "usage: %s THREADS REPS N...\n", argv[0]);
         return 1;

@@ -9,6 +9,7 @@
  * (the machine is shared: the best of a few runs is the least disturbed one); the dgemm
  * rate is measured before every repetition and its best is used for the bound.
  *        bench_rbf warm GB            (touches GB of fresh memory once, see bench_rbf.sh) */
+#include "cli/blas_reexec.h"
 #include "cadmorph/rbf.h"
 
 #include <cblas.h>
@@ -87,6 +88,7 @@ static double dgemm_rate(void)
 
 int main(int argc, char **argv)
 {
+    cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
     if (argc < 3) {
         fprintf(stderr, "usage: %s M DIR [THREADS] | %s warm GB\n", argv[0], argv[0]);
         return 1;

@@ -7,6 +7,8 @@
  *        [--fast-refine N] [--fast-eval-tol T] [--no-centres] [--relax 0|1]
  *        [--coarse-inner N] [--coarse-inner-tol T]
  * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
+#include "cli/blas_reexec.h"
+#include "cadmorph/blas.h"
 #include "cadmorph/rbf.h"
 #include "rbf/rbf_internal.h" /* the inner coarse solver's counts, the unit product */
 
@@ -114,6 +116,7 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
 
 int main(int argc, char **argv)
 {
+    cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
     if (argc < 2) {
         fprintf(stderr, "usage: bench_rbf_iterative PREFIX [options], see the source\n");
         return 1;
@@ -173,7 +176,9 @@ int main(int argc, char **argv)
     const double range = hi - lo;
 
     run it = {0}, dn = {0};
-    printf("set=%s m=%zu interior=%zu", prefix, m, ne);
+    cm_blas_summary blas;
+    cm_blas_info(NULL, &blas);
+    printf("set=%s m=%zu interior=%zu core=%s", prefix, m, ne, blas.core);
     if (iterative) {
         o.solver = CM_RBF_SOLVER_ITERATIVE;
         fit(ctx, &o, m, x, v, ne, p, &it);

@@ -12,6 +12,7 @@
  * --comp: the rounding levels of cm_rbf_tree_set_compensated, each in turn.
  * PREFIX.centres / .values as for bench_rbf_iterative; WEIGHTS: a cache of the solved
  * weights (written by the first run, read afterwards). One key=value line per setting. */
+#include "cli/blas_reexec.h"
 #include "cadmorph/rbf.h"
 #include "rbf/rbf_internal.h"
 #include "rbf/rbf_treecode.h"
@@ -270,6 +271,7 @@ static int at_points(const char *prefix, const char *file, size_t m, const doubl
 
 int main(int argc, char **argv)
 {
+    cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
     if (argc < 3) {
         fprintf(stderr, "usage: bench_rbf_treecode PREFIX WEIGHTS [options], see the source\n");
         return 1;

@@ -4,6 +4,7 @@
  * BENCH_VERBOSE=1 in the environment shows the library's log (stage timings) on stderr.
  * usage: bench_warp MESH [steps=20] [threads=2] [methods=rbf,rbf-biharmonic,femwarp,lbwarp,simplex]
  * One line per method: key=value pairs (RESULTS.md, "Warp methods"). */
+#include "cli/blas_reexec.h"
 #include "cadmorph/mesh.h"
 #include "cadmorph/warp.h"
 
@@ -122,6 +123,7 @@ static int run(const char *path, cm_warp_method method, int steps, int threads)
 
 int main(int argc, char **argv)
 {
+    cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
     if (argc < 2) {
         fprintf(stderr, "usage: bench_warp MESH [steps] [threads] [methods]\n");
         return 1;

@@ -7,6 +7,7 @@
  *   methods: comma list of rbf-s, rbf, rbf-s-biharmonic, femwarp, lbwarp, simplex
  *   modes: absolute,relative (default both)
  * One line per step: key=value pairs (benchmarks/bench_warp_sweep_table.py). */
+#include "cli/blas_reexec.h"
 #include "cadmorph/cad.h"
 #include "cadmorph/morph.h"
 #include "cadmorph/models.h"
@@ -35,6 +36,7 @@ static int parse_method(const char *name, cm_morph_method *m)
 
 int main(int argc, char **argv)
 {
+    cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
     if (argc < 5) {
         fprintf(stderr,
                 "usage: bench_warp_sweep MODEL M0.msh STEPS WORK [methods] [threads] [modes]\n");

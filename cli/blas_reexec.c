@@ -8,7 +8,7 @@
  *    spins forever); cm_rbf_create raises the count for the factorisation to --threads.
  * A marker variable keeps it to one re-exec. The cost is one more program start (~70 ms). */
 #define _GNU_SOURCE /* setenv, unsetenv */
-#include "cli.h"
+#include "blas_reexec.h"
 
 #include "cadmorph/blas.h"
 

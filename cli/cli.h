@@ -5,6 +5,7 @@
 
 #include "cadmorph/core.h"
 #include "cadmorph/mesh.h"
+#include "blas_reexec.h" /* cli_blas_setup, cli_blas_print_version */
 
 #include <stdio.h>
 
@@ -69,11 +70,6 @@ cm_status cli_print_quality(cm_context *ctx, const cm_mesh *mesh, const double *
  * Returns k. */
 size_t cli_warn_inverted(const char *cmd, const cm_mesh *mesh, const double *sj);
 
-/* OpenBLAS set-up (cli/blas_reexec.c), first thing in main: may execute the program again
- * with OPENBLAS_CORETYPE and OPENBLAS_NUM_THREADS set (blas.h); says so under --verbose. */
-void cli_blas_setup(int argc, char **argv);
-/* The BLAS lines of --version: library, core (and who chose it), threads. */
-void cli_blas_print_version(FILE *out);
 
 /* Subcommands: argv[0] is the subcommand name. */
 int cli_cmd_quality(int argc, char **argv);
