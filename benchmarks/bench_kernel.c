@@ -7,7 +7,9 @@
  * sum should reach).
  * usage: bench_kernel N REPS THREADS,... M,...      e.g. bench_kernel 10000 3 1,2 10000,100000
  * (one line of key=value per m, threads, variant and sum) */
+#include "cli/blas_reexec.h"
 #include "rbf/rbf_internal.h"
+#include "rbf/rbf_sum_isa.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -20,13 +22,18 @@
 #define NREF 64
 #define NC 3
 
+/* plain_sqrt / acc_sqrt: the vsqrtpd split forced on the hand-written blocks (0: the one
+ * the process probed, rbf_sum_isa.h) */
 static const struct {
     cm_rbf_isa isa;
     const char *name;
+    int plain_sqrt, acc_sqrt;
 } variants[] = {
-    {CM_RBF_ISA_AVX512_AUTOVEC, "avx512_autovec"}, /* before: GCC's vectorisation */
-    {CM_RBF_ISA_AVX512, "avx512"},                 /* after: rbf_sum_avx512.c */
-    {CM_RBF_ISA_AVX2, "avx2"},
+    {CM_RBF_ISA_AVX512_AUTOVEC, "avx512_autovec", 0, 0}, /* before: GCC's vectorisation */
+    {CM_RBF_ISA_AVX512, "avx512", 0, 0},                 /* after: rbf_sum_avx512.c */
+    {CM_RBF_ISA_AVX512, "avx512_split_3_2", 3, 2},       /* the Zen 5 split */
+    {CM_RBF_ISA_AVX512, "avx512_split_2_1", 2, 1},       /* the Sapphire-Rapids-class split */
+    {CM_RBF_ISA_AVX2, "avx2", 0, 0},
 };
 #define NVAR (int)(sizeof variants / sizeof variants[0])
 
@@ -44,6 +51,7 @@ static int parse_list(const char *s, long *out, int max)
 
 int main(int argc, char **argv)
 {
+    cli_blas_setup(argc, argv); /* the right OpenBLAS core for the dgemm probe */
     if (argc < 5) {
         fprintf(stderr, "usage: %s N REPS THREADS,... M,...\n", argv[0]);
         return 1;
@@ -61,8 +69,11 @@ int main(int argc, char **argv)
     if (!c || !w || !p || !out || !ref || !absum) return 2;
     for (size_t i = 0; i < 3 * n; ++i) p[i] = bench_urand();
 
-    printf("# bench_kernel: n=%zu points, %d weight vectors, reps=%d (best of), AUTO=%d\n", n,
-           NC, reps, (int)cm_rbf_isa_auto());
+    int split_plain = 0, split_acc = 0;
+    cm_rbf_sqrt_split(&split_plain, &split_acc);
+    printf("# bench_kernel: n=%zu points, %d weight vectors, reps=%d (best of), AUTO=%d, "
+           "probed sqrt split: plain %d of 4, compensated %d of 2 through vsqrtpd\n",
+           n, NC, reps, (int)cm_rbf_isa_auto(), split_plain, split_acc);
     for (int km = 0; km < nm; ++km) {
         const size_t m = (size_t)ms[km];
         for (size_t i = 0; i < 3 * m; ++i) c[i] = bench_urand();
@@ -90,6 +101,7 @@ int main(int argc, char **argv)
             for (int r = 0; r < reps; ++r)
                 for (int v = 0; v < NVAR; ++v) {
                     if (!cm_rbf_isa_supported(variants[v].isa)) continue;
+                    cm_rbf_sqrt_split_force(variants[v].plain_sqrt, variants[v].acc_sqrt);
                     for (int s = 0; s < 2; ++s) {
                         double t0 = bench_cpu_seconds(), w0 = cm_wtime();
                         if (s == 0)
@@ -110,6 +122,7 @@ int main(int argc, char **argv)
                         err_abs[v][s] = ea, err_rel[v][s] = er;
                     }
                 }
+            cm_rbf_sqrt_split_force(0, 0);
             for (int v = 0; v < NVAR; ++v)
                 for (int s = 0; s < 2; ++s) {
                     if (!cm_rbf_isa_supported(variants[v].isa)) continue;

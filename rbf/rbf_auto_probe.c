@@ -15,7 +15,7 @@
 /* CPU time of the calling thread: on a loaded machine a wall-clock probe of a few ms is
  * often preempted (measured at load 11: dgemm 16 GF/s by wall clock, 60 by thread CPU
  * time), and the probe runs on this thread alone (one BLAS thread, threads = 1) */
-static double thread_seconds(void)
+double cm_rbf_thread_seconds(void)
 {
     struct timespec ts;
     if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return cm_wtime();
@@ -42,10 +42,10 @@ static void probe(void)
     for (size_t i = 0; i < (size_t)n * n; ++i) a[i] = 1.0 / (1.0 + (double)(i % 13)), b[i] = 0.5;
     double best = INFINITY;
     for (int r = 0; r < 4; ++r) {
-        const double t = thread_seconds();
+        const double t = cm_rbf_thread_seconds();
         cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, n, n, n, 1.0, a, n, b, n, 0.0, d,
                     n);
-        best = fmin(best, thread_seconds() - t);
+        best = fmin(best, cm_rbf_thread_seconds() - t);
     }
     if (best > 0.0) rate_gemm = 2.0 * n * (double)n * n / best;
 
@@ -61,12 +61,12 @@ static void probe(void)
     const double pairs = (double)PROBE_M * PROBE_N;
     double bp = INFINITY, ba = INFINITY;
     for (int r = 0; r < 4; ++r) {
-        double t = thread_seconds();
+        double t = cm_rbf_thread_seconds();
         cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, PROBE_M, c, w, 3, PROBE_N, p, PROBE_N, out, 3, 1);
-        bp = fmin(bp, thread_seconds() - t);
-        t = thread_seconds();
+        bp = fmin(bp, cm_rbf_thread_seconds() - t);
+        t = cm_rbf_thread_seconds();
         cm_rbf_kernel_sum_acc(PROBE_M, c, w, 3, PROBE_N, p, PROBE_N, out, 3, 1);
-        ba = fmin(ba, thread_seconds() - t);
+        ba = fmin(ba, cm_rbf_thread_seconds() - t);
     }
     if (bp > 0.0) rate_plain = pairs / bp;
     if (ba > 0.0) rate_acc = pairs / ba;

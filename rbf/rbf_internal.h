@@ -127,6 +127,10 @@ cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *g
 int cm_rbf_blas_callers(int want);
 /* ---- iterative solver (rbf_iterative.c, rbf_schwarz.c) ---- */
 
+/* CPU seconds of the calling thread (CLOCK_THREAD_CPUTIME_ID; wall time if it fails): what
+ * the once-per-process probes time, as a loaded machine delays them without biasing them. */
+double cm_rbf_thread_seconds(void);
+
 /* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */
 int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m);
 /* dgemm flops per second and r^3 kernel-sum pairs per second (plain, compensated; 3 weight

@@ -6,29 +6,46 @@
  * (the fixed binade below). Measured on Zen 5 (benchmarks/bench_kernel.c, RESULTS.md issue
  * 10): plain 3.3e9 -> 3.8-4.0e9, compensated 1.2e9 -> 2.4-2.6e9 pairs per CPU-second.
  *
- * The square root is the bottleneck of the plain sum (in a register-resident test: all
- * vsqrtpd 3.46e9 pairs/s, all rsqrt14 + Newton 2.37e9). So of every four vectors of
- * points, three take vsqrtpd and one computes sqrt on the FMA pipes instead: rsqrt14
+ * The square root is the bottleneck (in a register-resident test on Zen 5: all vsqrtpd
+ * 3.46e9 pairs/s, all rsqrt14 + Newton 2.37e9). So of the vectors of points held in
+ * registers some take vsqrtpd and the others compute sqrt on the FMA pipes instead: rsqrt14
  * (14 bits), two Goldschmidt steps and a final Newton correction with an FMA residual
  * (Markstein's scheme). In a test of 1.6e7 arguments over 40 binades that sequence returned
  * the correctly rounded sqrt every time (one Goldschmidt step fewer errs by 1 ulp in 0.6 %),
  * so the entries phi_ij are the same whichever unit computed them, as the "fixed matrix"
- * argument of rbf_sum_acc.c needs. The mixture is 1.15x the all-vsqrtpd kernel.
+ * argument of rbf_sum_acc.c needs, and the split changes only the time.
+ *
+ * The best split is a property of the core, not of the ISA: vsqrtpd on 8 doubles is several
+ * times slower on a Sapphire-Rapids-class Xeon than on Zen 5. Measured (bench_kernel, 1
+ * thread, 3 weight vectors; RESULTS.md issue 10, fifth session): Zen 5 plain best with 3 of
+ * 4 vectors through vsqrtpd, fixed-binade compensated with 2 of 2; the Xeon plain 2 of 4
+ * (1.83e9 against 1.24e9 with 3 of 4), compensated 1 of 2 (1.30e9 against 0.93e9). So each
+ * block is built for both splits and split_probe times them once per process (a few ms).
  *
  * Built with -ffp-contract=off: the error-free transformations of the compensated block
  * need every rounding where it is written. */
 #include "rbf_sum_isa.h"
+#include "rbf_internal.h" /* cm_rbf_thread_seconds */
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <string.h>
 
 #define CM_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma")))
 #define CM_INLINE static inline __attribute__((always_inline))
 
 #define NV 4       /* vectors of 8 points held in registers */
-#define NSQRT 3    /* of them through vsqrtpd, the rest through rsqrt14 + Newton */
 #define TILE 512   /* centres per tile: 3 + 4 rows of 512 doubles stay in L1 */
 #define ACC_NV 2   /* compensated (both kinds): vectors of points held in registers (2 accumulators each) */
+/* the candidate splits, vectors through vsqrtpd (the others through sqrt_fma): the two
+ * measured best, on Zen 5 (the first) and on the Xeon (the second) */
+#define PLAIN_SQRT_A 3 /* of NV */
+#define PLAIN_SQRT_B 2
+#define ACC_SQRT_A 2   /* of ACC_NV, in the fixed-binade block */
+#define ACC_SQRT_B 1
 
 /* sqrt(x) for x >= 0 without the sqrt unit. x = 0 (a point on a centre) would give
  * rsqrt14 = inf and 0 * inf = NaN, so the seed is taken at max(x, 1e-300): then s = x * y
@@ -49,22 +66,23 @@ CM_AVX512 CM_INLINE __m512d sqrt_fma(__m512d x)
     return _mm512_fmadd_pd(d, h, s);
 }
 
-/* |p - c_j|^3 for vector v of a register block (which unit by v, see above) */
-CM_AVX512 CM_INLINE __m512d r3_of(int v, __m512d x, __m512d y, __m512d z, __m512d xj,
+/* |p - c_j|^3 for one vector of a register block, its sqrt by vsqrtpd or (on_fma) sqrt_fma */
+CM_AVX512 CM_INLINE __m512d r3_of(int on_fma, __m512d x, __m512d y, __m512d z, __m512d xj,
                                   __m512d yj, __m512d zj)
 {
     __m512d dx = _mm512_sub_pd(x, xj), dy = _mm512_sub_pd(y, yj), dz = _mm512_sub_pd(z, zj);
     __m512d r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
-    __m512d r = v < NSQRT ? _mm512_sqrt_pd(r2) : sqrt_fma(r2);
+    __m512d r = on_fma ? sqrt_fma(r2) : _mm512_sqrt_pd(r2);
     return _mm512_mul_pd(r2, r);
 }
 
 /* Centres [0, jn) of a tile (coordinate d at c + d * ldc, component q's weights at
  * w + q * ldw) against nv * 8 points at pt (coordinate d at pt + d * ldp, sums at acc + q *
- * ldp). nv = NV in the direct sums; the treecode's batches end with a tail of nv < NV
- * vectors, all through vsqrtpd. nv, nc and (in the direct sums) the strides are constants
- * after inlining. */
-CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nc, const double *c, size_t ldc,
+ * ldp), nsq of the NV vectors through vsqrtpd. nv = NV in the direct sums; the treecode's
+ * batches end with a tail of nv < NV vectors, all through vsqrtpd. nv, nsq, nc and (in the
+ * direct sums) the strides are constants after inlining. */
+CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nsq, const int nc, const double *c,
+                                    size_t ldc,
                                     const double *w, size_t ldw, size_t jn, const double *pt,
                                     size_t ldp, double *acc)
 {
@@ -82,7 +100,7 @@ CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nc, const double *c,
         __m512d wj[4];
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
         for (int v = 0; v < nv; ++v) {
-            const __m512d f = r3_of(nv == NV ? v : 0, x[v], y[v], z[v], xj, yj, zj);
+            const __m512d f = r3_of(nv == NV && v >= nsq, x[v], y[v], z[v], xj, yj, zj);
             for (int q = 0; q < nc; ++q) a[q][v] = _mm512_fmadd_pd(wj[q], f, a[q][v]);
         }
     }
@@ -93,9 +111,9 @@ CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nc, const double *c,
 /* All m centres, tile by tile, against npt points (rounded up to a multiple of 8: pt and
  * acc must hold that many). One body for the direct sums (npt = ldp = CM_RBF_SUM_PB,
  * ldc = ldw = m) and the treecode (any strides), so both run the same kernel. */
-CM_AVX512 CM_INLINE void block_plain(const int nc, size_t m, const double *c, size_t ldc,
-                                     const double *w, size_t ldw, size_t npt, const double *pt,
-                                     size_t ldp, double *acc)
+CM_AVX512 CM_INLINE void block_plain(const int nsq, const int nc, size_t m, const double *c,
+                                     size_t ldc, const double *w, size_t ldw, size_t npt,
+                                     const double *pt, size_t ldp, double *acc)
 {
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         const size_t jn = m - t0 < TILE ? m - t0 : TILE;
@@ -104,37 +122,34 @@ CM_AVX512 CM_INLINE void block_plain(const int nc, size_t m, const double *c, si
             const double *cb = c + t0, *wb = w + t0, *pb = pt + b;
             double *ab = acc + b;
             switch (left >= NV ? NV : (int)left) {
-            case 1: tile_plain(1, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
-            case 2: tile_plain(2, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
-            case 3: tile_plain(3, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
-            default: tile_plain(NV, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            case 1: tile_plain(1, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            case 2: tile_plain(2, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            case 3: tile_plain(3, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            default: tile_plain(NV, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
             }
         }
     }
 }
 
-CM_AVX512 void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
-                                      const double *pt, double *acc)
-{
-    const size_t PB = CM_RBF_SUM_PB;
-    switch (nc) {
-    case 1: block_plain(1, m, c, m, w, m, PB, pt, PB, acc); break;
-    case 2: block_plain(2, m, c, m, w, m, PB, pt, PB, acc); break;
-    case 3: block_plain(3, m, c, m, w, m, PB, pt, PB, acc); break;
-    default: block_plain(4, m, c, m, w, m, PB, pt, PB, acc); break;
-    }
-}
-
-CM_AVX512 void cm_rbf_r3_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
-                                        const double *w, size_t ldw, size_t npt,
+CM_AVX512 CM_INLINE void dispatch_plain(const int nsq, int nc, size_t m, const double *c,
+                                        size_t ldc, const double *w, size_t ldw, size_t npt,
                                         const double *pt, size_t ldp, double *acc)
 {
     switch (nc) {
-    case 1: block_plain(1, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
-    case 2: block_plain(2, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
-    case 3: block_plain(3, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
-    default: block_plain(4, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 1: block_plain(nsq, 1, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 2: block_plain(nsq, 2, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 3: block_plain(nsq, 3, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    default: block_plain(nsq, 4, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
     }
+}
+
+/* the direct sums' block (constant strides) under either split */
+CM_AVX512 static void plain_split(int alt, int nc, size_t m, const double *c, const double *w,
+                                  const double *pt, double *acc)
+{
+    const size_t PB = CM_RBF_SUM_PB;
+    if (alt) dispatch_plain(PLAIN_SQRT_B, nc, m, c, m, w, m, PB, pt, PB, acc);
+    else dispatch_plain(PLAIN_SQRT_A, nc, m, c, m, w, m, PB, pt, PB, acc);
 }
 
 /* ---- compensated sums: s + e += w * f exactly to first order ----
@@ -150,9 +165,10 @@ CM_AVX512 void cm_rbf_r3_strided_avx512(int nc, size_t m, const double *c, size_
  * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the vector operation
  * count was the limit: TwoSum ran at 0.4x the plain sum's throughput). This is the binned
  * summation of the reproducible-BLAS literature (Demmel and Nguyen) with a single bin. */
-CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nv, const int nc, const double *c,
-                                  size_t ldc, const double *w, size_t ldw, size_t jn,
-                                  const double *pt, size_t ldp, double *hi, double *lo)
+CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nsq, const int nv, const int nc,
+                                  const double *c, size_t ldc, const double *w, size_t ldw,
+                                  size_t jn, const double *pt, size_t ldp, double *hi,
+                                  double *lo)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     __m512d x[ACC_NV], y[ACC_NV], z[ACC_NV], s[4][ACC_NV], e[4][ACC_NV];
@@ -171,7 +187,7 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nv, const int nc, c
         __m512d wj[4];
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
         for (int v = 0; v < nv; ++v) {
-            const __m512d f = r3_of(fixed ? v : 0, x[v], y[v], z[v], xj, yj, zj);
+            const __m512d f = r3_of(fixed && v >= nsq, x[v], y[v], z[v], xj, yj, zj);
             for (int q = 0; q < nc; ++q) {
                 if (fixed) {
                     const __m512d t = _mm512_fmadd_pd(wj[q], f, s[q][v]);
@@ -199,39 +215,140 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nv, const int nc, c
 }
 
 /* as block_plain: one body for the direct sums (npt = ldp = CM_RBF_ACC_PB) and the
- * treecode's compensated products (any strides; a tail of one vector) */
-CM_AVX512 CM_INLINE void block_acc(const int fixed, const int nc, size_t m, const double *c,
-                                   size_t ldc, const double *w, size_t ldw, size_t npt,
-                                   const double *pt, size_t ldp, double *hi, double *lo)
+ * treecode's compensated products (any strides; a tail of one vector); nsq of the ACC_NV
+ * vectors through vsqrtpd in the fixed-binade block (the TwoSum block keeps the FMA pipes
+ * busy, so all of its vectors take vsqrtpd) */
+CM_AVX512 CM_INLINE void block_acc(const int fixed, const int nsq, const int nc, size_t m,
+                                   const double *c, size_t ldc, const double *w, size_t ldw,
+                                   size_t npt, const double *pt, size_t ldp, double *hi,
+                                   double *lo)
 {
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         const size_t jn = m - t0 < TILE ? m - t0 : TILE;
         for (size_t b = 0; b < npt; b += 8 * ACC_NV) {
             if (npt - b > 8 * (ACC_NV - 1))
-                tile_acc(fixed, ACC_NV, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp, hi + b,
-                         lo + b);
+                tile_acc(fixed, nsq, ACC_NV, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp,
+                         hi + b, lo + b);
             else
-                tile_acc(fixed, 1, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp, hi + b, lo + b);
+                tile_acc(fixed, nsq, 1, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp, hi + b,
+                         lo + b);
         }
     }
 }
 
-CM_AVX512 CM_INLINE void dispatch_acc(const int fixed, int nc, size_t m, const double *c,
-                                      size_t ldc, const double *w, size_t ldw, size_t npt,
-                                      const double *pt, size_t ldp, double *hi, double *lo)
+CM_AVX512 CM_INLINE void dispatch_acc(const int fixed, const int nsq, int nc, size_t m,
+                                      const double *c, size_t ldc, const double *w, size_t ldw,
+                                      size_t npt, const double *pt, size_t ldp, double *hi,
+                                      double *lo)
 {
     switch (nc) {
-    case 1: block_acc(fixed, 1, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
-    case 2: block_acc(fixed, 2, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
-    case 3: block_acc(fixed, 3, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
-    default: block_acc(fixed, 4, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 1: block_acc(fixed, nsq, 1, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 2: block_acc(fixed, nsq, 2, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 3: block_acc(fixed, nsq, 3, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    default: block_acc(fixed, nsq, 4, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
     }
+}
+
+/* the fixed-binade block of the direct sums under either split */
+CM_AVX512 static void accf_split(int alt, int nc, size_t m, const double *c, const double *w,
+                                 const double *pt, double *hi, double *lo)
+{
+    const size_t PB = CM_RBF_ACC_PB;
+    if (alt) dispatch_acc(1, ACC_SQRT_B, nc, m, c, m, w, m, PB, pt, PB, hi, lo);
+    else dispatch_acc(1, ACC_SQRT_A, nc, m, c, m, w, m, PB, pt, PB, hi, lo);
+}
+
+/* ---- the split of this CPU ---- */
+
+static int split_plain_alt, split_acc_alt; /* 1: the B split is faster here */
+static pthread_once_t split_once = PTHREAD_ONCE_INIT;
+static _Atomic int split_forced; /* cm_rbf_sqrt_split_force: 1 + plain_alt + 2 acc_alt */
+
+/* Times both splits of both blocks on one tile of centres against one work item of points
+ * (about 0.3 ms a call), interleaved, best of 3 by the thread's CPU clock, so a loaded
+ * machine delays the probe but does not bias it. */
+static void split_probe(void)
+{
+    enum { NPROBE = TILE, REPS = 3, CALLS = 4 };
+    static double c[3 * NPROBE], w[3 * NPROBE], pt[3 * CM_RBF_SUM_PB], acc[4 * CM_RBF_SUM_PB];
+    static double hi[4 * CM_RBF_ACC_PB], lo[4 * CM_RBF_ACC_PB];
+    for (int j = 0; j < NPROBE; ++j)
+        for (int k = 0; k < 3; ++k) {
+            c[k * NPROBE + j] = fmod(0.5 + j * (0.7548776662 + 0.1 * k), 1.0);
+            w[k * NPROBE + j] = (j % 2 ? -1.0 : 1.0) * (1.0 + 0.001 * k);
+        }
+    for (int i = 0; i < CM_RBF_SUM_PB; ++i)
+        for (int k = 0; k < 3; ++k) pt[k * CM_RBF_SUM_PB + i] = fmod(0.25 + i * (0.5698 + 0.1 * k), 1.0);
+    double best[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}}; /* [block][alt] */
+    for (int r = 0; r < REPS; ++r)
+        for (int alt = 0; alt < 2; ++alt) {
+            memset(acc, 0, sizeof acc);
+            double t = cm_rbf_thread_seconds();
+            for (int k = 0; k < CALLS; ++k) plain_split(alt, 3, NPROBE, c, w, pt, acc);
+            best[0][alt] = fmin(best[0][alt], cm_rbf_thread_seconds() - t);
+            for (int i = 0; i < 4 * CM_RBF_ACC_PB; ++i) hi[i] = 0x1.8p40, lo[i] = 0.0;
+            t = cm_rbf_thread_seconds();
+            for (int k = 0; k < CALLS; ++k) accf_split(alt, 3, NPROBE, c, w, pt, hi, lo);
+            best[1][alt] = fmin(best[1][alt], cm_rbf_thread_seconds() - t);
+        }
+    split_plain_alt = best[0][1] < best[0][0];
+    split_acc_alt = best[1][1] < best[1][0];
+}
+
+static void split_get(int *plain_alt, int *acc_alt)
+{
+    const int f = atomic_load_explicit(&split_forced, memory_order_relaxed);
+    if (f) {
+        *plain_alt = (f - 1) & 1, *acc_alt = (f - 1) >> 1;
+        return;
+    }
+    pthread_once(&split_once, split_probe);
+    *plain_alt = split_plain_alt, *acc_alt = split_acc_alt;
+}
+
+void cm_rbf_sqrt_split(int *plain_sqrt, int *acc_sqrt)
+{
+    int pa, aa;
+    split_get(&pa, &aa);
+    *plain_sqrt = pa ? PLAIN_SQRT_B : PLAIN_SQRT_A;
+    *acc_sqrt = aa ? ACC_SQRT_B : ACC_SQRT_A;
+}
+
+int cm_rbf_sqrt_split_force(int plain_sqrt, int acc_sqrt)
+{
+    if (plain_sqrt == 0 && acc_sqrt == 0) {
+        atomic_store(&split_forced, 0);
+        return 0;
+    }
+    if ((plain_sqrt != PLAIN_SQRT_A && plain_sqrt != PLAIN_SQRT_B) ||
+        (acc_sqrt != ACC_SQRT_A && acc_sqrt != ACC_SQRT_B))
+        return -1;
+    atomic_store(&split_forced, 1 + (plain_sqrt == PLAIN_SQRT_B) + 2 * (acc_sqrt == ACC_SQRT_B));
+    return 0;
+}
+
+CM_AVX512 void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
+                                      const double *pt, double *acc)
+{
+    int pa, aa;
+    split_get(&pa, &aa);
+    plain_split(pa, nc, m, c, w, pt, acc);
+}
+
+CM_AVX512 void cm_rbf_r3_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
+                                        const double *w, size_t ldw, size_t npt,
+                                        const double *pt, size_t ldp, double *acc)
+{
+    int pa, aa;
+    split_get(&pa, &aa);
+    if (pa) dispatch_plain(PLAIN_SQRT_B, nc, m, c, ldc, w, ldw, npt, pt, ldp, acc);
+    else dispatch_plain(PLAIN_SQRT_A, nc, m, c, ldc, w, ldw, npt, pt, ldp, acc);
 }
 
 CM_AVX512 void cm_rbf_r3_acc_block_avx512(int nc, size_t m, const double *c, const double *w,
                                           const double *pt, double *hi, double *lo)
 {
-    dispatch_acc(0, nc, m, c, m, w, m, CM_RBF_ACC_PB, pt, CM_RBF_ACC_PB, hi, lo);
+    dispatch_acc(0, ACC_NV, nc, m, c, m, w, m, CM_RBF_ACC_PB, pt, CM_RBF_ACC_PB, hi, lo);
 }
 
 CM_AVX512 void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
@@ -239,13 +356,15 @@ CM_AVX512 void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, s
                                             const double *pt, size_t ldp, double *hi,
                                             double *lo)
 {
-    dispatch_acc(0, nc, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo);
+    dispatch_acc(0, ACC_NV, nc, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo);
 }
 
 CM_AVX512 void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
                                            const double *pt, double *hi, double *lo)
 {
-    dispatch_acc(1, nc, m, c, m, w, m, CM_RBF_ACC_PB, pt, CM_RBF_ACC_PB, hi, lo);
+    int pa, aa;
+    split_get(&pa, &aa);
+    accf_split(aa, nc, m, c, w, pt, hi, lo);
 }
 
 int cm_rbf_cpu_avx512(void)
@@ -296,6 +415,11 @@ void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
     (void)ldp, (void)hi, (void)lo;
 }
 
+void cm_rbf_sqrt_split(int *plain_sqrt, int *acc_sqrt) { *plain_sqrt = *acc_sqrt = 0; }
+int cm_rbf_sqrt_split_force(int plain_sqrt, int acc_sqrt)
+{
+    return plain_sqrt == 0 && acc_sqrt == 0 ? 0 : -1;
+}
 int cm_rbf_cpu_avx512(void) { return 0; }
 int cm_rbf_cpu_avx2(void) { return 0; }
 

@@ -43,6 +43,15 @@ void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
 void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
                                  const double *pt, double *hi, double *lo);
 
+/* The vsqrtpd share of the AVX-512 r^3 blocks on this CPU (rbf_sum_avx512.c says why it
+ * varies): vectors of the plain block's 4, and of the fixed-binade block's 2, whose sqrt
+ * takes vsqrtpd; chosen by timing once per process, the results do not depend on it. */
+void cm_rbf_sqrt_split(int *plain_sqrt, int *acc_sqrt);
+/* For benchmarks and tests: use this split from now on (one of the two candidates of each
+ * block: plain 3 or 2, compensated 2 or 1), or (0, 0) the probed one again. -1: not a
+ * candidate (or no AVX-512 blocks in this build). */
+int cm_rbf_sqrt_split_force(int plain_sqrt, int acc_sqrt);
+
 /* 1 if this CPU and OS run AVX-512 F/DQ/VL code (cpuid, as GCC's __builtin_cpu_supports). */
 int cm_rbf_cpu_avx512(void);
 /* 1 if they run AVX2 + FMA code. */

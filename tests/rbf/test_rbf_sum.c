@@ -5,8 +5,10 @@
  * opposite weights), where a plain sum is off by far more; sizes off every block and vector
  * width (tails); points on centres (phi = 0, the rsqrt seed); 1 and 2 threads identical.
  * Coordinates are multiples of 2^-10, so r^2 is exact and phi_ij is the same double in every
- * variant: the comparison measures the summation alone. */
+ * variant: the comparison measures the summation alone. Both vsqrtpd splits of the AVX-512
+ * blocks give the same bits (off the grid too). */
 #include "rbf/rbf_internal.h"
+#include "rbf/rbf_sum_isa.h"
 #include "test_rng.h"
 #include "test_util.h"
 
@@ -156,6 +158,37 @@ int main(void)
             CHECK_MSG(e <= 1e-12 * scale, "kernel %d: %.3g of %.3g", kern, e, scale);
         }
         free_set(&s);
+    }
+    /* The vsqrtpd split of the AVX-512 blocks (chosen by timing, rbf_sum_isa.h) changes which
+     * unit computes each sqrt, never the result: the FMA sequence is correctly rounded. So
+     * both splits give the same bits, here on coordinates off the grid (r^2 not exact). */
+    if (cm_rbf_isa_supported(CM_RBF_ISA_AVX512)) {
+        enum { M = 1500, N = 301, NC = 3 };
+        double *c = malloc(3 * M * sizeof *c), *w = malloc(NC * M * sizeof *w);
+        double *p = malloc(3 * N * sizeof *p), *o[2][2];
+        uint64_t st = 4242;
+        for (int i = 0; i < 3 * M; ++i) c[i] = test_rng_uniform(&st);
+        for (int i = 0; i < NC * M; ++i) w[i] = 2.0 * test_rng_uniform(&st) - 1.0;
+        for (int i = 0; i < 3 * N; ++i) p[i] = test_rng_uniform(&st);
+        static const int split[2][2] = {{3, 2}, {2, 1}};
+        for (int k = 0; k < 2; ++k) {
+            CHECK(cm_rbf_sqrt_split_force(split[k][0], split[k][1]) == 0);
+            o[k][0] = malloc(NC * N * sizeof(double)), o[k][1] = malloc(NC * N * sizeof(double));
+            cm_rbf_kernel_sum_isa(CM_RBF_ISA_AVX512, CM_RBF_TRIHARMONIC, 3, M, c, w, NC, N, p, N,
+                                  o[k][0], NC, 2);
+            cm_rbf_kernel_sum_acc_isa(CM_RBF_ISA_AVX512, M, c, w, NC, N, p, N, o[k][1], NC, 2);
+        }
+        CHECK(cm_rbf_sqrt_split_force(4, 2) == -1); /* not a candidate */
+        CHECK(cm_rbf_sqrt_split_force(0, 0) == 0);
+        int pl = 0, ac = 0;
+        cm_rbf_sqrt_split(&pl, &ac);
+        printf("probed sqrt split here: plain %d of 4, compensated %d of 2 through vsqrtpd\n", pl,
+               ac);
+        CHECK((pl == 3 || pl == 2) && (ac == 2 || ac == 1));
+        CHECK(memcmp(o[0][0], o[1][0], NC * N * sizeof(double)) == 0);
+        CHECK(memcmp(o[0][1], o[1][1], NC * N * sizeof(double)) == 0);
+        for (int k = 0; k < 2; ++k) free(o[k][0]), free(o[k][1]);
+        free(c), free(w), free(p);
     }
     printf("AVX-512 blocks %s\n", tried_avx512 ? "tested" : "not supported here: not tested");
     return TEST_REPORT();
