@@ -22,6 +22,18 @@ double cm_rbf_thread_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+void cm_rbf_probe_data(size_t m, double *c, double *w, size_t n, double *p)
+{
+    /* a fixed low-discrepancy sequence over the unit cube, weights of alternating sign */
+    for (size_t j = 0; j < m; ++j)
+        for (int k = 0; k < 3; ++k) {
+            c[k * m + j] = fmod(0.5 + (double)j * (0.7548776662 + 0.1 * k), 1.0);
+            w[k * m + j] = (j % 2 ? -1.0 : 1.0) * (1.0 + 0.001 * k);
+        }
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) p[k * n + i] = fmod(0.25 + (double)i * (0.5698402910 + 0.1 * k), 1.0);
+}
+
 static double rate_gemm, rate_plain, rate_acc;
 static pthread_once_t probe_once = PTHREAD_ONCE_INIT;
 
@@ -49,15 +61,8 @@ static void probe(void)
     }
     if (best > 0.0) rate_gemm = 2.0 * n * (double)n * n / best;
 
-    /* centres and points spread over the unit cube by a fixed low-discrepancy sequence */
     double *w = c + 3 * PROBE_M, *p = w + 3 * PROBE_M, *out = p + 3 * PROBE_N;
-    for (int j = 0; j < PROBE_M; ++j)
-        for (int k = 0; k < 3; ++k) {
-            c[k * PROBE_M + j] = fmod(0.5 + j * (0.7548776662 + 0.1 * k), 1.0);
-            w[k * PROBE_M + j] = (j % 2 ? -1.0 : 1.0) * (1.0 + 0.001 * k);
-        }
-    for (int i = 0; i < PROBE_N; ++i)
-        for (int k = 0; k < 3; ++k) p[k * PROBE_N + i] = fmod(0.25 + i * (0.5698402910 + 0.1 * k), 1.0);
+    cm_rbf_probe_data(PROBE_M, c, w, PROBE_N, p);
     const double pairs = (double)PROBE_M * PROBE_N;
     double bp = INFINITY, ba = INFINITY;
     for (int r = 0; r < 4; ++r) {

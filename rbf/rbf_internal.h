@@ -130,6 +130,9 @@ int cm_rbf_blas_callers(int want);
 /* CPU seconds of the calling thread (CLOCK_THREAD_CPUTIME_ID; wall time if it fails): what
  * the once-per-process probes time, as a loaded machine delays them without biasing them. */
 double cm_rbf_thread_seconds(void);
+/* The probes' problem: m centres (3 x m SoA) with 3 weight vectors (3 x m), n points (3 x n)
+ * spread over the unit cube by a fixed sequence. */
+void cm_rbf_probe_data(size_t m, double *c, double *w, size_t n, double *p);
 
 /* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */
 int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m);

@@ -25,7 +25,7 @@
  * Built with -ffp-contract=off: the error-free transformations of the compensated block
  * need every rounding where it is written. */
 #include "rbf_sum_isa.h"
-#include "rbf_internal.h" /* cm_rbf_thread_seconds */
+#include "rbf_internal.h" /* cm_rbf_thread_seconds, cm_rbf_probe_data */
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
@@ -271,14 +271,9 @@ static void split_probe(void)
 {
     enum { NPROBE = TILE, REPS = 3, CALLS = 4 };
     static double c[3 * NPROBE], w[3 * NPROBE], pt[3 * CM_RBF_SUM_PB], acc[4 * CM_RBF_SUM_PB];
-    static double hi[4 * CM_RBF_ACC_PB], lo[4 * CM_RBF_ACC_PB];
-    for (int j = 0; j < NPROBE; ++j)
-        for (int k = 0; k < 3; ++k) {
-            c[k * NPROBE + j] = fmod(0.5 + j * (0.7548776662 + 0.1 * k), 1.0);
-            w[k * NPROBE + j] = (j % 2 ? -1.0 : 1.0) * (1.0 + 0.001 * k);
-        }
-    for (int i = 0; i < CM_RBF_SUM_PB; ++i)
-        for (int k = 0; k < 3; ++k) pt[k * CM_RBF_SUM_PB + i] = fmod(0.25 + i * (0.5698 + 0.1 * k), 1.0);
+    static double pa[3 * CM_RBF_ACC_PB], hi[4 * CM_RBF_ACC_PB], lo[4 * CM_RBF_ACC_PB];
+    cm_rbf_probe_data(NPROBE, c, w, CM_RBF_SUM_PB, pt);
+    cm_rbf_probe_data(0, NULL, NULL, CM_RBF_ACC_PB, pa);
     double best[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}}; /* [block][alt] */
     for (int r = 0; r < REPS; ++r)
         for (int alt = 0; alt < 2; ++alt) {
@@ -288,7 +283,7 @@ static void split_probe(void)
             best[0][alt] = fmin(best[0][alt], cm_rbf_thread_seconds() - t);
             for (int i = 0; i < 4 * CM_RBF_ACC_PB; ++i) hi[i] = 0x1.8p40, lo[i] = 0.0;
             t = cm_rbf_thread_seconds();
-            for (int k = 0; k < CALLS; ++k) accf_split(alt, 3, NPROBE, c, w, pt, hi, lo);
+            for (int k = 0; k < CALLS; ++k) accf_split(alt, 3, NPROBE, c, w, pa, hi, lo);
             best[1][alt] = fmin(best[1][alt], cm_rbf_thread_seconds() - t);
         }
     split_plain_alt = best[0][1] < best[0][0];
