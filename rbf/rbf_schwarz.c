@@ -162,10 +162,7 @@ static double boxbox_dist2(const leaf *a, const leaf *b)
     return s;
 }
 
-typedef struct keyed {
-    double key;
-    size_t idx;
-} keyed;
+typedef cm_rbf_keyed keyed;
 
 static int cmp_keyed(const void *a, const void *b)
 {
@@ -221,6 +218,43 @@ static size_t grow_leaf(const tree_build *t, int l, size_t nloc, size_t nmin, do
     if (keep < nc) nc = keep;
     for (size_t u = 0; u < nc; ++u) out[n++] = cand[u].idx;
     return n;
+}
+
+/* The thinned far band of leaf l's local set (thin_reach): out holds its n near centres,
+ * sorted by distance to the box as grow_leaf leaves them; appended are picks among all
+ * centres farther than those, up to far2 (squared) from the box, by cm_rbf_thin_pick with
+ * cells growing from d0 = max(near reach, fill), until cap centres in all. Returns the new
+ * count, or 0 out of memory. Scratch: cand (m). */
+static size_t thin_far(const tree_build *t, int l, size_t n, double far2, double fill,
+                       double cell, size_t cap, keyed *cand, size_t *out)
+{
+    const leaf *L = &t->leaves[l];
+    if (n >= cap) return n;
+    const size_t last = out[n - 1];
+    const double xl[3] = {coord(t, last, 0), coord(t, last, 1), coord(t, last, 2)};
+    const double dn2 = n > L->hi - L->lo ? box_dist2(xl, L->bmin, L->bmax) : 0.0;
+    if (dn2 >= far2) return n;
+    size_t nc = 0;
+    for (int b = 0; b < t->nleaves; ++b) {
+        if (b == l || boxbox_dist2(L, &t->leaves[b]) > far2) continue;
+        const leaf *B = &t->leaves[b];
+        for (size_t u = B->lo; u < B->hi; ++u) {
+            size_t i = t->perm[u];
+            double x[3] = {coord(t, i, 0), coord(t, i, 1), coord(t, i, 2)};
+            double k = box_dist2(x, L->bmin, L->bmax);
+            /* strictly beyond the near set: a tie with its last centre may be lost, never
+             * doubled */
+            if (k > dn2 && k <= far2) {
+                cand[nc].key = k;
+                cand[nc].idx = i;
+                ++nc;
+            }
+        }
+    }
+    qsort(cand, nc, sizeof *cand, cmp_keyed);
+    const double d0 = fmax(sqrt(dn2), fill);
+    long got = cm_rbf_thin_pick(t->c, t->m, cand, nc, d0, cell, L->bmin, cap - n, out + n);
+    return got < 0 ? 0 : n + (size_t)got;
 }
 
 /* ---- local projected inverses ---- */
@@ -500,6 +534,16 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
 }
 
 size_t cm_rbf_schwarz_bytes(const cm_rbf_schwarz *pc) { return pc ? pc->bytes : 0; }
+double cm_rbf_schwarz_fill(const cm_rbf_schwarz *pc) { return pc ? pc->fill : 0.0; }
+
+const size_t *cm_rbf_schwarz_subdomain(const cm_rbf_schwarz *pc, int l, size_t *n, size_t *n_in)
+{
+    *n = *n_in = 0;
+    if (!pc || l < 0 || l >= pc->nsub) return NULL;
+    *n = pc->sub_ptr[l + 1] - pc->sub_ptr[l];
+    *n_in = (size_t)pc->n_in[l];
+    return pc->sub_idx + pc->sub_ptr[l];
+}
 int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc) { return pc ? pc->nsub : 0; }
 int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc) { return pc ? (int)pc->nc : 0; }
 
@@ -523,17 +567,23 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
         nloc = (size_t)o->local_max < m ? (size_t)o->local_max : m;
         reach2 = (o->overlap * p->fill) * (o->overlap * p->fill);
     }
+    /* thinned far band (thin_reach): the near set above, then picks up to thin_max */
+    const int thin = o->thin_reach > 0.0 && p->fill > 0.0;
+    const double far2 = (o->thin_reach * p->fill) * (o->thin_reach * p->fill);
+    const size_t tcap = thin ? ((size_t)o->thin_max < m ? (size_t)o->thin_max : m) : 0;
     p->nsub = t.nleaves;
     p->sub_ptr = malloc(((size_t)t.nleaves + 1) * sizeof *p->sub_ptr);
     p->n_in = malloc((size_t)t.nleaves * sizeof *p->n_in);
-    const size_t stride = nloc > t.leaf_size ? nloc : t.leaf_size; /* compacted below */
+    size_t stride = nloc > t.leaf_size ? nloc : t.leaf_size; /* compacted below */
+    if (tcap > stride) stride = tcap;
     p->sub_idx = malloc((size_t)t.nleaves * stride * sizeof *p->sub_idx);
     if (!p->sub_ptr || !p->n_in || !p->sub_idx) {
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (subdomains)");
         goto done;
     }
     size_t *cnt = calloc((size_t)t.nleaves, sizeof *cnt);
-    int fail = 0;
+    size_t *nnear = calloc((size_t)t.nleaves, sizeof *nnear);
+    int fail = !nnear;
 #pragma omp parallel num_threads(threads) if (t.nleaves > 8 && threads > 1)
     {
         keyed *lk = malloc((size_t)t.nleaves * sizeof *lk);
@@ -545,25 +595,48 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
                 fail = 1;
                 continue;
             }
-            cnt[l] = grow_leaf(&t, l, nloc, nmin, reach2, lk, cand,
-                               p->sub_idx + (size_t)l * stride);
+            size_t *out = p->sub_idx + (size_t)l * stride;
+            cnt[l] = grow_leaf(&t, l, nloc, nmin, reach2, lk, cand, out);
+            if (thin) {
+                nnear[l] = cnt[l];
+                cnt[l] = thin_far(&t, l, cnt[l], far2, p->fill, o->thin_cell, tcap, cand, out);
+                if (cnt[l] == 0) {
+#pragma omp atomic write
+                    fail = 1;
+                }
+            }
         }
         free(lk);
         free(cand);
     }
     if (fail) {
         free(cnt);
+        free(nnear);
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (subdomains)");
         goto done;
     }
+    double near_sum = 0.0, reach_sum = 0.0;
     p->sub_ptr[0] = 0;
     for (int l = 0; l < t.nleaves; ++l) {
-        memmove(p->sub_idx + p->sub_ptr[l], p->sub_idx + (size_t)l * stride,
-                cnt[l] * sizeof *p->sub_idx);
+        size_t *sub = p->sub_idx + (size_t)l * stride, last = sub[cnt[l] - 1];
+        const double xl[3] = {coord(&t, last, 0), coord(&t, last, 1), coord(&t, last, 2)};
+        near_sum += (double)nnear[l];
+        reach_sum += sqrt(box_dist2(xl, t.leaves[l].bmin, t.leaves[l].bmax));
+        memmove(p->sub_idx + p->sub_ptr[l], sub, cnt[l] * sizeof *p->sub_idx);
         p->sub_ptr[l + 1] = p->sub_ptr[l] + cnt[l];
         p->n_in[l] = (int)(t.leaves[l].hi - t.leaves[l].lo);
     }
     free(cnt);
+    free(nnear);
+    if (thin)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "cm_rbf_create: Schwarz thinned overlap: mean %.0f near + %.0f far centres "
+               "(cap %zu), mean reach %.2f H (thin_reach %g H, cell %g x distance)",
+               near_sum / t.nleaves, (double)p->sub_ptr[t.nleaves] / t.nleaves - near_sum / t.nleaves,
+               tcap, reach_sum / t.nleaves / p->fill, o->thin_reach, o->thin_cell);
+    else
+        cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_create: Schwarz overlap: mean reach %.2f H",
+               p->fill > 0.0 ? reach_sum / t.nleaves / p->fill : 0.0);
 done:
     free(t.perm);
     free(t.leaves);
