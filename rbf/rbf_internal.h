@@ -180,10 +180,12 @@ typedef struct cm_rbf_keyed {
 /* The thinned far band of a subdomain (rbf_thin.c): of the nc candidates cand (sorted by
  * key ascending, each at distance d >= d0 > 0 from the leaf's box; c: 3 x m SoA), one per
  * voxel of the grid of cell cell x d0 x 2^k in distance band k = floor(log2(d / d0)) (grid
- * origin org), the one nearest to the voxel's centre; at most cap of them, the nearest first,
- * into out. Returns their count, or -1 out of memory. */
+ * origin org), the one nearest to the voxel's centroid; at most cap of them, the nearest
+ * first, into out. slot (nc, or NULL): each candidate's voxel as its pick's position in out,
+ * -1 if that pick fell past the cap. Returns the count, or -1 out of memory. */
 long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_t nc,
-                      double d0, double cell, const double org[3], size_t cap, size_t *out);
+                      double d0, double cell, const double org[3], size_t cap, size_t *out,
+                      long *slot);
 /* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
  * at most m / 4). */
 size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);

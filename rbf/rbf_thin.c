@@ -14,9 +14,11 @@
 
 typedef struct voxel {
     int64_t ix, iy, iz;
-    int band;     /* -1: empty slot */
-    size_t pos;   /* the candidate nearest to the voxel's centre so far */
-    double best;  /* its squared distance to that centre */
+    int band;      /* -1: empty slot */
+    size_t count;  /* candidates in the voxel */
+    double sum[3]; /* their coordinates' sum, then their centroid */
+    size_t pos;    /* the candidate nearest to the centroid */
+    double best;   /* its squared distance to the centroid */
 } voxel;
 
 static uint64_t voxel_hash(int64_t x, int64_t y, int64_t z, int band)
@@ -28,55 +30,72 @@ static uint64_t voxel_hash(int64_t x, int64_t y, int64_t z, int band)
     return h ^ (h >> 29);
 }
 
-long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_t nc,
-                      double d0, double cell, const double org[3], size_t cap, size_t *out)
+/* The table slot of candidate u's voxel (inserted if new). */
+static size_t voxel_of(voxel *tab, size_t tsize, const double *c, size_t m,
+                       const cm_rbf_keyed *cu, double d0, double cell, const double org[3])
 {
+    const size_t i = cu->idx;
+    const double d = sqrt(cu->key);
+    /* band k: d in [d0 2^k, d0 2^(k+1)), cell d0 2^k x cell, so between cell / 2 and cell of
+     * the distance; bands nest, the grids of two bands never mix in one voxel */
+    int band = d > d0 ? (int)floor(log2(d / d0)) : 0;
+    if (band > 60) band = 60;
+    const double h = cell * d0 * ldexp(1.0, band);
+    int64_t v[3];
+    for (int q = 0; q < 3; ++q) v[q] = (int64_t)floor((c[(size_t)q * m + i] - org[q]) / h);
+    size_t s = (size_t)(voxel_hash(v[0], v[1], v[2], band) & (tsize - 1));
+    while (tab[s].band >= 0 &&
+           !(tab[s].band == band && tab[s].ix == v[0] && tab[s].iy == v[1] && tab[s].iz == v[2]))
+        s = (s + 1) & (tsize - 1);
+    if (tab[s].band < 0) tab[s] = (voxel){v[0], v[1], v[2], band, 0, {0, 0, 0}, 0, INFINITY};
+    return s;
+}
+
+long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_t nc,
+                      double d0, double cell, const double org[3], size_t cap, size_t *out,
+                      long *slot)
+{
+    if (slot)
+        for (size_t u = 0; u < nc; ++u) slot[u] = -1;
     if (nc == 0 || cap == 0) return 0;
     size_t tsize = 64;
     while (tsize < 2 * nc) tsize *= 2;
     voxel *tab = malloc(tsize * sizeof *tab);
-    unsigned char *win = calloc(nc, 1);
-    if (!tab || !win) {
-        free(tab);
-        free(win);
+    size_t *vs = malloc(nc * sizeof *vs);
+    long *at = malloc(tsize * sizeof *at);
+    if (!tab || !vs || !at) {
+        free(tab), free(vs), free(at);
         return -1;
     }
-    for (size_t s = 0; s < tsize; ++s) tab[s].band = -1;
+    for (size_t s = 0; s < tsize; ++s) tab[s].band = -1, at[s] = -1;
     for (size_t u = 0; u < nc; ++u) {
-        const size_t i = cand[u].idx;
-        const double d = sqrt(cand[u].key);
-        /* band k: d in [d0 2^k, d0 2^(k+1)), cell d0 2^k x cell, so between cell / 2 and cell
-         * of the distance; bands nest, the grids of two bands never mix in one voxel */
-        int band = d > d0 ? (int)floor(log2(d / d0)) : 0;
-        if (band > 60) band = 60;
-        const double h = cell * d0 * ldexp(1.0, band);
-        const double x[3] = {c[i], c[m + i], c[2 * m + i]};
-        int64_t v[3];
-        double e2 = 0.0;
-        for (int q = 0; q < 3; ++q) {
-            const double f = floor((x[q] - org[q]) / h);
-            v[q] = (int64_t)f;
-            const double e = x[q] - (org[q] + (f + 0.5) * h);
-            e2 += e * e;
-        }
-        size_t s = (size_t)(voxel_hash(v[0], v[1], v[2], band) & (tsize - 1));
-        while (tab[s].band >= 0 && !(tab[s].band == band && tab[s].ix == v[0] &&
-                                     tab[s].iy == v[1] && tab[s].iz == v[2]))
-            s = (s + 1) & (tsize - 1);
-        if (tab[s].band < 0) {
-            tab[s] = (voxel){v[0], v[1], v[2], band, u, e2};
-        } else if (e2 < tab[s].best) {
-            tab[s].pos = u;
-            tab[s].best = e2;
-        }
+        voxel *v = &tab[vs[u] = voxel_of(tab, tsize, c, m, &cand[u], d0, cell, org)];
+        ++v->count;
+        for (int q = 0; q < 3; ++q) v->sum[q] += c[(size_t)q * m + cand[u].idx];
     }
     for (size_t s = 0; s < tsize; ++s)
-        if (tab[s].band >= 0) win[tab[s].pos] = 1;
+        if (tab[s].band >= 0)
+            for (int q = 0; q < 3; ++q) tab[s].sum[q] /= (double)tab[s].count;
+    /* the pick stands for its voxel (the voxel's mean residual with thin_average): the
+     * candidate nearest to the voxel's centroid */
+    for (size_t u = 0; u < nc; ++u) {
+        voxel *v = &tab[vs[u]];
+        double e2 = 0.0;
+        for (int q = 0; q < 3; ++q) {
+            double e = c[(size_t)q * m + cand[u].idx] - v->sum[q];
+            e2 += e * e;
+        }
+        if (e2 < v->best) v->best = e2, v->pos = u;
+    }
     /* the nearest picks first: the cap cuts the reach, not the resolution near the leaf */
     size_t n = 0;
     for (size_t u = 0; u < nc && n < cap; ++u)
-        if (win[u]) out[n++] = cand[u].idx;
-    free(tab);
-    free(win);
+        if (tab[vs[u]].pos == u) {
+            at[vs[u]] = (long)n;
+            out[n++] = cand[u].idx;
+        }
+    if (slot)
+        for (size_t u = 0; u < nc; ++u) slot[u] = at[vs[u]];
+    free(tab), free(vs), free(at);
     return (long)n;
 }
