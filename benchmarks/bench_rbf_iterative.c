@@ -6,6 +6,8 @@
  *        [--restart N] [--eval N] [--verbose] [--fast 0|1|-1] [--fast-tol T]
  *        [--fast-refine N] [--fast-eval-tol T] [--no-centres] [--relax 0|1]
  *        [--coarse-inner N] [--coarse-inner-tol T]
+ *        [--thin-reach R] [--thin-cell C] [--thin-max N] [--thin-average 0|1]
+ *        (thinned overlap, rbf.h)
  * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
 #include "cli/blas_reexec.h"
 #include "cadmorph/blas.h"
@@ -141,6 +143,10 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--post")) o.coarse_post = atoi(b), ++i;
         else if (!strcmp(a, "--overlap")) o.overlap = atof(b), ++i;
         else if (!strcmp(a, "--local-max")) o.local_max = atoi(b), ++i;
+        else if (!strcmp(a, "--thin-reach")) o.thin_reach = atof(b), ++i;
+        else if (!strcmp(a, "--thin-cell")) o.thin_cell = atof(b), ++i;
+        else if (!strcmp(a, "--thin-max")) o.thin_max = atoi(b), ++i;
+        else if (!strcmp(a, "--thin-average")) o.thin_average = atoi(b), ++i;
         else if (!strcmp(a, "--coarse-grow")) o.coarse_grow = atoi(b), ++i;
         else if (!strcmp(a, "--coarse-max")) o.coarse_max = atoi(b), ++i;
         else if (!strcmp(a, "--restart")) o.restart = atoi(b), ++i;
@@ -204,6 +210,8 @@ int main(int argc, char **argv)
                it.st.matvecs_plain, it.st.matvecs_fast);
         printf(" coarse_inner=%d coarse_inner_tol=%g inner_solves=%ld inner_its=%ld",
                o.coarse_inner, o.coarse_inner_tol, inner_solves, inner_its);
+        printf(" thin_reach=%g thin_cell=%g thin_max=%d thin_average=%d", o.thin_reach,
+               o.thin_cell, o.thin_max, o.thin_average);
     }
     if (dense) {
         o.solver = CM_RBF_SOLVER_DENSE;

@@ -179,6 +179,20 @@ typedef int (*cm_rbf_schwarz_sum)(void *arg, double *out, size_t n);
 int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc,
                              const double *in, double *out, int threads, cm_rbf_schwarz_sum sum,
                              void *arg);
+/* A centre index with a sort key (the squared distance to a leaf's box). */
+typedef struct cm_rbf_keyed {
+    double key;
+    size_t idx;
+} cm_rbf_keyed;
+/* The thinned far band of a subdomain (rbf_thin.c): of the nc candidates cand (sorted by
+ * key ascending, each at distance d >= d0 > 0 from the leaf's box; c: 3 x m SoA), one per
+ * voxel of the grid of cell cell x d0 x 2^k in distance band k = floor(log2(d / d0)) (grid
+ * origin org), the one nearest to the voxel's centroid; at most cap of them, the nearest
+ * first, into out. slot (nc, or NULL): each candidate's voxel as its pick's position in out,
+ * -1 if that pick fell past the cap. Returns the count, or -1 out of memory. */
+long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_t nc,
+                      double d0, double cell, const double org[3], size_t cap, size_t *out,
+                      long *slot);
 /* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
  * at most m / 4). */
 size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);
@@ -204,6 +218,10 @@ void cm_rbf_coarse_inner_stats(const cm_rbf_coarse_inner *ci, long *solves, long
 /* The preconditioner's inner coarse solver, NULL if its coarse problem is factored densely */
 const cm_rbf_coarse_inner *cm_rbf_schwarz_inner(const cm_rbf_schwarz *pc);
 size_t cm_rbf_schwarz_bytes(const cm_rbf_schwarz *pc);
+/* Subdomain l's centre indices (into r->c; its *n_in leaf centres first), *n in all; and
+ * the coarse fill distance H (0 without a coarse space). For tests. */
+const size_t *cm_rbf_schwarz_subdomain(const cm_rbf_schwarz *pc, int l, size_t *n, size_t *n_in);
+double cm_rbf_schwarz_fill(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc);
 

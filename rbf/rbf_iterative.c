@@ -123,6 +123,9 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->coarse_inner_tol = 1e-2;
     opt->overlap = 3.0;
     opt->local_max = 2800;
+    opt->thin_cell = 0.25;
+    opt->thin_max = 2000;
+    opt->thin_average = 0;
     opt->fast_sum = -1;
     opt->fast_tol = 1e-12;
     opt->fast_refine = 3;
@@ -225,16 +228,21 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
         o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0 ||
         o->local_float < 0 || o->local_float > 2 || o->fast_sum < -1 || o->fast_sum > 1 ||
         !(o->fast_tol > 0.0 && o->fast_tol <= 1e-3) || o->fast_refine < 0 ||
-        o->fast_refine > 10 || !(o->fast_eval_tol > 0.0) || o->relax < 0 || o->relax > 2)
+        o->fast_refine > 10 || !(o->fast_eval_tol > 0.0) || o->relax < 0 || o->relax > 2 ||
+        !(o->thin_reach >= 0.0) || (o->thin_reach > 0.0 && (!(o->thin_cell > 0.0) ||
+                                                            o->thin_max < o->leaf_size ||
+                                                            o->thin_average < 0 ||
+                                                            o->thin_average > 1)))
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
                         "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "
                         "%d, overlap %g, local_max %d, coarse_max %d, fast_sum %d, fast_tol %g, "
-                        "fast_refine %d, fast_eval_tol %g, relax %d)",
+                        "fast_refine %d, fast_eval_tol %g, relax %d, thin_reach %g, "
+                        "thin_cell %g, thin_max %d)",
                         o->tolerance, o->max_iterations, o->restart, o->leaf_size,
                         o->local_size, o->coarse_size, o->coarse_post, o->overlap, o->local_max,
                         o->coarse_max, o->fast_sum, o->fast_tol, o->fast_refine,
-                        o->fast_eval_tol, o->relax);
+                        o->fast_eval_tol, o->relax, o->thin_reach, o->thin_cell, o->thin_max);
     cm_rbf_iter *it = calloc(1, sizeof *it);
     if (!it) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     it->q1 = malloc(m * k * sizeof *it->q1);

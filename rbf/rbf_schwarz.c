@@ -36,6 +36,14 @@ struct cm_rbf_schwarz {
     size_t *sub_ptr;  /* nsub + 1: offsets into sub_idx */
     size_t *sub_idx;  /* centre indices of each local set, its n_in leaf centres first */
     int *n_in;        /* nsub: leaf centres of each local set */
+    /* thin_reach with thin_average: the thinned far band's data is its voxels' mean
+     * residual, not the picks' own (a pick's own residual is one sample of a field that is
+     * rough at the spacing, and its row stands for the whole voxel): subdomain l's far picks
+     * are its local centres from n_near[l] on, and far + far_ptr[l] lists for each of them
+     * in order its voxel's member count, then the members */
+    int *n_near;
+    size_t *far_ptr;  /* nsub + 1 */
+    size_t *far;
     /* local inverse rows of subdomain l, col-major local x n_in: the first hd[l] rows (its
      * own leaf's centres come first) in g64 + d_ptr[l], the rest in g32 + f_ptr[l] (float:
      * see store_local); only the subdomains of this part (l0 <= l < l1) are built */
@@ -162,10 +170,7 @@ static double boxbox_dist2(const leaf *a, const leaf *b)
     return s;
 }
 
-typedef struct keyed {
-    double key;
-    size_t idx;
-} keyed;
+typedef cm_rbf_keyed keyed;
 
 static int cmp_keyed(const void *a, const void *b)
 {
@@ -221,6 +226,76 @@ static size_t grow_leaf(const tree_build *t, int l, size_t nloc, size_t nmin, do
     if (keep < nc) nc = keep;
     for (size_t u = 0; u < nc; ++u) out[n++] = cand[u].idx;
     return n;
+}
+
+/* The thinned far band of leaf l's local set (thin_reach): out holds its n near centres,
+ * sorted by distance to the box as grow_leaf leaves them; appended are picks among all
+ * centres farther than those, up to far2 (squared) from the box, by cm_rbf_thin_pick with
+ * cells growing from d0 = max(near reach, fill), until cap centres in all. Returns the new
+ * count, or 0 out of memory. Scratch: cand (m). */
+static size_t thin_far(const tree_build *t, int l, size_t n, double far2, double fill,
+                       double cell, size_t cap, keyed *cand, size_t *out, size_t **agg,
+                       size_t *nagg)
+{
+    const leaf *L = &t->leaves[l];
+    if (n >= cap) return n;
+    const size_t last = out[n - 1];
+    const double xl[3] = {coord(t, last, 0), coord(t, last, 1), coord(t, last, 2)};
+    const double dn2 = n > L->hi - L->lo ? box_dist2(xl, L->bmin, L->bmax) : 0.0;
+    if (dn2 >= far2) return n;
+    size_t nc = 0;
+    for (int b = 0; b < t->nleaves; ++b) {
+        if (b == l || boxbox_dist2(L, &t->leaves[b]) > far2) continue;
+        const leaf *B = &t->leaves[b];
+        for (size_t u = B->lo; u < B->hi; ++u) {
+            size_t i = t->perm[u];
+            double x[3] = {coord(t, i, 0), coord(t, i, 1), coord(t, i, 2)};
+            double k = box_dist2(x, L->bmin, L->bmax);
+            /* strictly beyond the near set: a tie with its last centre may be lost, never
+             * doubled */
+            if (k > dn2 && k <= far2) {
+                cand[nc].key = k;
+                cand[nc].idx = i;
+                ++nc;
+            }
+        }
+    }
+    qsort(cand, nc, sizeof *cand, cmp_keyed);
+    const double d0 = fmax(sqrt(dn2), fill);
+    long *slot = agg ? malloc((nc ? nc : 1) * sizeof *slot) : NULL;
+    if (agg && !slot) return 0;
+    long got = cm_rbf_thin_pick(t->c, t->m, cand, nc, d0, cell, L->bmin, cap - n, out + n, slot);
+    if (got < 0) {
+        free(slot);
+        return 0;
+    }
+    if (agg) { /* per pick: member count, then members (the voxel's candidates) */
+        size_t *cnt = calloc((size_t)got + 1, sizeof *cnt), kept = 0;
+        for (size_t u = 0; cnt && u < nc; ++u)
+            if (slot[u] >= 0) ++cnt[slot[u]], ++kept;
+        size_t *a = cnt ? malloc(((size_t)got + kept + 1) * sizeof *a) : NULL;
+        if (!a) {
+            free(cnt), free(slot);
+            return 0;
+        }
+        size_t *pos = malloc(((size_t)got + 1) * sizeof *pos);
+        if (!pos) {
+            free(cnt), free(slot), free(a);
+            return 0;
+        }
+        for (long k = 0, o = 0; k < got; ++k) {
+            a[o] = cnt[k];
+            pos[k] = (size_t)o + 1;
+            o += 1 + (long)cnt[k];
+        }
+        for (size_t u = 0; u < nc; ++u)
+            if (slot[u] >= 0) a[pos[slot[u]]++] = cand[u].idx;
+        *agg = a;
+        *nagg = (size_t)got + kept;
+        free(cnt), free(pos);
+    }
+    free(slot);
+    return n + (size_t)got;
 }
 
 /* ---- local projected inverses ---- */
@@ -483,6 +558,9 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
     cm_rbf_schwarz *p = *pc;
     free(p->sub_ptr);
     free(p->sub_idx);
+    free(p->n_near);
+    free(p->far_ptr);
+    free(p->far);
     free(p->n_in);
     free(p->d_ptr);
     free(p->f_ptr);
@@ -500,6 +578,16 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
 }
 
 size_t cm_rbf_schwarz_bytes(const cm_rbf_schwarz *pc) { return pc ? pc->bytes : 0; }
+double cm_rbf_schwarz_fill(const cm_rbf_schwarz *pc) { return pc ? pc->fill : 0.0; }
+
+const size_t *cm_rbf_schwarz_subdomain(const cm_rbf_schwarz *pc, int l, size_t *n, size_t *n_in)
+{
+    *n = *n_in = 0;
+    if (!pc || l < 0 || l >= pc->nsub) return NULL;
+    *n = pc->sub_ptr[l + 1] - pc->sub_ptr[l];
+    *n_in = (size_t)pc->n_in[l];
+    return pc->sub_idx + pc->sub_ptr[l];
+}
 int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc) { return pc ? pc->nsub : 0; }
 int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc) { return pc ? (int)pc->nc : 0; }
 
@@ -523,17 +611,26 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
         nloc = (size_t)o->local_max < m ? (size_t)o->local_max : m;
         reach2 = (o->overlap * p->fill) * (o->overlap * p->fill);
     }
+    /* thinned far band (thin_reach): the near set above, then picks up to thin_max */
+    const int thin = o->thin_reach > 0.0 && p->fill > 0.0;
+    const double far2 = (o->thin_reach * p->fill) * (o->thin_reach * p->fill);
+    const size_t tcap = thin ? ((size_t)o->thin_max < m ? (size_t)o->thin_max : m) : 0;
     p->nsub = t.nleaves;
     p->sub_ptr = malloc(((size_t)t.nleaves + 1) * sizeof *p->sub_ptr);
     p->n_in = malloc((size_t)t.nleaves * sizeof *p->n_in);
-    const size_t stride = nloc > t.leaf_size ? nloc : t.leaf_size; /* compacted below */
+    size_t stride = nloc > t.leaf_size ? nloc : t.leaf_size; /* compacted below */
+    if (tcap > stride) stride = tcap;
     p->sub_idx = malloc((size_t)t.nleaves * stride * sizeof *p->sub_idx);
     if (!p->sub_ptr || !p->n_in || !p->sub_idx) {
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (subdomains)");
         goto done;
     }
     size_t *cnt = calloc((size_t)t.nleaves, sizeof *cnt);
-    int fail = 0;
+    size_t *nnear = calloc((size_t)t.nleaves, sizeof *nnear);
+    const int average = thin && o->thin_average;
+    size_t **aggs = average ? calloc((size_t)t.nleaves, sizeof *aggs) : NULL;
+    size_t *nagg = average ? calloc((size_t)t.nleaves, sizeof *nagg) : NULL;
+    int fail = !nnear || (average && (!aggs || !nagg));
 #pragma omp parallel num_threads(threads) if (t.nleaves > 8 && threads > 1)
     {
         keyed *lk = malloc((size_t)t.nleaves * sizeof *lk);
@@ -545,25 +642,67 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
                 fail = 1;
                 continue;
             }
-            cnt[l] = grow_leaf(&t, l, nloc, nmin, reach2, lk, cand,
-                               p->sub_idx + (size_t)l * stride);
+            size_t *out = p->sub_idx + (size_t)l * stride;
+            cnt[l] = grow_leaf(&t, l, nloc, nmin, reach2, lk, cand, out);
+            if (thin) {
+                nnear[l] = cnt[l];
+                cnt[l] = thin_far(&t, l, cnt[l], far2, p->fill, o->thin_cell, tcap, cand, out,
+                                  aggs ? &aggs[l] : NULL, aggs ? &nagg[l] : NULL);
+                if (cnt[l] == 0) {
+#pragma omp atomic write
+                    fail = 1;
+                }
+            }
         }
         free(lk);
         free(cand);
     }
+    if (average && !fail) { /* the far bands' voxel members, compacted */
+        p->far_ptr = malloc(((size_t)t.nleaves + 1) * sizeof *p->far_ptr);
+        p->n_near = malloc((size_t)t.nleaves * sizeof *p->n_near);
+        size_t tot = 0;
+        for (int l = 0; l < t.nleaves; ++l) tot += nagg[l];
+        p->far = malloc((tot ? tot : 1) * sizeof *p->far);
+        if (!p->far_ptr || !p->n_near || !p->far) fail = 1;
+        for (int l = 0; !fail && l < t.nleaves; ++l) {
+            p->far_ptr[l] = l ? p->far_ptr[l - 1] + nagg[l - 1] : 0;
+            if (nagg[l]) memcpy(p->far + p->far_ptr[l], aggs[l], nagg[l] * sizeof *p->far);
+            p->n_near[l] = (int)nnear[l];
+        }
+        if (!fail) p->far_ptr[t.nleaves] = tot;
+        p->bytes += tot * sizeof *p->far;
+    }
+    for (int l = 0; aggs && l < t.nleaves; ++l) free(aggs[l]);
+    free(aggs);
+    free(nagg);
     if (fail) {
         free(cnt);
+        free(nnear);
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (subdomains)");
         goto done;
     }
+    double near_sum = 0.0, reach_sum = 0.0;
     p->sub_ptr[0] = 0;
     for (int l = 0; l < t.nleaves; ++l) {
-        memmove(p->sub_idx + p->sub_ptr[l], p->sub_idx + (size_t)l * stride,
-                cnt[l] * sizeof *p->sub_idx);
+        size_t *sub = p->sub_idx + (size_t)l * stride, last = sub[cnt[l] - 1];
+        const double xl[3] = {coord(&t, last, 0), coord(&t, last, 1), coord(&t, last, 2)};
+        near_sum += (double)nnear[l];
+        reach_sum += sqrt(box_dist2(xl, t.leaves[l].bmin, t.leaves[l].bmax));
+        memmove(p->sub_idx + p->sub_ptr[l], sub, cnt[l] * sizeof *p->sub_idx);
         p->sub_ptr[l + 1] = p->sub_ptr[l] + cnt[l];
         p->n_in[l] = (int)(t.leaves[l].hi - t.leaves[l].lo);
     }
     free(cnt);
+    free(nnear);
+    if (thin)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "cm_rbf_create: Schwarz thinned overlap: mean %.0f near + %.0f far centres "
+               "(cap %zu), mean reach %.2f H (thin_reach %g H, cell %g x distance)",
+               near_sum / t.nleaves, (double)p->sub_ptr[t.nleaves] / t.nleaves - near_sum / t.nleaves,
+               tcap, reach_sum / t.nleaves / p->fill, o->thin_reach, o->thin_cell);
+    else
+        cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_create: Schwarz overlap: mean reach %.2f H",
+               p->fill > 0.0 ? reach_sum / t.nleaves / p->fill : 0.0);
 done:
     free(t.perm);
     free(t.leaves);
@@ -893,6 +1032,17 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
             if (!x) continue; /* out of memory: a weaker preconditioner, not a wrong result */
             for (int c = 0; c < nc; ++c)
                 for (size_t i = 0; i < n; ++i) x[(size_t)c * n + i] = res[(size_t)c * m + idx[i]];
+            if (p->far) /* thinned far band: each pick carries its voxel's mean residual */
+                for (size_t i = (size_t)p->n_near[l], *a = p->far + p->far_ptr[l]; i < n; ++i) {
+                    const size_t k = *a++;
+                    for (int c = 0; c < nc; ++c) {
+                        const double *rc = res + (size_t)c * m;
+                        double t = 0.0;
+                        for (size_t u = 0; u < k; ++u) t += rc[a[u]];
+                        x[(size_t)c * n + i] = t / (double)k;
+                    }
+                    a += k;
+                }
             if (p->lq) {
                 /* float rows: the local inverse annihilates linear data, so taking the local
                  * linear fit out first changes nothing in exact arithmetic, but the float

@@ -96,6 +96,27 @@ typedef struct cm_rbf_options {
                            * thin features): bracket 59k, first cycle 9-10 iterations
                            * instead of 12-13 at 1,501 centres on average instead of 1,400 */
     int local_max;        /* [2800] cap on a subdomain's centres for overlap > 0 */
+    double thin_reach;    /* [0] thinned overlap: beyond its near set (the leaf plus
+                           * local_size / overlap / local_max as above, all kept), a subdomain
+                           * also takes a thinned sample of the centres up to thin_reach x H
+                           * from its leaf's box: one per voxel, the voxel growing with the
+                           * distance (thin_cell), at most thin_max centres in all; the
+                           * local solve is on that set, only the leaf rows are kept as ever.
+                           * A geometric reach at a bounded centre count; 0: off. Measured
+                           * (RESULTS.md, "Thinned overlap"): better than no far band and than
+                           * the same count of nearest centres, worse than the overlap rule's
+                           * full 3 H (bracket 234k, 1,000 + 543 to 5.9 H: 5.6e-5 after 30
+                           * iterations, 1,543 nearest 1.7e-3, the defaults' 1,821 3e-7;
+                           * 103k: 40 iterations for 13) */
+    double thin_cell;     /* [0.25] voxel edge / distance from the leaf's box in the thinned
+                           * band (the distance rounded down to d0 2^k, d0 the near set's
+                           * reach): larger thins more */
+    int thin_max;         /* [2000] cap on a subdomain's centres with thin_reach > 0 (the far
+                           * picks nearest to the leaf are kept first) */
+    int thin_average;     /* [0] a far pick's data in the local solve: 0 the pick's own
+                           * residual, 1 the mean residual of its voxel (measured worse:
+                           * bracket 7.2k, 500 near + 199 far: 21 iterations instead of 13,
+                           * no better than no far band) */
     int coarse_grow;      /* [1] coarse_size is the count at 2e4 centres; above, it grows as
                            * sqrt(m) (coarse factor 8 coarse^2 bytes, O(m)): bracket 59k,
                            * 5,000 coarse centres: 17 iterations instead of 21 */
