@@ -6,13 +6,14 @@
  *        [--restart N] [--eval N] [--verbose] [--fast 0|1|-1] [--fast-tol T]
  *        [--fast-refine N] [--fast-eval-tol T] [--no-centres] [--relax 0|1]
  *        [--coarse-inner N] [--coarse-inner-tol T]
- *        [--thin-reach R] [--thin-cell C] [--thin-max N] [--thin-average 0|1]
+ *        [--thin-reach R] [--thin-cell C] [--thin-max N]
  *        (thinned overlap, rbf.h)
  * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
 #include "cli/blas_reexec.h"
 #include "cadmorph/blas.h"
 #include "cadmorph/rbf.h"
 #include "rbf/rbf_internal.h" /* the inner coarse solver's counts, the unit product */
+#include "rbf/rbf_sum_isa.h"   /* the sqrt split of the kernel blocks */
 
 #include <math.h>
 #include <stdio.h>
@@ -146,7 +147,6 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--thin-reach")) o.thin_reach = atof(b), ++i;
         else if (!strcmp(a, "--thin-cell")) o.thin_cell = atof(b), ++i;
         else if (!strcmp(a, "--thin-max")) o.thin_max = atoi(b), ++i;
-        else if (!strcmp(a, "--thin-average")) o.thin_average = atoi(b), ++i;
         else if (!strcmp(a, "--coarse-grow")) o.coarse_grow = atoi(b), ++i;
         else if (!strcmp(a, "--coarse-max")) o.coarse_max = atoi(b), ++i;
         else if (!strcmp(a, "--restart")) o.restart = atoi(b), ++i;
@@ -184,7 +184,10 @@ int main(int argc, char **argv)
     run it = {0}, dn = {0};
     cm_blas_summary blas;
     cm_blas_info(NULL, &blas);
-    printf("set=%s m=%zu interior=%zu core=%s", prefix, m, ne, blas.core);
+    int sq_plain = 0, sq_acc = 0;
+    cm_rbf_sqrt_split(&sq_plain, &sq_acc); /* of the AVX-512 kernel blocks, probed */
+    printf("set=%s m=%zu interior=%zu core=%s sqrt_split=%d/%d", prefix, m, ne, blas.core,
+           sq_plain, sq_acc);
     if (iterative) {
         o.solver = CM_RBF_SOLVER_ITERATIVE;
         fit(ctx, &o, m, x, v, ne, p, &it);
@@ -210,8 +213,8 @@ int main(int argc, char **argv)
                it.st.matvecs_plain, it.st.matvecs_fast);
         printf(" coarse_inner=%d coarse_inner_tol=%g inner_solves=%ld inner_its=%ld",
                o.coarse_inner, o.coarse_inner_tol, inner_solves, inner_its);
-        printf(" thin_reach=%g thin_cell=%g thin_max=%d thin_average=%d", o.thin_reach,
-               o.thin_cell, o.thin_max, o.thin_average);
+        printf(" thin_reach=%g thin_cell=%g thin_max=%d", o.thin_reach, o.thin_cell,
+               o.thin_max);
     }
     if (dense) {
         o.solver = CM_RBF_SOLVER_DENSE;

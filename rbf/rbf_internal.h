@@ -188,11 +188,9 @@ typedef struct cm_rbf_keyed {
  * key ascending, each at distance d >= d0 > 0 from the leaf's box; c: 3 x m SoA), one per
  * voxel of the grid of cell cell x d0 x 2^k in distance band k = floor(log2(d / d0)) (grid
  * origin org), the one nearest to the voxel's centroid; at most cap of them, the nearest
- * first, into out. slot (nc, or NULL): each candidate's voxel as its pick's position in out,
- * -1 if that pick fell past the cap. Returns the count, or -1 out of memory. */
+ * first, into out. Returns the count, or -1 out of memory. */
 long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_t nc,
-                      double d0, double cell, const double org[3], size_t cap, size_t *out,
-                      long *slot);
+                      double d0, double cell, const double org[3], size_t cap, size_t *out);
 /* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
  * at most m / 4). */
 size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);

@@ -125,7 +125,6 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->local_max = 2800;
     opt->thin_cell = 0.25;
     opt->thin_max = 2000;
-    opt->thin_average = 0;
     opt->fast_sum = -1;
     opt->fast_tol = 1e-12;
     opt->fast_refine = 3;
@@ -230,9 +229,7 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
         !(o->fast_tol > 0.0 && o->fast_tol <= 1e-3) || o->fast_refine < 0 ||
         o->fast_refine > 10 || !(o->fast_eval_tol > 0.0) || o->relax < 0 || o->relax > 2 ||
         !(o->thin_reach >= 0.0) || (o->thin_reach > 0.0 && (!(o->thin_cell > 0.0) ||
-                                                            o->thin_max < o->leaf_size ||
-                                                            o->thin_average < 0 ||
-                                                            o->thin_average > 1)))
+                                                            o->thin_max < o->leaf_size)))
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
                         "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "

@@ -36,14 +36,6 @@ struct cm_rbf_schwarz {
     size_t *sub_ptr;  /* nsub + 1: offsets into sub_idx */
     size_t *sub_idx;  /* centre indices of each local set, its n_in leaf centres first */
     int *n_in;        /* nsub: leaf centres of each local set */
-    /* thin_reach with thin_average: the thinned far band's data is its voxels' mean
-     * residual, not the picks' own (a pick's own residual is one sample of a field that is
-     * rough at the spacing, and its row stands for the whole voxel): subdomain l's far picks
-     * are its local centres from n_near[l] on, and far + far_ptr[l] lists for each of them
-     * in order its voxel's member count, then the members */
-    int *n_near;
-    size_t *far_ptr;  /* nsub + 1 */
-    size_t *far;
     /* local inverse rows of subdomain l, col-major local x n_in: the first hd[l] rows (its
      * own leaf's centres come first) in g64 + d_ptr[l], the rest in g32 + f_ptr[l] (float:
      * see store_local); only the subdomains of this part (l0 <= l < l1) are built */
@@ -234,8 +226,7 @@ static size_t grow_leaf(const tree_build *t, int l, size_t nloc, size_t nmin, do
  * cells growing from d0 = max(near reach, fill), until cap centres in all. Returns the new
  * count, or 0 out of memory. Scratch: cand (m). */
 static size_t thin_far(const tree_build *t, int l, size_t n, double far2, double fill,
-                       double cell, size_t cap, keyed *cand, size_t *out, size_t **agg,
-                       size_t *nagg)
+                       double cell, size_t cap, keyed *cand, size_t *out)
 {
     const leaf *L = &t->leaves[l];
     if (n >= cap) return n;
@@ -262,40 +253,8 @@ static size_t thin_far(const tree_build *t, int l, size_t n, double far2, double
     }
     qsort(cand, nc, sizeof *cand, cmp_keyed);
     const double d0 = fmax(sqrt(dn2), fill);
-    long *slot = agg ? malloc((nc ? nc : 1) * sizeof *slot) : NULL;
-    if (agg && !slot) return 0;
-    long got = cm_rbf_thin_pick(t->c, t->m, cand, nc, d0, cell, L->bmin, cap - n, out + n, slot);
-    if (got < 0) {
-        free(slot);
-        return 0;
-    }
-    if (agg) { /* per pick: member count, then members (the voxel's candidates) */
-        size_t *cnt = calloc((size_t)got + 1, sizeof *cnt), kept = 0;
-        for (size_t u = 0; cnt && u < nc; ++u)
-            if (slot[u] >= 0) ++cnt[slot[u]], ++kept;
-        size_t *a = cnt ? malloc(((size_t)got + kept + 1) * sizeof *a) : NULL;
-        if (!a) {
-            free(cnt), free(slot);
-            return 0;
-        }
-        size_t *pos = malloc(((size_t)got + 1) * sizeof *pos);
-        if (!pos) {
-            free(cnt), free(slot), free(a);
-            return 0;
-        }
-        for (long k = 0, o = 0; k < got; ++k) {
-            a[o] = cnt[k];
-            pos[k] = (size_t)o + 1;
-            o += 1 + (long)cnt[k];
-        }
-        for (size_t u = 0; u < nc; ++u)
-            if (slot[u] >= 0) a[pos[slot[u]]++] = cand[u].idx;
-        *agg = a;
-        *nagg = (size_t)got + kept;
-        free(cnt), free(pos);
-    }
-    free(slot);
-    return n + (size_t)got;
+    long got = cm_rbf_thin_pick(t->c, t->m, cand, nc, d0, cell, L->bmin, cap - n, out + n);
+    return got < 0 ? 0 : n + (size_t)got;
 }
 
 /* ---- local projected inverses ---- */
@@ -558,9 +517,6 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
     cm_rbf_schwarz *p = *pc;
     free(p->sub_ptr);
     free(p->sub_idx);
-    free(p->n_near);
-    free(p->far_ptr);
-    free(p->far);
     free(p->n_in);
     free(p->d_ptr);
     free(p->f_ptr);
@@ -627,10 +583,7 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
     }
     size_t *cnt = calloc((size_t)t.nleaves, sizeof *cnt);
     size_t *nnear = calloc((size_t)t.nleaves, sizeof *nnear);
-    const int average = thin && o->thin_average;
-    size_t **aggs = average ? calloc((size_t)t.nleaves, sizeof *aggs) : NULL;
-    size_t *nagg = average ? calloc((size_t)t.nleaves, sizeof *nagg) : NULL;
-    int fail = !nnear || (average && (!aggs || !nagg));
+    int fail = !nnear;
 #pragma omp parallel num_threads(threads) if (t.nleaves > 8 && threads > 1)
     {
         keyed *lk = malloc((size_t)t.nleaves * sizeof *lk);
@@ -646,8 +599,7 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
             cnt[l] = grow_leaf(&t, l, nloc, nmin, reach2, lk, cand, out);
             if (thin) {
                 nnear[l] = cnt[l];
-                cnt[l] = thin_far(&t, l, cnt[l], far2, p->fill, o->thin_cell, tcap, cand, out,
-                                  aggs ? &aggs[l] : NULL, aggs ? &nagg[l] : NULL);
+                cnt[l] = thin_far(&t, l, cnt[l], far2, p->fill, o->thin_cell, tcap, cand, out);
                 if (cnt[l] == 0) {
 #pragma omp atomic write
                     fail = 1;
@@ -657,24 +609,6 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
         free(lk);
         free(cand);
     }
-    if (average && !fail) { /* the far bands' voxel members, compacted */
-        p->far_ptr = malloc(((size_t)t.nleaves + 1) * sizeof *p->far_ptr);
-        p->n_near = malloc((size_t)t.nleaves * sizeof *p->n_near);
-        size_t tot = 0;
-        for (int l = 0; l < t.nleaves; ++l) tot += nagg[l];
-        p->far = malloc((tot ? tot : 1) * sizeof *p->far);
-        if (!p->far_ptr || !p->n_near || !p->far) fail = 1;
-        for (int l = 0; !fail && l < t.nleaves; ++l) {
-            p->far_ptr[l] = l ? p->far_ptr[l - 1] + nagg[l - 1] : 0;
-            if (nagg[l]) memcpy(p->far + p->far_ptr[l], aggs[l], nagg[l] * sizeof *p->far);
-            p->n_near[l] = (int)nnear[l];
-        }
-        if (!fail) p->far_ptr[t.nleaves] = tot;
-        p->bytes += tot * sizeof *p->far;
-    }
-    for (int l = 0; aggs && l < t.nleaves; ++l) free(aggs[l]);
-    free(aggs);
-    free(nagg);
     if (fail) {
         free(cnt);
         free(nnear);
@@ -1032,17 +966,6 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
             if (!x) continue; /* out of memory: a weaker preconditioner, not a wrong result */
             for (int c = 0; c < nc; ++c)
                 for (size_t i = 0; i < n; ++i) x[(size_t)c * n + i] = res[(size_t)c * m + idx[i]];
-            if (p->far) /* thinned far band: each pick carries its voxel's mean residual */
-                for (size_t i = (size_t)p->n_near[l], *a = p->far + p->far_ptr[l]; i < n; ++i) {
-                    const size_t k = *a++;
-                    for (int c = 0; c < nc; ++c) {
-                        const double *rc = res + (size_t)c * m;
-                        double t = 0.0;
-                        for (size_t u = 0; u < k; ++u) t += rc[a[u]];
-                        x[(size_t)c * n + i] = t / (double)k;
-                    }
-                    a += k;
-                }
             if (p->lq) {
                 /* float rows: the local inverse annihilates linear data, so taking the local
                  * linear fit out first changes nothing in exact arithmetic, but the float

@@ -20,7 +20,7 @@
  * thread, 3 weight vectors; RESULTS.md issue 10, fifth session): Zen 5 plain best with 3 of
  * 4 vectors through vsqrtpd, fixed-binade compensated with 2 of 2; the Xeon plain 2 of 4
  * (1.83e9 against 1.24e9 with 3 of 4), compensated 1 of 2 (1.30e9 against 0.93e9). So each
- * block is built for both splits and split_probe times them once per process (a few ms).
+ * block is built for both splits and split_probe times them once per process (~11 ms).
  *
  * Built with -ffp-contract=off: the error-free transformations of the compensated block
  * need every rounding where it is written. */
@@ -264,27 +264,30 @@ static int split_plain_alt, split_acc_alt; /* 1: the B split is faster here */
 static pthread_once_t split_once = PTHREAD_ONCE_INIT;
 static _Atomic int split_forced; /* cm_rbf_sqrt_split_force: 1 + plain_alt + 2 acc_alt */
 
-/* Times both splits of both blocks on one tile of centres against one work item of points
- * (about 0.3 ms a call), interleaved, best of 3 by the thread's CPU clock, so a loaded
- * machine delays the probe but does not bias it. */
+/* Times both splits of both blocks on four tiles of centres against one work item of
+ * points, interleaved, best of REPS by the thread's CPU clock (a loaded machine delays the
+ * probe but does not bias it), after one untimed round. Each timing is 4 calls of 0.26-0.52M
+ * pairs, 0.4-0.8 ms; ~11 ms in all, once per process. Shorter probes (one tile, 0.1 ms a
+ * timing, no warm-up) measured the faster split at only 1.05-1.1x the other on the Xeon,
+ * where long runs give 1.4x, and once picked the slower one on a quiet machine. */
 static void split_probe(void)
 {
-    enum { NPROBE = TILE, REPS = 3, CALLS = 4 };
+    enum { NPROBE = 4 * TILE, REPS = 4, CALLS = 4 };
     static double c[3 * NPROBE], w[3 * NPROBE], pt[3 * CM_RBF_SUM_PB], acc[4 * CM_RBF_SUM_PB];
     static double pa[3 * CM_RBF_ACC_PB], hi[4 * CM_RBF_ACC_PB], lo[4 * CM_RBF_ACC_PB];
     cm_rbf_probe_data(NPROBE, c, w, CM_RBF_SUM_PB, pt);
     cm_rbf_probe_data(0, NULL, NULL, CM_RBF_ACC_PB, pa);
     double best[2][2] = {{INFINITY, INFINITY}, {INFINITY, INFINITY}}; /* [block][alt] */
-    for (int r = 0; r < REPS; ++r)
+    for (int r = 0; r <= REPS; ++r) /* round 0 untimed */
         for (int alt = 0; alt < 2; ++alt) {
             memset(acc, 0, sizeof acc);
             double t = cm_rbf_thread_seconds();
             for (int k = 0; k < CALLS; ++k) plain_split(alt, 3, NPROBE, c, w, pt, acc);
-            best[0][alt] = fmin(best[0][alt], cm_rbf_thread_seconds() - t);
+            if (r) best[0][alt] = fmin(best[0][alt], cm_rbf_thread_seconds() - t);
             for (int i = 0; i < 4 * CM_RBF_ACC_PB; ++i) hi[i] = 0x1.8p40, lo[i] = 0.0;
             t = cm_rbf_thread_seconds();
             for (int k = 0; k < CALLS; ++k) accf_split(alt, 3, NPROBE, c, w, pa, hi, lo);
-            best[1][alt] = fmin(best[1][alt], cm_rbf_thread_seconds() - t);
+            if (r) best[1][alt] = fmin(best[1][alt], cm_rbf_thread_seconds() - t);
         }
     split_plain_alt = best[0][1] < best[0][0];
     split_acc_alt = best[1][1] < best[1][0];

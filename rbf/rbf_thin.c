@@ -52,22 +52,18 @@ static size_t voxel_of(voxel *tab, size_t tsize, const double *c, size_t m,
 }
 
 long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_t nc,
-                      double d0, double cell, const double org[3], size_t cap, size_t *out,
-                      long *slot)
+                      double d0, double cell, const double org[3], size_t cap, size_t *out)
 {
-    if (slot)
-        for (size_t u = 0; u < nc; ++u) slot[u] = -1;
     if (nc == 0 || cap == 0) return 0;
     size_t tsize = 64;
     while (tsize < 2 * nc) tsize *= 2;
     voxel *tab = malloc(tsize * sizeof *tab);
     size_t *vs = malloc(nc * sizeof *vs);
-    long *at = malloc(tsize * sizeof *at);
-    if (!tab || !vs || !at) {
-        free(tab), free(vs), free(at);
+    if (!tab || !vs) {
+        free(tab), free(vs);
         return -1;
     }
-    for (size_t s = 0; s < tsize; ++s) tab[s].band = -1, at[s] = -1;
+    for (size_t s = 0; s < tsize; ++s) tab[s].band = -1;
     for (size_t u = 0; u < nc; ++u) {
         voxel *v = &tab[vs[u] = voxel_of(tab, tsize, c, m, &cand[u], d0, cell, org)];
         ++v->count;
@@ -76,8 +72,9 @@ long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_
     for (size_t s = 0; s < tsize; ++s)
         if (tab[s].band >= 0)
             for (int q = 0; q < 3; ++q) tab[s].sum[q] /= (double)tab[s].count;
-    /* the pick stands for its voxel (the voxel's mean residual with thin_average): the
-     * candidate nearest to the voxel's centroid */
+    /* the pick stands for its voxel: the candidate nearest to the voxel's centroid (a pick's
+     * voxel-mean residual instead of its own was measured worse: RESULTS.md, "Thinned
+     * overlap") */
     for (size_t u = 0; u < nc; ++u) {
         voxel *v = &tab[vs[u]];
         double e2 = 0.0;
@@ -90,12 +87,7 @@ long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_
     /* the nearest picks first: the cap cuts the reach, not the resolution near the leaf */
     size_t n = 0;
     for (size_t u = 0; u < nc && n < cap; ++u)
-        if (tab[vs[u]].pos == u) {
-            at[vs[u]] = (long)n;
-            out[n++] = cand[u].idx;
-        }
-    if (slot)
-        for (size_t u = 0; u < nc; ++u) slot[u] = at[vs[u]];
-    free(tab), free(vs), free(at);
+        if (tab[vs[u]].pos == u) out[n++] = cand[u].idx;
+    free(tab), free(vs);
     return (long)n;
 }

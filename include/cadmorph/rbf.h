@@ -113,10 +113,6 @@ typedef struct cm_rbf_options {
                            * reach): larger thins more */
     int thin_max;         /* [2000] cap on a subdomain's centres with thin_reach > 0 (the far
                            * picks nearest to the leaf are kept first) */
-    int thin_average;     /* [0] a far pick's data in the local solve: 0 the pick's own
-                           * residual, 1 the mean residual of its voxel (measured worse:
-                           * bracket 7.2k, 500 near + 199 far: 21 iterations instead of 13,
-                           * no better than no far band) */
     int coarse_grow;      /* [1] coarse_size is the count at 2e4 centres; above, it grows as
                            * sqrt(m) (coarse factor 8 coarse^2 bytes, O(m)): bracket 59k,
                            * 5,000 coarse centres: 17 iterations instead of 21 */
