@@ -5,6 +5,8 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* Boundary nodes of a box [0,a] x [0,b] x [0,c] with a bore of radius rad along z through
  * (xc, yc), spaced about h, shifted by off: the kind of set a tet mesh of bore_a.step has
@@ -62,6 +64,24 @@ static void bore_motion(size_t n, const double *x, double xc, double yc, double 
         d[3 * i + 1] = s * dy / r;
         d[3 * i + 2] = 0.02 * x[3 * i] * x[3 * i] / 16.0;
     }
+}
+
+/* Evaluation points for the box sets: the m centres x, then nin points spread through the
+ * box [0.1, 3.9] x [0.1, 0.1 + ywidth] x [0.1, 0.9]; *np = m + nin. NULL out of memory. */
+static inline double *eval_points(size_t m, const double *x, size_t nin, double ywidth,
+                                  size_t *np)
+{
+    double *p = malloc((m + nin) * 3 * sizeof *p);
+    if (!p) return NULL;
+    memcpy(p, x, m * 3 * sizeof *p);
+    for (size_t i = 0; i < nin; ++i) {
+        double t = (double)i / (double)nin;
+        p[3 * (m + i)] = 0.1 + 3.8 * t;
+        p[3 * (m + i) + 1] = 0.1 + ywidth * fmod(7.0 * t, 1.0);
+        p[3 * (m + i) + 2] = 0.1 + 0.8 * fmod(13.0 * t, 1.0);
+    }
+    *np = m + nin;
+    return p;
 }
 
 static double range_of(size_t n, const double *v)

@@ -34,20 +34,6 @@ static cm_status fit_eval(cm_context *ctx, cm_rbf_solver solver, size_t m, const
     return fit_eval_opt(ctx, &o, m, x, val, np, p, out, stats);
 }
 
-/* Evaluation points: the centres and points inside the box. */
-static double *eval_points(size_t m, const double *x, size_t nin, size_t *np)
-{
-    double *p = malloc((m + nin) * 3 * sizeof *p);
-    memcpy(p, x, m * 3 * sizeof *p);
-    for (size_t i = 0; i < nin; ++i) {
-        double t = (double)i / (double)nin;
-        p[3 * (m + i)] = 0.1 + 3.8 * t;
-        p[3 * (m + i) + 1] = 0.1 + 0.3 * fmod(7.0 * t, 1.0);
-        p[3 * (m + i) + 2] = 0.1 + 0.8 * fmod(13.0 * t, 1.0);
-    }
-    *np = m + nin;
-    return p;
-}
 
 /* The box-with-bore set at m ~ 5k: iterative vs dense at the centres and inside, then the
  * iterative fit again on one thread. */
@@ -63,7 +49,7 @@ static void test_against_dense(cm_context *ctx)
     bore_motion(m, xl, 2.0, 1.0, d);
     free(xl);
     size_t np;
-    double *p = eval_points(m, x, 2000, &np);
+    double *p = eval_points(m, x, 2000, 0.3, &np);
     for (size_t i = m; i < np; ++i)
         for (int e = 0; e < 3; ++e) p[3 * i + e] += off[e];
     double *sd = malloc(np * 3 * sizeof *sd), *si = malloc(np * 3 * sizeof *si);
@@ -175,7 +161,7 @@ static void test_affine(cm_context *ctx)
     double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
     box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.11, off, x);
     size_t np;
-    double *p = eval_points(m, x, 500, &np);
+    double *p = eval_points(m, x, 500, 0.3, &np);
     double *ref = malloc(np * 3 * sizeof *ref), *out = malloc(np * 3 * sizeof *out);
     for (size_t i = 0; i < np; ++i)
         for (int e = 0; e < 3; ++e) {
@@ -203,7 +189,7 @@ static void test_storage(cm_context *ctx)
     box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.09, off, x);
     bore_motion(m, x, 2.0, 1.0, d);
     size_t np;
-    double *p = eval_points(m, x, 500, &np);
+    double *p = eval_points(m, x, 500, 0.3, &np);
     double *out[3];
     cm_rbf_stats st[3];
     cm_rbf_options o;

@@ -27,19 +27,12 @@ int main(int argc, char **argv)
     /* m ~ 5k boundary nodes, the bore's kind of motion, points inside */
     const double h = 0.076, no_offset[3] = {0, 0, 0};
     size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, no_offset, NULL);
-    const size_t nin = 3000, np = m + nin;
     double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
-    double *p = malloc(np * 3 * sizeof *p);
-    double *ss = malloc(np * 3 * sizeof *ss), *sp = malloc(np * 3 * sizeof *sp);
     box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, no_offset, x);
     bore_motion(m, x, 2.0, 1.0, d);
-    memcpy(p, x, m * 3 * sizeof *p);
-    for (size_t i = 0; i < nin; ++i) {
-        double t = (double)i / (double)nin;
-        p[3 * (m + i)] = 0.1 + 3.8 * t;
-        p[3 * (m + i) + 1] = 0.1 + 0.3 * fmod(7.0 * t, 1.0);
-        p[3 * (m + i) + 2] = 0.1 + 0.8 * fmod(13.0 * t, 1.0);
-    }
+    size_t np = 0;
+    double *p = eval_points(m, x, 3000, 0.3, &np);
+    double *ss = malloc(np * 3 * sizeof *ss), *sp = malloc(np * 3 * sizeof *sp);
 
     cm_rbf_options o;
     cm_rbf_options_init(&o);

@@ -40,15 +40,8 @@ static void test_inner(cm_context *ctx)
     double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
     box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, x);
     bore_motion(m, x, 2.0, 1.0, d);
-    const size_t nin = 1500, np = m + nin;
-    double *p = malloc(np * 3 * sizeof *p);
-    memcpy(p, x, m * 3 * sizeof *p);
-    for (size_t i = 0; i < nin; ++i) {
-        double t = (double)i / (double)nin;
-        p[3 * (m + i)] = 0.1 + 3.8 * t;
-        p[3 * (m + i) + 1] = 0.1 + 1.8 * fmod(7.0 * t, 1.0);
-        p[3 * (m + i) + 2] = 0.1 + 0.8 * fmod(13.0 * t, 1.0);
-    }
+    size_t np = 0;
+    double *p = eval_points(m, x, 1500, 1.8, &np);
     double *sd = malloc(np * 3 * sizeof *sd), *s0 = malloc(np * 3 * sizeof *s0);
     double *s1 = malloc(np * 3 * sizeof *s1);
     cm_rbf_options o;

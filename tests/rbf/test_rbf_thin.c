@@ -128,15 +128,8 @@ static void test_thin(cm_context *ctx)
     check_subdomains(ctx, &o, m, x, 1);
 
     /* the solver with thinning against dense, at the centres and inside */
-    const size_t nin = 1500, np = m + nin;
-    double *p = malloc(np * 3 * sizeof *p);
-    memcpy(p, x, m * 3 * sizeof *p);
-    for (size_t i = 0; i < nin; ++i) {
-        double t = (double)i / (double)nin;
-        p[3 * (m + i)] = 0.1 + 3.8 * t;
-        p[3 * (m + i) + 1] = 0.1 + 1.8 * fmod(7.0 * t, 1.0);
-        p[3 * (m + i) + 2] = 0.1 + 0.8 * fmod(13.0 * t, 1.0);
-    }
+    size_t np = 0;
+    double *p = eval_points(m, x, 1500, 1.8, &np);
     double *sd = malloc(np * 3 * sizeof *sd), *st = malloc(np * 3 * sizeof *st);
     cm_rbf_stats sdn, sth;
     cm_rbf *r = NULL;
