@@ -66,6 +66,27 @@ static void bore_motion(size_t n, const double *x, double xc, double yc, double 
     }
 }
 
+/* The standard set of these tests: the 4 x 2 x 1 box with the bore (radius 0.4) through
+ * (2, 1), spacing h; its m centres malloc'ed (m x 3), NULL out of memory. */
+static inline double *bore_centres(double h, size_t *m)
+{
+    const double off[3] = {0.0, 0.0, 0.0};
+    *m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, off, NULL);
+    double *x = malloc(*m * 3 * sizeof *x);
+    if (x) box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, off, x);
+    return x;
+}
+
+/* The same centres with the bore's motion: *x and *d malloc'ed (m x 3). Returns m. */
+static inline size_t bore_set(double h, double **x, double **d)
+{
+    size_t m = 0;
+    *x = bore_centres(h, &m);
+    *d = malloc(m * 3 * sizeof **d);
+    if (*x && *d) bore_motion(m, *x, 2.0, 1.0, *d);
+    return m;
+}
+
 /* Evaluation points for the box sets: the m centres x, then nin points spread through the
  * box [0.1, 3.9] x [0.1, 0.1 + ywidth] x [0.1, 0.9]; *np = m + nin. NULL out of memory. */
 static inline double *eval_points(size_t m, const double *x, size_t nin, double ywidth,

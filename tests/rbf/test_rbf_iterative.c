@@ -183,11 +183,8 @@ static void test_affine(cm_context *ctx)
  * interpolant to 1e-9 of the range, iterations within one, float smaller. */
 static void test_storage(cm_context *ctx)
 {
-    const double off[3] = {0.0, 0.0, 0.0};
-    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.09, off, NULL);
-    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
-    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.09, off, x);
-    bore_motion(m, x, 2.0, 1.0, d);
+    double *x = NULL, *d = NULL;
+    size_t m = bore_set(0.09, &x, &d);
     size_t np;
     double *p = eval_points(m, x, 500, 0.3, &np);
     double *out[3];

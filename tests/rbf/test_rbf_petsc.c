@@ -25,11 +25,9 @@ int main(int argc, char **argv)
     CHECK_MSG(size == want_ranks, "%d ranks, expected %d", size, want_ranks);
 
     /* m ~ 5k boundary nodes, the bore's kind of motion, points inside */
-    const double h = 0.076, no_offset[3] = {0, 0, 0};
-    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, no_offset, NULL);
-    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
-    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, no_offset, x);
-    bore_motion(m, x, 2.0, 1.0, d);
+    const double h = 0.076;
+    double *x = NULL, *d = NULL;
+    size_t m = bore_set(h, &x, &d);
     size_t np = 0;
     double *p = eval_points(m, x, 3000, 0.3, &np);
     double *ss = malloc(np * 3 * sizeof *ss), *sp = malloc(np * 3 * sizeof *sp);

@@ -35,11 +35,8 @@ static cm_status fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const d
 
 static void test_inner(cm_context *ctx)
 {
-    const double off[3] = {0.0, 0.0, 0.0};
-    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, NULL);
-    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
-    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, x);
-    bore_motion(m, x, 2.0, 1.0, d);
+    double *x = NULL, *d = NULL;
+    size_t m = bore_set(0.076, &x, &d);
     size_t np = 0;
     double *p = eval_points(m, x, 1500, 1.8, &np);
     double *sd = malloc(np * 3 * sizeof *sd), *s0 = malloc(np * 3 * sizeof *s0);

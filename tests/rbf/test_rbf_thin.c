@@ -108,11 +108,8 @@ static void check_subdomains(cm_context *ctx, const cm_rbf_options *o, size_t m,
 
 static void test_thin(cm_context *ctx)
 {
-    const double off[3] = {0.0, 0.0, 0.0};
-    size_t m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, NULL);
-    double *x = malloc(m * 3 * sizeof *x), *d = malloc(m * 3 * sizeof *d);
-    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.076, off, x);
-    bore_motion(m, x, 2.0, 1.0, d);
+    double *x = NULL, *d = NULL;
+    size_t m = bore_set(0.076, &x, &d);
     cm_rbf_options o;
     cm_rbf_options_init(&o);
     o.solver = CM_RBF_SOLVER_ITERATIVE;

@@ -13,15 +13,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static double *bore_set(double h, size_t *m)
-{
-    const double off[3] = {0.0, 0.0, 0.0};
-    *m = box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, off, NULL);
-    double *x = malloc(*m * 3 * sizeof *x);
-    box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, h, off, x);
-    return x;
-}
-
 /* max_i |fast_i - exact_i| / S_i with S_i = sum_j |w_j| phi_ij, over nc components; exact by
  * compensated sums. c: 3 x m SoA, p: 3 x n SoA. Also the cancellation max S / max |exact|. */
 static double bound_ratio(const cm_rbf_tree *t, size_t m, const double *c, const double *w,
@@ -62,7 +53,7 @@ static double ratio4(const double *fast, int nc, size_t n, const double *ex, con
 static void test_bound_random(void)
 {
     size_t m;
-    double *x = bore_set(0.06, &m); /* ~8k centres */
+    double *x = bore_centres(0.06, &m); /* ~8k centres */
     double *c = malloc(3 * m * sizeof *c), *w = malloc(4 * m * sizeof *w);
     for (size_t i = 0; i < m; ++i)
         for (int d = 0; d < 3; ++d) c[(size_t)d * m + i] = x[3 * i + d] / 4.0;
@@ -195,7 +186,7 @@ static void test_compensated(const cm_rbf *r)
 static void test_bound_real(cm_context *ctx)
 {
     size_t m;
-    double *x = bore_set(0.076, &m); /* ~5k centres */
+    double *x = bore_centres(0.076, &m); /* ~5k centres */
     double *d = malloc(m * 3 * sizeof *d);
     bore_motion(m, x, 2.0, 1.0, d);
     cm_rbf_options o;
@@ -239,7 +230,7 @@ static cm_status fit_eval(cm_context *ctx, const cm_rbf_options *o, size_t m, co
 static void test_fit(cm_context *ctx)
 {
     size_t m;
-    double *x = bore_set(0.076, &m);
+    double *x = bore_centres(0.076, &m);
     double *d = malloc(m * 3 * sizeof *d);
     bore_motion(m, x, 2.0, 1.0, d);
     const size_t nin = 4000, np = m + nin;
@@ -296,7 +287,7 @@ static void test_fit(cm_context *ctx)
 static void test_affine(cm_context *ctx)
 {
     size_t m;
-    double *x = bore_set(0.1, &m);
+    double *x = bore_centres(0.1, &m);
     double *d = malloc(m * 3 * sizeof *d), *out = malloc(m * 3 * sizeof *out);
     for (size_t i = 0; i < m; ++i) {
         d[3 * i] = 1.0 + 0.5 * x[3 * i] - 0.25 * x[3 * i + 2];
@@ -330,7 +321,7 @@ static void test_evaluation(cm_context *ctx)
             x = malloc(m * 3 * sizeof *x);
             for (size_t i = 0; i < 3 * m; ++i) x[i] = test_rng_range(&rng, 0.0, 1.0);
         } else {
-            x = bore_set(0.1, &m);
+            x = bore_centres(0.1, &m);
         }
         d = malloc(m * 3 * sizeof *d);
         for (size_t i = 0; i < m; ++i)
@@ -380,7 +371,7 @@ static void test_evaluation(cm_context *ctx)
 static void test_options(cm_context *ctx)
 {
     size_t m;
-    double *x = bore_set(0.2, &m);
+    double *x = bore_centres(0.2, &m);
     cm_rbf_options o;
     cm_rbf_options_init(&o);
     CHECK(o.fast_sum == -1 && o.fast_tol == 1e-12 && o.fast_refine == 3 && o.fast_eval_tol == 1e-9);
@@ -413,7 +404,7 @@ static void test_options(cm_context *ctx)
 static void test_isa(void)
 {
     size_t m;
-    double *x = bore_set(0.08, &m); /* ~4.5k centres */
+    double *x = bore_centres(0.08, &m); /* ~4.5k centres */
     double *c = malloc(3 * m * sizeof *c), *w = malloc(4 * m * sizeof *w);
     for (size_t i = 0; i < m; ++i)
         for (int d = 0; d < 3; ++d) c[(size_t)d * m + i] = x[3 * i + d] / 4.0;
