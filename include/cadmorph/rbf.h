@@ -45,7 +45,7 @@ typedef struct cm_rbf cm_rbf;
  *   fast_eval_tol x max |data| (or within the direct sums' own rounding, if that is
  *   larger), direct sums otherwise (stats: eval_fast, eval_error).
  * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
- *   crossover near 7,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
+ *   crossover near 4,000 centres: dense below (while 4 m^2 bytes fit in half the memory),
  *   iterative above; dense for the other kernels.
  * PETSC: the ITERATIVE solver distributed over the MPI ranks of PETSC_COMM_WORLD through
  *   PETSc (only in builds with -DCADMORPH_WITH_PETSC=ON; otherwise create fails with
@@ -76,9 +76,14 @@ typedef struct cm_rbf_options {
                            * its residual estimate has fallen 1e6-fold (rbf_iterative.c) */
     int leaf_size;        /* [256] kD-tree leaf size: leaves hold leaf_size/2..leaf_size
                            * centres and are the disjoint cores of the subdomains */
-    int local_size;       /* [1400] centres per overlapping subdomain (the leaf plus the
-                           * centres nearest to its box): the overlap is the knob that
-                           * matters on thin walls */
+    int local_size;       /* [700] centres per overlapping subdomain at least (the leaf
+                           * plus the centres nearest to its box; overlap below may add
+                           * more): the overlap is the knob that matters on thin walls.
+                           * 700 rather than 1,400: below ~3e4 centres the set-up (n^3 per
+                           * subdomain) outweighs the products, and halving n costs 0-1
+                           * iterations (bore 9.9k / 20.6k, pipe 17.8k, bracket 22.1k: fit
+                           * 1.3-2.2x less CPU); from ~6e4 the overlap rule sets n anyway
+                           * (RESULTS.md, issue 10, sixth session) */
     int coarse_size;      /* [2000] farthest-point centres of the coarse space (at m <= 2e4,
                            * see coarse_grow), 0: none */
     int local_float;      /* [1] storage of the local inverse rows: 1 float (4 instead of

@@ -307,7 +307,7 @@ static void test_choice(cm_context *ctx)
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     o.local_size = 8; /* smaller than the leaves */
     CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
-    o.local_size = 1400;
+    o.local_size = 700;
     o.coarse_post = 3;
     CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
     o.coarse_post = 0;
@@ -316,8 +316,9 @@ static void test_choice(cm_context *ctx)
     o.overlap = 3.0;
     o.relax = 3;
     CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
-    /* the cost model: dense at 5k, iterative at 20k (measured: 1.6x faster at 10k) */
-    CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 5000) == 1);
+    /* the cost model: dense at 2k, iterative at 20k (measured with subdomains of 700: the
+     * crossover near 4k, iterative 4x faster at 10k) */
+    CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 2000) == 1);
     CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 20000) == 0);
     CHECK(cm_rbf_auto_dense(CM_RBF_BIHARMONIC, 20000) == 1);
     /* the coarse space: 2000 up to 2e4 centres (m/4 below 8000), then grown as sqrt(m) up
