@@ -47,14 +47,19 @@ static void plane_basis(const double w[3], double u[3], double v[3])
 }
 
 /* Gaussian elimination with partial pivoting on a small n x n system (a destroyed);
- * returns 0 if singular. */
+ * returns 0 if singular to rounding: a pivot below 1e-13 x the largest entry (an exact
+ * zero test passes systems that are singular but for rounding, e.g. the circle through
+ * collinear points, which then gets a radius of ~1e16 x their extent: the result then
+ * depended on the LAPACK kernels' rounding in the plane fit, Zen 4 against the Xeon). */
 static int solve_small(int n, double *a, double *b)
 {
+    double amax = 0;
+    for (int i = 0; i < n * n; ++i) amax = fmax(amax, fabs(a[i]));
     for (int c = 0; c < n; ++c) {
         int p = c;
         for (int r = c + 1; r < n; ++r)
             if (fabs(a[r * n + c]) > fabs(a[p * n + c])) p = r;
-        if (!(fabs(a[p * n + c]) > 0)) return 0;
+        if (!(fabs(a[p * n + c]) > 1e-13 * amax)) return 0;
         if (p != c) {
             for (int j = 0; j < n; ++j) {
                 double t = a[c * n + j];
@@ -133,14 +138,19 @@ cm_status cm_shape_project_plane(cm_context *ctx, size_t n, const double *x, dou
     return CM_OK;
 }
 
-/* Kasa's algebraic circle through 2D points (s, t): min sum (s^2 + t^2 + D s + E t + F)^2.
- * Returns 0 when the points are collinear. */
+/* Kasa's algebraic circle through 2D points (s, t): min sum (s^2 + t^2 + D s + E t + F)^2,
+ * in coordinates scaled by the points' extent L, so that solve_small's relative singularity
+ * test does not depend on the units. Returns 0 when the points are collinear (to rounding:
+ * an arc whose sagitta is below ~1e-7 of L counts as a line). */
 static int circle_algebraic(size_t n, const double *s, const double *t, double *a, double *b,
                             double *r)
 {
-    double m[9] = {0}, rhs[3] = {0};
+    double m[9] = {0}, rhs[3] = {0}, L = 0;
+    for (size_t i = 0; i < n; ++i) L = fmax(L, fmax(fabs(s[i]), fabs(t[i])));
+    if (!(L > 0) || !isfinite(L)) return 0;
     for (size_t i = 0; i < n; ++i) {
-        double row[3] = {s[i], t[i], 1}, z = -(s[i] * s[i] + t[i] * t[i]);
+        const double si = s[i] / L, ti = t[i] / L;
+        double row[3] = {si, ti, 1}, z = -(si * si + ti * ti);
         for (int p = 0; p < 3; ++p) {
             rhs[p] += row[p] * z;
             for (int q = 0; q < 3; ++q)
@@ -151,7 +161,8 @@ static int circle_algebraic(size_t n, const double *s, const double *t, double *
     *a = -rhs[0] / 2, *b = -rhs[1] / 2;
     double r2 = *a * *a + *b * *b - rhs[2];
     if (!(r2 > 0) || !isfinite(r2)) return 0;
-    *r = sqrt(r2);
+    *r = L * sqrt(r2);
+    *a *= L, *b *= L;
     return 1;
 }
 
