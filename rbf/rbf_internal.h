@@ -179,6 +179,24 @@ typedef int (*cm_rbf_schwarz_sum)(void *arg, double *out, size_t n);
 int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc,
                              const double *in, double *out, int threads, cm_rbf_schwarz_sum sum,
                              void *arg);
+
+/* Null-space projected factorisations of local systems (rbf_local_inverse.c), on the n
+ * centres idx of the 3 x m SoA cg. projected_factor: in work (n*n + 8n doubles) the factor
+ * of Q'AQ's trailing block and the Householder vectors of the polynomials' rank-revealing
+ * QR (rank in *rk, tau: 4); returns 0, the failing pivot (> 0) or -1. projected_solve: x (n x
+ * nrhs) := Q2 (Q2'AQ2)^{-1} Q2' x with that factor. local_inverse: g (n x n_in) = the leaf
+ * rows of the local inverse (the leaf: the first n_in of idx); local_inverse_fast the same
+ * at ~0.6x the flops (work: n*n + 24n doubles), -2 if the set has no more overlap centres
+ * than polynomial terms (then use local_inverse). */
+int cm_rbf_projected_factor(const double *cg, size_t m, const size_t *idx, size_t n,
+                            double *work, int *rk, double *tau);
+int cm_rbf_projected_solve(const double *work, size_t n, int rk, const double *tau,
+                           size_t nrhs, double *x);
+int cm_rbf_local_inverse(const double *cg, size_t m, const size_t *idx, size_t n, size_t n_in,
+                         double *work, double *g);
+int cm_rbf_local_inverse_fast(const double *cg, size_t m, const size_t *idx, size_t n,
+                              size_t n_in, double *work, double *g);
+
 /* A centre index with a sort key (the squared distance to a leaf's box). */
 typedef struct cm_rbf_keyed {
     double key;
