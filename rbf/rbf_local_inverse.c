@@ -2,7 +2,8 @@
  * preconditioner (rbf_schwarz.c) is built from: the factor of a set's projected matrix, its
  * solve, and the leaf rows of a subdomain's inverse (two ways: a plain one and one at about
  * 0.6x the flops). Pure functions of the centres and an index set; the callers own the
- * work space and run them on one thread of BLAS each (OpenMP over subdomains). */
+ * work space and the BLAS threads (one per subdomain under OpenMP, all for the coarse
+ * factor). */
 #include "rbf_internal.h"
 
 #include <cblas.h>
