@@ -10,6 +10,7 @@
  * neighbours compatible with the refit, repeat until nothing is added. */
 #include "cadmorph/ransac.h"
 #include "cadmorph/shapeup.h"
+#include "shape_internal.h"
 
 #include <float.h>
 #include <math.h>
@@ -327,31 +328,7 @@ static int refit(cm_context *ctx, rs *s, cand *k, size_t m, const int32_t *list,
                     a[4 * p + q] += row[p] * row[q];
             }
         }
-        /* Gaussian elimination, 4 x 4 */
-        for (int c = 0; c < 4; ++c) {
-            int piv = c;
-            for (int r = c + 1; r < 4; ++r)
-                if (fabs(a[4 * r + c]) > fabs(a[4 * piv + c])) piv = r;
-            if (!(fabs(a[4 * piv + c]) > 0)) return 0;
-            for (int j = 0; j < 4; ++j) {
-                double t = a[4 * c + j];
-                a[4 * c + j] = a[4 * piv + j], a[4 * piv + j] = t;
-            }
-            double t = b[c];
-            b[c] = b[piv], b[piv] = t;
-            for (int r = c + 1; r < 4; ++r) {
-                double g = a[4 * r + c] / a[4 * c + c];
-                for (int j = c; j < 4; ++j)
-                    a[4 * r + j] -= g * a[4 * c + j];
-                b[r] -= g * b[c];
-            }
-        }
-        for (int c = 3; c >= 0; --c) {
-            double v = b[c];
-            for (int j = c + 1; j < 4; ++j)
-                v -= a[4 * c + j] * b[j];
-            b[c] = v / a[4 * c + c];
-        }
+        if (!cm_shape_solve_small(4, a, b)) return 0;
         double cen[3] = {-b[0] / 2, -b[1] / 2, -b[2] / 2}, r2 = dot3(cen, cen) - b[3];
         if (!(r2 > 0) || !isfinite(r2)) return 0;
         for (int i = 0; i < 3; ++i)

@@ -4,6 +4,7 @@
  * search, then Levenberg-Marquardt on the geometric distances), cone (the same search on a
  * cone's algebraic error, then Levenberg-Marquardt), similar/rigid match (Kabsch/Umeyama). */
 #include "cadmorph/shapeup.h"
+#include "shape_internal.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -46,12 +47,8 @@ static void plane_basis(const double w[3], double u[3], double v[3])
     cross3(w, u, v);
 }
 
-/* Gaussian elimination with partial pivoting on a small n x n system (a destroyed);
- * returns 0 if singular to rounding: a pivot below 1e-13 x the largest entry (an exact
- * zero test passes systems that are singular but for rounding, e.g. the circle through
- * collinear points, which then gets a radius of ~1e16 x their extent: the result then
- * depended on the LAPACK kernels' rounding in the plane fit, Zen 4 against the Xeon). */
-static int solve_small(int n, double *a, double *b)
+/* shape_internal.h says why the singularity test is relative */
+int cm_shape_solve_small(int n, double *a, double *b)
 {
     double amax = 0;
     for (int i = 0; i < n * n; ++i) amax = fmax(amax, fabs(a[i]));
@@ -139,8 +136,8 @@ cm_status cm_shape_project_plane(cm_context *ctx, size_t n, const double *x, dou
 }
 
 /* Kasa's algebraic circle through 2D points (s, t): min sum (s^2 + t^2 + D s + E t + F)^2,
- * in coordinates scaled by the points' extent L, so that solve_small's relative singularity
- * test does not depend on the units. Returns 0 when the points are collinear (to rounding:
+ * in coordinates scaled by the points' extent L, so that cm_shape_solve_small's relative
+ * singularity test does not depend on the units. Returns 0 when the points are collinear (to rounding:
  * an arc whose sagitta is below ~1e-7 of L counts as a line). */
 static int circle_algebraic(size_t n, const double *s, const double *t, double *a, double *b,
                             double *r)
@@ -157,7 +154,7 @@ static int circle_algebraic(size_t n, const double *s, const double *t, double *
                 m[3 * p + q] += row[p] * row[q];
         }
     }
-    if (!solve_small(3, m, rhs)) return 0;
+    if (!cm_shape_solve_small(3, m, rhs)) return 0;
     *a = -rhs[0] / 2, *b = -rhs[1] / 2;
     double r2 = *a * *a + *b * *b - rhs[2];
     if (!(r2 > 0) || !isfinite(r2)) return 0;
@@ -189,7 +186,7 @@ static int circle_geometric(size_t n, const double *s, const double *t, double *
                     jt[3 * p + q] += j[p] * j[q];
             }
         }
-        if (!solve_small(3, jt, g)) break;
+        if (!cm_shape_solve_small(3, jt, g)) break;
         double step = 1, nc = cost;
         double na = *a, nb = *b, nr = *r;
         for (int h = 0; h < 30; ++h, step /= 2) {
@@ -324,7 +321,7 @@ static void cylinder_refine(size_t n, const double *x, const double mean[3], dou
             memcpy(b, g, sizeof b);
             for (int k = 0; k < 5; ++k)
                 a[6 * k] += lambda * (jt[6 * k] > 0 ? jt[6 * k] : 1);
-            if (!solve_small(5, a, b)) {
+            if (!cm_shape_solve_small(5, a, b)) {
                 lambda *= 10;
                 continue;
             }
@@ -460,7 +457,7 @@ static double cone_direction_error(size_t n, const double *x, const double *mean
                 a[5 * p + q] += row[p] * row[q];
         }
     }
-    if (!solve_small(5, a, b)) return INFINITY;
+    if (!cm_shape_solve_small(5, a, b)) return INFINITY;
     /* the radius line r = c + d h by least squares */
     double sh = 0, sr = 0, shh = 0, shr = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -571,7 +568,7 @@ static void cone_refine(size_t n, const double *x, double *p, double scale, doub
             memcpy(b, g, sizeof b);
             for (int j = 0; j < 6; ++j)
                 aa[7 * j] += lambda * (a[7 * j] > 0 ? a[7 * j] : 1);
-            if (!solve_small(6, aa, b)) {
+            if (!cm_shape_solve_small(6, aa, b)) {
                 lambda *= 10;
                 continue;
             }
