@@ -51,7 +51,7 @@ static const cli_option options[] = {
     {.name = "--solver", .kind = CLI_ENUM, .dest = &args.solver, .names = cli_solver_names,
      .values = cli_solver_values, .bad = "%.0sunknown solver '%s' (auto, dense, iterative, petsc)",
      .label = "--solver S",
-     .help = "RBF warps: auto (default: dense below ~4,000 boundary nodes,\n"
+     .help = "RBF warps: auto (default: dense below ~3,500 boundary nodes,\n"
              "iterative above), dense, iterative (FGMRES + Schwarz) or petsc\n"
              "(the same distributed over MPI ranks: mpirun -n K; builds\n"
              "with -DCADMORPH_WITH_PETSC=ON)"},

@@ -121,7 +121,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->coarse_grow = 1;
     opt->coarse_max = 8000;
     opt->coarse_inner_tol = 1e-2;
-    opt->overlap = 3.0;
+    opt->overlap = 2.0;
     opt->local_max = 2800;
     opt->thin_cell = 0.25;
     opt->thin_max = 2000;
@@ -155,9 +155,9 @@ void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
  *               (FGMRES matvecs, the final residual, evaluation at the centres).
  * E, S and N were fitted to bench_rbf runs of both solvers at m = 5k, 10k, 20k in one
  * window (RESULTS.md, issue 10, "Kernel throughput and the dense path on a quiet machine");
- * S and N again with subdomains of 700 centres (sixth session: S 1.9e7 -> 4.4e6, N 12 ->
- * 8.4 on Zen 4; crossover ~4,000 centres, where real boundary sets agree: iterative ahead
- * on bore 3.3k and pipe 4.7k, dense on bracket 1.8k).
+ * S and N again with subdomains of 700 centres and an overlap of 2 H (sixth session, Zen 4:
+ * S 1.9e7 -> 3.0e6, N 12 -> 8.6; crossover ~3,500 centres, where real boundary sets agree:
+ * iterative ahead on bore 3.3k and pipe 4.7k, dense on bracket 1.8k).
  * Why rates and not seconds: the old constants (crossover ~7,500 centres) came from
  * Haswell kernels under load; with the AVX-512 dgemm the dense path is 2x faster and with the
  * hand-written AVX-512 sums the iterative one too, and the crossover follows their ratio.
@@ -167,10 +167,10 @@ void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
  * minutes and 7 GB, so those skip the probe. */
 #define CM_RBF_AUTO_E 1.0
 #define CM_RBF_AUTO_D 3.0
-#define CM_RBF_AUTO_S 4.4e6
-#define CM_RBF_AUTO_N 8.4
+#define CM_RBF_AUTO_S 3.0e6
+#define CM_RBF_AUTO_N 8.6
 #define CM_RBF_COST_DENSE_M3 7.9e-12
-#define CM_RBF_COST_ITER_M 8e-5  /* the old 3.5e-4 and 1.3e-8 scaled as S and N */
+#define CM_RBF_COST_ITER_M 5.5e-5 /* the old 3.5e-4 and 1.3e-8 scaled as S and N */
 #define CM_RBF_COST_ITER_M2 9e-9
 
 int cm_rbf_auto_costs(size_t m, double *dense, double *iter)
@@ -272,7 +272,7 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
  * (sum |w| of 1e6..1e7 x max |d| on the bracket and on two bodies far apart), and plain sums
  * then reproduce the data at the centres only to eps sum |w_j phi_ij| (bracket, m = 59k:
  * 1e-7 of the range, although the residual is 6e-11). The dense path keeps plain sums: its
- * callers at m <= ~4,000 do not see that floor, and it is 2.4x faster. */
+ * callers at m <= ~3,500 do not see that floor, and it is 2.4x faster. */
 /* The treecode on the centres for (order, theta), made on first use and kept. */
 static cm_rbf_tree *tree_for(const cm_rbf *r, int order, double theta)
 {

@@ -45,7 +45,7 @@ typedef struct cm_rbf cm_rbf;
  *   fast_eval_tol x max |data| (or within the direct sums' own rounding, if that is
  *   larger), direct sums otherwise (stats: eval_fast, eval_error).
  * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
- *   crossover near 4,000 centres: dense below (while 4 m^2 bytes fit in half the memory),
+ *   crossover near 3,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
  *   iterative above; dense for the other kernels.
  * PETSC: the ITERATIVE solver distributed over the MPI ranks of PETSC_COMM_WORLD through
  *   PETSc (only in builds with -DCADMORPH_WITH_PETSC=ON; otherwise create fails with
@@ -94,12 +94,17 @@ typedef struct cm_rbf_options {
     int coarse_post;      /* [0] order of the coarse correction: 0 before the local solves,
                            * 1 before and after them (symmetric multiplicative), 2 after
                            * them only */
-    double overlap;       /* [3] overlap measured in distance: a subdomain also takes every
+    double overlap;       /* [2] overlap measured in distance: a subdomain also takes every
                            * centre within overlap x H of its leaf's box (H: the coarse
                            * space's fill distance), up to local_max centres; 0: by count
                            * only. Grows the subdomains where the nodes are dense (edges,
                            * thin features): bracket 59k, first cycle 9-10 iterations
-                           * instead of 12-13 at 1,501 centres on average instead of 1,400 */
+                           * instead of 12-13 at 1,501 centres on average instead of 1,400
+                           * (by count). 2 rather than 3 since subdomains of 700: the same
+                           * iterations from 1e4 to 1.2e5 centres (+1 at 1.5e5) at 1/2-1/3 of
+                           * the set-up (bracket 103k: fit 18.2 instead of 22 products' CPU;
+                           * RESULTS.md, issue 10, sixth session); above ~2e5 more is needed
+                           * (4.5 with local_max 4000 at 2.3e5, fourth session) */
     int local_max;        /* [2800] cap on a subdomain's centres for overlap > 0 */
     double thin_reach;    /* [0] thinned overlap: beyond its near set (the leaf plus
                            * local_size / overlap / local_max as above, all kept), a subdomain

@@ -313,11 +313,11 @@ static void test_choice(cm_context *ctx)
     o.coarse_post = 0;
     o.overlap = -1.0;
     CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
-    o.overlap = 3.0;
+    o.overlap = 2.0;
     o.relax = 3;
     CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
-    /* the cost model: dense at 2k, iterative at 20k (measured with subdomains of 700: the
-     * crossover near 4k, iterative 4x faster at 10k) */
+    /* the cost model: dense at 2k, iterative at 20k (measured with subdomains of 700 and an
+     * overlap of 2 H: the crossover near 3.5k, iterative 5x faster at 10k) */
     CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 2000) == 1);
     CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 20000) == 0);
     CHECK(cm_rbf_auto_dense(CM_RBF_BIHARMONIC, 20000) == 1);
