@@ -101,10 +101,11 @@ typedef struct cm_rbf_options {
                            * thin features): bracket 59k, first cycle 9-10 iterations
                            * instead of 12-13 at 1,501 centres on average instead of 1,400
                            * (by count). 2 rather than 3 since subdomains of 700: the same
-                           * iterations from 1e4 to 1.2e5 centres (+1 at 1.5e5) at 1/2-1/3 of
-                           * the set-up (bracket 103k: fit 18.2 instead of 22 products' CPU;
-                           * RESULTS.md, issue 10, sixth session); above ~2e5 more is needed
-                           * (4.5 with local_max 4000 at 2.3e5, fourth session) */
+                           * iterations from 1e4 to 1e5 centres (+1 at 1.2e5 and 1.5e5) at
+                           * 1/2-1/3 of the set-up (bracket 103k: fit 18.2 instead of 22
+                           * products' CPU; RESULTS.md, issue 10, sixth session); above ~2e5
+                           * more is needed (4.5 with local_max 4000 at 2.3e5, fourth
+                           * session) */
     int local_max;        /* [2800] cap on a subdomain's centres for overlap > 0 */
     double thin_reach;    /* [0] thinned overlap: beyond its near set (the leaf plus
                            * local_size / overlap / local_max as above, all kept), a subdomain
