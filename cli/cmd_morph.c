@@ -129,18 +129,8 @@ static const cli_option options[] = {
      .names = cli_kernel_names, .values = cli_kernel_methods, .bad = "%.0sunknown kernel '%s'",
      .label = "--kernel K",
      .help = "triharmonic (= --method rbf) or biharmonic (= rbf-biharmonic)"},
-    {.name = "--solver", .kind = CLI_ENUM, .dest = &args.opt.method.warp.solver, .names = cli_solver_names,
-     .values = cli_solver_values, .bad = "%.0sunknown solver '%s' (auto, dense, iterative, petsc)",
-     .label = "--solver S",
-     .help = "RBF warps: auto (default: dense below ~3,500 boundary nodes,\n"
-             "iterative above), dense, iterative (FGMRES + Schwarz) or petsc\n"
-             "(the same distributed over MPI ranks: mpirun -n K; builds\n"
-             "with -DCADMORPH_WITH_PETSC=ON)"},
-    {.name = "--rbf-tol", .kind = CLI_DOUBLE, .dest = &args.opt.method.warp.tolerance, .lo = 0, .hi = 0.5,
-     .bad = "%s: expected a tolerance in 0..0.5, got '%s'", .label = "--rbf-tol T",
-     .help = "RBF warps, iterative solvers: stop at a miss at the centres of T x the\n"
-             "largest displacement (default 1e-10; the boundary is set exactly anyway,\n"
-             "the interior moves by about T x the motion: 1e-6 is ~2-3x faster)"},
+    {CLI_SOLVER_OPTION, .dest = &args.opt.method.warp.solver},
+    {CLI_RBF_TOL_OPTION, .dest = &args.opt.method.warp.tolerance},
     {.name = "--lattice", .kind = CLI_INT, .dest = &args.opt.method.warp.lattice, .lo = 4,
      .hi = 200, .bad = "%s: expected 4..200 control points per axis, got '%s'",
      .label = "--lattice N",

@@ -73,6 +73,22 @@ extern const char *const cli_kernel_names[];
 /* --solver of the RBF warps: auto, dense, iterative (cm_rbf_solver). */
 extern const char *const cli_solver_names[];
 extern const int cli_solver_values[];
+/* The fields of --solver and --rbf-tol that warp and morph share (each adds its .dest), so
+ * that the help's figures (the AUTO crossover) are written once. */
+#define CLI_SOLVER_OPTION                                                                      \
+    .name = "--solver", .kind = CLI_ENUM, .names = cli_solver_names,                           \
+    .values = cli_solver_values,                                                               \
+    .bad = "%.0sunknown solver '%s' (auto, dense, iterative, petsc)", .label = "--solver S",   \
+    .help = "RBF warps: auto (default: dense below ~3,500 boundary nodes,\n"                   \
+            "iterative above), dense, iterative (FGMRES + Schwarz) or petsc\n"                 \
+            "(the same distributed over MPI ranks: mpirun -n K; builds\n"                      \
+            "with -DCADMORPH_WITH_PETSC=ON)"
+#define CLI_RBF_TOL_OPTION                                                                     \
+    .name = "--rbf-tol", .kind = CLI_DOUBLE, .lo = 0, .hi = 0.5,                               \
+    .bad = "%s: expected a tolerance in 0..0.5, got '%s'", .label = "--rbf-tol T",             \
+    .help = "RBF warps, iterative solvers: stop at a miss at the centres of T x the\n"         \
+            "largest displacement (default 1e-10; the boundary is set exactly anyway,\n"       \
+            "the interior moves by about T x the motion: 1e-6 is ~2-3x faster)"
 /* -1 if the --solver value can run in this build, else the usage exit code after saying why
  * (petsc without PETSc). */
 int cli_check_solver(const char *cmd, const char *usage, int solver);

@@ -137,8 +137,8 @@ cm_status cm_shape_project_plane(cm_context *ctx, size_t n, const double *x, dou
 
 /* Kasa's algebraic circle through 2D points (s, t): min sum (s^2 + t^2 + D s + E t + F)^2,
  * in coordinates scaled by the points' extent L, so that cm_shape_solve_small's relative
- * singularity test does not depend on the units. Returns 0 when the points are collinear (to rounding:
- * an arc whose sagitta is below ~1e-7 of L counts as a line). */
+ * singularity test does not depend on the units. Returns 0 when the points are collinear
+ * (to rounding: an arc whose sagitta is below ~1e-7 of L counts as a line). */
 static int circle_algebraic(size_t n, const double *s, const double *t, double *a, double *b,
                             double *r)
 {
