@@ -1,13 +1,7 @@
 /* Iterative vs dense RBF solver on real boundary node sets (bench_rbf_iterative_data.py
  * writes them from `cadmorph morph` output): set-up, solve, evaluation at the interior
  * nodes, iterations, peak memory, and agreement with the dense solver in the same run.
- * usage: bench_rbf_iterative PREFIX [--dense] [--no-iterative] [--threads N] [--leaf N]
- *        [--local N] [--coarse N] [--float | --local-float 0|1|2] [--tol T] [--maxit N]
- *        [--restart N] [--eval N] [--verbose] [--fast 0|1|-1] [--fast-tol T]
- *        [--fast-refine N] [--fast-eval-tol T] [--no-centres] [--relax 0|1]
- *        [--coarse-inner N] [--coarse-inner-tol T]
- *        [--thin-reach R] [--thin-cell C] [--thin-max N]
- *        (thinned overlap, rbf.h)
+ * usage: `bench_rbf_iterative --help` (the usage string in main).
  * Prints one line of key=value. PREFIX.centres / .values / .interior: raw float64, n x 3. */
 #include "cli/blas_reexec.h"
 #include "cadmorph/blas.h"
@@ -120,9 +114,19 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
 int main(int argc, char **argv)
 {
     cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
-    if (argc < 2) {
-        fprintf(stderr, "usage: bench_rbf_iterative PREFIX [options], see the source\n");
-        return 1;
+    static const char usage[] =
+        "usage: bench_rbf_iterative PREFIX [--dense] [--no-iterative] [--threads N] [--leaf N]\n"
+        "       [--local N] [--coarse N] [--float | --local-float 0|1|2] [--tol T] [--maxit N]\n"
+        "       [--restart N] [--eval N] [--verbose] [--fast 0|1|-1] [--fast-tol T]\n"
+        "       [--fast-refine N] [--fast-eval-tol T] [--no-centres] [--relax 0|1]\n"
+        "       [--coarse-inner N] [--coarse-inner-tol T] [--thin-reach R] [--thin-cell C]\n"
+        "       [--thin-max N]\n"
+        "Iterative (and with --dense, dense) RBF fit of PREFIX.centres / .values, evaluated at\n"
+        "the first N of PREFIX.interior (--eval N; raw float64, n x 3, as written by\n"
+        "bench_rbf_iterative_data.py); prints one line of key=value (RESULTS.md, issue 10).\n";
+    if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
+        fputs(usage, argc < 2 ? stderr : stdout);
+        return argc < 2;
     }
     const char *prefix = argv[1];
     cm_rbf_options o;
