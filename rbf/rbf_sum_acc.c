@@ -196,8 +196,13 @@ void cm_rbf_kernel_sum_acc_isa(cm_rbf_isa isa, size_t m, const double *c, const 
     if ((isa == CM_RBF_ISA_AVX512 || isa == CM_RBF_ISA_AVX2) &&
         fixed_binade(m, c, w, nc, n, p, ldp, big))
         fn = isa == CM_RBF_ISA_AVX512 ? cm_rbf_r3_accf_block_avx512 : accf_avx2;
-    const long nblocks = (long)((n + PB - 1) / PB);
     const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
+    /* the self product (the Krylov products) computes each entry once for both rows */
+    if (fn == cm_rbf_r3_accf_block_avx512 && p == c && ldp == m && n == m &&
+        m >= CM_RBF_SELF_MIN_M &&
+        !cm_rbf_r3_accf_self_avx512(nc, m, c, w, big, out, ldo, parallel ? threads : 1))
+        return;
+    const long nblocks = (long)((n + PB - 1) / PB);
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
     for (long b = 0; b < nblocks; ++b) {
         double pt[3 * PB], hi[4 * PB], lo[4 * PB];

@@ -28,14 +28,11 @@
 #include "rbf_internal.h" /* cm_rbf_thread_seconds, cm_rbf_probe_data */
 
 #if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
+#include "rbf_r3_avx512.h"
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <string.h>
-
-#define CM_AVX512 __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma")))
-#define CM_INLINE static inline __attribute__((always_inline))
 
 #define NV 4       /* vectors of 8 points held in registers */
 #define TILE 512   /* centres per tile: 3 + 4 rows of 512 doubles stay in L1 */
@@ -46,35 +43,6 @@
 #define PLAIN_SQRT_B 2
 #define ACC_SQRT_A 2   /* of ACC_NV, in the fixed-binade block */
 #define ACC_SQRT_B 1
-
-/* sqrt(x) for x >= 0 without the sqrt unit. x = 0 (a point on a centre) would give
- * rsqrt14 = inf and 0 * inf = NaN, so the seed is taken at max(x, 1e-300): then s = x * y
- * = 0 and every step keeps 0; for 0 < x < 1e-300 the result is wrong, but x^(3/2) < 1e-450
- * underflows to 0 anyway, and that is all the callers use it for. */
-CM_AVX512 CM_INLINE __m512d sqrt_fma(__m512d x)
-{
-    const __m512d half = _mm512_set1_pd(0.5);
-    __m512d y = _mm512_rsqrt14_pd(_mm512_max_pd(x, _mm512_set1_pd(1e-300)));
-    __m512d s = _mm512_mul_pd(x, y), h = _mm512_mul_pd(half, y); /* s ~ sqrt x, h ~ 1/(2 s) */
-    __m512d r = _mm512_fnmadd_pd(s, h, half);
-    s = _mm512_fmadd_pd(s, r, s);
-    h = _mm512_fmadd_pd(h, r, h);
-    r = _mm512_fnmadd_pd(s, h, half);
-    s = _mm512_fmadd_pd(s, r, s);
-    h = _mm512_fmadd_pd(h, r, h);
-    __m512d d = _mm512_fnmadd_pd(s, s, x); /* x - s^2, exact by the FMA */
-    return _mm512_fmadd_pd(d, h, s);
-}
-
-/* |p - c_j|^3 for one vector of a register block, its sqrt by vsqrtpd or (on_fma) sqrt_fma */
-CM_AVX512 CM_INLINE __m512d r3_of(int on_fma, __m512d x, __m512d y, __m512d z, __m512d xj,
-                                  __m512d yj, __m512d zj)
-{
-    __m512d dx = _mm512_sub_pd(x, xj), dy = _mm512_sub_pd(y, yj), dz = _mm512_sub_pd(z, zj);
-    __m512d r2 = _mm512_fmadd_pd(dz, dz, _mm512_fmadd_pd(dy, dy, _mm512_mul_pd(dx, dx)));
-    __m512d r = on_fma ? sqrt_fma(r2) : _mm512_sqrt_pd(r2);
-    return _mm512_mul_pd(r2, r);
-}
 
 /* Centres [0, jn) of a tile (coordinate d at c + d * ldc, component q's weights at
  * w + q * ldw) against nv * 8 points at pt (coordinate d at pt + d * ldp, sums at acc + q *
@@ -100,7 +68,7 @@ CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nsq, const int nc, c
         __m512d wj[4];
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
         for (int v = 0; v < nv; ++v) {
-            const __m512d f = r3_of(nv == NV && v >= nsq, x[v], y[v], z[v], xj, yj, zj);
+            const __m512d f = cm_r3_of(nv == NV && v >= nsq, x[v], y[v], z[v], xj, yj, zj);
             for (int q = 0; q < nc; ++q) a[q][v] = _mm512_fmadd_pd(wj[q], f, a[q][v]);
         }
     }
@@ -187,13 +155,10 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nsq, const int nv, 
         __m512d wj[4];
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
         for (int v = 0; v < nv; ++v) {
-            const __m512d f = r3_of(fixed && v >= nsq, x[v], y[v], z[v], xj, yj, zj);
+            const __m512d f = cm_r3_of(fixed && v >= nsq, x[v], y[v], z[v], xj, yj, zj);
             for (int q = 0; q < nc; ++q) {
                 if (fixed) {
-                    const __m512d t = _mm512_fmadd_pd(wj[q], f, s[q][v]);
-                    const __m512d d = _mm512_sub_pd(t, s[q][v]); /* exact: same binade */
-                    e[q][v] = _mm512_add_pd(e[q][v], _mm512_fmsub_pd(wj[q], f, d));
-                    s[q][v] = t;
+                    cm_accf(&s[q][v], &e[q][v], wj[q], f);
                 } else {
                     const __m512d p = _mm512_mul_pd(wj[q], f);
                     const __m512d pe = _mm512_fmsub_pd(wj[q], f, p); /* p + pe = w f exactly */

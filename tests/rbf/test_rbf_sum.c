@@ -28,6 +28,8 @@ typedef struct set {
     double *sum_abs, *max_abs;  /* n x 4 */
 } set;
 
+static void fill_ref(set *s);
+
 static void make_set(set *s, size_t m, size_t n, int dipoles, uint64_t seed)
 {
     s->m = m, s->n = n;
@@ -47,6 +49,13 @@ static void make_set(set *s, size_t m, size_t n, int dipoles, uint64_t seed)
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d) /* every third point on a centre: phi = 0 there */
             s->p[d * n + i] = i % 3 == 0 ? s->c[d * m + (i * 7) % m] : grid(&st);
+    fill_ref(s);
+}
+
+/* the long-double sums at the points and the scales of the tolerances */
+static void fill_ref(set *s)
+{
+    const size_t m = s->m, n = s->n;
     for (size_t i = 0; i < n; ++i)
         for (int q = 0; q < 4; ++q) {
             long double acc = 0.0L;
@@ -189,6 +198,39 @@ int main(void)
         CHECK(memcmp(o[0][1], o[1][1], NC * N * sizeof(double)) == 0);
         for (int k = 0; k < 2; ++k) free(o[k][0]), free(o[k][1]);
         free(c), free(w), free(p);
+    }
+    /* The self product (targets = the centres: the Krylov products) computes each entry once
+     * for both rows (rbf_sum_self_avx512.c), from CM_RBF_SELF_MIN_M centres on. Sizes off its
+     * tile (256) and group (8), dipoles and plain weights, 1 and 2 threads: within the
+     * compensated tolerance of the reference, and of the general block on a copy of the
+     * centres (which takes the other path). */
+    if (cm_rbf_isa_supported(CM_RBF_ISA_AVX512)) {
+        static const size_t sm[] = {CM_RBF_SELF_MIN_M, 1283, 2600};
+        int same_bits = 1;
+        for (int dip = 0; dip < 2; ++dip)
+            for (size_t a = 0; a < sizeof sm / sizeof sm[0]; ++a) {
+                const size_t m = sm[a];
+                set s;
+                make_set(&s, m, m, dip, 2000 + 10 * a + (size_t)dip);
+                memcpy(s.p, s.c, 3 * m * sizeof *s.c);
+                fill_ref(&s);
+                double *o = malloc(4 * m * sizeof *o), *g = malloc(4 * m * sizeof *g);
+                for (int nc = 1; nc <= 4; nc += 1 + (a == 0)) {
+                    cm_rbf_kernel_sum_acc_isa(CM_RBF_ISA_AVX512, m, s.c, s.w, nc, m, s.p, m, g,
+                                              (size_t)nc, 1);
+                    for (int th = 1; th <= 2; ++th) {
+                        cm_rbf_kernel_sum_acc_isa(CM_RBF_ISA_AVX512, m, s.c, s.w, nc, m, s.c, m,
+                                                  o, (size_t)nc, th);
+                        const double e = worst(&s, nc, o, NULL, 1);
+                        CHECK_MSG(e <= 1.0, "self product m=%zu nc=%d dip=%d threads %d: %.3g",
+                                  m, nc, dip, th, e);
+                        same_bits &= memcmp(o, g, (size_t)nc * m * sizeof *o) == 0;
+                    }
+                }
+                free(o), free(g);
+                free_set(&s);
+            }
+        printf("self product %s the general block's bits\n", same_bits ? "equal to" : "off");
     }
     printf("AVX-512 blocks %s\n", tried_avx512 ? "tested" : "not supported here: not tested");
     return TEST_REPORT();
