@@ -44,7 +44,10 @@ int cm_rbf_threads(const cm_context *ctx);
 
 /* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (1..4), i < n.
  * p: dim x n SoA with stride ldp (p + d * ldp is coordinate d), centres as in rbf (SoA,
- * stride m). The sum over j runs in the same order for every i whatever the thread count. */
+ * stride m). The sum over j runs in the same order for every i whatever the thread count,
+ * except in the r^3 self product on AVX-512 (p = c, n = m >= CM_RBF_SELF_MIN_M), which
+ * sums each row in parts (rbf_sum_self_avx512.c): there the thread count changes the last
+ * bits. */
 void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                        const double *w, int nc, size_t n, const double *p, size_t ldp,
                        double *out, size_t ldo, int threads);

@@ -207,6 +207,11 @@ void cm_rbf_kernel_sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t
     const long nblocks = (long)((n + PB - 1) / PB);
     const int kern = (int)kernel;
     const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
+    /* the r^3 self product computes each entry once for both rows (its sums come in parts) */
+    if (fn == block_avx512_hand && kernel == CM_RBF_TRIHARMONIC && dim == 3 && p == c &&
+        ldp == m && n == m && m >= CM_RBF_SELF_MIN_M &&
+        !cm_rbf_r3_self_avx512(nc, m, c, w, NULL, out, ldo, parallel ? threads : 1))
+        return;
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
     for (long b = 0; b < nblocks; ++b) {
         double pt[3 * PB], acc[4 * PB];

@@ -200,7 +200,7 @@ void cm_rbf_kernel_sum_acc_isa(cm_rbf_isa isa, size_t m, const double *c, const 
     /* the self product (the Krylov products) computes each entry once for both rows */
     if (fn == cm_rbf_r3_accf_block_avx512 && p == c && ldp == m && n == m &&
         m >= CM_RBF_SELF_MIN_M &&
-        !cm_rbf_r3_accf_self_avx512(nc, m, c, w, big, out, ldo, parallel ? threads : 1))
+        !cm_rbf_r3_self_avx512(nc, m, c, w, big, out, ldo, parallel ? threads : 1))
         return;
     const long nblocks = (long)((n + PB - 1) / PB);
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)

@@ -43,14 +43,15 @@ void cm_rbf_r3_acc_strided_avx512(int nc, size_t m, const double *c, size_t ldc,
 void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double *w,
                                  const double *pt, double *hi, double *lo);
 
-/* The fixed-binade sums for the self product (targets = the m centres): out[i * ldo + q] =
+/* The r^3 sums for the self product (targets = the m centres): out[i * ldo + q] =
  * sum_j |c_i - c_j|^3 w[q * m + j], q < nc (1..4), each entry computed once for rows i and j
- * (rbf_sum_self_avx512.c). big: the offsets of cm_rbf_r3_accf_block_avx512. OpenMP over
- * threads. Returns 0, or 1 if its work space (about 2 (threads + 1) nc m doubles) could not
- * be allocated or this build has no AVX-512 blocks: then nothing is written. */
+ * (rbf_sum_self_avx512.c). big: the offsets of cm_rbf_r3_accf_block_avx512 for the
+ * fixed-binade compensated sums, or NULL for plain sums. OpenMP over threads. Returns 0, or
+ * 1 if its work space (about 2 (threads + 1) nc m doubles) could not be allocated or this
+ * build has no AVX-512 blocks: then nothing is written. */
 #define CM_RBF_SELF_MIN_M 1024 /* the self product from this many centres (fewer: few tiles) */
-int cm_rbf_r3_accf_self_avx512(int nc, size_t m, const double *c, const double *w,
-                               const double *big, double *out, size_t ldo, int threads);
+int cm_rbf_r3_self_avx512(int nc, size_t m, const double *c, const double *w,
+                          const double *big, double *out, size_t ldo, int threads);
 
 /* The vsqrtpd share of the AVX-512 r^3 blocks on this CPU (rbf_sum_avx512.c says why it
  * varies): vectors of the plain block's 4, and of the fixed-binade block's 2, whose sqrt

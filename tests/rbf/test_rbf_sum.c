@@ -201,9 +201,10 @@ int main(void)
     }
     /* The self product (targets = the centres: the Krylov products) computes each entry once
      * for both rows (rbf_sum_self_avx512.c), from CM_RBF_SELF_MIN_M centres on. Sizes off its
-     * tile (256) and group (8), dipoles and plain weights, 1 and 2 threads: within the
-     * compensated tolerance of the reference, and of the general block on a copy of the
-     * centres (which takes the other path). */
+     * tile (256) and group (8), dipoles and plain weights, 1 and 2 threads: compensated
+     * within the compensated tolerance of the reference (and reported: the same bits as the
+     * general block on a copy of the centres, which takes the other path); plain within the
+     * plain tolerance of the generic sums. */
     if (cm_rbf_isa_supported(CM_RBF_ISA_AVX512)) {
         static const size_t sm[] = {CM_RBF_SELF_MIN_M, 1283, 2600};
         int same_bits = 1;
@@ -225,6 +226,16 @@ int main(void)
                         CHECK_MSG(e <= 1.0, "self product m=%zu nc=%d dip=%d threads %d: %.3g",
                                   m, nc, dip, th, e);
                         same_bits &= memcmp(o, g, (size_t)nc * m * sizeof *o) == 0;
+                        /* plain: within the plain tolerance of the generic sums */
+                        cm_rbf_kernel_sum_isa(CM_RBF_ISA_GENERIC, CM_RBF_TRIHARMONIC, 3, m, s.c,
+                                              s.w, nc, m, s.p, m, g, (size_t)nc, 1);
+                        cm_rbf_kernel_sum_isa(CM_RBF_ISA_AVX512, CM_RBF_TRIHARMONIC, 3, m, s.c,
+                                              s.w, nc, m, s.c, m, o, (size_t)nc, th);
+                        const double ep = worst(&s, nc, o, g, 0);
+                        CHECK_MSG(ep <= 1.0, "plain self product m=%zu nc=%d dip=%d threads %d: %.3g",
+                                  m, nc, dip, th, ep);
+                        cm_rbf_kernel_sum_acc_isa(CM_RBF_ISA_AVX512, m, s.c, s.w, nc, m, s.p, m,
+                                                  g, (size_t)nc, 1);
                     }
                 }
                 free(o), free(g);
