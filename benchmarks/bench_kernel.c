@@ -5,6 +5,10 @@
  * Accuracy against a long-double reference on the first 64 points: max |out - ref| over
  * sum_j |w_j phi_ij| (what the plain sum can promise) and over |ref| (what the compensated
  * sum should reach).
+ * Then the self product (targets = the m centres, as in the Krylov products): the general
+ * AVX-512 blocks on a copy of the centres against the symmetric self product
+ * (rbf/rbf_sum_self_avx512.c, taken when the targets are the centres), pairs = m^2,
+ * accuracy on the first 64 centres.
  * usage: bench_kernel N REPS THREADS,... M,...      e.g. bench_kernel 10000 3 1,2 10000,100000
  * (one line of key=value per m, threads, variant and sum) */
 #include "cli/blas_reexec.h"
@@ -47,6 +51,68 @@ static int parse_list(const char *s, long *out, int max)
         if (end == s && *s) return -1;
     }
     return k;
+}
+
+/* max error over the first NREF targets of out (stride NC) against a long-double reference
+ * at the points p (stride ldp), relative to sum_j |w_j phi_ij| and to |ref| */
+static void ref_errors(size_t m, const double *c, const double *w, const double *p, size_t ldp,
+                       const double *out, double *err_abs, double *err_rel)
+{
+    double ea = 0.0, er = 0.0;
+    for (size_t i = 0; i < NREF; ++i)
+        for (int q = 0; q < NC; ++q) {
+            long double s = 0.0L, a = 0.0L;
+            for (size_t j = 0; j < m; ++j) {
+                long double dx = (long double)p[i] - c[j];
+                long double dy = (long double)p[ldp + i] - c[m + j];
+                long double dz = (long double)p[2 * ldp + i] - c[2 * m + j];
+                long double r2 = dx * dx + dy * dy + dz * dz, f = r2 * sqrtl(r2);
+                s += f * w[q * m + j];
+                a += fabsl(f * w[q * m + j]);
+            }
+            long double d = fabsl((long double)out[i * NC + (size_t)q] - s);
+            ea = fmax(ea, (double)(d / a)), er = fmax(er, (double)(d / fabsl(s)));
+        }
+    *err_abs = ea, *err_rel = er;
+}
+
+/* The self product: general blocks (targets a copy of the centres) against the symmetric
+ * one (the centres themselves), alternating, best of reps, plain and compensated. */
+static void self_product(size_t m, const double *c, const double *w, int threads, int reps)
+{
+    double *copy = malloc(3 * m * sizeof *copy), *out = malloc(NC * m * sizeof *out);
+    if (!copy || !out) exit(2);
+    memcpy(copy, c, 3 * m * sizeof *copy);
+    static const char *const name[2] = {"avx512_general_at_centres", "avx512_self"};
+    double best[2][2], wall[2][2], ea[2][2], er[2][2];
+    for (int k = 0; k < 4; ++k) best[k / 2][k % 2] = INFINITY;
+    for (int r = 0; r < reps; ++r)
+        for (int v = 0; v < 2; ++v)
+            for (int s = 0; s < 2; ++s) {
+                const double *pt = v ? c : copy;
+                double t0 = bench_cpu_seconds(), w0 = cm_wtime();
+                if (s == 0)
+                    cm_rbf_kernel_sum_isa(CM_RBF_ISA_AVX512, CM_RBF_TRIHARMONIC, 3, m, c, w, NC,
+                                          m, pt, m, out, NC, threads);
+                else
+                    cm_rbf_kernel_sum_acc_isa(CM_RBF_ISA_AVX512, m, c, w, NC, m, pt, m, out, NC,
+                                              threads);
+                double t = bench_cpu_seconds() - t0, tw = cm_wtime() - w0;
+                if (t < best[v][s]) best[v][s] = t, wall[v][s] = tw;
+                if (r == 0) ref_errors(m, c, w, c, m, out, &ea[v][s], &er[v][s]);
+            }
+    for (int v = 0; v < 2; ++v)
+        for (int s = 0; s < 2; ++s)
+            printf("m=%zu n=%zu threads=%d variant=%s sum=%s cpu_s=%.3f wall_s=%.3f "
+                   "pairs_per_cpu_s=%.3g pairs_per_s=%.3g err_over_sum_abs=%.2g "
+                   "err_over_ref=%.2g\n",
+                   m, m, threads, name[v], s ? "compensated" : "plain", best[v][s], wall[v][s],
+                   (double)m * (double)m / best[v][s], (double)m * (double)m / wall[v][s],
+                   ea[v][s], er[v][s]);
+    for (int s = 0; s < 2; ++s)
+        printf("m=%zu threads=%d sum=%s self_over_general_cpu=%.2f\n", m, threads,
+               s ? "compensated" : "plain", best[0][s] / best[1][s]);
+    free(copy), free(out);
 }
 
 int main(int argc, char **argv)
@@ -123,6 +189,7 @@ int main(int argc, char **argv)
                     }
                 }
             cm_rbf_sqrt_split_force(0, 0);
+            if (cm_rbf_isa_supported(CM_RBF_ISA_AVX512)) self_product(m, c, w, threads, reps);
             for (int v = 0; v < NVAR; ++v)
                 for (int s = 0; s < 2; ++s) {
                     if (!cm_rbf_isa_supported(variants[v].isa)) continue;
