@@ -53,12 +53,10 @@ static int parse_list(const char *s, long *out, int max)
     return k;
 }
 
-/* max error over the first NREF targets of out (stride NC) against a long-double reference
- * at the points p (stride ldp), relative to sum_j |w_j phi_ij| and to |ref| */
-static void ref_errors(size_t m, const double *c, const double *w, const double *p, size_t ldp,
-                       const double *out, double *err_abs, double *err_rel)
+/* the long-double sums at the first NREF points p (stride ldp) and their sum_j |w_j phi_ij| */
+static void reference(size_t m, const double *c, const double *w, const double *p, size_t ldp,
+                      long double *ref, long double *absum)
 {
-    double ea = 0.0, er = 0.0;
     for (size_t i = 0; i < NREF; ++i)
         for (int q = 0; q < NC; ++q) {
             long double s = 0.0L, a = 0.0L;
@@ -70,8 +68,22 @@ static void ref_errors(size_t m, const double *c, const double *w, const double 
                 s += f * w[q * m + j];
                 a += fabsl(f * w[q * m + j]);
             }
-            long double d = fabsl((long double)out[i * NC + (size_t)q] - s);
-            ea = fmax(ea, (double)(d / a)), er = fmax(er, (double)(d / fabsl(s)));
+            ref[q * NREF + i] = s;
+            absum[q * NREF + i] = a;
+        }
+}
+
+/* max error of out (stride NC) on those points, over sum_j |w_j phi_ij| (what the plain sum
+ * can promise) and over |ref| (what the compensated sum should reach) */
+static void ref_errors(const double *out, const long double *ref, const long double *absum,
+                       double *err_abs, double *err_rel)
+{
+    double ea = 0.0, er = 0.0;
+    for (int i = 0; i < NREF; ++i)
+        for (int q = 0; q < NC; ++q) {
+            long double d = fabsl((long double)out[i * NC + q] - ref[q * NREF + i]);
+            ea = fmax(ea, (double)(d / absum[q * NREF + i]));
+            er = fmax(er, (double)(d / fabsl(ref[q * NREF + i])));
         }
     *err_abs = ea, *err_rel = er;
 }
@@ -81,8 +93,10 @@ static void ref_errors(size_t m, const double *c, const double *w, const double 
 static void self_product(size_t m, const double *c, const double *w, int threads, int reps)
 {
     double *copy = malloc(3 * m * sizeof *copy), *out = malloc(NC * m * sizeof *out);
+    long double ref[NC * NREF], absum[NC * NREF];
     if (!copy || !out) exit(2);
     memcpy(copy, c, 3 * m * sizeof *copy);
+    reference(m, c, w, c, m, ref, absum);
     static const char *const name[2] = {"avx512_general_at_centres", "avx512_self"};
     double best[2][2], wall[2][2], ea[2][2], er[2][2];
     for (int k = 0; k < 4; ++k) best[k / 2][k % 2] = INFINITY;
@@ -99,7 +113,7 @@ static void self_product(size_t m, const double *c, const double *w, int threads
                                               threads);
                 double t = bench_cpu_seconds() - t0, tw = cm_wtime() - w0;
                 if (t < best[v][s]) best[v][s] = t, wall[v][s] = tw;
-                if (r == 0) ref_errors(m, c, w, c, m, out, &ea[v][s], &er[v][s]);
+                if (r == 0) ref_errors(out, ref, absum, &ea[v][s], &er[v][s]);
             }
     for (int v = 0; v < 2; ++v)
         for (int s = 0; s < 2; ++s)
@@ -144,20 +158,7 @@ int main(int argc, char **argv)
         const size_t m = (size_t)ms[km];
         for (size_t i = 0; i < 3 * m; ++i) c[i] = bench_urand();
         for (size_t i = 0; i < NC * m; ++i) w[i] = 2.0 * bench_urand() - 1.0;
-        for (int i = 0; i < NREF; ++i)
-            for (int q = 0; q < NC; ++q) {
-                long double s = 0.0L, a = 0.0L;
-                for (size_t j = 0; j < m; ++j) {
-                    long double dx = (long double)p[i] - c[j];
-                    long double dy = (long double)p[n + i] - c[m + j];
-                    long double dz = (long double)p[2 * n + i] - c[2 * m + j];
-                    long double r2 = dx * dx + dy * dy + dz * dz, f = r2 * sqrtl(r2);
-                    s += f * w[q * m + j];
-                    a += fabsl(f * w[q * m + j]);
-                }
-                ref[q * NREF + i] = s;
-                absum[q * NREF + i] = a;
-            }
+        reference(m, c, w, p, n, ref, absum);
         for (int kt = 0; kt < nth; ++kt) {
             const int threads = (int)th[kt];
             double best[NVAR][2], wall[NVAR][2], err_abs[NVAR][2], err_rel[NVAR][2];
@@ -178,14 +179,7 @@ int main(int argc, char **argv)
                                                       out, NC, threads);
                         double t = bench_cpu_seconds() - t0, tw = cm_wtime() - w0;
                         if (t < best[v][s]) best[v][s] = t, wall[v][s] = tw;
-                        double ea = 0.0, er = 0.0;
-                        for (int i = 0; i < NREF; ++i)
-                            for (int q = 0; q < NC; ++q) {
-                                long double d = fabsl((long double)out[i * NC + q] - ref[q * NREF + i]);
-                                ea = fmax(ea, (double)(d / absum[q * NREF + i]));
-                                er = fmax(er, (double)(d / fabsl(ref[q * NREF + i])));
-                            }
-                        err_abs[v][s] = ea, err_rel[v][s] = er;
+                        ref_errors(out, ref, absum, &err_abs[v][s], &err_rel[v][s]);
                     }
                 }
             cm_rbf_sqrt_split_force(0, 0);
