@@ -39,8 +39,9 @@
 #include <omp.h>
 #endif
 
-#define SELF_T 256 /* centres per J tile: 32 groups of 8 in 8 rotations, ~120 KB with their sums   \
-                    */
+/* centres per J tile: 32 groups of 8 in 8 rotations, ~120 KB with their sums (128 and 512
+ * measured the same at 6e4 centres) */
+#define SELF_T 256
 #define SELF_G (SELF_T / 8)
 #define IB 16 /* rows per register block (two vectors) */
 
@@ -191,13 +192,14 @@ CM_AVX512 CM_INLINE void tile(const int comp, const int nsq, const int nc, size_
             }
 }
 
+/* All tiles on threads. mode: 0 plain with one of the two vectors on the FMA pipes, 1
+ * plain all on vsqrtpd, 2 compensated. Thread t's row sums at rows + t per (s, then e, nc
+ * lds each), its tile scratch at scratch + t tsz; cols: the column sums of all tiles. */
 CM_AVX512 static void run_tiles(int mode, int nc, size_t m, const double *c, const double *w,
-                                const double *big, size_t lds, double *rows, double *cols,
-                                double *scratch, int threads)
+                                const double *big, size_t lds, size_t per, double *rows,
+                                double *cols, size_t tsz, double *scratch, int threads)
 {
     const long nt = (long)((m + SELF_T - 1) / SELF_T);
-    const size_t per = (size_t)2 * nc * lds; /* one thread's row sums s, e */
-    const size_t tsz = (size_t)8 * SELF_G * (RS(nc) + JS(nc));
 #pragma omp parallel num_threads(threads)
     {
         int t = 0;
@@ -213,44 +215,22 @@ CM_AVX512 static void run_tiles(int mode, int nc, size_t m, const double *c, con
             const size_t jn = m - j0 < SELF_T ? m - j0 : SELF_T;
             double *cs = cols, *ce = cols + (size_t)nc * lds;
 #define CM_SELF_TILE(a, q, b) tile(a, q, b, m, c, w, big, j0, jn, rot, jac, is, ie, lds, cs, ce)
+            /* clang-format off */
             switch (4 * mode + nc) { /* constants, so the register blocks stay in registers */
-            case 1:
-                CM_SELF_TILE(0, 1, 1);
-                break;
-            case 2:
-                CM_SELF_TILE(0, 1, 2);
-                break;
-            case 3:
-                CM_SELF_TILE(0, 1, 3);
-                break;
-            case 4:
-                CM_SELF_TILE(0, 1, 4);
-                break;
-            case 5:
-                CM_SELF_TILE(0, 2, 1);
-                break;
-            case 6:
-                CM_SELF_TILE(0, 2, 2);
-                break;
-            case 7:
-                CM_SELF_TILE(0, 2, 3);
-                break;
-            case 8:
-                CM_SELF_TILE(0, 2, 4);
-                break;
-            case 9:
-                CM_SELF_TILE(1, 2, 1);
-                break;
-            case 10:
-                CM_SELF_TILE(1, 2, 2);
-                break;
-            case 11:
-                CM_SELF_TILE(1, 2, 3);
-                break;
-            default:
-                CM_SELF_TILE(1, 2, 4);
-                break;
+            case 1: CM_SELF_TILE(0, 1, 1); break;
+            case 2: CM_SELF_TILE(0, 1, 2); break;
+            case 3: CM_SELF_TILE(0, 1, 3); break;
+            case 4: CM_SELF_TILE(0, 1, 4); break;
+            case 5: CM_SELF_TILE(0, 2, 1); break;
+            case 6: CM_SELF_TILE(0, 2, 2); break;
+            case 7: CM_SELF_TILE(0, 2, 3); break;
+            case 8: CM_SELF_TILE(0, 2, 4); break;
+            case 9: CM_SELF_TILE(1, 2, 1); break;
+            case 10: CM_SELF_TILE(1, 2, 2); break;
+            case 11: CM_SELF_TILE(1, 2, 3); break;
+            default: CM_SELF_TILE(1, 2, 4); break;
             }
+            /* clang-format on */
 #undef CM_SELF_TILE
         }
     }
@@ -264,8 +244,8 @@ int cm_rbf_r3_self_avx512(int nc, size_t m, const double *c, const double *w, co
     const int comp = big != NULL;
     if (!comp) big = zero;
     const size_t lds = (m + SELF_T - 1) / SELF_T * SELF_T;
-    const size_t per = (size_t)2 * nc * lds;
-    const size_t tsz = (size_t)8 * SELF_G * (RS(nc) + JS(nc));
+    const size_t per = (size_t)2 * nc * lds;                   /* a thread's row sums s, e */
+    const size_t tsz = (size_t)8 * SELF_G * (RS(nc) + JS(nc)); /* its tile's rotations, sums */
     double *rows = malloc(((size_t)threads * per + per) * sizeof(double));
     double *scratch = aligned_alloc(64, (size_t)threads * tsz * sizeof(double));
     if (!rows || !scratch) {
@@ -283,9 +263,8 @@ int cm_rbf_r3_self_avx512(int nc, size_t m, const double *c, const double *w, co
         }
     int plain_sqrt, acc_sqrt;
     cm_rbf_sqrt_split(&plain_sqrt, &acc_sqrt);
-    /* 0: plain, one vector on the FMA pipes; 1: plain, both on vsqrtpd; 2: compensated */
     const int mode = comp ? 2 : plain_sqrt == 3 ? 1 : 0;
-    run_tiles(mode, nc, m, c, w, big, lds, rows, cols, scratch, threads);
+    run_tiles(mode, nc, m, c, w, big, lds, per, rows, cols, tsz, scratch, threads);
     /* every row: the column side of its tile plus the row sides of all threads, offsets
      * (exact) then remainders */
     for (size_t i = 0; i < m; ++i)
