@@ -83,11 +83,16 @@
 /* the safe bound diam^3 sum |z| was 3.2-3.8 x S(z) on the bore (22.6k) */
 #define CM_RBF_S_SLACK 5.0
 #define CM_RBF_PLAIN_ERR 1e-13
-/* loose treecode products from this many centres (below, one plain direct product costs
- * about what the treecode at 1e-9 does: 59k, 0.52 vs ~0.9 CPU s, 22.6k 0.2 vs 0.08), and at
- * 1e-11 from the second count (119k: 1.9 vs ~3.6 CPU s; 59k: 0.82 vs ~0.9) */
+/* loose treecode products at 1e-6 from this many centres, at 1e-9 and 1e-11 from the other
+ * counts: where each is cheaper than a plain direct product, which since the symmetric self
+ * product (rbf_sum_self_avx512.c) is about half the general one. Measured (bench_rbf_treecode
+ * on real weights, 2 threads, model-167 Xeon, RESULTS.md issue 10 ninth session), CPU s of one
+ * product at 60.6k / 121k centres: treecode 1e-6 0.61 / 1.56, 1e-9 1.14 / 3.03, 1e-11 1.85 /
+ * 3.95; plain general 1.62 / 5.38 there, so the self product (1.7-2.2x that in bench_kernel)
+ * ~0.8 / ~2.7. Above CM_RBF_FAST_MIN_M the fast solve takes over. */
 #define CM_RBF_RELAX_TREE_M 50000
-#define CM_RBF_RELAX_TREE11_M 80000
+#define CM_RBF_RELAX_TREE9_M 200000
+#define CM_RBF_RELAX_TREE11_M 400000
 #define CM_RBF_RELAX_LEVELS 3
 static const double relax_tree_tol[CM_RBF_RELAX_LEVELS] = {1e-6, 1e-9, 1e-11};
 
@@ -876,7 +881,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     kr.relax = o->relax && !fast;
     kr.relax_tree = o->fast_sum == 0 || !kr.relax ? 0
                     : m >= CM_RBF_RELAX_TREE11_M || o->relax == 2 ? 3
-                    : m >= CM_RBF_RELAX_TREE_M ? 2 : 0;
+                    : m >= CM_RBF_RELAX_TREE9_M ? 2
+                    : m >= CM_RBF_RELAX_TREE_M ? 1 : 0;
     {
         double d2 = 0.0;
         for (int d = 0; d < 3; ++d) {
