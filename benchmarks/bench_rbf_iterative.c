@@ -120,7 +120,8 @@ int main(int argc, char **argv)
         "       [--restart N] [--eval N] [--verbose] [--fast 0|1|-1] [--fast-tol T]\n"
         "       [--fast-refine N] [--fast-eval-tol T] [--no-centres] [--relax 0|1]\n"
         "       [--coarse-inner N] [--coarse-inner-tol T] [--thin-reach R] [--thin-cell C]\n"
-        "       [--thin-max N]\n"
+        "       [--thin-max N] [--post 0|1|2] [--overlap H] [--local-max N] [--coarse-grow 0|1]\n"
+        "       [--coarse-max N]\n"
         "Iterative (and with --dense, dense) RBF fit of PREFIX.centres / .values, evaluated at\n"
         "the first N of PREFIX.interior (--eval N; raw float64, n x 3, as written by\n"
         "bench_rbf_iterative_data.py); prints one line of key=value (RESULTS.md, issue 10).\n";
