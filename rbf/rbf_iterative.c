@@ -71,7 +71,8 @@
  * bounded through S(z) = max_i sum_j |z_j| phi_ij <= diam^3 sum_j |z_j| (safe, a few times
  * too large): plain sums err by at most CM_RBF_PLAIN_ERR x S (measured 1.2e-14..1.4e-14 x S
  * with 3 weight vectors on the bracket and the two bodies, RESULTS.md "Fast summation"),
- * the treecode at tol by tol x S (its bound, margin 3-30), compensated ones by eps |A z|.
+ * the treecode at tol by tol x S (its bound, margin 3-30), compensated ones by nothing
+ * that counts (their result's rounding, see where eb is set).
  * Each step may take half of what is left of a budget of CM_RBF_RELAX_BUDGET x target for
  * sum_j |y_j| err_j (so the sum stays within it; |y_j| of the coming step guessed as
  * |r_{j-1}| times the largest |y_i| / |r_{i-1}| so far, the stand-in for 1 / sigma), the inner
@@ -122,6 +123,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->leaf_size = 256;
     opt->local_size = 700;
     opt->coarse_size = 2000;
+    opt->coarse_post = 1;
     opt->local_float = 1;
     opt->coarse_grow = 1;
     opt->coarse_max = 8000;
@@ -662,11 +664,16 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                        "allowed %.3g x diam^3 sum |z|)", cycle, j + 1,
                        kind == MV_COMP ? "compensated" : kind == MV_PLAIN ? "plain" : "treecode",
                        tau);
+                /* compensated products are charged nothing (rel 0): against the operator
+                 * the exact residual uses (the same rounded entries) they err only by their
+                 * result's rounding, which the stored basis vectors of any floating-point
+                 * GMRES have too. Charged as eps |A z_j| x |y_j| (the y_j huge where the
+                 * preconditioned directions cancel) it filled the budget in the first cycle
+                 * (brackets 60k / 103k, two bodies: 1e-10..2e-8 against 5e-11) and forbade
+                 * relaxing from then on, with nothing of it in the exact residuals */
                 const double rel = kind == MV_FAST ? relax_tree_tol[lev]
                                    : kind == MV_PLAIN ? CM_RBF_PLAIN_ERR : 0.0;
-                for (int u = 0; u < na; ++u)
-                    kr->eb[act[u]][j] = kind == MV_COMP ? DBL_EPSILON * norm_inf(m, wo[u])
-                                                        : rel * sz[u];
+                for (int u = 0; u < na; ++u) kr->eb[act[u]][j] = rel * sz[u];
             }
             int keep = 0;
             for (int u = 0; u < na; ++u) {
@@ -722,8 +729,8 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                     if (kr->gv0[c][i] > 0.0)
                         kr->grow[c] = fmax(kr->grow[c], fabs(y[i]) / kr->gv0[c][i]);
                 }
-                /* past the budget (bracket 103k, y component: the compensated products'
-                 * own rounding, eps |A z_j| x huge y_j, already was): no more relaxing */
+                /* past the budget (the relaxed products' bounds with a huge y_j): no more
+                 * relaxing */
                 if (gap > CM_RBF_RELAX_BUDGET * tol * fnorm[c]) kr->exact[c] = 1;
                 cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: component %d, cycle %d: gap bound of "
                        "the relaxed products %.3g (target %.3g)", c, cycle, gap / fnorm[c], tol);

@@ -9,7 +9,9 @@
  * m * local_size numbers over all leaves instead of sum local_size^2 for the factors, and
  * one application is one small matrix-vector product per leaf. A coarse space of
  * farthest-point centres is solved exactly first (multiplicative), so the local solves see
- * only the residual of the smooth, global part.
+ * only the residual of the smooth, global part, and by default (coarse_post 1) once more
+ * after them on what their correction left at the coarse centres: the residual then falls
+ * ~30x per iteration instead of ~6x on the bracket (RESULTS.md, issue 10, tenth session).
  * Storage (local_float): the rows can be kept in float at half the memory without costing
  * iterations, because the local linear fit is taken out of the data before the product
  * (G_l annihilates it in exact arithmetic, while its float rounding would multiply it).
