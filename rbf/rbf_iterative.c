@@ -55,8 +55,12 @@
  * 18 instead of 17 on two bodies 119k, the same below 1e5 (RESULTS.md, fourth session) */
 #define CM_RBF_CYCLE_GAIN 1e-6
 /* samples for the a-posteriori error estimate of a fast evaluation, and the factor on the
- * largest sampled error (the sampled max was within it of the true max on the real sets) */
-#define CM_RBF_FAST_SAMPLES 256
+ * largest sampled error (the sampled max was within it of the true max on the real sets).
+ * The treecode's errors are spiky below its finest orders: over 32,768 of the two-body
+ * interior points at order 10, every 256-point subset found at least 1/6.4 of their
+ * largest error, every 1,024-point one 1/2.2 (RESULTS.md, issue 10, tenth session); 1,024
+ * compensated sums cost ~1 % of a 10^6-point evaluation */
+#define CM_RBF_FAST_SAMPLES 1024
 #define CM_RBF_FAST_SAFETY 4.0
 /* relative rounding of one entry phi_ij = r2 sqrt(r2) (the differences, r2's three terms,
  * the root and the product), so compensated sums of the rounded entries err by up to about
