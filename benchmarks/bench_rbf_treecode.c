@@ -366,7 +366,10 @@ int main(int argc, char **argv)
     cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, wreal, 3, m, c, m, fast, 3, threads);
     compare(m, fast, ex[0], S[0], &rel_s, &pr_smax, &pr_res);
     double *ccopy = malloc(3 * m * sizeof *ccopy);
-    if (!ccopy) return 1;
+    if (!ccopy) {
+        fprintf(stderr, "out of memory for a copy of the %zu centres\n", m);
+        return 1;
+    }
     memcpy(ccopy, c, 3 * m * sizeof *ccopy);
     cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, wreal, 3, m, ccopy, m, fast, 3, threads);
     compare(m, fast, ex[0], S[0], &rel_s, &pg_smax, &pg_res);
