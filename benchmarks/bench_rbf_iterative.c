@@ -210,10 +210,10 @@ int main(int argc, char **argv)
                (double)it.st.memory_bytes / 1e6, bench_peak_rss_mb(), it.fit_cpu_s, it.eval_cpu_s,
                o.overlap, o.local_max, it.setup_cpu_s, it.centres_cpu_s,
                it.centres_cpu_s > 0.0 ? it.fit_cpu_s / it.centres_cpu_s : 0.0, o.local_float);
-        printf(" fast_sum=%d fast_tol=%g refinements=%d fast_residual=%.3g fast_bound=%.3g "
-               "eval_fast=%d eval_error=%.3g centres_fast=%d", it.st.fast_sum, o.fast_tol,
-               it.st.refinements, it.st.fast_residual, it.st.fast_bound, it.eval_fast,
-               it.eval_error, it.centres_fast);
+        printf(" fast_sum=%d fast_tol=%g refinements=%d fast_direct=%d fast_residual=%.3g "
+               "fast_bound=%.3g eval_fast=%d eval_error=%.3g centres_fast=%d", it.st.fast_sum,
+               o.fast_tol, it.st.refinements, it.st.fast_direct, it.st.fast_residual,
+               it.st.fast_bound, it.eval_fast, it.eval_error, it.centres_fast);
         printf(" relax=%d mv_comp=%d mv_plain=%d mv_fast=%d", o.relax, it.st.matvecs_compensated,
                it.st.matvecs_plain, it.st.matvecs_fast);
         printf(" coarse_inner=%d coarse_inner_tol=%g inner_solves=%ld inner_its=%ld",

@@ -493,7 +493,8 @@ static void ls_solve(const krylov *kr, int c, int n, double *y)
     }
 }
 
-/* Solves components [c0, c0 + g) of f (nc x m SoA) into w. it/stop/floor per component. */
+/* Solves components [c0, c0 + g) of f (nc x m SoA) into w + kr->wlo (high and low parts).
+ * it/stop/floor per component. */
 static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
                              double fmax_all, double tol, double *w, double *aw, int *iters,
                              double *floor_rel, int *status, int threads)
@@ -753,9 +754,8 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
             }
         }
     }
-    /* fold the low parts in; aw (= A(w + wlo) from the last true residual) stays */
-    for (int c = 0; c < g; ++c)
-        for (size_t u = 0; u < m; ++u) w[(size_t)c * m + u] += kr->wlo[(size_t)c * m + u];
+    /* the low parts stay in kr->wlo for the caller to fold in (or to keep, in a refinement);
+     * aw = A(w + wlo) from the last true residual */
     for (int c = 0; c < g; ++c) status[c] = state[c];
     return CM_OK;
 }
@@ -766,12 +766,20 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
  * treecode's error is relative to sum |w| phi, which the cancelling RBF weights make 1e4..1e7
  * x |A w|, so the first solve is exact only to fast_tol times that (measured: 1e-8..1e-5 on
  * the real sets); each step multiplies the residual by about that factor again. The
- * residual the caller sees is the exact one. steps: exact residuals formed; first: the
- * residual after the first solve. */
+ * residual the caller sees is the exact one. But where the Krylov space needs huge
+ * coefficients (two bodies far apart, 121k centres), the fast Krylov solve itself stalls:
+ * its residual by the treecode stays far above GMRES's estimate (4.8e-5 against 2.1e-7),
+ * the products' own errors (plain sums in double, eps x sum |z| phi each) amplified by the
+ * coefficients, and every further fast step stalls there again (4.5e-5 after a second step
+ * of 40 iterations; the floor 1.3e-7; RESULTS.md, issue 10, eleventh and twelfth sessions).
+ * A component whose fast solve stagnated, or whose steps stopped above the tolerance and
+ * above its floor, is then solved afresh with direct (compensated, relaxed) matvecs
+ * (*direct = 1): the fast work is lost, but the cost is bounded by one direct solve. steps:
+ * exact residuals formed; first: the residual after the first solve. */
 static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
                               double fmax_all, double *w, double *aw, int *iters,
                               double *floor_rel, int *status, int *steps, double *first,
-                              int threads)
+                              int *direct, int threads)
 {
     const size_t m = kr->m;
     const int g = kr->g;
@@ -788,18 +796,20 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
     memset(w, 0, gm * sizeof *w);
     for (int c = 0; c < g; ++c) iters[c] = 0;
     double prev[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
-    int done[4] = {0, 0, 0, 0};
+    int done[4] = {0, 0, 0, 0}, last = 0; /* last: this step is the direct one */
+    const cm_rbf_tree *tree = kr->tree;
     for (int step = 0;; ++step) {
         double rn = 0.0;
         for (int c = 0; c < g; ++c)
             if (!done[c]) rn = fmax(rn, norm_inf(m, rhs + (size_t)c * m));
-        double tol = o->fast_refine > 0 ? fmax(o->tolerance, CM_RBF_REFINE_GAIN * rn / fmax_all)
-                                        : o->tolerance;
+        double tol = o->fast_refine > 0 && !last
+                         ? fmax(o->tolerance, CM_RBF_REFINE_GAIN * rn / fmax_all)
+                         : o->tolerance;
         int it[4], stt[4];
         solve_group(ctx, r, kr, rhs, fmax_all, tol, dw, adw, it, floor_rel, stt, threads);
-        for (size_t i = 0; i < gm; ++i) { /* w += dw in double-double (TwoSum) */
+        for (size_t i = 0; i < gm; ++i) { /* w += dw + dw_lo in double-double (TwoSum) */
             double t = w[i] + dw[i], bv = t - w[i];
-            wl[i] += (w[i] - (t - bv)) + (dw[i] - bv);
+            wl[i] += (w[i] - (t - bv)) + (dw[i] - bv) + kr->wlo[i];
             w[i] = t;
         }
         for (int c = 0; c < g; ++c) iters[c] += it[c];
@@ -812,32 +822,71 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
         cm_rbf_kernel_sum_acc(m, r->c, w, g, m, r->c, m, rowm, (size_t)g, threads);
         for (int c = 0; c < g; ++c)
             for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] = rowm[i * (size_t)g + (size_t)c];
-        if (cm_rbf_tree_sum_self(kr->tree, wl, g, rowm, (size_t)g, threads) == 0)
+        if (cm_rbf_tree_sum_self(tree, wl, g, rowm, (size_t)g, threads) == 0)
             for (int c = 0; c < g; ++c)
                 for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] += rowm[i * (size_t)g + (size_t)c];
         ++kr->mv[MV_COMP];
         ++kr->mv[MV_FAST];
         ++*steps;
-        int running = 0;
+        int running = 0, stop[4], nstop = 0;
+        double res[4];
         for (int c = 0; c < g; ++c) {
             double *rv = rhs + (size_t)c * m;
             for (size_t i = 0; i < m; ++i) rv[i] = f[(size_t)c * m + i] - aw[(size_t)c * m + i];
             project(r->iter->q1, m, r->k, rv);
-            const double res = norm_inf(m, rv) / fmax_all;
-            if (step == 0) *first = fmax(*first, res);
+            res[c] = norm_inf(m, rv) / fmax_all;
+            if (step == 0) *first = fmax(*first, res[c]);
             cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: component %d, refinement %d: %d "
-                   "iterations (fast matvecs), exact residual %.3g", c, step + 1, it[c], res);
+                   "iterations (%s matvecs), exact residual %.3g", c, step + 1, it[c],
+                   last ? "direct" : "fast", res[c]);
             if (done[c]) continue;
-            if (res <= o->tolerance) done[c] = 1, status[c] = 1;
-            else if (step + 1 >= o->fast_refine || res > 0.5 * prev[c])
+            if (res[c] <= o->tolerance) done[c] = 1, status[c] = 1;
+            /* stt 3: the fast Krylov solve itself stagnated above its floor (see above) */
+            else if (last || step + 1 >= o->fast_refine || res[c] > 0.5 * prev[c] ||
+                     stt[c] == 3) {
                 done[c] = 1, status[c] = stt[c] == 1 ? 3 : stt[c];
-            prev[c] = res;
-            running += !done[c];
+                if (!last) stop[nstop++] = c;
+            }
+            prev[c] = res[c];
         }
+        if (nstop > 0) {
+            /* stopped above the tolerance: at the floor of w (the rounding of its own sums,
+             * eps max_i sum_j |w_j| phi_ij, by the treecode on |w|), or short of it */
+            for (size_t i = 0; i < gm; ++i) dw[i] = fabs(w[i]);
+            if (cm_rbf_tree_sum_self(tree, dw, g, rowm, (size_t)g, threads) == 0) {
+                ++kr->mv[MV_FAST];
+                for (int u = 0; u < nstop; ++u) {
+                    const int c = stop[u];
+                    double s = 0.0;
+                    for (size_t i = 0; i < m; ++i) s = fmax(s, rowm[i * (size_t)g + (size_t)c]);
+                    if (res[c] > CM_RBF_FLOOR_SLACK * DBL_EPSILON * s / fmax_all)
+                        done[c] = 0, last = 1;
+                }
+            }
+        }
+        for (int c = 0; c < g; ++c) running += !done[c];
         if (!running) break;
+        if (last) { /* a component reopened above: every open one is solved afresh with
+                     * direct matvecs, relaxed as in a direct solve (one step for the group,
+                     * then all are done). Afresh, not as a correction: what the fast steps
+                     * leave is what the preconditioner handles worst (two bodies: 47
+                     * iterations for the correction of 4.8e-5, 11 for the whole solve) */
+            kr->tree = NULL;
+            kr->relax = o->relax;
+            *direct = 1;
+            for (int c = 0; c < g; ++c)
+                if (!done[c]) {
+                    const size_t o0 = (size_t)c * m;
+                    memcpy(rhs + o0, f + o0, m * sizeof *rhs);
+                    memset(w + o0, 0, m * sizeof *w);
+                    memset(wl + o0, 0, m * sizeof *wl);
+                }
+        }
         for (int c = 0; c < g; ++c) /* converged components: nothing more to add */
             if (done[c]) memset(rhs + (size_t)c * m, 0, m * sizeof *rhs);
     }
+    kr->tree = tree;
+    kr->relax = 0;
     for (size_t i = 0; i < gm; ++i) w[i] += wl[i];
     free(rhs), free(dw), free(adw), free(wl), free(soa), free(rowm);
     return CM_OK;
@@ -888,9 +937,10 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     }
     int mvk[3] = {0, 0, 0};
     kr.mv = mvk;
-    /* relaxed products in the direct-matvec solve (the fast one refines on its own) */
+    /* relaxed products in the direct-matvec solve (the fast one refines on its own, but
+     * relaxes in its direct restart, refine_group) */
     kr.relax = o->relax && !fast;
-    kr.relax_tree = o->fast_sum == 0 || !kr.relax ? 0
+    kr.relax_tree = o->fast_sum == 0 || !o->relax ? 0
                     : m >= CM_RBF_RELAX_TREE11_M || o->relax == 2 ? 3
                     : m >= CM_RBF_RELAX_TREE9_M ? 2
                     : m >= CM_RBF_RELAX_TREE_M ? 1 : 0;
@@ -906,7 +956,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         }
         kr.diam3 = d2 * sqrt(d2);
     }
-    int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, steps = 0;
+    int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, steps = 0, direct = 0;
     double floor_max = 0.0, first = 0.0;
     for (size_t c0 = 0; c0 < nc; c0 += 4) {
         kr.g = nc - c0 < 4 ? (int)(nc - c0) : 4;
@@ -914,10 +964,13 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         double fl[4];
         if (fast)
             st = refine_group(ctx, r, &kr, f + c0 * m, fmax_all, w + c0 * m, aw + c0 * m, iters,
-                              fl, status, &steps, &first, threads);
+                              fl, status, &steps, &first, &direct, threads);
         else
+        {
             st = solve_group(ctx, r, &kr, f + c0 * m, fmax_all, o->tolerance, w + c0 * m,
                              aw + c0 * m, iters, fl, status, threads);
+            for (size_t i = 0; i < (size_t)kr.g * m; ++i) w[c0 * m + i] += kr.wlo[i];
+        }
         if (st != CM_OK) goto done;
         for (int c = 0; c < kr.g; ++c) {
             if (iters[c] > maxit) maxit = iters[c];
@@ -976,6 +1029,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                              (!fast || worst <= CM_RBF_FLOOR_SLACK * floor_max);
     r->stats.fast_sum = fast;
     r->stats.refinements = steps;
+    r->stats.fast_direct = direct;
     r->stats.fast_residual = fast ? first : 0.0;
     r->stats.fast_bound = fast ? o->fast_tol * floor_max / DBL_EPSILON : 0.0;
     r->stats.memory_bytes = cm_rbf_schwarz_bytes(r->iter->pc) + m * k * sizeof(double) +

@@ -199,6 +199,9 @@ typedef struct cm_rbf_stats {
     int fast_sum;          /* iterative: 1 if the last solve's Krylov matvecs were fast sums */
     int refinements;       /* last solve with fast sums: outer steps (each one Krylov solve
                             * with fast matvecs, then one exact residual) */
+    int fast_direct;       /* last solve with fast sums: 1 if the fast steps stalled above
+                            * the tolerance and above the floor, and the solve was done again
+                            * with direct matvecs (one more step in refinements) */
     double fast_residual;  /* last solve with fast sums and fast_refine > 0: residual after
                             * the first Krylov solve, by exact sums (what the treecode alone
                             * reached). With fast_refine = 0, residual above is the

@@ -264,14 +264,28 @@ static void test_fit(cm_context *ctx)
            "%.3g (dense residual %.3g), exact at the centres %.3g of the range\n",
            m, b.iterations, b.refinements, b.fast_residual, b.residual, a.iterations, agree,
            vsd, dn.residual, exact);
-    CHECK(b.fast_sum == 1 && a.fast_sum == 0);
+    CHECK(b.fast_sum == 1 && a.fast_sum == 0 && b.fast_direct == 0);
     CHECK_MSG(b.refinements >= 1 && b.refinements <= 3, "%d", b.refinements);
     CHECK_MSG(b.residual <= 1e-10, "%.3g", b.residual);
     CHECK_MSG(agree <= 1e-9, "%.3g", agree);
     CHECK_MSG(vsd <= fmax(1e-9, 3.0 * dn.residual), "%.3g", vsd);
     CHECK_MSG(exact <= 1e-9, "%.3g", exact);
-    /* no refinement: the treecode's own residual, looser but reported as such */
+    /* a treecode far too loose for the corrections (as at 121k on two bodies far apart at
+     * 1e-12): the fast steps stop short, a direct step finishes at the tolerance */
     o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.fast_tol = 1e-3;
+    cm_rbf_stats e;
+    cm_status s4 = fit_eval(ctx, &o, m, x, d, np, p, sf, &e);
+    agree = max_diff(np * 3, sf, sd) / range;
+    printf("fast_tol 1e-3: %d refinements, residual after the first %.3g, direct step %d, "
+           "final %.3g, |fast - direct| = %.3g\n", e.refinements, e.fast_residual,
+           e.fast_direct, e.residual, agree);
+    CHECK_MSG(s4 == CM_OK, "%d: %s", s4, cm_context_message(ctx));
+    CHECK_MSG(e.fast_direct == 1 && e.fast_residual > 1e-10, "%d %.3g", e.fast_direct,
+              e.fast_residual);
+    CHECK_MSG(e.residual <= 1e-10, "%.3g", e.residual);
+    CHECK_MSG(agree <= 1e-9, "%.3g", agree);
+    /* no refinement: the treecode's own residual, looser but reported as such */
     o.fast_refine = 0;
     o.fast_tol = 1e-6;
     cm_rbf_stats c;
