@@ -965,8 +965,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         if (fast)
             st = refine_group(ctx, r, &kr, f + c0 * m, fmax_all, w + c0 * m, aw + c0 * m, iters,
                               fl, status, &steps, &first, &direct, threads);
-        else
-        {
+        else {
             st = solve_group(ctx, r, &kr, f + c0 * m, fmax_all, o->tolerance, w + c0 * m,
                              aw + c0 * m, iters, fl, status, threads);
             for (size_t i = 0; i < (size_t)kr.g * m; ++i) w[c0 * m + i] += kr.wlo[i];

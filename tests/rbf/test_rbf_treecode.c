@@ -271,7 +271,7 @@ static void test_fit(cm_context *ctx)
     CHECK_MSG(vsd <= fmax(1e-9, 3.0 * dn.residual), "%.3g", vsd);
     CHECK_MSG(exact <= 1e-9, "%.3g", exact);
     /* a treecode far too loose for the corrections (as at 121k on two bodies far apart at
-     * 1e-12): the fast steps stop short, a direct step finishes at the tolerance */
+     * 1e-12): the fast steps stop short, and the solve is done again with direct products */
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     o.fast_tol = 1e-3;
     cm_rbf_stats e;
