@@ -768,9 +768,9 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
  * the real sets); each step multiplies the residual by about that factor again. The
  * residual the caller sees is the exact one. But where the Krylov space needs huge
  * coefficients (two bodies far apart, 121k centres), the fast Krylov solve itself stalls:
- * its residual by the treecode stays far above GMRES's estimate (4.8e-5 against 2.1e-7),
- * the products' own errors (plain sums in double, eps x sum |z| phi each) amplified by the
- * coefficients, and every further fast step stalls there again (4.5e-5 after a second step
+ * its residual by the treecode stays far above GMRES's estimate (4.8e-5 against 2.1e-7;
+ * likely the products' own errors, plain sums in double at eps x sum |z| phi each, amplified
+ * by the coefficients), and every further fast step stalls there again (4.5e-5 after a second step
  * of 40 iterations; the floor 1.3e-7; RESULTS.md, issue 10, eleventh and twelfth sessions).
  * A component whose fast solve stagnated, or whose steps stopped above the tolerance and
  * above its floor, is then solved afresh with direct (compensated, relaxed) matvecs
@@ -797,7 +797,8 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
     for (int c = 0; c < g; ++c) iters[c] = 0;
     double prev[4] = {INFINITY, INFINITY, INFINITY, INFINITY};
     int done[4] = {0, 0, 0, 0}, last = 0; /* last: this step is the direct one */
-    const cm_rbf_tree *tree = kr->tree;
+    const cm_rbf_tree *tree = kr->tree; /* restored with relax after a direct step */
+    const int relax = kr->relax;
     for (int step = 0;; ++step) {
         double rn = 0.0;
         for (int c = 0; c < g; ++c)
@@ -886,7 +887,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             if (done[c]) memset(rhs + (size_t)c * m, 0, m * sizeof *rhs);
     }
     kr->tree = tree;
-    kr->relax = 0;
+    kr->relax = relax;
     for (size_t i = 0; i < gm; ++i) w[i] += wl[i];
     free(rhs), free(dw), free(adw), free(wl), free(soa), free(rowm);
     return CM_OK;
