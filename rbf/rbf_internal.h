@@ -199,6 +199,25 @@ int cm_rbf_local_inverse(const double *cg, size_t m, const size_t *idx, size_t n
                          double *work, double *g);
 int cm_rbf_local_inverse_fast(const double *cg, size_t m, const size_t *idx, size_t n,
                               size_t n_in, double *work, double *g);
+/* q (n x 4 col-major): an orthonormal basis of the linear polynomials on the n centres idx,
+ * by the same rank-revealing QR (columns past the rank zero); work: 8n doubles. 0 or -1. */
+int cm_rbf_poly_basis(const double *cg, size_t m, const size_t *idx, size_t n, double *work,
+                      double *q);
+
+/* The bodies of a centre set as the Schwarz subdomains see them (rbf_bodies.c): leaves
+ * joined when one's local set holds a centre of the other. nsub subdomains, each
+ * sub_idx[sub_ptr[l] ..] with its n_in[l] leaf centres first (every centre in one leaf).
+ * NULL with *status CM_OK for one body (nothing to do). */
+typedef struct cm_rbf_bodies cm_rbf_bodies;
+cm_status cm_rbf_bodies_create(cm_context *ctx, const double *c, size_t m, int nsub,
+                               const size_t *sub_ptr, const size_t *sub_idx, const int *n_in,
+                               cm_rbf_bodies **bodies);
+void cm_rbf_bodies_destroy(cm_rbf_bodies **bodies);
+int cm_rbf_bodies_count(const cm_rbf_bodies *bodies); /* 1 for NULL */
+size_t cm_rbf_bodies_bytes(const cm_rbf_bodies *bodies);
+/* w (nc x m SoA) -= its part in the linear polynomials of each body (the weights keep no
+ * linear moment on any body) */
+void cm_rbf_bodies_project(const cm_rbf_bodies *bodies, int nc, size_t m, double *w);
 
 /* A centre index with a sort key (the squared distance to a leaf's box). */
 typedef struct cm_rbf_keyed {
@@ -243,6 +262,7 @@ const size_t *cm_rbf_schwarz_subdomain(const cm_rbf_schwarz *pc, int l, size_t *
 double cm_rbf_schwarz_fill(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc);
 int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc);
+const cm_rbf_bodies *cm_rbf_schwarz_bodies(const cm_rbf_schwarz *pc);
 
 /* ---- the distributed solver (rbf_petsc.c; rbf_petsc_none.c without PETSc) ---- */
 

@@ -767,12 +767,12 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
  * x |A w|, so the first solve is exact only to fast_tol times that (measured: 1e-8..1e-5 on
  * the real sets); each step multiplies the residual by about that factor again. The
  * residual the caller sees is the exact one. But where the Krylov space needs huge
- * coefficients (two bodies far apart, 121k centres), the fast Krylov solve itself stalls:
- * its residual by the treecode stays far above GMRES's estimate (4.8e-5 against 2.1e-7;
- * likely the products' own errors, plain sums in double at eps x sum |z| phi each, amplified
- * by the coefficients), and every further fast step stalls there again (4.5e-5 after a second step
- * of 40 iterations; the floor 1.3e-7; RESULTS.md, issue 10, eleventh and twelfth sessions).
- * A component whose fast solve stagnated, or whose steps stopped above the tolerance and
+ * coefficients, the fast Krylov solve itself stalls: its residual by the treecode stays far
+ * above GMRES's estimate, and every further fast step stalls there again. It did on two
+ * bodies far apart (121k centres: 4.8e-5 against 2.1e-7, then 4.5e-5 after a second step of
+ * 40 iterations; RESULTS.md, issue 10, eleventh and twelfth sessions) until the
+ * preconditioner stopped giving the bodies linear moments (rbf_bodies.c; thirteenth
+ * session: 10 iterations, no fallback). A component whose fast solve stagnated, or whose steps stopped above the tolerance and
  * above its floor, is then solved afresh with direct (compensated, relaxed) matvecs
  * (*direct = 1): the fast work is lost, but the cost is bounded by one direct solve. steps:
  * exact residuals formed; first: the residual after the first solve. */

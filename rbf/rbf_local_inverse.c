@@ -188,3 +188,25 @@ int cm_rbf_local_inverse_fast(const double *cg, size_t m, const size_t *idx, siz
     }
     return 0;
 }
+
+/* q (n x 4 col-major) = orthonormal basis of the linear polynomials on the n centres idx (the
+ * same rank-revealing QR as cm_rbf_projected_factor; columns past the rank zero). work: 8n. */
+int cm_rbf_poly_basis(const double *cg, size_t m, const size_t *idx, size_t n, double *work,
+                      double *q)
+{
+    double *pq = work;
+    lapack_int jpvt[4] = {0, 0, 0, 0};
+    double tau[4];
+    for (size_t i = 0; i < n; ++i) pq[i] = 1.0;
+    for (int d = 0; d < 3; ++d)
+        for (size_t i = 0; i < n; ++i) pq[(size_t)(d + 1) * n + i] = cg[(size_t)d * m + idx[i]];
+    const lapack_int ln = (lapack_int)n;
+    if (LAPACKE_dgeqp3(LAPACK_COL_MAJOR, ln, 4, pq, ln, jpvt, tau) != 0) return -1;
+    int rk = 0;
+    const double r00 = fabs(pq[0]);
+    while (rk < 4 && fabs(pq[(size_t)rk * n + (size_t)rk]) > 1e-9 * r00) ++rk;
+    if (LAPACKE_dorgqr(LAPACK_COL_MAJOR, ln, rk, rk, pq, ln, tau) != 0) return -1;
+    memset(q, 0, 4 * n * sizeof *q);
+    memcpy(q, pq, (size_t)rk * n * sizeof *q);
+    return 0;
+}

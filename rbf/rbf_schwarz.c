@@ -15,8 +15,10 @@
  * Storage (local_float): the rows can be kept in float at half the memory without costing
  * iterations, because the local linear fit is taken out of the data before the product
  * (G_l annihilates it in exact arithmetic, while its float rounding would multiply it).
+ * Separate bodies (rbf_bodies.c): the local part of the correction keeps no linear moment on
+ * any body, so the bodies' relative motion is left to the coarse level, which solves it.
  * Split set-up (rbf_petsc.c): a part builds and applies only its run of subdomains; the
- * parts' corrections add up to the whole one. */
+ * parts' corrections add up to the whole one (and are projected after the sum). */
 #include "rbf_internal.h"
 
 #include <cblas.h>
@@ -62,6 +64,7 @@ struct cm_rbf_schwarz {
     cm_rbf_coarse_inner *inner; /* coarse_inner > 0: the coarse problem solved by an inner
                        * Krylov method (rbf_schwarz_coarse.c) instead of gc */
     int post;         /* 0: coarse then local; 1: coarse, local, coarse; 2: local, coarse */
+    cm_rbf_bodies *bodies; /* separate bodies (NULL: one), see rbf_bodies.c */
     double fill;      /* largest distance from a centre to its nearest coarse centre */
     size_t bytes;
 };
@@ -109,6 +112,38 @@ static void select_kth(tree_build *t, size_t lo, size_t hi, size_t k, int d)
     }
 }
 
+/* After select_kth on perm[lo, hi) at mid by coordinate d: moves the split off the group of
+ * centres tied with the median (within tol), so that the group goes to one side whole, and
+ * returns the new split. Why: CAD boundary sets have thousands of centres on one axis-aligned
+ * plane (a planar face), and a median inside that group handed each child an arbitrary
+ * subset of the whole face. Such a leaf is a slab, its local set nearly coplanar, and its
+ * local solve extrapolates off the plane: on one of two copies of the same bracket (the ties
+ * are broken by the order the root split left) that put eigenvalues 0.09 and 1.9 into the
+ * preconditioned operator, and the solve took 100 iterations instead of 11 (RESULTS.md,
+ * issue 10, thirteenth session). With the group kept whole, sibling boxes are disjoint. */
+static size_t split_off_ties(tree_build *t, size_t lo, size_t hi, size_t mid, int d, double tol)
+{
+    size_t *p = t->perm;
+    const double v = coord(t, p[mid], d);
+    size_t a = lo, b = mid; /* [a, mid) and [mid, b): the tied centres on either side */
+    for (size_t u = lo; u < mid; ++u)
+        if (coord(t, p[u], d) < v - tol) {
+            size_t s = p[a];
+            p[a++] = p[u];
+            p[u] = s;
+        }
+    for (size_t u = mid; u < hi; ++u)
+        if (coord(t, p[u], d) <= v + tol) {
+            size_t s = p[b];
+            p[b++] = p[u];
+            p[u] = s;
+        }
+    /* the nearer of the group's two ends that leaves both sides non-empty */
+    size_t s = mid - a <= b - mid ? a : b;
+    if (s == lo || s == hi) s = s == a ? b : a;
+    return s == lo || s == hi ? mid : s; /* all tied: duplicates, which the local solves refuse */
+}
+
 static int split(tree_build *t, size_t lo, size_t hi)
 {
     double bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -138,6 +173,7 @@ static int split(tree_build *t, size_t lo, size_t hi)
         if (bmax[e] - bmin[e] > bmax[d] - bmin[d]) d = e;
     size_t mid = lo + (hi - lo) / 2;
     select_kth(t, lo, hi, mid, d);
+    mid = split_off_ties(t, lo, hi, mid, d, 1e-9 * (bmax[d] - bmin[d]));
     if (split(t, lo, mid) != 0) return -1;
     return split(t, mid, hi);
 }
@@ -346,6 +382,7 @@ void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc)
     free(p->c_xyz);
     free(p->gc);
     cm_rbf_coarse_inner_destroy(&p->inner);
+    cm_rbf_bodies_destroy(&p->bodies);
     free(p);
     *pc = NULL;
 }
@@ -363,6 +400,7 @@ const size_t *cm_rbf_schwarz_subdomain(const cm_rbf_schwarz *pc, int l, size_t *
 }
 int cm_rbf_schwarz_subdomains(const cm_rbf_schwarz *pc) { return pc ? pc->nsub : 0; }
 int cm_rbf_schwarz_coarse(const cm_rbf_schwarz *pc) { return pc ? (int)pc->nc : 0; }
+const cm_rbf_bodies *cm_rbf_schwarz_bodies(const cm_rbf_schwarz *pc) { return pc ? pc->bodies : NULL; }
 
 static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p,
                                   int threads)
@@ -445,6 +483,9 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
     }
     free(cnt);
     free(nnear);
+    st = cm_rbf_bodies_create(ctx, r->c, m, p->nsub, p->sub_ptr, p->sub_idx, p->n_in, &p->bodies);
+    if (st != CM_OK) goto done;
+    p->bytes += cm_rbf_bodies_bytes(p->bodies);
     if (thin)
         cm_log(ctx, CM_LOG_DEBUG,
                "cm_rbf_create: Schwarz thinned overlap: mean %.0f near + %.0f far centres "
@@ -462,28 +503,6 @@ done:
 
 /* Rows of the local inverse kept in double for a subdomain of n centres, n_in of its own:
  * local_float 0 all, 1 none, 2 the leaf's own rows (mixed: the overlap rows in float). */
-/* q (n x 4 col-major) = orthonormal basis of the linear polynomials on the n centres idx
- * (the same rank-revealing QR as cm_rbf_local_inverse; columns past the rank zero). work: 8n. */
-static int local_poly_basis(const double *cg, size_t m, const size_t *idx, size_t n,
-                            double *work, double *q)
-{
-    double *pq = work;
-    lapack_int jpvt[4] = {0, 0, 0, 0};
-    double tau[4];
-    for (size_t i = 0; i < n; ++i) pq[i] = 1.0;
-    for (int d = 0; d < 3; ++d)
-        for (size_t i = 0; i < n; ++i) pq[(size_t)(d + 1) * n + i] = cg[(size_t)d * m + idx[i]];
-    const lapack_int ln = (lapack_int)n;
-    if (LAPACKE_dgeqp3(LAPACK_COL_MAJOR, ln, 4, pq, ln, jpvt, tau) != 0) return -1;
-    int rk = 0;
-    const double r00 = fabs(pq[0]);
-    while (rk < 4 && fabs(pq[(size_t)rk * n + (size_t)rk]) > 1e-9 * r00) ++rk;
-    if (LAPACKE_dorgqr(LAPACK_COL_MAJOR, ln, rk, rk, pq, ln, tau) != 0) return -1;
-    memset(q, 0, 4 * n * sizeof *q);
-    memcpy(q, pq, (size_t)rk * n * sizeof *q);
-    return 0;
-}
-
 static int double_rows(int local_float, size_t n, size_t n_in)
 {
     return local_float == 1 ? 0 : local_float == 2 ? (int)n_in : (int)n;
@@ -589,7 +608,7 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
                 }
                 continue;
             }
-            if (p->lq && info == 0) info = local_poly_basis(r->c, m, idx, n, work, p->lq + p->q_ptr[l]);
+            if (p->lq && info == 0) info = cm_rbf_poly_basis(r->c, m, idx, n, work, p->lq + p->q_ptr[l]);
             if (info != 0) {
 #pragma omp critical
                 {
@@ -814,6 +833,7 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
         free(loc);
     }
     if (sum && sum(arg, out, (size_t)nc * m) != 0) failed = 1;
+    cm_rbf_bodies_project(p->bodies, nc, m, out);
     if (wc)
         for (int c = 0; c < nc; ++c)
             for (size_t a = 0; a < ncs; ++a) out[(size_t)c * m + p->c_idx[a]] += wc[(size_t)c * ncs + a];

@@ -23,6 +23,8 @@ cm_add_unit_test(test_blas_core ${CMAKE_CURRENT_LIST_DIR}/test_blas_core.c
 cm_add_unit_test(test_rbf_iterative ${CMAKE_CURRENT_LIST_DIR}/test_rbf_iterative.c LIBS cm_rbf LABELS rbf)
 # the Schwarz coarse problem by an inner Krylov solve (multilevel) against dense
 cm_add_unit_test(test_rbf_schwarz_inner ${CMAKE_CURRENT_LIST_DIR}/test_rbf_schwarz_inner.c LIBS cm_rbf LABELS rbf)
+# the kD-tree leaves on sets with tied coordinates (planar faces): a partition, boxes apart
+cm_add_unit_test(test_rbf_schwarz ${CMAKE_CURRENT_LIST_DIR}/test_rbf_schwarz.c LIBS cm_rbf LABELS rbf)
 # thinned overlap: a thinned subdomain keeps its leaf, its cap and its reach; against dense
 cm_add_unit_test(test_rbf_thin ${CMAKE_CURRENT_LIST_DIR}/test_rbf_thin.c LIBS cm_rbf LABELS rbf)
 

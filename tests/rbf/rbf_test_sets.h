@@ -11,7 +11,7 @@
 /* Boundary nodes of a box [0,a] x [0,b] x [0,c] with a bore of radius rad along z through
  * (xc, yc), spaced about h, shifted by off: the kind of set a tet mesh of bore_a.step has
  * (flat faces, a curved face, sharp edges). Returns the count written into x (n x 3). */
-static size_t box_with_bore(double a, double b, double c, double xc, double yc, double rad,
+static inline size_t box_with_bore(double a, double b, double c, double xc, double yc, double rad,
                             double h, const double *off, double *x)
 {
     size_t n = 0;
@@ -55,7 +55,7 @@ static size_t box_with_bore(double a, double b, double c, double xc, double yc, 
 
 /* A displacement like the bore's edit: the bore face (axis through (xc, yc)) moves
  * radially, the rest follows smoothly, plus a global bend. */
-static void bore_motion(size_t n, const double *x, double xc, double yc, double *d)
+static inline void bore_motion(size_t n, const double *x, double xc, double yc, double *d)
 {
     for (size_t i = 0; i < n; ++i) {
         double dx = x[3 * i] - xc, dy = x[3 * i + 1] - yc, r = hypot(dx, dy) + 1e-12;
@@ -105,7 +105,7 @@ static inline double *eval_points(size_t m, const double *x, size_t nin, double 
     return p;
 }
 
-static double range_of(size_t n, const double *v)
+static inline double range_of(size_t n, const double *v)
 {
     double lo = INFINITY, hi = -INFINITY;
     for (size_t i = 0; i < n; ++i) {
@@ -115,7 +115,7 @@ static double range_of(size_t n, const double *v)
     return hi - lo;
 }
 
-static double max_diff(size_t n, const double *a, const double *b)
+static inline double max_diff(size_t n, const double *a, const double *b)
 {
     double v = 0.0;
     for (size_t i = 0; i < n; ++i) v = fmax(v, fabs(a[i] - b[i]));

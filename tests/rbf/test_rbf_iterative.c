@@ -278,7 +278,8 @@ static void test_two_bodies(cm_context *ctx)
     printf("two bodies, second right-hand side: error at the centres %.3g\n", err2);
     CHECK_MSG(s3 == CM_OK && err2 <= 1e-9, "%.3g", err2);
     free(d2), free(out2), free(dn);
-    CHECK_MSG(st.iterations <= 40, "%d iterations", st.iterations);
+    /* 5 since the local part keeps no linear moment on either body (rbf_bodies.c); 11 before */
+    CHECK_MSG(st.iterations <= 8, "%d iterations", st.iterations);
     cm_rbf_destroy(&r);
     free(x), free(d), free(out);
 }
