@@ -3,20 +3,22 @@
  * each body (rbf_schwarz.c).
  * Why: the restricted local solves keep only their leaf's rows, so the weights they return
  * carry linear moments (sum w, sum w x) that their local sets' constraints do not cancel.
- * On one body the coarse correction after them and the global projection take these out.
  * With two bodies, a moment on one body and the opposite one on the other satisfy the global
  * constraints, and r^3 carries them across the gap at D^3: the local part then answered a
  * residual that is linear on each body (which every local solve annihilates) with a field
  * 20 x that residual (two bracket copies of 43,664 centres; RESULTS.md, issue 10, thirteenth
  * session). Removing those moments leaves the bodies' relative motion to the coarse level,
- * which solves it exactly: 121,242 centres in 9 iterations instead of 11-28. */
+ * which solves it exactly: 121,242 centres in 9 iterations instead of 11-28. On one body the
+ * global projection after the whole correction took them out, but only after the coarse
+ * correction that follows the local solves had seen them: projected before it, the bracket
+ * takes 7-8 iterations instead of 10 (21k-103k centres). */
 #include "rbf_internal.h"
 
 #include <stdlib.h>
 #include <string.h>
 
 struct cm_rbf_bodies {
-    int n;          /* bodies, > 1 */
+    int n;          /* bodies */
     size_t *ptr;    /* n + 1: offsets into idx and q / 4 */
     size_t *idx;    /* m centre indices, body by body */
     double *q;      /* 4 per centre: each body's orthonormal linear basis (cm_rbf_poly_basis),
@@ -58,7 +60,6 @@ cm_status cm_rbf_bodies_create(cm_context *ctx, const double *c, size_t m, int n
     int n = 0;
     for (int l = 0; l < nsub; ++l)
         if (find(parent, l) == l) body_of[l] = n++;
-    if (n <= 1) goto done;
     b = calloc(1, sizeof *b);
     if (!b) goto nomem;
     b->n = n;
@@ -87,8 +88,9 @@ cm_status cm_rbf_bodies_create(cm_context *ctx, const double *c, size_t m, int n
                           "%d (%zu centres) failed", k, n, b->ptr[k + 1] - b->ptr[k]);
             goto done;
         }
-    cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_create: Schwarz: %d separate bodies (the largest %zu "
-           "centres); the local corrections keep no linear moment on any", n, big);
+    cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_create: Schwarz: %d separate bod%s (the largest %zu "
+           "centres); the local corrections keep no linear moment on any", n, n > 1 ? "ies" : "y",
+           big);
     goto done;
 nomem:
     st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (bodies of the centres)");
@@ -107,7 +109,7 @@ void cm_rbf_bodies_destroy(cm_rbf_bodies **bodies)
     *bodies = NULL;
 }
 
-int cm_rbf_bodies_count(const cm_rbf_bodies *bodies) { return bodies ? bodies->n : 1; }
+int cm_rbf_bodies_count(const cm_rbf_bodies *bodies) { return bodies ? bodies->n : 0; }
 size_t cm_rbf_bodies_bytes(const cm_rbf_bodies *bodies) { return bodies ? bodies->bytes : 0; }
 
 void cm_rbf_bodies_project(const cm_rbf_bodies *bodies, int nc, size_t m, double *w)

@@ -206,14 +206,13 @@ int cm_rbf_poly_basis(const double *cg, size_t m, const size_t *idx, size_t n, d
 
 /* The bodies of a centre set as the Schwarz subdomains see them (rbf_bodies.c): leaves
  * joined when one's local set holds a centre of the other. nsub subdomains, each
- * sub_idx[sub_ptr[l] ..] with its n_in[l] leaf centres first (every centre in one leaf).
- * NULL with *status CM_OK for one body (nothing to do). */
+ * sub_idx[sub_ptr[l] ..] with its n_in[l] leaf centres first (every centre in one leaf). */
 typedef struct cm_rbf_bodies cm_rbf_bodies;
 cm_status cm_rbf_bodies_create(cm_context *ctx, const double *c, size_t m, int nsub,
                                const size_t *sub_ptr, const size_t *sub_idx, const int *n_in,
                                cm_rbf_bodies **bodies);
 void cm_rbf_bodies_destroy(cm_rbf_bodies **bodies);
-int cm_rbf_bodies_count(const cm_rbf_bodies *bodies); /* 1 for NULL */
+int cm_rbf_bodies_count(const cm_rbf_bodies *bodies);
 size_t cm_rbf_bodies_bytes(const cm_rbf_bodies *bodies);
 /* w (nc x m SoA) -= its part in the linear polynomials of each body (the weights keep no
  * linear moment on any body) */

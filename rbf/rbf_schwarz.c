@@ -15,8 +15,9 @@
  * Storage (local_float): the rows can be kept in float at half the memory without costing
  * iterations, because the local linear fit is taken out of the data before the product
  * (G_l annihilates it in exact arithmetic, while its float rounding would multiply it).
- * Separate bodies (rbf_bodies.c): the local part of the correction keeps no linear moment on
- * any body, so the bodies' relative motion is left to the coarse level, which solves it.
+ * Bodies (rbf_bodies.c): the local part of the correction keeps no linear moment on any
+ * separate body before the coarse level sees it, so the bodies' relative motion is left to
+ * the coarse level, which solves it.
  * Split set-up (rbf_petsc.c): a part builds and applies only its run of subdomains; the
  * parts' corrections add up to the whole one (and are projected after the sum). */
 #include "rbf_internal.h"
@@ -64,7 +65,7 @@ struct cm_rbf_schwarz {
     cm_rbf_coarse_inner *inner; /* coarse_inner > 0: the coarse problem solved by an inner
                        * Krylov method (rbf_schwarz_coarse.c) instead of gc */
     int post;         /* 0: coarse then local; 1: coarse, local, coarse; 2: local, coarse */
-    cm_rbf_bodies *bodies; /* separate bodies (NULL: one), see rbf_bodies.c */
+    cm_rbf_bodies *bodies; /* the separate bodies, see rbf_bodies.c */
     double fill;      /* largest distance from a centre to its nearest coarse centre */
     size_t bytes;
 };
