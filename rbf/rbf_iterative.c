@@ -39,8 +39,12 @@
  * 59k, 2.6 at 103k, 3.6 at 201k, 6.6 at 479k; 2.75 falls near 1.15e5. But on real data the
  * refinement costs more than at 59k: bracket 148k (real displacements), fast 46 iterations,
  * 65 products, 253 CPU s; direct 16 iterations, 22 products, 221 CPU s (RESULTS.md, "Quiet
- * reruns after the fourth session"). So 2e5, above the largest real set measured. */
-#define CM_RBF_FAST_MIN_M 200000
+ * reruns after the fourth session"). So it was 2e5. Since the preconditioner keeps the
+ * bodies free of linear moments (rbf_bodies.c) the fast solve needs as many iterations as
+ * the direct one (Zen 5, fit CPU s fast / direct: bracket 102,890 54.2 / 47.2, bracket
+ * 150,137 99.1 / 109.3, two bodies 164,820 108.0 / 118.9; RESULTS.md, issue 10, thirteenth
+ * session): 1.5e5, just under the first real single-body set where it wins. */
+#define CM_RBF_FAST_MIN_M 150000
 #define CM_RBF_FAST_EVAL_PAIRS 2e9
 /* an inner (fast-matvec) solve of a refinement step aims for this reduction of its own
  * right-hand side, or the final tolerance if that is nearer: the treecode's operator

@@ -37,7 +37,7 @@ typedef struct cm_rbf cm_rbf;
  *   sums; rbf_sum_acc.c), the weights are accumulated in double-double. Memory about
  *   4 m (mean subdomain size) bytes (local_float 0: 8) plus the coarse factor (8 coarse^2)
  *   and the Krylov basis, 16 m restart bytes per component; time O(m local^2) to set up,
- *   O(m^2) per iteration. From 200,000 centres (fast_sum) the Krylov matvecs are fast sums
+ *   O(m^2) per iteration. From 150,000 centres (fast_sum) the Krylov matvecs are fast sums
  *   instead (a barycentric Lagrange treecode for r^3, O(m log m), error at most fast_tol x
  *   sum_j |w_j| phi_ij), wrapped in 1..fast_refine refinement steps on exact (compensated
  *   direct) residuals, so the residual reported is still the exact one; evaluation of
@@ -141,7 +141,7 @@ typedef struct cm_rbf_options {
                            * 2-norm is reduced by this factor (or after coarse_inner steps) */
     int fast_sum;         /* [-1] fast summation (barycentric Lagrange treecode for r^3,
                            * rbf_treecode.c) for the Krylov matvecs and for evaluation:
-                           * 0 never (direct sums), 1 always, -1 auto (matvecs at m >= 200,000;
+                           * 0 never (direct sums), 1 always, -1 auto (matvecs at m >= 150,000;
                            * evaluation when n x m >= 2e9 pairs and the treecode's
                            * a-posteriori error estimate is within fast_eval_tol) */
     double fast_tol;      /* [1e-12] treecode accuracy in the Krylov loop, relative to
