@@ -60,6 +60,7 @@ cm_status cm_rbf_bodies_create(cm_context *ctx, const double *c, size_t m, int n
     int n = 0;
     for (int l = 0; l < nsub; ++l)
         if (find(parent, l) == l) body_of[l] = n++;
+    for (size_t i = 0; i < m; ++i) leaf_of[i] = body_of[find(parent, leaf_of[i])]; /* now: body */
     b = calloc(1, sizeof *b);
     if (!b) goto nomem;
     b->n = n;
@@ -69,14 +70,11 @@ cm_status cm_rbf_bodies_create(cm_context *ctx, const double *c, size_t m, int n
     if (!b->ptr || !b->idx || !b->q) goto nomem;
     b->bytes = ((size_t)n + 1) * sizeof *b->ptr + m * (sizeof *b->idx + 4 * sizeof *b->q);
     /* counting sort of the centres by body */
-    for (size_t i = 0; i < m; ++i) ++b->ptr[body_of[find(parent, leaf_of[i])] + 1];
+    for (size_t i = 0; i < m; ++i) ++b->ptr[leaf_of[i] + 1];
     for (int k = 0; k < n; ++k) b->ptr[k + 1] += b->ptr[k];
     fill = calloc((size_t)n, sizeof *fill);
     if (!fill) goto nomem;
-    for (size_t i = 0; i < m; ++i) {
-        int k = body_of[find(parent, leaf_of[i])];
-        b->idx[b->ptr[k] + fill[k]++] = i;
-    }
+    for (size_t i = 0; i < m; ++i) b->idx[b->ptr[leaf_of[i]] + fill[leaf_of[i]]++] = i;
     for (int k = 0; k < n; ++k)
         if (b->ptr[k + 1] - b->ptr[k] > big) big = b->ptr[k + 1] - b->ptr[k];
     work = malloc(8 * big * sizeof *work);

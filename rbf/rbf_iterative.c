@@ -776,8 +776,9 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
  * bodies far apart (121k centres: 4.8e-5 against 2.1e-7, then 4.5e-5 after a second step of
  * 40 iterations; RESULTS.md, issue 10, eleventh and twelfth sessions) until the
  * preconditioner stopped giving the bodies linear moments (rbf_bodies.c; thirteenth
- * session: 10 iterations, no fallback). A component whose fast solve stagnated, or whose steps stopped above the tolerance and
- * above its floor, is then solved afresh with direct (compensated, relaxed) matvecs
+ * session: 10 iterations, no fallback). A component whose fast solve stagnated, or whose
+ * steps stopped above the tolerance and above its floor, is then solved afresh with direct
+ * (compensated, relaxed) matvecs
  * (*direct = 1): the fast work is lost, but the cost is bounded by one direct solve. steps:
  * exact residuals formed; first: the residual after the first solve. */
 static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
