@@ -134,7 +134,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->coarse_post = 1;
     opt->local_float = 1;
     opt->coarse_grow = 1;
-    opt->coarse_max = 8000;
+    opt->coarse_max = 16000;
     opt->coarse_inner_tol = 1e-2;
     opt->overlap = 2.0;
     opt->local_max = 2800;

@@ -130,7 +130,12 @@ typedef struct cm_rbf_options {
     int coarse_grow;      /* [1] coarse_size is the count at 2e4 centres; above, it grows as
                            * sqrt(m) (coarse factor 8 coarse^2 bytes, O(m)): bracket 59k,
                            * 5,000 coarse centres: 17 iterations instead of 21 */
-    int coarse_max;       /* [8000] cap on the coarse centres (0: none but m/4) */
+    int coarse_max;       /* [16000] cap on the coarse centres (0: none but m/4); the
+                           * sqrt rule reaches 8,000 at 3.2e5 centres and 16,000 at
+                           * 1.28e6. 16,000 rather than 8,000: a finer coarse space keeps
+                           * the subdomains (overlap x H) small; 955k surface centres:
+                           * set-up 163 s instead of 333, 8.6 instead of 10.1 GB, 479k:
+                           * 6 iterations instead of 7 (RESULTS.md, fourteenth session) */
     int coarse_inner;     /* [0] 0: the coarse problem is solved exactly by its dense
                            * projected Cholesky factor (8 coarse^2 bytes, so coarse_max
                            * stays near 8,000-16,000); N > 0: by at most N iterations of an

@@ -327,7 +327,8 @@ static void test_choice(cm_context *ctx)
      * to coarse_max */
     cm_rbf_options_init(&o);
     CHECK(cm_rbf_coarse_count(&o, 20000) == 2000 && cm_rbf_coarse_count(&o, 6000) == 1500);
-    CHECK(cm_rbf_coarse_count(&o, 80000) == 4000 && cm_rbf_coarse_count(&o, 1000000) == 8000);
+    CHECK(cm_rbf_coarse_count(&o, 80000) == 4000 && cm_rbf_coarse_count(&o, 1000000) == 14142);
+    CHECK(cm_rbf_coarse_count(&o, 2000000) == 16000);
     o.coarse_max = 3000;
     CHECK(cm_rbf_coarse_count(&o, 80000) == 3000);
     o.coarse_grow = 0;
