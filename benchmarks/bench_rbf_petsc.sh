@@ -27,7 +27,9 @@ for run in $runs; do
     set -- $run
     out="$work/${1}_$2x$3.vtu"
     launch=""
+    # OpenMPI binds each rank to one core by default, so a rank of 2 threads would run on one
     [ "$1" = petsc ] && launch="mpirun -n $2 --oversubscribe"
+    [ "$1" = petsc ] && [ "$3" -gt 1 ] && launch="$launch --bind-to none"
     /usr/bin/time -f "time wall=%e cpu=%U+%S" $launch "$build/cli/cadmorph" warp --mesh "$mesh" \
         --displacements "$csv" -o "$out" --solver "$1" --threads "$3" -v \
         >"$work/out.txt" 2>"$work/err.txt"

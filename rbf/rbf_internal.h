@@ -156,6 +156,14 @@ void cm_rbf_iterative_destroy(cm_rbf_iter **it);
 /* out (n x ncomp) = sum_j w_j phi(|p_i - c_j|) by compensated sums; p: 3 x n SoA. */
 void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
                                int threads);
+/* Its fast path alone (the treecode where n x m is large and its error is within
+ * fast_eval_tol x the data scale): 1 if out holds the accepted result, 0 if direct sums must
+ * do it. Deterministic for given weights, so every rank that calls it gets the same out. */
+int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
+                                   int threads);
+/* The data scale (max |f| of the last solve) that fast_eval_tol is relative to: set by the
+ * serial solve, and by the PETSc one, so that both evaluate alike. */
+void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax);
 
 typedef struct cm_rbf_schwarz cm_rbf_schwarz;
 
@@ -271,8 +279,10 @@ cm_status cm_rbf_petsc_setup(cm_context *ctx, cm_rbf *r, int threads);
 cm_status cm_rbf_petsc_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f, double *w,
                              double *q);
 void cm_rbf_petsc_destroy(cm_rbf_petsc **ps);
-/* With more than one rank: out (n x ncomp) as cm_rbf_iterative_evaluate, each rank summing
- * its block of points, gathered to all; returns 1, or 0 if it did nothing (one rank). */
+/* With more than one rank: out (n x ncomp) as cm_rbf_iterative_evaluate: its fast path on
+ * every rank if it is taken (the treecode is cheap, and all ranks then hold the serial
+ * result for these weights), else each rank summing its block of points directly, gathered
+ * to all; returns 1, or 0 if it did nothing (one rank). */
 int cm_rbf_petsc_evaluate(const cm_rbf *r, size_t n, const double *p, double *out, int threads);
 
 #endif

@@ -362,12 +362,22 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
     return it->eval_fast;
 }
 
-void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
-                               int threads)
+int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
+                                   int threads)
 {
     const int fs = r->opt.fast_sum;
     if (fs == 1 || (fs < 0 && (double)n * (double)r->m >= CM_RBF_FAST_EVAL_PAIRS))
-        if (evaluate_fast(r, n, p, out, threads)) return;
+        return evaluate_fast(r, n, p, out, threads);
+    r->iter->eval_fast = 0; /* eval_error stays that of the last evaluation that tried */
+    return 0;
+}
+
+void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax) { r->iter->fmax = fmax; }
+
+void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
+                               int threads)
+{
+    if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads)) return;
     for (int g = 0; g < r->ncomp; g += 4) {
         int nc = r->ncomp - g < 4 ? r->ncomp - g : 4;
         cm_rbf_kernel_sum_acc(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
@@ -929,7 +939,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         goto done;
     }
     const double fmax_all = norm_inf(nc * m, f);
-    r->iter->fmax = fmax_all;
+    cm_rbf_iterative_set_scale(r, fmax_all);
     const int fast = o->fast_sum == 1 || (o->fast_sum < 0 && m >= CM_RBF_FAST_MIN_M);
     if (fast) {
         int order;

@@ -503,6 +503,9 @@ cm_status cm_rbf_petsc_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double
     const cm_rbf_options *o = &r->opt;
     double fmax_all = 0.0;
     for (size_t i = 0; i < nc * m; ++i) fmax_all = fmax(fmax_all, fabs(f[i]));
+    /* without it the evaluation would never take the treecode where the serial one does:
+     * interior nodes 1.1e-9 of the range apart on bracket 60.6k (RESULTS.md, issue 10) */
+    cm_rbf_iterative_set_scale(r, fmax_all);
     ps->matvecs = 0;
     int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, gmax = 0;
     double worst = 0.0, floor_max = 0.0;
@@ -543,6 +546,7 @@ int cm_rbf_petsc_evaluate(const cm_rbf *r, size_t n, const double *p, double *ou
     cm_rbf_petsc_rank(&rank, &size);
     const size_t nc = (size_t)r->ncomp;
     if (size < 2 || n * nc > (size_t)0x7fffffff) return 0; /* all on this rank */
+    if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads)) return 1;
     int *counts = malloc(2 * (size_t)size * sizeof *counts);
     if (!counts) return 0;
     int *displs = counts + size;
