@@ -24,3 +24,7 @@ add_executable(bench_kernel ${CMAKE_CURRENT_LIST_DIR}/bench_kernel.c)
 target_include_directories(bench_kernel PRIVATE ${PROJECT_SOURCE_DIR})
 target_link_libraries(bench_kernel PRIVATE cm_rbf cm_core cm_warnings cm_posix)
 cm_bench_blas_setup(bench_kernel)
+
+# first touch of fresh memory, 4 kB pages vs transparent huge pages (rbf/rbf_alloc.c's probe)
+add_executable(bench_first_touch ${CMAKE_CURRENT_LIST_DIR}/bench_first_touch.c)
+target_link_libraries(bench_first_touch PRIVATE OpenMP::OpenMP_C cm_warnings)

@@ -12,9 +12,6 @@
  * memory of full storage at the same BLAS-3 speed, which matters twice here: m = 20k takes
  * 1.6 GB instead of 3.2 GB, and first touch of fresh memory costs seconds per GB on the VMs
  * we run on. */
-#if defined(__linux__) && !defined(_DEFAULT_SOURCE)
-#define _DEFAULT_SOURCE /* madvise(MADV_HUGEPAGE) */
-#endif
 #include "rbf_internal.h"
 
 #include <cblas.h>
@@ -22,9 +19,6 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
 
 /* Centres closer than this times the bounding-box diagonal are one centre. */
 #define CM_RBF_MERGE_TOL 1e-12
@@ -32,30 +26,6 @@
 #define CM_RBF_UNISOLVENT_TOL 1e-10
 /* Merged centres must carry values that agree to this, relative to the largest value. */
 #define CM_RBF_VALUE_TOL 1e-8
-
-/* The m x m factor: on 2 MB boundaries, marked for transparent huge pages and populated by
- * one madvise call. On the VMs we run on, first touch of fresh memory page by page cost
- * about as much as assembling the matrix; populating it in the kernel in one call is
- * cheaper, and huge pages also spare dpftrf TLB misses. Both are hints: if they fail, the
- * memory is simply faulted in on first touch. */
-static double *alloc_matrix(size_t count)
-{
-    size_t bytes = count * sizeof(double);
-    const size_t huge = (size_t)2 << 20;
-    if (bytes < huge) return malloc(bytes ? bytes : 1);
-    bytes = (bytes + huge - 1) / huge * huge;
-    double *p = aligned_alloc(huge, bytes);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    if (p) (void)madvise(p, bytes, MADV_HUGEPAGE);
-#endif
-#if defined(__linux__)
-#ifndef MADV_POPULATE_WRITE
-#define MADV_POPULATE_WRITE 23 /* Linux 5.14; older kernels return EINVAL, harmless */
-#endif
-    if (p) (void)madvise(p, bytes, MADV_POPULATE_WRITE);
-#endif
-    return p;
-}
 
 /* OpenBLAS threads: many for the O(m^3) dpftrf only. Its idle workers spin (sched_yield)
  * for ~0.1 s after each threaded call and then compete with our OpenMP loops for the cores,
@@ -231,7 +201,8 @@ static cm_status factor_projected(cm_context *ctx, cm_rbf *r, int threads)
     double *z = malloc(m * (size_t)k * sizeof *z);
     double t[16] = {0}, s[16] = {0}, vw[16] = {0}, tmp[16] = {0};
     double ta = cm_wtime();
-    r->chol = alloc_matrix(n2 * (n2 + 1) / 2);
+    /* populated in one call: cheaper than faulting it in page by page while it is assembled */
+    r->chol = cm_rbf_alloc_large(n2 * (n2 + 1) / 2 * sizeof(double), 1);
     ta = cm_wtime() - ta;
     if (!v || !wv || !z || !r->chol) {
         st = cm_error(ctx, CM_ERR_NOMEM,

@@ -42,6 +42,11 @@ struct cm_rbf {
 /* Threads for a leaf loop: the context's count, or all that OpenMP offers for 0. */
 int cm_rbf_threads(const cm_context *ctx);
 
+/* A buffer of bytes that may be large (rbf_alloc.c): from 2 MB on, on 2 MB boundaries and
+ * marked for transparent huge pages; populate: faulted in now, in one call (for a buffer one
+ * thread fills; leave it 0 where threads fill their own parts). Freed with free(). */
+void *cm_rbf_alloc_large(size_t bytes, int populate);
+
 /* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (1..4), i < n.
  * p: dim x n SoA with stride ldp (p + d * ldp is coordinate d), centres as in rbf (SoA,
  * stride m). The sum over j runs in the same order for every i whatever the thread count,
