@@ -774,6 +774,34 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
     return CM_OK;
 }
 
+/* The bound, relative to fmax, on the error of plain direct sums of A w if it is at most
+ * CM_RBF_PLAIN_RES_SHARE of the tolerance, else -1 (compensated sums are needed). Plain sums
+ * err by at most CM_RBF_PLAIN_ERR x S(w), S(w) = max_i sum_j |w_j| phi_ij (by the treecode on
+ * |w|, as for the floor below). Why: a loose solve does not need the compensated product,
+ * which costs 1.5-2x a plain one (the fixed-binade update per entry and component,
+ * rbf_r3_avx512.h); at 10^6 centres to 1e-6 it was the one exact residual, 320 of 1,044 CPU
+ * s on Zen 5, where S(w) is 1.9e5 x max |f| and the bound 1.9e-8 (measured plain errors are
+ * 7x below it; RESULTS.md, issue 10, fourteenth and sixteenth sessions). The caller adds the
+ * bound to the residual it compares with the tolerance. Only tried from a relative
+ * tolerance of CM_RBF_PLAIN_RES_TOL: on real sets S(w) is 1e4..1e9 x max |f|, so below it
+ * the loose treecode's product on |w| would be spent for nothing. absw, out: g x m scratch
+ * (kr->soa and kr->rowm are the product's). */
+#define CM_RBF_PLAIN_RES_TOL 1e-8
+#define CM_RBF_PLAIN_RES_SHARE 0.1
+static double plain_bound(const cm_rbf *r, krylov *kr, const double *w, double tol,
+                          double fmax, double *absw, double *out, int threads)
+{
+    const size_t m = kr->m, gm = (size_t)kr->g * m;
+    if (!(tol >= CM_RBF_PLAIN_RES_TOL) || !(fmax > 0.0)) return -1.0;
+    double *in[4], *res[4];
+    for (int c = 0; c < kr->g; ++c) in[c] = absw + (size_t)c * m, res[c] = out + (size_t)c * m;
+    for (size_t i = 0; i < gm; ++i) absw[i] = fabs(w[i]);
+    /* positive weights: the loosest treecode (1e-6 of the sums) is enough for a bound */
+    if (matvec_kind(r, kr, MV_FAST, 0, kr->g, in, res, threads) != MV_FAST) return -1.0;
+    const double bound = CM_RBF_PLAIN_ERR * norm_inf(gm, out) / fmax;
+    return bound <= CM_RBF_PLAIN_RES_SHARE * tol ? bound : -1.0;
+}
+
 /* solve_group with fast (treecode) matvecs inside the Krylov loop, wrapped in iterative
  * refinement on exact residuals: w += solve(f - A w) with A w summed directly and
  * compensated (and A w_lo, the low parts, by the treecode: they are eps |w|). Why: the
@@ -834,14 +862,22 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             for (int c = 0; c < g; ++c) status[c] = stt[c];
             break;
         }
-        /* the exact residual f - A w_hi - A w_lo */
-        cm_rbf_kernel_sum_acc(m, r->c, w, g, m, r->c, m, rowm, (size_t)g, threads);
+        /* the exact residual f - A w_hi - A w_lo; A w_hi plainly where that is exact enough
+         * (then within pb of the exact one) */
+        const double pb = plain_bound(r, kr, w, o->tolerance, fmax_all, dw, adw, threads);
+        if (pb >= 0.0) {
+            cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, w, g, m, r->c, m, rowm,
+                              (size_t)g, threads);
+            ++kr->mv[MV_PLAIN];
+        } else {
+            cm_rbf_kernel_sum_acc(m, r->c, w, g, m, r->c, m, rowm, (size_t)g, threads);
+            ++kr->mv[MV_COMP];
+        }
         for (int c = 0; c < g; ++c)
             for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] = rowm[i * (size_t)g + (size_t)c];
         if (cm_rbf_tree_sum_self(tree, wl, g, rowm, (size_t)g, threads) == 0)
             for (int c = 0; c < g; ++c)
                 for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] += rowm[i * (size_t)g + (size_t)c];
-        ++kr->mv[MV_COMP];
         ++kr->mv[MV_FAST];
         ++*steps;
         int running = 0, stop[4], nstop = 0;
@@ -856,7 +892,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
                    "iterations (%s matvecs), exact residual %.3g", c, step + 1, it[c],
                    last ? "direct" : "fast", res[c]);
             if (done[c]) continue;
-            if (res[c] <= o->tolerance) done[c] = 1, status[c] = 1;
+            if (res[c] + fmax(pb, 0.0) <= o->tolerance) done[c] = 1, status[c] = 1;
             /* stt 3: the fast Krylov solve itself stagnated above its floor (see above) */
             else if (last || step + 1 >= o->fast_refine || res[c] > 0.5 * prev[c] ||
                      stt[c] == 3) {

@@ -40,7 +40,9 @@ typedef struct cm_rbf cm_rbf;
  *   O(m^2) per iteration. From 150,000 centres (fast_sum) the Krylov matvecs are fast sums
  *   instead (a barycentric Lagrange treecode for r^3, O(m log m), error at most fast_tol x
  *   sum_j |w_j| phi_ij), wrapped in 1..fast_refine refinement steps on exact (compensated
- *   direct) residuals, so the residual reported is still the exact one; evaluation of
+ *   direct; plain where their error bound is below 10 % of a tolerance of 1e-8 or
+ *   looser, and the bound is added before the comparison) residuals, so the residual
+ *   reported is still the exact one (or within that bound of it); evaluation of
  *   large n x m uses the treecode where a sampled check shows its error within
  *   fast_eval_tol x max |data| (or within the direct sums' own rounding, if that is
  *   larger), direct sums otherwise (stats: eval_fast, eval_error).
@@ -154,7 +156,8 @@ typedef struct cm_rbf_options {
                            * RBF weights cancel (sum |w| phi is 1e4..1e7 x the result), so the
                            * error relative to the result is that much larger: the solver
                            * corrects it by refinement on exact residuals (fast_refine) */
-    int fast_refine;      /* [3] outer refinement steps on exact (compensated direct)
+    int fast_refine;      /* [3] outer refinement steps on exact (direct: compensated, or
+                           * plain if they err by at most 10 % of a tolerance of 1e-8 or more)
                            * residuals around the fast-matvec Krylov solve; 0: none (the final
                            * residual is then the treecode's, cheaper but not exact) */
     double fast_eval_tol; /* [1e-9] evaluation takes the fast sum only if its estimated error

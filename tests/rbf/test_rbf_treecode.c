@@ -285,6 +285,24 @@ static void test_fit(cm_context *ctx)
               e.fast_residual);
     CHECK_MSG(e.residual <= 1e-10, "%.3g", e.residual);
     CHECK_MSG(agree <= 1e-9, "%.3g", agree);
+    /* a loose tolerance: the refinement's residual by plain sums (the compensated ones only
+     * where plain sums could err by 10 % of the tolerance), the result still within it at
+     * the centres by the compensated sums of cm_rbf_evaluate */
+    o.fast_tol = 1e-12;
+    o.tolerance = 1e-5;
+    cm_rbf_stats l;
+    cm_status s5 = fit_eval(ctx, &o, m, x, d, np, p, sf, &l);
+    double dmax = 0.0;
+    for (size_t i = 0; i < m * 3; ++i) dmax = fmax(dmax, fabs(d[i]));
+    exact = max_diff(m * 3, sf, d) / dmax;
+    printf("tolerance 1e-5: %d refinements, products %d compensated + %d plain + %d fast, "
+           "residual %.3g, floor %.3g, at the centres %.3g of max |d|\n", l.refinements,
+           l.matvecs_compensated, l.matvecs_plain, l.matvecs_fast, l.residual, l.floor, exact);
+    CHECK_MSG(s5 == CM_OK, "%d: %s", s5, cm_context_message(ctx));
+    CHECK_MSG(l.matvecs_compensated == 0 && l.matvecs_plain >= 1, "%d %d",
+              l.matvecs_compensated, l.matvecs_plain);
+    CHECK_MSG(l.residual <= 1e-5 && exact <= 1e-5, "%.3g %.3g", l.residual, exact);
+    o.tolerance = 1e-10;
     /* no refinement: the treecode's own residual, looser but reported as such */
     o.fast_refine = 0;
     o.fast_tol = 1e-6;
