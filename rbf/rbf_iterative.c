@@ -776,8 +776,8 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
 
 /* The bound, relative to fmax, on the error of plain direct sums of A w if it is at most
  * CM_RBF_PLAIN_RES_SHARE of the tolerance, else -1 (compensated sums are needed). Plain sums
- * err by at most CM_RBF_PLAIN_ERR x S(w), S(w) = max_i sum_j |w_j| phi_ij (by the treecode on
- * |w|, as for the floor below). Why: a loose solve does not need the compensated product,
+ * err by at most CM_RBF_PLAIN_ERR x S(w), S(w) = max_i sum_j |w_j| phi_ij (by the loosest
+ * treecode on |w|). Why: a loose solve does not need the compensated product,
  * which costs 1.5-2x a plain one (the fixed-binade update per entry and component,
  * rbf_r3_avx512.h); at 10^6 centres to 1e-6 it was the one exact residual, 320 of 1,044 CPU
  * s on Zen 5, where S(w) is 1.9e5 x max |f| and the bound 1.9e-8 (measured plain errors are
