@@ -865,16 +865,9 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
         /* the exact residual f - A w_hi - A w_lo; A w_hi plainly where that is exact enough
          * (then within pb of the exact one) */
         const double pb = plain_bound(r, kr, w, o->tolerance, fmax_all, dw, adw, threads);
-        if (pb >= 0.0) {
-            cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, w, g, m, r->c, m, rowm,
-                              (size_t)g, threads);
-            ++kr->mv[MV_PLAIN];
-        } else {
-            cm_rbf_kernel_sum_acc(m, r->c, w, g, m, r->c, m, rowm, (size_t)g, threads);
-            ++kr->mv[MV_COMP];
-        }
-        for (int c = 0; c < g; ++c)
-            for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] = rowm[i * (size_t)g + (size_t)c];
+        double *wc[4], *awc[4];
+        for (int c = 0; c < g; ++c) wc[c] = w + (size_t)c * m, awc[c] = aw + (size_t)c * m;
+        matvec_kind(r, kr, pb >= 0.0 ? MV_PLAIN : MV_COMP, 0, g, wc, awc, threads);
         if (cm_rbf_tree_sum_self(tree, wl, g, rowm, (size_t)g, threads) == 0)
             for (int c = 0; c < g; ++c)
                 for (size_t i = 0; i < m; ++i) aw[(size_t)c * m + i] += rowm[i * (size_t)g + (size_t)c];
