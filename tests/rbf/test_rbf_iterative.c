@@ -106,7 +106,11 @@ static void test_against_dense(cm_context *ctx)
         CHECK(sti.matvecs == sti.matvecs_compensated + sti.matvecs_plain + sti.matvecs_fast);
         /* without relaxation only the cycle ends' low-part and floor sums are plain */
         CHECK(sr[0].matvecs_fast == 0 && sr[0].matvecs_compensated >= sr[0].iterations);
-        CHECK_MSG(sti.matvecs_compensated < sr[0].matvecs_compensated && sti.matvecs_fast == 0,
+        /* each cycle relaxes to its own goal (the first one's is far above the tolerance):
+         * fewer than half the compensated products of the unrelaxed solve (bore 5k: 2 of 8;
+         * 4 when the first cycle aimed at the final tolerance too) */
+        CHECK_MSG(2 * sti.matvecs_compensated < sr[0].matvecs_compensated &&
+                      sti.matvecs_fast == 0,
                   "relax 1: %d compensated, relax 0: %d", sti.matvecs_compensated,
                   sr[0].matvecs_compensated);
         CHECK_MSG(sr[1].matvecs_fast >= 1 &&
