@@ -48,6 +48,8 @@ typedef struct run {
     double *out; /* (m + ne) x 3: at the centres, then the interior sample */
     int eval_fast;
     double eval_error;
+    int eval_order; /* the treecode row the evaluation took */
+    double eval_theta;
     int centres_fast; /* the evaluation at the centres (it_exact) took the treecode */
 } run;
 
@@ -84,6 +86,8 @@ static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double
         cm_rbf_get_stats(rbf, &es);
         r->eval_fast = es.eval_fast;
         r->eval_error = es.eval_error;
+        r->eval_order = es.eval_order;
+        r->eval_theta = es.eval_theta;
         if (r->status >= 0 && skip_centres) {
             cm_rbf_get_stats(rbf, &r->st);
             inner_counts(rbf);
@@ -211,9 +215,10 @@ int main(int argc, char **argv)
                o.overlap, o.local_max, it.setup_cpu_s, it.centres_cpu_s,
                it.centres_cpu_s > 0.0 ? it.fit_cpu_s / it.centres_cpu_s : 0.0, o.local_float);
         printf(" fast_sum=%d fast_tol=%g refinements=%d fast_direct=%d fast_residual=%.3g "
-               "fast_bound=%.3g eval_fast=%d eval_error=%.3g centres_fast=%d", it.st.fast_sum,
-               o.fast_tol, it.st.refinements, it.st.fast_direct, it.st.fast_residual,
-               it.st.fast_bound, it.eval_fast, it.eval_error, it.centres_fast);
+               "fast_bound=%.3g eval_fast=%d eval_error=%.3g eval_row=%d:%.2f centres_fast=%d",
+               it.st.fast_sum, o.fast_tol, it.st.refinements, it.st.fast_direct,
+               it.st.fast_residual, it.st.fast_bound, it.eval_fast, it.eval_error,
+               it.eval_order, it.eval_theta, it.centres_fast);
         printf(" relax=%d mv_comp=%d mv_plain=%d mv_fast=%d", o.relax, it.st.matvecs_compensated,
                it.st.matvecs_plain, it.st.matvecs_fast);
         printf(" coarse_inner=%d coarse_inner_tol=%g inner_solves=%ld inner_its=%ld",

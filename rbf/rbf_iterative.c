@@ -120,6 +120,8 @@ struct cm_rbf_iter {
     int eval_fast;     /* the last evaluation's choice and estimate (evaluation gets a
                         * const cm_rbf, the iterative state is where it can leave them) */
     double eval_error;
+    int eval_order;    /* the row it took */
+    double eval_theta;
     cm_rbf_tree *rtree[3]; /* loose treecodes for relaxed products (relax_tree_tol) */
 };
 
@@ -161,6 +163,8 @@ void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
     if (rbf->iter) {
         stats->eval_fast = rbf->iter->eval_fast;
         stats->eval_error = rbf->iter->eval_error;
+        stats->eval_order = rbf->iter->eval_order;
+        stats->eval_theta = rbf->iter->eval_theta;
     }
 }
 
@@ -313,7 +317,64 @@ static cm_rbf_tree *tree_for(const cm_rbf *r, int order, double theta)
  * 1.0e-9 (RESULTS.md, "The treecode on the AVX-512 block"). The check cannot see below
  * that, and the fallback is no better, so the fast sum is accepted within the larger of
  * fast_eval_tol x max |data| and that floor; eval_error says which was met.
- * 1 if out holds the accepted fast result; 0 (out undefined) if direct sums must do it. */
+ *
+ * The bound is relative to sum |w| phi at each point and is often far from the error on
+ * real weights: on two bodies far apart (121k centres, 10^6 points) the row for 1e-12
+ * erred no more than the finest (1.0e-16 x max sum |w| phi, the rounding floor) at 0.66x
+ * its CPU, while on the bracket (60.6k) only the finest met the floor (RESULTS.md, issue
+ * 10, seventeenth session). So the row for CM_RBF_PILOT_GAIN x the asked tolerance is tried
+ * first on a pilot, every k-th batch of targets (CM_RBF_PILOT_BATCHES of them: the same
+ * batches as the whole sum, so the same clusters go by their proxies), and taken if its
+ * error at CM_RBF_PILOT_PER points of each batch passes the check's test; the check itself
+ * still decides, and a coarser row that fails it is followed by the asked one before
+ * direct sums. The pilot costs about CM_RBF_PILOT_BATCHES / (n / 192) of a coarse sum
+ * (bracket, 211k points: 3 %). 1 if out holds the accepted fast result; 0 (out undefined)
+ * if direct sums must do it. */
+#define CM_RBF_PILOT_GAIN 1e2
+#define CM_RBF_PILOT_BATCHES 32
+#define CM_RBF_PILOT_PER 16
+
+/* The treecode sums of all components at the targets of every stride-th batch (1: all). */
+static int tree_sum_all(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
+                        size_t stride, double *out, int threads)
+{
+    const size_t m = r->m, nc = (size_t)r->ncomp;
+    for (size_t g = 0; g < nc; g += 4) {
+        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+        if (cm_rbf_tree_sum_targets(t, tg, stride, r->w + g * m, gc, out + g, nc, threads))
+            return -1;
+    }
+    return 0;
+}
+
+/* 1 if the treecode t passes the pilot: its largest error at the pilot's points (against
+ * compensated direct sums), x CM_RBF_FAST_SAFETY, is within accept. out: n x nc scratch. */
+static int pilot_passes(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
+                        size_t n, const double *p, double accept, double *out, int threads)
+{
+    const size_t m = r->m, nc = (size_t)r->ncomp, cap = CM_RBF_PILOT_BATCHES * CM_RBF_PILOT_PER;
+    size_t *idx = malloc(cap * sizeof *idx), stride;
+    double *sp = malloc(3 * cap * sizeof *sp), *ex = malloc(cap * nc * sizeof *ex);
+    int pass = 0;
+    const size_t np = idx ? cm_rbf_tree_targets_pilot(tg, CM_RBF_PILOT_BATCHES,
+                                                      CM_RBF_PILOT_PER, idx, &stride) : 0;
+    if (idx && sp && ex && tree_sum_all(r, t, tg, stride, out, threads) == 0) {
+        for (size_t k = 0; k < np; ++k)
+            for (int d = 0; d < 3; ++d) sp[(size_t)d * np + k] = p[(size_t)d * n + idx[k]];
+        for (size_t g = 0; g < nc; g += 4) {
+            int gc = nc - g < 4 ? (int)(nc - g) : 4;
+            cm_rbf_kernel_sum_acc(m, r->c, r->w + g * m, gc, np, sp, np, ex + g, nc, threads);
+        }
+        double e = 0.0;
+        for (size_t k = 0; k < np; ++k)
+            for (size_t q = 0; q < nc; ++q)
+                e = fmax(e, fabs(out[idx[k] * nc + q] - ex[k * nc + q]));
+        pass = CM_RBF_FAST_SAFETY * e <= accept;
+    }
+    free(idx), free(sp), free(ex);
+    return pass;
+}
+
 static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads)
 {
     cm_rbf_iter *it = r->iter;
@@ -343,25 +404,42 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
     if (!ok) return 0;
     /* what the direct fallback itself can promise (see above) */
     const double accept = fmax(target, CM_RBF_PHI_ROUND * DBL_EPSILON * smax);
-    /* the order that should meet it with room for the estimate's factor; below the
-     * rounding of the finest order (about 1e-16 x sum |w| phi) the finest is tried */
-    double tau = fmax(accept / (smax * CM_RBF_FAST_SAFETY), 1e-16);
-    int order;
-    double theta;
+    /* the row that should meet it with room for the estimate's factor; below the rounding
+     * of the finest row (about 1e-16 x sum |w| phi) the finest is asked for */
+    const double tau = fmax(accept / (smax * CM_RBF_FAST_SAFETY), CM_RBF_TREE_TOL_MIN);
+    int order, order_c;
+    double theta, theta_c;
     cm_rbf_tree_params(tau, &order, &theta);
-    const cm_rbf_tree *t = tree_for(r, order, theta);
-    if (!t) return 0;
-    double err = 0.0;
-    for (size_t g = 0; g < nc; g += 4) {
-        int gc = nc - g < 4 ? (int)(nc - g) : 4;
-        if (cm_rbf_tree_sum(t, r->w + g * m, gc, n, p, n, out + g, nc, threads)) return 0;
-        double e, sabs;
-        cm_rbf_tree_check(t, r->w + g * m, gc, n, p, n, out + g, nc, CM_RBF_FAST_SAMPLES, &e,
-                          &sabs, threads);
-        err = fmax(err, e);
+    cm_rbf_tree_params(CM_RBF_PILOT_GAIN * tau, &order_c, &theta_c);
+    cm_rbf_tree_targets *tg = cm_rbf_tree_targets_create(n, p, n);
+    if (!tg) return 0;
+    /* the coarser row first if it passes the pilot (at the table's coarse end it is the
+     * same row) */
+    int coarse = order_c != order || theta_c != theta;
+    if (coarse) {
+        const cm_rbf_tree *t = tree_for(r, order_c, theta_c);
+        coarse = t && pilot_passes(r, t, tg, n, p, accept, out, threads);
     }
-    it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
-    it->eval_fast = CM_RBF_FAST_SAFETY * err <= accept;
+    for (;; coarse = 0) {
+        const int o = coarse ? order_c : order;
+        const double th = coarse ? theta_c : theta;
+        const cm_rbf_tree *t = tree_for(r, o, th);
+        if (!t || tree_sum_all(r, t, tg, 1, out, threads)) break;
+        double err = 0.0;
+        for (size_t g = 0; g < nc; g += 4) {
+            int gc = nc - g < 4 ? (int)(nc - g) : 4;
+            double e, sabs;
+            cm_rbf_tree_check(t, r->w + g * m, gc, n, p, n, out + g, nc, CM_RBF_FAST_SAMPLES,
+                              &e, &sabs, threads);
+            err = fmax(err, e);
+        }
+        it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
+        it->eval_fast = CM_RBF_FAST_SAFETY * err <= accept;
+        it->eval_order = o;
+        it->eval_theta = th;
+        if (it->eval_fast || !coarse) break;
+    }
+    cm_rbf_tree_targets_destroy(&tg);
     return it->eval_fast;
 }
 

@@ -602,8 +602,10 @@ void cm_rbf_tree_set_isa(cm_rbf_tree *t, cm_rbf_isa isa)
 }
 
 /* the whole sum for targets ordered by tg (batches = its leaves) */
-static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int nc, size_t n,
-                    const double *p, size_t ldp, double *out, size_t ldo, int threads)
+/* The sums at the targets of every stride-th batch of tg (stride 1: all of them). */
+static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const double *w,
+                    int nc, size_t n, const double *p, size_t ldp, double *out, size_t ldo,
+                    int threads)
 {
     const size_t m = t->m, P = (size_t)t->P, np = (size_t)t->nprox;
     double *ws = malloc((size_t)nc * (m ? m : 1) * sizeof *ws);
@@ -623,7 +625,8 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
     const double *px = t->pxyz, *py = px + np * P, *pz = py + np * P;
     const double *xs = t->xs, *ys = xs + m, *zs = ys + m;
     int failed = 0;
-#pragma omp parallel num_threads(threads) if (threads > 1 && (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS)
+    const int step = stride > 0 && stride < (size_t)tg->nleaf ? (int)stride : 1;
+#pragma omp parallel num_threads(threads) if (threads > 1 && (double)n / step * (double)m > CM_RBF_PARALLEL_MIN_PAIRS)
     {
         int cap = 256;
         seg *sg = malloc((size_t)cap * sizeof *sg);
@@ -636,7 +639,7 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
             failed = 1;
         }
 #pragma omp for schedule(dynamic, 1)
-        for (int bi = 0; bi < tg->nleaf; ++bi) {
+        for (int bi = 0; bi < tg->nleaf; bi += step) {
             if (!sg) continue;
             const tnode *b = &tg->node[tg->leaf[bi]];
             const size_t cnt = b->end - b->begin;
@@ -715,24 +718,65 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, const double *w, int 
     return failed ? -1 : 0;
 }
 
+struct cm_rbf_tree_targets {
+    size_t n, ldp;
+    const double *p;
+    order o;
+};
+
+cm_rbf_tree_targets *cm_rbf_tree_targets_create(size_t n, const double *p, size_t ldp)
+{
+    cm_rbf_tree_targets *tg = calloc(1, sizeof *tg);
+    if (!tg) return NULL;
+    *tg = (cm_rbf_tree_targets){.n = n, .ldp = ldp, .p = p};
+    if (build_order(n, p, ldp, CM_TREE_BATCH, &tg->o)) cm_rbf_tree_targets_destroy(&tg);
+    return tg;
+}
+
+void cm_rbf_tree_targets_destroy(cm_rbf_tree_targets **tg)
+{
+    if (!tg || !*tg) return;
+    free_order(&(*tg)->o);
+    free(*tg);
+    *tg = NULL;
+}
+
+size_t cm_rbf_tree_targets_pilot(const cm_rbf_tree_targets *tg, size_t batches, size_t per,
+                                 size_t *idx, size_t *stride)
+{
+    const size_t nl = (size_t)tg->o.nleaf;
+    *stride = batches > 0 && nl > batches ? (nl + batches - 1) / batches : 1;
+    size_t k = 0;
+    for (size_t bi = 0; bi < nl; bi += *stride) {
+        const tnode *b = &tg->o.node[tg->o.leaf[bi]];
+        const size_t cnt = b->end - b->begin, take = cnt < per ? cnt : per;
+        for (size_t l = 0; l < take; ++l) idx[k++] = tg->o.perm[b->begin + l * cnt / take];
+    }
+    return k;
+}
+
+int cm_rbf_tree_sum_targets(const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
+                            size_t stride, const double *w, int nc, double *out, size_t ldo,
+                            int threads)
+{
+    if (tg->n == 0) return 0;
+    return tree_sum(t, &tg->o, stride, w, nc, tg->n, tg->p, tg->ldp, out, ldo, threads);
+}
+
 int cm_rbf_tree_sum(const cm_rbf_tree *t, const double *w, int nc, size_t n, const double *p,
                     size_t ldp, double *out, size_t ldo, int threads)
 {
     if (n == 0) return 0;
-    order tg;
-    if (build_order(n, p, ldp, CM_TREE_BATCH, &tg)) {
-        free_order(&tg);
-        return -1;
-    }
-    int st = tree_sum(t, &tg, w, nc, n, p, ldp, out, ldo, threads);
-    free_order(&tg);
+    cm_rbf_tree_targets *tg = cm_rbf_tree_targets_create(n, p, ldp);
+    int st = tg ? cm_rbf_tree_sum_targets(t, tg, 1, w, nc, out, ldo, threads) : -1;
+    cm_rbf_tree_targets_destroy(&tg);
     return st;
 }
 
 int cm_rbf_tree_sum_self(const cm_rbf_tree *t, const double *w, int nc, double *out,
                          size_t ldo, int threads)
 {
-    return tree_sum(t, &t->self, w, nc, t->m, t->c, t->m, out, ldo, threads);
+    return tree_sum(t, &t->self, 1, w, nc, t->m, t->c, t->m, out, ldo, threads);
 }
 
 void cm_rbf_tree_check(const cm_rbf_tree *t, const double *w, int nc, size_t n,

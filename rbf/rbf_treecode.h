@@ -12,8 +12,9 @@ typedef struct cm_rbf_tree cm_rbf_tree;
 /* Parameters for a requested accuracy: order n (n + 1 Chebyshev points per axis and
  * cluster) and opening angle theta such that, measured on random weights, the error of
  * every sum is at most tol x sum_j |w_j| phi_ij (rbf_treecode.c has the table and the bound).
- * tol is clamped to [1e-14, 1e-3]. */
+ * tol is clamped to [CM_RBF_TREE_TOL_MIN, 1e-3]. */
 void cm_rbf_tree_params(double tol, int *order, double *theta);
+#define CM_RBF_TREE_TOL_MIN 1e-14
 
 /* Source tree over the m centres c (3 x m SoA, stride m; kept by pointer, must outlive the
  * tree) for order (2..14) and theta (0.1..0.9). Also orders the centres themselves as target
@@ -40,6 +41,23 @@ void cm_rbf_tree_set_compensated(cm_rbf_tree *t, int level);
  * SoA with stride ldp. 0 on success, -1 on allocation failure (out untouched). */
 int cm_rbf_tree_sum(const cm_rbf_tree *t, const double *w, int nc, size_t n, const double *p,
                     size_t ldp, double *out, size_t ldo, int threads);
+/* The targets of cm_rbf_tree_sum in their batches (a kD tree of the points, leaves of a
+ * few hundred), kept for several sums over the same points: p (3 x n SoA, stride ldp) is
+ * kept by pointer and must outlive it. NULL on allocation failure. */
+typedef struct cm_rbf_tree_targets cm_rbf_tree_targets;
+cm_rbf_tree_targets *cm_rbf_tree_targets_create(size_t n, const double *p, size_t ldp);
+void cm_rbf_tree_targets_destroy(cm_rbf_tree_targets **tg);
+/* A pilot: every *stride-th batch (stride chosen for at most `batches` of them) and, in idx,
+ * up to `per` target indices spread over each (capacity batches x per); returns their count.
+ * The sums of cm_rbf_tree_sum_targets over those batches are what the whole sum gives
+ * there: the same batches open the same clusters. */
+size_t cm_rbf_tree_targets_pilot(const cm_rbf_tree_targets *tg, size_t batches, size_t per,
+                                 size_t *idx, size_t *stride);
+/* cm_rbf_tree_sum over the targets of every stride-th batch (1: all); out is written at
+ * those targets only. */
+int cm_rbf_tree_sum_targets(const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
+                            size_t stride, const double *w, int nc, double *out, size_t ldo,
+                            int threads);
 /* The same with the targets = the centres of the tree (their batches are cached). */
 int cm_rbf_tree_sum_self(const cm_rbf_tree *t, const double *w, int nc, double *out,
                          size_t ldo, int threads);

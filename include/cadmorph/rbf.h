@@ -224,6 +224,8 @@ typedef struct cm_rbf_stats {
                             * fast_eval_tol or within the direct sums' own rounding (about
                             * 4 eps sum_j |w_j| phi_ij / max |data|: weights that cancel
                             * 1e8-fold leave 1e-8 there, for any summation in doubles) */
+    int eval_order;        /* ... and the treecode's order and opening angle it took (the */
+    double eval_theta;     /* cheapest whose error on a pilot passed the same test) */
     int matvecs_compensated; /* last iterative solve: matvecs split by kind (they add up to */
     int matvecs_plain;       /* matvecs): compensated direct sums (~1.45x a plain one), plain */
     int matvecs_fast;        /* direct sums, treecode sums (a loose one: ~0.1-0.3x) */

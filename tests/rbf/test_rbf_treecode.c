@@ -376,9 +376,10 @@ static void test_evaluation(cm_context *ctx)
         double dmax = 0.0;
         for (size_t i = 0; i < 3 * m; ++i) dmax = fmax(dmax, fabs(d[i]));
         double diff = max_diff(n * 3, a, b) / dmax;
-        printf("evaluation, %s set, m = %zu: fast %s (estimated error %.3g of max |d|), "
-               "|fast - direct| = %.3g of max |d|\n", set ? "bore" : "random", m,
-               sb.eval_fast ? "accepted" : "refused", sb.eval_error, diff);
+        printf("evaluation, %s set, m = %zu: fast %s (estimated error %.3g of max |d|, "
+               "order %d, theta %.2f), |fast - direct| = %.3g of max |d|\n",
+               set ? "bore" : "random", m, sb.eval_fast ? "accepted" : "refused",
+               sb.eval_error, sb.eval_order, sb.eval_theta, diff);
         CHECK(s0 == CM_OK && s1 == CM_OK && sa.eval_fast == 0);
         CHECK_MSG(diff <= 1e-9 + 3e-10, "%.3g", diff); /* + the two solves' difference */
         if (sb.eval_fast) CHECK_MSG(sb.eval_error <= 1e-9, "%.3g", sb.eval_error);
@@ -512,6 +513,54 @@ static void log_stderr(void *user, cm_log_level level, const char *message)
     fprintf(stderr, "%s\n", message);
 }
 
+/* A pilot over every k-th batch of targets gives, at its points, exactly the sums of the
+ * whole evaluation (the same batches open the same clusters), and touches no other target:
+ * so its error there is the error the whole sum will have. */
+static void test_pilot(void)
+{
+    size_t m;
+    double *x = bore_centres(0.08, &m);
+    double *c = malloc(3 * m * sizeof *c), *w = malloc(3 * m * sizeof *w);
+    for (size_t i = 0; i < m; ++i)
+        for (int d = 0; d < 3; ++d) c[(size_t)d * m + i] = x[3 * i + d] / 4.0;
+    uint64_t rng = 17;
+    for (size_t i = 0; i < 3 * m; ++i) w[i] = test_rng_range(&rng, -1.0, 1.0);
+    const size_t n = 20000, batches = 8, per = 5;
+    double *p = malloc(3 * n * sizeof *p), *all = malloc(3 * n * sizeof *all);
+    double *pil = malloc(3 * n * sizeof *pil);
+    size_t idx[8 * 5], stride = 0;
+    for (size_t i = 0; i < n; ++i) {
+        p[i] = test_rng_range(&rng, 0.0, 1.0);
+        p[n + i] = test_rng_range(&rng, 0.0, 0.5);
+        p[2 * n + i] = test_rng_range(&rng, 0.0, 0.25);
+    }
+    int order;
+    double theta;
+    cm_rbf_tree_params(1e-9, &order, &theta);
+    cm_rbf_tree *t = cm_rbf_tree_create(m, c, order, theta);
+    cm_rbf_tree_targets *tg = cm_rbf_tree_targets_create(n, p, n);
+    CHECK(t && tg);
+    if (t && tg) {
+        for (size_t i = 0; i < 3 * n; ++i) pil[i] = NAN;
+        size_t np = cm_rbf_tree_targets_pilot(tg, batches, per, idx, &stride);
+        CHECK(cm_rbf_tree_sum_targets(t, tg, 1, w, 3, all, 3, 2) == 0);
+        CHECK(cm_rbf_tree_sum_targets(t, tg, stride, w, 3, pil, 3, 2) == 0);
+        size_t same = 0, touched = 0;
+        for (size_t k = 0; k < np; ++k)
+            same += memcmp(all + 3 * idx[k], pil + 3 * idx[k], 3 * sizeof *all) == 0;
+        for (size_t i = 0; i < n; ++i) touched += !isnan(pil[3 * i]);
+        printf("pilot: %zu of %zu targets summed (stride %zu), %zu of %zu checked points as "
+               "in the whole sum\n", touched, n, stride, same, np);
+        CHECK(np > batches / 2 && np <= batches * per && stride > 1);
+        CHECK(same == np);
+        /* about batches / (n / batch) of the targets; a whole sum would be n */
+        CHECK_MSG(touched >= np && touched <= n / 4, "%zu", touched);
+    }
+    cm_rbf_tree_targets_destroy(&tg);
+    cm_rbf_tree_destroy(&t);
+    free(x), free(c), free(w), free(p), free(all), free(pil);
+}
+
 int main(void)
 {
     cm_context *ctx = NULL;
@@ -520,6 +569,7 @@ int main(void)
     cm_context_set_threads(ctx, 2);
     test_bound_random();
     test_isa();
+    test_pilot();
     test_bound_real(ctx);
     test_fit(ctx);
     test_affine(ctx);
