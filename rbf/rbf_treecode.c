@@ -625,7 +625,10 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const 
     const double *px = t->pxyz, *py = px + np * P, *pz = py + np * P;
     const double *xs = t->xs, *ys = xs + m, *zs = ys + m;
     int failed = 0;
-    const int step = stride > 0 && stride < (size_t)tg->nleaf ? (int)stride : 1;
+    /* a stride past the last batch visits batch 0 alone */
+    const int step = stride == 0 ? 1
+                     : stride < (size_t)tg->nleaf ? (int)stride
+                                                  : (tg->nleaf > 0 ? tg->nleaf : 1);
 #pragma omp parallel num_threads(threads) if (threads > 1 && (double)n / step * (double)m > CM_RBF_PARALLEL_MIN_PAIRS)
     {
         int cap = 256;

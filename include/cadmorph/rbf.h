@@ -45,7 +45,9 @@ typedef struct cm_rbf cm_rbf;
  *   reported is still the exact one (or within that bound of it); evaluation of
  *   large n x m uses the treecode where a sampled check shows its error within
  *   fast_eval_tol x max |data| (or within the direct sums' own rounding, if that is
- *   larger), direct sums otherwise (stats: eval_fast, eval_error).
+ *   larger), direct sums otherwise (stats: eval_fast, eval_error); a cheaper treecode
+ *   than the bound asks for is taken where its error on a pilot (a few of the same target
+ *   batches) already passes that check (stats: eval_order, eval_theta).
  * AUTO: a cost model measured on this project's machine kind (rbf_iterative.c) puts the
  *   crossover near 3,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
  *   iterative above; dense for the other kernels.
