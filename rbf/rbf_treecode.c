@@ -601,8 +601,8 @@ void cm_rbf_tree_set_isa(cm_rbf_tree *t, cm_rbf_isa isa)
     if (t) t->isa = isa;
 }
 
-/* the whole sum for targets ordered by tg (batches = its leaves) */
-/* The sums at the targets of every stride-th batch of tg (stride 1: all of them). */
+/* The sums for targets ordered by tg (batches = its leaves), at the targets of every
+ * stride-th batch (stride 1: all of them). */
 static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const double *w,
                     int nc, size_t n, const double *p, size_t ldp, double *out, size_t ldo,
                     int threads)
