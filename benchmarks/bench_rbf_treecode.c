@@ -133,7 +133,7 @@ static int random_only(const char *prefix, const char *orders, const char *tols,
             cm_rbf_tree_sum_self(t, w, 3, out, 3, threads);
             double fast = bench_cpu_seconds() - c0, fast_wall = cm_wtime() - w0;
             double e, sabs;
-            cm_rbf_tree_check(t, w, 3, m, c, m, out, 3, 512, &e, &sabs, threads);
+            cm_rbf_tree_check(t, w, 3, m, c, m, out, 3, 512, NULL, &e, &sabs, threads);
             printf("tol=%.0e order=%d theta=%.2f isa=%s build_cpu_s=%.2f fast_cpu_s=%.2f "
                    "fast_wall_s=%.2f speedup=%.1f speedup_vs_compensated=%.1f "
                    "sampled_err_Smax=%.3g tree_mb=%.1f\n",
@@ -248,7 +248,7 @@ static int at_points(const char *prefix, const char *file, size_t m, const doubl
             if (cm_rbf_tree_sum(t, w, 3, n, p, n, out, 3, threads)) return 1;
             const double fast = bench_cpu_seconds() - c0;
             double e, sabs;
-            cm_rbf_tree_check(t, w, 3, n, p, n, out, 3, 2048, &e, &sabs, threads);
+            cm_rbf_tree_check(t, w, 3, n, p, n, out, 3, 2048, NULL, &e, &sabs, threads);
             double eld = 0.0;
             for (size_t kk = 0; kk < nsr; ++kk) {
                 const size_t i = (size_t)((double)kk * (double)n / (double)nsr);
@@ -402,7 +402,7 @@ int main(int argc, char **argv)
         double est_err, est_s;
         double true_max = 0.0;
         cm_rbf_tree_sum_self(t, wreal, 3, fast, 3, threads);
-        cm_rbf_tree_check(t, wreal, 3, m, c, m, fast, 3, 256, &est_err, &est_s, threads);
+        cm_rbf_tree_check(t, wreal, 3, m, c, m, fast, 3, 256, NULL, &est_err, &est_s, threads);
         (void)est_s;
         for (size_t i = 0; i < 3 * m; ++i) true_max = fmax(true_max, fabs(fast[i] - ex[0][i]));
         printf("tol=%.0e order=%d theta=%.2f build_cpu_s=%.3f fast_cpu_s=%.3f speedup=%.2f "

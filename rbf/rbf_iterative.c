@@ -87,10 +87,10 @@
  * loop stopping at 0.5 x target. The goal is the target, or CM_RBF_CYCLE_GAIN x the cycle's
  * starting residual if larger: such a cycle ends there, and the exact residual at the next
  * start sees what its products erred, as a refinement step would (two bodies 121k: the
- * first cycle's last two products plain instead of compensated). The gap bound with the final y is logged after each cycle;
- * the exact residual at the cycle's end decides as before (RESULTS.md, "Relaxed-accuracy
- * matvecs": on the real sets plain sums become admissible only after the residual fell by
- * 1e6..1e8, as the weights cancel). */
+ * first cycle's last two products plain instead of compensated). The gap bound with the
+ * final y is logged after each cycle; the exact residual at the cycle's end decides as
+ * before (RESULTS.md, "Relaxed-accuracy matvecs": on the real sets plain sums become
+ * admissible only after the residual fell by 1e6..1e8, as the weights cancel). */
 #define CM_RBF_RELAX_BUDGET 0.5
 /* the safe bound diam^3 sum |z| was 3.2-3.8 x S(z) on the bore (22.6k) */
 #define CM_RBF_S_SLACK 5.0
@@ -347,31 +347,36 @@ static int tree_sum_all(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree
     return 0;
 }
 
-/* 1 if the treecode t passes the pilot: its largest error at the pilot's points (against
- * compensated direct sums), x CM_RBF_FAST_SAFETY, is within accept. out: n x nc scratch. */
+/* The largest error of the fast sums out (n x nc) against compensated direct sums at
+ * `samples` of the targets (the indices idx, or NULL: spread over them), over all the
+ * components. */
+static double check_all(const cm_rbf *r, const cm_rbf_tree *t, size_t n, const double *p,
+                        const double *out, size_t samples, const size_t *idx, int threads)
+{
+    const size_t m = r->m, nc = (size_t)r->ncomp;
+    double err = 0.0;
+    for (size_t g = 0; g < nc; g += 4) {
+        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+        double e;
+        cm_rbf_tree_check(t, r->w + g * m, gc, n, p, n, out + g, nc, samples, idx, &e, NULL,
+                          threads);
+        err = fmax(err, e);
+    }
+    return err;
+}
+
+/* 1 if the treecode t passes the pilot: its largest error at the pilot's points, x
+ * CM_RBF_FAST_SAFETY, is within accept. out: n x nc scratch. */
 static int pilot_passes(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
                         size_t n, const double *p, double accept, double *out, int threads)
 {
-    const size_t m = r->m, nc = (size_t)r->ncomp, cap = CM_RBF_PILOT_BATCHES * CM_RBF_PILOT_PER;
-    size_t *idx = malloc(cap * sizeof *idx), stride;
-    double *sp = malloc(3 * cap * sizeof *sp), *ex = malloc(cap * nc * sizeof *ex);
-    int pass = 0;
-    const size_t np = idx ? cm_rbf_tree_targets_pilot(tg, CM_RBF_PILOT_BATCHES,
-                                                      CM_RBF_PILOT_PER, idx, &stride) : 0;
-    if (idx && sp && ex && tree_sum_all(r, t, tg, stride, out, threads) == 0) {
-        for (size_t k = 0; k < np; ++k)
-            for (int d = 0; d < 3; ++d) sp[(size_t)d * np + k] = p[(size_t)d * n + idx[k]];
-        for (size_t g = 0; g < nc; g += 4) {
-            int gc = nc - g < 4 ? (int)(nc - g) : 4;
-            cm_rbf_kernel_sum_acc(m, r->c, r->w + g * m, gc, np, sp, np, ex + g, nc, threads);
-        }
-        double e = 0.0;
-        for (size_t k = 0; k < np; ++k)
-            for (size_t q = 0; q < nc; ++q)
-                e = fmax(e, fabs(out[idx[k] * nc + q] - ex[k * nc + q]));
-        pass = CM_RBF_FAST_SAFETY * e <= accept;
-    }
-    free(idx), free(sp), free(ex);
+    size_t *idx = malloc(CM_RBF_PILOT_BATCHES * CM_RBF_PILOT_PER * sizeof *idx), stride = 1;
+    if (!idx) return 0;
+    const size_t np =
+        cm_rbf_tree_targets_pilot(tg, CM_RBF_PILOT_BATCHES, CM_RBF_PILOT_PER, idx, &stride);
+    const int pass = tree_sum_all(r, t, tg, stride, out, threads) == 0 &&
+                     CM_RBF_FAST_SAFETY * check_all(r, t, n, p, out, np, idx, threads) <= accept;
+    free(idx);
     return pass;
 }
 
@@ -425,14 +430,7 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
         const double th = coarse ? theta_c : theta;
         const cm_rbf_tree *t = tree_for(r, o, th);
         if (!t || tree_sum_all(r, t, tg, 1, out, threads)) break;
-        double err = 0.0;
-        for (size_t g = 0; g < nc; g += 4) {
-            int gc = nc - g < 4 ? (int)(nc - g) : 4;
-            double e, sabs;
-            cm_rbf_tree_check(t, r->w + g * m, gc, n, p, n, out + g, nc, CM_RBF_FAST_SAMPLES,
-                              &e, &sabs, threads);
-            err = fmax(err, e);
-        }
+        const double err = check_all(r, t, n, p, out, CM_RBF_FAST_SAMPLES, NULL, threads);
         it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
         it->eval_fast = CM_RBF_FAST_SAFETY * err <= accept;
         it->eval_order = o;
@@ -838,8 +836,8 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                  * relaxing */
                 if (gap > CM_RBF_RELAX_BUDGET * goal[c]) kr->exact[c] = 1;
                 cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: component %d, cycle %d: gap bound of "
-                       "the relaxed products %.3g (the cycle's goal %.3g)", c, cycle, gap / fnorm[c],
-                       goal[c] / fnorm[c]);
+                       "the relaxed products %.3g (the cycle's goal %.3g)", c, cycle,
+                       gap / fnorm[c], goal[c] / fnorm[c]);
             }
             double *wh = w + (size_t)c * m, *wl = kr->wlo + (size_t)c * m;
             for (int i = 0; i < jn[c]; ++i) {

@@ -784,36 +784,39 @@ int cm_rbf_tree_sum_self(const cm_rbf_tree *t, const double *w, int nc, double *
 
 void cm_rbf_tree_check(const cm_rbf_tree *t, const double *w, int nc, size_t n,
                        const double *p, size_t ldp, const double *out, size_t ldo,
-                       size_t samples, double *max_err, double *max_abs_sum, int threads)
+                       size_t samples, const size_t *idx, double *max_err,
+                       double *max_abs_sum, int threads)
 {
     *max_err = 0.0;
-    *max_abs_sum = 0.0;
-    if (samples > n) samples = n;
+    if (max_abs_sum) *max_abs_sum = 0.0;
+    if (samples > n && !idx) samples = n;
     if (samples == 0) return;
     const size_t m = t->m;
+    size_t *at = malloc(samples * sizeof *at);
     double *sp = malloc(3 * samples * sizeof *sp);
     double *ex = malloc(2 * samples * (size_t)nc * sizeof *ex);
-    double *aw = malloc((size_t)nc * m * sizeof *aw);
-    if (!sp || !ex || !aw) {
+    double *aw = max_abs_sum ? malloc((size_t)nc * m * sizeof *aw) : NULL;
+    if (!at || !sp || !ex || (max_abs_sum && !aw)) {
         *max_err = INFINITY; /* unknown: the caller falls back to direct sums */
-        free(sp), free(ex), free(aw);
+        free(at), free(sp), free(ex), free(aw);
         return;
     }
     double *ab = ex + samples * (size_t)nc;
     for (size_t k = 0; k < samples; ++k) {
-        size_t i = (size_t)((double)k * (double)n / (double)samples);
-        for (int d = 0; d < 3; ++d) sp[(size_t)d * samples + k] = p[(size_t)d * ldp + i];
+        at[k] = idx ? idx[k] : (size_t)((double)k * (double)n / (double)samples);
+        for (int d = 0; d < 3; ++d) sp[(size_t)d * samples + k] = p[(size_t)d * ldp + at[k]];
     }
-    for (size_t j = 0; j < (size_t)nc * m; ++j) aw[j] = fabs(w[j]);
     cm_rbf_kernel_sum_acc(m, t->c, w, nc, samples, sp, samples, ex, (size_t)nc, threads);
-    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, t->c, aw, nc, samples, sp, samples, ab,
-                      (size_t)nc, threads);
-    for (size_t k = 0; k < samples; ++k) {
-        size_t i = (size_t)((double)k * (double)n / (double)samples);
-        for (int q = 0; q < nc; ++q) {
-            *max_err = fmax(*max_err, fabs(out[i * ldo + (size_t)q] - ex[k * (size_t)nc + (size_t)q]));
-            *max_abs_sum = fmax(*max_abs_sum, ab[k * (size_t)nc + (size_t)q]);
-        }
+    if (max_abs_sum) {
+        for (size_t j = 0; j < (size_t)nc * m; ++j) aw[j] = fabs(w[j]);
+        cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, t->c, aw, nc, samples, sp, samples, ab,
+                          (size_t)nc, threads);
     }
-    free(sp), free(ex), free(aw);
+    for (size_t k = 0; k < samples; ++k)
+        for (int q = 0; q < nc; ++q) {
+            const size_t e = k * (size_t)nc + (size_t)q;
+            *max_err = fmax(*max_err, fabs(out[at[k] * ldo + (size_t)q] - ex[e]));
+            if (max_abs_sum) *max_abs_sum = fmax(*max_abs_sum, ab[e]);
+        }
+    free(at), free(sp), free(ex), free(aw);
 }

@@ -62,12 +62,13 @@ int cm_rbf_tree_sum_targets(const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
 int cm_rbf_tree_sum_self(const cm_rbf_tree *t, const double *w, int nc, double *out,
                          size_t ldo, int threads);
 
-/* A posteriori check of a fast sum: at `samples` targets spread over p (indices i = k n /
- * samples), the largest |out - exact| with exact by compensated direct summation, and the
- * largest sum_j |w_j| phi_ij there (the scale the error bound is relative to), both over
- * the nc components. */
+/* A posteriori check of a fast sum: at `samples` of the targets (the indices idx, or, for
+ * idx NULL, spread over p: i = k n / samples), the largest |out - exact| with exact by
+ * compensated direct summation, and (max_abs_sum not NULL) the largest sum_j |w_j| phi_ij
+ * there (the scale the error bound is relative to), both over the nc components. */
 void cm_rbf_tree_check(const cm_rbf_tree *t, const double *w, int nc, size_t n,
                        const double *p, size_t ldp, const double *out, size_t ldo,
-                       size_t samples, double *max_err, double *max_abs_sum, int threads);
+                       size_t samples, const size_t *idx, double *max_err,
+                       double *max_abs_sum, int threads);
 
 #endif

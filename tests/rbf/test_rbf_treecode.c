@@ -97,7 +97,7 @@ static void test_bound_random(void)
         /* the a-posteriori check sees an error of the same order as the true one */
         if (k == 1) {
             double e, sabs;
-            cm_rbf_tree_check(t, w, nc, n, p, n, fast, (size_t)nc, 256, &e, &sabs, 2);
+            cm_rbf_tree_check(t, w, nc, n, p, n, fast, (size_t)nc, 256, NULL, &e, &sabs, 2);
             double etrue = 0.0;
             for (size_t i = 0; i < n; ++i)
                 for (int q = 0; q < nc; ++q)
