@@ -7,7 +7,9 @@ benchmarks/RESULTS.md (docs/STYLE.md, "Comments"). This test fails on
   - an issue number ("issue 12", "issues #3"),
   - a numbered work session, in digits or in words ("6th session", "sixth session"),
   - a path into the steering repository ("../shared"),
-  - a relative include that climbs out of its folder (#include "../x.h").
+  - a relative include that climbs out of its folder (#include "../x.h"),
+and, in the installed headers (include/cadmorph/), on anything outside the installed tree: a
+source file, a script, benchmarks/ or tests/ (docs/ is installed with them).
 usage: check_citations.py ROOT
 """
 import os
@@ -25,6 +27,10 @@ RULES = [
     ("a work log", re.compile(r"\bwork[- ]?logs?\b", re.I)),
     ("a path outside the repository", re.compile(r"\.\./+shared\b")),
     ("a relative include out of its folder", re.compile(r'#\s*include\s*"\.\./')),
+]
+INSTALLED_RULES = [
+    ("a file that is not installed",
+     re.compile(r"[A-Za-z0-9_./-]+\.(c|cpp|hxx|py|sh)\b|RESULTS\.md|\bbenchmarks/|\btests/")),
 ]
 SOURCE_SUFFIXES = (".c", ".h", ".cpp", ".hxx", ".hpp", ".in", ".cmake", ".py", ".pyi", ".sh",
                    ".map")
@@ -59,8 +65,11 @@ def main():
             except OSError as e:
                 print(f"{path}: cannot read: {e}", file=sys.stderr)
                 return 1
+            rules = RULES
+            if os.path.relpath(top, root) == os.path.join("include", "cadmorph"):
+                rules = RULES + INSTALLED_RULES
             for no, line in enumerate(lines, 1):
-                for what, rx in RULES:
+                for what, rx in rules:
                     if rx.search(line):
                         found += 1
                         print(f"{os.path.relpath(path, root)}:{no}: cites {what}: {line.strip()[:160]}")
