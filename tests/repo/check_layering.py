@@ -41,8 +41,9 @@ def parse_design(path):
     circles = []
     m = re.search(r"^#+\s*Intended circles\s*$(.*?)(?=^#+\s|\Z)", text, re.M | re.S)
     if m:
-        for line in m.group(1).splitlines():
-            files = set(os.path.basename(f) for f in re.findall(r"`([^`]+\.(?:c|cpp))`", line))
+        # one bullet ("- ...", continued on the lines below it) names the files of one circle
+        for bullet in re.split(r"^\s*[-*]\s", m.group(1), flags=re.M)[1:]:
+            files = set(os.path.basename(f) for f in re.findall(r"`([^`]+\.(?:c|cpp))`", bullet))
             if len(files) > 1:
                 circles.append(files)
     return allowed, circles
