@@ -1,4 +1,4 @@
-# Tests of the TetGen bridge (volume/tetmesh.cpp, cad/triangulate.cpp) on the STEP fixtures of
+# Tests of the TetGen bridge (meshgen/tetmesh.cpp, cad/triangulate.cpp) on the STEP fixtures of
 # tests/data/models (written by gmsh: make_fixtures.py).
 cm_add_unit_test(test_tetmesh test_tetmesh.c LIBS cm_meshgen cm_cad cm_mesh LABELS cad)
 # TetGen in a child process: its crash on a self-intersecting surface (no -d), its time limit
