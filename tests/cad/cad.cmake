@@ -14,7 +14,7 @@ foreach(t model project sample boundary)
   set_tests_properties(test_cad_${t} PROPERTIES FIXTURES_REQUIRED cad_shapes)
 endforeach()
 # the correspondence of G and G' as graphs, and a morph onto a renumbered identical G'
-cm_add_unit_test(test_cad_correspond test_cad_correspond.c LIBS cm_morph cm_cad LABELS cad)
+cm_add_unit_test(test_cad_correspond test_cad_correspond.c LIBS cm_morph cm_meshgen cm_cad LABELS cad)
 set_tests_properties(test_cad_correspond PROPERTIES FIXTURES_REQUIRED cad_shapes
                      FIXTURES_SETUP cad_part_mesh)
 

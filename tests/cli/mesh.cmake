@@ -22,9 +22,9 @@ set_tests_properties(cli_mesh_bore_vtu cli_mesh_bore_msh cli_mesh_bore_tetgen_vt
 add_test(NAME cli_mesh_bore_medit COMMAND ${CM_RUN_CLI} --exit 0 --last-line ".* inverted=0 .*" --
   $<TARGET_FILE:cadmorph> mesh ${MD}/bore_0.step -o ${MW}/bore.mesh --size 0.4 --quality 1.6 --threads 1)
 add_test(NAME cli_mesh_bore_vtk_gmsh COMMAND ${CM_PYTHON}
-  ${PROJECT_SOURCE_DIR}/tests/volume/test_tetmesh_vtk.py ${MW}/bore.vtu ${MW}/bore.msh 7)
+  ${PROJECT_SOURCE_DIR}/tests/meshgen/test_tetmesh_vtk.py ${MW}/bore.vtu ${MW}/bore.msh 7)
 add_test(NAME cli_mesh_bore_tetgen_vtk_gmsh COMMAND ${CM_PYTHON}
-  ${PROJECT_SOURCE_DIR}/tests/volume/test_tetmesh_vtk.py ${MW}/bore_tetgen.vtu ${MW}/bore_tetgen.msh 7)
+  ${PROJECT_SOURCE_DIR}/tests/meshgen/test_tetmesh_vtk.py ${MW}/bore_tetgen.vtu ${MW}/bore_tetgen.msh 7)
 set_tests_properties(cli_mesh_bore_vtk_gmsh cli_mesh_bore_tetgen_vtk_gmsh PROPERTIES
   FIXTURES_REQUIRED cli_mesh_bore)
 # TetGen's options select TetGen; with --mesher gmsh they are a usage error
@@ -51,7 +51,7 @@ add_test(NAME cli_mesh_missing_file COMMAND ${CM_RUN_CLI} --exit 2 --stderr-line
 add_test(NAME cli_mesh_not_step COMMAND ${CM_RUN_CLI} --exit 2 --stderr-lines 1 --
   $<TARGET_FILE:cadmorph> mesh ${MD}/make_fixtures.py -o ${MW}/x.vtu)
 # TetGen runs in a child process under a time limit: far below the work it is killed, the
-# command says so in one line and writes nothing (issue 18)
+# command says so in one line and writes nothing
 add_test(NAME cli_mesh_time_limit COMMAND ${CM_RUN_CLI} --exit 2 --stderr-lines 1
   --stderr "cadmorph mesh: [^\n]*bore_0.step: TetGen[^\n]* did not finish in 0.05 s[^\n]*--time-limit"
   --absent ${MW}/time_limit.vtu --

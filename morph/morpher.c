@@ -1,6 +1,6 @@
 /* The morph engine (morph.h): M's boundary classified on G once; for each target G' the
- * surface morph (paper section 4) moves the boundary nodes onto G', and the interior follows
- * by a warp (section 3) whose factorisation depends only on M, kept per method. */
+ * surface morph [SMB12 §4] moves the boundary nodes onto G', and the interior follows
+ * by a warp [SMB12 §3] whose factorisation depends only on M, kept per method. */
 #include "cadmorph/morph.h"
 
 #include "off_cad.h"

@@ -1,8 +1,8 @@
 /* One TetGen run in a child process (child_process.h): the PLC in, the tets, points and
  * boundary triangles with their markers out, or a status saying how TetGen ended (its code,
- * a crash, an abort, the time limit). Private to volume/. */
-#ifndef CADMORPH_VOLUME_TETGEN_RUN_H
-#define CADMORPH_VOLUME_TETGEN_RUN_H
+ * a crash, an abort, the time limit). Private to meshgen/. */
+#ifndef CADMORPH_MESHGEN_TETGEN_RUN_H
+#define CADMORPH_MESHGEN_TETGEN_RUN_H
 
 #include "cadmorph/core.h"
 

@@ -1,8 +1,8 @@
-// gmsh as cadmorph's second mesher (volume/tetmesh_gmsh.cpp): the same STEP file read by gmsh's
+// gmsh as cadmorph's second mesher (meshgen/tetmesh_gmsh.cpp): the same STEP file read by gmsh's
 // OpenCASCADE kernel and meshed in 3D in a child process, its surfaces mapped to our face
-// indices. C++, private to volume/ (used by tetmesh.cpp).
-#ifndef CADMORPH_VOLUME_TETMESH_GMSH_H
-#define CADMORPH_VOLUME_TETMESH_GMSH_H
+// indices. C++, private to meshgen/ (used by tetmesh.cpp).
+#ifndef CADMORPH_MESHGEN_TETMESH_GMSH_H
+#define CADMORPH_MESHGEN_TETMESH_GMSH_H
 
 #include "cadmorph/cad.h"
 

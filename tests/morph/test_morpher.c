@@ -1,4 +1,4 @@
-/* The morph engine (volume/morpher.c) on gmsh meshes of the surface fixtures: its entry points
+/* The morph engine (morph/morpher.c) on gmsh meshes of the surface fixtures: its entry points
  * agree bit for bit (cm_morph_run, cm_morpher_apply, an explicit rebase chain vs --via), a
  * shared factorisation gives what a fresh one gives, morphing a mesh onto the geometry it
  * lies on changes nothing, and a target of another topology is refused. */

@@ -352,7 +352,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
         const attempt &at = attempts[a];
         /* the dihedral bound (after the radius-edge ratio) is what removes most slivers:
          * TetGen's -O optimisation levels changed no measured quality (benchmarks/RESULTS.md,
-         * issue 13) */
+         * quality guarantee: tet meshes) */
         char dihedral[32] = "";
         if (at.dihedral > 0) std::snprintf(dihedral, sizeof dihedral, "/%.6g", at.dihedral);
         std::snprintf(sw, sizeof sw, "pzq%.6g%sa%.6g%sQ", at.q, dihedral, vmax,

@@ -1,9 +1,9 @@
-# The morph engine (volume/morpher.c, volume/morph_pipeline.c) on the gmsh meshes of the
+# The morph engine (morph/morpher.c, morph/morph_pipeline.c) on the gmsh meshes of the
 # surface fixtures (fixture surface_meshes of tests/surface).
-cm_add_unit_test(test_morpher test_morpher.c LIBS cm_morph LABELS "cad;volume")
+cm_add_unit_test(test_morpher test_morpher.c LIBS cm_morph LABELS cad)
 set_tests_properties(test_morpher PROPERTIES FIXTURES_REQUIRED surface_meshes)
 
 # --off-cad fixed: a body in a box (gmsh's Python API), the box not on the body's STEP.
 add_test(NAME test_off_cad
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_off_cad.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
-set_tests_properties(test_off_cad PROPERTIES LABELS "volume;cad;cli" TIMEOUT 120)
+set_tests_properties(test_off_cad PROPERTIES LABELS "cad;cli" TIMEOUT 120)

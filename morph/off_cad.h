@@ -1,7 +1,7 @@
 /* Boundary nodes off G kept fixed (CM_OFF_CAD_FIXED): the check that they are whole boundary
  * components of their own. Private to the morph engine. */
-#ifndef CM_VOLUME_OFF_CAD_H
-#define CM_VOLUME_OFF_CAD_H
+#ifndef CM_MORPH_OFF_CAD_H
+#define CM_MORPH_OFF_CAD_H
 
 #include "cadmorph/mesh.h"
 #include "cadmorph/surface.h"

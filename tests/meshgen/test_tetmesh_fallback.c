@@ -1,4 +1,4 @@
-/* The retries of cm_tetmesh_create (volume/tetmesh.cpp) on a real TetGen failure: under an
+/* The retries of cm_tetmesh_create (meshgen/tetmesh.cpp) on a real TetGen failure: under an
  * address-space limit a little above what the process holds, TetGen's child runs out of
  * memory on the fine mesh asked for (its error path then crashes or reports code 1), and the
  * retry with the surface kept (-Y, far fewer tets) fits: the call succeeds, logs one warning

@@ -1,4 +1,4 @@
-/* Tet meshing of a STEP solid (volume/tetmesh.cpp over cad/triangulate.cpp): the bore
+/* Tet meshing of a STEP solid (meshgen/tetmesh.cpp over cad/triangulate.cpp): the bore
  * benchmark model at t = 0, written by gmsh, meshed at two sizes. Invariants: no inverted
  * tet; every boundary node on the analytic bore (a box face or the bore's cylinder, 1e-9);
  * the boundary triangles are exactly the tets' free faces, outward (their divergence-theorem

@@ -1,4 +1,4 @@
-/* TetGen in a child process (volume/tetgen_run.cpp over volume/child_process.c). Debian's
+/* TetGen in a child process (meshgen/tetgen_run.cpp over meshgen/child_process.c). Debian's
  * TetGen 1.5.0 crashes on its own error path (terminatetetgen frees the pools, ~tetgenmesh
  * frees them again): a self-intersecting surface given to it without the -d check, as two
  * overlapping boxes are, reproduces that crash every time. It must come back as a status with
@@ -8,7 +8,7 @@
  * none of TetGen's printing and none of the parent's buffered output reaches stdout twice;
  * OpenMP's thread pool works before and after the forks. */
 #include "test_util.h"
-#include "volume/tetgen_run.h"
+#include "meshgen/tetgen_run.h"
 
 #include <omp.h>
 #include <stdio.h>

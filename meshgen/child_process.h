@@ -1,8 +1,8 @@
 /* Running a dependency that may crash, abort or never end (TetGen 1.5.0, gmsh) in a forked
  * child: its result comes back through a pipe, its crash or hang becomes a status. Private
- * to volume/. */
-#ifndef CADMORPH_VOLUME_CHILD_PROCESS_H
-#define CADMORPH_VOLUME_CHILD_PROCESS_H
+ * to meshgen/. */
+#ifndef CADMORPH_MESHGEN_CHILD_PROCESS_H
+#define CADMORPH_MESHGEN_CHILD_PROCESS_H
 
 #include "cadmorph/core.h"
 

@@ -7,11 +7,11 @@ set(CHECK ${CM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/surface/check_morph.py)
 set(CLEAN "inverted=0 cells=[1-9][0-9]*\n?\\Z")
 add_test(NAME adaptive_setup
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/make_adaptive.py ${CM_TEST_WORK})
-set_tests_properties(adaptive_setup PROPERTIES FIXTURES_SETUP adaptive LABELS "unit;volume")
+set_tests_properties(adaptive_setup PROPERTIES FIXTURES_SETUP adaptive LABELS unit)
 
 function(cm_adaptive_cli name)
   add_test(NAME ${name} COMMAND ${ARGN})
-  set_tests_properties(${name} PROPERTIES LABELS "cli;volume" FIXTURES_REQUIRED adaptive)
+  set_tests_properties(${name} PROPERTIES LABELS cli FIXTURES_REQUIRED adaptive)
 endfunction()
 
 set(MORPH_MOVED $<TARGET_FILE:cadmorph> morph --from ${AW}/hole_0.step --to ${AW}/hole_moved.step
@@ -19,7 +19,7 @@ set(MORPH_MOVED $<TARGET_FILE:cadmorph> morph --from ${AW}/hole_0.step --to ${AW
 cm_adaptive_cli(cli_morph_one_step_inverts ${CM_RUN_CLI} --exit 3 --stderr "inverted cells" --
   ${MORPH_MOVED} -o ${AW}/one_step.vtu --fail-on-inverted)
 # the same without --fail-on-inverted: written, exit 0, and one warning line naming the count
-# and the worst cell (issue 18: the summary line alone is easy to miss)
+# and the worst cell (the summary line alone is easy to miss)
 cm_adaptive_cli(cli_morph_one_step_warns ${CM_RUN_CLI} --exit 0 --stderr-lines 1
   --stderr "^cadmorph morph: warning: [1-9][0-9]* inverted cells? \\(scaled Jacobian <= 0\\). the worst is cell [0-9]+ \\(0-based, tet4, scaled Jacobian -?[0-9.e+-]+\\) at \\("
   --stdout "inverted=[1-9][0-9]* cells=" -- ${MORPH_MOVED} -o ${AW}/one_step_warned.vtu)
@@ -35,7 +35,7 @@ add_test(NAME cli_morph_auto_easy COMMAND ${CM_RUN_CLI} --exit 0 --stdout "${CLE
   $<TARGET_FILE:cadmorph> morph --from ${CM_TEST_DATA}/surface/hole_a.step
   --to ${CM_TEST_DATA}/surface/hole_b.step --mesh ${CM_TEST_WORK}/surface/hole_a.msh
   -o ${AW}/easy.vtu --steps auto --report ${AW}/easy.csv)
-set_tests_properties(cli_morph_auto_easy PROPERTIES LABELS "cli;volume"
+set_tests_properties(cli_morph_auto_easy PROPERTIES LABELS cli
   FIXTURES_REQUIRED "adaptive;surface_meshes")
 cm_adaptive_cli(cli_morph_auto_easy_report ${CHECK} report ${AW}/easy.csv 1)
 set_tests_properties(cli_morph_auto_easy_report PROPERTIES DEPENDS cli_morph_auto_easy)
