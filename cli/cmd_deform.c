@@ -1,12 +1,11 @@
 /* `cadmorph deform`: handle-based deformation of a surface or volume mesh (the handle
- * metaphor of the MLS paper, section 3): handle nodes H move as given, fixed nodes F stay,
- * the rest follows a space deformation (triharmonic RBF or constrained MLS). */
+ * metaphor [CMLS §3]): handle nodes H move as given, fixed nodes F stay, the rest follows a
+ * space deformation of deform.h's table (triharmonic RBF, constrained MLS, shell, DM-FFD). */
 #include "cli.h"
 #include "deform_constraints.h"
 
 #include "cadmorph/deform.h"
 
-#include "cadmorph/mls.h"
 #include "cadmorph/warp.h"
 
 #include <math.h>
@@ -20,8 +19,6 @@ static const char *const usage_line =
     "[--cubature N] [--cover S] [--blend B] [--graded G] [--lattice N] [--clamp E] [--exact-constraints] "
     "[--constraint TYPE:SET ...] [--threads N] [--verbose]";
 
-enum { METHOD_RBF, METHOD_MLS, METHOD_SHELL, METHOD_DMFFD };
-
 typedef struct deform_args {
     const char *mesh, *handles, *fixed, *out;
     int method, fix_boundary, exact, threads, verbose, lattice;
@@ -33,8 +30,9 @@ typedef struct deform_args {
 static deform_args args;
 static int print_help(void);
 
-static const char *const method_names[] = {"rbf", "mls", "shell", "dmffd", NULL};
-static const int method_values[] = {METHOD_RBF, METHOD_MLS, METHOD_SHELL, METHOD_DMFFD};
+/* --method's names and values: deform.h's table, filled in by parse_args */
+static const char *method_names[CM_DEFORM_N_METHODS + 1];
+static int method_values[CM_DEFORM_N_METHODS];
 
 static const cli_option options[] = {
     {.name = "--help", .alias = "-h", .kind = CLI_HELP},
@@ -105,7 +103,9 @@ static int parse_args(int argc, char **argv, deform_args *a)
 {
     static const char *cmd = "deform";
     memset(&args, 0, sizeof args);
-    args.method = METHOD_MLS, args.lattice = 10;
+    for (int m = 0; m < CM_DEFORM_N_METHODS; ++m)
+        method_names[m] = cm_deform_method_name(m), method_values[m] = m;
+    args.method = CM_DEFORM_MLS, args.lattice = 10;
     cm_mls_options_init(&args.mls);
     cli_constraints_init(&args.cons);
     cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
@@ -119,9 +119,9 @@ static int parse_args(int argc, char **argv, deform_args *a)
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
     if (a->fixed && a->fix_boundary)
         return cli_usage(cmd, usage_line, "--fixed and --fix-unlisted-boundary exclude each other");
-    if ((a->method == METHOD_MLS || a->method == METHOD_SHELL) && a->mls.stretch + a->mls.bend <= 0)
+    if ((a->method == CM_DEFORM_MLS || a->method == CM_DEFORM_SHELL) && a->mls.stretch + a->mls.bend <= 0)
         return cli_usage(cmd, usage_line, "--stretch + --bend must be > 0");
-    if (cli_constraints_any(&a->cons) && a->method != METHOD_MLS)
+    if (cli_constraints_any(&a->cons) && a->method != CM_DEFORM_MLS)
         return cli_usage(cmd, usage_line, "--constraint needs --method mls");
     const char *inputs[] = {a->mesh, a->handles, a->fixed, a->cons.cad};
     return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 4) ? CLI_EXIT_USAGE : -1;
@@ -176,42 +176,45 @@ int cli_cmd_deform(int argc, char **argv)
     }
     if (s >= 0 && nh == 0) s = cm_error(ctx, CM_ERR_ARGUMENT, "%s: no handle node", a.handles);
     double residual = 0, t0 = cm_wtime();
-    if (s >= 0 && a.method == METHOD_SHELL && volume)
+    if (s >= 0 && a.method == CM_DEFORM_SHELL && volume)
         s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: --method shell deforms surface meshes only", a.mesh);
-    if (s >= 0 && a.method == METHOD_SHELL)
-        s = cm_mls_shell(ctx, mesh, con, a.mls.stretch, a.mls.bend, a.mls.fix, disp);
-    if (s >= 0 && a.method == METHOD_RBF) s = cm_deform_rbf(ctx, mesh->n_nodes, mesh->xyz, con, disp);
-    if (s >= 0 && a.method == METHOD_DMFFD)
-        s = cm_deform_dmffd(ctx, mesh->n_nodes, mesh->xyz, con, a.lattice, a.clamp, disp, &residual);
-    if (s >= 0 && a.method == METHOD_MLS) {
-        cm_mls *mls = NULL;
-        cm_shape_set sets[CLI_MAX_CONSTRAINTS];
-        s = cli_constraints_resolve(ctx, mesh, &a.cons, sets);
-        if (s >= 0) s = cm_mls_create(ctx, mesh, con, &a.mls, &mls);
-        if (s >= 0 && cli_constraints_any(&a.cons))
-            s = cli_constraints_run(ctx, mls, mesh, &a.cons, sets, disp, &residual);
-        else if (s >= 0)
-            s = cm_mls_apply(ctx, mls, disp, &residual);
-        cli_constraints_free(&a.cons, sets);
-        cm_mls_stats st;
-        cm_mls_get_stats(mls, &st);
-        if (s >= 0)
-            cm_log(ctx, CM_LOG_DEBUG,
-                   "deform mls: %zu samples (%zu surface), %zu cubature points, %zu constrained; "
-                   "sample %.3f s, basis %.3f s, factor %.3f s (%zu entries), apply %.3f s; CPU s "
-                   "%.3f, %.3f, %.3f, %.3f",
-                   st.samples, st.surface_samples, st.cubature, st.constrained, st.t_sample,
-                   st.t_basis, st.t_factor, st.factor_nonzeros, st.t_apply, st.c_sample, st.c_basis,
-                   st.c_factor, st.c_apply);
-        cm_mls_destroy(&mls);
-    }
+    cm_deform *def = NULL;
+    cm_deform_options dopt;
+    cm_deform_options_init(&dopt);
+    dopt.method = (cm_deform_method)a.method;
+    dopt.lattice = a.lattice, dopt.clamp = a.clamp, dopt.mls = a.mls;
+    cm_shape_set sets[CLI_MAX_CONSTRAINTS];
+    const int shaped = s >= 0 && a.method == CM_DEFORM_MLS; /* the sets to resolve and free */
+    if (shaped) s = cli_constraints_resolve(ctx, mesh, &a.cons, sets);
+    if (s >= 0) s = cm_deform_create(ctx, &dopt, n, mesh->xyz, con, mesh, &def);
+    if (s >= 0 && cli_constraints_any(&a.cons))
+        s = cli_constraints_run(ctx, cm_deform_get_mls(def), mesh, &a.cons, sets, disp, &residual);
+    else if (s >= 0)
+        s = cm_deform_apply(ctx, def, disp, &residual);
+    if (shaped) cli_constraints_free(&a.cons, sets);
+    cm_deform_stats st;
+    cm_deform_get_stats(def, &st);
+    if (s >= 0 && a.method == CM_DEFORM_MLS)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "deform mls: %zu samples (%zu surface), %zu cubature points, %zu constrained; "
+               "sample %.3f s, basis %.3f s, factor %.3f s (%zu entries), apply %.3f s; CPU s "
+               "%.3f, %.3f, %.3f, %.3f",
+               st.mls.samples, st.mls.surface_samples, st.mls.cubature, st.mls.constrained,
+               st.mls.t_sample, st.mls.t_basis, st.mls.t_factor, st.mls.factor_nonzeros,
+               st.mls.t_apply, st.mls.c_sample, st.mls.c_basis, st.mls.c_factor, st.mls.c_apply);
+    if (s >= 0 && a.method == CM_DEFORM_DMFFD)
+        cm_log(ctx, CM_LOG_DEBUG,
+               "deform dmffd-%d: %zu handles, %zu of %zu control points active, rank %zu (%zu "
+               "clamped)",
+               st.lattice, st.dmffd.handles, st.dmffd.active, st.control_points, st.dmffd.rank,
+               st.dmffd.clamped);
+    cm_deform_destroy(&def);
     double t1 = cm_wtime();
-    if (s >= 0) {
-        for (size_t i = 0; i < 3 * n; ++i)
-            mesh->xyz[i] += disp[i];
-        s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &field);
-        if (s >= 0) memcpy(field, disp, n * 3 * sizeof *field);
-    }
+    /* volume meshes get the quality; surfaces their mean curvature, below */
+    if (s >= 0)
+        s = cm_mesh_apply_displacement(ctx, mesh, disp,
+                                       CM_DISPLACEMENT_MOVE | (volume ? CM_DISPLACEMENT_QUALITY : 0),
+                                       &sj);
     double h_before[3] = {0, 0, 0}; /* min, mean, max over interior vertices */
     if (s >= 0 && !volume) {
         for (int pass = 0; pass < 2 && s >= 0; ++pass) {
@@ -230,7 +233,7 @@ int cli_cmd_deform(int argc, char **argv)
             if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
             if (s >= 0) {
                 printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                       method_names[a.method], nh, nf, n - nh - nf, t1 - t0, residual);
+                       cm_deform_method_name(a.method), nh, nf, n - nh - nf, t1 - t0, residual);
                 printf("mean_curvature (interior vertices): before min=%.6g mean=%.6g max=%.6g; "
                        "after min=%.6g mean=%.6g max=%.6g\n",
                        h_before[0], h_before[1], h_before[2], cnt ? mn : 0,
@@ -239,12 +242,10 @@ int cli_cmd_deform(int argc, char **argv)
         }
     }
     if (s >= 0 && volume) {
-        s = cm_mesh_add_field(ctx, mesh, "scaled_jacobian", CM_FIELD_CELL, 1, &sj);
-        if (s >= 0) s = cm_mesh_quality(ctx, mesh, sj);
-        if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
+        s = cm_mesh_write(ctx, mesh, a.out, NULL);
         if (s >= 0) {
             printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
-                   method_names[a.method], nh, nf, n - nh - nf, t1 - t0, residual);
+                   cm_deform_method_name(a.method), nh, nf, n - nh - nf, t1 - t0, residual);
             s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
         }
     }

@@ -136,24 +136,22 @@ int cli_cmd_ffd(int argc, char **argv)
     if (!ctx) return CLI_EXIT_INTERNAL;
     cm_mesh *mesh = NULL;
     cm_ffd *ffd = NULL;
-    double *dc = NULL, *field = NULL, *sj = NULL;
+    double *dc = NULL, *disp = NULL, *sj = NULL;
     cm_ffd_stats st;
     memset(&st, 0, sizeof st);
     cm_status s = load_lattice(ctx, &a, &ffd, &dc);
     if (s >= 0) s = cm_mesh_read(ctx, a.mesh, &mesh);
-    if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &field);
+    if (s >= 0 && !(disp = malloc(3 * (mesh->n_nodes ? mesh->n_nodes : 1) * sizeof *disp)))
+        s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
     if (s >= 0) {
         double t0 = cm_wtime();
-        s = cm_ffd_deform(ctx, ffd, dc, mesh->n_nodes, mesh->xyz, field, &st);
+        s = cm_ffd_deform(ctx, ffd, dc, mesh->n_nodes, mesh->xyz, disp, &st);
         if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
         cm_log(ctx, CM_LOG_DEBUG, "ffd: %zu nodes in %.3f s", mesh->n_nodes, cm_wtime() - t0);
     }
-    if (s >= 0) {
-        for (size_t i = 0; i < 3 * mesh->n_nodes; ++i)
-            mesh->xyz[i] += field[i];
-        s = cm_mesh_add_field(ctx, mesh, "scaled_jacobian", CM_FIELD_CELL, 1, &sj);
-    }
-    if (s >= 0) s = cm_mesh_quality(ctx, mesh, sj);
+    if (s >= 0)
+        s = cm_mesh_apply_displacement(ctx, mesh, disp, CM_DISPLACEMENT_MOVE | CM_DISPLACEMENT_QUALITY,
+                                       &sj);
     if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
     if (s >= 0) {
         printf("ffd: %zu nodes: %zu inside the lattice, %zu outside (not moved), %zu not "
@@ -162,7 +160,7 @@ int cli_cmd_ffd(int argc, char **argv)
         s = cli_print_quality(ctx, mesh, sj, stdout, NULL);
     }
     rc = s < 0 ? cli_fail(ctx, "ffd", s) : CLI_EXIT_OK;
-    free(dc);
+    free(dc), free(disp);
     cm_ffd_destroy(&ffd);
     cm_mesh_destroy(&mesh);
     cm_context_destroy(&ctx);

@@ -70,7 +70,7 @@ int cli_cmd_optimize(int argc, char **argv)
     cm_context *ctx = cli_context_create(cmd, verbose, threads);
     if (!ctx) return CLI_EXIT_INTERNAL;
     cm_mesh *mesh = NULL;
-    double *start = NULL, *disp = NULL, *sj = NULL;
+    double *start = NULL, *sj = NULL;
     cm_optimize_stats st;
     cm_status s = cm_mesh_read(ctx, in, &mesh);
     if (s >= 0) {
@@ -82,13 +82,11 @@ int cli_cmd_optimize(int argc, char **argv)
         s = cm_mesh_optimize(ctx, mesh, NULL, &opt, &st);
         if (s < 0) s = cm_error_prefix(ctx, s, "%s", in);
     }
-    if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &disp);
-    if (s >= 0) {
+    if (s >= 0) { /* the nodes have moved: start becomes their displacement */
         for (size_t i = 0; i < 3 * mesh->n_nodes; ++i)
-            disp[i] = mesh->xyz[i] - start[i];
-        s = cm_mesh_add_field(ctx, mesh, "scaled_jacobian", CM_FIELD_CELL, 1, &sj);
+            start[i] = mesh->xyz[i] - start[i];
+        s = cm_mesh_apply_displacement(ctx, mesh, start, CM_DISPLACEMENT_QUALITY, &sj);
     }
-    if (s >= 0) s = cm_mesh_quality(ctx, mesh, sj);
     if (s >= 0) s = cm_mesh_write(ctx, mesh, out, NULL);
     int rc = CLI_EXIT_OK;
     if (s >= 0) {

@@ -29,19 +29,21 @@ static cm_status result_mesh(cm_context *ctx, const cm_morpher *mp, const double
                              cm_morph_result *r)
 {
     const cm_mesh *m0 = cm_morpher_mesh(mp);
-    cm_status s = cm_mesh_copy(ctx, m0, &r->mesh);
-    double *disp = NULL, *sj = NULL;
-    if (s >= 0) s = cm_mesh_add_field(ctx, r->mesh, "scaled_jacobian", CM_FIELD_CELL, 1, &sj);
-    if (s >= 0) s = cm_mesh_add_field(ctx, r->mesh, "displacement", CM_FIELD_NODE, 3, &disp);
-    if (s < 0) return s;
     size_t nn = m0->n_nodes;
-    for (size_t i = 0; i < 3 * nn; ++i)
-        disp[i] = xyz[i] - r->mesh->xyz[i];
-    memcpy(r->mesh->xyz, xyz, 3 * nn * sizeof *xyz);
-    /* the scaled_jacobian field may have moved when the displacement field was added; it is
-     * measured again because the morpher's last trial may be a rejected adaptive step */
-    r->sj = cm_mesh_find_field(r->mesh, "scaled_jacobian", CM_FIELD_CELL)->data;
-    return cm_mesh_quality(ctx, r->mesh, r->sj);
+    cm_status s = cm_mesh_copy(ctx, m0, &r->mesh);
+    double *disp = malloc(3 * (nn ? nn : 1) * sizeof *disp);
+    if (s >= 0 && !disp) s = cm_error(ctx, CM_ERR_NOMEM, "cm_morph_run: out of memory");
+    /* the morphed mesh lists scaled_jacobian before displacement (replaced where it stands) */
+    if (s >= 0) s = cm_mesh_add_field(ctx, r->mesh, "scaled_jacobian", CM_FIELD_CELL, 1, NULL);
+    if (s >= 0) {
+        for (size_t i = 0; i < 3 * nn; ++i)
+            disp[i] = xyz[i] - r->mesh->xyz[i];
+        memcpy(r->mesh->xyz, xyz, 3 * nn * sizeof *xyz);
+        /* measured again: the morpher's last trial may be a rejected adaptive step */
+        s = cm_mesh_apply_displacement(ctx, r->mesh, disp, CM_DISPLACEMENT_QUALITY, &r->sj);
+    }
+    free(disp);
+    return s;
 }
 
 cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,

@@ -160,7 +160,7 @@ cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsig
     }
     cm_warp_destroy(&w);
     cm_mesh_boundary_destroy(&b);
-    double *field = NULL, *q = NULL;
+    double *q = NULL;
     if (s >= 0) {
         for (size_t i = 0; i < 3 * nn; ++i)
             mesh->xyz[i] += disp[i];
@@ -182,12 +182,8 @@ cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsig
         st.t_optimize = cm_wtime() - t0;
     }
     free(constrained);
-    if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "displacement", CM_FIELD_NODE, 3, &field);
-    if (s >= 0) {
-        memcpy(field, disp, 3 * nn * sizeof *disp);
-        s = cm_mesh_add_field(ctx, mesh, "scaled_jacobian", CM_FIELD_CELL, 1, &q);
-    }
-    if (s >= 0) s = cm_mesh_quality(ctx, mesh, q);
+    /* the nodes already stand where disp (with the optimisation's moves) brought them */
+    if (s >= 0) s = cm_mesh_apply_displacement(ctx, mesh, disp, CM_DISPLACEMENT_QUALITY, &q);
     if (s < 0) return s;
     if (sj) *sj = q;
     if (stats) *stats = st;

@@ -1,43 +1,33 @@
-/* The DM-FFD warp method (paper shape-deformation-benchmarks section 2.2, Fig. 13-14): one
- * cubic B-spline lattice whose valid domain is the mesh's bounding box, DM-FFD from the
- * constrained nodes (the handles), evaluated at every other node of a volume cell. The SVD is
- * done once in create; apply is C = Phi^+ H and one sparse product per node. Least squares,
- * not interpolation: the constrained nodes keep their prescribed displacement (the interface
- * contract) and the residual says how far the space deformation itself misses them. */
+/* The DM-FFD warp method [SMB14 §2.2, Fig. 13-14]: deform.h's dmffd deformation of the
+ * constrained nodes (the handles) and the other nodes of volume cells: one cubic B-spline
+ * lattice whose valid domain is their bounding box. The SVD is done once in create; apply is
+ * C = Phi^+ H and one sparse product per node. Least squares, not interpolation: the
+ * constrained nodes keep their prescribed displacement (the interface contract) and the
+ * residual says how far the space deformation itself misses them. */
 #include "warp_method.h"
 
 #include "cadmorph/deform.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* Margin around the bounding box, relative to its diagonal: the boundary nodes then lie
- * strictly inside the domain (not on its faces) and the lattice still hugs the mesh. */
-#define DMFFD_MARGIN 1e-3
-
+/* The deformation's points are the constrained nodes (ascending), then the free nodes of
+ * volume cells (ascending): the same arrays, in the same order, as the lattice always saw. */
 typedef struct dmffd_warp {
-    cm_ffd *ffd;
-    cm_dmffd *dm;
+    cm_deform *def;
     size_t n_fixed, n_free;
     int64_t *fixed, *free_nodes;
-    double *free_xyz, *fixed_xyz;
-    double *h, *dc, *out;
+    double *pts; /* apply's scratch: (n_fixed + n_free) x 3 displacements */
 } dmffd_warp;
 
 static void dmffd_destroy(void *state)
 {
     dmffd_warp *w = state;
     if (!w) return;
-    cm_dmffd_destroy(&w->dm);
-    cm_ffd_destroy(&w->ffd);
+    cm_deform_destroy(&w->def);
     free(w->fixed);
     free(w->free_nodes);
-    free(w->free_xyz);
-    free(w->fixed_xyz);
-    free(w->h);
-    free(w->dc);
-    free(w->out);
+    free(w->pts);
     free(w);
 }
 
@@ -73,36 +63,31 @@ static cm_status dmffd_create(cm_context *ctx, const cm_mesh *mesh, const cm_mes
                         "cm_warp_create: dmffd lattice of %d control points per axis (4..200)", n);
     size_t nn = mesh->n_nodes;
     dmffd_warp *w = calloc(1, sizeof *w);
-    unsigned char *in_volume = calloc(nn ? nn : 1, 1);
+    unsigned char *in_volume = calloc(nn ? nn : 1, 1), *con = NULL;
+    double *xyz = NULL;
     cm_status s = CM_OK;
     if (!w || !in_volume) {
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
         goto fail;
     }
     mark_volume_nodes(mesh, in_volume);
-    double bb[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (size_t v = 0; v < nn; ++v) {
         if (constrained[v])
             ++w->n_fixed;
         else if (in_volume[v])
             ++w->n_free;
-        if (!constrained[v] && !in_volume[v]) continue;
-        for (int a = 0; a < 3; ++a) {
-            bb[a] = fmin(bb[a], mesh->xyz[3 * v + a]);
-            bb[a + 3] = fmax(bb[a + 3], mesh->xyz[3 * v + a]);
-        }
     }
     if (w->n_fixed == 0) {
         s = cm_error(ctx, CM_ERR_NUMERIC, "cm_warp_create: dmffd: no constrained node");
         goto fail;
     }
+    size_t np = w->n_fixed + w->n_free;
     w->fixed = malloc(w->n_fixed * sizeof *w->fixed);
-    w->fixed_xyz = malloc(w->n_fixed * 3 * sizeof *w->fixed_xyz);
-    w->h = malloc(w->n_fixed * 3 * sizeof *w->h);
     w->free_nodes = malloc((w->n_free ? w->n_free : 1) * sizeof *w->free_nodes);
-    w->free_xyz = malloc((w->n_free ? w->n_free : 1) * 3 * sizeof *w->free_xyz);
-    w->out = malloc((w->n_free ? w->n_free : 1) * 3 * sizeof *w->out);
-    if (!w->fixed || !w->fixed_xyz || !w->h || !w->free_nodes || !w->free_xyz || !w->out) {
+    w->pts = malloc(np * 3 * sizeof *w->pts);
+    xyz = malloc(np * 3 * sizeof *xyz);
+    con = calloc(np, 1);
+    if (!w->fixed || !w->free_nodes || !w->pts || !xyz || !con) {
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
         goto fail;
     }
@@ -110,10 +95,11 @@ static cm_status dmffd_create(cm_context *ctx, const cm_mesh *mesh, const cm_mes
     for (size_t v = 0; v < nn; ++v) {
         if (constrained[v]) {
             w->fixed[kf] = (int64_t)v;
-            memcpy(w->fixed_xyz + 3 * kf++, mesh->xyz + 3 * v, 3 * sizeof(double));
+            con[kf] = 1;
+            memcpy(xyz + 3 * kf++, mesh->xyz + 3 * v, 3 * sizeof(double));
         } else if (in_volume[v]) {
             w->free_nodes[ku] = (int64_t)v;
-            memcpy(w->free_xyz + 3 * ku++, mesh->xyz + 3 * v, 3 * sizeof(double));
+            memcpy(xyz + 3 * (w->n_fixed + ku++), mesh->xyz + 3 * v, 3 * sizeof(double));
         } else {
             ++stray;
         }
@@ -123,35 +109,28 @@ static cm_status dmffd_create(cm_context *ctx, const cm_mesh *mesh, const cm_mes
                "cm_warp_create: %zu unconstrained nodes belong to no volume cell; they are left "
                "where they are",
                stray);
-    cm_ffd_desc desc;
-    cm_ffd_desc_enclosing(&desc, bb, DMFFD_MARGIN, n);
-    s = cm_ffd_create(ctx, &desc, &w->ffd);
-    if (s < 0) goto fail;
-    w->dc = malloc(cm_ffd_control_count(w->ffd) * 3 * sizeof *w->dc);
-    if (!w->dc) {
-        s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-        goto fail;
-    }
-    cm_dmffd_options dopt;
-    cm_dmffd_options_init(&dopt);
-    if (opt->clamp > 0) dopt.eps = opt->clamp;
-    s = cm_dmffd_create(ctx, w->ffd, w->n_fixed, w->fixed_xyz, &dopt, &w->dm);
+    cm_deform_options dopt;
+    cm_deform_options_init(&dopt);
+    dopt.method = CM_DEFORM_DMFFD;
+    dopt.lattice = n;
+    dopt.clamp = opt->clamp;
+    s = cm_deform_create(ctx, &dopt, np, xyz, con, NULL, &w->def);
     if (s < 0) {
         s = cm_error_prefix(ctx, s, "cm_warp_create: dmffd-%d", n);
         goto fail;
     }
-    cm_dmffd_info info;
-    cm_dmffd_get_info(w->dm, &info);
+    cm_deform_stats st;
+    cm_deform_get_stats(w->def, &st);
     cm_log(ctx, CM_LOG_DEBUG,
            "dmffd-%d: %zu handles, %zu of %zu control points active, rank %zu (%zu clamped), "
            "sigma %.3g .. %.3g",
-           n, info.handles, info.active, cm_ffd_control_count(w->ffd), info.rank, info.clamped,
-           info.sigma_max, info.sigma_min);
-    free(in_volume);
+           n, st.dmffd.handles, st.dmffd.active, st.control_points, st.dmffd.rank,
+           st.dmffd.clamped, st.dmffd.sigma_max, st.dmffd.sigma_min);
+    free(in_volume), free(con), free(xyz);
     *state = w;
     return CM_OK;
 fail:
-    free(in_volume);
+    free(in_volume), free(con), free(xyz);
     dmffd_destroy(w);
     return s;
 }
@@ -160,15 +139,11 @@ static cm_status dmffd_apply(cm_context *ctx, void *state, double *disp, double 
 {
     dmffd_warp *w = state;
     for (size_t i = 0; i < w->n_fixed; ++i)
-        memcpy(w->h + 3 * i, disp + 3 * w->fixed[i], 3 * sizeof(double));
-    cm_status s = cm_dmffd_solve(ctx, w->dm, w->h, w->dc);
-    if (s >= 0) s = cm_ffd_deform(ctx, w->ffd, w->dc, w->n_free, w->free_xyz, w->out, NULL);
+        memcpy(w->pts + 3 * i, disp + 3 * w->fixed[i], 3 * sizeof(double));
+    cm_status s = cm_deform_apply(ctx, w->def, w->pts, residual);
     if (s < 0) return cm_error_prefix(ctx, s, "cm_warp_apply: dmffd");
     for (size_t i = 0; i < w->n_free; ++i)
-        memcpy(disp + 3 * w->free_nodes[i], w->out + 3 * i, 3 * sizeof(double));
-    cm_dmffd_info info;
-    cm_dmffd_get_info(w->dm, &info);
-    *residual = info.residual_abs;
+        memcpy(disp + 3 * w->free_nodes[i], w->pts + 3 * (w->n_fixed + i), 3 * sizeof(double));
     return CM_OK;
 }
 

@@ -1,10 +1,10 @@
-/* The MLS warp method (deform/, mls.h): one constrained MLS space deformation over the whole
- * mesh, every component at once, with the options of cm_warp_options.mls. Approximate: the
- * constrained nodes keep their prescribed displacement and the apply reports how far the
- * field missed them. */
+/* The MLS warp method: deform.h's mls deformation, one constrained MLS space deformation
+ * (mls.h) over the whole mesh, every component at once, with the options of
+ * cm_warp_options.mls. Approximate: the constrained nodes keep their prescribed displacement
+ * and the apply reports how far the field missed them. */
 #include "warp_method.h"
 
-#include "cadmorph/mls.h"
+#include "cadmorph/deform.h"
 
 #include <stdlib.h>
 
@@ -13,34 +13,38 @@ static cm_status mls_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
                             void **state)
 {
     (void)b;
-    cm_mls_options o = opt->mls;
+    cm_deform_options o;
+    cm_deform_options_init(&o);
+    o.method = CM_DEFORM_MLS;
     /* the defaults (gamma_f = 1000): on the pipe hex a stiffer penalty (1e4 ... 1e7) meets the
      * boundary closer but leaves a worse first cell layer (benchmarks/RESULTS.md) */
-    cm_mls *m = NULL;
-    cm_status s = cm_mls_create(ctx, mesh, constrained, &o, &m);
+    o.mls = opt->mls;
+    cm_deform *d = NULL;
+    cm_status s = cm_deform_create(ctx, &o, mesh->n_nodes, mesh->xyz, constrained, mesh, &d);
     if (s < 0) return cm_error_prefix(ctx, s, "cm_warp_create");
-    *state = m;
+    *state = d;
     return s;
 }
 
 static cm_status mls_apply(cm_context *ctx, void *state, double *disp, double *residual)
 {
-    cm_status s = cm_mls_apply(ctx, state, disp, residual);
+    cm_status s = cm_deform_apply(ctx, state, disp, residual);
     if (s < 0) return cm_error_prefix(ctx, s, "cm_warp_apply");
-    cm_mls_stats st;
-    cm_mls_get_stats(state, &st);
+    cm_deform_stats d;
+    cm_deform_get_stats(state, &d);
+    const cm_mls_stats *st = &d.mls;
     cm_log(ctx, CM_LOG_DEBUG,
            "warp mls: %zu samples, %zu cubature points, %zu constrained nodes, %zu blended; "
            "residual %.3g; sample %.3f s, basis %.3f s, factor %.3f s, apply %.3f s",
-           st.samples, st.cubature, st.constrained, st.blend_nodes, *residual, st.t_sample,
-           st.t_basis, st.t_factor, st.t_apply);
+           st->samples, st->cubature, st->constrained, st->blend_nodes, *residual, st->t_sample,
+           st->t_basis, st->t_factor, st->t_apply);
     return s;
 }
 
 static void mls_destroy(void *state)
 {
-    cm_mls *m = state;
-    cm_mls_destroy(&m);
+    cm_deform *d = state;
+    cm_deform_destroy(&d);
 }
 
 const cm_warp_method_ops cm_warp_mls = {"mls", mls_create, mls_apply, mls_destroy, NULL};

@@ -1,28 +1,30 @@
-/* The RBF warp methods (paper section 3): one polyharmonic RBF per connected component of
- * volume cells, centred at the component's constrained nodes, carries their displacement
- * inside. Exact at the centres, so the residual is 0. */
+/* The RBF warp methods [SMB12 §3]: one polyharmonic RBF per connected component of volume
+ * cells, centred at the component's constrained nodes, carries their displacement inside: per
+ * component, deform.h's rbf deformation of its constrained and free nodes. Exact at the
+ * centres, so the residual is 0. */
 #include "warp_method.h"
+
+#include "cadmorph/deform.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-/* One component: the RBF is centred at `fixed`; `free_nodes` receive its values. */
+/* One component: the RBF is centred at `fixed`; `free_nodes` receive its values. The
+ * deformation's points are the fixed nodes, then the free ones. */
 typedef struct warp_component {
-    cm_rbf *rbf; /* NULL when every node of the component is constrained */
+    cm_deform *def; /* NULL when every node of the component is constrained */
     size_t n_fixed;
     int64_t *fixed; /* constrained nodes of the component, ascending */
     size_t n_free;
     int64_t *free_nodes; /* unconstrained nodes owned by the component, ascending */
-    double *free_xyz;    /* n_free x 3, copied: the mesh is only borrowed by create */
 } warp_component;
 
 typedef struct rbf_warp {
     size_t n_nodes;
     size_t n_components;
     warp_component *comp;
-    double *values; /* scratch: max n_fixed x 3 */
-    double *out;    /* scratch: max n_free x 3 */
+    double *values; /* scratch: max (n_fixed + n_free) x 3, one component's points */
 } rbf_warp;
 
 static void rbf_destroy(void *state)
@@ -30,14 +32,12 @@ static void rbf_destroy(void *state)
     rbf_warp *w = state;
     if (!w) return;
     for (size_t k = 0; w->comp && k < w->n_components; ++k) {
-        cm_rbf_destroy(&w->comp[k].rbf);
+        cm_deform_destroy(&w->comp[k].def);
         free(w->comp[k].fixed);
         free(w->comp[k].free_nodes);
-        free(w->comp[k].free_xyz);
     }
     free(w->comp);
     free(w->values);
-    free(w->out);
     free(w);
 }
 
@@ -81,8 +81,8 @@ static int cmp_i64(const void *a, const void *b)
  * owner: #nodes, the component that evaluates an unconstrained node (-1: none yet); a free
  * node shared by two components (only possible with a caller's mask that leaves a boundary
  * node free) goes to the first one, so that every node has exactly one displacement. */
-static cm_status split_component(cm_context *ctx, const cm_mesh *mesh,
-                                 const unsigned char *constrained, int k, const int64_t *list,
+static cm_status split_component(cm_context *ctx, const unsigned char *constrained, int k,
+                                 const int64_t *list,
                                  size_t n, int *owner, warp_component *wc, size_t *n_shared_free)
 {
     size_t nf = 0, nu = 0;
@@ -96,8 +96,7 @@ static cm_status split_component(cm_context *ctx, const cm_mesh *mesh,
     }
     wc->fixed = malloc((nf ? nf : 1) * sizeof *wc->fixed);
     wc->free_nodes = malloc((nu ? nu : 1) * sizeof *wc->free_nodes);
-    wc->free_xyz = malloc((nu ? nu : 1) * 3 * sizeof *wc->free_xyz);
-    if (!wc->fixed || !wc->free_nodes || !wc->free_xyz)
+    if (!wc->fixed || !wc->free_nodes)
         return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
     for (size_t i = 0; i < n; ++i) {
         int64_t v = list[i];
@@ -105,7 +104,6 @@ static cm_status split_component(cm_context *ctx, const cm_mesh *mesh,
             wc->fixed[wc->n_fixed++] = v;
         } else if (owner[v] < 0) {
             owner[v] = k;
-            memcpy(wc->free_xyz + 3 * wc->n_free, mesh->xyz + 3 * v, 3 * sizeof(double));
             wc->free_nodes[wc->n_free++] = v;
         }
     }
@@ -123,16 +121,27 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
         return cm_error(ctx, CM_ERR_NUMERIC,
                         "cm_warp_create: component %zu: no constrained node, %zu free nodes", k,
                         wc->n_free);
-    double *centres = malloc(wc->n_fixed * 3 * sizeof *centres);
-    if (!centres) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
-    for (size_t i = 0; i < wc->n_fixed; ++i)
-        memcpy(centres + 3 * i, mesh->xyz + 3 * wc->fixed[i], 3 * sizeof(double));
-    cm_rbf_options ro;
-    cm_rbf_options_init(&ro);
-    ro.solver = solver;
-    if (tolerance > 0) ro.tolerance = tolerance;
-    cm_status s = cm_rbf_create_opt(ctx, kernel, 3, wc->n_fixed, centres, &ro, &wc->rbf);
-    free(centres);
+    size_t np = wc->n_fixed + wc->n_free;
+    double *xyz = malloc(np * 3 * sizeof *xyz);
+    unsigned char *con = calloc(np, 1);
+    if (!xyz || !con) {
+        free(xyz), free(con);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+    }
+    for (size_t i = 0; i < wc->n_fixed; ++i) {
+        memcpy(xyz + 3 * i, mesh->xyz + 3 * wc->fixed[i], 3 * sizeof(double));
+        con[i] = 1;
+    }
+    for (size_t i = 0; i < wc->n_free; ++i)
+        memcpy(xyz + 3 * (wc->n_fixed + i), mesh->xyz + 3 * wc->free_nodes[i], 3 * sizeof(double));
+    cm_deform_options o;
+    cm_deform_options_init(&o);
+    o.method = CM_DEFORM_RBF;
+    o.kernel = kernel;
+    o.solver = solver;
+    o.tolerance = tolerance;
+    cm_status s = cm_deform_create(ctx, &o, np, xyz, con, NULL, &wc->def);
+    free(xyz), free(con);
     if (s < 0)
         return cm_error_prefix(ctx, s, "cm_warp_create: component %zu (%zu constrained nodes)", k,
                                wc->n_fixed);
@@ -184,7 +193,7 @@ static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm
             visit_cell(mesh, cells[i], &vis);
         /* ascending order: the centres, hence the result, do not depend on cell order */
         qsort(list, vis.n, sizeof *list, cmp_i64);
-        s = split_component(ctx, mesh, constrained, (int)k, list, vis.n, owner, &w->comp[k],
+        s = split_component(ctx, constrained, (int)k, list, vis.n, owner, &w->comp[k],
                             n_shared_free);
         if (s < 0) goto done;
         s = fit_component(ctx, mesh, kernel, solver, tolerance, k, &w->comp[k]);
@@ -236,14 +245,12 @@ static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
                "follows the first",
                n_shared_free);
 
-    size_t max_fixed = 1, max_free = 1;
-    for (size_t k = 0; k < w->n_components; ++k) {
-        if (w->comp[k].n_fixed > max_fixed) max_fixed = w->comp[k].n_fixed;
-        if (w->comp[k].n_free > max_free) max_free = w->comp[k].n_free;
-    }
-    w->values = malloc(max_fixed * 3 * sizeof *w->values);
-    w->out = malloc(max_free * 3 * sizeof *w->out);
-    if (!w->values || !w->out) {
+    size_t max_points = 1;
+    for (size_t k = 0; k < w->n_components; ++k)
+        if (w->comp[k].n_fixed + w->comp[k].n_free > max_points)
+            max_points = w->comp[k].n_fixed + w->comp[k].n_free;
+    w->values = malloc(max_points * 3 * sizeof *w->values);
+    if (!w->values) {
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
         goto fail;
     }
@@ -260,26 +267,25 @@ static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *r
     *residual = 0;
     for (size_t k = 0; k < warp->n_components; ++k) {
         warp_component *wc = &warp->comp[k];
-        if (!wc->rbf) continue;
+        if (!wc->def) continue;
         for (size_t i = 0; i < wc->n_fixed; ++i)
             memcpy(warp->values + 3 * i, disp + 3 * wc->fixed[i], 3 * sizeof(double));
-        double t0 = cm_wtime();
-        cm_status s = cm_rbf_solve(ctx, wc->rbf, 3, warp->values);
-        double t1 = cm_wtime();
-        if (s >= 0) s = cm_rbf_evaluate(ctx, wc->rbf, wc->n_free, wc->free_xyz, warp->out);
+        double r = 0;
+        cm_status s = cm_deform_apply(ctx, wc->def, warp->values, &r);
         if (s < 0) return cm_error_prefix(ctx, s, "cm_warp_apply: component %zu", k);
         /* the split that says where a large warp's time goes: an iterative fit's solve (its
          * Krylov matvecs, m^2 kernel pairs each) or the evaluation (n_free x m pairs) */
-        cm_rbf_stats st;
-        cm_rbf_get_stats(wc->rbf, &st);
+        cm_deform_stats st;
+        cm_deform_get_stats(wc->def, &st);
         cm_log(ctx, CM_LOG_DEBUG,
                "cm_warp_apply: component %zu: %zu centres, solve %.3f s (%s, %d iterations), "
                "evaluation at %zu nodes %.3f s",
-               k, wc->n_fixed, t1 - t0,
-               st.solver == CM_RBF_SOLVER_DENSE ? "dense" : "iterative", st.iterations, wc->n_free,
-               cm_wtime() - t1);
+               k, wc->n_fixed, st.t_solve,
+               st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" : "iterative", st.rbf.iterations,
+               wc->n_free, st.t_evaluate);
+        const double *out = warp->values + 3 * wc->n_fixed;
         for (size_t i = 0; i < wc->n_free; ++i)
-            memcpy(disp + 3 * wc->free_nodes[i], warp->out + 3 * i, 3 * sizeof(double));
+            memcpy(disp + 3 * wc->free_nodes[i], out + 3 * i, 3 * sizeof(double));
         cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components);
     }
     return CM_OK;

@@ -1,9 +1,10 @@
 /* cadmorph deform: space deformations driven by control points or constrained points.
- * FFD (free-form deformation) on a tensor-product lattice, uniform cubic B-splines (the
- * paper shape-deformation-benchmarks-ffd-dmffd-rbf, section 2.1) or Bernstein polynomials
- * of degree n-1 (PyGeM's FFD); DM-FFD (direct manipulation, section 2.2): the control
- * displacements that carry given points to given targets in the least-norm / least-squares
- * sense, through an SVD pseudo-inverse with clamped singular values. Conventions: core.h.
+ * FFD (free-form deformation) on a tensor-product lattice, uniform cubic B-splines
+ * [SMB14 §2.1] or Bernstein polynomials of degree n-1 (PyGeM's FFD); DM-FFD (direct
+ * manipulation [SMB14 §2.2]): the control displacements that carry given points to given
+ * targets in the least-norm / least-squares sense, through an SVD pseudo-inverse with clamped
+ * singular values; and one table of the point-set deformations behind `cadmorph deform` and
+ * the volume warp (RBF, constrained MLS, shell, DM-FFD). Conventions: core.h.
  *
  * The lattice maps local coordinates u in [0,1]^3 (the valid domain) to space. Its reference
  * (undeformed) form is a parallelepiped x = origin + A u, A = [a0 a1 a2] (columns); control
@@ -24,6 +25,8 @@
 #define CADMORPH_DEFORM_H
 
 #include "cadmorph/core.h"
+#include "cadmorph/mls.h"
+#include "cadmorph/rbf.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -182,22 +185,96 @@ CM_API void cm_ffd_prm_desc(const cm_ffd_prm *prm, cm_ffd_basis basis, cm_ffd_de
 CM_API cm_status cm_ffd_read_displacements(cm_context *ctx, const char *path, const int n[3],
                                     double *dc, unsigned char *listed);
 
-/* ---- the RBF space deformation (handles) ----
- * disp: n x 3; read at the constrained points (constrained: n flags), written at the others
- * by one triharmonic RBF (r^3 + linear, rbf.h) through the constrained points xyz (n x 3).
- * Needs no cells: surface and volume meshes alike. Errors: the RBF's (coplanar constrained
- * points are CM_ERR_NUMERIC). */
-CM_API cm_status cm_deform_rbf(cm_context *ctx, size_t n, const double *xyz,
-                               const unsigned char *constrained, double *disp);
+/* ---- one table of point-set deformations (the handle metaphor) ----
+ * A deformation carries the prescribed displacements of some points (the constrained ones: a
+ * handle region H and a fixed region F, or a mesh's boundary) to the other points. Every
+ * method has the life cycle of the warp interface (docs/DESIGN.md, "The warp interface"):
+ * create does what depends only on the points and on which of them are constrained (the
+ * factorisation, the SVD, the sampling), apply maps prescribed displacements to the free points,
+ * any number of times on one deformation. `cadmorph deform` and the volume warp's rbf, dmffd
+ * and mls methods (warp.h) go through this table. */
 
-/* The DM-FFD space deformation (handles): a cubic B-spline lattice of lattice^3 control
- * points (4..200) enclosing all n points, DM-FFD through the constrained points with singular
- * values <= clamp x sigma_max clamped (clamp <= 0: the default 1e-10), written at the others.
- * The constrained points keep their disp; *residual (may be NULL): the lattice's max miss of
- * them, |Phi C - H|_inf. Needs no cells. */
-CM_API cm_status cm_deform_dmffd(cm_context *ctx, size_t n, const double *xyz,
-                                 const unsigned char *constrained, int lattice, double clamp,
-                                 double *disp, double *residual);
+typedef enum cm_deform_method {
+    CM_DEFORM_RBF = 0,   /* "rbf": one polyharmonic RBF (rbf.h) through the constrained points,
+                            exact (residual 0); needs no cells */
+    CM_DEFORM_MLS = 1,   /* "mls": the constrained MLS space deformation (mls.h) over the cells
+                            of a mesh, approximate [CMLS §4-5] */
+    CM_DEFORM_SHELL = 2, /* "shell": the mesh-based shell of a surface mesh (cm_mls_shell), the
+                            MLS subspace's ground truth [CMLS §3]; solved anew by every apply */
+    CM_DEFORM_DMFFD = 3, /* "dmffd": DM-FFD on a cubic B-spline lattice enclosing the points,
+                            least squares [SMB14 §2.2]; needs no cells */
+    CM_DEFORM_N_METHODS
+} cm_deform_method;
+
+/* Short name of a method ("rbf", "mls", "shell", "dmffd"), NULL out of range. */
+CM_API const char *cm_deform_method_name(cm_deform_method method);
+/* The method of a name, or -1 if unknown. */
+CM_API int cm_deform_method_from_name(const char *name);
+
+typedef struct cm_deform_options {
+    cm_deform_method method; /* default CM_DEFORM_RBF */
+    /* rbf: the kernel (CM_RBF_TRIHARMONIC, the default, or CM_RBF_BIHARMONIC), the solver
+     * (rbf.h; default CM_RBF_SOLVER_AUTO) and the iterative solver's tolerance (0: the RBF's
+     * default) */
+    cm_rbf_kernel kernel;
+    cm_rbf_solver solver;
+    double tolerance;
+    /* dmffd: control points per axis (4..200; 0 = 10) of the lattice whose domain is the
+     * points' bounding box grown by 1e-3 of its diagonal; singular values <= clamp x sigma_max
+     * are truncated (0 = 1e-10) */
+    int lattice;
+    double clamp;
+    /* mls: all of them (cm_mls_options_init's defaults); shell: stretch, bend and fix weigh
+     * its energies */
+    cm_mls_options mls;
+} cm_deform_options;
+
+CM_API void cm_deform_options_init(cm_deform_options *opt);
+
+typedef struct cm_deform cm_deform;
+
+/* n points xyz (n x 3). constrained: n entries, 0 for a free point, else the point's
+ * constraint group (1..255; the MLS weighs groups apart, e.g. F = 1 and H = 2; the other
+ * methods only ask non-zero). rbf and dmffd need only the points (mesh may be NULL; the
+ * arrays are copied). mls and shell need the mesh whose nodes the points are (n =
+ * mesh->n_nodes; xyz is not read and may be NULL); shell needs its 2D cells and borrows mesh
+ * until destroy. opt NULL: the defaults. Errors: the method's (coplanar constrained points
+ * are the RBF's CM_ERR_NUMERIC), without a prefix: the caller knows what it was doing;
+ * CM_ERR_ARGUMENT for a dmffd lattice outside 4..200 or without a constrained point, or mls
+ * and shell without a mesh. */
+CM_API cm_status cm_deform_create(cm_context *ctx, const cm_deform_options *opt, size_t n,
+                                  const double *xyz, const unsigned char *constrained,
+                                  const cm_mesh *mesh, cm_deform **def);
+CM_API void cm_deform_destroy(cm_deform **def);
+
+/* disp: n x 3, read at the constrained points. rbf and dmffd write the free points and leave
+ * the constrained ones as they are (dmffd: least squares, so its field misses them by the
+ * residual); mls writes every point (the constrained ones as options.mls.keep_constrained
+ * says), shell every point. residual (may be NULL): the largest miss at the constrained points
+ * (rbf: 0, exact; dmffd: |Phi C - H|_inf; mls: cm_mls_apply's; shell: not measured, 0).
+ * A CM_WARNING of the method (dmffd: points Newton could not locate) is returned after the
+ * work is done. Not concurrently on one deformation. */
+CM_API cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double *residual);
+
+typedef struct cm_deform_stats {
+    cm_deform_method method;
+    size_t constrained, free;   /* the points, split */
+    double residual;            /* the last apply's */
+    double t_solve, t_evaluate; /* the last apply, seconds: the fit to the constrained values
+                                   (rbf: cm_rbf_solve; dmffd: C = Phi^+ H) and the evaluation
+                                   at the free points; mls and shell: all of it in t_solve */
+    cm_rbf_stats rbf;           /* rbf: cm_rbf_get_stats (zero for the others) */
+    cm_dmffd_info dmffd;        /* dmffd: cm_dmffd_get_info */
+    int lattice;                /* dmffd: control points per axis */
+    size_t control_points;      /* dmffd: of the lattice */
+    cm_mls_stats mls;           /* mls: cm_mls_get_stats */
+} cm_deform_stats;
+
+CM_API void cm_deform_get_stats(const cm_deform *def, cm_deform_stats *stats);
+
+/* The MLS behind an mls deformation (NULL for the other methods), for work on its factor
+ * beyond apply: shape constraints (shapeup.h). */
+CM_API cm_mls *cm_deform_get_mls(cm_deform *def);
 
 #ifdef __cplusplus
 }

@@ -330,6 +330,24 @@ typedef struct cm_foam_quality {
 
 CM_API cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_quality *q);
 
+/* ---- a moved mesh and its record ---- */
+
+typedef enum cm_displacement_flags {
+    CM_DISPLACEMENT_MOVE = 1,   /* add disp to mesh->xyz; without it the nodes already stand
+                                   where disp brought them */
+    CM_DISPLACEMENT_QUALITY = 2 /* then add the per-cell "scaled_jacobian" field: the quality
+                                   of the moved mesh (cm_mesh_quality) */
+} cm_displacement_flags;
+
+/* What every program that moves a mesh writes with it: moves the nodes by disp (#nodes x 3)
+ * when flags has CM_DISPLACEMENT_MOVE, stores disp as the per-node "displacement" field and,
+ * with CM_DISPLACEMENT_QUALITY, adds the "scaled_jacobian" field after it (fields the mesh
+ * already has are replaced where they stand, so the order of the fields is kept; disp must
+ * not be the data of the mesh's own "displacement" field). sj (may be NULL): the quality
+ * field's data, NULL without CM_DISPLACEMENT_QUALITY. */
+CM_API cm_status cm_mesh_apply_displacement(cm_context *ctx, cm_mesh *mesh, const double *disp,
+                                            unsigned flags, double **sj);
+
 #ifdef __cplusplus
 }
 #endif

@@ -9,7 +9,8 @@
  *                     calls on one warp share the factorisation (absolute studies);
  *   cm_warp_destroy.
  * A relative step creates a new warp on the moved mesh. Adding a method is one file in
- * volume/ (or a space deformation in deform/) and one row in volume/warp.c's table.
+ * volume/ and one row in volume/warp.c's table; a space deformation is a row of deform.h's
+ * table, and its warp row (warp_rbf.c, warp_dmffd.c, warp_mls.c) chooses the points.
  */
 #ifndef CADMORPH_WARP_H
 #define CADMORPH_WARP_H
