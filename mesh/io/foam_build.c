@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Faces of more nodes are refused for a polyMesh (the boundary extraction allows up to
+ * CM_TOPOLOGY_MAX_FACE_NODES). */
 enum { MAX_FACE = 256 };
 
 typedef struct order_rec {
