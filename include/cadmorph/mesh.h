@@ -224,7 +224,7 @@ typedef enum cm_mesh_format {
 
 CM_API cm_mesh_format cm_mesh_format_from_path(const char *path);
 /* The extensions cm_mesh_read and cm_mesh_write know, for messages:
- * ".msh .vtu .vtk .mesh, or an OpenFOAM case directory". */
+ * ".msh .vtu .vtk .mesh .obj .off .stl, or an OpenFOAM case directory". */
 CM_API const char *cm_mesh_format_list(void);
 
 typedef struct cm_mesh_write_options {

@@ -1,81 +1,21 @@
 /* Face addressing of any mesh's volume cells, as OpenFOAM wants it: each face once, oriented
  * out of its owner (the lower cell index), internal faces in upper-triangular order (by owner,
  * then neighbour), boundary faces grouped into patches by the physical group of the 2D cells
- * lying on them. Used to write a non-OpenFOAM mesh as a polyMesh and for checkMesh's metrics. */
+ * lying on them. Used to write a non-OpenFOAM mesh as a polyMesh and for checkMesh's metrics.
+ * The faces are matched by the topology builder (topology.h); this file only orders them. */
 #define _POSIX_C_SOURCE 200809L
 #include "foam_internal.h"
 
-#include "../cell_faces.h"
+#include "cell_faces.h"
+#include "topology.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+/* Faces of more nodes are refused for a polyMesh (the boundary extraction allows up to
+ * CM_TOPOLOGY_MAX_FACE_NODES). */
 enum { MAX_FACE = 256 };
-
-typedef struct face_rec {
-    int64_t owner, nei; /* cell indices among volume cells; nei -1 on the boundary */
-    int64_t off;        /* into the node pool */
-    int n;
-    int patch;          /* boundary: index into the patch list */
-} face_rec;
-
-typedef struct builder {
-    face_rec *f;
-    size_t nf, capf;
-    int64_t *pool;      /* face nodes as the owner sees them (outward) */
-    size_t npool, cappool;
-    int64_t *sorted;    /* the same nodes sorted: the key */
-    size_t *slot;       /* open-addressing table of face indices + 1 */
-    size_t cap_slot;
-} builder;
-
-static uint64_t key_hash(const int64_t *k, int n)
-{
-    uint64_t h = 1469598103934665603ull;
-    for (int i = 0; i < n; ++i) {
-        h ^= (uint64_t)k[i];
-        h *= 1099511628211ull;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
-static int cmp_i64(const void *a, const void *b)
-{
-    int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
-    return x < y ? -1 : x > y;
-}
-
-/* Finds the face with these sorted nodes; returns its index or -1. *where: the free slot. */
-static int64_t lookup(const builder *b, const int64_t *key, int n, size_t *where)
-{
-    size_t i = (size_t)(key_hash(key, n) & (b->cap_slot - 1));
-    for (;;) {
-        size_t s = b->slot[i];
-        if (!s) {
-            *where = i;
-            return -1;
-        }
-        const face_rec *r = &b->f[s - 1];
-        if (r->n == n && !memcmp(b->sorted + r->off, key, (size_t)n * sizeof *key)) return (int64_t)(s - 1);
-        i = (i + 1) & (b->cap_slot - 1);
-    }
-}
-
-static int grow_pool(builder *b, size_t extra)
-{
-    if (b->npool + extra <= b->cappool) return 1;
-    size_t nc = 2 * b->cappool + extra;
-    int64_t *p = realloc(b->pool, nc * sizeof *p);
-    if (!p) return 0;
-    b->pool = p;
-    int64_t *q = realloc(b->sorted, nc * sizeof *q);
-    if (!q) return 0;
-    b->sorted = q;
-    b->cappool = nc;
-    return 1;
-}
 
 typedef struct order_rec {
     int64_t a, b;
@@ -134,74 +74,74 @@ static int unique_names(cm_foam_patch *pt, size_t n)
     return 1;
 }
 
+/* The faults of the face matching, reported as the polyMesh writer always has: in instance
+ * order (cell order, then local face), the first face of three cells or the first face with
+ * too few or too many nodes, whichever comes first. Two faults only this writer meets through
+ * the shared builder: a node out of range (unchecked here before: such a mesh gave a polyMesh
+ * with labels past its points), and more than 2^31-1 nodes, cells or faces (the builder's
+ * 32-bit indices; far beyond what fits in memory here anyway). */
+static cm_status topology_fault(cm_context *ctx, const cm_topology *t, const cm_topology_problem *why)
+{
+    const int64_t third = cm_topology_first_overshared(t);
+    if (third >= 0)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "cm_mesh_write: cell %zu: a face shared by three or more cells cannot be written as a polyMesh",
+                        (size_t)t->inst_cell[third]);
+    switch (why->what) {
+    case CM_TOPOLOGY_BAD_FACE:
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: cell %zu: face %d has %s nodes for a polyMesh", why->cell,
+                        why->face, why->n < 0 ? "too many" : "fewer than 3");
+    case CM_TOPOLOGY_BAD_NODE:
+        return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_write: cell %zu: node %lld out of range (%zu nodes)", why->cell,
+                        (long long)why->node, why->n_nodes);
+    case CM_TOPOLOGY_TOO_LARGE:
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: %zu nodes, %zu cells, %zu faces: more than 2^31-1",
+                        why->n_nodes, why->n_cells, why->n_inst);
+    default: return CM_OK;
+    }
+}
+
 cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out)
 {
     *out = NULL;
-    builder b = {0};
+    cm_topology t = {0};
     cm_foam_poly *p = cm_foam_poly_new();
-    int64_t *cell_of = NULL;
+    int64_t *cell_of = NULL; /* mesh cell -> index among the volume cells */
+    int *patch = NULL;       /* per face: index into the patch list (boundary), -1 */
     int *tags = NULL;
     order_rec *ord = NULL;
     size_t ntags = 0;
     cm_status s = CM_OK;
-    size_t total = 0;
     int64_t nvol = 0;
     if (!p) goto nomem;
     for (size_t c = 0; c < mesh->n_cells; ++c)
-        if (cm_cell_type_info((cm_cell_type)mesh->type[c])->dim == 3) {
-            total += (size_t)cm_cell_face_count(mesh, c);
-            ++nvol;
-        }
+        if (cm_cell_type_info((cm_cell_type)mesh->type[c])->dim == 3) ++nvol;
     if (nvol == 0) {
         cm_foam_poly_release(&p);
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: an OpenFOAM polyMesh needs volume cells; the mesh has none");
     }
-    b.cap_slot = 16;
-    while (b.cap_slot < 2 * total + 16) b.cap_slot *= 2;
-    b.slot = calloc(b.cap_slot, sizeof *b.slot);
-    b.capf = total + 1;
-    b.f = malloc(b.capf * sizeof *b.f);
-    if (!b.slot || !b.f || !grow_pool(&b, total * 4 + 16)) goto nomem;
-    int64_t cell = 0;
-    int64_t nodes[MAX_FACE];
-    for (size_t c = 0; c < mesh->n_cells; ++c) {
-        if (cm_cell_type_info((cm_cell_type)mesh->type[c])->dim != 3) continue;
-        const int nfc = cm_cell_face_count(mesh, c);
-        for (int k = 0; k < nfc; ++k) {
-            int n = cm_cell_face_nodes(mesh, c, k, nodes, MAX_FACE);
-            if (n < 3) {
-                s = cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: cell %zu: face %d has %s nodes for a polyMesh", c, k,
-                             n < 0 ? "too many" : "fewer than 3");
-                goto fail;
-            }
-            if (!grow_pool(&b, (size_t)n)) goto nomem;
-            int64_t *key = b.sorted + b.npool;
-            memcpy(key, nodes, (size_t)n * sizeof *key);
-            qsort(key, (size_t)n, sizeof *key, cmp_i64);
-            size_t where = 0;
-            int64_t hit = lookup(&b, key, n, &where);
-            if (hit >= 0) {
-                face_rec *r = &b.f[hit];
-                if (r->nei >= 0) {
-                    s = cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: cell %zu: a face shared by three or more cells cannot be written as a polyMesh", c);
-                    goto fail;
-                }
-                r->nei = cell;
-                continue;
-            }
-            face_rec *r = &b.f[b.nf];
-            r->owner = cell;
-            r->nei = -1;
-            r->off = (int64_t)b.npool;
-            r->n = n;
-            r->patch = -1;
-            memcpy(b.pool + b.npool, nodes, (size_t)n * sizeof *nodes);
-            b.npool += (size_t)n;
-            b.slot[where] = ++b.nf;
-        }
-        ++cell;
+    cm_topology_problem why;
+    s = cm_topology_build(mesh, MAX_FACE, cm_context_threads_for(ctx, mesh->n_cells, 1), &t, &why);
+    if (why.what == CM_TOPOLOGY_NOMEM) goto nomem;
+    if (why.what == CM_TOPOLOGY_TOO_LARGE) {
+        s = topology_fault(ctx, &t, &why);
+        goto fail;
     }
+    if (cm_topology_faces(&t) != CM_OK) goto nomem;
+    if (s != CM_OK || cm_topology_first_overshared(&t) >= 0) {
+        s = topology_fault(ctx, &t, &why);
+        goto fail;
+    }
+    const size_t nf = t.n_faces;
+    cell_of = malloc((mesh->n_cells ? mesh->n_cells : 1) * sizeof *cell_of);
+    patch = malloc((nf ? nf : 1) * sizeof *patch);
+    if (!cell_of || !patch) goto nomem;
+    int64_t cell = 0;
+    for (size_t c = 0; c < mesh->n_cells; ++c)
+        cell_of[c] = cm_cell_type_info((cm_cell_type)mesh->type[c])->dim == 3 ? cell++ : -1;
+    for (size_t f = 0; f < nf; ++f) patch[f] = -1;
     /* patches: the physical tag of a 2D cell on each boundary face */
+    int64_t nodes[MAX_FACE];
     tags = malloc((mesh->n_groups + mesh->n_cells + 1) * sizeof *tags);
     if (!tags) goto nomem;
     for (size_t c = 0; c < mesh->n_cells; ++c) {
@@ -210,39 +150,41 @@ cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out
         int n = lt == CM_CELL_POLYGON ? (int)(mesh->offset[c + 1] - mesh->offset[c]) : cm_cell_type_info(lt)->nodes;
         if (n < 3 || n > MAX_FACE) continue;
         memcpy(nodes, mesh->conn + mesh->offset[c], (size_t)n * sizeof *nodes);
-        qsort(nodes, (size_t)n, sizeof *nodes, cmp_i64);
-        size_t where;
-        int64_t hit = lookup(&b, nodes, n, &where);
-        if (hit < 0 || b.f[hit].nei >= 0 || b.f[hit].patch >= 0) continue;
-        int tag = mesh->physical[c], t = 0;
-        while ((size_t)t < ntags && tags[t] != tag) ++t;
-        if ((size_t)t == ntags) tags[ntags++] = tag;
-        b.f[hit].patch = t;
+        const int64_t hit = cm_topology_find(&t, mesh, nodes, n);
+        if (hit < 0 || t.neighbour[hit] >= 0 || patch[hit] >= 0) continue;
+        int tag = mesh->physical[c], k = 0;
+        while ((size_t)k < ntags && tags[k] != tag) ++k;
+        if ((size_t)k == ntags) tags[ntags++] = tag;
+        patch[hit] = k;
     }
     int unassigned = 0;
-    for (size_t i = 0; i < b.nf; ++i)
-        if (b.f[i].nei < 0 && b.f[i].patch < 0) {
-            b.f[i].patch = (int)ntags;
+    for (size_t i = 0; i < nf; ++i)
+        if (t.neighbour[i] < 0 && patch[i] < 0) {
+            patch[i] = (int)ntags;
             unassigned = 1;
         }
-    /* order: internal (owner, neighbour), then boundary (patch, owner) */
-    ord = malloc((b.nf ? b.nf : 1) * sizeof *ord);
+    /* order: internal (owner, neighbour), then boundary (patch, owner); faces are numbered in
+     * the order of their first instance, which breaks ties as before */
+    ord = malloc((nf ? nf : 1) * sizeof *ord);
     if (!ord) goto nomem;
-    size_t nint = 0;
-    for (size_t i = 0; i < b.nf; ++i)
-        if (b.f[i].nei >= 0) ord[nint++] = (order_rec){b.f[i].owner, b.f[i].nei, i};
+    size_t nint = 0, npool = 0;
+    for (size_t i = 0; i < nf; ++i) {
+        const cm_topo_idx own = t.owner[i], inst = t.face_inst[i];
+        npool += (size_t)cm_cell_face_nodes(mesh, (size_t)own, (int)(inst - t.inst_off[own]), nodes, MAX_FACE);
+        if (t.neighbour[i] >= 0) ord[nint++] = (order_rec){cell_of[own], cell_of[t.neighbour[i]], i};
+    }
     size_t nb = nint;
-    for (size_t i = 0; i < b.nf; ++i)
-        if (b.f[i].nei < 0) ord[nb++] = (order_rec){(int64_t)1 << 62 | b.f[i].patch, b.f[i].owner, i};
+    for (size_t i = 0; i < nf; ++i)
+        if (t.neighbour[i] < 0) ord[nb++] = (order_rec){(int64_t)1 << 62 | patch[i], cell_of[t.owner[i]], i};
     qsort(ord, nint, sizeof *ord, cmp_order);
-    qsort(ord + nint, b.nf - nint, sizeof *ord, cmp_order);
+    qsort(ord + nint, nf - nint, sizeof *ord, cmp_order);
     p->n_points = (int64_t)mesh->n_nodes;
     p->n_cells = nvol;
-    p->n_faces = (int64_t)b.nf;
+    p->n_faces = (int64_t)nf;
     p->n_internal = (int64_t)nint;
-    p->face_off = malloc((b.nf + 1) * sizeof *p->face_off);
-    p->face_nodes = malloc((b.npool ? b.npool : 1) * sizeof *p->face_nodes);
-    p->owner = malloc((b.nf ? b.nf : 1) * sizeof *p->owner);
+    p->face_off = malloc((nf + 1) * sizeof *p->face_off);
+    p->face_nodes = malloc((npool ? npool : 1) * sizeof *p->face_nodes);
+    p->owner = malloc((nf ? nf : 1) * sizeof *p->owner);
     p->neighbour = malloc((nint ? nint : 1) * sizeof *p->neighbour);
     size_t npatch = ntags + (size_t)unassigned;
     p->patches = calloc(npatch ? npatch : 1, sizeof *p->patches);
@@ -250,32 +192,31 @@ cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out
     p->n_patches = npatch;
     int64_t at = 0;
     p->face_off[0] = 0;
-    for (size_t i = 0; i < b.nf; ++i) {
-        const face_rec *r = &b.f[ord[i].face];
-        memcpy(p->face_nodes + at, b.pool + r->off, (size_t)r->n * sizeof *p->face_nodes);
-        at += r->n;
+    for (size_t i = 0; i < nf; ++i) {
+        const size_t f = ord[i].face;
+        const cm_topo_idx own = t.owner[f], inst = t.face_inst[f];
+        /* as the owner sees the face: outward */
+        at += cm_cell_face_nodes(mesh, (size_t)own, (int)(inst - t.inst_off[own]), p->face_nodes + at, MAX_FACE);
         p->face_off[i + 1] = at;
-        p->owner[i] = r->owner;
-        if (i < nint) p->neighbour[i] = r->nei;
+        p->owner[i] = cell_of[own];
+        if (i < nint) p->neighbour[i] = cell_of[t.neighbour[f]];
     }
-    for (size_t t = 0; t < npatch; ++t) {
-        cm_foam_patch *pt = &p->patches[t];
-        pt->name = t < ntags ? name_of_group(mesh, tags[t]) : strdup("defaultFaces");
-        pt->type = strdup(t < ntags ? "patch" : "wall");
+    for (size_t k = 0; k < npatch; ++k) {
+        cm_foam_patch *pt = &p->patches[k];
+        pt->name = k < ntags ? name_of_group(mesh, tags[k]) : strdup("defaultFaces");
+        pt->type = strdup(k < ntags ? "patch" : "wall");
         pt->n = 0;
         pt->start = -1;
         if (!pt->name || !pt->type) goto nomem;
     }
     if (!unique_names(p->patches, npatch)) goto nomem;
-    for (size_t i = nint; i < b.nf; ++i) {
-        cm_foam_patch *pt = &p->patches[b.f[ord[i].face].patch];
+    for (size_t i = nint; i < nf; ++i) {
+        cm_foam_patch *pt = &p->patches[patch[ord[i].face]];
         if (pt->start < 0) pt->start = (int64_t)i;
         ++pt->n;
     }
-    free(b.f);
-    free(b.pool);
-    free(b.sorted);
-    free(b.slot);
+    cm_topology_free(&t);
+    free(patch);
     free(tags);
     free(ord);
     free(cell_of);
@@ -284,10 +225,8 @@ cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out
 nomem:
     s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory building the face addressing");
 fail:
-    free(b.f);
-    free(b.pool);
-    free(b.sorted);
-    free(b.slot);
+    cm_topology_free(&t);
+    free(patch);
     free(tags);
     free(ord);
     free(cell_of);

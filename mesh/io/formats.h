@@ -1,6 +1,7 @@
-/* The per-format readers and writers (not public): only the dispatcher (io.c) calls them,
- * so that every mesh read goes through cm_mesh_validate. Adding a format is one file here
- * and one case in io.c. */
+/* The per-format readers and writers (not public) and the registry of formats: only the
+ * dispatcher (io.c) calls them, so that every mesh read goes through cm_mesh_validate. Adding
+ * a format is one file here (its reader and writer, declared below) and one row in the
+ * registry table in io.c. */
 #ifndef CADMORPH_MESH_IO_FORMATS_H
 #define CADMORPH_MESH_IO_FORMATS_H
 
@@ -38,5 +39,43 @@ cm_status cm_mesh_write_stl(cm_context *ctx, const cm_mesh *mesh, const char *pa
 cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *path,
                              const cm_mesh_write_options *opt);
+
+/* ---- the registry ---- */
+
+typedef cm_status (*cm_mesh_read_fn)(cm_context *ctx, const char *path, cm_mesh **mesh);
+typedef cm_status (*cm_mesh_write_fn)(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                                      const cm_mesh_write_options *opt);
+
+/* What a format holds (a description for listings and tests; the writers decide). */
+enum {
+    CM_MESH_IO_VOLUME = 1u << 0,  /* 3D cells */
+    CM_MESH_IO_SURFACE = 1u << 1, /* 2D cells (and lines) */
+    CM_MESH_IO_FIELDS = 1u << 2,  /* node fields */
+    CM_MESH_IO_GROUPS = 1u << 3   /* physical groups (tags, and names where the format has them) */
+};
+
+typedef struct cm_mesh_format_row {
+    cm_mesh_format format;
+    const char *name;
+    /* Recognised by extension: lower-case names without the dot, space-separated, matched
+     * case-insensitively against the text after the last '.' of the last path component. */
+    const char *extensions;
+    /* Or by the path itself (a directory format): claims is asked first, for every path, and
+     * described names the path in the list of formats. NULL for a file format. */
+    int (*claims)(const char *path);
+    const char *described;
+    cm_mesh_read_fn read;
+    cm_mesh_write_fn write;
+    unsigned holds; /* CM_MESH_IO_* */
+} cm_mesh_format_row;
+
+/* The rows, in the order cm_mesh_format_list names them; the row of a format, NULL for
+ * CM_FORMAT_UNKNOWN. */
+extern const cm_mesh_format_row cm_mesh_format_rows[];
+extern const size_t cm_mesh_format_row_count;
+const cm_mesh_format_row *cm_mesh_format_row_of(cm_mesh_format format);
+/* The format a path's extension names (CM_FORMAT_UNKNOWN for none or another), without asking
+ * the directory formats. */
+cm_mesh_format cm_mesh_format_of_extension(const char *path);
 
 #endif

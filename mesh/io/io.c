@@ -1,29 +1,64 @@
-/* Mesh file dispatch by extension and the helpers every reader and writer shares. */
+/* Mesh file dispatch through the registry of formats (formats.h): the table, which format a
+ * path names, cm_mesh_read (every reader's output validated) and cm_mesh_write. The frame the
+ * readers and writers share is in frame.c, below this file. */
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
 #include "foam_internal.h"
 
 #include <ctype.h>
-#include <errno.h>
-#include <stdlib.h>
+#include <pthread.h>
 #include <string.h>
 #include <sys/stat.h>
 
-/* The format a file name's extension names (CM_FORMAT_UNKNOWN for none or another). */
-static cm_mesh_format format_of_extension(const char *path)
+/* The registry: one row per format. A directory format is asked first (it claims paths by
+ * what they name on disk), then the extension decides. */
+const cm_mesh_format_row cm_mesh_format_rows[] = {
+    {CM_FORMAT_MSH, "gmsh", "msh", NULL, NULL, cm_mesh_read_msh, cm_mesh_write_msh,
+     CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
+    {CM_FORMAT_VTU, "VTK XML", "vtu", NULL, NULL, cm_mesh_read_vtu, cm_mesh_write_vtu,
+     CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
+    {CM_FORMAT_VTK, "VTK legacy", "vtk", NULL, NULL, cm_mesh_read_vtk, cm_mesh_write_vtk,
+     CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
+    {CM_FORMAT_MEDIT, "Medit", "mesh", NULL, NULL, cm_mesh_read_medit, cm_mesh_write_medit,
+     CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {CM_FORMAT_OBJ, "Wavefront", "obj", NULL, NULL, cm_mesh_read_obj, cm_mesh_write_obj,
+     CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {CM_FORMAT_OFF, "OFF", "off", NULL, NULL, cm_mesh_read_off, cm_mesh_write_off, CM_MESH_IO_SURFACE},
+    {CM_FORMAT_STL, "STL", "stl", NULL, NULL, cm_mesh_read_stl, cm_mesh_write_stl,
+     CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {CM_FORMAT_FOAM, "OpenFOAM polyMesh", NULL, cm_foam_is_path, "an OpenFOAM case directory", cm_mesh_read_foam,
+     cm_mesh_write_foam, CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},
+};
+const size_t cm_mesh_format_row_count = sizeof cm_mesh_format_rows / sizeof cm_mesh_format_rows[0];
+
+const cm_mesh_format_row *cm_mesh_format_row_of(cm_mesh_format format)
+{
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
+        if (cm_mesh_format_rows[i].format == format) return &cm_mesh_format_rows[i];
+    return NULL;
+}
+
+/* Whether ext (n bytes) is one of the space-separated names in list, ignoring case. */
+static int in_list(const char *list, const char *ext, size_t n)
+{
+    for (const char *w = list; w && *w;) {
+        const char *e = strchr(w, ' ');
+        const size_t len = e ? (size_t)(e - w) : strlen(w);
+        size_t i = 0;
+        while (i < n && i < len && tolower((unsigned char)ext[i]) == w[i]) ++i;
+        if (i == n && i == len) return 1;
+        w = e ? e + 1 : NULL;
+    }
+    return 0;
+}
+
+cm_mesh_format cm_mesh_format_of_extension(const char *path)
 {
     const char *dot = path ? strrchr(path, '.') : NULL;
     if (!dot || strchr(dot, '/')) return CM_FORMAT_UNKNOWN;
-    char ext[8] = {0};
-    if (strlen(dot + 1) >= sizeof ext) return CM_FORMAT_UNKNOWN;
-    for (size_t i = 0; dot[1 + i]; ++i) ext[i] = (char)tolower((unsigned char)dot[1 + i]);
-    if (!strcmp(ext, "msh")) return CM_FORMAT_MSH;
-    if (!strcmp(ext, "vtu")) return CM_FORMAT_VTU;
-    if (!strcmp(ext, "vtk")) return CM_FORMAT_VTK;
-    if (!strcmp(ext, "mesh")) return CM_FORMAT_MEDIT;
-    if (!strcmp(ext, "obj")) return CM_FORMAT_OBJ;
-    if (!strcmp(ext, "off")) return CM_FORMAT_OFF;
-    if (!strcmp(ext, "stl")) return CM_FORMAT_STL;
+    const size_t n = strlen(dot + 1);
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
+        if (in_list(cm_mesh_format_rows[i].extensions, dot + 1, n)) return cm_mesh_format_rows[i].format;
     return CM_FORMAT_UNKNOWN;
 }
 
@@ -36,7 +71,7 @@ int cm_foam_is_path(const char *path)
     size_t l = strlen(path);
     if (path[l - 1] == '/') return 1;
     /* a name with a file format's extension stays that format, even if it is a directory */
-    if (format_of_extension(path) != CM_FORMAT_UNKNOWN) return 0;
+    if (cm_mesh_format_of_extension(path) != CM_FORMAT_UNKNOWN) return 0;
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
     struct stat st;
@@ -46,42 +81,45 @@ int cm_foam_is_path(const char *path)
 
 cm_mesh_format cm_mesh_format_from_path(const char *path)
 {
-    return cm_foam_is_path(path) ? CM_FORMAT_FOAM : format_of_extension(path);
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
+        if (cm_mesh_format_rows[i].claims && cm_mesh_format_rows[i].claims(path)) return cm_mesh_format_rows[i].format;
+    return cm_mesh_format_of_extension(path);
 }
 
-cm_status cm_mesh_read_whole(cm_context *ctx, const char *fn, const char *path,
-                             cm_mesh_parse_fn parse, cm_mesh **mesh)
+/* ".msh .vtu ... .stl, or an OpenFOAM case directory": the extensions of the rows in order,
+ * then the directory formats. */
+static char format_list[256];
+static pthread_once_t format_list_once = PTHREAD_ONCE_INIT;
+
+static void add_text(size_t *at, const char *text, size_t n)
 {
-    if (!mesh || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL argument", fn);
-    *mesh = NULL;
-    char *data = NULL;
-    size_t size = 0;
-    cm_status s = cm_file_read(ctx, path, &data, &size);
-    if (s != CM_OK) return s;
-    cm_mesh *m = NULL;
-    s = cm_mesh_create(ctx, &m);
-    if (s == CM_OK) s = parse(ctx, path, data, size, m);
-    free(data);
-    if (s != CM_OK) {
-        cm_mesh_destroy(&m);
-        return s;
-    }
-    *mesh = m;
-    return CM_OK;
+    for (size_t i = 0; i < n && *at + 1 < sizeof format_list; ++i) format_list[(*at)++] = text[i];
+    format_list[*at] = '\0';
+}
+
+static void compose_format_list(void)
+{
+    size_t at = 0;
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
+        for (const char *w = cm_mesh_format_rows[i].extensions; w && *w;) {
+            const char *e = strchr(w, ' ');
+            const size_t len = e ? (size_t)(e - w) : strlen(w);
+            if (at) add_text(&at, " ", 1);
+            add_text(&at, ".", 1);
+            add_text(&at, w, len);
+            w = e ? e + 1 : NULL;
+        }
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
+        if (cm_mesh_format_rows[i].described) {
+            add_text(&at, ", or ", 5);
+            add_text(&at, cm_mesh_format_rows[i].described, strlen(cm_mesh_format_rows[i].described));
+        }
 }
 
 const char *cm_mesh_format_list(void)
 {
-    return ".msh .vtu .vtk .mesh .obj .off .stl, or an OpenFOAM case directory";
-}
-
-void cm_mesh_write_options_init(cm_mesh_write_options *opt)
-{
-    if (!opt) return;
-    opt->msh_version = 41;
-    opt->binary = 1;
-    opt->compress = 1;
-    opt->appended = 0;
+    pthread_once(&format_list_once, compose_format_list);
+    return format_list;
 }
 
 static cm_status unknown_extension(cm_context *ctx, const char *fn, const char *path)
@@ -95,18 +133,9 @@ cm_status cm_mesh_read(cm_context *ctx, const char *path, cm_mesh **mesh)
 {
     if (!mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_read: mesh is NULL");
     *mesh = NULL;
-    cm_status s;
-    switch (cm_mesh_format_from_path(path)) {
-    case CM_FORMAT_MSH: s = cm_mesh_read_msh(ctx, path, mesh); break;
-    case CM_FORMAT_VTU: s = cm_mesh_read_vtu(ctx, path, mesh); break;
-    case CM_FORMAT_VTK: s = cm_mesh_read_vtk(ctx, path, mesh); break;
-    case CM_FORMAT_MEDIT: s = cm_mesh_read_medit(ctx, path, mesh); break;
-    case CM_FORMAT_OBJ: s = cm_mesh_read_obj(ctx, path, mesh); break;
-    case CM_FORMAT_OFF: s = cm_mesh_read_off(ctx, path, mesh); break;
-    case CM_FORMAT_STL: s = cm_mesh_read_stl(ctx, path, mesh); break;
-    case CM_FORMAT_FOAM: s = cm_mesh_read_foam(ctx, path, mesh); break;
-    default: return unknown_extension(ctx, "cm_mesh_read", path);
-    }
+    const cm_mesh_format_row *row = cm_mesh_format_row_of(cm_mesh_format_from_path(path));
+    if (!row || !row->read) return unknown_extension(ctx, "cm_mesh_read", path);
+    cm_status s = row->read(ctx, path, mesh);
     if (s < 0) return s;
     /* Every reader's output goes through the same checks, so no reader can let an out-of-range
      * index or a NaN through to the algorithms. */
@@ -125,15 +154,7 @@ cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
     cm_mesh_write_options_init(&defaults);
     if (!opt) opt = &defaults;
     if (!mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: mesh is NULL");
-    switch (cm_mesh_format_from_path(path)) {
-    case CM_FORMAT_MSH: return cm_mesh_write_msh(ctx, mesh, path, opt);
-    case CM_FORMAT_VTU: return cm_mesh_write_vtu(ctx, mesh, path, opt);
-    case CM_FORMAT_VTK: return cm_mesh_write_vtk(ctx, mesh, path, opt);
-    case CM_FORMAT_MEDIT: return cm_mesh_write_medit(ctx, mesh, path, opt);
-    case CM_FORMAT_OBJ: return cm_mesh_write_obj(ctx, mesh, path, opt);
-    case CM_FORMAT_OFF: return cm_mesh_write_off(ctx, mesh, path, opt);
-    case CM_FORMAT_STL: return cm_mesh_write_stl(ctx, mesh, path, opt);
-    case CM_FORMAT_FOAM: return cm_mesh_write_foam(ctx, mesh, path, opt);
-    default: return unknown_extension(ctx, "cm_mesh_write", path);
-    }
+    const cm_mesh_format_row *row = cm_mesh_format_row_of(cm_mesh_format_from_path(path));
+    if (!row || !row->write) return unknown_extension(ctx, "cm_mesh_write", path);
+    return row->write(ctx, mesh, path, opt);
 }

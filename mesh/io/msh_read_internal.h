@@ -28,8 +28,12 @@ typedef struct cm_msh_reader {
 /* Sets "path:line: message" (bin = 0) or "path: byte <at>: message" and returns code. */
 cm_status cm_msh_err(cm_msh_reader *r, cm_status code, int bin, size_t at, const char *fmt, ...)
     __attribute__((format(printf, 5, 6)));
+/* "expected <what>, got '<token>'" (tok NULL: end of file) at the current line, or at the
+ * current byte when bin. */
+cm_status cm_msh_expected(cm_msh_reader *r, int bin, const char *what, const char *tok, size_t len);
 
-/* bin: read raw bytes (int: 4, size: dsize, double: 8); else the next ASCII token. */
+/* The values (msh_read_values.c). bin: read raw bytes (int: 4, size: dsize, double: 8); else
+ * the next ASCII token. */
 cm_status cm_msh_int(cm_msh_reader *r, int bin, const char *what, int64_t *v);
 cm_status cm_msh_size(cm_msh_reader *r, int bin, const char *what, int64_t *v);
 cm_status cm_msh_double(cm_msh_reader *r, int bin, const char *what, double *v);

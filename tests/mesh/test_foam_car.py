@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The polyhedral morph test of issue 17 at ctest size: benchmarks/foam/make_case.py builds the
+"""The polyhedral morph test at ctest size: benchmarks/foam/make_case.py builds the
 car-like body in a wind tunnel (snappyHexMesh with layers, --base 10: ~52k cells); one RBF warp
 of the three roof handles (morph_table.py's handles, the tunnel and the rest of the body fixed)
 and the CAD-driven morph onto the body's STEP with the roof 5% higher (`morph --off-cad fixed

@@ -1,4 +1,4 @@
-/* Hostile input that is not a file (issue 11): names every writer must turn into something
+/* Hostile input that is not a file: names every writer must turn into something
  * every reader accepts, a cell copied from the mesh's own connectivity, geometric growth,
  * one-line messages, and the registry of output temporaries a signal handler unlinks. */
 #include "cadmorph/mesh.h"

@@ -1,0 +1,56 @@
+/* The registry of mesh formats (mesh/io/formats.h): every row complete and recognised by its
+ * own extensions in any case, the list of formats the messages and --help texts show, and
+ * the path rules (extension, directory = OpenFOAM case). */
+#include "cadmorph/mesh.h"
+#include "formats.h"
+#include "test_util.h"
+
+#include <ctype.h>
+#include <stdio.h>
+#include <string.h>
+
+static void test_rows(void)
+{
+    CHECK(cm_mesh_format_row_count == 8);
+    CHECK(cm_mesh_format_row_of(CM_FORMAT_UNKNOWN) == NULL);
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i) {
+        const cm_mesh_format_row *r = &cm_mesh_format_rows[i];
+        CHECK(r->name && r->read && r->write && r->holds);
+        CHECK(cm_mesh_format_row_of(r->format) == r);
+        CHECK_MSG((r->extensions != NULL) != (r->claims != NULL), "%s: an extension or a path rule", r->name);
+        CHECK((r->claims != NULL) == (r->described != NULL));
+        for (const char *w = r->extensions; w && *w;) {
+            const char *e = strchr(w, ' ');
+            const size_t len = e ? (size_t)(e - w) : strlen(w);
+            char path[64], upper[64];
+            snprintf(path, sizeof path, "dir.d/m.%.*s", (int)len, w);
+            for (size_t k = 0; k <= strlen(path); ++k) upper[k] = (char)toupper((unsigned char)path[k]);
+            CHECK_MSG(cm_mesh_format_from_path(path) == r->format, "%s", path);
+            CHECK_MSG(cm_mesh_format_from_path(upper) == r->format, "%s", upper);
+            w = e ? e + 1 : NULL;
+        }
+    }
+}
+
+static void test_paths(void)
+{
+    CHECK(!strcmp(cm_mesh_format_list(), ".msh .vtu .vtk .mesh .obj .off .stl, or an OpenFOAM case directory"));
+    CHECK(cm_mesh_format_from_path(NULL) == CM_FORMAT_UNKNOWN);
+    CHECK(cm_mesh_format_from_path("") == CM_FORMAT_UNKNOWN);
+    CHECK(cm_mesh_format_from_path("m.vtu") == CM_FORMAT_VTU);
+    CHECK(cm_mesh_format_from_path("m.Mesh") == CM_FORMAT_MEDIT);
+    CHECK(cm_mesh_format_from_path("m.step") == CM_FORMAT_UNKNOWN);
+    CHECK(cm_mesh_format_from_path("m.mshx") == CM_FORMAT_UNKNOWN);
+    CHECK(cm_mesh_format_from_path("m.verylongext") == CM_FORMAT_UNKNOWN);
+    CHECK(cm_mesh_format_from_path("m.vtu/") == CM_FORMAT_FOAM);
+    CHECK(cm_mesh_format_from_path("a.b/case") == CM_FORMAT_FOAM);
+    CHECK(cm_mesh_format_from_path("a/constant/polyMesh") == CM_FORMAT_FOAM);
+    CHECK(cm_mesh_format_from_path("no_such_dir.d/m.stl") == CM_FORMAT_STL);
+}
+
+int main(void)
+{
+    test_rows();
+    test_paths();
+    return TEST_REPORT();
+}
