@@ -27,7 +27,10 @@ test: build
 test-all: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
-bench: build
+# the benchmarks are built on request only: the same build directory, configured with them
+bench: setup
+	cmake -S . -B $(BUILD) $(CMAKE_FLAGS) -DCADMORPH_BUILD_BENCHMARKS=ON
+	cmake --build $(BUILD) -j $(JOBS)
 	sh benchmarks/run_all.sh $(BUILD)
 
 # Unit and CLI tests with AddressSanitizer and UBSan in $(BUILD)-asan. LSan skips

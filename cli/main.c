@@ -27,6 +27,7 @@ static const cli_command commands[] = {
     {"mesh", cli_cmd_mesh, "tet mesh of a STEP solid (gmsh by default, or TetGen)"},
     {"optimize", cli_cmd_optimize, "move interior nodes to untangle and raise the worst cells"},
     {"info", cli_cmd_info, "topology summary of a STEP file, correspondence with another"},
+    {"model", cli_cmd_model, "a built-in model (bore, pipe, bracket) at parameter T as STEP, its hex mesh"},
 };
 
 static int usage(FILE *out)

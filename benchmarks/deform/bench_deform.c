@@ -1,7 +1,7 @@
-/* The paper's benchmark suite for FFD, DM-FFD and the RBF (shape-deformation-benchmarks,
- * section 3): `bench_deform perf|precision|robust|smooth OUTDIR [threads]`. Each block prints
- * a table and writes CSV (and surface meshes with per-vertex mean curvature for ParaView) into
- * OUTDIR; plots.py turns the CSVs into SVG. Not a test: run by run_deform.sh. */
+/* The benchmark suite of [SMB14 §3] for FFD, DM-FFD and the RBF:
+ * `bench_deform perf|precision|robust|smooth OUTDIR [threads]`. Each block prints a table and
+ * writes CSV (and surface meshes with per-vertex mean curvature for ParaView) into OUTDIR;
+ * plots.py turns the CSVs into SVG. Not a test: run by run_deform.sh. */
 #include "surface.h"
 
 #include "cadmorph/deform.h"

@@ -1,5 +1,5 @@
 #!/bin/sh
-# The FFD / DM-FFD / RBF benchmark suite of benchmarks/RESULTS.md (issue 14): blocks 1, 5, 2,
+# The FFD / DM-FFD / RBF benchmark suite of [SMB14] (benchmarks/RESULTS.md): blocks 1, 5, 2,
 # 3 with bench_deform, block 6 on the pipe tet and hex meshes (RBF-S morphs by
 # `cadmorph morph`, DM-FFD-5/10/15/25 by bench_deform volume), then the SVG plots.
 # usage: run_deform.sh BUILD_DIR [WORK_DIR] [THREADS]
@@ -8,7 +8,7 @@ build=${1:?usage: run_deform.sh BUILD_DIR [WORK_DIR] [THREADS]}
 work=${2:-$build/deform}
 threads=${3:-2}
 here=$(dirname "$0")
-bench=$build/benchmarks/bench_deform
+bench=$build/benchmarks/deform/bench_deform
 cadmorph=$build/cli/cadmorph
 mkdir -p "$work/pipe"
 echo "# $(date -u '+%Y-%m-%d %H:%M UTC')  $(lscpu | sed -n 's/^Model name: *//p')  nproc=$(nproc)  load=$(cut -d' ' -f1-3 /proc/loadavg)"
@@ -20,9 +20,9 @@ OPENBLAS_VERBOSE=2 "$bench" perf "$work" "$threads"
 
 cd "$work/pipe"
 steps="0.2 0.4 0.6 0.8 1.0"
-for t in 0 $steps; do "$build/benchmarks/models/cm_model" pipe "$t" "pipe_$t.step"; done
+for t in 0 $steps; do "$cadmorph" model pipe "$t" "pipe_$t.step"; done
 "$cadmorph" mesh pipe_0.step -o pipe_tet.vtu --size 0.2 --mesher tetgen | tail -1
-"$build/benchmarks/models/cm_hexmesh" pipe pipe_hex.vtu | tail -1
+"$cadmorph" model pipe 0 --hex-mesh pipe_hex.vtu | tail -1
 for mesh in tet hex; do
     targets=""
     for t in $steps; do

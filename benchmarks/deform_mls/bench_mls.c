@@ -1,4 +1,4 @@
-/* The MLS deformation at scale (issue 15, sections 7.1/7.3): set-up (sampling, shape
+/* The MLS deformation at scale ([CMLS §7.1, §7.3]): set-up (sampling, shape
  * functions, factorisation) once, then R deformations of the same handles with different
  * displacements (a design loop), each one CHOLMOD solve and one sparse product. Prints wall
  * and CPU seconds per phase and the peak resident set.

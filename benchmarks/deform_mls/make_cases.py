@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Meshes and handle tables of the MLS benchmarks (issue 15), written with gmsh:
+"""Meshes and handle tables of the MLS benchmarks ([CMLS]), written with gmsh:
   sphere: a box with a spherical cavity (tets, ~13k nodes; paper section 7.2): outer boundary
           fixed, the cavity's nodes moved as the handle (sphere_H.csv, sphere_F.csv);
   plane:  a square plate (triangles, ~1,100 vertices; paper Figure 3): a central disc lifted,

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""A structured hex mesh of the sphere-handle case at any size (issue 15, section 7.3's ~1M-node
+"""A structured hex mesh of the sphere-handle case at any size ([CMLS §7.3]'s ~1M-node
 volume, where gmsh/TetGen tets are too slow on a loaded 2-core machine): the cube [0,4]^3 with
 a spherical cavity of radius 1 at its centre, as six blocks between the cube's faces and the
 sphere (a "cubed sphere" shell); each block is n x n nodes on its face by m + 1 layers,

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The SVG figures of the MLS benchmarks (issue 15), drawn by cadmorph's plot writer
+"""The SVG figures of the MLS benchmarks [CMLS], drawn by cadmorph's plot writer
 (cm_plot_write_svg through the mls_plot tool) from the CSVs the run scripts write:
   sphere.svg      run_sphere.sh's sphere_rows.csv: min SJ against k, per method and DX
   hex.svg         run_hex_options.sh's hex_rows.csv: min SJ against k, blend on/off, RBF

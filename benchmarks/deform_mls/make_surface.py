@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Large surface case of the MLS scale block (issue 15, paper section 7.1): a gmsh torus
+"""Large surface case of the MLS scale block ([CMLS §7.1]): a gmsh torus
 surface (R = 2, r = 0.6) of triangles; the handle is the cap x > 2.3 (moved by (0, 0, 0.3)),
 the fixed region the cap x < -2.3.
 usage: make_surface.py OUTDIR SIZE"""

@@ -1,5 +1,5 @@
 /* A CSV of points to an SVG line plot through cadmorph's plot writer (cm_plot_write_svg): the
- * figures of the MLS benchmarks (issue 15).
+ * figures of the MLS benchmarks (benchmarks/deform_mls/README.md).
  * CSV: header series,x,y[,style[,colour]]; style: solid|dashed, optionally +markers; colour:
  * a slot of the colour table (default: the series' order). Series in order of appearance.
  * usage: mls_plot IN.csv OUT.svg TITLE XLABEL YLABEL [logx] [logy] [ymin=A] [ymax=B] [note=TEXT] */

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plane mean-curvature profile (issue 15; paper section 4, Figures 3 and 5): the plate of
+"""Plane mean-curvature profile ([CMLS §4], Figures 3 and 5): the plate of
 make_cases.py (~1,100 vertices), its central disc lifted by 0.2, the border fixed; pure
 bending and pure stretching.
   ground truth: the mesh-based shell of section 3 (eq. 10: gamma_s K + gamma_b K M^-1 K +

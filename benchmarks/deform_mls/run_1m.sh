@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Sections 7.1/7.3 at the paper's volume size (issue 15): a ~1M-node structured hex mesh of the
+# Sections 7.1/7.3 of [CMLS] at the paper's volume size: a ~1M-node structured hex mesh of the
 # sphere-handle case (make_cubed_shell.py: cube [0,4]^3 minus a ball of radius 1, six blocks
 # of 64 x 64 x 41 nodes), H = the cavity's nodes moved by (0.5, 0, 0), F = the cube's faces;
 # MLS with 7,000 samples (70 % = 4,900 on the boundary, 2,100 inside: the paper's 5k + 2k)

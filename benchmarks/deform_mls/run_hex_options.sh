@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Section 7.2 pipe/bore hex (issue 15), the MLS options against the RBF: one absolute step
+# [CMLS §7.2] on the pipe/bore hex meshes, the MLS options against the RBF: one absolute step
 # G(0) -> G(1) with `cadmorph morph --method mls` and the MLS options of cm_warp_options
 # (samples k, cubature N, coverage s, gamma_s, gamma_b, the residual blend), one row per
 # setting, next to rbf. Rows also go to WORK_DIR/hex_rows.csv.
@@ -7,7 +7,7 @@
 set -euo pipefail
 build=$1 work=$2; shift 2
 models=${*:-pipe bore}
-C=$build/cli/cadmorph M=$build/benchmarks/models
+C=$build/cli/cadmorph
 mkdir -p "$work" && cd "$work"
 echo "# $(date -u '+%F %H:%M UTC')  $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)  nproc=$(nproc)  load=$(cut -d' ' -f1-3 /proc/loadavg)"
 echo "model,method,options,min_sj,mean_sj,inverted,residual,cpu_s" > hex_rows.csv
@@ -32,9 +32,9 @@ variants=(
     "--samples 2000 --stretch 0 --bend 1"
 )
 for model in $models; do
-    [ -f ${model}_0.step ] || $M/cm_model $model 0 ${model}_0.step > /dev/null
-    [ -f ${model}_1.step ] || $M/cm_model $model 1 ${model}_1.step > /dev/null
-    [ -f hex_$model.vtu ] || $M/cm_hexmesh $model hex_$model.vtu > /dev/null
+    [ -f ${model}_0.step ] || $C model $model 0 ${model}_0.step > /dev/null
+    [ -f ${model}_1.step ] || $C model $model 1 ${model}_1.step > /dev/null
+    [ -f hex_$model.vtu ] || $C model $model 0 --hex-mesh hex_$model.vtu > /dev/null
     row() { # method options...
         local method=$1; shift
         local out cpu

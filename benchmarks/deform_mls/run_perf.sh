@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Figure 4 of the MLS paper (issue 15): time against the number of centres / samples, global
+# Figure 4 of [CMLS]: time against the number of centres / samples, global
 # dense RBF (bench_rbf: fit + evaluation at 10 m points; the triharmonic kernel, whose dense
 # Cholesky costs the same as the biharmonic one) next to the MLS deformation (cadmorph deform
 # on the sphere mesh of make_cases.py: sampling, shape functions, CHOLMOD factorisation, one
-# apply), run alternately in one session, both on one thread: the RBF's best-of-repeats wall
+# apply), run alternately in one run, both on one thread: the RBF's best-of-repeats wall
 # time, the MLS's CPU seconds (the machine is shared; CPU seconds are what a quiet one shows).
 # Rows also go to WORK_DIR/perf_rows.csv.
 # usage: run_perf.sh BUILD_DIR WORK_DIR [K...]
@@ -19,8 +19,11 @@ echo "# $(date -u '+%F %H:%M UTC')  nproc=$(nproc)  load=$(cut -d' ' -f1-3 /proc
 echo "k,rbf_fit,rbf_eval,rbf_total,mls_sample,mls_basis,mls_factor,mls_apply,mls_setup,mls_total" > perf_rows.csv
 echo "| k | rbf fit s | rbf eval s | rbf total s | mls sample CPU s | mls basis CPU s | mls factor CPU s | mls apply CPU s | mls total CPU s | factor entries |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
+# bench_rbf, where benchmarks/CMakeLists.txt builds it (benchmarks/rbf/ or benchmarks/)
+bench_rbf=$build/benchmarks/rbf/bench_rbf
+[ -x "$bench_rbf" ] || bench_rbf=$build/benchmarks/bench_rbf
 for k in $ks; do
-    r=$("$build/benchmarks/bench_rbf" "$k" "$work" 1 2)
+    r=$("$bench_rbf" "$k" "$work" 1 2)
     fit=$(echo "$r" | tr ' ' '\n' | sed -n 's/^fit_s=//p')
     ev=$(echo "$r" | tr ' ' '\n' | sed -n 's/^eval_s=//p')
     d=$($C deform --mesh sphere.msh --handles perf_H.csv --fixed sphere_F.csv --method mls \

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Scale block of the MLS paper (issue 15, sections 7.1/7.3) at the sizes this machine meshes in
+# Scale block of [CMLS §7.1, §7.3] at the sizes this machine meshes in
 # minutes: the sphere case of make_cases.py at size S (0.075: 115k nodes, 650k tets), cavity
 # moved by 0.5; MLS at the default and at 5,000 samples, then the dense RBF (all H and F
 # nodes as centres). Peak memory from /usr/bin/time.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Scale of the MLS deformation (issue 15, sections 7.1/7.3): the structured sphere-handle
+# Scale of the MLS deformation ([CMLS §7.1, §7.3]): the structured sphere-handle
 # meshes of make_cubed_shell.py from ~16k to ~1M nodes, the paper's 7,000 samples (4,900 on
 # the boundary) and 28,000 cubature points at every size; bench_mls: set-up once (CPU s per
 # phase), 5 deformations of the same handles, peak RSS. Rows to WORK_DIR/scale_rows.csv.
@@ -16,7 +16,7 @@ for nm in "${sizes[@]}"; do
     read -r n m <<< "$nm"
     d="$work/shell_${n}_$m"
     [ -f "$d/shell.vtu" ] || /usr/bin/python3 "$here/make_cubed_shell.py" "$d" "$n" "$m" 0.5 > /dev/null
-    out=$("$build/benchmarks/bench_mls" "$d/shell.vtu" "$d/shell_H.csv" "$d/shell_F.csv" 7000 28000 5)
+    out=$("$build/benchmarks/deform_mls/bench_mls" "$d/shell.vtu" "$d/shell_H.csv" "$d/shell_F.csv" 7000 28000 5)
     echo "$out" | sed "s|^|[$n x $m] |"
     nodes=$(echo "$out" | sed -n 's/^nodes \([0-9]*\),.*/\1/p')
     sc=$(echo "$out" | sed -n 's/.*sample [^ ]* s (CPU \([^)]*\)).*/\1/p')

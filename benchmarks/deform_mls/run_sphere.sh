@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Section 7.2 sphere handle (issue 15): a gmsh box with a spherical cavity (~13k nodes), the
+# [CMLS §7.2] sphere handle: a gmsh box with a spherical cavity (~13k nodes), the
 # outer boundary fixed, the cavity's nodes moved by (DX, 0, 0); min scaled Jacobian for the
 # triharmonic RBF and the MLS deformation (default, pure bending, pure stretching), and FEMWARP
 # (`cadmorph warp --method femwarp`: P1 Laplace per coordinate, i.e. the exact minimiser of

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The CAD-driven morph of the snappyHexMesh case (issue 17): the body's STEP edited (make_case.py
+"""The CAD-driven morph of the snappyHexMesh case: the body's STEP edited (make_case.py
 --height: the roof higher, same topology) and `cadmorph morph --off-cad fixed` of the polyMesh
 onto it, the tunnel patches (not on the body's STEP) kept fixed. snappyHexMesh snaps the body
 to an STL of the STEP, so its nodes lie up to a few percent of a cell off the STEP: they are

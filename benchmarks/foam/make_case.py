@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """A car-like body in a wind tunnel, meshed by OpenFOAM's snappyHexMesh with a boundary layer
-(second paper, section 3.6.2): a rounded box with four wheel arches and a sloped rear, built
+([SMB14 §3.6.2]): a rounded box with four wheel arches and a sloped rear, built
 with gmsh's OpenCASCADE kernel (STEP and STL), a blockMesh tunnel, snappyHexMesh (castellate,
 snap, 2 layers on the body).  usage: make_case.py CASE_DIR [--base N] [--level L] [--height H] [--step-only PATH]
   --base N   background cells along the body length (default 10: ~50k cells; 20 ~ 300k)

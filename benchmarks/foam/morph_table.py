@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The second paper's Table 2 on a snappyHexMesh mesh (section 3.6.2): lift three roof handles
+"""[SMB14]'s Table 2 on a snappyHexMesh mesh (section 3.6.2): lift three roof handles
 of the car-like body with the tunnel boundary fixed, by RBF, DM-FFD (lattices 10/15/25) and
 MLS, write each result as an OpenFOAM case (points only), and judge it by the real checkMesh
 and by `cadmorph quality --foam`: worst aspect ratio, non-orthogonality, skewness, wrongly

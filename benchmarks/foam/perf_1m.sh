@@ -1,6 +1,6 @@
 #!/bin/sh
 # ~1M cells (make_case.py car1m --base 28: 974,704 cells, 1,033,220 points): the Table-2 rows
-# of the second paper at 1M cells, one job at a time (benchmarks/foam/table_row.py: GNU time,
+# of [SMB14] at 1M cells, one job at a time (benchmarks/foam/table_row.py: GNU time,
 # the real checkMesh and `quality --foam` on each written case), and read / morph / write of
 # the polyMesh against the same mesh as .vtu.
 # usage (in the directory holding CASE): nice -n 10 sh perf_1m.sh CADMORPH CASE

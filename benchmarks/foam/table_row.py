@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""One row of the second paper's Table 2 on the car case (section 3.6.2), run on its own so
+"""One row of [SMB14]'s Table 2 on the car case (§3.6.2), run on its own so
 that a ~1M-cell case can be measured one job at a time: the morph under GNU time (CPU s =
 user + sys, peak RSS), the written case judged by the real checkMesh and by
 `cadmorph quality --foam` (every printed metric string-equal to checkMesh's, the parser of

@@ -1,5 +1,5 @@
 """`cadmorph detect` on a gmsh surface mesh of a STEP part scored against the CAD face types
-(issue 16): each triangle's CAD face is its gmsh surface tag, whose type gmsh reports.
+: each triangle's CAD face is its gmsh surface tag, whose type gmsh reports.
 usage: detect_score.py CADMORPH G.step OUT_PREFIX
 Per triangle: precision = triangles labelled with the type of their CAD face / labelled
 triangles; recall = the same / triangles of plane, cylinder, sphere or cone faces. Per CAD face

@@ -1,5 +1,5 @@
 #!/bin/sh
-# FreeCAD-made parts through cadmorph (RESULTS.md "FreeCAD-made parts (issues 16, 18)"):
+# FreeCAD-made parts through cadmorph (benchmarks/RESULTS.md, FreeCAD-made parts):
 # info --compare of every edit and re-export, mesh by gmsh and TetGen, morph of each mesh onto
 # the edits (--steps auto when one step inverts) and onto the re-export, detect on a gmsh surface
 # mesh scored against the CAD face types.

@@ -1,6 +1,6 @@
 #!/bin/sh
-# TetGen against gmsh in `cadmorph mesh` (issue 18) on the built-in models at t = 0 (bore, pipe,
-# bracket, written by cm_model): CPU seconds of the whole command (the mesher's child included:
+# TetGen against gmsh in `cadmorph mesh` on the built-in models at t = 0 (bore, pipe,
+# bracket, written by `cadmorph model`): CPU seconds of the whole command (the mesher's child included:
 # /usr/bin/time counts waited-for children), tets, min and 1st-percentile scaled Jacobian,
 # with the interior optimisation (default) and without (--no-optimize: the mesher's own).
 # usage: benchmarks/meshers/bench_meshers.sh [BUILD_DIR]   (default: build)
@@ -14,9 +14,9 @@ OUT=$BUILD/bench/meshers
 mkdir -p "$OUT"
 CM=$BUILD/cli/cadmorph
 for model in bore pipe bracket; do
-  OPENBLAS_VERBOSE=0 "$BUILD/benchmarks/models/cm_model" $model 0 "$OUT/$model.step"
+  OPENBLAS_VERBOSE=0 "$CM" model $model 0 "$OUT/$model.step"
 done
-# and two parts made by another CAD kernel than ours (gmsh's OpenCASCADE, issue 13's script)
+# and two parts made by another CAD kernel than ours (gmsh's OpenCASCADE, quality_guard/make_parts.py)
 /usr/bin/python3 "$ROOT/benchmarks/quality_guard/make_parts.py" "$OUT" > /dev/null 2>&1
 # the bbox diagonal, from `cadmorph info`'s "bbox: [a, b] x [c, d] x [e, f]"
 diag() {

@@ -11,7 +11,7 @@ echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 for run in "bore 0.173" "bore 0.084" "pipe 0.118" "pipe 0.052" "bracket 0.18" "bracket 0.0835"; do
     set -- $run
     model=$1 size=$2
-    "$build/benchmarks/models/cm_model" "$model" 0 "$work/$model.step"
+    "$build/cli/cadmorph" model "$model" 0 "$work/$model.step"
     /usr/bin/time -f "rss_kb=%M wall_s=%e" "$build/cli/cadmorph" mesh "$work/$model.step" \
         -o "$work/${model}_$size.vtu" --size "$size" --mesher tetgen -v >"$work/out.txt" 2>"$work/err.txt"
     awk -v model="$model" -v size="$size" '

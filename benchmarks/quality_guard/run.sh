@@ -1,5 +1,5 @@
 #!/bin/sh
-# Issue 13 figures: adaptive steps and interior optimisation, side by side in one run.
+# Adaptive steps and interior optimisation, side by side in one run.
 #   sh benchmarks/quality_guard/run.sh BUILD OUT_DIR
 # 1. bracket tet mesh (TetGen as before: --min-dihedral 0 --no-optimize), G(0) -> G(1): plain / --steps auto /
 #    --optimize / both, absolute and relative (--relative --via G(0.1) .. G(0.9));
@@ -13,7 +13,6 @@ B=$1
 O=$2
 mkdir -p "$O"
 C=$B/cli/cadmorph
-M=$B/benchmarks/models/cm_model
 here=$(dirname "$0")
 # run OUT cmd...: the command's stdout into OUT; prints "wall,cpu" seconds
 run() { out=$1; shift; /usr/bin/time -f "%e %U %S" -o "$O/time" "$@" > "$out" 2> "$out.err" || true
@@ -21,7 +20,7 @@ run() { out=$1; shift; /usr/bin/time -f "%e %U %S" -o "$O/time" "$@" > "$out" 2>
 summary() { tail -1 "$1" | sed 's/min_scaled_jacobian=\([^ ]*\) mean_scaled_jacobian=[^ ]* inverted=\([^ ]*\) cells=.*/\1,\2/'; }
 
 for m in bore pipe bracket; do
-  for t in 0 0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.9 1; do $M $m $t "$O/${m}_$t.step" > /dev/null; done
+  for t in 0 0.1 0.2 0.3 0.4 0.5 0.6 0.7 0.8 0.9 1; do $C model $m $t "$O/${m}_$t.step" > /dev/null; done
 done
 via() { echo "$O/$1_0.1.step,$O/$1_0.2.step,$O/$1_0.3.step,$O/$1_0.4.step,$O/$1_0.5.step,$O/$1_0.6.step,$O/$1_0.7.step,$O/$1_0.8.step,$O/$1_0.9.step"; }
 

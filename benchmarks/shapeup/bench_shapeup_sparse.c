@@ -1,4 +1,4 @@
-/* The two constraint formulations of section 6.1 side by side on a planarity constraint
+/* The two constraint formulations of [CMLS §6.1] side by side on a planarity constraint
  * covering a whole plate (the worst case of the mean-centred C): entries of C, of the factor
  * update Phi^T C^T and of the constrained factor, the update's time and the alternations'.
  * usage: bench_shapeup_sparse N K [dense] [update]   (an N x N quad plate, K MLS samples;

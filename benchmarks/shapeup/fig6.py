@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The MLS paper's Figure 6: one synthetic example per constraint type (plane, circle,
+"""Figure 6 of [CMLS]: one synthetic example per constraint type (plane, circle,
 feature line, cylinder, rigid), each deformed by `cadmorph deform --method mls` without and
 with the constraint (bending only: gamma_s = 0, gamma_b = 1, gamma_c = 10, the paper's).
 Writes OUT/fig6.csv (residual before/after, iterations, times) and OUT/fig6.svg (original,

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The MLS paper's Figures 8-10 on two gmsh-built parts (OpenCASCADE kernel, surface meshes):
+"""Figures 8-10 of [CMLS] on two gmsh-built parts (OpenCASCADE kernel, surface meshes):
 - fandisk-like (Figure 8): a block whose profile (plateau, slanted face, lower step) is
   extruded, with a chamfered front edge; the bottom band (z < 0.35) fixed, a corner of the lower step (the
   handle) moved left and up; constraints: three sharp edges as feature lines, then also the

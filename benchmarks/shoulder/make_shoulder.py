@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The compressed-shoulder case of issue 18 section 4 (RESULTS.md, "A compressed shoulder"):
+"""The compressed-shoulder case (benchmarks/RESULTS.md, "A compressed shoulder"):
 a block 5 x 5 x 3 with a counterbore (radius 1.5, from z = 1.5) over a through bore of radius
 r2, written as STEP through gmsh's OpenCASCADE kernel. shoulder_a has r2 = 0.6 (annulus 0.9
 wide); shoulder_rR has r2 = R (the annulus compressed (1.5 - 0.6) / (1.5 - R) times).

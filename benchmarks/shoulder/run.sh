@@ -1,5 +1,5 @@
 #!/bin/sh
-# The compressed shoulder under one step, 5 steps and --steps auto (RESULTS.md, issue 18).
+# The compressed shoulder under one step, 5 steps and --steps auto (benchmarks/RESULTS.md, A compressed shoulder).
 #   benchmarks/shoulder/run.sh CADMORPH OUT_DIR
 set -u
 C=$1; O=$2

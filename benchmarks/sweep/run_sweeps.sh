@@ -1,5 +1,5 @@
 #!/bin/sh
-# The sweeps of benchmarks/RESULTS.md (issue 6): bore tet + hex, pipe tet + hex, bracket
+# The sweeps [SKM11] of benchmarks/RESULTS.md: bore tet + hex, pipe tet + hex, bracket
 # tet; absolute and relative, the three methods, 20 steps. Outputs in WORK/<model>_<mesh>/.
 # usage: run_sweeps.sh BUILD_DIR [WORK_DIR] [THREADS]
 set -u

@@ -46,7 +46,8 @@ set_tests_properties(cli_warp_method_unknown PROPERTIES LABELS "cli;volume"
   FIXTURES_REQUIRED warp_staten)
 
 # The benchmark models: bore and pipe, TetGen tets (cadmorph mesh) and O-grid hexes
-# (cm_hexmesh) at the sweeps' sizes, an affine motion of their boundary through each method.
+# (cadmorph model --hex-mesh) at the sweeps' sizes, an affine motion of their boundary through
+# each method.
 # Each stage is a fixture of the next, so any one test can run alone (ctest -R).
 set(BM ${CM_TEST_WORK}/staten_models)
 add_test(NAME warp_methods_models_setup COMMAND ${CMAKE_COMMAND} -E make_directory ${BM})
@@ -54,11 +55,11 @@ set_tests_properties(warp_methods_models_setup PROPERTIES FIXTURES_SETUP staten_
   LABELS "cli;volume")
 foreach(model bore pipe)
   add_test(NAME warp_methods_${model}_step
-    COMMAND $<TARGET_FILE:cm_model> ${model} 0 ${BM}/${model}.step)
+    COMMAND $<TARGET_FILE:cadmorph> model ${model} 0 ${BM}/${model}.step)
   add_test(NAME warp_methods_${model}_tet
     COMMAND $<TARGET_FILE:cadmorph> mesh ${BM}/${model}.step -o ${BM}/${model}_tet.msh --size 0.25 --mesher tetgen)
   add_test(NAME warp_methods_${model}_hex
-    COMMAND $<TARGET_FILE:cm_hexmesh> ${model} ${BM}/${model}_hex.msh 0.6667)
+    COMMAND $<TARGET_FILE:cadmorph> model ${model} 0 --hex-mesh ${BM}/${model}_hex.msh --scale 0.6667)
   set_tests_properties(warp_methods_${model}_step PROPERTIES LABELS "cli;volume"
     FIXTURES_REQUIRED staten_models_dir FIXTURES_SETUP staten_${model}_step)
   set_tests_properties(warp_methods_${model}_hex PROPERTIES LABELS "cli;volume"

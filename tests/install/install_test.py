@@ -10,7 +10,9 @@ build run on the plate-with-a-hole STEP fixtures (tests/data/surface) and gmsh's
                   --mesh HOLE_A_MESH --work DIR
 
 Also checked: the exported symbols of libcadmorph.so are exactly the functions the installed
-headers declare (CM_API), and `cadmorph --version`, cadmorph.pc and the config version agree.
+headers declare (CM_API), `cadmorph --version`, cadmorph.pc and the config version agree, and
+the installed program writes a built-in model that it reads back (`cadmorph model bore 0
+b.step`, then `cadmorph info b.step`: the README's first step).
 """
 import argparse
 import glob
@@ -89,6 +91,13 @@ def main():
     pc = run(["pkg-config", "--modversion", "cadmorph"], env=env).stdout.strip()
     if version != "cadmorph " + pc or not re.fullmatch(r"\d+\.\d+\.\d+", pc):
         fail("cadmorph --version says %r, cadmorph.pc %r" % (version, pc))
+
+    # the README's first step with the installed program alone
+    b_step = os.path.join(a.work, "b.step")
+    run([os.path.join(prefix, "bin", "cadmorph"), "model", "bore", "0", b_step])
+    info = run([os.path.join(prefix, "bin", "cadmorph"), "info", b_step]).stdout
+    if not re.search(r"^solids 1 ", info, re.MULTILINE):
+        fail("cadmorph info of the installed model's STEP: %r" % info)
 
     # the plate with a hole, its edit, one of another topology, a rigid motion of it
     g0, g1, other, rigid = (os.path.join(a.data, "surface", k + ".step")

@@ -1,4 +1,4 @@
-# The iterative RBF solver against the dense one on real boundary sets (issue 10's test):
+# The iterative RBF solver against the dense one on real boundary sets:
 # the bore and the thin-walled bracket, gmsh tets of G(0) with about 5k boundary nodes
 # (bore 5,338 at size 0.125, bracket 4,505 at 0.15), morphed onto G(1) once with each
 # solver. The moved meshes agree to 1e-9 of the displacement range (measured 1.4e-11 and
@@ -16,7 +16,7 @@ foreach(case bore:0.125 bracket:0.15)
   set(base ${SV}/${model})
   foreach(t 0 1)
     add_test(NAME morph_solvers_${model}_step${t}
-      COMMAND $<TARGET_FILE:cm_model> ${model} ${t} ${base}_${t}.step)
+      COMMAND $<TARGET_FILE:cadmorph> model ${model} ${t} ${base}_${t}.step)
     set_tests_properties(morph_solvers_${model}_step${t} PROPERTIES LABELS "cli;cad"
       FIXTURES_REQUIRED morph_solvers_dir FIXTURES_SETUP morph_solvers_${model}_steps)
   endforeach()

@@ -19,7 +19,7 @@ for run in "1 2" "2 1"; do
         --mesh "$mesh" --variants "$variants" -o "$work/r$1" --mode absolute --methods rbf-s \
         --threads "$2" >"$work/out_r$1.txt" 2>&1
     same=-
-    [ "$1" -gt 1 ] && same=$(/usr/bin/python3 "$here/../tests/study/same_study.py" "$work/r1/study.csv" "$work/r$1/study.csv" 1e-9 2>&1 || true)
+    [ "$1" -gt 1 ] && same=$(/usr/bin/python3 "$here/../../tests/study/same_study.py" "$work/r1/study.csv" "$work/r$1/study.csv" 1e-9 2>&1 || true)
     read wall user sys < "$work/time.txt"
     echo "| $1 x $2 | $wall | $(echo "$user + $sys" | bc) | $same |"
 done

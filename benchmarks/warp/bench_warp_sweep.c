@@ -1,13 +1,13 @@
-/* Staten-style comparison of the interior-warp methods on the benchmark models (issue 12),
+/* Staten-style comparison [SKM11] of the interior-warp methods on the benchmark models,
  * through the morph engine: M0 (a mesh of G(0)) onto G(k/steps), k = 1..steps, absolute
  * (one morpher, each method factorised once) and relative (rebased after every step). Every
  * method except "rbf" gets the CAD-aware surface morph (RBF-S), so the volume methods are
- * compared on the same boundary; "rbf" is the paper's RBF: closest-point surface + RBF.
+ * compared on the same boundary; "rbf" is the RBF of [SKM11]: closest-point surface + RBF.
  * usage: bench_warp_sweep MODEL M0.msh STEPS WORK [methods] [threads] [modes]
  *   methods: comma list of rbf-s, rbf, rbf-s-biharmonic, femwarp, lbwarp, simplex
  *   modes: absolute,relative (default both)
- * One line per step: key=value pairs (benchmarks/bench_warp_sweep_table.py). */
-#include "cli/blas_reexec.h"
+ * One line per step: key=value pairs (benchmarks/warp/bench_warp_sweep_table.py). */
+#include "blas_reexec.h"
 #include "cadmorph/cad.h"
 #include "cadmorph/morph.h"
 #include "cadmorph/models.h"

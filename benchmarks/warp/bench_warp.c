@@ -1,10 +1,10 @@
-/* Warp methods side by side (issue 12): for one mesh, each method in a forked child (so that
+/* Warp methods side by side: for one mesh, each method in a forked child (so that
  * each gets its own peak RSS) creates its warp on M0 (assembly + factorisation) and applies
  * it to the same smooth boundary motion `steps` times, as an absolute study does.
  * BENCH_VERBOSE=1 in the environment shows the library's log (stage timings) on stderr.
  * usage: bench_warp MESH [steps=20] [threads=2] [methods=rbf,rbf-biharmonic,femwarp,lbwarp,simplex]
  * One line per method: key=value pairs (RESULTS.md, "Warp methods"). */
-#include "cli/blas_reexec.h"
+#include "blas_reexec.h"
 #include "cadmorph/mesh.h"
 #include "cadmorph/warp.h"
 

@@ -1,4 +1,4 @@
-"""Runs `cadmorph sweep` and checks what it wrote (issue 6 integration test).
+"""Runs `cadmorph sweep` (or `cadmorph demo`) and checks what it wrote.
 
 sweep.csv: exactly one row per mode x method x step 1..N with t = k/N, finite values,
 min <= mean scaled Jacobian, at most --max-inverted inverted cells and a boundary distance to

@@ -1,11 +1,11 @@
 #!/bin/sh
-# Benchmark of `cadmorph quality` on a ~1M-tet gmsh mesh of the unit box (issue 2).
-# usage: benchmarks/bench_quality.sh [BUILD_DIR]   (default: build)
+# Benchmark of `cadmorph quality` on a ~1M-tet gmsh mesh of the unit box.
+# usage: benchmarks/quality/bench_quality.sh [BUILD_DIR]   (default: build)
 # Generates BUILD_DIR/bench/box_1m.msh once (gmsh, binary msh 4.1; not committed), then times
 # the whole command with /usr/bin/time -v (wall time, peak memory) at 1 and 2 threads, and
-# the stages alone with bench_quality (built with the project).
+# the stages alone with bench_quality (built with -DCADMORPH_BUILD_BENCHMARKS=ON).
 set -eu
-ROOT=$(cd "$(dirname "$0")/.." && pwd)
+ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 BUILD=$(cd "${1:-$ROOT/build}" && pwd)
 OUT=$BUILD/bench
 MESH=$OUT/box_1m.msh
@@ -35,5 +35,5 @@ for t in 1 2; do
   /usr/bin/time -v "$BUILD/cli/cadmorph" quality "$MESH" --threads $t 2> "$OUT/time_$t.txt"
   grep -E "Elapsed \(wall|Maximum resident|User time|System time" "$OUT/time_$t.txt"
   echo "== stages, $t threads"
-  "$BUILD/benchmarks/bench_quality" "$MESH" $t
+  "$BUILD/benchmarks/quality/bench_quality" "$MESH" $t
 done

@@ -1,8 +1,8 @@
 #!/bin/sh
-# Issue 9: an absolute study of 20 bore variants against a study of one (the last, t = 1):
+# An absolute study of 20 bore variants against a study of one (the last, t = 1):
 # the classification of M0 and the warp factorisation are made once for the family, so the
 # 20-variant study should cost at most 2 x the single one. Writes G0 and G(k/20), k = 1..20,
-# with cm_model, a TetGen mesh of G0 with `cadmorph mesh`, then times `cadmorph study
+# with `cadmorph model`, a TetGen mesh of G0 with `cadmorph mesh`, then times `cadmorph study
 # --mode absolute --methods rbf-s --write-meshes none` on both lists and prints one table row
 # per mesh size (wall and CPU seconds from /usr/bin/time; one-time and per-variant stages from
 # study.csv: one-time = classify + factorise, per variant = the median over variants of
@@ -15,11 +15,10 @@ threads=${3:-2}
 [ $# -ge 3 ] && shift 3 || shift $#
 sizes=${*:-0.25 0.15}
 cadmorph=${CADMORPH:-$build/cli/cadmorph}
-model=$build/benchmarks/models/cm_model
 mkdir -p "$work/v20" "$work/v1"
-"$model" bore 0 "$work/G0.step"
+"$cadmorph" model bore 0 "$work/G0.step"
 for k in $(seq 1 20); do
-    "$model" bore "$(awk -v k="$k" 'BEGIN { print k / 20 }')" "$work/v20/bore_$(printf %02d "$k").step"
+    "$cadmorph" model bore "$(awk -v k="$k" 'BEGIN { print k / 20 }')" "$work/v20/bore_$(printf %02d "$k").step"
 done
 cp "$work/v20/bore_20.step" "$work/v1/"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1-3 /proc/loadavg)"

@@ -1,4 +1,4 @@
-/* Benchmark of the CAD layer (issue 4): dense sampling + kD-tree build at about 1M samples,
+/* Benchmark of the CAD layer: dense sampling + kD-tree build at about 1M samples,
  * nearest-sample queries, and projection of 100k points near the surface (nearest sample +
  * Newton). Usage: bench_cad MODEL.step [samples=1e6] [points=1e5] [threads=2] */
 #include "cadmorph/cad.h"

@@ -16,15 +16,15 @@ bin=${BENCH_BIN:-$build}  # a copy of the binaries, to rebuild meanwhile
 mkdir -p "$work"
 cd "$work"
 echo "# $(date -u '+%Y-%m-%d %H:%M UTC')  $(lscpu | sed -n 's/^Model name: *//p')  nproc=$(nproc)  threads=$threads  load=$(cut -d' ' -f1-3 /proc/loadavg)"
-for m in bore pipe bracket; do "$bin/benchmarks/models/cm_model" $m 0 $m.step >/dev/null; done
+for m in bore pipe bracket; do "$bin/cli/cadmorph" model $m 0 $m.step >/dev/null; done
 [ -f bracket_tet.msh ] && [ -f pipe_hex.msh ] || {
 "$bin/cli/cadmorph" mesh bore.step -o bore_tet.msh --size 0.25 --mesher tetgen >/dev/null
 "$bin/cli/cadmorph" mesh pipe.step -o pipe_tet.msh --size 0.2 --mesher tetgen >/dev/null
 "$bin/cli/cadmorph" mesh bracket.step -o bracket_tet.msh --size 0.25 --mesher tetgen >/dev/null
-"$bin/benchmarks/models/cm_hexmesh" bore bore_hex.msh 0.6667 >/dev/null
-"$bin/benchmarks/models/cm_hexmesh" pipe pipe_hex.msh 1 >/dev/null
+"$bin/cli/cadmorph" model bore 0 --hex-mesh bore_hex.msh --scale 0.6667 >/dev/null
+"$bin/cli/cadmorph" model pipe 0 --hex-mesh pipe_hex.msh >/dev/null
 }
 for run in $runs; do
     model=${run%_*}
-    /usr/bin/time -f "# $run $mode: wall_s=%e rss_kb=%M" "$bin/benchmarks/bench_warp_sweep" $model $run.msh "$steps" . "$methods" "$threads" "$mode"
+    /usr/bin/time -f "# $run $mode: wall_s=%e rss_kb=%M" "$bin/benchmarks/warp/bench_warp_sweep" $model $run.msh "$steps" . "$methods" "$threads" "$mode"
 done

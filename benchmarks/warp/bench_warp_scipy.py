@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """`cadmorph warp` end to end against scipy's RBFInterpolator(kernel='cubic', degree=1) on the
-same problem (issue 10, Figures): the boundary nodes of a tet mesh move by the displacement
+same problem (benchmarks/RESULTS.md, RBF solvers): the boundary nodes of a tet mesh move by the displacement
 field of a real CAD morph (the 'displacement' point data of a `cadmorph morph` output), the
 interior follows the r^3 + linear interpolant.
 
