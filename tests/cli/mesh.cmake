@@ -51,7 +51,7 @@ add_test(NAME cli_mesh_missing_file COMMAND ${CM_RUN_CLI} --exit 2 --stderr-line
 add_test(NAME cli_mesh_not_step COMMAND ${CM_RUN_CLI} --exit 2 --stderr-lines 1 --
   $<TARGET_FILE:cadmorph> mesh ${MD}/make_fixtures.py -o ${MW}/x.vtu)
 # TetGen runs in a child process under a time limit: far below the work it is killed, the
-# command says so in one line and writes nothing (issue 18)
+# command says so in one line and writes nothing
 add_test(NAME cli_mesh_time_limit COMMAND ${CM_RUN_CLI} --exit 2 --stderr-lines 1
   --stderr "cadmorph mesh: [^\n]*bore_0.step: TetGen[^\n]* did not finish in 0.05 s[^\n]*--time-limit"
   --absent ${MW}/time_limit.vtu --

@@ -19,7 +19,7 @@ set(MORPH_MOVED $<TARGET_FILE:cadmorph> morph --from ${AW}/hole_0.step --to ${AW
 cm_adaptive_cli(cli_morph_one_step_inverts ${CM_RUN_CLI} --exit 3 --stderr "inverted cells" --
   ${MORPH_MOVED} -o ${AW}/one_step.vtu --fail-on-inverted)
 # the same without --fail-on-inverted: written, exit 0, and one warning line naming the count
-# and the worst cell (issue 18: the summary line alone is easy to miss)
+# and the worst cell (the summary line alone is easy to miss)
 cm_adaptive_cli(cli_morph_one_step_warns ${CM_RUN_CLI} --exit 0 --stderr-lines 1
   --stderr "^cadmorph morph: warning: [1-9][0-9]* inverted cells? \\(scaled Jacobian <= 0\\). the worst is cell [0-9]+ \\(0-based, tet4, scaled Jacobian -?[0-9.e+-]+\\) at \\("
   --stdout "inverted=[1-9][0-9]* cells=" -- ${MORPH_MOVED} -o ${AW}/one_step_warned.vtu)
