@@ -1,7 +1,7 @@
 // Row-wise trimming test for the locator's sampling grid (cad/locator.cpp): one exact
 // classification (BRepTopAdaptor_FClass2d, a point-in-polygon test over the whole boundary
 // polygon) per grid candidate made B-spline-heavy parts with long boundaries cost tens of
-// seconds to sample (issue 18 section 4). A row v = const meets the face's boundary in a few
+// seconds to sample (benchmarks/RESULTS.md, CAD layer). A row v = const meets the face's boundary in a few
 // crossings: with the pcurves as a polyline, the even-odd count of crossings left of a
 // candidate decides it, and only candidates within delta of the polyline (delta bounds how
 // far it is from the pcurves: the sampled chord deviation, with a margin, and any gap

@@ -111,7 +111,7 @@ int cli_cmd_mesh(int argc, char **argv)
         return cli_usage(cmd, usage, "--quality, --min-dihedral and --preserve-surface are "
                          "TetGen's: not with --mesher gmsh");
     /* gmsh by default: better tets than TetGen's at the same size or tet count
-     * (benchmarks/RESULTS.md, issue 18) and no crash on its error paths */
+     * (benchmarks/RESULTS.md, Meshers) and no crash on its error paths */
     if (opt.mesher < 0) opt.mesher = tetgen_options ? CM_MESHER_TETGEN : CM_MESHER_GMSH;
     if (preserve_surface) opt.preserve_surface = 1;
     if (no_optimize) opt.optimize = 0;

@@ -1,4 +1,4 @@
-/* `cadmorph sweep`: a Staten-style study of a benchmark model (issue 6): M(0) morphed onto
+/* `cadmorph sweep`: a Staten-style study of a benchmark model [SKM11]: M(0) morphed onto
  * G(t) for t = 1/N .. 1 by several methods, absolutely and/or relatively; sweep.csv, sweep.svg
  * and the meshes at 50 and 100 % in the output directory, a summary on stdout. */
 #include "cli.h"

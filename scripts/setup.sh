@@ -18,8 +18,9 @@ packages=(
 # MUMPS, Trilinos, ScaLAPACK and gfortran it is ~340 packages for one optional solver.
 if [ "${CADMORPH_WITH_PETSC:-0}" = 1 ]; then packages+=(libpetsc-real-dev openmpi-bin); fi
 # Optional, only to regenerate tests/data/freecad/ and run benchmarks/freecad/ (FreeCAD 0.20
-# parts, issue 18): CADMORPH_WITH_FREECAD=1 bash scripts/setup.sh. Not in the default list: a
-# GUI application (Qt, Coin, PySide2: 43 packages on top of this list) for a fixture generator.
+# parts; benchmarks/RESULTS.md, FreeCAD-made parts): CADMORPH_WITH_FREECAD=1 bash
+# scripts/setup.sh. Not in the default list: a GUI application (Qt, Coin, PySide2: 43 packages
+# on top of this list) for a fixture generator.
 if [ "${CADMORPH_WITH_FREECAD:-0}" = 1 ]; then packages+=(freecad); fi
 
 missing=()

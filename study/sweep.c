@@ -1,4 +1,4 @@
-/* Sweeps of the built-in models (issue 6) as studies: the family G(k / N), k = 1 .. N, is
+/* Sweeps of the built-in models [SKM11] as studies: the family G(k / N), k = 1 .. N, is
  * written as STEP by the model library and read back by the CAD layer (what a user's file goes
  * through), M(0) is a TetGen or O-grid mesh of G(0) or a file, and cm_study_run does the rest. */
 #include "cadmorph/models.h"

@@ -1,4 +1,4 @@
-/* Affine edits G' = A G + b reproduced exactly (issue 18 section 2). Arc length is not
+/* Affine edits G' = A G + b reproduced exactly (benchmarks/RESULTS.md, Affine edits). Arc length is not
  * affine-invariant (a circle becomes an ellipse), nor is a face's (u,v) once OpenCASCADE
  * converts a plane into a B-spline, so the surface morph's correspondences slide nodes along
  * G' under such edits. Here A, b are estimated from the corresponding vertices (least

@@ -1,4 +1,4 @@
-/* The constraint sets a CAD model already knows (issue 16, `--constraints-from-cad`): every
+/* The constraint sets a CAD model already knows ([CMLS §6], `--constraints-from-cad`): every
  * node of a planar face - on the face, its edges or their vertices - forms that face's
  * planarity set, of a cylindrical (conical) face its cylinder (cone) set, of a circular edge its circularity
  * set. The nodes are classified once and grouped by entity, so the cost is linear in the

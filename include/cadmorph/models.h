@@ -1,7 +1,8 @@
 /* cadmorph built-in models: the parametric families G(t), t in [0, 1], of `cadmorph sweep`
- * and `cadmorph demo` (issue 6): bore, pipe, bracket. The values are fixed by the issue; every
- * t gives the same topology in the same face/edge/vertex order. Lengths are in millimetre
- * (the STEP unit written). Conventions: see core.h.
+ * and `cadmorph demo`: bore and pipe after [SKM11], and a bracket. The values are fixed (the
+ * recorded sweeps and studies depend on them); every t gives the same topology in the same
+ * face/edge/vertex order. Lengths are in millimetre (the STEP unit written). Conventions: see
+ * core.h.
  *
  * Two libraries implement this header, each inside its module's rules: the solids and their
  * STEP export are OpenCASCADE code and live in cad/ (cad/models.cpp, cad/model_params.c); the

@@ -1,4 +1,4 @@
-# Parts made by FreeCAD 0.20 (tests/data/freecad/make_parts.py, issue 18): an L bracket whose
+# Parts made by FreeCAD 0.20 (tests/data/freecad/make_parts.py; benchmarks/RESULTS.md, FreeCAD-made parts): an L bracket whose
 # shoulder annulus (boss radius 6, outer radius 14) is edited to 8 (bracket_2, 4x narrower) and
 # FreeCAD's own re-export of it (bracket_re). Pins what worked on them: the re-export corresponds
 # and leaves every node in place; and what failed: one step of the 4x compression inverts

@@ -1,4 +1,4 @@
-# The BLAS set-up of cli/blas_reexec.c (issue 10 section 1) and the bounds of issue 11:
+# The BLAS set-up of cli/blas_reexec.c (README.md, the OpenBLAS core) and the resource bounds:
 # --version names the BLAS, its core and threads (on a Sapphire-Rapids-class Xeon OpenBLAS
 # 0.3.21 picks Prescott and the real re-exec happens; elsewhere OpenBLAS's choice stands);
 # the re-exec with OPENBLAS_CORETYPE (on machines where OpenBLAS chooses well,
@@ -24,13 +24,13 @@ add_test(NAME cli_blas_user_coretype COMMAND ${CMAKE_COMMAND} -E env OPENBLAS_CO
   -- $<TARGET_FILE:cadmorph> --version -v)
 set_tests_properties(cli_version_blas cli_blas_reexec cli_blas_user_coretype PROPERTIES LABELS "cli")
 
-# issue 11 item 5: bounded time and a clean exit code under ulimit -v
+# bounded time and a clean exit code under ulimit -v
 add_test(NAME cli_ulimit COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/ulimit.sh $<TARGET_FILE:cadmorph>
   ${BW}/sphere.msh ${BW}/sphere_disp.csv ${BW})
 set_tests_properties(cli_ulimit PROPERTIES LABELS "cli" FIXTURES_REQUIRED warp_sphere
   SKIP_RETURN_CODE 77 TIMEOUT 600)
 
-# issue 11 item 7: libgomp aborted at --threads 512..4096; now a usage error naming the cap
+# libgomp aborts at --threads 512..4096: a usage error naming the cap instead
 foreach(t 512 4096 100000)
   add_test(NAME cli_threads_cap_${t} COMMAND ${BRUN} --exit 1 --stderr-lines 2
     --stderr "^cadmorph warp: --threads ${t} is more than 4 per core \\([0-9]+ cores: at most [0-9]+\\)"

@@ -1,4 +1,4 @@
-# Hostile and broken input (issue 11): one ctest per case of hostile.py, which writes each
+# Hostile and broken input: one ctest per case of hostile.py, which writes each
 # input itself and checks exit code, the one stderr line naming the file, time and memory.
 set(_hostile_py ${CMAKE_CURRENT_LIST_DIR}/hostile.py)
 execute_process(COMMAND ${CM_PYTHON} ${_hostile_py} list OUTPUT_VARIABLE _hostile_cases

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Hostile and broken input (issue 11): each case writes its input (no large fixtures), runs
+"""Hostile and broken input: each case writes its input (no large fixtures), runs
 the cadmorph CLI in bounded time, and checks the exit code from the README's list, exactly one
 stderr line that matches the case's pattern and names the file, and peak memory.
 

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Issue 11 item 5: under an address-space limit (ulimit -v) cadmorph must finish in bounded
+# Under an address-space limit (ulimit -v) cadmorph must finish in bounded
 # time with a clean exit code: 0, or 4 with one "out of memory" line. Before the fix
 # `cadmorph --version` printed and then hung at exit joining an OpenBLAS worker that spun in
 # its buffer allocation, and `warp` spun in that allocation itself.

@@ -1,4 +1,4 @@
-/* DM-FFD: ffd.md 4.7 checks 9-13 - exact at full row rank, least norm / least squares against
+/* DM-FFD [HHK92; SMB14 §2.2]: exact at full row rank, least norm / least squares against
  * LAPACK's dgelsd, the precomputed B = M Phi^+, clamping (Fig. 8 setting), and the documented
  * non-reproduction of translations (the RBF with its linear polynomial does reproduce them). */
 #include "deform_test_util.h"

@@ -1,6 +1,6 @@
-/* FFD lattice and deformation: ffd.md 4.7 checks 1-8 (partition of unity, identity bit for
+/* FFD lattice and deformation [SP86; SMB14 §2.1]: partition of unity, identity bit for
  * bit, translation, affine/rigid on a rotated lattice, local coordinates, locality, faces and
- * outside - PyGeM #272 - and C2 continuity at a zero border). */
+ * outside - PyGeM #272 - and C2 continuity at a zero border. */
 #include "deform_test_util.h"
 #include "test_util.h"
 

@@ -1,4 +1,4 @@
-/* ffd.md 4.7 check 14: PyGeM's FFD (Bernstein, rotated box) against numbers PyGeM produced,
+/* The PyGeM cross-check [PyGeM]: PyGeM's FFD (Bernstein, rotated box) against numbers PyGeM produced,
  * stored with the script that made them (tests/data/deform/make_pygem_fixture.py): the .prm
  * files are PyGeM's own write_parameters output, so the reader is checked on them too. At 4
  * control points per axis the clamped cubic B-spline is the cubic Bernstein basis: the same

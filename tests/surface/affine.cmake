@@ -1,4 +1,4 @@
-# Affine edits reproduced exactly: gen_affine writes the STEP pairs
+# Affine edits reproduced exactly (benchmarks/RESULTS.md, Affine edits): gen_affine writes the STEP pairs
 # G0, G1 = A G0 + b with OpenCASCADE (fixture affine_steps); test_affine checks the surface
 # morph of every pair and the whole morph (tets and hexes) against A M0 + b.
 add_executable(gen_affine gen_affine.cpp)

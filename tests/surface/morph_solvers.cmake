@@ -1,4 +1,4 @@
-# The iterative RBF solver against the dense one on real boundary sets:
+# The iterative RBF solver against the dense one on real boundary sets (benchmarks/RESULTS.md, Iterative solver):
 # the bore and the thin-walled bracket, gmsh tets of G(0) with about 5k boundary nodes
 # (bore 5,338 at size 0.125, bracket 4,505 at 0.15), morphed onto G(1) once with each
 # solver. The moved meshes agree to 1e-9 of the displacement range (measured 1.4e-11 and

@@ -1,4 +1,4 @@
-/* Affine edits G1 = A G0 + b are reproduced exactly (issue 18 section 2): M1 = A M0 + b to
+/* Affine edits G1 = A G0 + b are reproduced exactly (benchmarks/RESULTS.md, Affine edits): M1 = A M0 + b to
  * 1e-8 x diagonal, for a rigid motion, a uniform scale (OpenCASCADE keeps the surface types)
  * and a non-uniform scale with shear (BRepBuilderAPI_GTransform: planes and cylinders become
  * B-splines, arc length and (u,v) are no longer preserved), on the built-in bore (tets and

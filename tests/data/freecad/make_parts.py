@@ -1,4 +1,5 @@
-# FreeCAD 0.20 parts for tests/cad/freecad.cmake and benchmarks/freecad/run.sh (issues 16, 18):
+# FreeCAD 0.20 parts for tests/cad/freecad.cmake and benchmarks/freecad/run.sh
+# (benchmarks/RESULTS.md, FreeCAD-made parts):
 # run with `freecadcmd make_parts.py`
 # and OUT_DIR in the environment variable CM_FREECAD_OUT (freecadcmd passes no argv to scripts).
 # Each part is a Part-workbench document object recomputed at two or three values of one
