@@ -135,3 +135,7 @@ install(FILES ${PROJECT_BINARY_DIR}/cadmorphConfig.cmake
   ${PROJECT_BINARY_DIR}/cadmorphConfigVersion.cmake
   DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/cadmorph)
 install(FILES ${PROJECT_BINARY_DIR}/cadmorph.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
+# the design, the style and the references that the installed headers cite
+install(FILES ${PROJECT_SOURCE_DIR}/docs/DESIGN.md ${PROJECT_SOURCE_DIR}/docs/STYLE.md
+  ${PROJECT_SOURCE_DIR}/docs/references.md ${PROJECT_SOURCE_DIR}/docs/ffd.md
+  DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs)

@@ -1,4 +1,4 @@
-/* DM-FFD (paper section 2.2, eqs. 3-5 and 9-10; design notes ffd.md 4.4-4.5): the control
+/* DM-FFD [SMB14 §2.2, eqs. 3-5 and 9-10] (design notes: docs/ffd.md, sections 4-5): the control
  * displacements C = Phi^+ H that move m handles by H, Phi_ip = N_p(u(h_i)), through an SVD
  * of Phi restricted to the control points some handle touches (the least-norm solution gives
  * the others exactly 0, and dropping them shrinks the SVD). Singular values <= eps sigma_max

@@ -1,4 +1,4 @@
-/* The FFD lattice (paper shape-deformation-benchmarks section 2.1; design notes ffd.md 4.1-4.2):
+/* The FFD lattice [SMB14 §2.1] (design notes: docs/ffd.md, sections 1-2):
  * knots, cubic B-spline and Bernstein bases per axis, Greville placement of the control
  * points (so the reference map is exactly affine), and local coordinates - the affine inverse
  * for the reference lattice, damped Newton for a moved one. */

@@ -216,7 +216,7 @@ CM_API cm_status cm_cad_face_boundary(cm_context *ctx, const cm_cad_model *model
 /* The same samples at other points of the edges: t (n entries, n and layout as
  * cm_cad_face_boundary gives them) is the edge parameter of each sample, NaN for the
  * arc-length one. For corresponding samples that do not sit at equal arc-length fractions
- * (the images of G's samples under an affine edit, surface/affine.c). Degenerate edges keep
+ * (the images of G's samples under an affine edit). Degenerate edges keep
  * their uniform samples; s keeps the nominal fraction. */
 CM_API cm_status cm_cad_face_boundary_at(cm_context *ctx, const cm_cad_model *model, int face,
                                          const int *per_edge, int count, const double *t,

@@ -5,8 +5,8 @@
  * core.h.
  *
  * Two libraries implement this header, each inside its module's rules: the solids and their
- * STEP export are OpenCASCADE code and live in cad/ (cad/models.cpp, cad/model_params.c); the
- * structured hex meshes of G(0) are mesh code and live in study/ (study/hexmesh.c). */
+ * STEP export are OpenCASCADE code (the cad module); the structured hex meshes of G(0) are mesh
+ * code (the study module): docs/DESIGN.md, "Modules". */
 #ifndef CADMORPH_MODELS_H
 #define CADMORPH_MODELS_H
 
@@ -72,7 +72,7 @@ CM_API cm_status cm_model_write_step(cm_context *ctx, const char *model, double 
 CM_API cm_status cm_model_signature(cm_context *ctx, const char *model, double t, char *buf,
                              size_t size, double *volume);
 
-/* ---- structured hex meshes of G(0) (study/hexmesh.c) ----
+/* ---- structured hex meshes of G(0) ----
  * O-grids whose boundary nodes lie exactly on G(0) (the parameters above at t = 0). */
 
 /* bore: an O-grid of the annulus between the bore (radius 0.6) and the block's square

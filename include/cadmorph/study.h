@@ -31,7 +31,7 @@ enum { CM_STUDY_ABSOLUTE = 1, CM_STUDY_RELATIVE = 2, CM_STUDY_BOTH = 3 };
 CM_API const char *cm_study_mode_name(int mode);
 
 /* ---- methods: a surface morph and a warp, named ----
- * Names (one table in study/method.c; a new warp method of warp.h is a study method without
+ * Names (one table in the study module; a new warp method of warp.h is a study method without
  * changes here):
  *   "rbf-s"              RBF-S surface morph + triharmonic RBF warp (the method)
  *   "project"            closest-point surface + triharmonic RBF warp (baseline)

@@ -8,9 +8,9 @@
  *   cm_warp_apply   - displacements at the constrained nodes in, at every node out; many
  *                     calls on one warp share the factorisation (absolute studies);
  *   cm_warp_destroy.
- * A relative step creates a new warp on the moved mesh. Adding a method is one file in
- * volume/ and one row in volume/warp.c's table; a space deformation is a row of deform.h's
- * table, and its warp row (warp_rbf.c, warp_dmffd.c, warp_mls.c) chooses the points.
+ * A relative step creates a new warp on the moved mesh. Adding a method is one file in the
+ * volume module and one row in its method table; a space deformation is a row of deform.h's
+ * table, and its warp row chooses the points (docs/DESIGN.md, "The warp interface").
  */
 #ifndef CADMORPH_WARP_H
 #define CADMORPH_WARP_H
