@@ -12,7 +12,7 @@
  * FULL=1: also dpotrf on full storage, unpacked from and packed back into RFP (dtfttr,
  * dtrttf; timed with the copies and without), the alternative for small n. */
 #include "cli/blas_reexec.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
 #include "bench_util.h"
 
 #include <cblas.h>
@@ -156,7 +156,7 @@ int main(int argc, char **argv)
     }
     const int threads = atoi(argv[1]), reps = atoi(argv[2]) > 0 ? atoi(argv[2]) : 1;
     int got = 0;
-    if (cm_rbf_blas_threads(NULL, "bench_cholesky", threads > 0 ? threads : 2, &got) != CM_OK)
+    if (cm_blas_threads(NULL, "bench_cholesky", threads > 0 ? threads : 2, &got) != CM_OK)
         return 2;
     for (int k = 3; k < argc; ++k) {
         const int n = atoi(argv[k]);

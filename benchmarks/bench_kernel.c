@@ -12,8 +12,8 @@
  * usage: bench_kernel N REPS THREADS,... M,...      e.g. bench_kernel 10000 3 1,2 10000,100000
  * (one line of key=value per m, threads, variant and sum) */
 #include "cli/blas_reexec.h"
-#include "rbf/rbf_internal.h"
-#include "rbf/rbf_sum_isa.h"
+#include "rbf_internal.h"
+#include "rbf_sum_isa.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -198,7 +198,7 @@ int main(int argc, char **argv)
         }
     }
     /* what AUTO's cost model sees in this process (one thread, as cm_rbf_create sets it) */
-    cm_rbf_blas_threads(NULL, "bench_kernel", 1, NULL);
+    cm_blas_threads(NULL, "bench_kernel", 1, NULL);
     double g, kp, ka;
     cm_rbf_auto_rates(&g, &kp, &ka);
     printf("auto_probe dgemm_gflops=%.1f plain_pairs_per_s=%.3g compensated_pairs_per_s=%.3g\n",

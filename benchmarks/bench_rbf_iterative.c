@@ -6,8 +6,8 @@
 #include "cli/blas_reexec.h"
 #include "cadmorph/blas.h"
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h" /* the inner coarse solver's counts, the unit product */
-#include "rbf/rbf_sum_isa.h"   /* the sqrt split of the kernel blocks */
+#include "rbf_internal.h" /* the inner coarse solver's counts, the unit product */
+#include "rbf_sum_isa.h"   /* the sqrt split of the kernel blocks */
 
 #include <math.h>
 #include <stdio.h>

@@ -14,8 +14,8 @@
  * weights (written by the first run, read afterwards). One key=value line per setting. */
 #include "cli/blas_reexec.h"
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
-#include "rbf/rbf_treecode.h"
+#include "rbf_internal.h"
+#include "rbf_treecode.h"
 
 #include <math.h>
 #include <stdio.h>

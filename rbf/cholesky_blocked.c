@@ -116,7 +116,7 @@ int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
     int threads = openblas_get_num_threads();
     /* under ulimit -v, as many callers as have room for their buffers (blas_threads.c) */
     if (threads > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N && !omp_in_parallel())
-        threads = cm_rbf_blas_callers(threads);
+        threads = cm_blas_callers(threads);
     else threads = 1;
     if (threads > 1) return cm_rbf_cholesky_rfp_lookahead(ctx, n, a, block, threads);
     return cm_rbf_cholesky_rfp_panels(ctx, n, a, block);

@@ -202,7 +202,7 @@ static cm_status factor_projected(cm_context *ctx, cm_rbf *r, int threads)
     double t[16] = {0}, s[16] = {0}, vw[16] = {0}, tmp[16] = {0};
     double ta = cm_wtime();
     /* populated in one call: cheaper than faulting it in page by page while it is assembled */
-    r->chol = cm_rbf_alloc_large(n2 * (n2 + 1) / 2 * sizeof(double), 1);
+    r->chol = cm_alloc_large(n2 * (n2 + 1) / 2 * sizeof(double), 1);
     ta = cm_wtime() - ta;
     if (!v || !wv || !z || !r->chol) {
         st = cm_error(ctx, CM_ERR_NOMEM,
@@ -255,7 +255,7 @@ static cm_status factor_projected(cm_context *ctx, cm_rbf *r, int threads)
     double t1 = cm_wtime();
 
     int blas_n = 1;
-    st = cm_rbf_blas_threads(ctx, "cm_rbf_create", threads, &blas_n);
+    st = cm_blas_threads(ctx, "cm_rbf_create", threads, &blas_n);
     if (st != CM_OK) goto done;
     /* dpftrf's arithmetic, panel by panel, so that progress moves (cholesky_blocked.c) */
     info = cm_rbf_cholesky_rfp(ctx, (int)n2, r->chol, 0);
@@ -332,7 +332,7 @@ cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size
     const int saved_blas_threads = openblas_get_num_threads();
 
     /* before the first LAPACK call: OpenBLAS hangs, not fails, without its buffer */
-    cm_status st = cm_rbf_blas_threads(ctx, "cm_rbf_create", 1, NULL);
+    cm_status st = cm_blas_threads(ctx, "cm_rbf_create", 1, NULL);
     if (st == CM_OK) st = place_centres(ctx, r, centres);
     if (st == CM_OK && r->m < (size_t)r->k)
         st = cm_error(ctx, CM_ERR_NUMERIC,
@@ -417,7 +417,7 @@ static cm_status solve_pass(cm_context *ctx, const cm_rbf *r, size_t nc, const d
         /* on the factorisation's BLAS threads: the packed triangular solves stream the
          * factor, more than one core's bandwidth (10k, 3 components: 0.086 -> 0.066 s) */
         int blas_n = 1;
-        cm_status st = cm_rbf_blas_threads(ctx, "cm_rbf_solve", threads, &blas_n);
+        cm_status st = cm_blas_threads(ctx, "cm_rbf_solve", threads, &blas_n);
         if (st != CM_OK) return st;
         info = LAPACKE_dpftrs_work(LAPACK_COL_MAJOR, 'N', 'L', (lapack_int)n2, (lapack_int)nc,
                                    r->chol, w + k, (lapack_int)m);

@@ -4,6 +4,7 @@
 #define CADMORPH_RBF_INTERNAL_H
 
 #include "cadmorph/rbf.h"
+#include "cm_platform.h" /* BLAS threads, large buffers (cm_platform) */
 
 #include <stddef.h>
 
@@ -41,11 +42,6 @@ struct cm_rbf {
 
 /* Threads for a leaf loop: the context's count, or all that OpenMP offers for 0. */
 int cm_rbf_threads(const cm_context *ctx);
-
-/* A buffer of bytes that may be large (rbf_alloc.c): from 2 MB on, on 2 MB boundaries and
- * marked for transparent huge pages; populate: faulted in now, in one call (for a buffer one
- * thread fills; leave it 0 where threads fill their own parts). Freed with free(). */
-void *cm_rbf_alloc_large(size_t bytes, int populate);
 
 /* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (1..4), i < n.
  * p: dim x n SoA with stride ldp (p + d * ldp is coordinate d), centres as in rbf (SoA,
@@ -105,7 +101,7 @@ long cm_rbf_merge_duplicates(int dim, size_t m_in, const double *c, double tol, 
  * UPLO 'L', as dpftrf), in place, panel by panel of `block` columns (0: the default), with
  * cm_progress(ctx, "rbf factor", done, total) after every panel (done in flops, monotonic).
  * Returns dpftrf's info: 0, or i > 0 if the leading minor of order i is not positive definite.
- * BLAS threads: as the caller set them (cm_rbf_blas_threads); on T > 1 of them and n in
+ * BLAS threads: as the caller set them (cm_blas_threads); on T > 1 of them and n in
  * [CM_LOOKAHEAD_MIN_N, CM_LOOKAHEAD_MAX_N] outside a parallel region, the look-ahead path
  * below on T OpenMP threads, else the panel-by-panel one (both: the same factor to rounding,
  * the same info and progress). */
@@ -125,14 +121,6 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
 #define CM_LOOKAHEAD_MIN_N 4000
 #define CM_LOOKAHEAD_MAX_N 60000
 
-/* Sets OpenBLAS's thread count for the calls that follow to `want`, or fewer if the
- * address-space limit cannot back their 128 MB buffers (blas.h, point 2); got (may be NULL)
- * receives the count. CM_ERR_NOMEM, with a message starting with who, if not even the
- * calling thread's buffer fits: OpenBLAS would spin forever trying to allocate it. */
-cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *got);
-/* How many of `want` threads can call one-thread BLAS at the same time (each needs its own
- * OpenBLAS buffer) under the address-space limit: want if there is none, at least 1. */
-int cm_rbf_blas_callers(int want);
 /* ---- iterative solver (rbf_iterative.c, rbf_schwarz.c) ---- */
 
 /* CPU seconds of the calling thread (CLOCK_THREAD_CPUTIME_ID; wall time if it fails): what

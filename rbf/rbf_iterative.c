@@ -1035,8 +1035,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     kr.R = R;
     int ok = 1;
     for (int c = 0; c < gmax; ++c) {
-        kr.v[c] = cm_rbf_alloc_large((size_t)(R + 1) * m * sizeof(double), 0);
-        kr.z[c] = cm_rbf_alloc_large((size_t)R * m * sizeof(double), 0);
+        kr.v[c] = cm_alloc_large((size_t)(R + 1) * m * sizeof(double), 0);
+        kr.z[c] = cm_alloc_large((size_t)R * m * sizeof(double), 0);
         kr.h[c] = calloc((size_t)(R + 1) * (size_t)R, sizeof(double));
         ok = ok && kr.v[c] && kr.z[c] && kr.h[c];
     }

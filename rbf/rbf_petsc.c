@@ -28,6 +28,7 @@
  * as the gather does): fine on one node. For many nodes the design is to number the rows
  * by Schwarz leaves, so that a rank's rows are its subdomains' leaves and the reduction
  * shrinks to the overlap halo, and to replace the gather by a treecode's far field. */
+#include "cadmorph/parallel.h"
 #include "rbf_internal.h"
 
 #include <float.h>
@@ -57,10 +58,6 @@ struct cm_rbf_petsc {
     int matvecs;       /* products with A since the solve began */
 };
 
-static int g_initialised_here; /* we called PetscInitialize, so we finalise */
-
-int cm_rbf_petsc_available(void) { return 1; }
-
 static cm_status petsc_fail(cm_context *ctx, PetscErrorCode e, const char *what)
 {
     const char *text = NULL;
@@ -78,95 +75,6 @@ static cm_status petsc_fail(cm_context *ctx, PetscErrorCode e, const char *what)
             goto done;                                   \
         }                                                \
     } while (0)
-
-cm_status cm_rbf_petsc_initialize(cm_context *ctx)
-{
-    PetscBool up = PETSC_FALSE;
-    PetscInitialized(&up);
-    if (up) return CM_OK;
-    cm_status st = CM_OK;
-    /* the program's signal handlers stay (they remove temporary outputs); PETSc's errors
-     * come back as codes, not as printed tracebacks: the library never prints */
-    P(PetscOptionsSetValue(NULL, "-no_signal_handler", NULL));
-    P(PetscInitializeNoArguments());
-    g_initialised_here = 1;
-    P(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-done:
-    return st;
-}
-
-void cm_rbf_petsc_rank(int *rank, int *size)
-{
-    int rk = 0, sz = 1;
-    PetscBool up = PETSC_FALSE;
-    PetscInitialized(&up);
-    if (up) {
-        MPI_Comm_rank(PETSC_COMM_WORLD, &rk);
-        MPI_Comm_size(PETSC_COMM_WORLD, &sz);
-    }
-    if (rank) *rank = rk;
-    if (size) *size = sz;
-}
-
-void cm_rbf_petsc_finalize(void)
-{
-    PetscBool up = PETSC_FALSE;
-    PetscInitialized(&up);
-    if (up && g_initialised_here) PetscFinalize();
-    g_initialised_here = 0;
-}
-
-cm_status cm_rbf_petsc_allgather(cm_context *ctx, const void *mine, size_t n, size_t size,
-                                 void **all, size_t *n_all)
-{
-    int rank, ranks;
-    cm_rbf_petsc_rank(&rank, &ranks);
-    *all = NULL;
-    *n_all = 0;
-    long long my = (long long)n, *cnt = malloc((size_t)ranks * sizeof *cnt);
-    int *bytes = malloc(2 * (size_t)ranks * sizeof *bytes);
-    cm_status st = CM_OK;
-    if (!cnt || !bytes) {
-        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_petsc_allgather: out of memory");
-        goto done;
-    }
-    /* a rank out of memory still takes part, or the others would wait for it forever */
-    if (ranks > 1 &&
-        MPI_Allgather(&my, 1, MPI_LONG_LONG, cnt, 1, MPI_LONG_LONG, PETSC_COMM_WORLD) != MPI_SUCCESS) {
-        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_petsc_allgather: MPI_Allgather failed");
-        goto done;
-    }
-    if (ranks == 1) cnt[0] = my;
-    size_t total = 0;
-    for (int q = 0; q < ranks; ++q) {
-        if ((double)total * (double)size + (double)cnt[q] * (double)size > 2e9) {
-            st = cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_rbf_petsc_allgather: more than 2 GB");
-            goto done;
-        }
-        bytes[q] = (int)((size_t)cnt[q] * size);
-        bytes[ranks + q] = (int)(total * size);
-        total += (size_t)cnt[q];
-    }
-    *all = malloc(total * size > 0 ? total * size : 1);
-    if (!*all) {
-        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_petsc_allgather: out of memory");
-        goto done;
-    }
-    if (ranks == 1) {
-        if (n) memcpy(*all, mine, n * size);
-    } else if (MPI_Allgatherv(mine, bytes[rank], MPI_BYTE, *all, bytes, bytes + ranks, MPI_BYTE,
-                              PETSC_COMM_WORLD) != MPI_SUCCESS) {
-        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_petsc_allgather: MPI_Allgatherv failed");
-        free(*all);
-        *all = NULL;
-        goto done;
-    }
-    *n_all = total;
-done:
-    free(cnt);
-    free(bytes);
-    return st;
-}
 
 /* v -= Q1 (Q1' v) on every component, twice, as project() in rbf_iterative.c. */
 static PetscErrorCode project(cm_rbf_petsc *ps, Vec v)
@@ -246,7 +154,7 @@ static PetscErrorCode shell_pc(PC pc, Vec x, Vec y)
     PetscScalar *ya;
     PetscCall(gather(ps, x, ps->soa_in));
     int ranks = 1;
-    cm_rbf_petsc_rank(NULL, &ranks);
+    cm_parallel_rank(NULL, &ranks);
     if (cm_rbf_schwarz_apply_sum(cm_rbf_iterative_pc(ps->r), ps->r, (int)g, ps->soa_in,
                                  ps->soa_out, ps->threads, ranks > 1 ? sum_ranks : NULL,
                                  NULL) != 0)
@@ -343,14 +251,14 @@ done:
 
 cm_status cm_rbf_petsc_setup(cm_context *ctx, cm_rbf *r, int threads)
 {
-    cm_status st = cm_rbf_petsc_initialize(ctx);
+    cm_status st = cm_parallel_initialize(ctx);
     if (st != CM_OK) return st;
     if ((size_t)(PetscInt)(4 * r->m) != 4 * r->m)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
                         "cm_rbf_create: %zu centres exceed PETSc's index type", r->m);
     /* Q1 on every rank, the Schwarz preconditioner's subdomains split over the ranks */
     int rank0 = 0, size0 = 1;
-    cm_rbf_petsc_rank(&rank0, &size0);
+    cm_parallel_rank(&rank0, &size0);
     r->pc_part = rank0;
     r->pc_parts = size0;
     st = cm_rbf_iterative_setup(ctx, r, threads);
@@ -360,7 +268,7 @@ cm_status cm_rbf_petsc_setup(cm_context *ctx, cm_rbf *r, int threads)
     ps->r = r;
     ps->threads = threads;
     int rank, size;
-    cm_rbf_petsc_rank(&rank, &size);
+    cm_parallel_rank(&rank, &size);
     ps->lo = (PetscInt)((long long)r->m * rank / size);
     ps->hi = (PetscInt)((long long)r->m * (rank + 1) / size);
     ps->soa_in = malloc(4 * r->m * sizeof *ps->soa_in);
@@ -543,7 +451,7 @@ cm_status cm_rbf_petsc_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double
 int cm_rbf_petsc_evaluate(const cm_rbf *r, size_t n, const double *p, double *out, int threads)
 {
     int rank, size;
-    cm_rbf_petsc_rank(&rank, &size);
+    cm_parallel_rank(&rank, &size);
     const size_t nc = (size_t)r->ncomp;
     if (size < 2 || n * nc > (size_t)0x7fffffff) return 0; /* all on this rank */
     if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads)) return 1;

@@ -562,8 +562,8 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
     const size_t nd = p->d_ptr[p->nsub], nf = p->f_ptr[p->nsub];
     p->nmax = nmax;
     /* filled below by the threads, each its own subdomains: faulted in by them */
-    p->g64 = cm_rbf_alloc_large(nd * sizeof *p->g64, 0);
-    p->g32 = cm_rbf_alloc_large(nf * sizeof *p->g32, 0);
+    p->g64 = cm_alloc_large(nd * sizeof *p->g64, 0);
+    p->g32 = cm_alloc_large(nf * sizeof *p->g32, 0);
     if (!p->g32 || !p->g64)
         return cm_error(ctx, CM_ERR_NOMEM,
                         "cm_rbf_create: out of memory for the local solves (%.3g GB)",
@@ -658,7 +658,7 @@ static cm_status build_coarse(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *
     p->c_idx = malloc(nc * sizeof *p->c_idx);
     p->c_xyz = malloc(3 * nc * sizeof *p->c_xyz);
     const int inner = r->opt.coarse_inner > 0;
-    p->gc = inner ? NULL : cm_rbf_alloc_large((nc * nc + 8 * nc) * sizeof *p->gc, 0);
+    p->gc = inner ? NULL : cm_alloc_large((nc * nc + 8 * nc) * sizeof *p->gc, 0);
     double *d2 = malloc(m * sizeof *d2);
     cm_status st = CM_OK;
     if (!p->c_idx || !p->c_xyz || (!inner && !p->gc) || !d2) {

@@ -57,7 +57,7 @@ typedef struct cm_rbf cm_rbf;
  *   over the ranks, the same Schwarz preconditioner as a PCSHELL (each rank factorises
  *   and applies only its share of the subdomains, the coarse solve on all). Create, solve and
  *   evaluate are then collective: every rank calls them with the same centres and values
- *   (each holds all centres and gets all weights); see cm_rbf_petsc_initialize.
+ *   (each holds all centres and gets all weights); see cm_parallel_initialize (parallel.h).
  * cm_rbf_evaluate works for both; an iterative fit evaluates with compensated sums too
  * (about 1.5x the time of plain sums with the AVX-512 kernels), so it reproduces the data at the centres to its
  * residual, where plain sums, as the dense path uses, stop at the floor in cm_rbf_stats. */
@@ -266,27 +266,6 @@ CM_API cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, c
 
 /* Centres after merging duplicates. */
 CM_API size_t cm_rbf_centre_count(const cm_rbf *rbf);
-
-/* ---- the distributed solver (CM_RBF_SOLVER_PETSC) ----
- * 1 if this build has it (-DCADMORPH_WITH_PETSC=ON), else 0 and the calls below do nothing. */
-CM_API int cm_rbf_petsc_available(void);
-/* Initialises PETSc (and MPI) once per process, collectively over the ranks that mpirun
- * started, unless the caller already did; PETSc's own options come from the PETSC_OPTIONS
- * environment variable (prefix cm_: PETSC_OPTIONS=-cm_ksp_monitor). Called by cm_rbf_create
- * for the PETSC solver by itself; a program calls it first when it needs the rank earlier.
- * CM_ERR_UNSUPPORTED without PETSc. */
-CM_API cm_status cm_rbf_petsc_initialize(cm_context *ctx);
-/* This process's rank and the number of ranks (0 and 1 before initialisation or without
- * PETSc); either pointer may be NULL. */
-CM_API void cm_rbf_petsc_rank(int *rank, int *size);
-/* Finalises PETSc (and MPI) if cm_rbf_petsc_initialize initialised it; collective, call it
- * once before the program ends, after destroying every PETSC-solver cm_rbf. */
-CM_API void cm_rbf_petsc_finalize(void);
-/* Every rank's n records of `size` bytes (mine) to every rank: *all (malloc'd, free() it)
- * gets them in rank order, *n_all their count; collective. On one rank, or without PETSc, a
- * copy of mine. Plain-data records only (a study's rows: cm_study_run with ranks > 1). */
-CM_API cm_status cm_rbf_petsc_allgather(cm_context *ctx, const void *mine, size_t n, size_t size,
-                                        void **all, size_t *n_all);
 
 #ifdef __cplusplus
 }

@@ -124,7 +124,7 @@ typedef struct cm_study_options {
     int rank, ranks;        /* distributed over MPI ranks (ranks > 1, absolute mode only;
                                default 0, 1): this process runs variants i with
                                i mod ranks = rank and writes their meshes; the result, on
-                               every rank, has all rows (cm_rbf_petsc_allgather). Every
+                               every rank, has all rows (cm_parallel_allgather). Every
                                rank calls cm_study_run with the same inputs. */
 } cm_study_options;
 
@@ -188,7 +188,7 @@ CM_API void cm_study_result_destroy(cm_study_result **result);
 
 enum {
     CM_STUDY_CSV_FULL = 0, /* study.csv: every row, with columns variant, status, message */
-    CM_STUDY_CSV_SWEEP = 1 /* sweep.csv of issue 6: its columns only, complete rows only */
+    CM_STUDY_CSV_SWEEP = 1 /* sweep.csv of `cadmorph sweep`: its columns only, complete rows only */
 };
 
 /* Header, then one row per cm_study_row (through a temporary file, renamed at the end).

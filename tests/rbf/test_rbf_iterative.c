@@ -2,7 +2,7 @@
  * the dense solver on a box-with-bore boundary set, affine data, two bodies far apart,
  * thread-count independence, the solver choice and the option checks. */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 

@@ -6,7 +6,7 @@
  * the subdomains see (rbf_bodies.c): one for one part, two for two parts far apart, and the
  * projection leaves no linear moment on either. */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 

@@ -6,7 +6,7 @@
  * on the coarse centres is a real one (with the default 1,400 its subdomains would be the
  * whole coarse set). */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 

@@ -7,8 +7,8 @@
  * Coordinates are multiples of 2^-10, so r^2 is exact and phi_ij is the same double in every
  * variant: the comparison measures the summation alone. Both vsqrtpd splits of the AVX-512
  * blocks give the same bits (off the grid too). */
-#include "rbf/rbf_internal.h"
-#include "rbf/rbf_sum_isa.h"
+#include "rbf_internal.h"
+#include "rbf_sum_isa.h"
 #include "test_rng.h"
 #include "test_util.h"
 

@@ -3,7 +3,7 @@
  * lies within a voxel diagonal of a pick) with fewer centres than the full overlap there,
  * and the solver with thinning agrees with the dense one on a box-with-bore set at ~5k. */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 

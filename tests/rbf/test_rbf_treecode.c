@@ -4,8 +4,8 @@
  * and the dense solver; affine data; the choice of the fast evaluation; the hand-written
  * AVX-512 products against the compiled fallbacks. */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
-#include "rbf/rbf_treecode.h"
+#include "rbf_internal.h"
+#include "rbf_treecode.h"
 #include "rbf_test_sets.h"
 #include "test_rng.h"
 #include "test_util.h"

@@ -1,9 +1,9 @@
 /* Which OpenBLAS kernels this process runs, and which it should (see blas.h for why):
  * cpuid/xgetbv detection, the pure decision table, and cm_blas_info. */
 #include "cadmorph/blas.h"
-#include "rbf_internal.h"
 
 #include <cblas.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -114,7 +114,8 @@ void cm_blas_info(const cm_context *ctx, cm_blas_summary *out)
     const char *lazy = getenv(CM_BLAS_LAZY_THREADS_ENV);
     out->lazy_threads = lazy && !strcmp(lazy, "1");
     out->threads_now = openblas_get_num_threads();
-    out->threads = cm_rbf_threads(ctx);
+    /* as the dense factorisation sizes its BLAS threads: every thread the context allows */
+    out->threads = cm_context_threads_for(ctx, SIZE_MAX, 1);
     cm_blas_cpu_detect(&out->cpu);
     out->action = cm_blas_decide(&out->cpu, out->core, out->coretype_set);
 }

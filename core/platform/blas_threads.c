@@ -10,7 +10,7 @@
 #define _DEFAULT_SOURCE /* MAP_ANONYMOUS, MAP_NORESERVE */
 #endif
 #include "cadmorph/blas.h"
-#include "rbf_internal.h"
+#include "cm_platform.h"
 
 #include <cblas.h>
 #include <pthread.h>
@@ -73,7 +73,7 @@ static size_t need_for(int t)
     return need + CM_BLAS_MARGIN_BYTES;
 }
 
-cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *got)
+cm_status cm_blas_threads(cm_context *ctx, const char *who, int want, int *got)
 {
     if (want < 1) want = 1;
     pthread_mutex_lock(&lock);
@@ -114,12 +114,12 @@ cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *g
     return CM_OK;
 }
 
-/* OpenMP threads that call one-thread BLAS side by side (cholesky_lookahead.c): besides
+/* OpenMP threads that call one-thread BLAS side by side (the RBF module's look-ahead Cholesky): besides
  * OpenBLAS's own workers, each such thread gets its own 128 MB buffer on its first call,
  * and keeps it (libgomp's threads live on). Granted once, a count stays granted. */
 static int callers_held; /* threads besides the calling one known to hold a buffer */
 
-int cm_rbf_blas_callers(int want)
+int cm_blas_callers(int want)
 {
     if (want <= 1) return want < 1 ? 1 : want;
     struct rlimit rl;
@@ -140,6 +140,6 @@ int cm_rbf_blas_callers(int want)
 
 cm_status cm_blas_reserve(cm_context *ctx, const char *who)
 {
-    return cm_rbf_blas_threads(ctx, who ? who : "cm_blas_reserve", openblas_get_num_threads(),
+    return cm_blas_threads(ctx, who ? who : "cm_blas_reserve", openblas_get_num_threads(),
                                NULL);
 }

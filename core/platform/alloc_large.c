@@ -1,9 +1,9 @@
-/* Large buffers of the RBF solvers: the dense factor, the local factors of the Schwarz
- * preconditioner, its coarse factor and the Krylov bases, 10^8..10^10 bytes at m = 10^5..10^6.
+/* Large buffers, such as the RBF solvers' (the dense factor, the local factors of the Schwarz
+ * preconditioner, its coarse factor and the Krylov bases): 10^8..10^10 bytes at m = 10^5..10^6.
  *
  * Why: the VMs we run on back guest memory on first touch and take freed memory back, so
  * every fresh buffer is faulted in again in every fit. Page by page (4 kB) that cost about
- * 2 s per GB on two threads here (benchmarks/bench_first_touch.c, Zen 5: 1.6 GB in
+ * 2 s per GB on two threads here (benchmarks/rbf/bench_first_touch.c, Zen 5: 1.6 GB in
  * 2.7-3.4 s); marked for transparent huge pages, 0.6-1.7 s, and almost nothing when the
  * freed huge pages of an earlier fit are still backed. Huge pages also spare the BLAS and
  * the streaming local solves TLB misses. Both calls are hints: where they fail the memory
@@ -11,7 +11,7 @@
 #if defined(__linux__) && !defined(_DEFAULT_SOURCE)
 #define _DEFAULT_SOURCE /* madvise(MADV_HUGEPAGE) */
 #endif
-#include "rbf_internal.h"
+#include "cm_platform.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -23,7 +23,7 @@
 #endif
 #endif
 
-void *cm_rbf_alloc_large(size_t bytes, int populate)
+void *cm_alloc_large(size_t bytes, int populate)
 {
     const size_t huge = (size_t)2 << 20;
     if (bytes < huge) return malloc(bytes ? bytes : 1);
