@@ -9,7 +9,7 @@ mkdir -p "$work"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "== mesh I/O";            "$build/benchmarks/bench_mesh_io" "$work"
 echo "== quality";             sh "$root/benchmarks/bench_quality.sh" "$build"
-echo "== RBF vs scipy";        sh "$root/benchmarks/bench_rbf.sh" "$build" 2
+echo "== RBF vs scipy";        sh "$root/benchmarks/rbf/bench_rbf.sh" "$build" 2
 echo "== CAD layer";           "$build/benchmarks/bench_cad" "$root/tests/data/cad/bore_a.step" 1e6 1e5 2
 echo "== models, tet meshes";  sh "$root/benchmarks/models/bench_models.sh" "$build" "$work/models"
 echo "== sweeps (20 steps, all models)"; sh "$root/benchmarks/sweep/run_sweeps.sh" "$build" "$work/sweeps" 2

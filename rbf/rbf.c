@@ -1,5 +1,5 @@
-/* RBF interpolation with polyharmonic kernels and a linear polynomial (paper section 3, 3D;
- * section 4, 2D thin plate): fit by null-space projection + Cholesky, solve, evaluate.
+/* RBF interpolation with polyharmonic kernels and a linear polynomial ([SMB12 §3], 3D;
+ * [SMB12 §4], 2D thin plate): fit by null-space projection + Cholesky, solve, evaluate.
  *
  * Why the projection: the saddle-point system [A P; P' 0] is indefinite, but A is
  * conditionally positive definite on the null space of P'. With P = QR (Householder),
@@ -62,6 +62,51 @@ void cm_rbf_destroy(cm_rbf **rbf)
 }
 
 size_t cm_rbf_centre_count(const cm_rbf *rbf) { return rbf ? rbf->m : 0; }
+
+void cm_rbf_options_init(cm_rbf_options *opt)
+{
+    if (!opt) return;
+    memset(opt, 0, sizeof *opt);
+    opt->solver = CM_RBF_SOLVER_AUTO;
+    opt->tolerance = 1e-10;
+    opt->max_iterations = 300;
+    opt->restart = 40;
+    opt->fast_sum = -1;
+}
+
+void cm_rbf_tuning_init(cm_rbf_tuning *t)
+{
+    if (!t) return;
+    memset(t, 0, sizeof *t);
+    t->leaf_size = 256;
+    t->local_size = 700;
+    t->coarse_size = 2000;
+    t->coarse_post = 1;
+    t->local_float = 1;
+    t->coarse_grow = 1;
+    t->coarse_max = 16000;
+    t->coarse_inner_tol = 1e-2;
+    t->overlap = 2.0;
+    t->local_max = 2800;
+    t->thin_cell = 0.25;
+    t->thin_max = 2000;
+    t->fast_tol = 1e-12;
+    t->fast_refine = 3;
+    t->fast_eval_tol = 1e-9;
+    t->relax = 1;
+}
+
+void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
+{
+    if (!stats) return;
+    if (!rbf) {
+        memset(stats, 0, sizeof *stats);
+        return;
+    }
+    *stats = rbf->stats;
+    cm_rbf_iterative_stats(rbf, stats);
+}
+
 
 /* Unit-box map and merging; fills r->c, rep, first, m. */
 static cm_status place_centres(cm_context *ctx, cm_rbf *r, const double *centres)
@@ -302,6 +347,13 @@ cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m
 cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
                             const double *centres, const cm_rbf_options *opt, cm_rbf **rbf)
 {
+    return cm_rbf_create_tuned(ctx, kernel, dim, m, centres, opt, NULL, rbf);
+}
+
+cm_status cm_rbf_create_tuned(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
+                              const double *centres, const cm_rbf_options *opt,
+                              const cm_rbf_tuning *tuning, cm_rbf **rbf)
+{
     const double t_start = cm_wtime();
     if (!rbf) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: rbf is NULL");
     *rbf = NULL;
@@ -328,6 +380,8 @@ cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size
     r->sign = kernel == CM_RBF_BIHARMONIC ? -1.0 : 1.0;
     if (opt) r->opt = *opt;
     else cm_rbf_options_init(&r->opt);
+    if (tuning) r->tun = *tuning;
+    else cm_rbf_tuning_init(&r->tun);
     const int threads = cm_rbf_threads(ctx);
     const int saved_blas_threads = openblas_get_num_threads();
 

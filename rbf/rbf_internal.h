@@ -1,9 +1,10 @@
 /* Internal state of cm_rbf and the kernel-sum primitives shared by fit, solve and evaluation
- * (paper section 3 for 3D, section 4 for the 2D thin-plate warp). Not a public header. */
+ * ([SMB12 §3] for 3D, [SMB12 §4] for the 2D thin-plate warp). Not a public header. */
 #ifndef CADMORPH_RBF_INTERNAL_H
 #define CADMORPH_RBF_INTERNAL_H
 
 #include "cadmorph/rbf.h"
+#include "rbf_tuning.h"
 #include "cm_platform.h" /* BLAS threads, large buffers (cm_platform) */
 
 #include <stddef.h>
@@ -33,6 +34,7 @@ struct cm_rbf {
     double *w;        /* ncomp x m, SoA: kernel weights */
     double *q;        /* ncomp x k: polynomial coefficients in unit-box coordinates */
     cm_rbf_options opt;
+    cm_rbf_tuning tun;  /* the internal knobs (rbf_tuning.h) */
     cm_rbf_stats stats;
     cm_rbf_iter *iter; /* iterative solver state, NULL for dense (then chol is set) */
     cm_rbf_petsc *petsc; /* PETSC solver (rbf_petsc.c): set with iter, NULL otherwise */
@@ -120,8 +122,15 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
  * thread, it lost to them (3k: 1.28 x their time, 2k: 1.9 x). */
 #define CM_LOOKAHEAD_MIN_N 4000
 #define CM_LOOKAHEAD_MAX_N 60000
+/* The look-ahead path's most update chunks per step. */
+#define CM_LOOKAHEAD_MAX_CHUNKS 64
+/* For the schedule model of benchmarks/rbf/bench_cholesky.c: while set (NULL in normal use;
+ * set it only between factorisations), every task of the look-ahead path reports its step
+ * (-1: outside the steps), its kind (0: the look-ahead panel, q > 0: update chunk q - 1) and
+ * its CPU seconds by its thread's clock. Called from the OpenMP threads concurrently. */
+extern void (*cm_lookahead_trace_hook)(int step, int kind, double cpu_seconds);
 
-/* ---- iterative solver (rbf_iterative.c, rbf_schwarz.c) ---- */
+/* ---- the timing probes' leaf (sum/rbf_probe.c) ---- */
 
 /* CPU seconds of the calling thread (CLOCK_THREAD_CPUTIME_ID; wall time if it fails): what
  * the once-per-process probes time, as a loaded machine delays them without biasing them. */
@@ -129,6 +138,8 @@ double cm_rbf_thread_seconds(void);
 /* The probes' problem: m centres (3 x m SoA) with 3 weight vectors (3 x m), n points (3 x n)
  * spread over the unit cube by a fixed sequence. */
 void cm_rbf_probe_data(size_t m, double *c, double *w, size_t n, double *p);
+
+/* ---- iterative solver (iterative/) ---- */
 
 /* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */
 int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m);
@@ -154,6 +165,9 @@ void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, doubl
  * do it. Deterministic for given weights, so every rank that calls it gets the same out. */
 int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
                                    int threads);
+/* The last evaluation's fast-sum figures (eval_fast, eval_error, eval_order, eval_theta) into
+ * stats; nothing for a dense fit. */
+void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats);
 /* The data scale (max |f| of the last solve) that fast_eval_tol is relative to: set by the
  * serial solve, and by the PETSc one, so that both evaluate alike. */
 void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax);
@@ -231,9 +245,9 @@ typedef struct cm_rbf_keyed {
  * first, into out. Returns the count, or -1 out of memory. */
 long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_t nc,
                       double d0, double cell, const double org[3], size_t cap, size_t *out);
-/* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
+/* Coarse centres for m centres under the tuning (coarse_size, coarse_grow, coarse_max;
  * at most m / 4). */
-size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);
+size_t cm_rbf_coarse_count(const cm_rbf_tuning *tu, size_t m);
 /* The coarse problem solved inexactly (rbf_schwarz_coarse.c, options coarse_inner and
  * coarse_inner_tol): an inner FGMRES on the nc coarse centres (c_xyz: 3 x nc SoA; m_fine:
  * the outer centres, for the choice of the coarse-to-fine product) preconditioned by a

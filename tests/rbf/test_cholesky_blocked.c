@@ -1,4 +1,4 @@
-/* The panel-by-panel RFP Cholesky (rbf/cholesky_blocked.c) against LAPACK's dpftrf on random
+/* The panel-by-panel RFP Cholesky (rbf/dense/cholesky_blocked.c) against LAPACK's dpftrf on random
  * SPD matrices: odd and even n, n below, at and off multiples of the block; the pivot of an
  * indefinite matrix; progress monotonic up to its total. */
 #include "rbf_internal.h"

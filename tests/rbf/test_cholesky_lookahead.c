@@ -1,4 +1,4 @@
-/* The look-ahead RFP Cholesky (rbf/cholesky_lookahead.c) against LAPACK's dpftrf on random
+/* The look-ahead RFP Cholesky (rbf/dense/cholesky_lookahead.c) against LAPACK's dpftrf on random
  * SPD matrices on 1, 2 and 3 threads: the factors agree to round-off and A - LL' is at
  * round-off; odd and even n, n below a block, blocks that straddle the two halves of the RFP
  * layout, many update chunks per step; the failing pivot of an indefinite matrix (info as

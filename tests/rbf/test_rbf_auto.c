@@ -1,4 +1,4 @@
-/* AUTO's cost model (cm_rbf_auto_dense in rbf/rbf_iterative.c, the probe in rbf_auto_probe.c):
+/* AUTO's cost model (cm_rbf_auto_dense in rbf/iterative/rbf_auto.c, the probe in rbf_auto_probe.c):
  * the probe measures positive rates; the model's costs grow as they must (dense ~ m^3,
  * iterative ~ m to m^2); the choice is dense for small sets, iterative for large ones, with a
  * single crossover in between, and always dense for the kernels the iterative solver does not

@@ -11,7 +11,7 @@
  * farthest-point centres is solved exactly first (multiplicative), so the local solves see
  * only the residual of the smooth, global part, and by default (coarse_post 1) once more
  * after them on what their correction left at the coarse centres: the residual then falls
- * ~30x per iteration instead of ~6x on the bracket (RESULTS.md, issue 10, tenth session).
+ * ~30x per iteration instead of ~6x on the bracket (RESULTS.md, RBF solvers).
  * Storage (local_float): the rows can be kept in float at half the memory without costing
  * iterations, because the local linear fit is taken out of the data before the product
  * (G_l annihilates it in exact arithmetic, while its float rounding would multiply it).
@@ -121,7 +121,7 @@ static void select_kth(tree_build *t, size_t lo, size_t hi, size_t k, int d)
  * local solve extrapolates off the plane: on one of two copies of the same bracket (the ties
  * are broken by the order the root split left) that put eigenvalues 0.09 and 1.9 into the
  * preconditioned operator, and the solve took 100 iterations instead of 11 (RESULTS.md,
- * issue 10, thirteenth session). With the group kept whole, sibling boxes are disjoint. */
+ * RBF solvers). With the group kept whole, sibling boxes are disjoint. */
 static size_t split_off_ties(tree_build *t, size_t lo, size_t hi, size_t mid, int d, double tol)
 {
     size_t *p = t->perm;
@@ -352,15 +352,15 @@ static double farthest_points(const double *c, size_t m, size_t nc, size_t *out,
     return sqrt(fill2);
 }
 
-size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m)
+size_t cm_rbf_coarse_count(const cm_rbf_tuning *tu, size_t m)
 {
-    size_t nc = (size_t)o->coarse_size;
+    size_t nc = (size_t)tu->coarse_size;
     /* coarse_grow: coarse_size is the count at 2e4 centres, grown as sqrt(m) above, so that
      * the coarse spacing keeps closer to the fixed-size subdomains' reach (which shrinks as
      * m^-1/2) at O(m) memory for the coarse factor */
-    if (o->coarse_grow && (double)m > CM_RBF_COARSE_BASE_M)
+    if (tu->coarse_grow && (double)m > CM_RBF_COARSE_BASE_M)
         nc = (size_t)((double)nc * sqrt((double)m / CM_RBF_COARSE_BASE_M));
-    if (o->coarse_max > 0 && nc > (size_t)o->coarse_max) nc = (size_t)o->coarse_max;
+    if (tu->coarse_max > 0 && nc > (size_t)tu->coarse_max) nc = (size_t)tu->coarse_max;
     if (nc > m / 4) nc = m / 4; /* a coarse space as fine as the problem is no coarse space */
     return nc;
 }
@@ -407,8 +407,8 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
                                   int threads)
 {
     const size_t m = r->m;
-    const cm_rbf_options *o = &r->opt;
-    tree_build t = {r->c, m, malloc(m * sizeof(size_t)), NULL, 0, 0, (size_t)o->leaf_size};
+    const cm_rbf_tuning *tu = &r->tun;
+    tree_build t = {r->c, m, malloc(m * sizeof(size_t)), NULL, 0, 0, (size_t)tu->leaf_size};
     if (!t.perm) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (kD-tree)");
     for (size_t i = 0; i < m; ++i) t.perm[i] = i;
     cm_status st = CM_OK;
@@ -416,17 +416,17 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (kD-tree)");
         goto done;
     }
-    size_t nloc = (size_t)o->local_size < m ? (size_t)o->local_size : m;
+    size_t nloc = (size_t)tu->local_size < m ? (size_t)tu->local_size : m;
     const size_t nmin = nloc;
     double reach2 = -1.0;
-    if (o->overlap > 0.0 && p->fill > 0.0 && o->local_max > o->local_size) {
-        nloc = (size_t)o->local_max < m ? (size_t)o->local_max : m;
-        reach2 = (o->overlap * p->fill) * (o->overlap * p->fill);
+    if (tu->overlap > 0.0 && p->fill > 0.0 && tu->local_max > tu->local_size) {
+        nloc = (size_t)tu->local_max < m ? (size_t)tu->local_max : m;
+        reach2 = (tu->overlap * p->fill) * (tu->overlap * p->fill);
     }
     /* thinned far band (thin_reach): the near set above, then picks up to thin_max */
-    const int thin = o->thin_reach > 0.0 && p->fill > 0.0;
-    const double far2 = (o->thin_reach * p->fill) * (o->thin_reach * p->fill);
-    const size_t tcap = thin ? ((size_t)o->thin_max < m ? (size_t)o->thin_max : m) : 0;
+    const int thin = tu->thin_reach > 0.0 && p->fill > 0.0;
+    const double far2 = (tu->thin_reach * p->fill) * (tu->thin_reach * p->fill);
+    const size_t tcap = thin ? ((size_t)tu->thin_max < m ? (size_t)tu->thin_max : m) : 0;
     p->nsub = t.nleaves;
     p->sub_ptr = malloc(((size_t)t.nleaves + 1) * sizeof *p->sub_ptr);
     p->n_in = malloc((size_t)t.nleaves * sizeof *p->n_in);
@@ -455,7 +455,7 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
             cnt[l] = grow_leaf(&t, l, nloc, nmin, reach2, lk, cand, out);
             if (thin) {
                 nnear[l] = cnt[l];
-                cnt[l] = thin_far(&t, l, cnt[l], far2, p->fill, o->thin_cell, tcap, cand, out);
+                cnt[l] = thin_far(&t, l, cnt[l], far2, p->fill, tu->thin_cell, tcap, cand, out);
                 if (cnt[l] == 0) {
 #pragma omp atomic write
                     fail = 1;
@@ -492,7 +492,7 @@ static cm_status build_subdomains(cm_context *ctx, const cm_rbf *r, cm_rbf_schwa
                "cm_rbf_create: Schwarz thinned overlap: mean %.0f near + %.0f far centres "
                "(cap %zu), mean reach %.2f H (thin_reach %g H, cell %g x distance)",
                near_sum / t.nleaves, (double)p->sub_ptr[t.nleaves] / t.nleaves - near_sum / t.nleaves,
-               tcap, reach_sum / t.nleaves / p->fill, o->thin_reach, o->thin_cell);
+               tcap, reach_sum / t.nleaves / p->fill, tu->thin_reach, tu->thin_cell);
     else
         cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_create: Schwarz overlap: mean reach %.2f H",
                p->fill > 0.0 ? reach_sum / t.nleaves / p->fill : 0.0);
@@ -542,7 +542,7 @@ static void split_parts(cm_rbf_schwarz *p, int part, int parts)
 static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p, int threads)
 {
     const size_t m = r->m;
-    const int mode = r->opt.local_float;
+    const int mode = r->tun.local_float;
     p->d_ptr = malloc(((size_t)p->nsub + 1) * sizeof *p->d_ptr);
     p->f_ptr = malloc(((size_t)p->nsub + 1) * sizeof *p->f_ptr);
     p->hd = malloc(((size_t)p->nsub + 1) * sizeof *p->hd);
@@ -652,12 +652,12 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
 static cm_status build_coarse(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p, int threads)
 {
     const size_t m = r->m;
-    size_t nc = cm_rbf_coarse_count(&r->opt, m); /* a coarse space as fine as the problem is no coarse space */
+    size_t nc = cm_rbf_coarse_count(&r->tun, m); /* a coarse space as fine as the problem is no coarse space */
     if (nc < 16) return CM_OK;
     p->nc = nc;
     p->c_idx = malloc(nc * sizeof *p->c_idx);
     p->c_xyz = malloc(3 * nc * sizeof *p->c_xyz);
-    const int inner = r->opt.coarse_inner > 0;
+    const int inner = r->tun.coarse_inner > 0;
     p->gc = inner ? NULL : cm_alloc_large((nc * nc + 8 * nc) * sizeof *p->gc, 0);
     double *d2 = malloc(m * sizeof *d2);
     cm_status st = CM_OK;
@@ -696,14 +696,14 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
     cm_rbf_schwarz *p = calloc(1, sizeof *p);
     if (!p) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     p->m = r->m;
-    p->post = r->opt.coarse_post;
-    if (r->opt.coarse_inner < 0 || r->opt.coarse_inner > 200 ||
-        (r->opt.coarse_inner > 0 && !(r->opt.coarse_inner_tol > 0.0 && r->opt.coarse_inner_tol < 1.0))) {
+    p->post = r->tun.coarse_post;
+    if (r->tun.coarse_inner < 0 || r->tun.coarse_inner > 200 ||
+        (r->tun.coarse_inner > 0 && !(r->tun.coarse_inner_tol > 0.0 && r->tun.coarse_inner_tol < 1.0))) {
         free(p);
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_rbf_create: bad coarse_inner %d / coarse_inner_tol %g (expected "
                         "0..200 iterations and a tolerance in (0, 1))",
-                        r->opt.coarse_inner, r->opt.coarse_inner_tol);
+                        r->tun.coarse_inner, r->tun.coarse_inner_tol);
     }
     /* the coarse space first: its fill distance sets the overlap when measured in distance */
     double t0 = cm_wtime();
@@ -725,7 +725,7 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
                "cm_rbf_create: Schwarz coarse level: %zu centres solved by <= %d inner FGMRES "
                "iterations (to %g) with %d subdomains (mean %.0f) and a dense coarse of %zu, "
                "%.1f MB",
-               p->nc, r->opt.coarse_inner, r->opt.coarse_inner_tol, q->nsub,
+               p->nc, r->tun.coarse_inner, r->tun.coarse_inner_tol, q->nsub,
                (double)q->sub_ptr[q->nsub] / (double)q->nsub, q->nc,
                (double)cm_rbf_coarse_inner_bytes(p->inner) / 1e6);
     }
@@ -733,7 +733,7 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
            "cm_rbf_create: Schwarz: %d subdomains of <= %zu centres (mean %.0f, leaves <= %d), "
            "coarse %zu (fill distance %.3g); coarse %.3f s, tree + overlap %.3f s, local %.3f "
            "s (%d subdomains built here), %.1f MB",
-           p->nsub, p->nmax, (double)p->sub_ptr[p->nsub] / (double)p->nsub, r->opt.leaf_size,
+           p->nsub, p->nmax, (double)p->sub_ptr[p->nsub] / (double)p->nsub, r->tun.leaf_size,
            p->nc, p->fill, t1 - t0, t2 - t1, t3 - t2, p->l1 - p->l0, (double)p->bytes / 1e6);
     *pc = p;
     return CM_OK;

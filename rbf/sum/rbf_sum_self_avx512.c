@@ -1,11 +1,11 @@
 /* The r^3 self product out = A w, A_ij = |c_i - c_j|^3, by hand for AVX-512, compensated
  * (fixed binade) or plain, each entry computed once for both of its rows. Why: the Krylov
- * products of the iterative solver (rbf_iterative.c) and its exact residuals are self
+ * products of the iterative solver (iterative/rbf_fgmres.c) and its exact residuals are self
  * products (the targets are the centres), and the kernel sums are bound by the distance and
  * the square root, not by the accumulation (rbf_sum_avx512.c). phi_ij = phi_ji bit for bit,
  * so one evaluation serves w_j phi_ij in row i and w_i phi_ij in row j: per pair of
  * contributions one distance and sqrt instead of two, the accumulation as before. Measured
- * on the model-167 Xeon (RESULTS.md, issue 10, ninth session), 2 threads: compensated
+ * on the model-167 Xeon (RESULTS.md, RBF solvers), 2 threads: compensated
  * 1.3-1.6x, plain 1.4-2.0x the general blocks at 2e4-6e4 centres; the 1.2e5-centre fit's
  * solve 1.43x.
  *

@@ -1,5 +1,5 @@
 /* The two O(m^2) loops of the RBF core: kernel sums (evaluation, A*w, A*V) and assembly of
- * the projected system (paper section 3, eq. 3). Both are written so that GCC vectorises
+ * the projected system ([SMB12 §3]). Both are written so that GCC vectorises
  * them at -O3 (points in the inner loop, no reductions), and both are compiled for AVX-512,
  * AVX2+FMA and baseline x86-64, chosen at run time: no global -march flag is needed. */
 #include "rbf_internal.h"

@@ -1,6 +1,6 @@
 /* The dense factorisation alone: LAPACK's dpftrf against cadmorph's panel-by-panel RFP
- * Cholesky (rbf/cholesky_blocked.c) and its look-ahead variant on THREADS OpenMP threads of
- * one-thread BLAS (rbf/cholesky_lookahead.c) on the same SPD matrix, alternating in one
+ * Cholesky (rbf/dense/cholesky_blocked.c) and its look-ahead variant on THREADS OpenMP threads of
+ * one-thread BLAS (rbf/dense/cholesky_lookahead.c) on the same SPD matrix, alternating in one
  * process, at the OpenBLAS core and thread count of this run; with the Cholesky bound n^3/3
  * at the best dgemm rate measured in the same process.
  * usage: bench_cholesky THREADS REPS N...   (one line of key=value per n; `blocked` is the
@@ -23,19 +23,13 @@
 #include <string.h>
 #include <time.h>
 
-/* MODEL=1: the look-ahead factorisation once more per repetition, compiled here with its
- * tasks timed by their thread's CPU clock (cholesky_lookahead.c, CM_LOOKAHEAD_TRACE), and its
+/* MODEL=1: the look-ahead factorisation once more per repetition with its tasks timed by
+ * their thread's CPU clock (the library's trace hook, cm_lookahead_trace_hook), and its
  * schedule replayed on THREADS idle cores: each step's look-ahead task on one thread, its
  * chunks in order on whichever thread is free first (the dynamic schedule), a barrier per
  * step. On a machine that other jobs load, wall time says how busy the machine was; this
  * says what the schedule costs, against the bound at THREADS x the one-thread dgemm rate
  * by the same CPU clock. */
-#define CM_LOOKAHEAD_TRACE
-#define cm_rbf_cholesky_rfp_lookahead traced_lookahead
-int traced_lookahead(cm_context *ctx, int n, double *a, int block, int threads);
-#include "../rbf/cholesky_lookahead.c"
-#undef cm_rbf_cholesky_rfp_lookahead
-
 typedef struct trace_rec {
     int step, kind;
     double s;
@@ -44,7 +38,7 @@ typedef struct trace_rec {
 static trace_rec trace_recs[TRACE_MAX];
 static int trace_count;
 
-void cm_lookahead_trace(int step, int kind, double cpu_seconds)
+static void trace_record(int step, int kind, double cpu_seconds)
 {
     int i = __atomic_fetch_add(&trace_count, 1, __ATOMIC_RELAXED);
     if (i < TRACE_MAX) trace_recs[i] = (trace_rec){step, kind, cpu_seconds};
@@ -204,7 +198,9 @@ int main(int argc, char **argv)
                 rate1 = fmax(rate1, dgemm_rate_of(1));
                 fill_rfp(n, l);
                 trace_count = 0;
-                traced_lookahead(NULL, n, l, model_block, got);
+                cm_lookahead_trace_hook = trace_record;
+                cm_rbf_cholesky_rfp_lookahead(NULL, n, l, model_block, got);
+                cm_lookahead_trace_hook = NULL;
                 double ms, busy;
                 trace_model(got, &ms, &busy);
                 best_model = fmin(best_model, ms);

@@ -1,4 +1,4 @@
-/* The rates that AUTO's cost model (cm_rbf_auto_dense, rbf_iterative.c) weighs: dgemm flops
+/* The rates that AUTO's cost model (cm_rbf_auto_dense, rbf_auto.c) weighs: dgemm flops
  * per second and r^3 kernel pairs per second, plain and compensated, of one thread, timed
  * once per process on small problems (about 10 ms in all). Why measured, not constants: the
  * crossover of the two solvers moves with the BLAS core (Haswell's dgemm runs at half the
@@ -10,29 +10,6 @@
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
-#include <time.h>
-
-/* CPU time of the calling thread: on a loaded machine a wall-clock probe of a few ms is
- * often preempted (measured at load 11: dgemm 16 GF/s by wall clock, 60 by thread CPU
- * time), and the probe runs on this thread alone (one BLAS thread, threads = 1) */
-double cm_rbf_thread_seconds(void)
-{
-    struct timespec ts;
-    if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts) != 0) return cm_wtime();
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-void cm_rbf_probe_data(size_t m, double *c, double *w, size_t n, double *p)
-{
-    /* a fixed low-discrepancy sequence over the unit cube, weights of alternating sign */
-    for (size_t j = 0; j < m; ++j)
-        for (int k = 0; k < 3; ++k) {
-            c[k * m + j] = fmod(0.5 + (double)j * (0.7548776662 + 0.1 * k), 1.0);
-            w[k * m + j] = (j % 2 ? -1.0 : 1.0) * (1.0 + 0.001 * k);
-        }
-    for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) p[k * n + i] = fmod(0.25 + (double)i * (0.5698402910 + 0.1 * k), 1.0);
-}
 
 static double rate_gemm, rate_plain, rate_acc;
 static pthread_once_t probe_once = PTHREAD_ONCE_INIT;

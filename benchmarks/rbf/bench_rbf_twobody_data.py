@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The two-body set of the issue-10 benchmarks: two copies of one boundary set (the second
+"""The two-body set of the RBF solver benchmarks: two copies of one boundary set (the second
 moved along x by GAP x the set's bounding-box diagonal, with the same real displacements) and
 N points on a regular grid in the bounding box of both, standing in for the interior nodes of a
 1e6-node mesh (evaluation cost does not depend on where they are).

@@ -1,4 +1,4 @@
-/* Throughput of the r^3 kernel sums (rbf/rbf_sum.c plain, rbf/rbf_sum_acc.c compensated) in
+/* Throughput of the r^3 kernel sums (rbf/sum/rbf_sum.c plain, rbf/sum/rbf_sum_acc.c compensated) in
  * pairs per CPU-second (getrusage: user + system of the process, so 2 threads count both),
  * each instruction-set variant side by side in one process, alternating, on the same data:
  * m random centres in the unit cube, n random points, 3 weight vectors uniform in [-1, 1].
@@ -7,13 +7,13 @@
  * sum should reach).
  * Then the self product (targets = the m centres, as in the Krylov products): the general
  * AVX-512 blocks on a copy of the centres against the symmetric self product
- * (rbf/rbf_sum_self_avx512.c, taken when the targets are the centres), pairs = m^2,
+ * (rbf/sum/rbf_sum_self_avx512.c, taken when the targets are the centres), pairs = m^2,
  * accuracy on the first 64 centres.
  * usage: bench_kernel N REPS THREADS,... M,...      e.g. bench_kernel 10000 3 1,2 10000,100000
  * (one line of key=value per m, threads, variant and sum) */
 #include "cli/blas_reexec.h"
 #include "rbf_internal.h"
-#include "rbf_sum_isa.h"
+#include "sum/rbf_sum_isa.h"
 
 #include <math.h>
 #include <stdio.h>

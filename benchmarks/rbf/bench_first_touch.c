@@ -1,5 +1,5 @@
 /* First touch of fresh memory, 4 kB pages against transparent huge pages: the probe behind
- * cm_alloc_large (rbf/rbf_alloc.c; RESULTS.md, issue 10, fifteenth session). Allocates
+ * cm_alloc_large (core/platform/alloc_large.c; benchmarks/RESULTS.md, RBF solvers). Allocates
  * MB megabytes on 2 MB boundaries, optionally madvise(MADV_HUGEPAGE) and MADV_POPULATE_WRITE,
  * then writes one byte per 4 kB page from all OpenMP threads. Run it in fresh processes and
  * in varied order: on the VMs we run on, memory freed by the previous process is still

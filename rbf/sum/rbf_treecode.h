@@ -34,7 +34,7 @@ void cm_rbf_tree_set_isa(cm_rbf_tree *t, cm_rbf_isa isa);
  * by TwoSum (the compensated block of the direct sums); 2: also the proxy weights in
  * double-double. Only where the AVX-512 block runs (the isa above); elsewhere plain. For
  * evaluations whose weights cancel far more than the approximation error leaves room for
- * (RESULTS.md, issue 10, fourth session, says what it buys). */
+ * (RESULTS.md, RBF solvers, says what it buys). */
 void cm_rbf_tree_set_compensated(cm_rbf_tree *t, int level);
 
 /* out[i * ldo + q] ~ sum_j phi(|p_i - c_j|) w[q * m + j] for q < nc (1..4), i < n; p: 3 x n

@@ -27,28 +27,27 @@
 
 #define CM_LOOKAHEAD_BLOCK 192
 
-/* bench_cholesky compiles this file once more with CM_LOOKAHEAD_TRACE defined, to time every
- * task by its thread's CPU clock (a schedule model that the other jobs on a shared machine
- * do not disturb); in the library these are empty. */
-#ifdef CM_LOOKAHEAD_TRACE
 #include <time.h>
-void cm_lookahead_trace(int step, int kind, double cpu_seconds);
+
+/* The task trace (rbf_internal.h): every task timed by its thread's CPU clock while a
+ * benchmark has set the hook (a schedule model that the other jobs on a shared machine do
+ * not disturb); one test of a NULL pointer per task otherwise. */
+void (*cm_lookahead_trace_hook)(int step, int kind, double cpu_seconds);
 static double trace_clock(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
-#define TRACE_START() const double trace_t0 = trace_clock()
-#define TRACE_END(step, kind) cm_lookahead_trace(step, kind, trace_clock() - trace_t0)
-#else
-#define TRACE_START() (void)0
-#define TRACE_END(step, kind) (void)0
-#endif
+#define TRACE_START() const double trace_t0 = cm_lookahead_trace_hook ? trace_clock() : 0.0
+#define TRACE_END(step, kind)                                                             \
+    do {                                                                                  \
+        if (cm_lookahead_trace_hook)                                                      \
+            cm_lookahead_trace_hook(step, kind, trace_clock() - trace_t0);                \
+    } while (0)
 #ifndef CM_LOOKAHEAD_MIN_CHUNK
 #define CM_LOOKAHEAD_MIN_CHUNK 256
 #endif
-#define CM_LOOKAHEAD_MAX_CHUNKS 64
 #ifndef CM_LOOKAHEAD_TRSM_LEAF
 #define CM_LOOKAHEAD_TRSM_LEAF 64
 #endif

@@ -17,7 +17,7 @@
  *
  * The best split is a property of the core, not of the ISA: vsqrtpd on 8 doubles is several
  * times slower on a Sapphire-Rapids-class Xeon than on Zen 5. Measured (bench_kernel, 1
- * thread, 3 weight vectors; RESULTS.md issue 10, fifth session): Zen 5 plain best with 3 of
+ * thread, 3 weight vectors; RESULTS.md, RBF solvers): Zen 5 plain best with 3 of
  * 4 vectors through vsqrtpd, fixed-binade compensated with 2 of 2; the Xeon plain 2 of 4
  * (1.83e9 against 1.24e9 with 3 of 4), compensated 1 of 2 (1.30e9 against 0.93e9). So each
  * block is built for both splits and split_probe times them once per process (~11 ms).

@@ -9,7 +9,7 @@
  * much as m / nc matvecs of the coarse problem: from CM_COARSE_TREE_PAIRS on it goes through
  * the treecode (rbf_treecode.c), whose error is far below what a preconditioner needs. */
 #include "rbf_internal.h"
-#include "rbf_treecode.h"
+#include "sum/rbf_treecode.h"
 
 #include <cblas.h>
 #include <lapacke.h>
@@ -53,8 +53,8 @@ cm_status cm_rbf_coarse_inner_create(cm_context *ctx, const cm_rbf *r, size_t nc
     *out = NULL;
     cm_rbf_coarse_inner *ci = calloc(1, sizeof *ci);
     if (!ci) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (coarse)");
-    ci->maxit = r->opt.coarse_inner;
-    ci->tol = r->opt.coarse_inner_tol;
+    ci->maxit = r->tun.coarse_inner;
+    ci->tol = r->tun.coarse_inner_tol;
     ci->sub.kernel = r->kernel;
     ci->sub.dim = 3;
     ci->sub.k = 4;
@@ -63,11 +63,12 @@ cm_status cm_rbf_coarse_inner_create(cm_context *ctx, const cm_rbf *r, size_t nc
     /* the inner levels take the standard coarse rule (sqrt growth, dense, capped): the
      * caller's counts describe the outer coarse space */
     ci->sub.opt = r->opt;
-    ci->sub.opt.coarse_inner = 0;
-    ci->sub.opt.coarse_post = 0;
-    ci->sub.opt.coarse_size = 2000;
-    ci->sub.opt.coarse_grow = 1;
-    ci->sub.opt.coarse_max = 8000;
+    ci->sub.tun = r->tun;
+    ci->sub.tun.coarse_inner = 0;
+    ci->sub.tun.coarse_post = 0;
+    ci->sub.tun.coarse_size = 2000;
+    ci->sub.tun.coarse_grow = 1;
+    ci->sub.tun.coarse_max = 8000;
     ci->sub.c = malloc(3 * nc * sizeof *ci->sub.c);
     ci->q1 = calloc(4 * nc, sizeof *ci->q1);
     ci->stat = calloc(2, sizeof *ci->stat);

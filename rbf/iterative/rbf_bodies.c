@@ -6,8 +6,8 @@
  * With two bodies, a moment on one body and the opposite one on the other satisfy the global
  * constraints, and r^3 carries them across the gap at D^3: the local part then answered a
  * residual that is linear on each body (which every local solve annihilates) with a field
- * 20 x that residual (two bracket copies of 43,664 centres; RESULTS.md, issue 10, thirteenth
- * session). Removing those moments leaves the bodies' relative motion to the coarse level,
+ * 20 x that residual (two bracket copies of 43,664 centres; RESULTS.md, RBF solvers).
+ * Removing those moments leaves the bodies' relative motion to the coarse level,
  * which solves it exactly: 121,242 centres in 9 iterations instead of 11-28. On one body the
  * global projection after the whole correction took them out, but only after the coarse
  * correction that follows the local solves had seen them: projected before it, the bracket

@@ -1,14 +1,14 @@
-/* The iterative r^3 solver distributed over MPI ranks through PETSc (issue 10, section 3):
+/* The iterative r^3 solver distributed over MPI ranks through PETSc:
  * KSPFGMRES on a MatShell whose rows are split over the ranks, the two-level restricted
  * Schwarz preconditioner of rbf_schwarz.c as a PCSHELL, the polynomial block handled in its
- * null space as in rbf_iterative.c.
+ * null space as in iterative/rbf_fgmres.c.
  *
  * The mathematics is the serial solver's, step for step, so that both take the same
  * iterations and agree to round-off: the operator is Pi A on range(Pi) (Pi = I - Q1 Q1'),
  * the preconditioner Pi M, classical Gram-Schmidt with one refinement, and the restarts are
  * ours: each restart cycle is one KSPSolve (at most `restart` iterations, so PETSc never
  * restarts by itself) on the true projected residual, stopped by our test on FGMRES's
- * 2-norm estimate against the max-norm target, as solve_group in rbf_iterative.c does.
+ * 2-norm estimate against the max-norm target, as solve_group in iterative/rbf_fgmres.c does.
  * The serial solver runs up to four components in lock step so that one kernel sum serves
  * them all; here they form one block-diagonal system (vectors interleaved by row), which
  * keeps that saving (solving them one by one cost 4x the CPU of the serial solve at
@@ -76,7 +76,7 @@ static cm_status petsc_fail(cm_context *ctx, PetscErrorCode e, const char *what)
         }                                                \
     } while (0)
 
-/* v -= Q1 (Q1' v) on every component, twice, as project() in rbf_iterative.c. */
+/* v -= Q1 (Q1' v) on every component, twice, as project() in iterative/rbf_fgmres.c. */
 static PetscErrorCode project(cm_rbf_petsc *ps, Vec v)
 {
     const int n = ps->cur->g * ps->r->k;
@@ -288,7 +288,7 @@ typedef struct outcome {
 
 /* Components [c0, c0 + g) of f (nc x m SoA) as one block-diagonal system: one kernel sum
  * serves all of them, as in the serial solver's lock step. Restart cycles as solve_group in
- * rbf_iterative.c; a cycle's inner loop stops when the joint estimate is below the smallest
+ * iterative/rbf_fgmres.c; a cycle's inner loop stops when the joint estimate is below the smallest
  * of the components' targets (so each component's own estimate is too). */
 static cm_status solve_group(cm_context *ctx, cm_rbf_petsc *ps, int g, const double *f,
                              double fmax_all, double *w, double *q, outcome *out)
@@ -412,7 +412,7 @@ cm_status cm_rbf_petsc_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double
     double fmax_all = 0.0;
     for (size_t i = 0; i < nc * m; ++i) fmax_all = fmax(fmax_all, fabs(f[i]));
     /* without it the evaluation would never take the treecode where the serial one does:
-     * interior nodes 1.1e-9 of the range apart on bracket 60.6k (RESULTS.md, issue 10) */
+     * interior nodes 1.1e-9 of the range apart on bracket 60.6k (RESULTS.md, RBF solvers) */
     cm_rbf_iterative_set_scale(r, fmax_all);
     ps->matvecs = 0;
     int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, gmax = 0;

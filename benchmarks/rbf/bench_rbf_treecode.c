@@ -1,4 +1,4 @@
-/* The r^3 treecode (rbf/rbf_treecode.c) against direct summation on real RBF weights and on
+/* The r^3 treecode (rbf/sum/rbf_treecode.c) against direct summation on real RBF weights and on
  * random ones, on the centres of a boundary set: error relative to sum_j |w_j| phi_ij (what
  * the bound controls) and to the result (what cancellation costs), CPU time of one fast and
  * one direct product.
@@ -15,7 +15,7 @@
 #include "cli/blas_reexec.h"
 #include "cadmorph/rbf.h"
 #include "rbf_internal.h"
-#include "rbf_treecode.h"
+#include "sum/rbf_treecode.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,6 +1,6 @@
 #!/bin/sh
 # RBF core vs scipy on identical data (torus, m centres, n = 10 m points inside).
-# usage: benchmarks/bench_rbf.sh BUILD_DIR [THREADS] [M...]
+# usage: benchmarks/rbf/bench_rbf.sh BUILD_DIR [THREADS] [M...]
 #   SCIPY_MAX=M  largest m also run through scipy (default 10000)
 #   REPS=R       repetitions per m, best times reported (default 3; 1 for m > 10000)
 #   SOLVER=S     auto (default: cm_rbf_create's choice, iterative above its crossover), dense
@@ -16,7 +16,7 @@ threads=${2:-0}
 [ $# -ge 2 ] && shift 2 || shift $#
 sizes=${*:-1000 2000 5000 10000 20000}
 here=$(cd "$(dirname "$0")" && pwd)
-bench=$build/benchmarks/bench_rbf
+bench=$build/benchmarks/rbf/bench_rbf
 scipy_max=${SCIPY_MAX:-10000}
 scipy_threads=$threads; [ "$threads" -gt 0 ] || scipy_threads=$(nproc)
 work=$(mktemp -d /tmp/bench_rbf.XXXXXX)

@@ -5,7 +5,7 @@
 # thread. Rows: wall and CPU seconds (the child's user + sys), warp create (set-up) and apply
 # (solve + evaluation) seconds, joint iterations, max node difference to the serial result
 # over the displacement range. usage: bench_rbf_petsc.sh BUILD_DIR MESH D.csv [WORK] [THREADS]
-# (D.csv: benchmarks/bench_warp_scipy.py --csv MESH MORPHED D.csv). RUNS (environment) picks
+# (D.csv: bench_warp_scipy.py --csv MESH MORPHED D.csv, of the warp benchmarks). RUNS (environment) picks
 # the rows, "solver ranks threads" separated by ';' (default: the three above); the serial
 # reference for "vs serial" is WORK/iterative_1xTHREADS.vtu, from this or an earlier run.
 set -eu
@@ -34,7 +34,7 @@ for run in $runs; do
         --displacements "$csv" -o "$out" --solver "$1" --threads "$3" -v \
         >"$work/out.txt" 2>"$work/err.txt"
     cmp=-
-    [ "$1" = petsc ] && cmp=$(OPENBLAS_VERBOSE=0 /usr/bin/python3 "$here/../tests/cli/compare_moved.py" \
+    [ "$1" = petsc ] && cmp=$(OPENBLAS_VERBOSE=0 /usr/bin/python3 "$here/../../tests/cli/compare_moved.py" \
         "$work/iterative_1x$threads.vtu" "$out" 1 | sed 's/max node difference \([^ ]*\).*/\1/')
     awk -v s="$1" -v rt="$2 x $3" -v cmp="$cmp" '
         /^time / { split($2, a, "="); wall = a[2]; split($3, b, "[=+]"); cpu = b[2] + b[3] }

@@ -114,7 +114,7 @@ int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
 int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block)
 {
     int threads = openblas_get_num_threads();
-    /* under ulimit -v, as many callers as have room for their buffers (blas_threads.c) */
+    /* under ulimit -v, as many callers as have room for their buffers (core/platform/blas_threads.c) */
     if (threads > 1 && n >= CM_LOOKAHEAD_MIN_N && n <= CM_LOOKAHEAD_MAX_N && !omp_in_parallel())
         threads = cm_blas_callers(threads);
     else threads = 1;

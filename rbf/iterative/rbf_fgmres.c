@@ -13,15 +13,13 @@
  * short recurrence does not hold; GMRES needs one matvec per iteration like CG, and the
  * iteration counts here are small, so the extra orthogonalisation is cheap. The components
  * of the data run in lock step, so one kernel-sum pass serves up to four of them (and a
- * converged one leaves the pass). The Krylov products are relaxed (opt.relax, see
+ * converged one leaves the pass). The Krylov products are relaxed (tuning relax, see
  * CM_RBF_RELAX_BUDGET): compensated while the residual is large, plain or loose treecode
  * sums as it falls; the exact residual at the end of a cycle decides. */
-#include "rbf_internal.h"
-#include "rbf_treecode.h"
+#include "rbf_iter.h"
 
 #include <cblas.h>
 #include <float.h>
-#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,17 +33,16 @@
  * residuals where direct matvecs take 12 compensated products (bracket 59k; RESULTS.md
  * "Fast summation"), so it pays once one compensated product costs more than 22 / (12 - 4)
  * = 2.75 treecode products at fast_tol 1e-12. Measured with the treecode on the AVX-512
- * block (RESULTS.md, issue 10, fourth session; bracket sets, one product, CPU s): 1.9 at
+ * block (RESULTS.md, RBF solvers; bracket sets, one product, CPU s): 1.9 at
  * 59k, 2.6 at 103k, 3.6 at 201k, 6.6 at 479k; 2.75 falls near 1.15e5. But on real data the
  * refinement costs more than at 59k: bracket 148k (real displacements), fast 46 iterations,
- * 65 products, 253 CPU s; direct 16 iterations, 22 products, 221 CPU s (RESULTS.md, "Quiet
- * reruns after the fourth session"). So it was 2e5. Since the preconditioner keeps the
+ * 65 products, 253 CPU s; direct 16 iterations, 22 products, 221 CPU s (RESULTS.md, RBF
+ * solvers). So it was 2e5. Since the preconditioner keeps the
  * bodies free of linear moments (rbf_bodies.c) the fast solve needs as many iterations as
  * the direct one (Zen 5, fit CPU s fast / direct: bracket 102,890 54.2 / 47.2, bracket
- * 150,137 99.1 / 109.3, two bodies 164,820 108.0 / 118.9; RESULTS.md, issue 10, thirteenth
- * session): 1.5e5, just under the first real single-body set where it wins. */
+ * 150,137 99.1 / 109.3, two bodies 164,820 108.0 / 118.9; RESULTS.md, RBF solvers):
+ * 1.5e5, just under the first real single-body set where it wins. */
 #define CM_RBF_FAST_MIN_M 150000
-#define CM_RBF_FAST_EVAL_PAIRS 2e9
 /* an inner (fast-matvec) solve of a refinement step aims for this reduction of its own
  * right-hand side, or the final tolerance if that is nearer: the treecode's operator
  * differs from A by about fast_tol x (sum |w| phi / |A w|), 1e-8..1e-5 on real sets, so
@@ -56,22 +53,9 @@
  * residual part in long cycles (bracket 148k, y: after 40 iterations estimate 3e-7, true
  * 3e-6 in the 2-norm; 48 iterations in all), and a fresh start costs the refinement-free
  * two products plus the floor's. With it: 16 iterations there, 13 instead of 16 at 103k,
- * 18 instead of 17 on two bodies 119k, the same below 1e5 (RESULTS.md, fourth session) */
+ * 18 instead of 17 on two bodies 119k, the same below 1e5 (RESULTS.md, RBF solvers) */
 #define CM_RBF_CYCLE_GAIN 1e-6
-/* samples for the a-posteriori error estimate of a fast evaluation, and the factor on the
- * largest sampled error (the sampled max was within it of the true max on the real sets).
- * The treecode's errors are spiky below its finest orders: over 32,768 of the two-body
- * interior points at order 10, every 256-point subset found at least 1/6.4 of their
- * largest error, every 1,024-point one 1/2.2 (RESULTS.md, issue 10, tenth session); 1,024
- * compensated sums cost ~1 % of a 10^6-point evaluation */
-#define CM_RBF_FAST_SAMPLES 1024
-#define CM_RBF_FAST_SAFETY 4.0
-/* relative rounding of one entry phi_ij = r2 sqrt(r2) (the differences, r2's three terms,
- * the root and the product), so compensated sums of the rounded entries err by up to about
- * this x eps sum_j |w_j| phi_ij against the true kernel */
-#define CM_RBF_PHI_ROUND 4.0
-
-/* Relaxed products (opt.relax). Inexact Krylov (Simoncini & Szyld 2003, van den Eshof &
+/* Relaxed products (tuning relax). Inexact Krylov (Simoncini & Szyld 2003, van den Eshof &
  * Sleijpen 2004): with E_j = (A~ - A) z_j the error of the j-th product, the true residual
  * differs from the one GMRES sees by E y = sum_j y_j E_j, and |y_j| <= |r_{j-1}| /
  * sigma_min(H). So step j may err by about target x sigma / |r_{j-1}|, growing as the
@@ -98,7 +82,7 @@
 /* loose treecode products at 1e-6 from this many centres, at 1e-9 and 1e-11 from the other
  * counts: where each is cheaper than a plain direct product, which since the symmetric self
  * product (rbf_sum_self_avx512.c) is about half the general one. Measured (bench_rbf_treecode
- * on real weights, 2 threads, model-167 Xeon, RESULTS.md issue 10 ninth session), CPU s of one
+ * on real weights, 2 threads, model-167 Xeon, RESULTS.md, RBF solvers), CPU s of one
  * product at 60.6k / 121k centres: treecode 1e-6 0.61 / 1.56, 1e-9 1.14 / 3.03, 1e-11 1.85 /
  * 3.95; plain general 1.62 / 5.38 there, so the self product (1.7-2.2x that in bench_kernel)
  * ~0.8 / ~2.7. Above CM_RBF_FAST_MIN_M the fast solve takes over. */
@@ -109,360 +93,6 @@
 static const double relax_tree_tol[CM_RBF_RELAX_LEVELS] = {1e-6, 1e-9, 1e-11};
 
 enum { MV_COMP = 0, MV_PLAIN = 1, MV_FAST = 2 };
-
-struct cm_rbf_iter {
-    cm_rbf_schwarz *pc;
-    double *q1; /* m x k col-major, orthonormal basis of the polynomials at the centres */
-    cm_rbf_tree *tree; /* treecode on the centres, for the order below (NULL: none yet) */
-    int tree_order;
-    double tree_theta;
-    double fmax;       /* max |data| of the last solve: the scale of fast_eval_tol */
-    int eval_fast;     /* the last evaluation's choice and estimate (evaluation gets a
-                        * const cm_rbf, the iterative state is where it can leave them) */
-    double eval_error;
-    int eval_order;    /* the row it took */
-    double eval_theta;
-    cm_rbf_tree *rtree[3]; /* loose treecodes for relaxed products (relax_tree_tol) */
-};
-
-void cm_rbf_options_init(cm_rbf_options *opt)
-{
-    if (!opt) return;
-    memset(opt, 0, sizeof *opt);
-    opt->solver = CM_RBF_SOLVER_AUTO;
-    opt->tolerance = 1e-10;
-    opt->max_iterations = 300;
-    opt->restart = 40;
-    opt->leaf_size = 256;
-    opt->local_size = 700;
-    opt->coarse_size = 2000;
-    opt->coarse_post = 1;
-    opt->local_float = 1;
-    opt->coarse_grow = 1;
-    opt->coarse_max = 16000;
-    opt->coarse_inner_tol = 1e-2;
-    opt->overlap = 2.0;
-    opt->local_max = 2800;
-    opt->thin_cell = 0.25;
-    opt->thin_max = 2000;
-    opt->fast_sum = -1;
-    opt->fast_tol = 1e-12;
-    opt->fast_refine = 3;
-    opt->fast_eval_tol = 1e-9;
-    opt->relax = 1;
-}
-
-void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
-{
-    if (!stats) return;
-    if (!rbf) {
-        memset(stats, 0, sizeof *stats);
-        return;
-    }
-    *stats = rbf->stats;
-    if (rbf->iter) {
-        stats->eval_fast = rbf->iter->eval_fast;
-        stats->eval_error = rbf->iter->eval_error;
-        stats->eval_order = rbf->iter->eval_order;
-        stats->eval_theta = rbf->iter->eval_theta;
-    }
-}
-
-/* Cost model for AUTO, in seconds of one thread, from rates timed in this process
- * (cm_rbf_auto_rates: G dgemm flops/s, Kp and Ka plain and compensated kernel pairs/s):
- *   dense     ~ m^3/3 / (E G) + D m^2 / Kp: the Cholesky factorisation at E times the dgemm
- *               rate, assembly and the refinement's kernel sums;
- *   iterative ~ S m / G + N m^2 / Ka: the Schwarz set-up (local and coarse factorisations,
- *               S flops per centre at the dgemm rate) and N compensated sums of m^2 pairs
- *               (FGMRES matvecs, the final residual, evaluation at the centres).
- * E, S and N were fitted to bench_rbf runs of both solvers at m = 5k, 10k, 20k in one
- * window (RESULTS.md, issue 10, "Kernel throughput and the dense path on a quiet machine");
- * S and N again with subdomains of 700 centres and an overlap of 2 H (sixth session, Zen 4:
- * S 1.9e7 -> 3.0e6, N 12 -> 8.6; crossover ~3,500 centres, where real boundary sets agree:
- * iterative ahead on bore 3.3k and pipe 4.7k, dense on bracket 1.8k).
- * Why rates and not seconds: the old constants (crossover ~7,500 centres) came from
- * Haswell kernels under load; with the AVX-512 dgemm the dense path is 2x faster and with the
- * hand-written AVX-512 sums the iterative one too, and the crossover follows their ratio.
- * Without rates (the probe could not allocate) the old constants stand. Dense is also
- * refused when its factor (4 m^2 bytes) would take more than half the physical memory.
- * Below 1,000 centres dense always wins and above 60,000 its factorisation alone takes
- * minutes and 7 GB, so those skip the probe. */
-#define CM_RBF_AUTO_E 1.0
-#define CM_RBF_AUTO_D 3.0
-#define CM_RBF_AUTO_S 3.0e6
-#define CM_RBF_AUTO_N 8.6
-#define CM_RBF_COST_DENSE_M3 7.9e-12
-#define CM_RBF_COST_ITER_M 5.5e-5 /* the old 3.5e-4 and 1.3e-8 scaled as S and N */
-#define CM_RBF_COST_ITER_M2 9e-9
-
-int cm_rbf_auto_costs(size_t m, double *dense, double *iter)
-{
-    const double x = (double)m;
-    double g, kp, ka;
-    cm_rbf_auto_rates(&g, &kp, &ka);
-    if (g > 0.0 && kp > 0.0 && ka > 0.0) {
-        *dense = x * x * x / 3.0 / (CM_RBF_AUTO_E * g) + CM_RBF_AUTO_D * x * x / kp;
-        *iter = CM_RBF_AUTO_S * x / g + CM_RBF_AUTO_N * x * x / ka;
-        return 1;
-    }
-    *dense = CM_RBF_COST_DENSE_M3 * x * x * x;
-    *iter = CM_RBF_COST_ITER_M * x + CM_RBF_COST_ITER_M2 * x * x;
-    return 0;
-}
-
-int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
-{
-    if (kernel != CM_RBF_TRIHARMONIC) return 1;
-    const double x = (double)m;
-    const double budget = cm_memory_budget();
-    if (budget > 0 && 4.0 * x * x > budget) return 0;
-    if (m < 1000) return 1;
-    if (m > 60000) return 0;
-    double dense, iter;
-    cm_rbf_auto_costs(m, &dense, &iter);
-    return dense <= iter;
-}
-
-const double *cm_rbf_iterative_q1(const cm_rbf *r) { return r->iter ? r->iter->q1 : NULL; }
-
-const cm_rbf_schwarz *cm_rbf_iterative_pc(const cm_rbf *r) { return r->iter ? r->iter->pc : NULL; }
-
-void cm_rbf_iterative_destroy(cm_rbf_iter **it)
-{
-    if (!it || !*it) return;
-    cm_rbf_schwarz_destroy(&(*it)->pc);
-    cm_rbf_tree_destroy(&(*it)->tree);
-    cm_rbf_tree_destroy(&(*it)->rtree[0]);
-    cm_rbf_tree_destroy(&(*it)->rtree[1]);
-    cm_rbf_tree_destroy(&(*it)->rtree[2]);
-    free((*it)->q1);
-    free(*it);
-    *it = NULL;
-}
-
-cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
-{
-    const size_t m = r->m, k = (size_t)r->k;
-    const cm_rbf_options *o = &r->opt;
-    if (r->kernel != CM_RBF_TRIHARMONIC || r->dim != 3)
-        return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                        "cm_rbf_create: the iterative solver handles the 3D r^3 kernel only");
-    if (!(o->tolerance > 0.0) || o->max_iterations < 1 || o->restart < 2 || o->leaf_size < 8 ||
-        o->local_size < o->leaf_size || o->coarse_size < 0 || o->coarse_post < 0 ||
-        o->coarse_post > 2 || !(o->overlap >= 0.0) || o->local_max < 0 || o->coarse_max < 0 ||
-        o->local_float < 0 || o->local_float > 2 || o->fast_sum < -1 || o->fast_sum > 1 ||
-        !(o->fast_tol > 0.0 && o->fast_tol <= 1e-3) || o->fast_refine < 0 ||
-        o->fast_refine > 10 || !(o->fast_eval_tol > 0.0) || o->relax < 0 || o->relax > 2 ||
-        !(o->thin_reach >= 0.0) || (o->thin_reach > 0.0 && (!(o->thin_cell > 0.0) ||
-                                                            o->thin_max < o->leaf_size)))
-        return cm_error(ctx, CM_ERR_ARGUMENT,
-                        "cm_rbf_create: bad iterative options (tolerance %g, max_iterations %d, "
-                        "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "
-                        "%d, overlap %g, local_max %d, coarse_max %d, fast_sum %d, fast_tol %g, "
-                        "fast_refine %d, fast_eval_tol %g, relax %d, thin_reach %g, "
-                        "thin_cell %g, thin_max %d)",
-                        o->tolerance, o->max_iterations, o->restart, o->leaf_size,
-                        o->local_size, o->coarse_size, o->coarse_post, o->overlap, o->local_max,
-                        o->coarse_max, o->fast_sum, o->fast_tol, o->fast_refine,
-                        o->fast_eval_tol, o->relax, o->thin_reach, o->thin_cell, o->thin_max);
-    cm_rbf_iter *it = calloc(1, sizeof *it);
-    if (!it) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
-    it->q1 = malloc(m * k * sizeof *it->q1);
-    if (!it->q1) {
-        free(it);
-        return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
-    }
-    memcpy(it->q1, r->qr, m * k * sizeof *it->q1);
-    lapack_int info = LAPACKE_dorgqr(LAPACK_COL_MAJOR, (lapack_int)m, (lapack_int)k,
-                                     (lapack_int)k, it->q1, (lapack_int)m, r->tau);
-    cm_status st = info == 0 ? CM_OK
-                             : cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: dorgqr failed (info %d)",
-                                        (int)info);
-    if (st == CM_OK) st = cm_rbf_schwarz_create(ctx, r, threads, &it->pc);
-    if (st != CM_OK) {
-        cm_rbf_iterative_destroy(&it);
-        return st;
-    }
-    r->iter = it;
-    r->stats.subdomains = cm_rbf_schwarz_subdomains(it->pc);
-    r->stats.coarse_size = cm_rbf_schwarz_coarse(it->pc);
-    r->stats.memory_bytes = cm_rbf_schwarz_bytes(it->pc) + m * k * sizeof(double);
-    return CM_OK;
-}
-
-/* Why compensated sums for evaluation too: the weights of large or spread sets are large
- * (sum |w| of 1e6..1e7 x max |d| on the bracket and on two bodies far apart), and plain sums
- * then reproduce the data at the centres only to eps sum |w_j phi_ij| (bracket, m = 59k:
- * 1e-7 of the range, although the residual is 6e-11). The dense path keeps plain sums: its
- * callers at m <= ~3,500 do not see that floor, and it is 2.4x faster. */
-/* The treecode on the centres for (order, theta), made on first use and kept. */
-static cm_rbf_tree *tree_for(const cm_rbf *r, int order, double theta)
-{
-    cm_rbf_iter *it = r->iter;
-    if (it->tree && it->tree_order == order && it->tree_theta == theta) return it->tree;
-    cm_rbf_tree_destroy(&it->tree);
-    it->tree = cm_rbf_tree_create(r->m, r->c, order, theta);
-    it->tree_order = order;
-    it->tree_theta = theta;
-    return it->tree;
-}
-
-/* Evaluation by the treecode if its error can be shown to be within fast_eval_tol x max
- * |data|: the order is chosen from sum_j |w_j| phi_ij at a few of the points (the scale of
- * its bound, which the cancellation of the weights makes 1e4..1e7 x the result), then the
- * fast result is checked against compensated direct sums at CM_RBF_FAST_SAMPLES points.
- * Those are exact for the rounded entries phi_ij, not for the true ones, so they err by up
- * to about CM_RBF_PHI_ROUND eps sum_j |w_j| phi_ij themselves: 7.8e-9 of max |d| on two
- * bodies at 1e6 points against a long-double reference, where the order-14 treecode errs by
- * 1.0e-9 (RESULTS.md, "The treecode on the AVX-512 block"). The check cannot see below
- * that, and the fallback is no better, so the fast sum is accepted within the larger of
- * fast_eval_tol x max |data| and that floor; eval_error says which was met.
- *
- * The bound is relative to sum |w| phi at each point and is often far from the error on
- * real weights: on two bodies far apart (121k centres, 10^6 points) the row for 1e-12
- * erred no more than the finest (1.0e-16 x max sum |w| phi, the rounding floor) at 0.66x
- * its CPU, while on the bracket (60.6k) only the finest met the floor (RESULTS.md, issue
- * 10, seventeenth session). So the row for CM_RBF_PILOT_GAIN x the asked tolerance is tried
- * first on a pilot, every k-th batch of targets (CM_RBF_PILOT_BATCHES of them: the same
- * batches as the whole sum, so the same clusters go by their proxies), and taken if its
- * error at CM_RBF_PILOT_PER points of each batch passes the check's test; the check itself
- * still decides, and a coarser row that fails it is followed by the asked one before
- * direct sums. The pilot costs about CM_RBF_PILOT_BATCHES / (n / 192) of a coarse sum
- * (bracket, 211k points: 3 %). 1 if out holds the accepted fast result; 0 (out undefined)
- * if direct sums must do it. */
-#define CM_RBF_PILOT_GAIN 1e2
-#define CM_RBF_PILOT_BATCHES 32
-#define CM_RBF_PILOT_PER 16
-
-/* The treecode sums of all components at the targets of every stride-th batch (1: all). */
-static int tree_sum_all(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
-                        size_t stride, double *out, int threads)
-{
-    const size_t m = r->m, nc = (size_t)r->ncomp;
-    for (size_t g = 0; g < nc; g += 4) {
-        int gc = nc - g < 4 ? (int)(nc - g) : 4;
-        if (cm_rbf_tree_sum_targets(t, tg, stride, r->w + g * m, gc, out + g, nc, threads))
-            return -1;
-    }
-    return 0;
-}
-
-/* The largest error of the fast sums out (n x nc) against compensated direct sums at
- * `samples` of the targets (the indices idx, or NULL: spread over them), over all the
- * components. */
-static double check_all(const cm_rbf *r, const cm_rbf_tree *t, size_t n, const double *p,
-                        const double *out, size_t samples, const size_t *idx, int threads)
-{
-    const size_t m = r->m, nc = (size_t)r->ncomp;
-    double err = 0.0;
-    for (size_t g = 0; g < nc; g += 4) {
-        int gc = nc - g < 4 ? (int)(nc - g) : 4;
-        double e;
-        cm_rbf_tree_check(t, r->w + g * m, gc, n, p, n, out + g, nc, samples, idx, &e, NULL,
-                          threads);
-        err = fmax(err, e);
-    }
-    return err;
-}
-
-/* 1 if the treecode t passes the pilot: its largest error at the pilot's points, x
- * CM_RBF_FAST_SAFETY, is within accept. out: n x nc scratch. */
-static int pilot_passes(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
-                        size_t n, const double *p, double accept, double *out, int threads)
-{
-    size_t *idx = malloc(CM_RBF_PILOT_BATCHES * CM_RBF_PILOT_PER * sizeof *idx), stride = 1;
-    if (!idx) return 0;
-    const size_t np =
-        cm_rbf_tree_targets_pilot(tg, CM_RBF_PILOT_BATCHES, CM_RBF_PILOT_PER, idx, &stride);
-    const int pass = tree_sum_all(r, t, tg, stride, out, threads) == 0 &&
-                     CM_RBF_FAST_SAFETY * check_all(r, t, n, p, out, np, idx, threads) <= accept;
-    free(idx);
-    return pass;
-}
-
-static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads)
-{
-    cm_rbf_iter *it = r->iter;
-    const size_t m = r->m, nc = (size_t)r->ncomp;
-    const double target = r->opt.fast_eval_tol * it->fmax;
-    it->eval_fast = 0;
-    it->eval_error = 0.0;
-    if (!(target > 0.0)) return 0;
-    const size_t ns = n < 64 ? n : 64;
-    double *sp = malloc(3 * ns * sizeof *sp), *aw = malloc(nc * m * sizeof *aw);
-    double *ab = malloc(ns * nc * sizeof *ab);
-    int ok = sp && aw && ab;
-    double smax = 0.0;
-    if (ok) {
-        for (size_t k = 0; k < ns; ++k)
-            for (int d = 0; d < 3; ++d)
-                sp[(size_t)d * ns + k] = p[(size_t)d * n + (size_t)((double)k * (double)n / (double)ns)];
-        for (size_t j = 0; j < nc * m; ++j) aw[j] = fabs(r->w[j]);
-        for (size_t g = 0; g < nc; g += 4) {
-            int gc = nc - g < 4 ? (int)(nc - g) : 4;
-            cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw + g * m, gc, ns, sp, ns, ab + g,
-                              nc, threads);
-        }
-        for (size_t i = 0; i < ns * nc; ++i) smax = fmax(smax, ab[i]);
-    }
-    free(sp), free(aw), free(ab);
-    if (!ok) return 0;
-    /* what the direct fallback itself can promise (see above) */
-    const double accept = fmax(target, CM_RBF_PHI_ROUND * DBL_EPSILON * smax);
-    /* the row that should meet it with room for the estimate's factor; below the rounding
-     * of the finest row (about 1e-16 x sum |w| phi) the finest is asked for */
-    const double tau = fmax(accept / (smax * CM_RBF_FAST_SAFETY), CM_RBF_TREE_TOL_MIN);
-    int order, order_c;
-    double theta, theta_c;
-    cm_rbf_tree_params(tau, &order, &theta);
-    cm_rbf_tree_params(CM_RBF_PILOT_GAIN * tau, &order_c, &theta_c);
-    cm_rbf_tree_targets *tg = cm_rbf_tree_targets_create(n, p, n);
-    if (!tg) return 0;
-    /* the coarser row first if it passes the pilot (at the table's coarse end it is the
-     * same row) */
-    int coarse = order_c != order || theta_c != theta;
-    if (coarse) {
-        const cm_rbf_tree *t = tree_for(r, order_c, theta_c);
-        coarse = t && pilot_passes(r, t, tg, n, p, accept, out, threads);
-    }
-    for (;; coarse = 0) {
-        const int o = coarse ? order_c : order;
-        const double th = coarse ? theta_c : theta;
-        const cm_rbf_tree *t = tree_for(r, o, th);
-        if (!t || tree_sum_all(r, t, tg, 1, out, threads)) break;
-        const double err = check_all(r, t, n, p, out, CM_RBF_FAST_SAMPLES, NULL, threads);
-        it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
-        it->eval_fast = CM_RBF_FAST_SAFETY * err <= accept;
-        it->eval_order = o;
-        it->eval_theta = th;
-        if (it->eval_fast || !coarse) break;
-    }
-    cm_rbf_tree_targets_destroy(&tg);
-    return it->eval_fast;
-}
-
-int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
-                                   int threads)
-{
-    const int fs = r->opt.fast_sum;
-    if (fs == 1 || (fs < 0 && (double)n * (double)r->m >= CM_RBF_FAST_EVAL_PAIRS))
-        return evaluate_fast(r, n, p, out, threads);
-    r->iter->eval_fast = 0; /* eval_error stays that of the last evaluation that tried */
-    return 0;
-}
-
-void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax) { r->iter->fmax = fmax; }
-
-void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
-                               int threads)
-{
-    if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads)) return;
-    for (int g = 0; g < r->ncomp; g += 4) {
-        int nc = r->ncomp - g < 4 ? r->ncomp - g : 4;
-        cm_rbf_kernel_sum_acc(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
-                              (size_t)r->ncomp, threads);
-    }
-}
 
 /* v -= Q1 (Q1' v), twice (the second pass removes what round-off left of the first). */
 static void project(const double *q1, size_t m, int k, double *v)
@@ -866,7 +496,7 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
  * which costs 1.5-2x a plain one (the fixed-binade update per entry and component,
  * rbf_r3_avx512.h); at 10^6 centres to 1e-6 it was the one exact residual, 320 of 1,044 CPU
  * s on Zen 5, where S(w) is 1.9e5 x max |f| and the bound 1.9e-8 (measured plain errors are
- * 7x below it; RESULTS.md, issue 10, fourteenth and sixteenth sessions). The caller adds the
+ * 7x below it; RESULTS.md, RBF solvers). The caller adds the
  * bound to the residual it compares with the tolerance. Only tried from a relative
  * tolerance of CM_RBF_PLAIN_RES_TOL: on real sets S(w) is 1e4..1e9 x max |f|, so below it
  * the loose treecode's product on |w| would be spent for nothing. absw, out: g x m scratch
@@ -897,9 +527,9 @@ static double plain_bound(const cm_rbf *r, krylov *kr, const double *w, double t
  * coefficients, the fast Krylov solve itself stalls: its residual by the treecode stays far
  * above GMRES's estimate, and every further fast step stalls there again. It did on two
  * bodies far apart (121k centres: 4.8e-5 against 2.1e-7, then 4.5e-5 after a second step of
- * 40 iterations; RESULTS.md, issue 10, eleventh and twelfth sessions) until the
- * preconditioner stopped giving the bodies linear moments (rbf_bodies.c; thirteenth
- * session: 10 iterations, no fallback). A component whose fast solve stagnated, or whose
+ * 40 iterations; RESULTS.md, RBF solvers) until the
+ * preconditioner stopped giving the bodies linear moments (rbf_bodies.c: then
+ * 10 iterations, no fallback). A component whose fast solve stagnated, or whose
  * steps stopped above the tolerance and above its floor, is then solved afresh with direct
  * (compensated, relaxed) matvecs
  * (*direct = 1): the fast work is lost, but the cost is bounded by one direct solve. steps:
@@ -912,6 +542,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
     const size_t m = kr->m;
     const int g = kr->g;
     const cm_rbf_options *o = &r->opt;
+    const cm_rbf_tuning *tu = &r->tun;
     const size_t gm = (size_t)g * m;
     double *rhs = malloc(gm * sizeof *rhs), *dw = malloc(gm * sizeof *dw);
     double *adw = malloc(gm * sizeof *adw), *wl = calloc(gm, sizeof *wl);
@@ -931,7 +562,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
         double rn = 0.0;
         for (int c = 0; c < g; ++c)
             if (!done[c]) rn = fmax(rn, norm_inf(m, rhs + (size_t)c * m));
-        double tol = o->fast_refine > 0 && !last
+        double tol = tu->fast_refine > 0 && !last
                          ? fmax(o->tolerance, CM_RBF_REFINE_GAIN * rn / fmax_all)
                          : o->tolerance;
         int it[4], stt[4];
@@ -942,7 +573,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             w[i] = t;
         }
         for (int c = 0; c < g; ++c) iters[c] += it[c];
-        if (o->fast_refine == 0) { /* the treecode's own residual: A w = A dw here */
+        if (tu->fast_refine == 0) { /* the treecode's own residual: A w = A dw here */
             memcpy(aw, adw, gm * sizeof *aw);
             for (int c = 0; c < g; ++c) status[c] = stt[c];
             break;
@@ -972,7 +603,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             if (done[c]) continue;
             if (res[c] + fmax(pb, 0.0) <= o->tolerance) done[c] = 1, status[c] = 1;
             /* stt 3: the fast Krylov solve itself stagnated above its floor (see above) */
-            else if (last || step + 1 >= o->fast_refine || res[c] > 0.5 * prev[c] ||
+            else if (last || step + 1 >= tu->fast_refine || res[c] > 0.5 * prev[c] ||
                      stt[c] == 3) {
                 done[c] = 1, status[c] = stt[c] == 1 ? 3 : stt[c];
                 if (!last) stop[nstop++] = c;
@@ -1002,7 +633,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
                      * leave is what the preconditioner handles worst (two bodies: 47
                      * iterations for the correction of 4.8e-5, 11 for the whole solve) */
             kr->tree = NULL;
-            kr->relax = o->relax;
+            kr->relax = tu->relax;
             *direct = 1;
             for (int c = 0; c < g; ++c)
                 if (!done[c]) {
@@ -1027,6 +658,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
 {
     const size_t m = r->m, k = (size_t)r->k;
     const cm_rbf_options *o = &r->opt;
+    const cm_rbf_tuning *tu = &r->tun;
     const int R = o->restart < 63 ? o->restart : 63;
     const int gmax = nc < 4 ? (int)nc : 4;
     krylov kr;
@@ -1058,8 +690,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     if (fast) {
         int order;
         double theta;
-        cm_rbf_tree_params(o->fast_tol, &order, &theta);
-        kr.tree = tree_for(r, order, theta);
+        cm_rbf_tree_params(tu->fast_tol, &order, &theta);
+        kr.tree = cm_rbf_iterative_tree(r, order, theta);
         if (!kr.tree) {
             st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_solve: out of memory for the treecode");
             goto done;
@@ -1069,9 +701,9 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     kr.mv = mvk;
     /* relaxed products in the direct-matvec solve (the fast one refines on its own, but
      * relaxes in its direct restart, refine_group) */
-    kr.relax = o->relax && !fast;
-    kr.relax_tree = o->fast_sum == 0 || !o->relax ? 0
-                    : m >= CM_RBF_RELAX_TREE11_M || o->relax == 2 ? 3
+    kr.relax = tu->relax && !fast;
+    kr.relax_tree = o->fast_sum == 0 || !tu->relax ? 0
+                    : m >= CM_RBF_RELAX_TREE11_M || tu->relax == 2 ? 3
                     : m >= CM_RBF_RELAX_TREE9_M ? 2
                     : m >= CM_RBF_RELAX_TREE_M ? 1 : 0;
     {
@@ -1160,7 +792,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     r->stats.refinements = steps;
     r->stats.fast_direct = direct;
     r->stats.fast_residual = fast ? first : 0.0;
-    r->stats.fast_bound = fast ? o->fast_tol * floor_max / DBL_EPSILON : 0.0;
+    r->stats.fast_bound = fast ? tu->fast_tol * floor_max / DBL_EPSILON : 0.0;
     r->stats.memory_bytes = cm_rbf_schwarz_bytes(r->iter->pc) + m * k * sizeof(double) +
                             (size_t)gmax * (size_t)(2 * R + 6) * m * sizeof(double) +
                             (fast ? cm_rbf_tree_bytes(kr.tree) + (size_t)gmax * 6 * m * sizeof(double) : 0) +

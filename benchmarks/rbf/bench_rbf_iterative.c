@@ -6,8 +6,9 @@
 #include "cli/blas_reexec.h"
 #include "cadmorph/blas.h"
 #include "cadmorph/rbf.h"
-#include "rbf_internal.h" /* the inner coarse solver's counts, the unit product */
-#include "rbf_sum_isa.h"   /* the sqrt split of the kernel blocks */
+#include "rbf_internal.h"
+#include "rbf_tuning.h" /* the inner coarse solver's counts, the unit product */
+#include "sum/rbf_sum_isa.h"   /* the sqrt split of the kernel blocks */
 
 #include <math.h>
 #include <stdio.h>
@@ -65,13 +66,13 @@ static void inner_counts(const cm_rbf *rbf)
     cm_rbf_coarse_inner_stats(ci, &inner_solves, &inner_its);
 }
 
-static void fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
+static void fit(cm_context *ctx, const cm_rbf_options *o, const cm_rbf_tuning *tun, size_t m, const double *x,
                 const double *v, size_t ne, const double *p, run *r)
 {
     cm_rbf *rbf = NULL;
     r->out = malloc((m + ne) * 3 * sizeof *r->out);
     double c0 = bench_cpu_seconds();
-    r->status = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &rbf);
+    r->status = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, tun, &rbf);
     r->setup_cpu_s = bench_cpu_seconds() - c0;
     if (r->status >= 0) r->status = cm_rbf_solve(ctx, rbf, 3, v);
     r->fit_cpu_s = bench_cpu_seconds() - c0;
@@ -128,47 +129,49 @@ int main(int argc, char **argv)
         "       [--coarse-max N]\n"
         "Iterative (and with --dense, dense) RBF fit of PREFIX.centres / .values, evaluated at\n"
         "the first N of PREFIX.interior (--eval N; raw float64, n x 3, as written by\n"
-        "bench_rbf_iterative_data.py); prints one line of key=value (RESULTS.md, issue 10).\n";
+        "bench_rbf_iterative_data.py); prints one line of key=value (RESULTS.md, RBF solvers).\n";
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
         fputs(usage, argc < 2 ? stderr : stdout);
         return argc < 2;
     }
     const char *prefix = argv[1];
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     int dense = 0, iterative = 1, threads = 0, verbose = 0;
     long neval = -1;
     for (int i = 2; i < argc; ++i) {
         const char *a = argv[i], *b = i + 1 < argc ? argv[i + 1] : "0";
         if (!strcmp(a, "--dense")) dense = 1;
         else if (!strcmp(a, "--no-iterative")) iterative = 0;
-        else if (!strcmp(a, "--float")) o.local_float = 1;
-        else if (!strcmp(a, "--local-float")) o.local_float = atoi(b), ++i;
+        else if (!strcmp(a, "--float")) tun.local_float = 1;
+        else if (!strcmp(a, "--local-float")) tun.local_float = atoi(b), ++i;
         else if (!strcmp(a, "--verbose")) verbose = 1;
         else if (!strcmp(a, "--no-centres")) skip_centres = 1;
         else if (!strcmp(a, "--threads")) threads = atoi(b), ++i;
-        else if (!strcmp(a, "--leaf")) o.leaf_size = atoi(b), ++i;
-        else if (!strcmp(a, "--local")) o.local_size = atoi(b), ++i;
-        else if (!strcmp(a, "--coarse")) o.coarse_size = atoi(b), ++i;
-        else if (!strcmp(a, "--post")) o.coarse_post = atoi(b), ++i;
-        else if (!strcmp(a, "--overlap")) o.overlap = atof(b), ++i;
-        else if (!strcmp(a, "--local-max")) o.local_max = atoi(b), ++i;
-        else if (!strcmp(a, "--thin-reach")) o.thin_reach = atof(b), ++i;
-        else if (!strcmp(a, "--thin-cell")) o.thin_cell = atof(b), ++i;
-        else if (!strcmp(a, "--thin-max")) o.thin_max = atoi(b), ++i;
-        else if (!strcmp(a, "--coarse-grow")) o.coarse_grow = atoi(b), ++i;
-        else if (!strcmp(a, "--coarse-max")) o.coarse_max = atoi(b), ++i;
+        else if (!strcmp(a, "--leaf")) tun.leaf_size = atoi(b), ++i;
+        else if (!strcmp(a, "--local")) tun.local_size = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse")) tun.coarse_size = atoi(b), ++i;
+        else if (!strcmp(a, "--post")) tun.coarse_post = atoi(b), ++i;
+        else if (!strcmp(a, "--overlap")) tun.overlap = atof(b), ++i;
+        else if (!strcmp(a, "--local-max")) tun.local_max = atoi(b), ++i;
+        else if (!strcmp(a, "--thin-reach")) tun.thin_reach = atof(b), ++i;
+        else if (!strcmp(a, "--thin-cell")) tun.thin_cell = atof(b), ++i;
+        else if (!strcmp(a, "--thin-max")) tun.thin_max = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-grow")) tun.coarse_grow = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-max")) tun.coarse_max = atoi(b), ++i;
         else if (!strcmp(a, "--restart")) o.restart = atoi(b), ++i;
         else if (!strcmp(a, "--tol")) o.tolerance = atof(b), ++i;
         else if (!strcmp(a, "--maxit")) o.max_iterations = atoi(b), ++i;
         else if (!strcmp(a, "--eval")) neval = atol(b), ++i;
         else if (!strcmp(a, "--fast")) o.fast_sum = atoi(b), ++i;
-        else if (!strcmp(a, "--fast-tol")) o.fast_tol = atof(b), ++i;
-        else if (!strcmp(a, "--fast-refine")) o.fast_refine = atoi(b), ++i;
-        else if (!strcmp(a, "--fast-eval-tol")) o.fast_eval_tol = atof(b), ++i;
-        else if (!strcmp(a, "--relax")) o.relax = atoi(b), ++i;
-        else if (!strcmp(a, "--coarse-inner")) o.coarse_inner = atoi(b), ++i;
-        else if (!strcmp(a, "--coarse-inner-tol")) o.coarse_inner_tol = atof(b), ++i;
+        else if (!strcmp(a, "--fast-tol")) tun.fast_tol = atof(b), ++i;
+        else if (!strcmp(a, "--fast-refine")) tun.fast_refine = atoi(b), ++i;
+        else if (!strcmp(a, "--fast-eval-tol")) tun.fast_eval_tol = atof(b), ++i;
+        else if (!strcmp(a, "--relax")) tun.relax = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-inner")) tun.coarse_inner = atoi(b), ++i;
+        else if (!strcmp(a, "--coarse-inner-tol")) tun.coarse_inner_tol = atof(b), ++i;
         else {
             fprintf(stderr, "unknown option %s\n", a);
             return 1;
@@ -199,7 +202,7 @@ int main(int argc, char **argv)
            sq_plain, sq_acc);
     if (iterative) {
         o.solver = CM_RBF_SOLVER_ITERATIVE;
-        fit(ctx, &o, m, x, v, ne, p, &it);
+        fit(ctx, &o, &tun, m, x, v, ne, p, &it);
         double exact = 0.0;
         for (size_t i = 0; !skip_centres && i < 3 * m; ++i) exact = fmax(exact, fabs(it.out[i] - v[i]));
         printf(" it_status=%d leaf=%d local=%d coarse=%d post=%d subdomains=%d it_setup_s=%.2f "
@@ -207,28 +210,28 @@ int main(int argc, char **argv)
                "it_floor=%.3g at_floor=%d it_exact=%.3g it_mem_mb=%.1f it_rss_mb=%.0f "
                "it_fit_cpu_s=%.1f it_eval_cpu_s=%.1f overlap=%g local_max=%d it_setup_cpu_s=%.1f "
                "matvec_cpu_s=%.2f fit_in_matvecs=%.1f local_float=%d",
-               it.status, o.leaf_size, o.local_size, it.st.coarse_size, o.coarse_post,
+               it.status, tun.leaf_size, tun.local_size, it.st.coarse_size, tun.coarse_post,
                it.st.subdomains,
                it.st.setup_seconds, it.st.solve_seconds, it.eval_s, it.st.iterations,
                it.st.matvecs, it.st.residual, it.st.floor, it.st.floor_limited, exact / range,
                (double)it.st.memory_bytes / 1e6, bench_peak_rss_mb(), it.fit_cpu_s, it.eval_cpu_s,
-               o.overlap, o.local_max, it.setup_cpu_s, it.centres_cpu_s,
-               it.centres_cpu_s > 0.0 ? it.fit_cpu_s / it.centres_cpu_s : 0.0, o.local_float);
+               tun.overlap, tun.local_max, it.setup_cpu_s, it.centres_cpu_s,
+               it.centres_cpu_s > 0.0 ? it.fit_cpu_s / it.centres_cpu_s : 0.0, tun.local_float);
         printf(" fast_sum=%d fast_tol=%g refinements=%d fast_direct=%d fast_residual=%.3g "
                "fast_bound=%.3g eval_fast=%d eval_error=%.3g eval_row=%d:%.2f centres_fast=%d",
-               it.st.fast_sum, o.fast_tol, it.st.refinements, it.st.fast_direct,
+               it.st.fast_sum, tun.fast_tol, it.st.refinements, it.st.fast_direct,
                it.st.fast_residual, it.st.fast_bound, it.eval_fast, it.eval_error,
                it.eval_order, it.eval_theta, it.centres_fast);
-        printf(" relax=%d mv_comp=%d mv_plain=%d mv_fast=%d", o.relax, it.st.matvecs_compensated,
+        printf(" relax=%d mv_comp=%d mv_plain=%d mv_fast=%d", tun.relax, it.st.matvecs_compensated,
                it.st.matvecs_plain, it.st.matvecs_fast);
         printf(" coarse_inner=%d coarse_inner_tol=%g inner_solves=%ld inner_its=%ld",
-               o.coarse_inner, o.coarse_inner_tol, inner_solves, inner_its);
-        printf(" thin_reach=%g thin_cell=%g thin_max=%d", o.thin_reach, o.thin_cell,
-               o.thin_max);
+               tun.coarse_inner, tun.coarse_inner_tol, inner_solves, inner_its);
+        printf(" thin_reach=%g thin_cell=%g thin_max=%d", tun.thin_reach, tun.thin_cell,
+               tun.thin_max);
     }
     if (dense) {
         o.solver = CM_RBF_SOLVER_DENSE;
-        fit(ctx, &o, m, x, v, ne, p, &dn);
+        fit(ctx, &o, &tun, m, x, v, ne, p, &dn);
         double dex = 0.0;
         for (size_t i = 0; dn.status >= 0 && i < 3 * m; ++i) dex = fmax(dex, fabs(dn.out[i] - v[i]));
         printf(" dense_status=%d dense_setup_s=%.2f dense_solve_s=%.2f dense_eval_s=%.2f "
