@@ -55,6 +55,13 @@ void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                        const double *w, int nc, size_t n, const double *p, size_t ldp,
                        double *out, size_t ldo, int threads);
 
+/* cm_rbf_kernel_sum of r's kernel and centres for any number of components (w: ncomp x m
+ * SoA), four at a time; out: n x ncomp. */
+void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
+                           const double *p, size_t ldp, double *out, int threads);
+/* "triharmonic", "biharmonic", "thin-plate" (for messages) */
+const char *cm_rbf_kernel_name(cm_rbf_kernel k);
+
 /* cm_rbf_kernel_sum for r^3 in 3D with compensated (double-double) accumulation: error about
  * eps |result| instead of eps sum_j |w_j phi_ij| (rbf_sum_acc.c says why). */
 void cm_rbf_kernel_sum_acc(size_t m, const double *c, const double *w, int nc, size_t n,
@@ -99,6 +106,16 @@ void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const do
 long cm_rbf_merge_duplicates(int dim, size_t m_in, const double *c, double tol, size_t *rep,
                              size_t *first);
 
+/* ---- the dense path (dense/) ---- */
+
+/* Builds sign * Q2' A Q2 (lower triangle, packed: r->chol) for the centres in r (placed, P
+ * factored) and factors it on `threads` BLAS threads (rbf_dense.c). */
+cm_status cm_rbf_dense_factor(cm_context *ctx, cm_rbf *r, int threads);
+/* One pass of the projected solve: f (m x nc col-major) -> w (nc x m SoA, i.e. m x nc
+ * col-major) and q (nc x k); aw receives A w (row-major m x nc), g is m x nc scratch. */
+cm_status cm_rbf_dense_solve_pass(cm_context *ctx, const cm_rbf *r, size_t nc, const double *f,
+                                  double *w, double *q, double *aw, double *g, int threads);
+
 /* Cholesky factorisation of the n x n SPD matrix in a (n(n+1)/2 doubles, RFP with TRANSR 'N',
  * UPLO 'L', as dpftrf), in place, panel by panel of `block` columns (0: the default), with
  * cm_progress(ctx, "rbf factor", done, total) after every panel (done in flops, monotonic).
@@ -115,11 +132,11 @@ int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
  * own default. */
 int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block);
 int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, int threads);
-/* cm_rbf_cholesky_rfp's range for the look-ahead path (benchmarks/RESULTS.md, "The dense
- * factorisation on 2 threads at small m"): its schedule, replayed from per-task CPU times,
- * beats the threaded panels from 5k to 20k; below 4k a factorisation takes < 0.15 s, and on
- * a loaded machine, where each of its barriers can wait a time slice for a preempted
- * thread, it lost to them (3k: 1.28 x their time, 2k: 1.9 x). */
+/* cm_rbf_cholesky_rfp's range for the look-ahead path (benchmarks/RESULTS.md, RBF solvers):
+ * its schedule, replayed from per-task CPU times, beats the threaded panels from 5k to 20k;
+ * below 4k a factorisation takes < 0.15 s, and on a loaded machine, where each of its barriers
+ * can wait a time slice for a preempted thread, it lost to them (3k: 1.28 x their time, 2k:
+ * 1.9 x). */
 #define CM_LOOKAHEAD_MIN_N 4000
 #define CM_LOOKAHEAD_MAX_N 60000
 /* The look-ahead path's most update chunks per step. */

@@ -1,7 +1,7 @@
 /* The internal knobs of the RBF solvers (not a public header): what a caller of rbf.h does
  * not choose, but tests and benchmarks vary. cm_rbf_tuning_init fills the defaults (in
  * brackets), which are the ones every cm_rbf_create / cm_rbf_create_opt uses; the figures
- * below are the measurements behind them (benchmarks/RESULTS.md, "RBF solvers"). All but
+ * below are the measurements behind them (benchmarks/RESULTS.md, RBF solvers). All but
  * fast_eval_tol matter only for the iterative solver (ITERATIVE, or AUTO above its
  * crossover, and PETSC). */
 #ifndef CADMORPH_RBF_TUNING_H
@@ -51,7 +51,7 @@ typedef struct cm_rbf_tuning {
                            * distance (thin_cell), at most thin_max centres in all; the
                            * local solve is on that set, only the leaf rows are kept as ever.
                            * A geometric reach at a bounded centre count; 0: off. Measured
-                           * (RESULTS.md, "Thinned overlap"): better than no far band and than
+                           * (RESULTS.md, RBF solvers): better than no far band and than
                            * the same count of nearest centres, worse than the overlap rule's
                            * full 3 H (bracket 234k, 1,000 + 543 to 5.9 H: 5.6e-5 after 30
                            * iterations, 1,543 nearest 1.7e-3, the defaults' 1,821 3e-7;

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Turns the key=value lines of bench_rbf.sh into the markdown table of RESULTS.md (RBF section).
+"""Turns the key=value lines of bench_rbf.sh into the markdown table of RESULTS.md (RBF solvers).
 usage: bench_rbf.sh ... | tee raw.txt; bench_rbf_table.py raw.txt"""
 import shlex
 import sys

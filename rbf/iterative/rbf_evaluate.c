@@ -34,7 +34,7 @@
  * Those are exact for the rounded entries phi_ij, not for the true ones, so they err by up
  * to about CM_RBF_PHI_ROUND eps sum_j |w_j| phi_ij themselves: 7.8e-9 of max |d| on two
  * bodies at 1e6 points against a long-double reference, where the order-14 treecode errs by
- * 1.0e-9 (RESULTS.md, "The treecode on the AVX-512 block"). The check cannot see below
+ * 1.0e-9 (RESULTS.md, RBF solvers). The check cannot see below
  * that, and the fallback is no better, so the fast sum is accepted within the larger of
  * fast_eval_tol x max |data| and that floor; eval_error says which was met.
  *

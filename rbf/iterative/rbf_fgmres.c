@@ -30,18 +30,17 @@
 
 /* fast_sum = -1 (auto): treecode matvecs from this many centres, evaluation from this many
  * point-centre pairs. A fast fit costs about 22 treecode products + 4 exact (compensated)
- * residuals where direct matvecs take 12 compensated products (bracket 59k; RESULTS.md
- * "Fast summation"), so it pays once one compensated product costs more than 22 / (12 - 4)
- * = 2.75 treecode products at fast_tol 1e-12. Measured with the treecode on the AVX-512
- * block (RESULTS.md, RBF solvers; bracket sets, one product, CPU s): 1.9 at
- * 59k, 2.6 at 103k, 3.6 at 201k, 6.6 at 479k; 2.75 falls near 1.15e5. But on real data the
- * refinement costs more than at 59k: bracket 148k (real displacements), fast 46 iterations,
- * 65 products, 253 CPU s; direct 16 iterations, 22 products, 221 CPU s (RESULTS.md, RBF
- * solvers). So it was 2e5. Since the preconditioner keeps the
- * bodies free of linear moments (rbf_bodies.c) the fast solve needs as many iterations as
- * the direct one (Zen 5, fit CPU s fast / direct: bracket 102,890 54.2 / 47.2, bracket
- * 150,137 99.1 / 109.3, two bodies 164,820 108.0 / 118.9; RESULTS.md, RBF solvers):
- * 1.5e5, just under the first real single-body set where it wins. */
+ * residuals where direct matvecs take 12 compensated products (bracket 59k; RESULTS.md, RBF
+ * solvers), so it pays once one compensated product costs more than 22 / (12 - 4) = 2.75
+ * treecode products at fast_tol 1e-12. Measured with the treecode on the AVX-512 block
+ * (RESULTS.md, RBF solvers; bracket sets, one product, CPU s): 1.9 at 59k, 2.6 at 103k, 3.6 at
+ * 201k, 6.6 at 479k; 2.75 falls near 1.15e5. But on real data the refinement costs more than
+ * at 59k: bracket 148k (real displacements), fast 46 iterations, 65 products, 253 CPU s;
+ * direct 16 iterations, 22 products, 221 CPU s (RESULTS.md, RBF solvers). So it was 2e5. Since
+ * the preconditioner keeps the bodies free of linear moments (rbf_bodies.c) the fast solve
+ * needs as many iterations as the direct one (Zen 5, fit CPU s fast / direct: bracket 102,890
+ * 54.2 / 47.2, bracket 150,137 99.1 / 109.3, two bodies 164,820 108.0 / 118.9; RESULTS.md, RBF
+ * solvers): 1.5e5, just under the first real single-body set where it wins. */
 #define CM_RBF_FAST_MIN_M 150000
 /* an inner (fast-matvec) solve of a refinement step aims for this reduction of its own
  * right-hand side, or the final tolerance if that is nearer: the treecode's operator
@@ -62,7 +61,7 @@
  * residual falls. The error of a sum is
  * bounded through S(z) = max_i sum_j |z_j| phi_ij <= diam^3 sum_j |z_j| (safe, a few times
  * too large): plain sums err by at most CM_RBF_PLAIN_ERR x S (measured 1.2e-14..1.4e-14 x S
- * with 3 weight vectors on the bracket and the two bodies, RESULTS.md "Fast summation"),
+ * with 3 weight vectors on the bracket and the two bodies, RESULTS.md, RBF solvers),
  * the treecode at tol by tol x S (its bound, margin 3-30), compensated ones by nothing
  * that counts (their result's rounding, see where eb is set).
  * Each step may take half of what is left of a budget of CM_RBF_RELAX_BUDGET x the cycle's
@@ -73,7 +72,7 @@
  * start sees what its products erred, as a refinement step would (two bodies 121k: the
  * first cycle's last two products plain instead of compensated). The gap bound with the
  * final y is logged after each cycle; the exact residual at the cycle's end decides as
- * before (RESULTS.md, "Relaxed-accuracy matvecs": on the real sets plain sums become
+ * before (RESULTS.md, RBF solvers: on the real sets plain sums become
  * admissible only after the residual fell by 1e6..1e8, as the weights cancel). */
 #define CM_RBF_RELAX_BUDGET 0.5
 /* the safe bound diam^3 sum |z| was 3.2-3.8 x S(z) on the bore (22.6k) */

@@ -73,8 +73,7 @@ long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_
         if (tab[s].band >= 0)
             for (int q = 0; q < 3; ++q) tab[s].sum[q] /= (double)tab[s].count;
     /* the pick stands for its voxel: the candidate nearest to the voxel's centroid (a pick's
-     * voxel-mean residual instead of its own was measured worse: RESULTS.md, "Thinned
-     * overlap") */
+     * voxel-mean residual instead of its own was measured worse: RESULTS.md, RBF solvers) */
     for (size_t u = 0; u < nc; ++u) {
         voxel *v = &tab[vs[u]];
         double e2 = 0.0;

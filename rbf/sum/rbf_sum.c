@@ -341,3 +341,24 @@ void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const do
         fn(kern, m, c, v, z, sign, kk + col, kk + col, n - col, out + head);
     }
 }
+
+const char *cm_rbf_kernel_name(cm_rbf_kernel k)
+{
+    switch (k) {
+    case CM_RBF_TRIHARMONIC: return "triharmonic";
+    case CM_RBF_BIHARMONIC: return "biharmonic";
+    case CM_RBF_THIN_PLATE: return "thin-plate";
+    }
+    return "unknown";
+}
+
+/* Kernel sums for any number of components, four at a time. */
+void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
+                           const double *p, size_t ldp, double *out, int threads)
+{
+    for (int g = 0; g < ncomp; g += 4) {
+        int nc = ncomp - g < 4 ? ncomp - g : 4;
+        cm_rbf_kernel_sum(r->kernel, r->dim, r->m, r->c, w + (size_t)g * r->m, nc, n, p, ldp,
+                          out + g, (size_t)ncomp, threads);
+    }
+}

@@ -11,7 +11,7 @@
  * Where FMA is in hardware (AVX2, AVX-512) the sum runs in a fixed binade instead
  * (rbf_sum_avx512.c says how): the same accuracy at 4 operations per product instead of 10.
  * A cheaper compensation does not do: plain sums over blocks of 8-32 centres added in
- * double-double took FGMRES on the bracket from 10 to 14-15 iterations (RESULTS.md).
+ * double-double took FGMRES on the bracket from 10 to 14-15 iterations (RESULTS.md, RBF solvers).
  * Built without FP contraction: the error-free transformations need every rounding where
  * it is written. */
 #include "rbf_internal.h"

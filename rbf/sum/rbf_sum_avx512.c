@@ -3,8 +3,8 @@
  * entry points, by the treecode's products in rbf_treecode.c); other CPUs keep the
  * compiler-vectorised loops there. Why by hand: the compiler cannot balance the sqrt unit
  * against the FMA pipes (plain sums), and the compensated sums need a different algorithm
- * (the fixed binade below). Measured on Zen 5 (benchmarks/bench_kernel.c, RESULTS.md issue
- * 10): plain 3.3e9 -> 3.8-4.0e9, compensated 1.2e9 -> 2.4-2.6e9 pairs per CPU-second.
+ * (the fixed binade below). Measured on Zen 5 (benchmarks/rbf/bench_kernel.c, RESULTS.md,
+ * RBF solvers): plain 3.3e9 -> 3.8-4.0e9, compensated 1.2e9 -> 2.4-2.6e9 pairs per CPU-second.
  *
  * The square root is the bottleneck (in a register-resident test on Zen 5: all vsqrtpd
  * 3.46e9 pairs/s, all rsqrt14 + Newton 2.37e9). So of the vectors of points held in

@@ -83,7 +83,7 @@ struct cm_rbf_tree {
 
 /* (n, theta) measured to keep max_i err_i / sum_j |w_j| phi_ij below tol, with a margin of
  * 3..30, on random and on real weights (bench_rbf_treecode on bore 22.6k and bracket 59.4k,
- * RESULTS.md "Fast summation"): at theta 0.5 the error fell from 5e-6 (n = 3) to 2.5e-12
+ * RESULTS.md, RBF solvers): at theta 0.5 the error fell from 5e-6 (n = 3) to 2.5e-12
  * (n = 10), about 0.9 decades per order; real weights err up to 8x more relative to
  * sum |w| phi than random ones at the same point, hence the margin. Below 1e-14 rounding
  * (about 3e-16 x sum |w| phi) is the floor. */
