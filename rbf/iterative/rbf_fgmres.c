@@ -1,4 +1,4 @@
-/* Iterative solver for the r^3 + linear RBF system: restarted FGMRES in the null space of
+/* Iterative solver for the r^3 + linear RBF system: restarted FGMRES [Saad93] in the null space of
  * the polynomial block, right-preconditioned by two-level restricted Schwarz
  * (rbf_schwarz.c), with compensated direct-summation matvecs (rbf_sum_acc.c) or, for large
  * m, fast ones (the r^3 treecode, rbf_treecode.c) inside an outer refinement on exact

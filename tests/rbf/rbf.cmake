@@ -33,8 +33,7 @@ cm_add_unit_test(test_rbf_thin ${CMAKE_CURRENT_LIST_DIR}/test_rbf_thin.c LIBS cm
 # on one rank without mpirun
 if(CADMORPH_WITH_PETSC)
   add_executable(test_rbf_petsc ${CMAKE_CURRENT_LIST_DIR}/test_rbf_petsc.c)
-  target_include_directories(test_rbf_petsc PRIVATE ${PROJECT_SOURCE_DIR}/tests/helpers
-    ${PROJECT_SOURCE_DIR})
+  target_include_directories(test_rbf_petsc PRIVATE ${PROJECT_SOURCE_DIR}/tests/helpers)
   target_link_libraries(test_rbf_petsc PRIVATE cm_rbf cm_platform cm_core cm_warnings cm_posix)
   set(CM_MPI_ENV "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1")
   add_test(NAME test_rbf_petsc_2ranks
