@@ -12,9 +12,7 @@ if [ ! -x "$build/benchmarks/mesh_io/bench_mesh_io" ]; then
     echo "run_all.sh: no benchmark programs in $build: configure it with -DCADMORPH_BUILD_BENCHMARKS=ON" >&2
     exit 1
 fi
-# the RBF benchmarks' folder, or the scripts beside this one
 rbf=$here/rbf
-[ -f "$rbf/bench_rbf.sh" ] || rbf=$here
 mkdir -p "$work"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "== mesh I/O";            "$build/benchmarks/mesh_io/bench_mesh_io" "$work"

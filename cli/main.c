@@ -1,7 +1,7 @@
 /* The cadmorph program: picks the subcommand; each lives in its own cmd_<name>.c. */
 #include "cli.h"
 
-#include "cadmorph/rbf.h"
+#include "cadmorph/parallel.h"
 #include "cadmorph/version.h"
 
 #include <signal.h>
@@ -77,7 +77,7 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < sizeof commands / sizeof *commands; ++i)
         if (!strcmp(argv[1], commands[i].name)) {
             int rc = commands[i].run(argc - 1, argv + 1);
-            cm_rbf_petsc_finalize(); /* MPI must end before the process does (--solver petsc) */
+            cm_parallel_finalize(); /* MPI must end before the process does (--solver petsc) */
             return rc;
         }
     fprintf(stderr, "cadmorph: unknown command '%s'\n", argv[1]);

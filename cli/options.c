@@ -3,6 +3,7 @@
 
 #include "cli.h"
 
+#include "cadmorph/parallel.h"
 #include "cadmorph/study.h"
 #include "cadmorph/warp.h"
 
@@ -150,7 +151,7 @@ const int cli_solver_values[] = {CM_RBF_SOLVER_AUTO, CM_RBF_SOLVER_DENSE, CM_RBF
 
 int cli_check_solver(const char *cmd, const char *usage, int solver)
 {
-    if (solver == CM_RBF_SOLVER_PETSC && !cm_rbf_petsc_available())
+    if (solver == CM_RBF_SOLVER_PETSC && !cm_parallel_available())
         return cli_usage(cmd, usage, "--solver petsc: this cadmorph was built without PETSc "
                          "(configure with -DCADMORPH_WITH_PETSC=ON)");
     return -1;
@@ -163,21 +164,21 @@ int cli_mpi_ranks(cm_context *ctx, const char *cmd, int *rank, int *ranks)
     const char *v = getenv("OMPI_COMM_WORLD_SIZE");
     if (!v) v = getenv("PMI_SIZE");
     if (!v || atoi(v) <= 1) return 0;
-    if (!cm_rbf_petsc_available()) {
+    if (!cm_parallel_available()) {
         fprintf(stderr, "cadmorph %s: started by mpirun with %s ranks, but this cadmorph was "
                 "built without PETSc/MPI (configure with -DCADMORPH_WITH_PETSC=ON)\n", cmd, v);
         return CLI_EXIT_USAGE;
     }
-    cm_status s = cm_rbf_petsc_initialize(ctx);
+    cm_status s = cm_parallel_initialize(ctx);
     if (s < 0) return cli_fail(ctx, cmd, s);
-    cm_rbf_petsc_rank(rank, ranks);
+    cm_parallel_rank(rank, ranks);
     return 0;
 }
 
 int cli_output_rank(void)
 {
     int rank;
-    cm_rbf_petsc_rank(&rank, NULL);
+    cm_parallel_rank(&rank, NULL);
     return rank == 0;
 }
 const int cli_kernel_methods[] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};

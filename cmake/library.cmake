@@ -11,7 +11,8 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(CM_LIBRARY_MODULES cm_core cm_rbf cm_mesh cm_deform cm_mls cm_cad cm_surface cm_volume cm_meshgen cm_morph)
+set(CM_LIBRARY_MODULES cm_core cm_platform cm_rbf cm_mesh cm_deform cm_mls cm_cad cm_surface cm_volume
+  cm_meshgen cm_morph)
 if(TARGET cm_study)
   list(APPEND CM_LIBRARY_MODULES cm_study)
 endif()

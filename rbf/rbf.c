@@ -1,5 +1,5 @@
-/* RBF interpolation with polyharmonic kernels and a linear polynomial (paper section 3, 3D;
- * section 4, 2D thin plate): fit by null-space projection + Cholesky, solve, evaluate.
+/* RBF interpolation with polyharmonic kernels and a linear polynomial ([SMB12 §3], 3D;
+ * [SMB12 §4], 2D thin plate): fit by null-space projection + Cholesky, solve, evaluate.
  *
  * Why the projection: the saddle-point system [A P; P' 0] is indefinite, but A is
  * conditionally positive definite on the null space of P'. With P = QR (Householder),
@@ -33,16 +33,6 @@
  * the caller's setting before they return. */
 static void blas_threads(int n) { openblas_set_num_threads(n > 0 ? n : 1); }
 
-static const char *kernel_name(cm_rbf_kernel k)
-{
-    switch (k) {
-    case CM_RBF_TRIHARMONIC: return "triharmonic";
-    case CM_RBF_BIHARMONIC: return "biharmonic";
-    case CM_RBF_THIN_PLATE: return "thin-plate";
-    }
-    return "unknown";
-}
-
 void cm_rbf_destroy(cm_rbf **rbf)
 {
     if (!rbf || !*rbf) return;
@@ -62,6 +52,51 @@ void cm_rbf_destroy(cm_rbf **rbf)
 }
 
 size_t cm_rbf_centre_count(const cm_rbf *rbf) { return rbf ? rbf->m : 0; }
+
+void cm_rbf_options_init(cm_rbf_options *opt)
+{
+    if (!opt) return;
+    memset(opt, 0, sizeof *opt);
+    opt->solver = CM_RBF_SOLVER_AUTO;
+    opt->tolerance = 1e-10;
+    opt->max_iterations = 300;
+    opt->restart = 40;
+    opt->fast_sum = -1;
+}
+
+void cm_rbf_tuning_init(cm_rbf_tuning *t)
+{
+    if (!t) return;
+    memset(t, 0, sizeof *t);
+    t->leaf_size = 256;
+    t->local_size = 700;
+    t->coarse_size = 2000;
+    t->coarse_post = 1;
+    t->local_float = 1;
+    t->coarse_grow = 1;
+    t->coarse_max = 16000;
+    t->coarse_inner_tol = 1e-2;
+    t->overlap = 2.0;
+    t->local_max = 2800;
+    t->thin_cell = 0.25;
+    t->thin_max = 2000;
+    t->fast_tol = 1e-12;
+    t->fast_refine = 3;
+    t->fast_eval_tol = 1e-9;
+    t->relax = 1;
+}
+
+void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats)
+{
+    if (!stats) return;
+    if (!rbf) {
+        memset(stats, 0, sizeof *stats);
+        return;
+    }
+    *stats = rbf->stats;
+    cm_rbf_iterative_stats(rbf, stats);
+}
+
 
 /* Unit-box map and merging; fills r->c, rep, first, m. */
 static cm_status place_centres(cm_context *ctx, cm_rbf *r, const double *centres)
@@ -155,144 +190,6 @@ static cm_status factor_polynomial(cm_context *ctx, cm_rbf *r)
     return CM_OK;
 }
 
-/* For the message when the Cholesky factorisation fails: two centres closer than 1e-6 of the unit box (input
- * indices a, b; dist in unit-box units). Returns 0 if there are none. */
-static int closest_pair(const cm_rbf *r, size_t *a, size_t *b, double *dist)
-{
-    int found = 0;
-    size_t *rep = malloc(r->m * sizeof *rep), *first = malloc(r->m * sizeof *first);
-    if (rep && first && cm_rbf_merge_duplicates(r->dim, r->m, r->c, 1e-6, rep, first) < (long)r->m) {
-        for (size_t u = 0; u < r->m && !found; ++u) {
-            size_t v = first[rep[u]];
-            if (v == u) continue;
-            double d2 = 0.0;
-            for (int d = 0; d < r->dim; ++d) {
-                double t = r->c[(size_t)d * r->m + u] - r->c[(size_t)d * r->m + v];
-                d2 += t * t;
-            }
-            *a = r->first[v];
-            *b = r->first[u];
-            *dist = sqrt(d2);
-            found = 1;
-        }
-    }
-    free(rep);
-    free(first);
-    return found;
-}
-
-/* Builds sign * Q2' A Q2 (lower triangle, packed) and factors it. */
-static cm_status factor_projected(cm_context *ctx, cm_rbf *r, int threads)
-{
-    const size_t m = r->m;
-    const int k = r->k;
-    const size_t n2 = m - (size_t)k;
-    if (n2 == 0) return CM_OK; /* k centres: the interpolant is the linear polynomial */
-    /* LAPACK's 32-bit indices address the packed factor up to n(n+1)/2 < 2^31 */
-    if (n2 > 60000)
-        return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                        "cm_rbf_create: %zu centres is too many for one dense system (at most "
-                        "60000; split the mesh into components)",
-                        m);
-
-    cm_status st = CM_OK;
-    double *v = calloc(m * (size_t)k, sizeof *v);
-    double *wv = malloc(m * (size_t)k * sizeof *wv);
-    double *z = malloc(m * (size_t)k * sizeof *z);
-    double t[16] = {0}, s[16] = {0}, vw[16] = {0}, tmp[16] = {0};
-    double ta = cm_wtime();
-    /* populated in one call: cheaper than faulting it in page by page while it is assembled */
-    r->chol = cm_rbf_alloc_large(n2 * (n2 + 1) / 2 * sizeof(double), 1);
-    ta = cm_wtime() - ta;
-    if (!v || !wv || !z || !r->chol) {
-        st = cm_error(ctx, CM_ERR_NOMEM,
-                      "cm_rbf_create: out of memory for the %zu x %zu system (%.2f GB)", n2, n2,
-                      (double)n2 * (double)(n2 + 1) * 4e-9);
-        goto done;
-    }
-    /* explicit V: unit diagonal, zeros above */
-    for (int q = 0; q < k; ++q) {
-        v[(size_t)q * m + (size_t)q] = 1.0;
-        for (size_t i = (size_t)q + 1; i < m; ++i) v[(size_t)q * m + i] = r->qr[(size_t)q * m + i];
-    }
-    lapack_int info = LAPACKE_dlarft(LAPACK_COL_MAJOR, 'F', 'C', (lapack_int)m, k, v,
-                                     (lapack_int)m, r->tau, t, k);
-    if (info != 0) {
-        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: dlarft failed (info %d)", (int)info);
-        goto done;
-    }
-    double t0 = cm_wtime();
-    /* W = A V (row-major m x k), by kernel sums: A is never stored */
-    cm_rbf_kernel_sum(r->kernel, r->dim, m, r->c, v, k, m, r->c, m, wv, (size_t)k, threads);
-    /* vw = V' W (k x k), s = T' vw T */
-    for (int a = 0; a < k; ++a)
-        for (int b = 0; b < k; ++b) {
-            double acc = 0.0;
-            for (size_t i = 0; i < m; ++i) acc += v[(size_t)a * m + i] * wv[i * (size_t)k + (size_t)b];
-            vw[a * k + b] = acc;
-        }
-    for (int a = 0; a < k; ++a) /* tmp = vw T; t is col-major upper: T(i,j) = t[i + j k] */
-        for (int b = 0; b < k; ++b) {
-            double acc = 0.0;
-            for (int c = 0; c < k; ++c) acc += vw[a * k + c] * t[c + b * k];
-            tmp[a * k + b] = acc;
-        }
-    for (int a = 0; a < k; ++a)
-        for (int b = 0; b < k; ++b) {
-            double acc = 0.0;
-            for (int c = 0; c < k; ++c) acc += t[c + a * k] * tmp[c * k + b];
-            s[a * k + b] = acc;
-        }
-    /* Z = W T - V s / 2 (col-major m x k) */
-    for (size_t i = 0; i < m; ++i)
-        for (int b = 0; b < k; ++b) {
-            double acc = 0.0;
-            for (int c = 0; c < k; ++c)
-                acc += wv[i * (size_t)k + (size_t)c] * t[c + b * k] - 0.5 * v[(size_t)c * m + i] * s[c * k + b];
-            z[(size_t)b * m + i] = acc;
-        }
-    cm_rbf_assemble_projected(r->kernel, r->dim, m, r->c, k, v, z, r->sign, r->chol, threads);
-    double t1 = cm_wtime();
-
-    int blas_n = 1;
-    st = cm_rbf_blas_threads(ctx, "cm_rbf_create", threads, &blas_n);
-    if (st != CM_OK) goto done;
-    /* dpftrf's arithmetic, panel by panel, so that progress moves (cholesky_blocked.c) */
-    info = cm_rbf_cholesky_rfp(ctx, (int)n2, r->chol, 0);
-    double t2 = cm_wtime();
-    blas_threads(1);
-    cm_log(ctx, CM_LOG_DEBUG,
-           "cm_rbf_create: %zu centres, %d threads (BLAS %d): memory %.3f s, projection + "
-           "assembly %.3f s, cholesky %.3f s",
-           m, threads, blas_n, ta, t1 - t0, t2 - t1);
-    if (info > 0) {
-        size_t a, b;
-        double dist;
-        if (closest_pair(r, &a, &b, &dist))
-            st = cm_error(ctx, CM_ERR_NUMERIC,
-                          "cm_rbf_create: Cholesky of the projected %zu x %zu %s system failed "
-                          "at pivot %d (not definite): centres %zu and %zu are only %.3g apart "
-                          "(%.2g of the bounding box), too close to resolve but not close "
-                          "enough to merge; merge or remove near-duplicate centres",
-                          n2, n2, kernel_name(r->kernel), (int)info, a, b, dist / r->scale,
-                          dist);
-        else
-            st = cm_error(ctx, CM_ERR_NUMERIC,
-                          "cm_rbf_create: Cholesky of the projected %zu x %zu %s system failed "
-                          "at pivot %d (not definite): most likely near-duplicate centres "
-                          "(closer than about 1e-6 of the bounding box but not merged)",
-                          n2, n2, kernel_name(r->kernel), (int)info);
-    } else if (info < 0) {
-        st = cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_create: Cholesky argument %d invalid",
-                      (int)-info);
-    }
-done:
-    free(v);
-    free(wv);
-    free(z);
-    return st;
-}
-
 cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
                         const double *centres, cm_rbf **rbf)
 {
@@ -301,6 +198,13 @@ cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m
 
 cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
                             const double *centres, const cm_rbf_options *opt, cm_rbf **rbf)
+{
+    return cm_rbf_create_tuned(ctx, kernel, dim, m, centres, opt, NULL, rbf);
+}
+
+cm_status cm_rbf_create_tuned(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,
+                              const double *centres, const cm_rbf_options *opt,
+                              const cm_rbf_tuning *tuning, cm_rbf **rbf)
 {
     const double t_start = cm_wtime();
     if (!rbf) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: rbf is NULL");
@@ -311,7 +215,7 @@ cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size
     int want = kernel == CM_RBF_THIN_PLATE ? 2 : 3;
     if (dim != want)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: the %s kernel needs dim %d, got %d",
-                        kernel_name(kernel), want, dim);
+                        cm_rbf_kernel_name(kernel), want, dim);
     if (m > 0 && !centres) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_create: centres is NULL");
     if (m < (size_t)dim + 1)
         return cm_error(ctx, CM_ERR_NUMERIC,
@@ -328,11 +232,13 @@ cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size
     r->sign = kernel == CM_RBF_BIHARMONIC ? -1.0 : 1.0;
     if (opt) r->opt = *opt;
     else cm_rbf_options_init(&r->opt);
+    if (tuning) r->tun = *tuning;
+    else cm_rbf_tuning_init(&r->tun);
     const int threads = cm_rbf_threads(ctx);
     const int saved_blas_threads = openblas_get_num_threads();
 
     /* before the first LAPACK call: OpenBLAS hangs, not fails, without its buffer */
-    cm_status st = cm_rbf_blas_threads(ctx, "cm_rbf_create", 1, NULL);
+    cm_status st = cm_blas_threads(ctx, "cm_rbf_create", 1, NULL);
     if (st == CM_OK) st = place_centres(ctx, r, centres);
     if (st == CM_OK && r->m < (size_t)r->k)
         st = cm_error(ctx, CM_ERR_NUMERIC,
@@ -348,7 +254,7 @@ cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size
     if (st == CM_OK)
         st = solver == CM_RBF_SOLVER_ITERATIVE ? cm_rbf_iterative_setup(ctx, r, threads)
              : solver == CM_RBF_SOLVER_PETSC   ? cm_rbf_petsc_setup(ctx, r, threads)
-                                               : factor_projected(ctx, r, threads);
+                                               : cm_rbf_dense_factor(ctx, r, threads);
     if (st == CM_OK && solver == CM_RBF_SOLVER_DENSE)
         r->stats.memory_bytes = (r->m - (size_t)r->k) * (r->m - (size_t)r->k + 1) / 2 * 8;
     r->stats.setup_seconds = cm_wtime() - t_start;
@@ -359,17 +265,6 @@ cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int dim, size
     }
     *rbf = r;
     return CM_OK;
-}
-
-/* Kernel sums for any number of components, four at a time. */
-static void kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
-                           const double *p, size_t ldp, double *out, int threads)
-{
-    for (int g = 0; g < ncomp; g += 4) {
-        int nc = ncomp - g < 4 ? ncomp - g : 4;
-        cm_rbf_kernel_sum(r->kernel, r->dim, r->m, r->c, w + (size_t)g * r->m, nc, n, p, ldp,
-                          out + g, (size_t)ncomp, threads);
-    }
 }
 
 /* Refuses merged centres whose values disagree. */
@@ -397,56 +292,6 @@ static cm_status check_merged_values(cm_context *ctx, const cm_rbf *r, int ncomp
                                 "duplicates) but their values differ: component %d is %.17g "
                                 "vs %.17g",
                                 j, i, q, a, b);
-        }
-    }
-    return CM_OK;
-}
-
-/* One pass of the projected solve: f (m x nc col-major) -> w (nc x m SoA, i.e. m x nc
- * col-major) and q (nc x k); aw receives A w (row-major m x nc), g is m x nc scratch. */
-static cm_status solve_pass(cm_context *ctx, const cm_rbf *r, size_t nc, const double *f,
-                            double *w, double *q, double *aw, double *g, int threads)
-{
-    const size_t m = r->m;
-    const int k = r->k;
-    const size_t n2 = m - (size_t)k;
-    memcpy(w, f, m * nc * sizeof *w);
-    lapack_int info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', (lapack_int)m, (lapack_int)nc,
-                                     k, r->qr, (lapack_int)m, r->tau, w, (lapack_int)m);
-    if (info == 0 && n2 > 0) {
-        /* on the factorisation's BLAS threads: the packed triangular solves stream the
-         * factor, more than one core's bandwidth (10k, 3 components: 0.086 -> 0.066 s) */
-        int blas_n = 1;
-        cm_status st = cm_rbf_blas_threads(ctx, "cm_rbf_solve", threads, &blas_n);
-        if (st != CM_OK) return st;
-        info = LAPACKE_dpftrs_work(LAPACK_COL_MAJOR, 'N', 'L', (lapack_int)n2, (lapack_int)nc,
-                                   r->chol, w + k, (lapack_int)m);
-        blas_threads(1);
-    }
-    /* w = Q [0; sign z] */
-    for (size_t c = 0; c < nc && info == 0; ++c) {
-        for (int i = 0; i < k; ++i) w[c * m + (size_t)i] = 0.0;
-        for (size_t i = (size_t)k; i < m; ++i) w[c * m + i] *= r->sign;
-    }
-    if (info == 0)
-        info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'N', (lapack_int)m, (lapack_int)nc, k,
-                              r->qr, (lapack_int)m, r->tau, w, (lapack_int)m);
-    if (info != 0)
-        return cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_solve: LAPACK failed (info %d)", (int)info);
-    /* R q = Q1'(f - A w), with A w by kernel sums at the centres */
-    kernel_sum_all(r, w, (int)nc, m, r->c, m, aw, threads);
-    for (size_t u = 0; u < m; ++u)
-        for (size_t c = 0; c < nc; ++c) g[c * m + u] = f[c * m + u] - aw[u * nc + c];
-    info = LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', (lapack_int)m, (lapack_int)nc, k, r->qr,
-                          (lapack_int)m, r->tau, g, (lapack_int)m);
-    if (info != 0)
-        return cm_error(ctx, CM_ERR_INTERNAL, "cm_rbf_solve: dormqr failed (info %d)", (int)info);
-    for (size_t c = 0; c < nc; ++c) {
-        for (int i = k - 1; i >= 0; --i) {
-            double acc = g[c * m + (size_t)i];
-            for (int j = i + 1; j < k; ++j)
-                acc -= r->qr[(size_t)j * m + (size_t)i] * q[c * (size_t)k + (size_t)j];
-            q[c * (size_t)k + (size_t)i] = acc / r->qr[(size_t)i * m + (size_t)i];
         }
     }
     return CM_OK;
@@ -509,7 +354,7 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
     const double t_start = cm_wtime();
     st = rbf->petsc  ? cm_rbf_petsc_solve(ctx, rbf, nc, f, w, q)
          : rbf->iter ? cm_rbf_iterative_solve(ctx, rbf, nc, f, w, q, threads)
-                     : solve_pass(ctx, rbf, nc, f, w, q, aw, g, threads);
+                     : cm_rbf_dense_solve_pass(ctx, rbf, nc, f, w, q, aw, g, threads);
     /* Iterative refinement with the same factorisation: the cubic kernel's system is badly
      * conditioned for dense centres, and one or two cheap O(m^2) passes recover digits the
      * O(m^3) factorisation lost. Skipped when the first residual is already tiny. */
@@ -520,7 +365,7 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
         if (first < 0.0) first = e;
         if (e <= CM_RBF_REFINE_TOL || !(e < 0.5 * prev) || steps == CM_RBF_REFINE_STEPS) break;
         prev = e;
-        st = solve_pass(ctx, rbf, nc, res, dw, dq, adw, g, threads);
+        st = cm_rbf_dense_solve_pass(ctx, rbf, nc, res, dw, dq, adw, g, threads);
         if (st != CM_OK) break;
         for (size_t i = 0; i < m * nc; ++i) {
             w[i] += dw[i];
@@ -573,7 +418,7 @@ cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const do
     else if (rbf->iter) /* compensated sums: see cm_rbf_iterative_evaluate */
         cm_rbf_iterative_evaluate(rbf, n, p, out, cm_rbf_threads(ctx));
     else
-        kernel_sum_all(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx));
+        cm_rbf_kernel_sum_all(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx));
     for (size_t i = 0; i < n; ++i) {
         for (int c = 0; c < ncomp; ++c) {
             const double *qc = rbf->q + (size_t)c * (size_t)k;

@@ -1,9 +1,11 @@
 /* Internal state of cm_rbf and the kernel-sum primitives shared by fit, solve and evaluation
- * (paper section 3 for 3D, section 4 for the 2D thin-plate warp). Not a public header. */
+ * ([SMB12 §3] for 3D, [SMB12 §4] for the 2D thin-plate warp). Not a public header. */
 #ifndef CADMORPH_RBF_INTERNAL_H
 #define CADMORPH_RBF_INTERNAL_H
 
 #include "cadmorph/rbf.h"
+#include "rbf_tuning.h"
+#include "cm_platform.h" /* BLAS threads, large buffers (cm_platform) */
 
 #include <stddef.h>
 
@@ -32,6 +34,7 @@ struct cm_rbf {
     double *w;        /* ncomp x m, SoA: kernel weights */
     double *q;        /* ncomp x k: polynomial coefficients in unit-box coordinates */
     cm_rbf_options opt;
+    cm_rbf_tuning tun;  /* the internal knobs (rbf_tuning.h) */
     cm_rbf_stats stats;
     cm_rbf_iter *iter; /* iterative solver state, NULL for dense (then chol is set) */
     cm_rbf_petsc *petsc; /* PETSC solver (rbf_petsc.c): set with iter, NULL otherwise */
@@ -42,11 +45,6 @@ struct cm_rbf {
 /* Threads for a leaf loop: the context's count, or all that OpenMP offers for 0. */
 int cm_rbf_threads(const cm_context *ctx);
 
-/* A buffer of bytes that may be large (rbf_alloc.c): from 2 MB on, on 2 MB boundaries and
- * marked for transparent huge pages; populate: faulted in now, in one call (for a buffer one
- * thread fills; leave it 0 where threads fill their own parts). Freed with free(). */
-void *cm_rbf_alloc_large(size_t bytes, int populate);
-
 /* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (1..4), i < n.
  * p: dim x n SoA with stride ldp (p + d * ldp is coordinate d), centres as in rbf (SoA,
  * stride m). The sum over j runs in the same order for every i whatever the thread count,
@@ -56,6 +54,13 @@ void *cm_rbf_alloc_large(size_t bytes, int populate);
 void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                        const double *w, int nc, size_t n, const double *p, size_t ldp,
                        double *out, size_t ldo, int threads);
+
+/* cm_rbf_kernel_sum of r's kernel and centres for any number of components (w: ncomp x m
+ * SoA), four at a time; out: n x ncomp. */
+void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
+                           const double *p, size_t ldp, double *out, int threads);
+/* "triharmonic", "biharmonic", "thin-plate" (for messages) */
+const char *cm_rbf_kernel_name(cm_rbf_kernel k);
 
 /* cm_rbf_kernel_sum for r^3 in 3D with compensated (double-double) accumulation: error about
  * eps |result| instead of eps sum_j |w_j phi_ij| (rbf_sum_acc.c says why). */
@@ -101,11 +106,21 @@ void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const do
 long cm_rbf_merge_duplicates(int dim, size_t m_in, const double *c, double tol, size_t *rep,
                              size_t *first);
 
+/* ---- the dense path (dense/) ---- */
+
+/* Builds sign * Q2' A Q2 (lower triangle, packed: r->chol) for the centres in r (placed, P
+ * factored) and factors it on `threads` BLAS threads (rbf_dense.c). */
+cm_status cm_rbf_dense_factor(cm_context *ctx, cm_rbf *r, int threads);
+/* One pass of the projected solve: f (m x nc col-major) -> w (nc x m SoA, i.e. m x nc
+ * col-major) and q (nc x k); aw receives A w (row-major m x nc), g is m x nc scratch. */
+cm_status cm_rbf_dense_solve_pass(cm_context *ctx, const cm_rbf *r, size_t nc, const double *f,
+                                  double *w, double *q, double *aw, double *g, int threads);
+
 /* Cholesky factorisation of the n x n SPD matrix in a (n(n+1)/2 doubles, RFP with TRANSR 'N',
  * UPLO 'L', as dpftrf), in place, panel by panel of `block` columns (0: the default), with
  * cm_progress(ctx, "rbf factor", done, total) after every panel (done in flops, monotonic).
  * Returns dpftrf's info: 0, or i > 0 if the leading minor of order i is not positive definite.
- * BLAS threads: as the caller set them (cm_rbf_blas_threads); on T > 1 of them and n in
+ * BLAS threads: as the caller set them (cm_blas_threads); on T > 1 of them and n in
  * [CM_LOOKAHEAD_MIN_N, CM_LOOKAHEAD_MAX_N] outside a parallel region, the look-ahead path
  * below on T OpenMP threads, else the panel-by-panel one (both: the same factor to rounding,
  * the same info and progress). */
@@ -117,23 +132,22 @@ int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
  * own default. */
 int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block);
 int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, int threads);
-/* cm_rbf_cholesky_rfp's range for the look-ahead path (benchmarks/RESULTS.md, "The dense
- * factorisation on 2 threads at small m"): its schedule, replayed from per-task CPU times,
- * beats the threaded panels from 5k to 20k; below 4k a factorisation takes < 0.15 s, and on
- * a loaded machine, where each of its barriers can wait a time slice for a preempted
- * thread, it lost to them (3k: 1.28 x their time, 2k: 1.9 x). */
+/* cm_rbf_cholesky_rfp's range for the look-ahead path (benchmarks/RESULTS.md, RBF solvers):
+ * its schedule, replayed from per-task CPU times, beats the threaded panels from 5k to 20k;
+ * below 4k a factorisation takes < 0.15 s, and on a loaded machine, where each of its barriers
+ * can wait a time slice for a preempted thread, it lost to them (3k: 1.28 x their time, 2k:
+ * 1.9 x). */
 #define CM_LOOKAHEAD_MIN_N 4000
 #define CM_LOOKAHEAD_MAX_N 60000
+/* The look-ahead path's most update chunks per step. */
+#define CM_LOOKAHEAD_MAX_CHUNKS 64
+/* For the schedule model of benchmarks/rbf/bench_cholesky.c: while set (NULL in normal use;
+ * set it only between factorisations), every task of the look-ahead path reports its step
+ * (-1: outside the steps), its kind (0: the look-ahead panel, q > 0: update chunk q - 1) and
+ * its CPU seconds by its thread's clock. Called from the OpenMP threads concurrently. */
+extern void (*cm_lookahead_trace_hook)(int step, int kind, double cpu_seconds);
 
-/* Sets OpenBLAS's thread count for the calls that follow to `want`, or fewer if the
- * address-space limit cannot back their 128 MB buffers (blas.h, point 2); got (may be NULL)
- * receives the count. CM_ERR_NOMEM, with a message starting with who, if not even the
- * calling thread's buffer fits: OpenBLAS would spin forever trying to allocate it. */
-cm_status cm_rbf_blas_threads(cm_context *ctx, const char *who, int want, int *got);
-/* How many of `want` threads can call one-thread BLAS at the same time (each needs its own
- * OpenBLAS buffer) under the address-space limit: want if there is none, at least 1. */
-int cm_rbf_blas_callers(int want);
-/* ---- iterative solver (rbf_iterative.c, rbf_schwarz.c) ---- */
+/* ---- the timing probes' leaf (sum/rbf_probe.c) ---- */
 
 /* CPU seconds of the calling thread (CLOCK_THREAD_CPUTIME_ID; wall time if it fails): what
  * the once-per-process probes time, as a loaded machine delays them without biasing them. */
@@ -141,6 +155,8 @@ double cm_rbf_thread_seconds(void);
 /* The probes' problem: m centres (3 x m SoA) with 3 weight vectors (3 x m), n points (3 x n)
  * spread over the unit cube by a fixed sequence. */
 void cm_rbf_probe_data(size_t m, double *c, double *w, size_t n, double *p);
+
+/* ---- iterative solver (iterative/) ---- */
 
 /* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */
 int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m);
@@ -166,6 +182,9 @@ void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, doubl
  * do it. Deterministic for given weights, so every rank that calls it gets the same out. */
 int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
                                    int threads);
+/* The last evaluation's fast-sum figures (eval_fast, eval_error, eval_order, eval_theta) into
+ * stats; nothing for a dense fit. */
+void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats);
 /* The data scale (max |f| of the last solve) that fast_eval_tol is relative to: set by the
  * serial solve, and by the PETSc one, so that both evaluate alike. */
 void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax);
@@ -243,9 +262,9 @@ typedef struct cm_rbf_keyed {
  * first, into out. Returns the count, or -1 out of memory. */
 long cm_rbf_thin_pick(const double *c, size_t m, const cm_rbf_keyed *cand, size_t nc,
                       double d0, double cell, const double org[3], size_t cap, size_t *out);
-/* Coarse centres for m centres under the options (coarse_size, coarse_grow, coarse_max;
+/* Coarse centres for m centres under the tuning (coarse_size, coarse_grow, coarse_max;
  * at most m / 4). */
-size_t cm_rbf_coarse_count(const cm_rbf_options *o, size_t m);
+size_t cm_rbf_coarse_count(const cm_rbf_tuning *tu, size_t m);
 /* The coarse problem solved inexactly (rbf_schwarz_coarse.c, options coarse_inner and
  * coarse_inner_tol): an inner FGMRES on the nc coarse centres (c_xyz: 3 x nc SoA; m_fine:
  * the outer centres, for the choice of the coarse-to-fine product) preconditioned by a

@@ -3,7 +3,7 @@
  * warp method for the whole family: the point of the design, DESIGN.md) and relatively
  * through one morpher per method re-based on each result. */
 #include "cadmorph/study.h"
-#include "cadmorph/rbf.h"
+#include "cadmorph/parallel.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -157,7 +157,7 @@ static cm_status gather_rows(cm_context *ctx, cm_study_result *r)
 {
     void *all = NULL;
     size_t n = 0;
-    cm_status s = cm_rbf_petsc_allgather(ctx, r->rows, r->n_rows, sizeof *r->rows, &all, &n);
+    cm_status s = cm_parallel_allgather(ctx, r->rows, r->n_rows, sizeof *r->rows, &all, &n);
     if (s < 0) return s;
     const cm_study_row *got = all;
     row_key *key = malloc((n ? n : 1) * sizeof *key);

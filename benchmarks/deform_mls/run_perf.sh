@@ -19,11 +19,8 @@ echo "# $(date -u '+%F %H:%M UTC')  nproc=$(nproc)  load=$(cut -d' ' -f1-3 /proc
 echo "k,rbf_fit,rbf_eval,rbf_total,mls_sample,mls_basis,mls_factor,mls_apply,mls_setup,mls_total" > perf_rows.csv
 echo "| k | rbf fit s | rbf eval s | rbf total s | mls sample CPU s | mls basis CPU s | mls factor CPU s | mls apply CPU s | mls total CPU s | factor entries |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
-# bench_rbf, where benchmarks/CMakeLists.txt builds it (benchmarks/rbf/ or benchmarks/)
-bench_rbf=$build/benchmarks/rbf/bench_rbf
-[ -x "$bench_rbf" ] || bench_rbf=$build/benchmarks/bench_rbf
 for k in $ks; do
-    r=$("$bench_rbf" "$k" "$work" 1 2)
+    r=$("$build/benchmarks/rbf/bench_rbf" "$k" "$work" 1 2)
     fit=$(echo "$r" | tr ' ' '\n' | sed -n 's/^fit_s=//p')
     ev=$(echo "$r" | tr ' ' '\n' | sed -n 's/^eval_s=//p')
     d=$($C deform --mesh sphere.msh --handles perf_H.csv --fixed sphere_F.csv --method mls \

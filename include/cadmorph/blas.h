@@ -12,7 +12,7 @@
  *     Haswell (AVX2) kernels on AMD Zen 5, which has AVX-512. Only the environment variable
  *     OPENBLAS_CORETYPE, read at load time, changes the choice, so a running process cannot
  *     fix it: it must execute itself again with the variable set. cm_blas_decide says
- *     whether to; the cadmorph program does it (cli/blas_reexec.c) unless the user has set
+ *     whether to; the cadmorph program does it at start-up unless the user has set
  *     OPENBLAS_CORETYPE, and records the core OpenBLAS had picked in CM_BLAS_PICKED_ENV.
  *
  *  2. Threads and address space. OpenBLAS starts all its worker threads when it loads, and

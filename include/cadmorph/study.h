@@ -124,7 +124,7 @@ typedef struct cm_study_options {
     int rank, ranks;        /* distributed over MPI ranks (ranks > 1, absolute mode only;
                                default 0, 1): this process runs variants i with
                                i mod ranks = rank and writes their meshes; the result, on
-                               every rank, has all rows (cm_rbf_petsc_allgather). Every
+                               every rank, has all rows (cm_parallel_allgather). Every
                                rank calls cm_study_run with the same inputs. */
 } cm_study_options;
 

@@ -11,31 +11,30 @@ set_tests_properties(rbf_scipy_check PROPERTIES LABELS "unit;rbf" FIXTURES_REQUI
 
 # the panel-by-panel RFP Cholesky against dpftrf (round-off), pivots, progress
 cm_add_unit_test(test_cholesky_blocked ${CMAKE_CURRENT_LIST_DIR}/test_cholesky_blocked.c
-  LIBS cm_rbf cm_lapack LABELS rbf)
+  LIBS cm_rbf_internal cm_lapack LABELS rbf)
 # the look-ahead RFP Cholesky on 1-3 threads against dpftrf (round-off, A - LL'), pivots,
 # progress, the path cm_rbf_cholesky_rfp takes
 cm_add_unit_test(test_cholesky_lookahead ${CMAKE_CURRENT_LIST_DIR}/test_cholesky_lookahead.c
-  LIBS cm_rbf cm_lapack LABELS rbf)
+  LIBS cm_rbf_internal cm_lapack LABELS rbf)
 # the BLAS-core decision table (cpuid flags and core names in, decision out), cm_blas_info
 cm_add_unit_test(test_blas_core ${CMAKE_CURRENT_LIST_DIR}/test_blas_core.c
-  LIBS cm_rbf LABELS rbf)
+  LIBS cm_platform LABELS rbf)
 # iterative solver vs dense on a box-with-bore boundary set, affine data, two bodies, threads
-cm_add_unit_test(test_rbf_iterative ${CMAKE_CURRENT_LIST_DIR}/test_rbf_iterative.c LIBS cm_rbf LABELS rbf)
+cm_add_unit_test(test_rbf_iterative ${CMAKE_CURRENT_LIST_DIR}/test_rbf_iterative.c LIBS cm_rbf_internal LABELS rbf)
 # the Schwarz coarse problem by an inner Krylov solve (multilevel) against dense
-cm_add_unit_test(test_rbf_schwarz_inner ${CMAKE_CURRENT_LIST_DIR}/test_rbf_schwarz_inner.c LIBS cm_rbf LABELS rbf)
+cm_add_unit_test(test_rbf_schwarz_inner ${CMAKE_CURRENT_LIST_DIR}/test_rbf_schwarz_inner.c LIBS cm_rbf_internal LABELS rbf)
 # the kD-tree leaves on sets with tied coordinates (planar faces): a partition, boxes apart
-cm_add_unit_test(test_rbf_schwarz ${CMAKE_CURRENT_LIST_DIR}/test_rbf_schwarz.c LIBS cm_rbf LABELS rbf)
+cm_add_unit_test(test_rbf_schwarz ${CMAKE_CURRENT_LIST_DIR}/test_rbf_schwarz.c LIBS cm_rbf_internal LABELS rbf)
 # thinned overlap: a thinned subdomain keeps its leaf, its cap and its reach; against dense
-cm_add_unit_test(test_rbf_thin ${CMAKE_CURRENT_LIST_DIR}/test_rbf_thin.c LIBS cm_rbf LABELS rbf)
+cm_add_unit_test(test_rbf_thin ${CMAKE_CURRENT_LIST_DIR}/test_rbf_thin.c LIBS cm_rbf_internal LABELS rbf)
 
 # the distributed solver (CADMORPH_WITH_PETSC only): against the serial iterative solver
 # under `mpirun -n 2` (--oversubscribe: the CI machine may have fewer slots; as root too), and
 # on one rank without mpirun
 if(CADMORPH_WITH_PETSC)
   add_executable(test_rbf_petsc ${CMAKE_CURRENT_LIST_DIR}/test_rbf_petsc.c)
-  target_include_directories(test_rbf_petsc PRIVATE ${PROJECT_SOURCE_DIR}/tests/helpers
-    ${PROJECT_SOURCE_DIR})
-  target_link_libraries(test_rbf_petsc PRIVATE cm_rbf cm_core cm_warnings cm_posix)
+  target_include_directories(test_rbf_petsc PRIVATE ${PROJECT_SOURCE_DIR}/tests/helpers)
+  target_link_libraries(test_rbf_petsc PRIVATE cm_rbf cm_platform cm_core cm_warnings cm_posix)
   set(CM_MPI_ENV "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1;OMP_NUM_THREADS=1")
   add_test(NAME test_rbf_petsc_2ranks
     COMMAND ${MPIEXEC_EXECUTABLE} ${MPIEXEC_NUMPROC_FLAG} 2 --oversubscribe
@@ -47,9 +46,9 @@ if(CADMORPH_WITH_PETSC)
 endif()
 # the r^3 treecode: its error bound on random and real weights; fits with fast matvecs
 # against direct ones and dense; affine data; the choice of the fast evaluation
-cm_add_unit_test(test_rbf_treecode ${CMAKE_CURRENT_LIST_DIR}/test_rbf_treecode.c LIBS cm_rbf LABELS rbf)
+cm_add_unit_test(test_rbf_treecode ${CMAKE_CURRENT_LIST_DIR}/test_rbf_treecode.c LIBS cm_rbf_internal LABELS rbf)
 # the kernel sums per instruction set (generic, AVX2, AVX-512 compiled and by hand) against
 # each other and a long-double reference: plain and compensated, tails, threads
-cm_add_unit_test(test_rbf_sum ${CMAKE_CURRENT_LIST_DIR}/test_rbf_sum.c LIBS cm_rbf LABELS rbf)
+cm_add_unit_test(test_rbf_sum ${CMAKE_CURRENT_LIST_DIR}/test_rbf_sum.c LIBS cm_rbf_internal LABELS rbf)
 # AUTO's cost model: probe rates, growth of the costs, one crossover
-cm_add_unit_test(test_rbf_auto ${CMAKE_CURRENT_LIST_DIR}/test_rbf_auto.c LIBS cm_rbf LABELS rbf)
+cm_add_unit_test(test_rbf_auto ${CMAKE_CURRENT_LIST_DIR}/test_rbf_auto.c LIBS cm_rbf_internal LABELS rbf)

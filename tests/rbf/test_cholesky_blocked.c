@@ -1,7 +1,7 @@
-/* The panel-by-panel RFP Cholesky (rbf/cholesky_blocked.c) against LAPACK's dpftrf on random
+/* The panel-by-panel RFP Cholesky (rbf/dense/cholesky_blocked.c) against LAPACK's dpftrf on random
  * SPD matrices: odd and even n, n below, at and off multiples of the block; the pivot of an
  * indefinite matrix; progress monotonic up to its total. */
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
 #include "cholesky_test_util.h"
 #include "test_util.h"
 

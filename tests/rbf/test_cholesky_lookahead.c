@@ -1,4 +1,4 @@
-/* The look-ahead RFP Cholesky (rbf/cholesky_lookahead.c) against LAPACK's dpftrf on random
+/* The look-ahead RFP Cholesky (rbf/dense/cholesky_lookahead.c) against LAPACK's dpftrf on random
  * SPD matrices on 1, 2 and 3 threads: the factors agree to round-off and A - LL' is at
  * round-off; odd and even n, n below a block, blocks that straddle the two halves of the RFP
  * layout, many update chunks per step; the failing pivot of an indefinite matrix (info as
@@ -7,7 +7,7 @@
 #if defined(__linux__) && !defined(_DEFAULT_SOURCE)
 #define _DEFAULT_SOURCE /* fork, waitpid, setrlimit */
 #endif
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
 #include "cholesky_test_util.h"
 #include "test_util.h"
 
@@ -176,7 +176,7 @@ static void check_dispatch(int n)
 
 /* Under an address-space limit with no room for a second OpenBLAS buffer the look-ahead is
  * not taken (its second thread's first BLAS call would spin forever in OpenBLAS's
- * allocation): cm_rbf_blas_callers says 1. In a child, which the limit must not outlive. */
+ * allocation): cm_blas_callers says 1. In a child, which the limit must not outlive. */
 static void check_ulimit(void)
 {
     FILE *f = fopen("/proc/self/statm", "r");
@@ -186,7 +186,7 @@ static void check_ulimit(void)
         return; /* not Linux: nothing to check */
     }
     fclose(f);
-    CHECK(cm_rbf_blas_callers(2) == 2); /* no limit here */
+    CHECK(cm_blas_callers(2) == 2); /* no limit here */
     pid_t pid = fork();
     if (pid == 0) {
         /* 100 MB more than mapped now: less than one more 128 MB buffer */
@@ -194,7 +194,7 @@ static void check_ulimit(void)
         getrlimit(RLIMIT_AS, &rl);
         rl.rlim_cur = (rlim_t)pages * 4096u + ((rlim_t)100 << 20);
         if (setrlimit(RLIMIT_AS, &rl) != 0) _exit(4);
-        _exit(cm_rbf_blas_callers(2) == 1 ? 0 : 5);
+        _exit(cm_blas_callers(2) == 1 ? 0 : 5);
     }
     int status = 0;
     CHECK(pid > 0 && waitpid(pid, &status, 0) == pid);

@@ -1,15 +1,15 @@
-/* AUTO's cost model (cm_rbf_auto_dense in rbf/rbf_iterative.c, the probe in rbf_auto_probe.c):
+/* AUTO's cost model (cm_rbf_auto_dense in rbf/iterative/rbf_auto.c, the probe in rbf_auto_probe.c):
  * the probe measures positive rates; the model's costs grow as they must (dense ~ m^3,
  * iterative ~ m to m^2); the choice is dense for small sets, iterative for large ones, with a
  * single crossover in between, and always dense for the kernels the iterative solver does not
  * handle. No timing is asserted: the rates depend on the machine. */
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
 #include "test_util.h"
 
 int main(void)
 {
     double g = 0.0, kp = 0.0, ka = 0.0;
-    cm_rbf_blas_threads(NULL, "test_rbf_auto", 1, NULL); /* as cm_rbf_create decides */
+    cm_blas_threads(NULL, "test_rbf_auto", 1, NULL); /* as cm_rbf_create decides */
     cm_rbf_auto_rates(&g, &kp, &ka);
     printf("probe: dgemm %.3g flop/s, plain %.3g, compensated %.3g pairs/s\n", g, kp, ka);
     CHECK(g > 1e8 && kp > 1e7 && ka > 1e7);

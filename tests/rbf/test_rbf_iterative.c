@@ -2,7 +2,8 @@
  * the dense solver on a box-with-bore boundary set, affine data, two bodies far apart,
  * thread-count independence, the solver choice and the option checks. */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
+#include "rbf_tuning.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 
@@ -10,13 +11,13 @@
 #include <string.h>
 
 /* Fits values on x with the given options and evaluates at p (np points). */
-static cm_status fit_eval_opt(cm_context *ctx, const cm_rbf_options *opt, size_t m,
+static cm_status fit_eval_opt(cm_context *ctx, const cm_rbf_options *opt, const cm_rbf_tuning *tun, size_t m,
                               const double *x, const double *val, size_t np, const double *p,
                               double *out, cm_rbf_stats *stats)
 {
     cm_rbf_options o = *opt;
     cm_rbf *r = NULL;
-    cm_status st = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r);
+    cm_status st = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, tun, &r);
     if (st == CM_OK) st = cm_rbf_solve(ctx, r, 3, val);
     if (st == CM_OK) st = cm_rbf_evaluate(ctx, r, np, p, out);
     if (r) cm_rbf_get_stats(r, stats);
@@ -29,9 +30,11 @@ static cm_status fit_eval(cm_context *ctx, cm_rbf_solver solver, size_t m, const
                           cm_rbf_stats *stats)
 {
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = solver;
-    return fit_eval_opt(ctx, &o, m, x, val, np, p, out, stats);
+    return fit_eval_opt(ctx, &o, &tun, m, x, val, np, p, out, stats);
 }
 
 
@@ -83,10 +86,12 @@ static void test_against_dense(cm_context *ctx)
         cm_status sts[2];
         for (int v = 0; v < 2; ++v) {
             cm_rbf_options o;
+            cm_rbf_tuning tun;
             cm_rbf_options_init(&o);
+            cm_rbf_tuning_init(&tun);
             o.solver = CM_RBF_SOLVER_ITERATIVE;
-            o.relax = v == 0 ? 0 : 2;
-            sts[v] = fit_eval_opt(ctx, &o, m, x, d, np, p, v == 0 ? s1 : sx, &sr[v]);
+            tun.relax = v == 0 ? 0 : 2;
+            sts[v] = fit_eval_opt(ctx, &o, &tun, m, x, d, np, p, v == 0 ? s1 : sx, &sr[v]);
         }
         double d0 = max_diff(np * 3, s1, sd) / range, d2 = max_diff(np * 3, sx, sd) / range;
         printf("relax 0: %d iterations, %d compensated + %d plain + %d fast products, residual "
@@ -136,17 +141,19 @@ static void test_against_dense(cm_context *ctx)
      * nearest) */
     for (int v = 0; v < 3; ++v) {
         cm_rbf_options o;
+        cm_rbf_tuning tun;
         cm_rbf_options_init(&o);
+        cm_rbf_tuning_init(&tun);
         o.solver = CM_RBF_SOLVER_ITERATIVE;
-        if (v == 0) o.coarse_post = 0;
-        if (v == 1) o.coarse_post = 2;
+        if (v == 0) tun.coarse_post = 0;
+        if (v == 1) tun.coarse_post = 2;
         if (v == 2) {
-            o.overlap = 2.0;
-            o.local_max = 2000;
-            o.coarse_size = 300;
+            tun.overlap = 2.0;
+            tun.local_max = 2000;
+            tun.coarse_size = 300;
         }
         cm_rbf_stats sv;
-        cm_status e = fit_eval_opt(ctx, &o, m, x, d, np, p, s1, &sv);
+        cm_status e = fit_eval_opt(ctx, &o, &tun, m, x, d, np, p, s1, &sv);
         double dv = max_diff(np * 3, s1, sd) / range;
         printf("variant %d: %d iterations, coarse %d, residual %.3g, |variant - dense| = %.3g "
                "of the range\n", v, sv.iterations, sv.coarse_size, sv.residual, dv);
@@ -195,13 +202,15 @@ static void test_storage(cm_context *ctx)
     double *out[3];
     cm_rbf_stats st[3];
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     const double range = range_of(m * 3, d);
     for (int f = 0; f < 3; ++f) {
         out[f] = malloc(np * 3 * sizeof *out[f]);
-        o.local_float = f;
-        cm_status s = fit_eval_opt(ctx, &o, m, x, d, np, p, out[f], &st[f]);
+        tun.local_float = f;
+        cm_status s = fit_eval_opt(ctx, &o, &tun, m, x, d, np, p, out[f], &st[f]);
         CHECK_MSG(s == CM_OK, "local_float %d: %s", f, cm_context_message(ctx));
         CHECK_MSG(st[f].residual <= o.tolerance, "local_float %d: %.3g", f, st[f].residual);
     }
@@ -217,9 +226,9 @@ static void test_storage(cm_context *ctx)
         free(out[f]);
     }
     free(out[0]);
-    o.local_float = 3;
+    tun.local_float = 3;
     cm_rbf *bad = NULL;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &bad) == CM_ERR_ARGUMENT);
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &bad) == CM_ERR_ARGUMENT);
     CHECK(bad == NULL);
     free(x), free(d), free(p);
 }
@@ -243,10 +252,12 @@ static void test_two_bodies(cm_context *ctx)
         d[3 * i + 2] = 0.05;
     }
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     cm_rbf *r = NULL;
-    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r);
+    cm_status s = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r);
     if (s == CM_OK) s = cm_rbf_solve(ctx, r, 3, d);
     cm_rbf_stats st;
     cm_rbf_get_stats(r, &st);
@@ -303,25 +314,28 @@ static void test_choice(cm_context *ctx)
     CHECK(st.solver == CM_RBF_SOLVER_DENSE && st.centres == m);
     cm_rbf_destroy(&r);
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_BIHARMONIC, 3, m, x, &o, &r) == CM_ERR_UNSUPPORTED);
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_BIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_UNSUPPORTED);
     CHECK(r == NULL);
     o.tolerance = 0.0;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
-    o.local_size = 8; /* smaller than the leaves */
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
-    o.local_size = 700;
-    o.coarse_post = 3;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
-    o.coarse_post = 0;
-    o.overlap = -1.0;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
-    o.overlap = 2.0;
-    o.relax = 3;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    tun.local_size = 8; /* smaller than the leaves */
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
+    tun.local_size = 700;
+    tun.coarse_post = 3;
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
+    tun.coarse_post = 0;
+    tun.overlap = -1.0;
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
+    tun.overlap = 2.0;
+    tun.relax = 3;
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
     /* the cost model: dense at 2k, iterative at 20k (measured with subdomains of 700 and an
      * overlap of 2 H: the crossover near 3.5k, iterative 5x faster at 10k) */
     CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 2000) == 1);
@@ -330,13 +344,14 @@ static void test_choice(cm_context *ctx)
     /* the coarse space: 2000 up to 2e4 centres (m/4 below 8000), then grown as sqrt(m) up
      * to coarse_max */
     cm_rbf_options_init(&o);
-    CHECK(cm_rbf_coarse_count(&o, 20000) == 2000 && cm_rbf_coarse_count(&o, 6000) == 1500);
-    CHECK(cm_rbf_coarse_count(&o, 80000) == 4000 && cm_rbf_coarse_count(&o, 1000000) == 14142);
-    CHECK(cm_rbf_coarse_count(&o, 2000000) == 16000);
-    o.coarse_max = 3000;
-    CHECK(cm_rbf_coarse_count(&o, 80000) == 3000);
-    o.coarse_grow = 0;
-    CHECK(cm_rbf_coarse_count(&o, 150000) == 2000);
+    cm_rbf_tuning_init(&tun);
+    CHECK(cm_rbf_coarse_count(&tun, 20000) == 2000 && cm_rbf_coarse_count(&tun, 6000) == 1500);
+    CHECK(cm_rbf_coarse_count(&tun, 80000) == 4000 && cm_rbf_coarse_count(&tun, 1000000) == 14142);
+    CHECK(cm_rbf_coarse_count(&tun, 2000000) == 16000);
+    tun.coarse_max = 3000;
+    CHECK(cm_rbf_coarse_count(&tun, 80000) == 3000);
+    tun.coarse_grow = 0;
+    CHECK(cm_rbf_coarse_count(&tun, 150000) == 2000);
     free(x);
 }
 

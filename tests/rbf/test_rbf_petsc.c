@@ -3,6 +3,7 @@
  * each rank holding only its share of the local solves, the preconditioner reused for a
  * second right-hand side, the errors it must give.
  * usage: test_rbf_petsc DATA WORK K (K: the ranks mpirun was asked for, checked). */
+#include "cadmorph/parallel.h"
 #include "cadmorph/rbf.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
@@ -17,11 +18,11 @@ int main(int argc, char **argv)
     cm_context *ctx = NULL;
     if (cm_context_create(&ctx) != CM_OK) return 1;
     cm_context_set_threads(ctx, 1); /* one thread per rank: the ranks share the cores */
-    CHECK_MSG(cm_rbf_petsc_available(), "built without PETSc");
-    cm_status s0 = cm_rbf_petsc_initialize(ctx);
+    CHECK_MSG(cm_parallel_available(), "built without PETSc");
+    cm_status s0 = cm_parallel_initialize(ctx);
     CHECK_MSG(s0 == CM_OK, "%s", cm_context_message(ctx));
     int rank, size;
-    cm_rbf_petsc_rank(&rank, &size);
+    cm_parallel_rank(&rank, &size);
     CHECK_MSG(size == want_ranks, "%d ranks, expected %d", size, want_ranks);
 
     /* m ~ 5k boundary nodes, the bore's kind of motion, points inside */
@@ -125,6 +126,6 @@ int main(int argc, char **argv)
 
     free(x), free(d), free(p), free(ss), free(sp);
     cm_context_destroy(&ctx);
-    cm_rbf_petsc_finalize();
+    cm_parallel_finalize();
     return TEST_REPORT();
 }

@@ -2,11 +2,12 @@
  * sets have (thousands of centres on one axis-aligned planar face): the leaves partition the
  * centres and no two leaf boxes touch, so no leaf holds a scattered subset of a plane. A
  * median split inside such a group made slab leaves whose nearly coplanar local solves
- * stalled the two-body bracket (RESULTS.md, issue 10, thirteenth session). And the bodies
+ * stalled the two-body bracket (RESULTS.md, RBF solvers). And the bodies
  * the subdomains see (rbf_bodies.c): one for one part, two for two parts far apart, and the
  * projection leaves no linear moment on either. */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
+#include "rbf_tuning.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 
@@ -20,12 +21,14 @@
 static void check_leaves(cm_context *ctx, const char *name, size_t m, const double *x)
 {
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
-    o.leaf_size = 64; /* many splits on a small set */
-    o.local_size = 200;
+    tun.leaf_size = 64; /* many splits on a small set */
+    tun.local_size = 200;
     cm_rbf *r = NULL;
-    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r);
+    cm_status s = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r);
     CHECK_MSG(s == CM_OK, "%s: %s", name, cm_context_message(ctx));
     if (s != CM_OK) return;
     const cm_rbf_schwarz *pc = cm_rbf_iterative_pc(r);
@@ -94,12 +97,14 @@ static void test_bodies(cm_context *ctx)
     box_with_bore(4.0, 2.0, 1.0, 2.0, 1.0, 0.4, 0.1, off0, x);
     box_with_bore(3.0, 1.5, 1.0, 1.5, 0.75, 0.3, 0.1, off1, x + 3 * m0);
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     for (int two = 0; two < 2; ++two) {
         const size_t n = two ? m : m0;
         cm_rbf *r = NULL;
-        cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, n, x, &o, &r);
+        cm_status s = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, n, x, &o, &tun, &r);
         CHECK_MSG(s == CM_OK, "%s", cm_context_message(ctx));
         if (s != CM_OK) break;
         const cm_rbf_bodies *b = cm_rbf_schwarz_bodies(cm_rbf_iterative_pc(r));

@@ -6,7 +6,8 @@
  * on the coarse centres is a real one (with the default 1,400 its subdomains would be the
  * whole coarse set). */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
+#include "rbf_tuning.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 
@@ -16,12 +17,12 @@
 #include <string.h>
 
 /* fit, evaluate at the np points p; inner solves / iterations of the preconditioner */
-static cm_status fit(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
+static cm_status fit(cm_context *ctx, const cm_rbf_options *o, const cm_rbf_tuning *tun, size_t m, const double *x,
                      const double *d, size_t np, const double *p, double *out,
                      cm_rbf_stats *st, long *solves, long *its)
 {
     cm_rbf *r = NULL;
-    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &r);
+    cm_status s = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, tun, &r);
     if (s == CM_OK) s = cm_rbf_solve(ctx, r, 3, d);
     if (s == CM_OK) s = cm_rbf_evaluate(ctx, r, np, p, out);
     if (r) {
@@ -42,19 +43,21 @@ static void test_inner(cm_context *ctx)
     double *sd = malloc(np * 3 * sizeof *sd), *s0 = malloc(np * 3 * sizeof *s0);
     double *s1 = malloc(np * 3 * sizeof *s1);
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_DENSE;
     cm_rbf_stats std, st0, st1;
-    cm_status a = fit(ctx, &o, m, x, d, np, p, sd, &std, NULL, NULL);
+    cm_status a = fit(ctx, &o, &tun, m, x, d, np, p, sd, &std, NULL, NULL);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
-    o.leaf_size = 128;
-    o.local_size = 500;
-    o.local_max = 700;
+    tun.leaf_size = 128;
+    tun.local_size = 500;
+    tun.local_max = 700;
     long n0 = -1, i0 = -1, n1 = 0, i1 = 0;
-    cm_status b = fit(ctx, &o, m, x, d, np, p, s0, &st0, &n0, &i0);
+    cm_status b = fit(ctx, &o, &tun, m, x, d, np, p, s0, &st0, &n0, &i0);
     /* the same coarse space (m/4: the most the rule allows) solved inexactly */
-    o.coarse_inner = 20;
-    cm_status c = fit(ctx, &o, m, x, d, np, p, s1, &st1, &n1, &i1);
+    tun.coarse_inner = 20;
+    cm_status c = fit(ctx, &o, &tun, m, x, d, np, p, s1, &st1, &n1, &i1);
     CHECK_MSG(a == CM_OK && b == CM_OK && c == CM_OK, "%d %d %d: %s", a, b, c,
               cm_context_message(ctx));
     const double range = fmax(range_of(m * 3, d), 1e-300);
@@ -77,9 +80,9 @@ static void test_inner(cm_context *ctx)
     /* a tight inner tolerance is the exact coarse solve in all but rounding: the same
      * iteration count as the dense coarse factor of the same coarse space */
     cm_rbf_stats st2;
-    o.coarse_inner = 60;
-    o.coarse_inner_tol = 1e-9;
-    cm_status e = fit(ctx, &o, m, x, d, np, p, s1, &st2, &n1, &i1);
+    tun.coarse_inner = 60;
+    tun.coarse_inner_tol = 1e-9;
+    cm_status e = fit(ctx, &o, &tun, m, x, d, np, p, s1, &st2, &n1, &i1);
     printf("inner to 1e-9: %d iterations (dense coarse: %d), %ld inner iterations\n",
            st2.iterations, st0.iterations, i1);
     CHECK(e == CM_OK);
@@ -89,11 +92,11 @@ static void test_inner(cm_context *ctx)
 
     /* refused: negative counts and tolerances outside (0, 1) */
     cm_rbf *r = NULL;
-    o.coarse_inner = -1;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT && !r);
-    o.coarse_inner = 5;
-    o.coarse_inner_tol = 1.5;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT && !r);
+    tun.coarse_inner = -1;
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT && !r);
+    tun.coarse_inner = 5;
+    tun.coarse_inner_tol = 1.5;
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT && !r);
     CHECK(strstr(cm_context_message(ctx), "coarse_inner") != NULL);
     free(x), free(d), free(p), free(sd), free(s0), free(s1);
 }

@@ -1,4 +1,4 @@
-/* The instruction-set variants of the kernel sums (rbf/rbf_sum.c, rbf_sum_acc.c, the hand-written
+/* The instruction-set variants of the kernel sums (rbf/sum/rbf_sum.c, rbf_sum_acc.c, the hand-written
  * AVX-512 blocks of rbf_sum_avx512.c) against the generic code and a long-double reference:
  * plain sums within 64 eps sum_j |w_j phi_ij| of the generic ones; compensated sums within
  * 4 eps |ref| (+ 1e-18 sum |w phi|) of the reference on a cancelling set (dipoles of large
@@ -7,8 +7,8 @@
  * Coordinates are multiples of 2^-10, so r^2 is exact and phi_ij is the same double in every
  * variant: the comparison measures the summation alone. Both vsqrtpd splits of the AVX-512
  * blocks give the same bits (off the grid too). */
-#include "rbf/rbf_internal.h"
-#include "rbf/rbf_sum_isa.h"
+#include "rbf_internal.h"
+#include "sum/rbf_sum_isa.h"
 #include "test_rng.h"
 #include "test_util.h"
 

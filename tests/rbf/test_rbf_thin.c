@@ -3,7 +3,8 @@
  * lies within a voxel diagonal of a pick) with fewer centres than the full overlap there,
  * and the solver with thinning agrees with the dense one on a box-with-bore set at ~5k. */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
+#include "rbf_internal.h"
+#include "rbf_tuning.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 
@@ -25,15 +26,15 @@ static double box_d2(const double *c, size_t m, size_t i, const double *lo, cons
 
 /* The subdomains of a thinned preconditioner on x (m centres): leaves partition the centres,
  * counts within the cap, every centre within the reach covered by a pick. */
-static void check_subdomains(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
+static void check_subdomains(cm_context *ctx, const cm_rbf_options *o, const cm_rbf_tuning *tun, size_t m, const double *x,
                              int expect_cap_hit)
 {
     cm_rbf *r = NULL;
-    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &r);
+    cm_status s = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, tun, &r);
     CHECK_MSG(s == CM_OK, "%s", cm_context_message(ctx));
     if (s != CM_OK) return;
     const cm_rbf_schwarz *pc = cm_rbf_iterative_pc(r);
-    const double H = cm_rbf_schwarz_fill(pc), R = o->thin_reach * H;
+    const double H = cm_rbf_schwarz_fill(pc), R = tun->thin_reach * H;
     const size_t mm = r->m;
     const double *c = r->c;
     CHECK(H > 0.0 && mm == m);
@@ -53,8 +54,8 @@ static void check_subdomains(cm_context *ctx, const cm_rbf_options *o, size_t m,
                 hi[d] = fmax(hi[d], c[(size_t)d * mm + idx[u]]);
             }
         }
-        if (n > (size_t)o->thin_max) ++over_cap;
-        if (n == (size_t)o->thin_max) ++capped;
+        if (n > (size_t)tun->thin_max) ++over_cap;
+        if (n == (size_t)tun->thin_max) ++capped;
         double far = 0.0;
         for (size_t u = 0; u < n; ++u) {
             in[idx[u]] = 1;
@@ -70,8 +71,8 @@ static void check_subdomains(cm_context *ctx, const cm_rbf_options *o, size_t m,
             double d2 = box_d2(c, mm, i, lo, hi);
             if (d2 > R * R) continue;
             ++within;
-            if (in[i] || n >= (size_t)o->thin_max) continue;
-            const double tol = sqrt(3.0) * o->thin_cell * fmax(sqrt(d2), H) * (1.0 + 1e-9);
+            if (in[i] || n >= (size_t)tun->thin_max) continue;
+            const double tol = sqrt(3.0) * tun->thin_cell * fmax(sqrt(d2), H) * (1.0 + 1e-9);
             int ok = 0;
             for (size_t u = 0; u < n && !ok; ++u) {
                 double e = 0.0;
@@ -89,8 +90,8 @@ static void check_subdomains(cm_context *ctx, const cm_rbf_options *o, size_t m,
     int part = 1;
     for (size_t i = 0; i < mm; ++i) part &= own[i] == 1;
     printf("thin_reach %g H (H %.3g), cell %g, cap %d: %d subdomains, mean count / full overlap "
-           "%.2f, mean reach %.2f of R, %d at the cap, %d uncovered\n", o->thin_reach, H,
-           o->thin_cell, o->thin_max, nsub, ratio / nsub, reach / nsub, capped, uncovered);
+           "%.2f, mean reach %.2f of R, %d at the cap, %d uncovered\n", tun->thin_reach, H,
+           tun->thin_cell, tun->thin_max, nsub, ratio / nsub, reach / nsub, capped, uncovered);
     CHECK_MSG(part, "the leaves (first n_in of each subdomain) do not partition the centres");
     CHECK_MSG(over_cap == 0 && beyond == 0, "%d over the cap, %d centres beyond the reach",
               over_cap, beyond);
@@ -111,18 +112,20 @@ static void test_thin(cm_context *ctx)
     double *x = NULL, *d = NULL;
     size_t m = bore_set(0.076, &x, &d);
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
-    o.leaf_size = 128;
-    o.local_size = 300;
-    o.overlap = 0.0; /* the near set by count alone */
-    o.coarse_size = 500;
-    o.thin_reach = 8.0;
-    o.thin_cell = 0.3;
-    o.thin_max = 5000; /* no cap: the reach and the coverage */
-    check_subdomains(ctx, &o, m, x, 0);
-    o.thin_max = 450; /* the cap */
-    check_subdomains(ctx, &o, m, x, 1);
+    tun.leaf_size = 128;
+    tun.local_size = 300;
+    tun.overlap = 0.0; /* the near set by count alone */
+    tun.coarse_size = 500;
+    tun.thin_reach = 8.0;
+    tun.thin_cell = 0.3;
+    tun.thin_max = 5000; /* no cap: the reach and the coverage */
+    check_subdomains(ctx, &o, &tun, m, x, 0);
+    tun.thin_max = 450; /* the cap */
+    check_subdomains(ctx, &o, &tun, m, x, 1);
 
     /* the solver with thinning against dense, at the centres and inside */
     size_t np = 0;
@@ -131,16 +134,18 @@ static void test_thin(cm_context *ctx)
     cm_rbf_stats sdn, sth;
     cm_rbf *r = NULL;
     cm_rbf_options od;
+    cm_rbf_tuning tun_d;
     cm_rbf_options_init(&od);
+    cm_rbf_tuning_init(&tun_d);
     od.solver = CM_RBF_SOLVER_DENSE;
-    cm_status a = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &od, &r);
+    cm_status a = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &od, &tun_d, &r);
     if (a == CM_OK) a = cm_rbf_solve(ctx, r, 3, d);
     if (a == CM_OK) a = cm_rbf_evaluate(ctx, r, np, p, sd);
     cm_rbf_get_stats(r, &sdn);
     cm_rbf_destroy(&r);
-    o.thin_max = 700;
+    tun.thin_max = 700;
     {
-        cm_status b = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r);
+        cm_status b = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r);
         if (b == CM_OK) b = cm_rbf_solve(ctx, r, 3, d);
         if (b == CM_OK) b = cm_rbf_evaluate(ctx, r, np, p, st);
         cm_rbf_get_stats(r, &sth);
@@ -156,11 +161,11 @@ static void test_thin(cm_context *ctx)
     }
 
     /* bad options are refused */
-    o.thin_reach = -1.0;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
-    o.thin_reach = 4.0;
-    o.thin_cell = 0.0;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    tun.thin_reach = -1.0;
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
+    tun.thin_reach = 4.0;
+    tun.thin_cell = 0.0;
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
     CHECK(r == NULL);
     free(x), free(d), free(p), free(sd), free(st);
 }

@@ -1,11 +1,12 @@
-/* Tests of the r^3 treecode (rbf/rbf_treecode.c) and of the iterative solver with fast
+/* Tests of the r^3 treecode (rbf/sum/rbf_treecode.c) and of the iterative solver with fast
  * matvecs: the error bound |fast_i - exact_i| <= tol sum_j |w_j| phi_ij on random and on real
  * RBF weights, at the centres and elsewhere; fits with fast_sum on against direct matvecs
  * and the dense solver; affine data; the choice of the fast evaluation; the hand-written
  * AVX-512 products against the compiled fallbacks. */
 #include "cadmorph/rbf.h"
-#include "rbf/rbf_internal.h"
-#include "rbf/rbf_treecode.h"
+#include "rbf_internal.h"
+#include "rbf_tuning.h"
+#include "sum/rbf_treecode.h"
 #include "rbf_test_sets.h"
 #include "test_rng.h"
 #include "test_util.h"
@@ -190,10 +191,12 @@ static void test_bound_real(cm_context *ctx)
     double *d = malloc(m * 3 * sizeof *d);
     bore_motion(m, x, 2.0, 1.0, d);
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_DENSE;
     cm_rbf *r = NULL;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_OK);
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_OK);
     CHECK(cm_rbf_solve(ctx, r, 3, d) == CM_OK);
     const double tols[] = {1e-6, 1e-10};
     for (int k = 0; k < 2; ++k) {
@@ -213,12 +216,12 @@ static void test_bound_real(cm_context *ctx)
     free(x), free(d);
 }
 
-static cm_status fit_eval(cm_context *ctx, const cm_rbf_options *o, size_t m, const double *x,
+static cm_status fit_eval(cm_context *ctx, const cm_rbf_options *o, const cm_rbf_tuning *tun, size_t m, const double *x,
                           const double *d, size_t np, const double *p, double *out,
                           cm_rbf_stats *st)
 {
     cm_rbf *r = NULL;
-    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, &r);
+    cm_status s = cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, o, tun, &r);
     if (s == CM_OK) s = cm_rbf_solve(ctx, r, 3, d);
     if (s == CM_OK) s = cm_rbf_evaluate(ctx, r, np, p, out);
     if (r) cm_rbf_get_stats(r, st);
@@ -245,15 +248,17 @@ static void test_fit(cm_context *ctx)
     double *sf = malloc(np * 3 * sizeof *sf), *sd = malloc(np * 3 * sizeof *sd);
     double *sn = malloc(np * 3 * sizeof *sn);
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     o.fast_sum = 0;
     cm_rbf_stats a, b, dn;
-    cm_status s0 = fit_eval(ctx, &o, m, x, d, np, p, sd, &a);
+    cm_status s0 = fit_eval(ctx, &o, &tun, m, x, d, np, p, sd, &a);
     o.fast_sum = 1;
-    cm_status s1 = fit_eval(ctx, &o, m, x, d, np, p, sf, &b);
+    cm_status s1 = fit_eval(ctx, &o, &tun, m, x, d, np, p, sf, &b);
     o.solver = CM_RBF_SOLVER_DENSE;
-    cm_status s2 = fit_eval(ctx, &o, m, x, d, np, p, sn, &dn);
+    cm_status s2 = fit_eval(ctx, &o, &tun, m, x, d, np, p, sn, &dn);
     CHECK_MSG(s0 == CM_OK && s1 == CM_OK && s2 == CM_OK, "%d %d %d: %s", s0, s1, s2,
               cm_context_message(ctx));
     const double range = range_of(m * 3, d);
@@ -273,9 +278,9 @@ static void test_fit(cm_context *ctx)
     /* a treecode far too loose for the corrections (as at 121k on two bodies far apart at
      * 1e-12): the fast steps stop short, and the solve is done again with direct products */
     o.solver = CM_RBF_SOLVER_ITERATIVE;
-    o.fast_tol = 1e-3;
+    tun.fast_tol = 1e-3;
     cm_rbf_stats e;
-    cm_status s4 = fit_eval(ctx, &o, m, x, d, np, p, sf, &e);
+    cm_status s4 = fit_eval(ctx, &o, &tun, m, x, d, np, p, sf, &e);
     agree = max_diff(np * 3, sf, sd) / range;
     printf("fast_tol 1e-3: %d refinements, residual after the first %.3g, direct step %d, "
            "final %.3g, |fast - direct| = %.3g\n", e.refinements, e.fast_residual,
@@ -288,10 +293,10 @@ static void test_fit(cm_context *ctx)
     /* a loose tolerance: the refinement's residual by plain sums (the compensated ones only
      * where plain sums could err by 10 % of the tolerance), the result still within it at
      * the centres by the compensated sums of cm_rbf_evaluate */
-    o.fast_tol = 1e-12;
+    tun.fast_tol = 1e-12;
     o.tolerance = 1e-5;
     cm_rbf_stats l;
-    cm_status s5 = fit_eval(ctx, &o, m, x, d, np, p, sf, &l);
+    cm_status s5 = fit_eval(ctx, &o, &tun, m, x, d, np, p, sf, &l);
     double dmax = 0.0;
     for (size_t i = 0; i < m * 3; ++i) dmax = fmax(dmax, fabs(d[i]));
     exact = max_diff(m * 3, sf, d) / dmax;
@@ -304,10 +309,10 @@ static void test_fit(cm_context *ctx)
     CHECK_MSG(l.residual <= 1e-5 && exact <= 1e-5, "%.3g %.3g", l.residual, exact);
     o.tolerance = 1e-10;
     /* no refinement: the treecode's own residual, looser but reported as such */
-    o.fast_refine = 0;
-    o.fast_tol = 1e-6;
+    tun.fast_refine = 0;
+    tun.fast_tol = 1e-6;
     cm_rbf_stats c;
-    cm_status s3 = fit_eval(ctx, &o, m, x, d, np, p, sf, &c);
+    cm_status s3 = fit_eval(ctx, &o, &tun, m, x, d, np, p, sf, &c);
     printf("fast_tol 1e-6 without refinement: residual %.3g, |fast - direct| = %.3g\n",
            c.residual, max_diff(np * 3, sf, sd) / range);
     CHECK(s3 >= CM_OK && c.refinements == 0);
@@ -327,11 +332,13 @@ static void test_affine(cm_context *ctx)
         d[3 * i + 2] = 0.125 * x[3 * i] + 0.375 * x[3 * i + 1];
     }
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     o.fast_sum = 1;
     cm_rbf_stats st;
-    cm_status s = fit_eval(ctx, &o, m, x, d, m, x, out, &st);
+    cm_status s = fit_eval(ctx, &o, &tun, m, x, d, m, x, out, &st);
     double err = max_diff(m * 3, out, d);
     printf("affine data with fast sums: max error %.3g\n", err);
     CHECK(s == CM_OK);
@@ -366,13 +373,15 @@ static void test_evaluation(cm_context *ctx)
         for (size_t i = 0; i < n; ++i)
             for (int e = 0; e < 3; ++e) p[3 * i + e] = x[3 * (i % m) + e] * 0.97 + 0.01;
         cm_rbf_options o;
+        cm_rbf_tuning tun;
         cm_rbf_options_init(&o);
+        cm_rbf_tuning_init(&tun);
         o.solver = CM_RBF_SOLVER_ITERATIVE;
         o.fast_sum = 0;
         cm_rbf_stats sa, sb;
-        cm_status s0 = fit_eval(ctx, &o, m, x, d, n, p, a, &sa);
+        cm_status s0 = fit_eval(ctx, &o, &tun, m, x, d, n, p, a, &sa);
         o.fast_sum = 1;
-        cm_status s1 = fit_eval(ctx, &o, m, x, d, n, p, b, &sb);
+        cm_status s1 = fit_eval(ctx, &o, &tun, m, x, d, n, p, b, &sb);
         double dmax = 0.0;
         for (size_t i = 0; i < 3 * m; ++i) dmax = fmax(dmax, fabs(d[i]));
         double diff = max_diff(n * 3, a, b) / dmax;
@@ -388,8 +397,8 @@ static void test_evaluation(cm_context *ctx)
             /* a tolerance below what any sum in doubles reaches: the fast sum is taken only
              * within the direct sums' own rounding (about 4 eps sum |w| phi, 1e-12 of max
              * |d| here with the weights' 2e4-fold cancellation), else refused */
-            o.fast_eval_tol = 1e-17;
-            cm_status s2 = fit_eval(ctx, &o, m, x, d, n, p, b, &sb);
+            tun.fast_eval_tol = 1e-17;
+            cm_status s2 = fit_eval(ctx, &o, &tun, m, x, d, n, p, b, &sb);
             double d2 = max_diff(n * 3, a, b) / dmax;
             printf("fast_eval_tol 1e-17: fast %s (estimate %.3g), |result - direct| = %.3g\n",
                    sb.eval_fast ? "accepted" : "refused", sb.eval_error, d2);
@@ -406,16 +415,19 @@ static void test_options(cm_context *ctx)
     size_t m;
     double *x = bore_centres(0.2, &m);
     cm_rbf_options o;
+    cm_rbf_tuning tun;
     cm_rbf_options_init(&o);
-    CHECK(o.fast_sum == -1 && o.fast_tol == 1e-12 && o.fast_refine == 3 && o.fast_eval_tol == 1e-9);
+    cm_rbf_tuning_init(&tun);
+    CHECK(o.fast_sum == -1 && tun.fast_tol == 1e-12 && tun.fast_refine == 3 && tun.fast_eval_tol == 1e-9);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     cm_rbf *r = NULL;
-    o.fast_tol = 0.0;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    tun.fast_tol = 0.0;
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
     cm_rbf_options_init(&o);
+    cm_rbf_tuning_init(&tun);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     o.fast_sum = 2;
-    CHECK(cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r) == CM_ERR_ARGUMENT);
+    CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
     CHECK(r == NULL);
     /* the table: finer tolerances never give a lower order or a wider angle */
     int prev_n = 0;

@@ -1,0 +1,195 @@
+/* Evaluation of an iterative fit: compensated direct sums, or the r^3 treecode where n x m is
+ * large and a sampled check (after a pilot that may pick a cheaper treecode) shows its error
+ * within fast_eval_tol x max |data|. */
+#include "rbf_iter.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+
+/* fast_sum = -1 (auto): evaluation by the treecode from this many point-centre pairs */
+#define CM_RBF_FAST_EVAL_PAIRS 2e9
+/* samples for the a-posteriori error estimate of a fast evaluation, and the factor on the
+ * largest sampled error (the sampled max was within it of the true max on the real sets).
+ * The treecode's errors are spiky below its finest orders: over 32,768 of the two-body
+ * interior points at order 10, every 256-point subset found at least 1/6.4 of their
+ * largest error, every 1,024-point one 1/2.2 (RESULTS.md, RBF solvers); 1,024
+ * compensated sums cost ~1 % of a 10^6-point evaluation */
+#define CM_RBF_FAST_SAMPLES 1024
+#define CM_RBF_FAST_SAFETY 4.0
+/* relative rounding of one entry phi_ij = r2 sqrt(r2) (the differences, r2's three terms,
+ * the root and the product), so compensated sums of the rounded entries err by up to about
+ * this x eps sum_j |w_j| phi_ij against the true kernel */
+#define CM_RBF_PHI_ROUND 4.0
+
+/* Why compensated sums for evaluation too: the weights of large or spread sets are large
+ * (sum |w| of 1e6..1e7 x max |d| on the bracket and on two bodies far apart), and plain sums
+ * then reproduce the data at the centres only to eps sum |w_j phi_ij| (bracket, m = 59k:
+ * 1e-7 of the range, although the residual is 6e-11). The dense path keeps plain sums: its
+ * callers at m <= ~3,500 do not see that floor, and it is 2.4x faster. */
+/* Evaluation by the treecode if its error can be shown to be within fast_eval_tol x max
+ * |data|: the order is chosen from sum_j |w_j| phi_ij at a few of the points (the scale of
+ * its bound, which the cancellation of the weights makes 1e4..1e7 x the result), then the
+ * fast result is checked against compensated direct sums at CM_RBF_FAST_SAMPLES points.
+ * Those are exact for the rounded entries phi_ij, not for the true ones, so they err by up
+ * to about CM_RBF_PHI_ROUND eps sum_j |w_j| phi_ij themselves: 7.8e-9 of max |d| on two
+ * bodies at 1e6 points against a long-double reference, where the order-14 treecode errs by
+ * 1.0e-9 (RESULTS.md, RBF solvers). The check cannot see below
+ * that, and the fallback is no better, so the fast sum is accepted within the larger of
+ * fast_eval_tol x max |data| and that floor; eval_error says which was met.
+ *
+ * The bound is relative to sum |w| phi at each point and is often far from the error on
+ * real weights: on two bodies far apart (121k centres, 10^6 points) the row for 1e-12
+ * erred no more than the finest (1.0e-16 x max sum |w| phi, the rounding floor) at 0.66x
+ * its CPU, while on the bracket (60.6k) only the finest met the floor (RESULTS.md, RBF
+ * solvers). So the row for CM_RBF_PILOT_GAIN x the asked tolerance is tried
+ * first on a pilot, every k-th batch of targets (CM_RBF_PILOT_BATCHES of them: the same
+ * batches as the whole sum, so the same clusters go by their proxies), and taken if its
+ * error at CM_RBF_PILOT_PER points of each batch passes the check's test; the check itself
+ * still decides, and a coarser row that fails it is followed by the asked one before
+ * direct sums. The pilot costs about CM_RBF_PILOT_BATCHES / (n / 192) of a coarse sum
+ * (bracket, 211k points: 3 %). 1 if out holds the accepted fast result; 0 (out undefined)
+ * if direct sums must do it. */
+#define CM_RBF_PILOT_GAIN 1e2
+#define CM_RBF_PILOT_BATCHES 32
+#define CM_RBF_PILOT_PER 16
+
+/* The treecode sums of all components at the targets of every stride-th batch (1: all). */
+static int tree_sum_all(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
+                        size_t stride, double *out, int threads)
+{
+    const size_t m = r->m, nc = (size_t)r->ncomp;
+    for (size_t g = 0; g < nc; g += 4) {
+        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+        if (cm_rbf_tree_sum_targets(t, tg, stride, r->w + g * m, gc, out + g, nc, threads))
+            return -1;
+    }
+    return 0;
+}
+
+/* The largest error of the fast sums out (n x nc) against compensated direct sums at
+ * `samples` of the targets (the indices idx, or NULL: spread over them), over all the
+ * components. */
+static double check_all(const cm_rbf *r, const cm_rbf_tree *t, size_t n, const double *p,
+                        const double *out, size_t samples, const size_t *idx, int threads)
+{
+    const size_t m = r->m, nc = (size_t)r->ncomp;
+    double err = 0.0;
+    for (size_t g = 0; g < nc; g += 4) {
+        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+        double e;
+        cm_rbf_tree_check(t, r->w + g * m, gc, n, p, n, out + g, nc, samples, idx, &e, NULL,
+                          threads);
+        err = fmax(err, e);
+    }
+    return err;
+}
+
+/* 1 if the treecode t passes the pilot: its largest error at the pilot's points, x
+ * CM_RBF_FAST_SAFETY, is within accept. out: n x nc scratch. */
+static int pilot_passes(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
+                        size_t n, const double *p, double accept, double *out, int threads)
+{
+    size_t *idx = malloc(CM_RBF_PILOT_BATCHES * CM_RBF_PILOT_PER * sizeof *idx), stride = 1;
+    if (!idx) return 0;
+    const size_t np =
+        cm_rbf_tree_targets_pilot(tg, CM_RBF_PILOT_BATCHES, CM_RBF_PILOT_PER, idx, &stride);
+    const int pass = tree_sum_all(r, t, tg, stride, out, threads) == 0 &&
+                     CM_RBF_FAST_SAFETY * check_all(r, t, n, p, out, np, idx, threads) <= accept;
+    free(idx);
+    return pass;
+}
+
+static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads)
+{
+    cm_rbf_iter *it = r->iter;
+    const size_t m = r->m, nc = (size_t)r->ncomp;
+    const double target = r->tun.fast_eval_tol * it->fmax;
+    it->eval_fast = 0;
+    it->eval_error = 0.0;
+    if (!(target > 0.0)) return 0;
+    const size_t ns = n < 64 ? n : 64;
+    double *sp = malloc(3 * ns * sizeof *sp), *aw = malloc(nc * m * sizeof *aw);
+    double *ab = malloc(ns * nc * sizeof *ab);
+    int ok = sp && aw && ab;
+    double smax = 0.0;
+    if (ok) {
+        for (size_t k = 0; k < ns; ++k)
+            for (int d = 0; d < 3; ++d)
+                sp[(size_t)d * ns + k] = p[(size_t)d * n + (size_t)((double)k * (double)n / (double)ns)];
+        for (size_t j = 0; j < nc * m; ++j) aw[j] = fabs(r->w[j]);
+        for (size_t g = 0; g < nc; g += 4) {
+            int gc = nc - g < 4 ? (int)(nc - g) : 4;
+            cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw + g * m, gc, ns, sp, ns, ab + g,
+                              nc, threads);
+        }
+        for (size_t i = 0; i < ns * nc; ++i) smax = fmax(smax, ab[i]);
+    }
+    free(sp), free(aw), free(ab);
+    if (!ok) return 0;
+    /* what the direct fallback itself can promise (see above) */
+    const double accept = fmax(target, CM_RBF_PHI_ROUND * DBL_EPSILON * smax);
+    /* the row that should meet it with room for the estimate's factor; below the rounding
+     * of the finest row (about 1e-16 x sum |w| phi) the finest is asked for */
+    const double tau = fmax(accept / (smax * CM_RBF_FAST_SAFETY), CM_RBF_TREE_TOL_MIN);
+    int order, order_c;
+    double theta, theta_c;
+    cm_rbf_tree_params(tau, &order, &theta);
+    cm_rbf_tree_params(CM_RBF_PILOT_GAIN * tau, &order_c, &theta_c);
+    cm_rbf_tree_targets *tg = cm_rbf_tree_targets_create(n, p, n);
+    if (!tg) return 0;
+    /* the coarser row first if it passes the pilot (at the table's coarse end it is the
+     * same row) */
+    int coarse = order_c != order || theta_c != theta;
+    if (coarse) {
+        const cm_rbf_tree *t = cm_rbf_iterative_tree(r, order_c, theta_c);
+        coarse = t && pilot_passes(r, t, tg, n, p, accept, out, threads);
+    }
+    for (;; coarse = 0) {
+        const int o = coarse ? order_c : order;
+        const double th = coarse ? theta_c : theta;
+        const cm_rbf_tree *t = cm_rbf_iterative_tree(r, o, th);
+        if (!t || tree_sum_all(r, t, tg, 1, out, threads)) break;
+        const double err = check_all(r, t, n, p, out, CM_RBF_FAST_SAMPLES, NULL, threads);
+        it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
+        it->eval_fast = CM_RBF_FAST_SAFETY * err <= accept;
+        it->eval_order = o;
+        it->eval_theta = th;
+        if (it->eval_fast || !coarse) break;
+    }
+    cm_rbf_tree_targets_destroy(&tg);
+    return it->eval_fast;
+}
+
+int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
+                                   int threads)
+{
+    const int fs = r->opt.fast_sum;
+    if (fs == 1 || (fs < 0 && (double)n * (double)r->m >= CM_RBF_FAST_EVAL_PAIRS))
+        return evaluate_fast(r, n, p, out, threads);
+    r->iter->eval_fast = 0; /* eval_error stays that of the last evaluation that tried */
+    return 0;
+}
+
+void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax) { r->iter->fmax = fmax; }
+
+void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
+                               int threads)
+{
+    if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads)) return;
+    for (int g = 0; g < r->ncomp; g += 4) {
+        int nc = r->ncomp - g < 4 ? r->ncomp - g : 4;
+        cm_rbf_kernel_sum_acc(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
+                              (size_t)r->ncomp, threads);
+    }
+}
+
+
+void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats)
+{
+    if (!r->iter) return;
+    stats->eval_fast = r->iter->eval_fast;
+    stats->eval_error = r->iter->eval_error;
+    stats->eval_order = r->iter->eval_order;
+    stats->eval_theta = r->iter->eval_theta;
+}

@@ -1,0 +1,364 @@
+/* The two O(m^2) loops of the RBF core: kernel sums (evaluation, A*w, A*V) and assembly of
+ * the projected system ([SMB12 §3]). Both are written so that GCC vectorises
+ * them at -O3 (points in the inner loop, no reductions), and both are compiled for AVX-512,
+ * AVX2+FMA and baseline x86-64, chosen at run time: no global -march flag is needed. */
+#include "rbf_internal.h"
+#include "rbf_sum_isa.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+
+#define NB 16      /* points held in registers while streaming the centres */
+#define PB CM_RBF_SUM_PB /* points per parallel work item (a multiple of NB) */
+#define TILE 512   /* centres per tile: 7 x 512 doubles stay in L1 */
+
+/* log(r2 + tiny) keeps phi(0) = 0 without a branch: r2 = 0 gives 0 * (-690); merged
+ * centres are at least 1e-24 apart in r2, so the shift changes nothing else. */
+#define CM_TPS_TINY 1e-300
+
+/* log(x) for positive normal x, branch-free so that it vectorises (libm's log is a call
+ * that stops the vectoriser: the thin-plate kernel ran 20x slower than r^3 with it).
+ * x = 2^e f with f in [sqrt(1/2), sqrt(2)); log f = 2 atanh(s), s = (f-1)/(f+1), |s| < 0.172,
+ * by its series to s^21 (truncation < 1e-17); e ln 2 in two parts. Within 2 ulp of libm. */
+static inline __attribute__((always_inline)) double log_positive(double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    /* exponent as a double without an int64 -> double conversion: 2^52 + e, minus 2^52 */
+    uint64_t ebits = (bits >> 52) | UINT64_C(0x4330000000000000);
+    double e;
+    memcpy(&e, &ebits, sizeof e);
+    e -= 4503599627370496.0 + 1023.0;
+    uint64_t fbits = (bits & UINT64_C(0x000FFFFFFFFFFFFF)) | UINT64_C(0x3FF0000000000000);
+    double f;
+    memcpy(&f, &fbits, sizeof f);
+    const int big = f > 1.4142135623730951;
+    f = big ? 0.5 * f : f;
+    e = big ? e + 1.0 : e;
+    const double s = (f - 1.0) / (f + 1.0), z = s * s;
+    double p = 1.0 / 21.0;
+    p = p * z + 1.0 / 19.0;
+    p = p * z + 1.0 / 17.0;
+    p = p * z + 1.0 / 15.0;
+    p = p * z + 1.0 / 13.0;
+    p = p * z + 1.0 / 11.0;
+    p = p * z + 1.0 / 9.0;
+    p = p * z + 1.0 / 7.0;
+    p = p * z + 1.0 / 5.0;
+    p = p * z + 1.0 / 3.0;
+    const double ln2_hi = 6.93147180369123816490e-01, ln2_lo = 1.90821492927058770002e-10;
+    return e * ln2_hi + (e * ln2_lo + (2.0 * s + 2.0 * s * z * p));
+}
+
+static inline __attribute__((always_inline)) double phi_of_r2(const int kern, double r2)
+{
+    switch (kern) {
+    case CM_RBF_TRIHARMONIC: return r2 * sqrt(r2);
+    case CM_RBF_BIHARMONIC: return sqrt(r2);
+    default: return 0.5 * r2 * log_positive(r2 + CM_TPS_TINY);
+    }
+}
+
+/* Adds the contributions of centres [0, jn) to NB points. */
+static inline __attribute__((always_inline)) void tile_body(const int kern, const int dim,
+                                                            const int nc, const double *c,
+                                                            size_t ldc, const double *w,
+                                                            size_t ldw, size_t jn,
+                                                            const double *pt, double *acc)
+{
+    const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
+    double x[NB], y[NB], z[NB], a[4][NB];
+    for (int l = 0; l < NB; ++l) {
+        x[l] = pt[l];
+        y[l] = pt[PB + l];
+        z[l] = dim == 3 ? pt[2 * PB + l] : 0.0;
+        for (int q = 0; q < nc; ++q) a[q][l] = acc[q * PB + l];
+    }
+    for (size_t j = 0; j < jn; ++j) {
+        const double xj = cx[j], yj = cy[j], zj = dim == 3 ? cz[j] : 0.0;
+        double wj[4];
+        for (int q = 0; q < nc; ++q) wj[q] = w[q * ldw + j];
+        for (int l = 0; l < NB; ++l) {
+            double dx = x[l] - xj, dy = y[l] - yj;
+            double r2 = dx * dx + dy * dy;
+            if (dim == 3) {
+                double dz = z[l] - zj;
+                r2 += dz * dz;
+            }
+            double f = phi_of_r2(kern, r2);
+            for (int q = 0; q < nc; ++q) a[q][l] += wj[q] * f;
+        }
+    }
+    for (int l = 0; l < NB; ++l)
+        for (int q = 0; q < nc; ++q) acc[q * PB + l] = a[q][l];
+}
+
+/* All centres against one block of PB points (pt: dim x PB SoA, acc: nc x PB). Tiles of
+ * centres in order, so each point's sum has a fixed order. */
+static inline __attribute__((always_inline)) void block_body(const int kern, const int dim,
+                                                             const int nc, size_t m,
+                                                             const double *c, const double *w,
+                                                             const double *pt, double *acc)
+{
+    for (size_t t0 = 0; t0 < m; t0 += TILE) {
+        size_t jn = m - t0 < TILE ? m - t0 : TILE;
+        for (int b = 0; b < PB; b += NB)
+            tile_body(kern, dim, nc, c + t0, m, w + t0, m, jn, pt + b, acc + b);
+    }
+}
+
+/* One instantiation per (kernel, nc) so that the inner loop has constant trip counts. */
+#define CM_BLOCK_DISPATCH                                                                      \
+    switch (kern * 4 + (nc - 1)) {                                                             \
+    case 0: block_body(0, 3, 1, m, c, w, pt, acc); break;                                      \
+    case 1: block_body(0, 3, 2, m, c, w, pt, acc); break;                                      \
+    case 2: block_body(0, 3, 3, m, c, w, pt, acc); break;                                      \
+    case 3: block_body(0, 3, 4, m, c, w, pt, acc); break;                                      \
+    case 4: block_body(1, 3, 1, m, c, w, pt, acc); break;                                      \
+    case 5: block_body(1, 3, 2, m, c, w, pt, acc); break;                                      \
+    case 6: block_body(1, 3, 3, m, c, w, pt, acc); break;                                      \
+    case 7: block_body(1, 3, 4, m, c, w, pt, acc); break;                                      \
+    case 8: block_body(2, 2, 1, m, c, w, pt, acc); break;                                      \
+    case 9: block_body(2, 2, 2, m, c, w, pt, acc); break;                                      \
+    case 10: block_body(2, 2, 3, m, c, w, pt, acc); break;                                     \
+    default: block_body(2, 2, 4, m, c, w, pt, acc); break;                                     \
+    }
+
+typedef void (*block_fn)(int kern, int nc, size_t m, const double *c, const double *w,
+                         const double *pt, double *acc);
+
+static void block_generic(int kern, int nc, size_t m, const double *c, const double *w,
+                          const double *pt, double *acc)
+{
+    CM_BLOCK_DISPATCH
+}
+
+__attribute__((target("avx2,fma"))) static void block_avx2(int kern, int nc, size_t m,
+                                                            const double *c, const double *w,
+                                                            const double *pt, double *acc)
+{
+    CM_BLOCK_DISPATCH
+}
+
+__attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) static void
+block_avx512(int kern, int nc, size_t m, const double *c, const double *w, const double *pt,
+             double *acc)
+{
+    CM_BLOCK_DISPATCH
+}
+
+/* AVX-512 blocks for r^3 in 3D by hand (rbf_sum_avx512.c), the other kernels as compiled */
+static void block_avx512_hand(int kern, int nc, size_t m, const double *c, const double *w,
+                              const double *pt, double *acc)
+{
+    if (kern == (int)CM_RBF_TRIHARMONIC) cm_rbf_r3_block_avx512(nc, m, c, w, pt, acc);
+    else block_avx512(kern, nc, m, c, w, pt, acc);
+}
+
+int cm_rbf_isa_supported(cm_rbf_isa isa)
+{
+    switch (isa) {
+    case CM_RBF_ISA_AUTO:
+    case CM_RBF_ISA_GENERIC: return 1;
+    case CM_RBF_ISA_AVX2: return cm_rbf_cpu_avx2();
+    default: return cm_rbf_cpu_avx512();
+    }
+}
+
+cm_rbf_isa cm_rbf_isa_auto(void)
+{
+    if (cm_rbf_cpu_avx512()) return CM_RBF_ISA_AVX512;
+    if (cm_rbf_cpu_avx2()) return CM_RBF_ISA_AVX2;
+    return CM_RBF_ISA_GENERIC;
+}
+
+static block_fn pick_block(cm_rbf_isa isa)
+{
+    if (isa == CM_RBF_ISA_AUTO) isa = cm_rbf_isa_auto();
+    switch (isa) {
+    case CM_RBF_ISA_AVX512: return block_avx512_hand;
+    case CM_RBF_ISA_AVX512_AUTOVEC: return block_avx512;
+    case CM_RBF_ISA_AVX2: return block_avx2;
+    default: return block_generic;
+    }
+}
+
+int cm_rbf_threads(const cm_context *ctx)
+{
+    /* the dense kernels have work for every thread the context allows */
+    return cm_context_threads_for(ctx, SIZE_MAX, 1);
+}
+
+void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                       const double *w, int nc, size_t n, const double *p, size_t ldp,
+                       double *out, size_t ldo, int threads)
+{
+    cm_rbf_kernel_sum_isa(CM_RBF_ISA_AUTO, kernel, dim, m, c, w, nc, n, p, ldp, out, ldo,
+                          threads);
+}
+
+void cm_rbf_kernel_sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m,
+                           const double *c, const double *w, int nc, size_t n, const double *p,
+                           size_t ldp, double *out, size_t ldo, int threads)
+{
+    const block_fn fn = pick_block(isa);
+    const long nblocks = (long)((n + PB - 1) / PB);
+    const int kern = (int)kernel;
+    const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
+    /* the r^3 self product computes each entry once for both rows (its sums come in parts) */
+    if (fn == block_avx512_hand && kernel == CM_RBF_TRIHARMONIC && dim == 3 && p == c &&
+        ldp == m && n == m && m >= CM_RBF_SELF_MIN_M &&
+        !cm_rbf_r3_self_avx512(nc, m, c, w, NULL, out, ldo, parallel ? threads : 1))
+        return;
+#pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
+    for (long b = 0; b < nblocks; ++b) {
+        double pt[3 * PB], acc[4 * PB];
+        const size_t i0 = (size_t)b * PB;
+        const size_t cnt = n - i0 < PB ? n - i0 : PB;
+        for (int d = 0; d < 3; ++d) {
+            for (size_t l = 0; l < PB; ++l) {
+                /* pad the last block with its last point; the padding is not written out */
+                size_t i = l < cnt ? i0 + l : i0 + cnt - 1;
+                pt[d * PB + l] = d < dim ? p[d * ldp + i] : 0.0;
+            }
+        }
+        memset(acc, 0, sizeof acc);
+        fn(kern, nc, m, c, w, pt, acc);
+        for (size_t l = 0; l < cnt; ++l)
+            for (int q = 0; q < nc; ++q) out[(i0 + l) * ldo + (size_t)q] = acc[q * PB + l];
+    }
+}
+
+/* ---- assembly of the projected matrix ---- */
+
+/* out[t] = sign * (A - V Z' - Z V')(a, b0 + t) for t < count (centre indices): one stretch
+ * of a row or column of the symmetric projected matrix. */
+static inline __attribute__((always_inline)) void stretch_body(const int kern, const int dim,
+                                                               size_t m, const double *c,
+                                                               const double *v, const double *z,
+                                                               double sign, size_t a, size_t b0,
+                                                               size_t count, double *out0)
+{
+    const double *restrict cx = c, *restrict cy = c + m, *restrict cz = c + 2 * m;
+    const double xa = cx[a], ya = cy[a], za = dim == 3 ? cz[a] : 0.0;
+    /* the k = dim + 1 columns of V and Z spelled out: a loop over them here would stop
+     * GCC from vectorising the loop over b */
+    const double *restrict v0 = v, *restrict v1 = v + m, *restrict v2 = v + 2 * m;
+    const double *restrict v3 = dim == 3 ? v + 3 * m : v;
+    const double *restrict z0 = z, *restrict z1 = z + m, *restrict z2 = z + 2 * m;
+    const double *restrict z3 = dim == 3 ? z + 3 * m : z;
+    const double v0a = v0[a], v1a = v1[a], v2a = v2[a], v3a = v3[a];
+    const double z0a = z0[a], z1a = z1[a], z2a = z2[a], z3a = z3[a];
+    double *restrict out = out0 - b0;
+    /* out never overlaps the inputs; without this GCC gives up on more than 10 run-time
+     * alias checks and leaves the loop scalar */
+#pragma GCC ivdep
+    for (size_t b = b0; b < b0 + count; ++b) {
+        double dx = cx[b] - xa, dy = cy[b] - ya;
+        double r2 = dx * dx + dy * dy;
+        if (dim == 3) {
+            double dz = cz[b] - za;
+            r2 += dz * dz;
+        }
+        double e = phi_of_r2(kern, r2);
+        e -= v0[b] * z0a + z0[b] * v0a;
+        e -= v1[b] * z1a + z1[b] * v1a;
+        e -= v2[b] * z2a + z2[b] * v2a;
+        if (dim == 3) e -= v3[b] * z3a + z3[b] * v3a;
+        out[b] = sign * e;
+    }
+}
+
+#define CM_STRETCH_DISPATCH                                                                    \
+    switch (kern) {                                                                            \
+    case 0: stretch_body(0, 3, m, c, v, z, sign, a, b0, count, out); break;                   \
+    case 1: stretch_body(1, 3, m, c, v, z, sign, a, b0, count, out); break;                   \
+    default: stretch_body(2, 2, m, c, v, z, sign, a, b0, count, out); break;                  \
+    }
+
+typedef void (*stretch_fn)(int kern, size_t m, const double *c, const double *v,
+                           const double *z, double sign, size_t a, size_t b0, size_t count,
+                           double *out);
+
+static void stretch_generic(int kern, size_t m, const double *c, const double *v,
+                            const double *z, double sign, size_t a, size_t b0, size_t count,
+                            double *out)
+{
+    CM_STRETCH_DISPATCH
+}
+
+__attribute__((target("avx2,fma"))) static void
+stretch_avx2(int kern, size_t m, const double *c, const double *v, const double *z, double sign,
+             size_t a, size_t b0, size_t count, double *out)
+{
+    CM_STRETCH_DISPATCH
+}
+
+__attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) static void
+stretch_avx512(int kern, size_t m, const double *c, const double *v, const double *z,
+               double sign, size_t a, size_t b0, size_t count, double *out)
+{
+    CM_STRETCH_DISPATCH
+}
+
+static stretch_fn pick_stretch(void)
+{
+#if defined(__x86_64__) && defined(__GNUC__)
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+        __builtin_cpu_supports("avx512vl"))
+        return stretch_avx512;
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return stretch_avx2;
+#endif
+    return stretch_generic;
+}
+
+/* Rectangular full packed storage (LAPACK's RFP, TRANSR = 'N', UPLO = 'L') of the n x n
+ * lower triangle: half the memory of full storage, and dpftrf factors it with the same
+ * BLAS-3 calls as dpotrf. Column col of the RFP array (n even: n/2 columns of n + 1;
+ * n odd: (n + 1)/2 columns of n) holds a stretch of row (half + head - 1) of the trailing
+ * triangle (head entries, head = col + 1 for n even, col for n odd), then column col of the
+ * leading block from the diagonal down. Every RFP column has the same length, so a static
+ * schedule over them is balanced. */
+void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                               int k, const double *v, const double *z, double sign,
+                               double *rfp, int threads)
+{
+    const stretch_fn fn = pick_stretch();
+    const size_t n = m - (size_t)k, kk = (size_t)k;
+    const int even = n % 2 == 0;
+    const size_t half = even ? n / 2 : (n + 1) / 2, lda = even ? n + 1 : n;
+    const int kern = (int)kernel;
+    (void)dim;
+    const int parallel = (double)n * (double)n > 2.0 * CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
+#pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
+    for (long lc = 0; lc < (long)half; ++lc) {
+        const size_t col = (size_t)lc, head = even ? col + 1 : col;
+        double *out = rfp + col * lda;
+        if (head > 0) fn(kern, m, c, v, z, sign, kk + half + head - 1, kk + half, head, out);
+        fn(kern, m, c, v, z, sign, kk + col, kk + col, n - col, out + head);
+    }
+}
+
+const char *cm_rbf_kernel_name(cm_rbf_kernel k)
+{
+    switch (k) {
+    case CM_RBF_TRIHARMONIC: return "triharmonic";
+    case CM_RBF_BIHARMONIC: return "biharmonic";
+    case CM_RBF_THIN_PLATE: return "thin-plate";
+    }
+    return "unknown";
+}
+
+/* Kernel sums for any number of components, four at a time. */
+void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
+                           const double *p, size_t ldp, double *out, int threads)
+{
+    for (int g = 0; g < ncomp; g += 4) {
+        int nc = ncomp - g < 4 ? ncomp - g : 4;
+        cm_rbf_kernel_sum(r->kernel, r->dim, r->m, r->c, w + (size_t)g * r->m, nc, n, p, ldp,
+                          out + g, (size_t)ncomp, threads);
+    }
+}
