@@ -77,8 +77,9 @@ static cm_status topology_error(cm_context *ctx, const cm_topology_problem *why)
                         why->n_cells, why->n_inst);
     case CM_TOPOLOGY_BAD_FACE:
         if (why->n < 0)
-            return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_boundary_create: cell %zu: face %d has more than %d nodes",
-                            why->cell, why->face, CM_TOPOLOGY_MAX_FACE_NODES);
+            return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                            "cm_mesh_boundary_create: cell %zu: face %d has more than %d nodes", why->cell,
+                            why->face, CM_TOPOLOGY_MAX_FACE_NODES);
         return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_boundary_create: cell %zu: face %d has %d nodes", why->cell,
                         why->face, why->n);
     case CM_TOPOLOGY_BAD_NODE:

@@ -89,8 +89,8 @@ static cm_status topology_fault(cm_context *ctx, const cm_topology *t, const cm_
                         (size_t)t->inst_cell[third]);
     switch (why->what) {
     case CM_TOPOLOGY_BAD_FACE:
-        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: cell %zu: face %d has %s nodes for a polyMesh", why->cell,
-                        why->face, why->n < 0 ? "too many" : "fewer than 3");
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: cell %zu: face %d has %s nodes for a polyMesh",
+                        why->cell, why->face, why->n < 0 ? "too many" : "fewer than 3");
     case CM_TOPOLOGY_BAD_NODE:
         return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_write: cell %zu: node %lld out of range (%zu nodes)", why->cell,
                         (long long)why->node, why->n_nodes);
@@ -118,7 +118,8 @@ cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out
         if (cm_cell_type_info((cm_cell_type)mesh->type[c])->dim == 3) ++nvol;
     if (nvol == 0) {
         cm_foam_poly_release(&p);
-        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: an OpenFOAM polyMesh needs volume cells; the mesh has none");
+        return cm_error(ctx, CM_ERR_ARGUMENT,
+                        "cm_mesh_write: an OpenFOAM polyMesh needs volume cells; the mesh has none");
     }
     cm_topology_problem why;
     s = cm_topology_build(mesh, MAX_FACE, cm_context_threads_for(ctx, mesh->n_cells, 1), &t, &why);
