@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Figure 4 of [CMLS]: time against the number of centres / samples, global
+# Figure 4 of the MLS paper [CMLS]: time against the number of centres / samples, global
 # dense RBF (bench_rbf: fit + evaluation at 10 m points; the triharmonic kernel, whose dense
 # Cholesky costs the same as the biharmonic one) next to the MLS deformation (cadmorph deform
 # on the sphere mesh of make_cases.py: sampling, shape functions, CHOLMOD factorisation, one
