@@ -24,4 +24,18 @@ int cm_blas_callers(int want);
  * thread fills; leave it 0 where threads fill their own parts). Freed with free(). */
 void *cm_alloc_large(size_t bytes, int populate);
 
+/* PETSc builds: a nonzero PETSc error code as a status (CM_ERR_NOMEM for PETSc's out of
+ * memory, else CM_ERR_INTERNAL) with PETSc's message: "<who> (PETSc): <what> failed: ...". */
+cm_status cm_parallel_petsc_error(cm_context *ctx, int code, const char *who, const char *what);
+/* Runs a PETSc call in a function that has a cm_context *ctx, a cm_status st and a label
+ * done: on an error code, st gets the status and control goes to done. */
+#define CM_PETSC_TRY(who, call)                                          \
+    do {                                                                 \
+        int cm_e_ = (int)(call);                                         \
+        if (cm_e_) {                                                     \
+            st = cm_parallel_petsc_error(ctx, cm_e_, who, #call);        \
+            goto done;                                                   \
+        }                                                                \
+    } while (0)
+
 #endif

@@ -3,6 +3,7 @@
  * gather of plain records that a distributed study uses. The distributed RBF solver
  * (rbf/petsc/rbf_petsc.c) builds on it. */
 #include "cadmorph/parallel.h"
+#include "cm_platform.h"
 
 #include <petscsys.h>
 #include <stdlib.h>
@@ -12,23 +13,16 @@ static int g_initialised_here; /* we called PetscInitialize, so we finalise */
 
 int cm_parallel_available(void) { return 1; }
 
-static cm_status petsc_fail(cm_context *ctx, PetscErrorCode e, const char *what)
+cm_status cm_parallel_petsc_error(cm_context *ctx, int code, const char *who, const char *what)
 {
     const char *text = NULL;
-    PetscErrorMessage((int)e, &text, NULL);
-    return cm_error(ctx, e == PETSC_ERR_MEM ? CM_ERR_NOMEM : CM_ERR_INTERNAL,
-                    "cm_parallel (PETSc): %s failed: %s (PETSc error %d)", what,
-                    text ? text : "unknown error", (int)e);
+    PetscErrorMessage(code, &text, NULL);
+    return cm_error(ctx, code == PETSC_ERR_MEM ? CM_ERR_NOMEM : CM_ERR_INTERNAL,
+                    "%s (PETSc): %s failed: %s (PETSc error %d)", who, what,
+                    text ? text : "unknown error", code);
 }
 
-#define P(call)                                          \
-    do {                                                 \
-        PetscErrorCode e_ = (call);                      \
-        if (e_) {                                        \
-            st = petsc_fail(ctx, e_, #call);             \
-            goto done;                                   \
-        }                                                \
-    } while (0)
+#define P(call) CM_PETSC_TRY("cm_parallel", call)
 
 cm_status cm_parallel_initialize(cm_context *ctx)
 {

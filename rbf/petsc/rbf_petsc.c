@@ -58,23 +58,7 @@ struct cm_rbf_petsc {
     int matvecs;       /* products with A since the solve began */
 };
 
-static cm_status petsc_fail(cm_context *ctx, PetscErrorCode e, const char *what)
-{
-    const char *text = NULL;
-    PetscErrorMessage((int)e, &text, NULL);
-    return cm_error(ctx, e == PETSC_ERR_MEM ? CM_ERR_NOMEM : CM_ERR_INTERNAL,
-                    "cm_rbf (PETSc): %s failed: %s (PETSc error %d)", what,
-                    text ? text : "unknown error", (int)e);
-}
-
-#define P(call)                                          \
-    do {                                                 \
-        PetscErrorCode e_ = (call);                      \
-        if (e_) {                                        \
-            st = petsc_fail(ctx, e_, #call);             \
-            goto done;                                   \
-        }                                                \
-    } while (0)
+#define P(call) CM_PETSC_TRY("cm_rbf", call)
 
 /* v -= Q1 (Q1' v) on every component, twice, as project() in iterative/rbf_fgmres.c. */
 static PetscErrorCode project(cm_rbf_petsc *ps, Vec v)
