@@ -13,8 +13,9 @@ all: build
 setup:
 	bash scripts/setup.sh
 
+# benchmarks off here even where `make bench` turned them on in the same build directory
 build: setup
-	cmake -S . -B $(BUILD) $(CMAKE_FLAGS)
+	cmake -S . -B $(BUILD) $(CMAKE_FLAGS) -DCADMORPH_BUILD_BENCHMARKS=OFF
 	cmake --build $(BUILD) -j $(JOBS)
 
 demo: build
@@ -28,6 +29,7 @@ test-all: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
 
 # the benchmarks are built on request only: the same build directory, configured with them
+# (benchmarks/README.md)
 bench: setup
 	cmake -S . -B $(BUILD) $(CMAKE_FLAGS) -DCADMORPH_BUILD_BENCHMARKS=ON
 	cmake --build $(BUILD) -j $(JOBS)
