@@ -12,3 +12,7 @@ add_library(cm_mls STATIC
 target_link_libraries(cm_mls
   PUBLIC cm_mesh cm_core
   PRIVATE cm_warnings cm_posix OpenMP::OpenMP_C cm_lapack cm_suitesparse ${MATH_LIBRARY})
+# white-box access for tests (mls_internal.h): the module's folder on the include path
+add_library(cm_mls_internal INTERFACE)
+target_include_directories(cm_mls_internal INTERFACE ${CMAKE_CURRENT_LIST_DIR})
+target_link_libraries(cm_mls_internal INTERFACE cm_mls)

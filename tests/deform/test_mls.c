@@ -4,7 +4,7 @@
  * plate, the warp method). Meshes are built in code. */
 #include "cadmorph/mls.h"
 #include "cadmorph/warp.h"
-#include "deform/mls_internal.h"
+#include "mls_internal.h"
 #include "test_rng.h"
 #include "test_util.h"
 

@@ -1,6 +1,6 @@
 /* libFuzzer driver for the STEP pre-scan (cad/step_scan.c): linear, constant memory, one-line
  * messages, whatever the bytes. */
-#include "cad/step_scan.h"
+#include "step_scan.h"
 
 #include <stdint.h>
 #include <stdlib.h>

@@ -8,7 +8,7 @@
  * none of TetGen's printing and none of the parent's buffered output reaches stdout twice;
  * OpenMP's thread pool works before and after the forks. */
 #include "test_util.h"
-#include "meshgen/tetgen_run.h"
+#include "tetgen_run.h"
 
 #include <omp.h>
 #include <stdio.h>

@@ -6,7 +6,7 @@
  * points outside every tet. argv[2]/staten/mixed.msh comes from warp_staten.py setup. */
 #include "cadmorph/warp.h"
 #include "test_util.h"
-#include "volume/warp_method.h"
+#include "warp_method.h"
 #include "test_mesh.h"
 
 #include <math.h>

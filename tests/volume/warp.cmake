@@ -23,5 +23,5 @@ set_tests_properties(warp_sphere_scipy PROPERTIES
 add_test(NAME warp_staten_setup
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/warp_staten.py setup ${CM_TEST_WORK})
 set_tests_properties(warp_staten_setup PROPERTIES FIXTURES_SETUP warp_staten LABELS "unit;volume")
-cm_add_unit_test(test_warp_staten test_warp_staten.c LIBS cm_volume LABELS volume)
+cm_add_unit_test(test_warp_staten test_warp_staten.c LIBS cm_volume_internal LABELS volume)
 set_tests_properties(test_warp_staten PROPERTIES FIXTURES_REQUIRED warp_staten)
