@@ -1,0 +1,21 @@
+"""cadmorph: morph simulation meshes after a CAD edit, from Python.
+
+A thin layer over libcadmorph's C API (through cffi, ABI mode): no algorithm is written in
+Python, arrays are NumPy views onto the library's memory where its layout allows, and the
+library's status becomes an exception carrying its message.
+
+    import cadmorph
+    mesh = cadmorph.read_mesh("M0.msh")
+    print(cadmorph.quality(mesh).min_sj, mesh.points.shape)
+"""
+from ._capi import ffi as _ffi, lib as _lib
+from .errors import (BadInputError, CadmorphWarning, Error, MismatchError, RejectedError,
+                     ResourceError)
+from .mesh import Mesh, read_mesh, write_mesh
+from .quality import Quality, quality
+
+__version__: str = _ffi.string(_lib.cm_version()).decode()
+
+__all__ = ["Error", "BadInputError", "MismatchError", "RejectedError", "ResourceError",
+           "CadmorphWarning", "Mesh", "read_mesh", "write_mesh", "Quality", "quality",
+           "__version__"]

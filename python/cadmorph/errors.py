@@ -1,0 +1,89 @@
+"""The library's status as Python exceptions, and the context every call runs in.
+
+A cm_status below 0 becomes an exception of the class its code maps to, carrying the status
+and the library's message (which names the file and the place); a status above 0 (a complete
+result with something odd about it) becomes a CadmorphWarning.
+"""
+import warnings
+
+from ._capi import ffi, lib
+
+
+class Error(Exception):
+    """An error reported by libcadmorph.
+
+    Attributes:
+        status: the library's cm_status code (an int below 0).
+        status_name: its short fixed name, e.g. "format error".
+        message: the library's message, e.g. "cm_mesh_read: M.msh:12: expected ...".
+    """
+
+    def __init__(self, status: int, message: str) -> None:
+        self.status: int = status
+        self.status_name: str = ffi.string(lib.cm_status_name(status)).decode()
+        self.message: str = message
+        super().__init__(message or self.status_name)
+
+
+class BadInputError(Error):
+    """The input is bad: a file that cannot be read or is malformed, valid input cadmorph
+    does not handle, a CAD or numeric failure on it (exit code 2 of the CLI)."""
+
+
+class MismatchError(BadInputError):
+    """Inputs that do not belong together: a mesh and a geometry, G and G'."""
+
+
+class RejectedError(Error):
+    """A result refused by a quality guard (exit code 3 of the CLI)."""
+
+
+class ResourceError(Error):
+    """Out of memory, or a request beyond what the machine can hold (exit code 4)."""
+
+
+class CadmorphWarning(UserWarning):
+    """A complete result about which the library reports something odd."""
+
+
+def error_class(status: int) -> type:
+    """The exception class of an error status (< 0): the CLI's exit codes, by class."""
+    if status == lib.CM_ERR_MISMATCH:
+        return MismatchError
+    if status == lib.CM_ERR_REJECTED:
+        return RejectedError
+    if status == lib.CM_ERR_NOMEM:
+        return ResourceError
+    if lib.cm_status_is_input_error(status):
+        return BadInputError
+    return Error  # CM_ERR_ARGUMENT, CM_ERR_INTERNAL: a bug here or in the library
+
+
+class Context:
+    """A cm_context for one call (or one object's calls): threads, and the message of the
+    last error. Use `check(status)` after each call."""
+
+    def __init__(self, threads: int = 0) -> None:
+        p = ffi.new("cm_context *[1]")
+        s = lib.cm_context_create(p)
+        if s != lib.CM_OK:
+            raise ResourceError(s, "cm_context_create failed")
+        self.ptr = ffi.gc(p[0], _destroy_context)
+        if threads:
+            lib.cm_context_set_threads(self.ptr, int(threads))
+
+    def message(self) -> str:
+        """The library's message of the last error or warning ("" if none)."""
+        return ffi.string(lib.cm_context_message(self.ptr)).decode("utf-8", "replace")
+
+    def check(self, status: int) -> int:
+        """Raises the exception of an error status, warns on a warning, returns status."""
+        if status < 0:
+            raise error_class(status)(status, self.message())
+        if status > 0:
+            warnings.warn(self.message(), CadmorphWarning, stacklevel=3)
+        return status
+
+
+def _destroy_context(ptr) -> None:
+    lib.cm_context_destroy(ffi.new("cm_context *[1]", [ptr]))

@@ -1,0 +1,219 @@
+"""Mesh: a cm_mesh owned by Python, its arrays as NumPy views; read_mesh and write_mesh.
+
+Views (points, fields, connectivity) point into the library's memory. Each holds, through
+its `.base`, the owner of the cm_mesh, so the memory lives while any view does, also after
+Mesh.close() or after the Mesh is gone; nothing in this package resizes a mesh, so a view
+never dangles.
+"""
+import os
+from typing import Dict, List, Optional, Tuple, Union
+
+import numpy as np
+
+from ._capi import ffi, lib
+from .errors import Context
+
+PathLike = Union[str, bytes, "os.PathLike[str]"]
+
+_CELL_NAMES = [ffi.string(lib.cm_cell_type_info(t).name).decode()
+               for t in range(lib.CM_CELL_TYPE_COUNT)]
+_CELL_NODES = [lib.cm_cell_type_info(t).nodes for t in range(lib.CM_CELL_TYPE_COUNT)]
+
+
+class _View:
+    """The base of an array onto library memory: holds the memory's owner."""
+
+    def __init__(self, owner, address: int, shape: Tuple[int, ...], typestr: str,
+                 writable: bool) -> None:
+        self.owner = owner
+        self.__array_interface__ = {"shape": shape, "typestr": typestr, "version": 3,
+                                    "data": (address, not writable)}
+
+
+def _array(owner, ptr, shape: Tuple[int, ...], dtype, writable: bool = True) -> np.ndarray:
+    dtype = np.dtype(dtype)
+    if ptr == ffi.NULL or 0 in shape:
+        a = np.zeros(shape, dtype)
+        a.flags.writeable = writable
+        return a
+    address = int(ffi.cast("uintptr_t", ptr))
+    return np.asarray(_View(owner, address, shape, dtype.str, writable))
+
+
+def _path(path: PathLike, what: str) -> bytes:
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError("%s: a path (str, bytes or os.PathLike), not %s"
+                        % (what, type(path).__name__))
+    b = os.fsencode(path)
+    if not b or b"\0" in b:
+        raise ValueError("%s: an empty path or one with a NUL byte: %r" % (what, path))
+    return b
+
+
+def _destroy_mesh(ptr) -> None:
+    lib.cm_mesh_destroy(ffi.new("cm_mesh *[1]", [ptr]))
+
+
+class Mesh:
+    """A mixed-cell mesh held by libcadmorph (a cm_mesh), as read by read_mesh.
+
+    Node order inside a cell is VTK's for every type; node indices are 0-based. The arrays
+    are views onto the library's memory (see the module's docstring); `close()` lets the
+    memory go once no view is left.
+    """
+
+    def __init__(self, _owner) -> None:
+        """Not for users: a Mesh comes from read_mesh."""
+        self._owner = _owner
+
+    @property
+    def _ptr(self):
+        if self._owner is None:
+            raise ValueError("cadmorph.Mesh: the mesh is closed")
+        return self._owner
+
+    def close(self) -> None:
+        """Drops this object's hold on the cm_mesh; it is freed when no view holds it."""
+        self._owner = None
+
+    def __enter__(self) -> "Mesh":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    @property
+    def closed(self) -> bool:
+        """True after close()."""
+        return self._owner is None
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of nodes."""
+        return int(self._ptr.n_nodes)
+
+    @property
+    def n_cells(self) -> int:
+        """Number of elements of every dimension (volume cells, faces, edges, points)."""
+        return int(self._ptr.n_cells)
+
+    @property
+    def points(self) -> np.ndarray:
+        """Node coordinates: (n_nodes, 3) float64, a writable view onto the mesh (no copy):
+        writing to it moves the nodes that write_mesh and quality see."""
+        m = self._ptr
+        return _array(m, m.xyz, (int(m.n_nodes), 3), np.float64)
+
+    def _cell_arrays(self) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        m = self._ptr
+        n = int(m.n_cells)
+        types = _array(m, m.type, (n,), np.uint8, writable=False)
+        offset = _array(m, m.offset, (n + 1,), np.int64, writable=False)
+        conn = _array(m, m.conn, (int(offset[-1]) if n else 0,), np.int64, writable=False)
+        return types, offset, conn
+
+    @property
+    def cell_types(self) -> List[str]:
+        """The type name of each element in file order ("tet4", "hex8", "tri3", ...)."""
+        return [_CELL_NAMES[t] for t in self._cell_arrays()[0]]
+
+    @property
+    def cells(self) -> List[Tuple[str, Union[np.ndarray, List[np.ndarray]]]]:
+        """The elements in file order, one block per run of consecutive elements of one type:
+        a list of (type name, array). For fixed-size types the array is (k, nodes) int64, a
+        read-only view onto the mesh's connectivity (the library stores every element's
+        nodes one after the other, so a run is dense; no copy). For "polygon" and
+        "polyhedron" it is a list of k 1-D int64 copies: a polygon's nodes in order, a
+        polyhedron's face stream (nf, n0, nodes of face 0, n1, ...)."""
+        types, offset, conn = self._cell_arrays()
+        if len(types) == 0:
+            return []
+        starts = np.flatnonzero(np.diff(types.astype(np.int16))) + 1
+        bounds = np.concatenate(([0], starts, [len(types)]))
+        blocks = []
+        for a, b in zip(bounds[:-1], bounds[1:]):
+            t = int(types[a])
+            nodes = _CELL_NODES[t]
+            if nodes > 0:
+                block = conn[offset[a]:offset[b]].reshape(b - a, nodes)
+            else:
+                block = [conn[offset[c]:offset[c + 1]].copy() for c in range(a, b)]
+            blocks.append((_CELL_NAMES[t], block))
+        return blocks
+
+    def _field_dict(self, location: int, count: int) -> Dict[str, np.ndarray]:
+        m = self._ptr
+        out = {}
+        for i in range(int(m.n_fields)):
+            f = m.fields[i]
+            if f.location != location:
+                continue
+            shape = (count,) if f.components == 1 else (count, int(f.components))
+            out[ffi.string(f.name).decode("utf-8", "replace")] = _array(m, f.data, shape,
+                                                                         np.float64)
+        return out
+
+    @property
+    def point_data(self) -> Dict[str, np.ndarray]:
+        """Per-node fields by name: (n_nodes,) or (n_nodes, components) float64 views."""
+        return self._field_dict(lib.CM_FIELD_NODE, self.n_nodes)
+
+    @property
+    def cell_data(self) -> Dict[str, np.ndarray]:
+        """Per-element fields by name: (n_cells,) or (n_cells, components) float64 views,
+        over every element in file order (as cells, concatenated)."""
+        return self._field_dict(lib.CM_FIELD_CELL, self.n_cells)
+
+    @property
+    def groups(self) -> List[Tuple[int, int, str]]:
+        """Named physical groups as (dim, tag, name)."""
+        m = self._ptr
+        return [(int(g.dim), int(g.tag), ffi.string(g.name).decode("utf-8", "replace"))
+                for g in (m.groups[i] for i in range(int(m.n_groups)))]
+
+    def __repr__(self) -> str:
+        if self.closed:
+            return "<cadmorph.Mesh (closed)>"
+        return "<cadmorph.Mesh %d nodes, %d cells>" % (self.n_nodes, self.n_cells)
+
+
+def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
+    """Reads a mesh; the format is chosen by the name (.msh, .vtu, .vtk, .mesh, .obj, .off,
+    .stl, or an OpenFOAM case directory), as in the CLI.
+
+    Raises BadInputError (with the library's message naming the file, and the line or the
+    byte offset) for a file that is missing, unreadable or malformed.
+    """
+    p = _path(path, "cadmorph.read_mesh")
+    ctx = Context(threads)
+    out = ffi.new("cm_mesh *[1]")
+    ctx.check(lib.cm_mesh_read(ctx.ptr, p, out))
+    return Mesh(ffi.gc(out[0], _destroy_mesh))
+
+
+def write_mesh(path: PathLike, mesh: Mesh, binary: Optional[bool] = None,
+               msh_version: Optional[int] = None, compress: Optional[bool] = None,
+               threads: int = 0) -> None:
+    """Writes a mesh in the format its name says (as read_mesh); through a temporary file
+    renamed at the end, so a failed write leaves no partial file.
+
+    binary: msh, vtk, stl binary, vtu base64 (library default when None); msh_version: 22 or
+    41 (default 41); compress: vtu zlib compression (default on).
+    """
+    if not isinstance(mesh, Mesh):
+        raise TypeError("cadmorph.write_mesh: mesh must be a cadmorph.Mesh, not %s"
+                        % type(mesh).__name__)
+    p = _path(path, "cadmorph.write_mesh")
+    opt = ffi.new("cm_mesh_write_options *")
+    lib.cm_mesh_write_options_init(opt)
+    if msh_version is not None:
+        if msh_version not in (22, 41):
+            raise ValueError("cadmorph.write_mesh: msh_version must be 22 or 41, not %r"
+                             % (msh_version,))
+        opt.msh_version = msh_version
+    if binary is not None:
+        opt.binary = bool(binary)
+    if compress is not None:
+        opt.compress = bool(compress)
+    ctx = Context(threads)
+    ctx.check(lib.cm_mesh_write(ctx.ptr, mesh._ptr, p, opt))
