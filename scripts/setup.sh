@@ -9,6 +9,7 @@ packages=(
   libocct-data-exchange-dev libocct-ocaf-dev
   libflann-dev libtet1.5-dev liblapacke-dev libopenblas-dev zlib1g-dev libsuitesparse-dev
   gmsh libgmsh-dev python3-gmsh python3-numpy python3-scipy python3-vtk9 python3-meshio
+  python3-cffi python3-pytest  # the Python package (python/cadmorph) and its tests
   openfoam  # blockMesh, snappyHexMesh, checkMesh: polyMesh test meshes and the checkMesh cross-check
   python3-matplotlib  # imported by PyGeM, for tests/data/deform/make_pygem_fixture.py
   clang libclang-rt-14-dev  # make fuzz (libFuzzer); make check-asan uses gcc's sanitizers
