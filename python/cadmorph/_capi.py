@@ -2,8 +2,10 @@
 
 The declarations below copy those of include/cadmorph/core.h and mesh.h that the package
 uses, struct layouts included (cm_mesh is read field by field); a change of those headers is
-a change here. The library is the one CMake recorded in _libpath.py (the build tree's, or the
-installed one relative to this package), else the soname through the dynamic loader.
+a change here (tests/python checks the layout against the fixtures). The library is
+CADMORPH_LIBRARY if set, else the one CMake recorded in _libpath.py (the build tree's, or the
+installed one relative to this package), else the soname through the dynamic loader. cffi
+releases the GIL around every call into the library.
 """
 import os
 
@@ -72,7 +74,8 @@ cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const doubl
                                cm_quality_stats *per_type, cm_quality_stats *all);
 """
 
-# the soname of libcadmorph 0.x: the minor version is part of it (cmake/library.cmake)
+# the soname of libcadmorph 0.x when CMake did not record it: the minor version is part of
+# it (cmake/library.cmake)
 SONAME = "libcadmorph.so.0.1"
 
 ffi = cffi.FFI()
@@ -80,18 +83,20 @@ ffi.cdef(CDEF)
 
 
 def _candidates():
+    """CADMORPH_LIBRARY if set, the library CMake recorded, then the soname."""
     try:
-        from ._libpath import LIBRARY
-    except ImportError:
-        LIBRARY = None
+        from . import _libpath
+    except ImportError:  # a copy of the sources that CMake did not configure
+        _libpath = None
     if os.environ.get("CADMORPH_LIBRARY"):
         yield os.environ["CADMORPH_LIBRARY"]
-    if LIBRARY:
-        yield LIBRARY
-    yield SONAME
+    if getattr(_libpath, "LIBRARY", None):
+        yield _libpath.LIBRARY
+    yield getattr(_libpath, "SONAME", SONAME)
 
 
 def _load():
+    """The first library that loads, and its path; ImportError naming every attempt."""
     errors = []
     for path in _candidates():
         if os.sep in path and not os.path.exists(path):

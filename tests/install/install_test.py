@@ -12,7 +12,9 @@ build run on the plate-with-a-hole STEP fixtures (tests/data/surface) and gmsh's
 Also checked: the exported symbols of libcadmorph.so are exactly the functions the installed
 headers declare (CM_API), `cadmorph --version`, cadmorph.pc and the config version agree, and
 the installed program writes a built-in model that it reads back (`cadmorph model bore 0
-b.step`, then `cadmorph info b.step`: the README's first step).
+b.step`, then `cadmorph info b.step`: the README's first step), and the installed Python
+package imports from the prefix's site directory and reads a mesh through the installed
+libcadmorph.so.
 """
 import argparse
 import glob
@@ -98,6 +100,25 @@ def main():
     info = run([os.path.join(prefix, "bin", "cadmorph"), "info", b_step]).stdout
     if not re.search(r"^solids 1 ", info, re.MULTILINE):
         fail("cadmorph info of the installed model's STEP: %r" % info)
+
+    # the Python package: importable from the prefix's site directory, on the installed library
+    pkgs = glob.glob(os.path.join(prefix, "lib*", "python3*", "*-packages", "cadmorph",
+                                  "__init__.py"))
+    if len(pkgs) != 1:
+        fail("the Python package is installed %d times: %s" % (len(pkgs), pkgs))
+    else:
+        site = os.path.dirname(os.path.dirname(pkgs[0]))
+        pyenv = {k: v for k, v in os.environ.items() if not k.startswith(("PYTHON", "CADMORPH"))}
+        pyenv.update(PYTHONPATH=site, PYTHONDONTWRITEBYTECODE="1")
+        r = run([sys.executable, "-c", "import cadmorph, sys; m = cadmorph.read_mesh(sys.argv[1]); "
+                 "print(cadmorph._capi.LIBRARY_PATH, m.points.shape[0], "
+                 "cadmorph.quality(m).cells)", a.mesh], env=pyenv)
+        words = r.stdout.split()
+        if len(words) != 3 or not os.path.realpath(words[0]).startswith(os.path.realpath(prefix)) \
+                or int(words[1]) <= 0 or int(words[2]) <= 0:
+            fail("the installed Python package: %r" % r.stdout)
+    if not ok:
+        return 1
 
     # the plate with a hole, its edit, one of another topology, a rigid motion of it
     g0, g1, other, rigid = (os.path.join(a.data, "surface", k + ".step")

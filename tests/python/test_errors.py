@@ -64,3 +64,20 @@ def test_error_classes():
     assert issubclass(cadmorph.MismatchError, cadmorph.BadInputError)
     for c in (cadmorph.BadInputError, cadmorph.RejectedError, cadmorph.ResourceError):
         assert issubclass(c, cadmorph.Error)
+
+
+def test_docstrings():
+    """Every public name, and every public method and property of its classes."""
+    import inspect
+    missing = []
+    for name in cadmorph.__all__:
+        obj = getattr(cadmorph, name)
+        if name.startswith("__"):
+            continue
+        if not inspect.getdoc(obj):
+            missing.append(name)
+        if inspect.isclass(obj):
+            for attr, member in vars(obj).items():
+                if not attr.startswith("_") and not inspect.getdoc(member):
+                    missing.append(name + "." + attr)
+    assert not missing, missing
