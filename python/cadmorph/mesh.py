@@ -15,6 +15,7 @@ from .errors import Context
 
 PathLike = Union[str, bytes, "os.PathLike[str]"]
 
+_TOKEN = object()  # Mesh objects are made here only
 _CELL_NAMES = [ffi.string(lib.cm_cell_type_info(t).name).decode()
                for t in range(lib.CM_CELL_TYPE_COUNT)]
 _CELL_NODES = [lib.cm_cell_type_info(t).nodes for t in range(lib.CM_CELL_TYPE_COUNT)]
@@ -40,6 +41,14 @@ def _array(owner, ptr, shape: Tuple[int, ...], dtype, writable: bool = True) -> 
     return np.asarray(_View(owner, address, shape, dtype.str, writable))
 
 
+def _threads(threads: int, what: str) -> int:
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
+        raise TypeError("%s: threads must be an int, not %s" % (what, type(threads).__name__))
+    if not 0 <= threads <= 4096:
+        raise ValueError("%s: threads must be 0 (all) to 4096, not %d" % (what, threads))
+    return int(threads)
+
+
 def _path(path: PathLike, what: str) -> bytes:
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise TypeError("%s: a path (str, bytes or os.PathLike), not %s"
@@ -62,8 +71,11 @@ class Mesh:
     memory go once no view is left.
     """
 
-    def __init__(self, _owner) -> None:
-        """Not for users: a Mesh comes from read_mesh."""
+    def __init__(self, _owner=None, _token=None) -> None:
+        """Not for users: a Mesh comes from read_mesh (a TypeError otherwise)."""
+        if _token is not _TOKEN or ffi.typeof(_owner) is not ffi.typeof("cm_mesh *") \
+                or _owner == ffi.NULL:
+            raise TypeError("cadmorph.Mesh: made by cadmorph.read_mesh, not directly")
         self._owner = _owner
 
     @property
@@ -103,6 +115,19 @@ class Mesh:
         writing to it moves the nodes that write_mesh and quality see."""
         m = self._ptr
         return _array(m, m.xyz, (int(m.n_nodes), 3), np.float64)
+
+    @points.setter
+    def points(self, value) -> None:
+        """Sets every node's coordinates (copied into the mesh): an array-like of shape
+        (n_nodes, 3) of real numbers."""
+        m = self._ptr
+        n = int(m.n_nodes)
+        a = np.asarray(value)
+        if a.dtype.kind not in "fiu":
+            raise TypeError("cadmorph.Mesh.points: real numbers, not dtype %s" % a.dtype)
+        if a.shape != (n, 3):
+            raise ValueError("cadmorph.Mesh.points: shape (%d, 3), not %s" % (n, a.shape))
+        self.points[...] = a
 
     def _cell_arrays(self) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
         m = self._ptr
@@ -179,16 +204,17 @@ class Mesh:
 
 def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
     """Reads a mesh; the format is chosen by the name (.msh, .vtu, .vtk, .mesh, .obj, .off,
-    .stl, or an OpenFOAM case directory), as in the CLI.
+    .stl, or an OpenFOAM case directory), as in the CLI. threads: for the library's OpenMP
+    loops, 0 = all the machine has.
 
     Raises BadInputError (with the library's message naming the file, and the line or the
     byte offset) for a file that is missing, unreadable or malformed.
     """
     p = _path(path, "cadmorph.read_mesh")
-    ctx = Context(threads)
+    ctx = Context(_threads(threads, "cadmorph.read_mesh"))
     out = ffi.new("cm_mesh *[1]")
     ctx.check(lib.cm_mesh_read(ctx.ptr, p, out))
-    return Mesh(ffi.gc(out[0], _destroy_mesh))
+    return Mesh(ffi.gc(out[0], _destroy_mesh), _TOKEN)
 
 
 def write_mesh(path: PathLike, mesh: Mesh, binary: Optional[bool] = None,
@@ -215,5 +241,5 @@ def write_mesh(path: PathLike, mesh: Mesh, binary: Optional[bool] = None,
         opt.binary = bool(binary)
     if compress is not None:
         opt.compress = bool(compress)
-    ctx = Context(threads)
+    ctx = Context(_threads(threads, "cadmorph.write_mesh"))
     ctx.check(lib.cm_mesh_write(ctx.ptr, mesh._ptr, p, opt))

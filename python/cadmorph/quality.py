@@ -5,7 +5,7 @@ import numpy as np
 
 from ._capi import ffi, lib
 from .errors import Context
-from .mesh import Mesh
+from .mesh import Mesh, _threads
 
 
 @dataclass(frozen=True)
@@ -38,7 +38,7 @@ def quality(mesh: Mesh, threads: int = 0) -> Quality:
                         % type(mesh).__name__)
     m = mesh._ptr
     sj = np.empty(max(int(m.n_cells), 1), np.float64)
-    ctx = Context(threads)
+    ctx = Context(_threads(threads, "cadmorph.quality"))
     buf = ffi.from_buffer("double[]", sj)
     ctx.check(lib.cm_mesh_quality(ctx.ptr, m, buf))
     all_ = ffi.new("cm_quality_stats *")

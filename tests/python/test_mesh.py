@@ -118,3 +118,43 @@ def test_context_manager(data):
     with cadmorph.read_mesh(data / "vtk/meshio_ascii.vtu") as mesh:
         assert mesh.n_nodes == 14
     assert mesh.closed and "closed" in repr(mesh)
+
+
+def test_polyhedra(data):
+    mesh = cadmorph.read_mesh(data / "vtk/vtk_legacy_ascii.vtk")
+    blocks = dict(mesh.cells)
+    (stream,) = blocks["polyhedron"]  # one polyhedron: a copy of its face stream
+    assert stream.dtype == np.int64 and stream.ndim == 1
+    nf, at = stream[0], 1
+    for _ in range(nf):  # nf faces, each its count and its nodes, and nothing after them
+        at += 1 + stream[at]
+    assert at == len(stream) and stream[1:].max() < mesh.n_nodes
+    q = cadmorph.quality(mesh)
+    assert np.isfinite(q.per_cell[mesh.cell_types.index("polyhedron")])
+
+
+def test_set_points(data, work):
+    mesh = cadmorph.read_mesh(data / "vtk/meshio_ascii.vtu")
+    new = mesh.points * 2.0
+    mesh.points = new.tolist()  # any array-like of reals, copied into the mesh
+    assert np.array_equal(mesh.points, new)
+    with pytest.raises(ValueError, match=r"\(14, 3\)"):
+        mesh.points = np.zeros((13, 3))
+    with pytest.raises(ValueError):
+        mesh.points = np.zeros((14, 2))
+    with pytest.raises(TypeError):
+        mesh.points = np.array([["a", "b", "c"]] * 14)
+    assert np.array_equal(mesh.points, new)  # the refused assignments changed nothing
+
+
+def test_no_direct_construction():
+    for args in ((), (None,), (0,), (cadmorph._ffi.NULL,)):
+        with pytest.raises(TypeError, match="read_mesh"):
+            cadmorph.Mesh(*args)
+
+
+@pytest.mark.parametrize("threads, exc", [(-1, ValueError), (10**6, ValueError),
+                                           ("2", TypeError), (True, TypeError)])
+def test_threads_checked(data, threads, exc):
+    with pytest.raises(exc, match="threads"):
+        cadmorph.read_mesh(data / "vtk/meshio_ascii.vtu", threads=threads)

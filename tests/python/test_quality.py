@@ -14,7 +14,8 @@ def cli_summary(cli, path):
 
 
 @pytest.mark.parametrize("name", ["msh/box_hole_41.msh", "vtk/meshio_ascii.vtu",
-                                  "msh/hybrid_o2_41.msh"])
+                                  "msh/hybrid_o2_41.msh", "quality/mixed.vtu",
+                                  "vtk/vtk_legacy_ascii.vtk"])
 def test_quality_equals_cli(cli, data, name):
     q = cadmorph.quality(cadmorph.read_mesh(data / name))
     line = cli_summary(cli, data / name)
