@@ -22,7 +22,10 @@ class Error(Exception):
         self.status: int = status
         self.status_name: str = ffi.string(lib.cm_status_name(status)).decode()
         self.message: str = message
-        super().__init__(message or self.status_name)
+        super().__init__(status, message)  # both, so that the exception pickles
+
+    def __str__(self) -> str:
+        return self.message or self.status_name
 
 
 class BadInputError(Error):

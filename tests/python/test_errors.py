@@ -81,3 +81,13 @@ def test_docstrings():
                 if not attr.startswith("_") and not inspect.getdoc(member):
                     missing.append(name + "." + attr)
     assert not missing, missing
+
+
+def test_error_pickles(work):
+    import pickle
+    with pytest.raises(cadmorph.BadInputError) as e:
+        cadmorph.read_mesh(work / "absent.msh")
+    back = pickle.loads(pickle.dumps(e.value))
+    assert type(back) is cadmorph.BadInputError
+    assert (back.status, back.message, str(back)) == (e.value.status, e.value.message,
+                                                       str(e.value))
