@@ -2,10 +2,10 @@
 
 The declarations below copy those of include/cadmorph/core.h and mesh.h that the package
 uses, struct layouts included (cm_mesh is read field by field); a change of those headers is
-a change here (tests/python/test_layout.py compares the layout with the compiler's). The library is
-CADMORPH_LIBRARY if set, else the one CMake recorded in _libpath.py (the build tree's, or the
-installed one relative to this package), else the soname through the dynamic loader. cffi
-releases the GIL around every call into the library.
+a change here (tests/python/test_layout.py compares the layouts with the compiler's). The
+library is CADMORPH_LIBRARY if set, else the one CMake recorded in _libpath.py (the build
+tree's, or the installed one relative to this package), else the soname through the dynamic
+loader. cffi releases the GIL around every call into the library.
 """
 import os
 
