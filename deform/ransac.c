@@ -581,9 +581,11 @@ cm_status cm_ransac_detect(cm_context *ctx, size_t n_nodes, const double *xyz, s
         }
         for (int64_t i = 0; i < m; ++i) {
             int64_t a = fnodes[off[f] + i], b = fnodes[off[f] + (i + 1) % m];
-            if (a < 0 || (size_t)a >= n_nodes) {
+            /* both ends of the edge are read below: check both before using either */
+            if (a < 0 || (size_t)a >= n_nodes || b < 0 || (size_t)b >= n_nodes) {
+                const int64_t bad = a < 0 || (size_t)a >= n_nodes ? a : b;
                 st = cm_error(ctx, CM_ERR_ARGUMENT, "%s: face %zu: node %lld of %zu", who, f,
-                              (long long)a, n_nodes);
+                              (long long)bad, n_nodes);
                 goto done;
             }
             const double *p = xyz + 3 * a, *q = xyz + 3 * b;
