@@ -5,6 +5,7 @@
 #include <math.h>
 #include <omp.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +22,9 @@ struct cm_context {
     void *log_user;
     cm_progress_fn progress;
     void *progress_user;
+    /* set by cm_context_interrupt from any thread or a signal handler, consumed by
+     * cm_progress: a lock-free atomic is async-signal-safe */
+    atomic_int interrupt;
 };
 
 const char *cm_status_name(cm_status s)
@@ -38,6 +42,7 @@ const char *cm_status_name(cm_status s)
     case CM_ERR_CAD: return "CAD error";
     case CM_ERR_INTERNAL: return "internal error";
     case CM_ERR_REJECTED: return "result rejected";
+    case CM_ERR_INTERRUPTED: return "interrupted";
     }
     return "unknown status";
 }
@@ -52,7 +57,9 @@ cm_status cm_context_create(cm_context **ctx)
 {
     if (!ctx) return CM_ERR_ARGUMENT;
     *ctx = calloc(1, sizeof **ctx);
-    return *ctx ? CM_OK : CM_ERR_NOMEM;
+    if (!*ctx) return CM_ERR_NOMEM;
+    atomic_init(&(*ctx)->interrupt, 0);
+    return CM_OK;
 }
 
 void cm_context_destroy(cm_context **ctx)
@@ -66,7 +73,9 @@ const char *cm_context_message(const cm_context *ctx) { return ctx ? ctx->messag
 
 void cm_context_clear(cm_context *ctx)
 {
-    if (ctx) ctx->message[0] = '\0';
+    if (!ctx) return;
+    ctx->message[0] = '\0';
+    atomic_store(&ctx->interrupt, 0);
 }
 
 void cm_context_set_threads(cm_context *ctx, int threads)
@@ -198,9 +207,17 @@ void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
     ctx->log(ctx->log_user, level, buf);
 }
 
-void cm_progress(cm_context *ctx, const char *stage, double done, double total)
+void cm_context_interrupt(cm_context *ctx)
 {
-    if (ctx && ctx->progress) ctx->progress(ctx->progress_user, stage, done, total);
+    if (ctx) atomic_store(&ctx->interrupt, 1);
+}
+
+cm_status cm_progress(cm_context *ctx, const char *stage, double done, double total)
+{
+    if (!ctx) return CM_OK;
+    if (ctx->progress) ctx->progress(ctx->progress_user, stage, done, total);
+    if (!atomic_exchange(&ctx->interrupt, 0)) return CM_OK;
+    return cm_error(ctx, CM_ERR_INTERRUPTED, "%s: interrupted", stage ? stage : "cadmorph");
 }
 
 double cm_memory_budget(void)

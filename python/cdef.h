@@ -15,7 +15,8 @@ CM_ERR_MISMATCH = -6,
 CM_ERR_NUMERIC = -7,
 CM_ERR_CAD = -8,
 CM_ERR_INTERNAL = -9,
-CM_ERR_REJECTED = -10
+CM_ERR_REJECTED = -10,
+CM_ERR_INTERRUPTED = -11
 } cm_status;
 const char *cm_status_name(cm_status s);
 int cm_status_is_input_error(cm_status s);
@@ -31,13 +32,14 @@ void cm_context_set_threads(cm_context *ctx, int threads);
 int cm_context_threads(const cm_context *ctx);
 void cm_context_set_log(cm_context *ctx, cm_log_fn fn, void *user);
 void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user);
+void cm_context_interrupt(cm_context *ctx);
 cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
 ;
 cm_status cm_error_prefix(cm_context *ctx, cm_status code, const char *fmt, ...)
 ;
 void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
 ;
-void cm_progress(cm_context *ctx, const char *stage, double done, double total);
+cm_status cm_progress(cm_context *ctx, const char *stage, double done, double total);
 int cm_context_threads_for(const cm_context *ctx, size_t n, size_t min_per_thread);
 double cm_bbox_diagonal(const double bb[6]);
 double cm_wtime(void);

@@ -57,8 +57,10 @@ typedef enum cm_status {
     CM_ERR_NUMERIC = -7,       /* singular or indefinite system, non-finite values */
     CM_ERR_CAD = -8,           /* OpenCASCADE failed */
     CM_ERR_INTERNAL = -9,      /* a bug or an exception from a dependency */
-    CM_ERR_REJECTED = -10      /* a result refused by a quality guard (inverted cells that no
+    CM_ERR_REJECTED = -10,     /* a result refused by a quality guard (inverted cells that no
                                   adaptive step avoids): exit code 3 in the CLI */
+    CM_ERR_INTERRUPTED = -11   /* the caller asked the call to stop (cm_context_interrupt);
+                                  nothing was written and outputs are as on any error */
 } cm_status;
 
 /* Short fixed name of a status, e.g. "format error". */
@@ -80,6 +82,7 @@ CM_API void cm_context_destroy(cm_context **ctx);
 
 /* Message of the last error or warning set on this context ("" if none). */
 CM_API const char *cm_context_message(const cm_context *ctx);
+/* Forgets the message and an interrupt request not yet reported (cm_context_interrupt). */
 CM_API void cm_context_clear(cm_context *ctx);
 
 /* Threads for OpenMP leaf loops and BLAS; 0 = all available (default). Under an address-space
@@ -90,6 +93,13 @@ CM_API int cm_context_threads(const cm_context *ctx);
 
 CM_API void cm_context_set_log(cm_context *ctx, cm_log_fn fn, void *user);
 CM_API void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user);
+
+/* Asks the call running on ctx to stop: it returns CM_ERR_INTERRUPTED at its next progress
+ * point (long loops report progress often enough to stop within a fraction of a second,
+ * except inside one call of a dependency: a LAPACK factorisation, CHOLMOD, TetGen). Safe
+ * from another thread, from a signal handler and from the progress callback itself. The
+ * request stays until a call reports it or cm_context_clear drops it. */
+CM_API void cm_context_interrupt(cm_context *ctx);
 
 /* ---- for module code ---- */
 
@@ -106,7 +116,10 @@ CM_API cm_status cm_error_prefix(cm_context *ctx, cm_status code, const char *fm
 CM_API void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
-CM_API void cm_progress(cm_context *ctx, const char *stage, double done, double total);
+/* Reports progress to the callback, then returns CM_ERR_INTERRUPTED (message "<stage>:
+ * interrupted") when an interrupt was requested, consuming the request; CM_OK otherwise.
+ * Long work calls it at points where it can stop cleanly and returns its error there. */
+CM_API cm_status cm_progress(cm_context *ctx, const char *stage, double done, double total);
 
 /* Threads for a leaf loop of n items that is worth parallelising above min_per_thread items
  * a thread: between 1 and the context's threads (0 there = all the machine has). */
