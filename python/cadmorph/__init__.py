@@ -9,13 +9,17 @@ library's status becomes an exception carrying its message.
     print(cadmorph.quality(mesh).min_sj, mesh.points.shape)
 """
 from ._capi import ffi as _ffi, lib as _lib
-from .errors import (BadInputError, CadmorphWarning, Error, MismatchError, RejectedError,
-                     ResourceError)
+from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, MismatchError,
+                     RejectedError, ResourceError)
 from .mesh import Mesh, read_mesh, write_mesh
 from .quality import Quality, quality
 
 __version__: str = _ffi.string(_lib.cm_version()).decode()
 
-__all__ = ["Error", "BadInputError", "MismatchError", "RejectedError", "ResourceError",
-           "CadmorphWarning", "Mesh", "read_mesh", "write_mesh", "Quality", "quality",
-           "__version__"]
+__all__ = [
+    "Error", "BadInputError", "MismatchError", "RejectedError", "ResourceError",
+    "InterruptedCall", "CadmorphWarning",
+    "Mesh", "read_mesh", "write_mesh",
+    "Quality", "quality",
+    "__version__",
+]

@@ -1,11 +1,9 @@
-"""The library's status as Python exceptions, and the context every call runs in.
+"""The library's status as Python exceptions.
 
 A cm_status below 0 becomes an exception of the class its code maps to, carrying the status
 and the library's message (which names the file and the place); a status above 0 (a complete
 result with something odd about it) becomes a CadmorphWarning.
 """
-import warnings
-
 from ._capi import ffi, lib
 
 
@@ -45,6 +43,11 @@ class ResourceError(Error):
     """Out of memory, or a request beyond what the machine can hold (exit code 4)."""
 
 
+class InterruptedCall(Error):
+    """The call stopped on a cm_context_interrupt that no Python exception asked for (a
+    Ctrl-C or an exception of the progress callable is raised as itself instead)."""
+
+
 class CadmorphWarning(UserWarning):
     """A complete result about which the library reports something odd."""
 
@@ -57,36 +60,8 @@ def error_class(status: int) -> type:
         return RejectedError
     if status == lib.CM_ERR_NOMEM:
         return ResourceError
+    if status == lib.CM_ERR_INTERRUPTED:
+        return InterruptedCall
     if lib.cm_status_is_input_error(status):
         return BadInputError
     return Error  # CM_ERR_ARGUMENT, CM_ERR_INTERNAL: a bug here or in the library
-
-
-class Context:
-    """A cm_context for one call (or one object's calls): threads, and the message of the
-    last error. Use `check(status)` after each call."""
-
-    def __init__(self, threads: int = 0) -> None:
-        p = ffi.new("cm_context *[1]")
-        s = lib.cm_context_create(p)
-        if s != lib.CM_OK:
-            raise ResourceError(s, "cm_context_create failed")
-        self.ptr = ffi.gc(p[0], _destroy_context)
-        if threads:
-            lib.cm_context_set_threads(self.ptr, int(threads))
-
-    def message(self) -> str:
-        """The library's message of the last error or warning ("" if none)."""
-        return ffi.string(lib.cm_context_message(self.ptr)).decode("utf-8", "replace")
-
-    def check(self, status: int) -> int:
-        """Raises the exception of an error status, warns on a warning, returns status."""
-        if status < 0:
-            raise error_class(status)(status, self.message())
-        if status > 0:
-            warnings.warn(self.message(), CadmorphWarning, stacklevel=3)
-        return status
-
-
-def _destroy_context(ptr) -> None:
-    lib.cm_context_destroy(ffi.new("cm_context *[1]", [ptr]))

@@ -11,7 +11,7 @@ from typing import Dict, List, Optional, Tuple, Union
 import numpy as np
 
 from ._capi import ffi, lib
-from .errors import Context
+from ._context import Context
 
 PathLike = Union[str, bytes, "os.PathLike[str]"]
 
@@ -39,14 +39,6 @@ def _array(owner, ptr, shape: Tuple[int, ...], dtype, writable: bool = True) -> 
         return a
     address = int(ffi.cast("uintptr_t", ptr))
     return np.asarray(_View(owner, address, shape, dtype.str, writable))
-
-
-def _threads(threads: int, what: str) -> int:
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
-        raise TypeError("%s: threads must be an int, not %s" % (what, type(threads).__name__))
-    if not 0 <= threads <= 4096:
-        raise ValueError("%s: threads must be 0 (all) to 4096, not %d" % (what, threads))
-    return int(threads)
 
 
 def _path(path: PathLike, what: str) -> bytes:
@@ -211,9 +203,9 @@ def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
     byte offset) for a file that is missing, unreadable or malformed.
     """
     p = _path(path, "cadmorph.read_mesh")
-    ctx = Context(_threads(threads, "cadmorph.read_mesh"))
+    ctx = Context(threads, False, "cadmorph.read_mesh")
     out = ffi.new("cm_mesh *[1]")
-    ctx.check(lib.cm_mesh_read(ctx.ptr, p, out))
+    ctx.call(lib.cm_mesh_read, p, out)
     return Mesh(ffi.gc(out[0], _destroy_mesh), _TOKEN)
 
 
@@ -241,5 +233,5 @@ def write_mesh(path: PathLike, mesh: Mesh, binary: Optional[bool] = None,
         opt.binary = bool(binary)
     if compress is not None:
         opt.compress = bool(compress)
-    ctx = Context(_threads(threads, "cadmorph.write_mesh"))
-    ctx.check(lib.cm_mesh_write(ctx.ptr, mesh._ptr, p, opt))
+    ctx = Context(threads, False, "cadmorph.write_mesh")
+    ctx.call(lib.cm_mesh_write, mesh._ptr, p, opt)

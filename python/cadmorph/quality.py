@@ -4,8 +4,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._capi import ffi, lib
-from .errors import Context
-from .mesh import Mesh, _threads
+from ._context import Context
+from .mesh import Mesh
 
 
 @dataclass(frozen=True)
@@ -38,11 +38,11 @@ def quality(mesh: Mesh, threads: int = 0) -> Quality:
                         % type(mesh).__name__)
     m = mesh._ptr
     sj = np.empty(max(int(m.n_cells), 1), np.float64)
-    ctx = Context(_threads(threads, "cadmorph.quality"))
+    ctx = Context(threads, False, "cadmorph.quality")
     buf = ffi.from_buffer("double[]", sj)
-    ctx.check(lib.cm_mesh_quality(ctx.ptr, m, buf))
+    ctx.call(lib.cm_mesh_quality, m, buf)
     all_ = ffi.new("cm_quality_stats *")
-    ctx.check(lib.cm_quality_summarize(ctx.ptr, m, buf, ffi.NULL, all_))
+    ctx.call(lib.cm_quality_summarize, m, buf, ffi.NULL, all_)
     return Quality(min_sj=float(all_.min), mean_sj=float(all_.mean), p01_sj=float(all_.p01),
                    inverted=int(all_.inverted), cells=int(all_.count),
                    per_cell=sj[:int(m.n_cells)])
