@@ -13,6 +13,11 @@ from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, Mis
                      RejectedError, ResourceError)
 from .mesh import Mesh, read_mesh, write_mesh
 from .quality import Quality, quality
+from .deform import Deformer, deform
+from .ffd import FFDStats, Lattice, ffd
+from .optimize import OptimizeStats, optimize
+from .meshgen import mesh_step
+from .study import StudyResult, StudyRow, study, sweep
 
 __version__: str = _ffi.string(_lib.cm_version()).decode()
 
@@ -22,4 +27,9 @@ __all__ = [
     "Mesh", "read_mesh", "write_mesh",
     "Quality", "quality",
     "__version__",
+    "Deformer", "deform",
+    "Lattice", "FFDStats", "ffd",
+    "OptimizeStats", "optimize",
+    "mesh_step",
+    "StudyResult", "StudyRow", "study", "sweep",
 ]
