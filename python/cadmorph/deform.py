@@ -215,5 +215,10 @@ def deform(points: Union[Mesh, np.ndarray], handles: Any, displacements: Any,
     displacements), as `cadmorph deform --handles H.csv [--fixed F.csv |
     --fix-unlisted-boundary] --method M` (whose default method is mls; here rbf).
     The mesh itself is not changed."""
-    return Deformer(points, handles, fixed, method, threads=threads, progress=progress,
-                    **options).apply(displacements)
+    what = "cadmorph.deform"
+    # the arrays checked before the set-up, which may take long
+    xyz, _ = points_of(points, what + ": points")
+    h = index_array(handles, xyz.shape[0], what + ": handles")
+    d = real_array(displacements, (len(h), 3), what + ": displacements")
+    return Deformer(points, h, fixed, method, threads=threads, progress=progress,
+                    **options).apply(d)
