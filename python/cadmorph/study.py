@@ -224,8 +224,9 @@ def study(g0: Any, mesh: Mesh, targets: Sequence[Any],
             raise ValueError("%s: write_meshes=%r needs out_dir" % (what, write_meshes))
         d = path_bytes(out_dir, what + ": out_dir")
         os.makedirs(d, exist_ok=True)
-        keep.append(d)
-        so.out_dir = d
+        c = ffi.new("char[]", d)
+        keep.append(c)
+        so.out_dir = c
     unit = lib.cm_cad_unit(model)
     so.morph.cad_unit = unit
     g0_path = lib.cm_cad_path(model)
@@ -301,9 +302,8 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
     ctx = Context(threads, progress, what)
     so = ffi.new("cm_sweep_options *")
     lib.cm_sweep_options_init(so)
-    model_b = model.encode()
-    so.model = model_b
-    so.mesh = mesh_b
+    model_c, mesh_c = ffi.new("char[]", model.encode()), ffi.new("char[]", mesh_b)
+    so.model, so.mesh = model_c, mesh_c
     so.steps = integer(steps, what + ": steps", 1, 1000)
     so.modes = _MODES[choice(mode, tuple(_MODES), what + ": mode")]
     if size is not None:
@@ -327,6 +327,7 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
     with tempfile.TemporaryDirectory(prefix="cadmorph_sweep_") as tmp:
         d = path_bytes(tmp if out_dir is None else out_dir, what + ": out_dir")
         os.makedirs(d, exist_ok=True)
-        so.out_dir = d
+        dir_c = ffi.new("char[]", d)
+        so.out_dir = dir_c
         ctx.call(lib.cm_sweep_run, so, out)
     return StudyResult(ffi.gc(out[0], _destroy_result), lib.CM_STUDY_CSV_SWEEP)
