@@ -11,6 +11,7 @@ from ._capi import ffi, lib
 from ._context import Context, Progress
 from ._inputs import choice, integer, number, path_bytes
 from .mesh import Mesh, PathLike
+from .geometry import Geometry
 from .meshgen import _model_ptr
 
 _MODES = {"absolute": lib.CM_STUDY_ABSOLUTE, "relative": lib.CM_STUDY_RELATIVE,
@@ -178,7 +179,7 @@ def _stem(path: bytes) -> str:
     return os.fsdecode(stem or base)
 
 
-def study(g0: Any, mesh: Mesh, targets: Sequence[Any],
+def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]],
           methods: Union[None, str, Sequence[str]] = None, mode: str = "absolute",
           steps: Union[int, str] = 1, optimize: bool = False, write_meshes: str = "none",
           out_dir: Optional[PathLike] = None, model_name: Optional[str] = None,
