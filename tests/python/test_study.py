@@ -119,3 +119,21 @@ def test_sweep_equals_cli(cli, work):
     for obj in (cadmorph.study, cadmorph.sweep, cadmorph.StudyResult, cadmorph.StudyRow,
                 cadmorph.StudyResult.write_csv, cadmorph.StudyResult.write_svg):
         assert obj.__doc__ and obj.__doc__.strip()
+
+
+def test_study_progress_and_stop(bore):
+    g0 = cadmorph.read_step(bore / "bore_0.step")
+    mesh = cadmorph.read_mesh(bore / "M0.vtu")
+    targets = [bore / "bore_0.5.step", bore / "bore_1.step"]
+    calls = []
+    cadmorph.study(g0, mesh, targets, progress=lambda *a: calls.append(a))
+    assert ("study", 2.0, 2.0) in [(s, float(d), float(t)) for s, d, t in calls]
+
+    class Stop(Exception):
+        pass
+
+    def stop(stage, done, total):
+        if stage == "study" and done >= 1:
+            raise Stop()
+    with pytest.raises(Stop):
+        cadmorph.study(g0, mesh, targets, progress=stop)
