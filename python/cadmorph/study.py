@@ -210,6 +210,8 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     if isinstance(targets, (str, bytes, os.PathLike)):
         raise TypeError("%s: targets is a list (of paths and/or Geometry objects)" % what)
     targets = list(targets)
+    if not targets:
+        raise ValueError("%s: no target" % what)
     ctx = Context(threads, progress, what)
     so = ffi.new("cm_study_options *")
     lib.cm_study_options_init(so)
@@ -294,6 +296,8 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
     """
     what = "cadmorph.sweep"
     choice(model, ("bore", "pipe", "bracket"), what + ": model")
+    if out_dir is None and (write_step or write_meshes):
+        raise ValueError("%s: write_step and write_meshes need out_dir" % what)
     if isinstance(mesh, str) and mesh in ("tet", "hex"):
         mesh_b = mesh.encode()
         if mesh == "hex" and model == "bracket":

@@ -98,6 +98,8 @@ def test_study_errors(bore):
         cadmorph.study(g0, mesh, [1.5])
     with pytest.raises(TypeError, match="Mesh"):
         cadmorph.study(g0, mesh.points, t)
+    with pytest.raises(ValueError, match="no target"):
+        cadmorph.study(g0, mesh, [])
     with pytest.raises(cadmorph.Error):  # M0 is not a mesh of the pipe
         cadmorph.study(cadmorph.model("pipe", 0.0), mesh, t, progress=False)
 
@@ -116,6 +118,8 @@ def test_sweep_equals_cli(cli, work):
         cadmorph.sweep("bracket", "hex")
     with pytest.raises(ValueError, match="model"):
         cadmorph.sweep("teapot")
+    with pytest.raises(ValueError, match="out_dir"):
+        cadmorph.sweep("bore", write_step=True)
     for obj in (cadmorph.study, cadmorph.sweep, cadmorph.StudyResult, cadmorph.StudyRow,
                 cadmorph.StudyResult.write_csv, cadmorph.StudyResult.write_svg):
         assert obj.__doc__ and obj.__doc__.strip()
