@@ -683,6 +683,8 @@ static cm_status build_coarse(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *
         if (st == CM_OK) p->bytes += cm_rbf_coarse_inner_bytes(p->inner);
         goto done;
     }
+    /* between choosing the coarse centres and their dense factor (one LAPACK sequence) */
+    if ((st = cm_progress(ctx, "rbf coarse", 0.5, 1)) < 0) goto done;
     const int saved = openblas_get_num_threads();
     openblas_set_num_threads(threads);
     int info = cm_rbf_projected_factor(r->c, m, p->c_idx, nc, p->gc, &p->c_rk, p->c_tau);
