@@ -468,7 +468,8 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
 {
     int n = mp->opt.steps;
     for (int k = 1; k <= n; ++k) {
-        cm_progress(ctx, "morph", k - 1, n);
+        cm_status p = cm_progress(ctx, "morph", k - 1, n);
+        if (p < 0) return p;
         cm_morph_step *row = new_row(ctx, mp);
         if (!row) return CM_ERR_NOMEM;
         cm_status s =
@@ -476,8 +477,7 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
         if (s < 0) return cm_error_prefix(ctx, s, "step %d of %d", k, n);
         memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
     }
-    cm_progress(ctx, "morph", n, n);
-    return CM_OK;
+    return cm_progress(ctx, "morph", n, n);
 }
 
 /* Adaptive steps (CM_MORPH_STEPS_AUTO), see cm_morph_options. */
@@ -490,7 +490,8 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
     while (done < 1) {
         double f = done + step;
         if (f > 1 - 1e-12) f = 1;
-        cm_progress(ctx, "morph", done, 1);
+        cm_status p = cm_progress(ctx, "morph", done, 1);
+        if (p < 0) return p;
         cm_morph_step *row = new_row(ctx, mp);
         if (!row) return CM_ERR_NOMEM;
         cm_status s = trial(ctx, mp, wo, f, done == 0, optimize, xyz, mp->next, row);
@@ -536,8 +537,7 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
                                      : "; interior optimisation (--optimize) may lift them");
         }
     }
-    cm_progress(ctx, "morph", 1, 1);
-    return CM_OK;
+    return cm_progress(ctx, "morph", 1, 1);
 }
 
 cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
@@ -549,6 +549,9 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     if ((int)method->warp.method < 0 || method->warp.method >= CM_WARP_N_METHODS)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_apply: unknown warp method %d",
                         (int)method->warp.method);
+    if (!mp->nodes)
+        return cm_error(ctx, CM_ERR_ARGUMENT,
+                        "cm_morpher_apply: the last cm_morpher_rebase failed; rebase again first");
     mp->n_rows = 0;
     double t_sample = 0;
     cm_status s = use_target(ctx, mp, target, &t_sample);
@@ -632,7 +635,12 @@ cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
     drop_warps(mp);
     held_warnings held = {0};
     cm_status s = classify(ctx, mp, &held);
-    if (s < 0) return s;
+    if (s < 0) {
+        /* half re-based (stopped by the caller, or g not under the mesh): no apply until a
+         * rebase succeeds */
+        cm_surface_nodes_destroy(&mp->nodes);
+        return s;
+    }
     return release(ctx, &held);
 }
 

@@ -365,6 +365,11 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
         if (first < 0.0) first = e;
         if (e <= CM_RBF_REFINE_TOL || !(e < 0.5 * prev) || steps == CM_RBF_REFINE_STEPS) break;
         prev = e;
+        /* a pass of a large fit streams the factor and sums m^2 pairs (20k centres: ~1 s):
+         * the caller may stop between passes (the weights stay the last solve's) */
+        if ((double)m * (double)m * (double)nc >= CM_RBF_TICK_PAIRS &&
+            (st = cm_progress(ctx, "rbf solve", steps + 1, CM_RBF_REFINE_STEPS + 1)) < 0)
+            break;
         st = cm_rbf_dense_solve_pass(ctx, rbf, nc, res, dw, dq, adw, g, threads);
         if (st != CM_OK) break;
         for (size_t i = 0; i < m * nc; ++i) {
@@ -413,12 +418,20 @@ cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const do
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < dim; ++d)
             p[(size_t)d * n + i] = (points[i * (size_t)dim + (size_t)d] - rbf->shift[d]) * rbf->scale;
+    /* in chunks with progress, so that cm_context_interrupt stops a large evaluation */
+    cm_rbf_tick tick;
+    cm_rbf_tick_init(&tick, ctx, "rbf evaluate",
+                     (double)((ncomp + 3) / 4) * (double)n * (double)rbf->m);
     if (rbf->petsc && cm_rbf_petsc_evaluate(rbf, n, p, out, cm_rbf_threads(ctx)))
         ; /* collective: each rank its block of points */
     else if (rbf->iter) /* compensated sums: see cm_rbf_iterative_evaluate */
-        cm_rbf_iterative_evaluate(rbf, n, p, out, cm_rbf_threads(ctx));
+        cm_rbf_iterative_evaluate(rbf, n, p, out, cm_rbf_threads(ctx), &tick);
     else
-        cm_rbf_kernel_sum_all(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx));
+        cm_rbf_kernel_sum_all_tick(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx), &tick);
+    if (cm_rbf_tick_finish(&tick) < 0) {
+        free(p);
+        return tick.status;
+    }
     for (size_t i = 0; i < n; ++i) {
         for (int c = 0; c < ncomp; ++c) {
             const double *qc = rbf->q + (size_t)c * (size_t)k;
