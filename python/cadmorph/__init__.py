@@ -13,6 +13,8 @@ from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, Mis
                      RejectedError, ResourceError)
 from .mesh import Mesh, read_mesh, write_mesh
 from .quality import Quality, quality
+from .morph import Morpher, MorpherInfo, MorphStep, SurfaceStats, morph
+from .warp import Warp, warp
 
 __version__: str = _ffi.string(_lib.cm_version()).decode()
 
@@ -21,5 +23,7 @@ __all__ = [
     "InterruptedCall", "CadmorphWarning",
     "Mesh", "read_mesh", "write_mesh",
     "Quality", "quality",
+    "Morpher", "MorphStep", "MorpherInfo", "SurfaceStats", "morph",
+    "Warp", "warp",
     "__version__",
 ]
