@@ -1,8 +1,13 @@
 """Shared by test_morph.py and test_warp.py: STEP models as Geometry objects, the bore's
 files made by the CLI, and the CLI's own runs."""
+import json
+import os
 import pathlib
 import subprocess
+import sys
 from typing import List
+
+import numpy as np
 
 import cadmorph
 from cadmorph._capi import ffi, lib
@@ -45,3 +50,41 @@ def bore(cli: str, work: pathlib.Path, ts: List[float], scale: float = 0.5) -> L
         run(cli, "model", "bore", t, p)
         out.append(p)
     return out
+
+
+def child_env() -> dict:
+    """The environment of a child Python that runs OpenBLAS as the CLI does: the cadmorph
+    program starts it with OPENBLAS_NUM_THREADS=1 (include/cadmorph/blas.h), and the sparse
+    methods' (CHOLMOD's) sums depend on OpenBLAS's thread count."""
+    env = dict(os.environ)
+    env["OPENBLAS_NUM_THREADS"] = "1"
+    env["PYTHONPATH"] = os.pathsep.join(p for p in [os.path.dirname(os.path.dirname(
+        cadmorph.__file__)), env.get("PYTHONPATH", "")] if p)
+    return env
+
+
+def in_child(*args) -> None:
+    """Runs this file's main() in a child Python with child_env()."""
+    r = subprocess.run([sys.executable, __file__] + [str(a) for a in args], env=child_env(),
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def main(argv: List[str]) -> None:
+    """morph OUT.npy G0 G1 M0 OPTIONS_JSON: Morpher(G0, M0, **options).apply(G1);
+    warp OUT.npy M0 NODES.npy D.npy OPTIONS_JSON: Warp(M0, nodes, **options).apply(D)."""
+    kind, out = argv[0], argv[1]
+    if kind == "morph":
+        g0, g1, m0, options = argv[2:6]
+        m = cadmorph.Morpher(read_step(g0), cadmorph.read_mesh(m0), **json.loads(options))
+        np.save(out, m.apply(read_step(g1)))
+    elif kind == "warp":
+        m0, nodes, D, options = argv[2:6]
+        w = cadmorph.Warp(cadmorph.read_mesh(m0), np.load(nodes), **json.loads(options))
+        np.save(out, w.apply(np.load(D)))
+    else:
+        raise SystemExit("unknown command %r" % kind)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
