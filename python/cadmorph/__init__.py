@@ -12,7 +12,8 @@ from ._capi import ffi as _ffi, lib as _lib
 from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, MismatchError,
                      RejectedError, ResourceError)
 from .mesh import Mesh, read_mesh, write_mesh
-from .quality import Quality, quality
+from .quality import FoamQuality, Quality, quality
+from .geometry import Comparison, Counts, Edge, Face, Geometry, model, model_names, read_step
 from .morph import Morpher, MorpherInfo, MorphStep, SurfaceStats, morph
 from .warp import Warp, warp
 
@@ -26,4 +27,6 @@ __all__ = [
     "Morpher", "MorphStep", "MorpherInfo", "SurfaceStats", "morph",
     "Warp", "warp",
     "__version__",
+    "FoamQuality",
+    "Geometry", "Face", "Edge", "Counts", "Comparison", "read_step", "model", "model_names",
 ]
