@@ -71,12 +71,23 @@ def test_morph_options_equal_cli_bit_for_bit(cli, bore_files, work, options, arg
     assert np.array_equal(np.load(work / "pts.npy"), ref.points)
 
 
+@pytest.fixture(scope="module")
+def fixture_meshes(cli, data, tmp_path_factory):
+    """Tet meshes (gmsh, through `cadmorph mesh`) of the held-in STEP fixtures bore_a
+    (tests/data/cad) and hole_a (tests/data/surface), by name."""
+    work = tmp_path_factory.mktemp("fixture_meshes")
+    out = {}
+    for folder, name in [("cad", "bore_a"), ("surface", "hole_a")]:
+        out[name] = work / (name + ".vtu")
+        run(cli, "mesh", data / folder / (name + ".step"), "-o", out[name], "--threads", 1)
+    return out
+
+
 @pytest.mark.parametrize("folder,a,b", [("cad", "bore_a", "bore_b"),
                                         ("surface", "hole_a", "hole_b")])
-def test_morph_equals_cli_on_held_in_fixtures(cli, data, work, folder, a, b):
+def test_morph_equals_cli_on_held_in_fixtures(cli, data, work, fixture_meshes, folder, a, b):
     g0_path, g1_path = data / folder / (a + ".step"), data / folder / (b + ".step")
-    m0 = work / "M0.vtu"
-    run(cli, "mesh", g0_path, "-o", m0, "--threads", 1)  # a tet mesh of G0 (gmsh)
+    m0 = fixture_meshes[a]
     ref = cli_morph(cli, work, g0_path, g1_path, m0)
     pts = cadmorph.Morpher(read_step(g0_path), cadmorph.read_mesh(m0), threads=1,
                            progress=False).apply(read_step(g1_path))
@@ -380,7 +391,7 @@ def test_bad_arguments_raise_before_the_library(bore_files):
         cadmorph.morph(g0, g1, mesh, via=g1)
 
 
-def test_mismatches_carry_the_library_message(cli, data, bore_files, work):
+def test_mismatches_carry_the_library_message(cli, data, bore_files, fixture_meshes, work):
     m0, g0_path, g1_path, _ = bore_files
     mesh = cadmorph.read_mesh(m0)
     # a mesh that is not a mesh of G: the held-in bore fixture is another solid
@@ -392,18 +403,12 @@ def test_mismatches_carry_the_library_message(cli, data, bore_files, work):
     assert r.returncode == 2 and e.value.message in r.stderr
     # a target of another topology: the differences named
     g_a = read_step(data / "cad" / "bore_a.step")
-    m = cadmorph.Morpher(g_a, cadmorph.read_mesh(run_mesh(cli, data, work)), progress=False)
+    m = cadmorph.Morpher(g_a, cadmorph.read_mesh(fixture_meshes["bore_a"]), progress=False)
     with pytest.raises(cadmorph.MismatchError, match="faces: 9 in G, 10 in G'|faces"):
         m.apply(read_step(data / "cad" / "bore_2holes.step"))
     # and the Morpher still works on a right one
     m.apply(read_step(data / "cad" / "bore_b.step"))
     assert m.steps[-1].accepted
-
-
-def run_mesh(cli, data, work):
-    path = work / "bore_a.vtu"
-    run(cli, "mesh", data / "cad" / "bore_a.step", "-o", path, "--threads", 1)
-    return path
 
 
 def test_keyboard_interrupt_stops_a_long_morph(cli, tmp_path_factory):

@@ -226,3 +226,23 @@ def test_warp_releases_the_gil(bore_mesh):
     inside = [x for x in ticks if t0 < x < t1]
     assert t1 - t0 > 0.01
     assert len(inside) > 100, (len(inside), t1 - t0)
+
+
+def test_keyboard_interrupt_stops_a_long_warp(cli, tmp_path_factory):
+    """Ctrl-C (SIGINT from a timer thread) during the dense factorisation of a warp of the
+    bore's 6912 boundary nodes (about 6 s on one thread): KeyboardInterrupt from the call
+    within a second, nothing made, and the next call runs."""
+    import _thread
+    m0 = bore(cli, tmp_path_factory.mktemp("warp_interrupt"), [], scale=1)[0]
+    mesh = cadmorph.read_mesh(m0)
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    t0 = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        cadmorph.Warp(mesh, solver="dense", threads=1, progress=False)
+    elapsed = time.perf_counter() - t0
+    timer.join()
+    assert elapsed < 1.5, elapsed
+    w = cadmorph.Warp(mesh, method="simplex", threads=1, progress=False)
+    D = motion(mesh.points[w.nodes])
+    assert np.array_equal(w.apply(D)[w.nodes], D)
