@@ -6,6 +6,7 @@ every other node of the volume cells, by one of the library's methods (docs/DESI
 warp interface"): "rbf" (triharmonic RBF, the method), "rbf-biharmonic", "femwarp",
 "lbwarp", "simplex", "dmffd", "mls".
 """
+import threading
 from typing import Any, Optional
 
 import numpy as np
@@ -54,8 +55,10 @@ class Warp:
 
     Raises ValueError/TypeError for bad arguments, BadInputError and its subclasses for what
     the library refuses (e.g. a mesh without volume cells, a flat boundary of an RBF
-    component), with the library's message. One Warp is used by one thread at a time; two
-    Warp objects may run in two threads.
+    component), with the library's message. Calls on one Warp from several threads wait for
+    each other; two Warp objects run in parallel in two threads (the GIL is released in the
+    library). Bit for bit what `cadmorph warp` computes when OpenBLAS runs as in the CLI
+    (started with OPENBLAS_NUM_THREADS=1): the sparse methods' sums depend on its threads.
     """
 
     def __init__(self, mesh: Mesh, nodes: Any = None, *, method: str = "rbf",
@@ -66,6 +69,7 @@ class Warp:
                  graded: float = 0.0, threads: int = 0, progress: Progress = None) -> None:
         what = "cadmorph.Warp"
         self._warp = None
+        self._lock = threading.Lock()  # the C API: one call at a time on a warp
         if not isinstance(mesh, Mesh):
             raise TypeError("%s: mesh must be a cadmorph.Mesh, not %s"
                             % (what, type(mesh).__name__))
@@ -146,7 +150,8 @@ class Warp:
         out = np.zeros((self._n, 3), np.float64)
         out[self._nodes] = d
         if self._n:
-            self._ctx.call(lib.cm_warp_apply, self._warp, ffi.from_buffer("double[]", out))
+            with self._lock:
+                self._ctx.call(lib.cm_warp_apply, self._warp, ffi.from_buffer("double[]", out))
         return out
 
     def __repr__(self) -> str:

@@ -6,6 +6,7 @@ import ctypes
 import gc
 import inspect
 import json
+import re
 import sys
 import threading
 import time
@@ -92,6 +93,29 @@ def test_morph_equals_cli_on_held_in_fixtures(cli, data, work, fixture_meshes, f
     pts = cadmorph.Morpher(read_step(g0_path), cadmorph.read_mesh(m0), threads=1,
                            progress=False).apply(read_step(g1_path))
     assert np.array_equal(pts, ref.points)
+
+
+def reversed_shell(src, dst):
+    """src with the faces of its closed shell listed the other way round: the same model,
+    numbered otherwise (OpenCASCADE numbers faces in the shell's order)."""
+    text = src.read_text()
+    m = re.search(r"CLOSED_SHELL\('',\(([^)]*)\)\)", text)
+    ids = m.group(1).split(",")
+    dst.write_text(text[:m.start(1)] + ",".join(reversed(ids)) + text[m.end(1):])
+
+
+def test_target_numbered_otherwise_is_renumbered_as_the_cli_does(cli, data, work,
+                                                                 fixture_meshes):
+    g0_path = data / "cad" / "bore_a.step"
+    reversed_shell(data / "cad" / "bore_b.step", work / "bore_b_rev.step")
+    m0 = fixture_meshes["bore_a"]
+    ref = cli_morph(cli, work, g0_path, work / "bore_b_rev.step", m0)
+    g0, g1 = read_step(g0_path), read_step(work / "bore_b_rev.step")
+    assert g0.compare(g1).renumbered
+    m = cadmorph.Morpher(g0, cadmorph.read_mesh(m0), threads=1, progress=False)
+    assert np.array_equal(m.apply(g1), ref.points)
+    comparison = g0.compare(g1)  # g1 now numbered like G, in place
+    assert comparison.corresponds and not comparison.renumbered
 
 
 def test_relative_morph_equals_cli(cli, bore_files, work):
