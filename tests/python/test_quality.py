@@ -158,3 +158,13 @@ def test_quality_keeps_its_form(data):
     assert cadmorph.quality(mesh, 1).min_sj == cadmorph.quality(mesh).min_sj  # threads
     with pytest.raises(TypeError, match="foam"):
         cadmorph.quality(mesh, foam="yes")
+
+
+def test_foam_needs_volume_cells(cli, work):
+    tri = cadmorph.Mesh.from_arrays(np.eye(3), [("triangle", [[0, 1, 2]])])
+    with pytest.raises(ValueError, match="volume cells"):
+        cadmorph.quality(tri, foam=True)
+    cadmorph.write_mesh(work / "tri.vtu", tri)
+    r = subprocess.run([cli, "quality", "--foam", str(work / "tri.vtu")], capture_output=True,
+                       text=True)
+    assert r.returncode == 2 and "no volume cells" in r.stderr
