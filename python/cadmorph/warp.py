@@ -86,8 +86,9 @@ class Warp:
         ctx.call(lib.cm_mesh_boundary_create, m, bp)
         b = ffi.gc(bp[0], _destroy_boundary)
         if nodes is None:
-            self._nodes = np.array(ffi.unpack(b.nodes, int(b.n_nodes)) if b.n_nodes else [],
-                                   dtype=np.int64)
+            k = int(b.n_nodes)
+            self._nodes = (np.frombuffer(ffi.buffer(b.nodes, 8 * k), np.int64).copy() if k
+                           else np.zeros(0, np.int64))
             constrained = ffi.NULL
         else:
             self._nodes = node_indices(what, "nodes", nodes, n).copy()
