@@ -13,7 +13,7 @@ import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._options import WarpSettings, node_indices, points
+from ._options import MAX_DISPLACEMENT, WarpSettings, node_indices, points
 from .mesh import Mesh
 
 
@@ -141,13 +141,15 @@ class Warp:
     def apply(self, D: Any) -> np.ndarray:
         """The displacement of every node, (n_nodes, 3) float64, for the displacements D of
         the constrained nodes: an array-like of shape (len(nodes), 3), row k for nodes[k]
-        (for a displacement of every node, pass D_all[w.nodes]). Constrained nodes get their
-        row of D exactly; nodes of no volume cell that are not constrained get 0.
+        (for a displacement of every node, pass D_all[w.nodes]); finite, each component at
+        most 1e150 in magnitude, as in `cadmorph warp`'s table (else ValueError). Constrained
+        nodes get their row of D exactly; nodes of no volume cell that are not constrained
+        get 0.
 
         The result is a new array the library fills in place; on an exception (Ctrl-C, the
         progress callable) nothing is returned and the warp stays usable.
         """
-        d = points("cadmorph.Warp.apply", "D", D, len(self._nodes))
+        d = points("cadmorph.Warp.apply", "D", D, len(self._nodes), MAX_DISPLACEMENT)
         out = np.zeros((self._n, 3), np.float64)
         out[self._nodes] = d
         if self._n:

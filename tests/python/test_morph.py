@@ -433,6 +433,17 @@ def test_mismatches_carry_the_library_message(cli, data, bore_files, fixture_mes
     # and the Morpher still works on a right one
     m.apply(read_step(data / "cad" / "bore_b.step"))
     assert m.steps[-1].accepted
+    # hostile: G' in metres (one changed unit in the STEP file), 1000x the mesh's G
+    text = g0_path.read_text()
+    assert "SI_UNIT(.MILLI.,.METRE.)" in text
+    (work / "metres.step").write_text(text.replace("SI_UNIT(.MILLI.,.METRE.)",
+                                                   "SI_UNIT($,.METRE.)"))
+    r = run_status(cli, "morph", "--from", g0_path, "--to", work / "metres.step", "--mesh", m0,
+                   "-o", work / "m.vtu")
+    m = cadmorph.Morpher(read_step(g0_path), mesh, progress=False)
+    with pytest.raises(cadmorph.MismatchError, match=r"differ in size by 1e\+03x") as e:
+        m.apply(read_step(work / "metres.step"))
+    assert r.returncode == 2 and e.value.message in r.stderr
 
 
 def test_keyboard_interrupt_stops_a_long_morph(cli, tmp_path_factory):

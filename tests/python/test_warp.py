@@ -131,6 +131,13 @@ def test_warp_bad_arrays_raise_before_the_library(bore_mesh):
     bad[7, 1] = np.inf
     with pytest.raises(ValueError, match="row 7 is not finite"):
         w.apply(bad)
+    # the hostile table's displacement, refused as `cadmorph warp` refuses it (squares of it
+    # overflow in the warp: LAPACK's error for the RBF, inf in the DM-FFD's result)
+    bad[7, 1] = 1.7e308
+    with pytest.raises(ValueError, match=r"row 7 is .* beyond any mesh \(\|d\| <= 1e\+150\)"):
+        w.apply(bad)
+    bad[7, 1] = -1e150
+    assert np.isfinite(w.apply(bad)).all()  # the bound itself is fine
     for nodes, kind, msg in [([0, n], ValueError, r"nodes\[1\] = %d is not a node index" % n),
                              ([-1, 3], ValueError, "is not a node index"),
                              ([3, 5, 3], ValueError, "lists node 3 2 times"),
