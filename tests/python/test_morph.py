@@ -72,6 +72,25 @@ def test_morph_options_equal_cli_bit_for_bit(cli, bore_files, work, options, arg
     assert np.array_equal(np.load(work / "pts.npy"), ref.points)
 
 
+@pytest.mark.parametrize("options,args", [
+    ({"kernel": "biharmonic", "steps": 2}, ["--kernel", "biharmonic", "--steps", "2"]),
+    ({"keep_offset": True, "cad_tol": 1e-3, "off_cad": "fixed"},
+     ["--keep-offset", "--cad-tol", "1e-3", "--off-cad", "fixed"]),
+    ({"method": "dmffd", "lattice": 6, "clamp": 1e-3}, ["--method", "dmffd", "--lattice", "6",
+                                                       "--clamp", "1e-3"]),
+], ids=["biharmonic-steps2", "keep-offset-fixed", "dmffd"])
+def test_morph_cli_option_names_in_process(cli, bore_files, work, options, args):
+    """The CLI's options under their Python names, in this process (the RBF and DM-FFD
+    paths set OpenBLAS's threads themselves or use none)."""
+    m0, g0_path, g1_path, _ = bore_files
+    ref = cli_morph(cli, work, g0_path, g1_path, m0, *args)
+    m = cadmorph.Morpher(read_step(g0_path), cadmorph.read_mesh(m0), threads=1,
+                         progress=False, **options)
+    assert np.array_equal(m.apply(read_step(g1_path)), ref.points)
+    if options.get("keep_offset"):  # G' = G moves nothing
+        assert np.array_equal(m.apply(read_step(g0_path)), cadmorph.read_mesh(m0).points)
+
+
 @pytest.fixture(scope="module")
 def fixture_meshes(cli, data, tmp_path_factory):
     """Tet meshes (gmsh, through `cadmorph mesh`) of the held-in STEP fixtures bore_a
