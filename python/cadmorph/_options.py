@@ -108,6 +108,8 @@ class WarpSettings:
     def replaced(self, what: str, **changes: Any) -> "WarpSettings":
         """These settings with some replaced (checked again); method= alone keeps the rest."""
         values = {k: getattr(self, k) for k in self.NAMES if k != "kernel"}
+        if "kernel" in changes and "method" not in changes:
+            values["method"] = "rbf"  # kernel= names the method by itself
         values.update(changes)
         return WarpSettings(what, **values)
 

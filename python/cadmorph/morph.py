@@ -496,15 +496,15 @@ class Morpher:
         p = points("cadmorph.Morpher.result_mesh", "pts", pts, self._n)
         with self._lock:
             mesh = _copy_mesh(self._ctx, lib.cm_morpher_mesh(self._mp))
-        m = mesh._ptr
-        # as cm_morph_run: the quality field before the displacement field
-        self._ctx.call(lib.cm_mesh_add_field, m, b"scaled_jacobian", lib.CM_FIELD_CELL, 1,
-                       ffi.NULL)
-        x = mesh.points
-        disp = p - x
-        x[...] = p
-        self._ctx.call(lib.cm_mesh_apply_displacement, m, ffi.from_buffer("double[]", disp),
-                       lib.CM_DISPLACEMENT_QUALITY, ffi.NULL)
+            m = mesh._ptr
+            # as cm_morph_run: the quality field before the displacement field
+            self._ctx.call(lib.cm_mesh_add_field, m, b"scaled_jacobian", lib.CM_FIELD_CELL, 1,
+                           ffi.NULL)
+            x = mesh.points
+            disp = p - x
+            x[...] = p
+            self._ctx.call(lib.cm_mesh_apply_displacement, m, ffi.from_buffer("double[]", disp),
+                           lib.CM_DISPLACEMENT_QUALITY, ffi.NULL)
         return mesh
 
     def __repr__(self) -> str:

@@ -245,6 +245,8 @@ def test_apply_with_another_method(bore_files):
     assert np.array_equal(proj, cadmorph.Morpher(g0, mesh, surface="project",
                                                  progress=False).apply(g1))
     assert np.array_equal(m.apply(g1), rbf)  # the Morpher's own method again, unchanged
+    fem_m = cadmorph.Morpher(g0, mesh, method="femwarp", progress=False)
+    assert np.array_equal(fem_m.apply(g1, kernel="triharmonic"), rbf)  # kernel: a method
     with pytest.raises(ValueError, match="method must be one of"):
         m.apply(g1, method="spline")
     with pytest.raises(TypeError, match="unknown option steps"):
