@@ -151,6 +151,13 @@ def test_relative_morph_equals_cli(cli, bore_files, work):
     m.rebase(gh, half)
     assert np.array_equal(m.mesh.points, half)
     assert np.array_equal(m.apply(g1), ref.points)
+    # a rebase onto a model the mesh is not on fails; apply refuses until a rebase succeeds
+    with pytest.raises(cadmorph.MismatchError):
+        m.rebase(g1, half)
+    with pytest.raises(cadmorph.Error, match="rebase again first"):
+        m.apply(g1)
+    m.rebase(gh, half)
+    assert np.array_equal(m.apply(g1), ref.points)
     # relative differs from absolute (else the test could not tell them apart)
     assert not np.array_equal(cadmorph.Morpher(g0, mesh, threads=1, progress=False).apply(g1),
                               ref.points)
