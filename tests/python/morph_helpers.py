@@ -55,8 +55,9 @@ def bore(cli: str, work: pathlib.Path, ts: List[float], scale: float = 0.5) -> L
 class CtrlC:
     """Ctrl-C from a timer thread after `delay` seconds (_thread.interrupt_main: SIGINT's
     KeyboardInterrupt), and a progress callable that records every report with its time:
-    `after()` lists the reports the library made once the signal was sent. A call that
-    stops at its next progress point makes at most one more (the one that raises)."""
+    `after()` lists the reports recorded once the signal was sent. A call that stops at
+    its next progress point records none: the KeyboardInterrupt is raised in the callback
+    of that point before the callable runs (at most one, if the signal lands inside it)."""
 
     def __init__(self, delay: float = 0.3) -> None:
         import threading

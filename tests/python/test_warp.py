@@ -249,8 +249,9 @@ def test_keyboard_interrupt_stops_a_long_warp(cli, tmp_path_factory):
     assert ctrl_c.sent is not None
     after = ctrl_c.after()
     assert len(after) <= 1, after
-    last = ctrl_c.reports[-1][1:]
-    assert last[0] == "rbf factor" and last[1] < last[2], ctrl_c.reports[-3:]
+    # the warp's factorisation did not finish (it reports "warp factorise" when it does);
+    # the report at which the KeyboardInterrupt is raised is not recorded
+    assert not any(s == "warp factorise" for _, s, d, t in ctrl_c.reports), ctrl_c.reports
     assert stopped - ctrl_c.sent < 5.0
     w = cadmorph.Warp(mesh, method="simplex", threads=1, progress=False)
     D = motion(mesh.points[w.nodes])
