@@ -14,6 +14,8 @@ from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, Mis
 from .mesh import Mesh, read_mesh, write_mesh
 from .quality import FoamQuality, Quality, quality
 from .geometry import Comparison, Counts, Edge, Face, Geometry, model, model_names, read_step
+from .morph import Morpher, MorpherInfo, MorphStep, SurfaceStats, morph
+from .warp import Warp, warp
 from .deform import Deformer, deform
 from .ffd import FFDStats, Lattice, ffd
 from .optimize import OptimizeStats, optimize
@@ -26,13 +28,14 @@ __all__ = [
     "Error", "BadInputError", "MismatchError", "RejectedError", "ResourceError",
     "InterruptedCall", "CadmorphWarning",
     "Mesh", "read_mesh", "write_mesh",
-    "Quality", "quality",
-    "__version__",
-    "FoamQuality",
+    "Quality", "FoamQuality", "quality",
     "Geometry", "Face", "Edge", "Counts", "Comparison", "read_step", "model", "model_names",
+    "Morpher", "MorphStep", "MorpherInfo", "SurfaceStats", "morph",
+    "Warp", "warp",
     "Deformer", "deform",
     "Lattice", "FFDStats", "ffd",
     "OptimizeStats", "optimize",
     "mesh_step",
     "StudyResult", "StudyRow", "study", "sweep",
+    "__version__",
 ]
