@@ -1,0 +1,298 @@
+#!/usr/bin/python3
+"""The Python package's overhead on a whole morph, side by side in one run: the same morph of
+a mesh of G(0) onto G(1) of a built-in model by the CLI (`cadmorph morph`), by the library
+from C (bench_morph.c: examples/morph_family.c's calls, each stage timed, compiled here
+against BUILD_DIR) and by the package (read_step, read_mesh, Morpher, Morpher.apply,
+write_mesh); then the interior warp of that morph's boundary motion by cadmorph.Warp and by
+PyGeM's RBF with the same kernel (polyharmonic_spline, k = 3: phi = r^3, plus PyGeM's linear
+polynomial, as cadmorph's "rbf"), when a PyGeM checkout is given.
+
+usage: bench_overhead.py BUILD_DIR WORK_DIR [--model bore] [--size H] [--mesher gmsh|tetgen]
+           [--no-optimize] [--hex-scale S] [--repeat N] [--rounds R] [--threads T]
+           [--pygem PYGEM_DIR] [--pygem-max N]
+
+Every program runs in its own process under /usr/bin/time, one at a time, so that each peak
+resident set (its maxrss) is that program's alone; R rounds alternate them and
+the best wall time of each is kept. Inside each run, Morpher.apply (Python) and
+cm_morpher_apply (C) are timed around the call, REPEAT times onto the same G(1): the first
+call (Python: with the correspondence check of a new target, cm_cad_compare) and the best.
+The printed ratios are Python / C. Every child gets OPENBLAS_NUM_THREADS=1 (what the CLI sets
+for itself before OpenBLAS loads) and the CLI's OpenBLAS core through OPENBLAS_CORETYPE, so
+all of them factorise on the same kernels.
+
+The mesh is WORK_DIR/M0_<model>_<size>[t].vtu from `cadmorph mesh` (made once, reused), or
+with --hex-scale the model's structured hex mesh (`cadmorph model M 0 --hex-mesh --scale S`).
+PyGeM's RBF is dense (an (n+4)^2 system, then an (N, n) distance matrix for the N points):
+it is skipped above --pygem-max boundary nodes (default 30,000) with the memory it would need.
+"""
+import argparse
+import json
+import os
+import platform
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+
+def run_child(cmd, env, cwd=None):
+    """Runs cmd; (stdout, stderr, wall s); exits on failure."""
+    t = time.monotonic()
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, cwd=cwd,
+                         text=True)
+    out, err = p.communicate()
+    wall = time.monotonic() - t
+    if p.returncode != 0:
+        sys.exit("failed (%d): %s\n%s%s" % (p.returncode, " ".join(cmd), out, err))
+    return out, err, wall
+
+
+def timed(cmd, env, cwd=None):
+    """cmd under /usr/bin/time: (stdout, wall s, CPU s, peak RSS MB)."""
+    tf = os.path.join(env["BENCH_WORK"], "time.txt")
+    out, err, wall = run_child(["/usr/bin/time", "-o", tf, "-f", "%e %U %S %M"] + cmd, env, cwd)
+    e, u, s, m = open(tf).read().split()[-4:]
+    return out, float(e), float(u) + float(s), int(m) / 1024.0
+
+
+# ---------------------------------------------------------------- children (one per process)
+
+def child_python(a):
+    """The package's morph: the C driver's stages through cadmorph."""
+    t0 = time.perf_counter()
+    import numpy as np
+    import cadmorph
+    t_import = time.perf_counter() - t0
+    t = time.perf_counter()
+    g0 = cadmorph.read_step(a["g0"])
+    g1 = cadmorph.read_step(a["g1"])
+    t_cad = time.perf_counter() - t
+    t = time.perf_counter()
+    mesh = cadmorph.read_mesh(a["m0"], threads=a["threads"])
+    t_mesh = time.perf_counter() - t
+    t = time.perf_counter()
+    morpher = cadmorph.Morpher(g0, mesh, threads=a["threads"], progress=False)
+    t_create = time.perf_counter() - t
+    t_apply = []
+    for _ in range(a["repeat"]):
+        t = time.perf_counter()
+        pts = morpher.apply(g1)
+        t_apply.append(time.perf_counter() - t)
+    t = time.perf_counter()
+    out = morpher.mesh
+    out.points = pts
+    cadmorph.write_mesh(a["m1"], out, threads=a["threads"])
+    t_write = time.perf_counter() - t
+    row = morpher.steps[-1]
+    return dict(import_=t_import, read_cad=t_cad, read_mesh=t_mesh, create=t_create,
+                apply=t_apply, write=t_write, nodes=mesh.n_nodes,
+                boundary=morpher.info.boundary_nodes, min_sj=row.min_sj,
+                inverted=row.inverted, finite=bool(np.isfinite(pts).all()))
+
+
+def child_warp(a):
+    """cadmorph.Warp of the boundary motion M0 -> M1: fit, apply; saves nodes, D and the
+    result for the PyGeM child."""
+    import numpy as np
+    import cadmorph
+    m0 = cadmorph.read_mesh(a["m0"])
+    x1 = cadmorph.read_mesh(a["m1"]).points
+    t = time.perf_counter()
+    w = cadmorph.Warp(m0, None, method="rbf", threads=a["threads"], progress=False)
+    t_fit = time.perf_counter() - t
+    d = x1[w.nodes] - m0.points[w.nodes]
+    t = time.perf_counter()
+    u = w.apply(d)
+    t_apply = time.perf_counter() - t
+    np.savez(a["npz"], x0=m0.points, nodes=w.nodes, d=d, u=u)
+    return dict(fit=t_fit, apply=t_apply, boundary=len(w.nodes), nodes=m0.n_nodes)
+
+
+def child_pygem(a):
+    """PyGeM's RBF of the same boundary motion, every node evaluated."""
+    import numpy as np
+    sys.path.insert(0, a["pygem"])
+    from pygem import RBF
+    z = np.load(a["npz"])
+    x0, nodes, d, u = z["x0"], z["nodes"], z["d"], z["u"]
+    b0 = x0[nodes]
+    t = time.perf_counter()
+    rbf = RBF(original_control_points=b0, deformed_control_points=b0 + d,
+              func="polyharmonic_spline", radius=1.0, extra_parameter={"k": 3})
+    t_fit = time.perf_counter() - t
+    t = time.perf_counter()
+    x1 = rbf(x0)
+    t_apply = time.perf_counter() - t
+    diff = float(np.abs((x1 - x0) - u).max())
+    return dict(fit=t_fit, apply=t_apply, diff=diff, scale=float(np.abs(u).max()))
+
+
+def child_main(mode, arg):
+    """Runs one child and prints its result as JSON."""
+    print(json.dumps({"python": child_python, "warp": child_warp,
+                      "pygem": child_pygem}[mode](json.loads(arg))))
+
+
+# ---------------------------------------------------------------- the parent
+
+def machine(cli, env):
+    """CPU model, cores, the CLI's BLAS lines."""
+    cpu = "?"
+    for line in open("/proc/cpuinfo"):
+        if line.startswith("model name"):
+            cpu = line.split(":", 1)[1].strip()
+            break
+    fam = re.search(r"cpu family\s*:\s*(\d+)", open("/proc/cpuinfo").read())
+    version = subprocess.run([cli, "--version"], capture_output=True, text=True,
+                             env=env).stdout.strip().splitlines()
+    load = open("/proc/loadavg").read().split()[:3]
+    return cpu, fam.group(1) if fam else "?", os.cpu_count(), version, load
+
+
+def main():
+    if len(sys.argv) >= 2 and sys.argv[1] == "--child":
+        return child_main(sys.argv[2], sys.argv[3])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("build")
+    ap.add_argument("work")
+    ap.add_argument("--model", default="bore", choices=["bore", "pipe", "bracket"])
+    ap.add_argument("--size", type=float, default=0.3)
+    ap.add_argument("--mesher", default="gmsh", choices=["gmsh", "tetgen"])
+    ap.add_argument("--no-optimize", action="store_true")
+    ap.add_argument("--hex-scale", type=float)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=2)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--pygem", help="a PyGeM checkout (the directory holding pygem/)")
+    ap.add_argument("--pygem-max", type=int, default=30000)
+    a = ap.parse_args()
+    build, work = os.path.abspath(a.build), os.path.abspath(a.work)
+    os.makedirs(work, exist_ok=True)
+    cli = os.path.join(build, "cli", "cadmorph")
+    env = dict(os.environ, PYTHONPATH=os.path.join(build, "python"), PYTHONDONTWRITEBYTECODE="1",
+               OPENBLAS_NUM_THREADS="1", BENCH_WORK=work)
+    env.pop("CADMORPH_LIBRARY", None)
+    m = re.search(r"^BLAS core: (\w+)", subprocess.run([cli, "--version"], capture_output=True,
+                                                       text=True).stdout, re.MULTILINE)
+    if m and "OPENBLAS_CORETYPE" not in env:
+        env["OPENBLAS_CORETYPE"] = m.group(1)
+
+    g0, g1 = os.path.join(work, a.model + "_0.step"), os.path.join(work, a.model + "_1.step")
+    for t, g in ((0, g0), (1, g1)):
+        if not os.path.exists(g):
+            run_child([cli, "model", a.model, str(t), g], env)
+    if a.hex_scale:
+        m0 = os.path.join(work, "M0_%s_hex%g.vtu" % (a.model, a.hex_scale))
+        make = [cli, "model", a.model, "0", "--hex-mesh", m0, "--scale", str(a.hex_scale)]
+    else:
+        m0 = os.path.join(work, "M0_%s_%g%s%s.vtu" % (a.model, a.size, a.mesher[0],
+                                                     "n" if a.no_optimize else ""))
+        make = [cli, "mesh", g0, "-o", m0, "--size", str(a.size), "--mesher", a.mesher] + \
+            (["--no-optimize"] if a.no_optimize else [])
+    if not os.path.exists(m0):
+        print("$ " + " ".join(make), flush=True)
+        t = time.monotonic()
+        run_child(make, env)
+        print("  %.1f s" % (time.monotonic() - t), flush=True)
+
+    exe = os.path.join(work, "bench_morph")
+    subprocess.run(["cc", "-O2", "-std=c11", "-I" + os.path.join(ROOT, "include"),
+                    "-I" + os.path.join(build, "include"), os.path.join(HERE, "bench_morph.c"),
+                    "-o", exe, "-L" + build, "-lcadmorph", "-Wl,-rpath," + build], check=True)
+
+    cpu, fam, cores, version, load = machine(cli, env)
+    import numpy
+    print("machine: %s (family %s), %d cores, load %s; Python %s, numpy %s"
+          % (cpu, fam, cores, " ".join(load), platform.python_version(), numpy.__version__))
+    print("\n".join("  " + v for v in version))
+    print("threads %d, OPENBLAS_CORETYPE=%s, OPENBLAS_NUM_THREADS=1; mesh %s"
+          % (a.threads, env.get("OPENBLAS_CORETYPE", "-"), os.path.basename(m0)), flush=True)
+
+    me = [sys.executable, os.path.abspath(__file__), "--child"]
+    args = dict(g0=g0, g1=g1, m0=m0, threads=a.threads, repeat=a.repeat)
+    best = {}
+
+    def keep(key, wall, cpu_s, rss, extra=None):
+        b = best.get(key)
+        if b is None or wall < b["wall"]:
+            best[key] = dict(wall=wall, cpu=cpu_s, rss=max(rss, b["rss"] if b else 0), **(extra or {}))
+        else:
+            b["rss"] = max(b["rss"], rss)
+
+    for r in range(a.rounds):
+        out, wall, cpu_s, rss = timed([cli, "morph", "--from", g0, "--to", g1, "--mesh", m0,
+                                       "-o", os.path.join(work, "m1_cli.vtu"), "--threads",
+                                       str(a.threads)], env)
+        keep("cli", wall, cpu_s, rss)
+        out, wall, cpu_s, rss = timed([exe, g0, g1, m0, os.path.join(work, "m1_c.vtu"),
+                                       str(a.repeat), str(a.threads)], env)
+        w = out.split()
+        c = dict(zip(w[0::2], w[1::2]))
+        c["apply"] = [float(x) for x in c["apply"].split(",")]
+        keep("c", wall, cpu_s, rss, c)
+        out, wall, cpu_s, rss = timed(me + ["python", json.dumps(
+            dict(args, m1=os.path.join(work, "m1_py.vtu")))], env)
+        keep("py", wall, cpu_s, rss, json.loads(out.strip().splitlines()[-1]))
+        print("round %d: CLI %.2f s, C %.2f s, Python %.2f s" % (
+            r + 1, best["cli"]["wall"], best["c"]["wall"], best["py"]["wall"]), flush=True)
+
+    c, py = best["c"], best["py"]
+    print("\nmesh: %d nodes, %d boundary nodes; morph: min scaled Jacobian %.4f, %d inverted"
+          % (py["nodes"], py["boundary"], py["min_sj"], py["inverted"]))
+    print("\n| stage | C (library) s | Python s | Python / C |")
+    print("|---|---:|---:|---:|")
+    rows = [("read G0, G1", float(c["read_cad"]), py["read_cad"]),
+            ("read M0", float(c["read_mesh"]), py["read_mesh"]),
+            ("Morpher / cm_morpher_create", float(c["create"]), py["create"]),
+            ("apply, first call", c["apply"][0], py["apply"][0]),
+            ("apply, best of %d" % a.repeat, min(c["apply"]), min(py["apply"])),
+            ("write M1", float(c["write"]), py["write"])]
+    for name, tc, tp in rows:
+        print("| %s | %.3f | %.3f | %.3f |" % (name, tc, tp, tp / tc))
+    print("| (import cadmorph) | – | %.3f | |" % py["import_"])
+    print("\n| process | wall s | CPU s | peak RSS MB | / CLI (wall, RSS) |")
+    print("|---|---:|---:|---:|---:|")
+    for key, name in (("cli", "cadmorph morph"), ("c", "C (bench_morph.c)"),
+                      ("py", "Python (cadmorph)")):
+        b = best[key]
+        print("| %s | %.2f | %.2f | %.0f | %.3f, %.3f |" % (
+            name, b["wall"], b["cpu"], b["rss"], b["wall"] / best["cli"]["wall"],
+            b["rss"] / best["cli"]["rss"]))
+
+    # the warp of the same boundary motion: cadmorph.Warp against PyGeM's RBF
+    npz = os.path.join(work, "warp_motion.npz")
+    wa = dict(m0=m0, m1=os.path.join(work, "m1_c.vtu"), threads=a.threads, npz=npz)
+    out, wall, cpu_s, rss = timed(me + ["warp", json.dumps(wa)], env)
+    cw = json.loads(out.strip().splitlines()[-1])
+    print("\nwarp of the morph's boundary motion (%d boundary nodes, %d nodes):"
+          % (cw["boundary"], cw["nodes"]))
+    print("\n| | fit s | evaluation s | process wall s | CPU s | peak RSS MB |")
+    print("|---|---:|---:|---:|---:|---:|")
+    print("| cadmorph.Warp (rbf) | %.3f | %.3f | %.2f | %.2f | %.0f |"
+          % (cw["fit"], cw["apply"], wall, cpu_s, rss))
+    if not a.pygem:
+        print("| PyGeM RBF | (no --pygem) | | | | |")
+    elif cw["boundary"] > a.pygem_max:
+        n, big_n = cw["boundary"], cw["nodes"]
+        print("| PyGeM RBF | skipped: dense, (n+4)^2 = %.1f GB to solve, then %.1f GB of "
+              "distances | | | | |" % (8.0 * (n + 4) ** 2 / 2 ** 30, 8.0 * n * big_n / 2 ** 30))
+    else:
+        pa = dict(npz=npz, pygem=os.path.abspath(a.pygem))
+        out, wall, cpu_s, rss = timed(me + ["pygem", json.dumps(pa)], env)
+        pg = json.loads(out.strip().splitlines()[-1])
+        print("| PyGeM RBF (polyharmonic_spline k=3) | %.3f | %.3f | %.2f | %.2f | %.0f |"
+              % (pg["fit"], pg["apply"], wall, cpu_s, rss))
+        print("\nPyGeM / cadmorph: fit %.1fx, evaluation %.1fx; largest difference of the "
+              "displacements %.2e (largest displacement %.3g)"
+              % (pg["fit"] / cw["fit"], pg["apply"] / cw["apply"], pg["diff"], pg["scale"]))
+    shutil.rmtree(os.path.join(work, "__pycache__"), ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
