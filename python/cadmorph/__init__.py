@@ -12,7 +12,8 @@ from ._capi import ffi as _ffi, lib as _lib
 from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, MismatchError,
                      RejectedError, ResourceError)
 from .mesh import Mesh, read_mesh, write_mesh
-from .quality import Quality, quality
+from .quality import FoamQuality, Quality, quality
+from .geometry import Comparison, Counts, Edge, Face, Geometry, model, model_names, read_step
 
 __version__: str = _ffi.string(_lib.cm_version()).decode()
 
@@ -22,4 +23,6 @@ __all__ = [
     "Mesh", "read_mesh", "write_mesh",
     "Quality", "quality",
     "__version__",
+    "FoamQuality",
+    "Geometry", "Face", "Edge", "Counts", "Comparison", "read_step", "model", "model_names",
 ]

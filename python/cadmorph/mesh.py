@@ -64,10 +64,12 @@ class Mesh:
     """
 
     def __init__(self, _owner=None, _token=None) -> None:
-        """Not for users: a Mesh comes from read_mesh (a TypeError otherwise)."""
+        """Not for users: a Mesh comes from read_mesh, from_arrays or from_meshio (a
+        TypeError otherwise)."""
         if _token is not _TOKEN or ffi.typeof(_owner) is not ffi.typeof("cm_mesh *") \
                 or _owner == ffi.NULL:
-            raise TypeError("cadmorph.Mesh: made by cadmorph.read_mesh, not directly")
+            raise TypeError("cadmorph.Mesh: made by cadmorph.read_mesh, Mesh.from_arrays "
+                            "or Mesh.from_meshio, not directly")
         self._owner = _owner
 
     @property
@@ -182,11 +184,153 @@ class Mesh:
         return self._field_dict(lib.CM_FIELD_CELL, self.n_cells)
 
     @property
+    def physical(self) -> np.ndarray:
+        """Each element's physical group tag, 0 if none: (n_cells,) int32, a read-only view
+        (gmsh's physical tags, Medit's references; "gmsh:physical" in a .vtu)."""
+        m = self._ptr
+        return _array(m, m.physical, (int(m.n_cells),), np.intc, writable=False)
+
+    @property
+    def entity(self) -> np.ndarray:
+        """Each element's geometric (elementary) entity tag, 0 if none: (n_cells,) int32, a
+        read-only view ("gmsh:geometrical" in a .vtu)."""
+        m = self._ptr
+        return _array(m, m.entity, (int(m.n_cells),), np.intc, writable=False)
+
+    @property
     def groups(self) -> List[Tuple[int, int, str]]:
         """Named physical groups as (dim, tag, name)."""
         m = self._ptr
         return [(int(g.dim), int(g.tag), ffi.string(g.name).decode("utf-8", "replace"))
                 for g in (m.groups[i] for i in range(int(m.n_groups)))]
+
+    @classmethod
+    def from_arrays(cls, points, cells, point_data: Optional[Dict[str, object]] = None,
+                    cell_data: Optional[Dict[str, object]] = None,
+                    groups: Optional[List[Tuple[int, int, str]]] = None,
+                    threads: int = 0) -> "Mesh":
+        """A mesh from arrays (copied into a new cm_mesh), checked before the library sees
+        them.
+
+        points: (n, 3) real numbers (or (n, 2): z = 0), all finite, n > 0.
+        cells: a list of (type name, array), as meshio keeps them (meshio CellBlocks and a
+            {name: array} dict work too). Names are cadmorph's ("tet4", "hex20", ...,
+            Mesh.cells' names, nodes in VTK's order) or meshio's ("tetra", "hexahedron20",
+            "wedge", ..., nodes in meshio's order: VTK's except "wedge", whose nodes 1 and 2,
+            4 and 5 are swapped). The array is (k, nodes) integers for fixed-size types;
+            "polygon" takes a (k, n) array or a list of 1-D node lists; "polyhedron" a list
+            of face streams (nf, n0, nodes of face 0, n1, ...) or of lists of faces, and
+            meshio's "polyhedron<n>" a list of lists of faces.
+        point_data: {name: (n,) or (n, c) reals} (trailing axes are flattened into
+            components). cell_data: {name: reals over every cell, in the order of `cells`
+            concatenated, or a list with one array per block as meshio keeps them}; the names
+            "gmsh:physical" and "gmsh:geometrical" are the cells' physical and entity tags
+            (Mesh.physical, Mesh.entity; integers), not fields.
+        groups: named physical groups as (dim, tag, name), as Mesh.groups gives them.
+
+        Raises TypeError for a wrong type or dtype (strings, complex, float node indices)
+        and ValueError for a wrong shape, an unknown type name, a node index out of range or
+        a non-finite point (naming the block and the row).
+        """
+        from . import _convert
+        what = "cadmorph.Mesh.from_arrays"
+        xyz = _convert.points_array(points, what)
+        n = len(xyz)
+        blocks = _convert.cell_blocks(cells, n, what)
+        n_cells = sum(b.count for b in blocks)
+        fields, tags = [], {}
+        for data, location, count, bl in ((point_data, lib.CM_FIELD_NODE, n, None),
+                                          (cell_data, lib.CM_FIELD_CELL, n_cells, blocks)):
+            if data is None:
+                continue
+            if not isinstance(data, dict):
+                raise TypeError("%s: point_data and cell_data must be dicts, not %s"
+                                % (what, type(data).__name__))
+            for name, value in data.items():
+                key = _convert._name(name, what)
+                if bl is not None and name in _convert.TAGS:
+                    tags[name] = _convert.tag_array(name, value, count, bl, what)
+                else:
+                    fields.append((key, location,
+                                   _convert.field_array(name, value, count, bl, what)))
+        group_list = _convert.groups_list(groups, what)
+
+        ctx = Context(threads, False, what)
+        out = ffi.new("cm_mesh *[1]")
+        ctx.call(lib.cm_mesh_create, out)
+        m = ffi.gc(out[0], _destroy_mesh)
+        ctx.call(lib.cm_mesh_resize_nodes, m, n, 0)
+        _array(m, m.xyz, (n, 3), np.float64)[...] = xyz
+        n_conn = sum(b.data.size if isinstance(b.data, np.ndarray) else
+                     sum(len(r) for r in b.data) for b in blocks)
+        ctx.call(lib.cm_mesh_reserve_cells, m, n_cells, n_conn)
+        physical = tags.get("gmsh:physical", np.zeros(n_cells, np.int32)).tolist()
+        entity = tags.get("gmsh:geometrical", np.zeros(n_cells, np.int32)).tolist()
+        add, p, c = lib.cm_mesh_add_cell, ctx.ptr, 0
+        for b in blocks:
+            if b.count == 0:
+                continue
+            if isinstance(b.data, np.ndarray):
+                k = b.data.shape[1]
+                buf = ffi.from_buffer("int64_t[]", b.data)
+                rows = ((buf + i * k, k) for i in range(b.count))
+            else:
+                rows = ((ffi.from_buffer("int64_t[]", r), len(r)) for r in b.data)
+            for ptr, k in rows:
+                status = add(p, m, b.type, ptr, k, physical[c], entity[c], 0)
+                if status != lib.CM_OK:
+                    ctx.check(status)
+                c += 1
+        for key, location, a in fields:
+            data = ffi.new("double *[1]")
+            ctx.call(lib.cm_mesh_add_field, m, key, location, a.shape[1], data)
+            _array(m, data[0], a.shape, np.float64)[...] = a
+        for dim, tag, key in group_list:
+            ctx.call(lib.cm_mesh_add_group, m, dim, tag, key)
+        ctx.call(lib.cm_mesh_validate, m, what.encode())  # what Python checked, once more
+        return cls(m, _TOKEN)
+
+    @classmethod
+    def from_meshio(cls, mesh, threads: int = 0) -> "Mesh":
+        """A mesh from a meshio.Mesh: points, cells (meshio's node order, see from_arrays),
+        point_data and cell_data as fields, "gmsh:physical" and "gmsh:geometrical" as the
+        cells' tags and field_data's {name: [tag, dim]} as groups (meshio's form of gmsh's
+        physical groups). Without "gmsh:physical", meshio's cell_sets become groups (tags 1,
+        2, ... in their order; a cell in two sets raises ValueError). meshio's bookkeeping
+        "gmsh:dim_tags" is dropped. Checked as from_arrays checks.
+
+        meshio's gmsh reader gives wedge15 mirrored and wedge18, pyramid14 in gmsh's order
+        (its VTK reader in VTK's): read such .msh files with read_mesh instead.
+        """
+        from . import _convert
+        return cls.from_arrays(threads=threads,
+                               **_convert.from_meshio_args(mesh, "cadmorph.Mesh.from_meshio"))
+
+    def to_meshio(self):
+        """A meshio.Mesh with copies of the points, cells (meshio's names and node order: the
+        wedge's nodes 1 and 2, 4 and 5 swapped; one block per run of one type, polygons per
+        run of one size, polyhedra as "polyhedron<n>" lists of faces), point_data, cell_data
+        (per block), the cells' tags as "gmsh:physical" and "gmsh:geometrical" (when any is
+        set) and the groups as field_data {name: array([tag, dim])}, as meshio reads gmsh
+        files; meshio.write then writes every format meshio knows."""
+        import meshio
+        from . import _convert
+        types, offset, conn = self._cell_arrays()
+        blocks = _convert.meshio_blocks(types, offset, conn)
+        cell_data = {}
+        for name, a in self.cell_data.items():
+            cell_data[name] = [a[b0:b1].copy() for _, _, b0, b1 in blocks]
+        for name, a in zip(_convert.TAGS, (self.physical, self.entity)):
+            if (self.physical != 0).any() or (self.entity != 0).any():
+                cell_data[name] = [a[b0:b1].copy() for _, _, b0, b1 in blocks]
+        field_data = {name: np.array([tag, dim]) for dim, tag, name in self.groups}
+        try:
+            return meshio.Mesh(self.points.copy(), [(t, data) for t, data, _, _ in blocks],
+                               point_data={k: v.copy() for k, v in self.point_data.items()},
+                               cell_data=cell_data, field_data=field_data)
+        except KeyError as e:  # meshio 5.0 has no wedge15 and pyramid13 (no dimension)
+            raise ValueError("cadmorph.Mesh.to_meshio: meshio %s cannot hold cells of type %s"
+                             % (meshio.__version__, e)) from None
 
     def __repr__(self) -> str:
         if self.closed:

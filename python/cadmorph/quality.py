@@ -1,5 +1,7 @@
-"""quality(mesh): the scaled Jacobian of every cell and its summary, as `cadmorph quality`."""
+"""quality(mesh): the scaled Jacobian of every cell and its summary, as `cadmorph quality`;
+quality(mesh, foam=True): OpenFOAM checkMesh's geometry checks, as `cadmorph quality --foam`."""
 from dataclasses import dataclass
+from typing import Tuple, Union
 
 import numpy as np
 
@@ -30,15 +32,110 @@ class Quality:
     per_cell: np.ndarray
 
 
-def quality(mesh: Mesh, threads: int = 0) -> Quality:
+@dataclass(frozen=True)
+class FoamQuality:
+    """OpenFOAM checkMesh's mesh statistics and geometry checks (as OpenFOAM v1912 defines
+    them, cm_mesh_quality_foam), the numbers `cadmorph quality --foam` prints. On a mesh read
+    from a polyMesh its own faces; on other meshes the faces of the volume cells.
+
+    Attributes:
+        points, faces, internal_faces, cells, patches: the mesh's counts.
+        hexahedra, prisms, pyramids, tetrahedra, polyhedra: cells by shape.
+        bbox: (xmin, ymin, zmin, xmax, ymax, zmax).
+        directions: per axis 1 (a geometric direction) or -1 (empty: a 2-D mesh).
+        boundary_openness: the sum of the boundary's face area vectors over its total, per
+            axis; boundary_open: it exceeds 1e-6 (a hole in the boundary).
+        max_cell_openness, open_cells: the same per cell, and cells past 1e-6.
+        max_aspect_ratio, high_aspect_cells (> 1000), worst_aspect_cell.
+        min_face_area, max_face_area, zero_area_faces.
+        min_volume, max_volume, total_volume, negative_volume_cells (volume < 1e-300).
+        max_non_orthogonality, avg_non_orthogonality: degrees over internal faces;
+            severe_non_orthogonal_faces (> 70), non_orthogonality_errors (> 90),
+            worst_non_orthogonal_face.
+        wrong_pyramids: faces whose pyramid (owner or neighbour) has a negative volume.
+        max_skewness, high_skew_faces (> 4), worst_skew_face.
+        failed_checks: as checkMesh counts them ("Failed N mesh checks."), 0 for "Mesh OK."
+    """
+
+    points: int
+    faces: int
+    internal_faces: int
+    cells: int
+    patches: int
+    hexahedra: int
+    prisms: int
+    pyramids: int
+    tetrahedra: int
+    polyhedra: int
+    bbox: Tuple[float, float, float, float, float, float]
+    directions: Tuple[int, int, int]
+    boundary_openness: Tuple[float, float, float]
+    max_cell_openness: float
+    open_cells: int
+    max_aspect_ratio: float
+    high_aspect_cells: int
+    worst_aspect_cell: int
+    min_face_area: float
+    max_face_area: float
+    zero_area_faces: int
+    min_volume: float
+    max_volume: float
+    total_volume: float
+    negative_volume_cells: int
+    max_non_orthogonality: float
+    avg_non_orthogonality: float
+    severe_non_orthogonal_faces: int
+    non_orthogonality_errors: int
+    worst_non_orthogonal_face: int
+    wrong_pyramids: int
+    max_skewness: float
+    high_skew_faces: int
+    worst_skew_face: int
+    boundary_open: bool
+    failed_checks: int
+
+    @property
+    def ok(self) -> bool:
+        """No check failed (checkMesh's "Mesh OK.")."""
+        return self.failed_checks == 0
+
+
+def _foam_quality(q) -> FoamQuality:
+    """The dataclass of a cm_foam_quality, field by field."""
+    values = {}
+    for name, kind in FoamQuality.__annotations__.items():
+        v = getattr(q, name)
+        if kind is int:
+            values[name] = int(v)
+        elif kind is float:
+            values[name] = float(v)
+        elif kind is bool:
+            values[name] = bool(v)
+        else:  # a fixed array of the struct
+            values[name] = tuple(type(x)(x) for x in v)
+    return FoamQuality(**values)
+
+
+def quality(mesh: Mesh, threads: int = 0, *,
+            foam: bool = False) -> Union[Quality, FoamQuality]:
     """The scaled Jacobian of every cell of mesh and the summary that `cadmorph quality`
-    prints on its last line (cm_mesh_quality, cm_quality_summarize)."""
+    prints on its last line (cm_mesh_quality, cm_quality_summarize): a Quality.
+
+    foam=True: OpenFOAM checkMesh's geometry checks instead (cm_mesh_quality_foam), the
+    numbers `cadmorph quality --foam` prints: a FoamQuality.
+    """
     if not isinstance(mesh, Mesh):
         raise TypeError("cadmorph.quality: mesh must be a cadmorph.Mesh, not %s"
                         % type(mesh).__name__)
+    if not isinstance(foam, (bool, np.bool_)):
+        raise TypeError("cadmorph.quality: foam must be a bool, not %s" % type(foam).__name__)
     m = mesh._ptr
-    sj = np.empty(max(int(m.n_cells), 1), np.float64)
     ctx = Context(threads, False, "cadmorph.quality")
+    if foam:
+        q = ffi.new("cm_foam_quality *")
+        ctx.call(lib.cm_mesh_quality_foam, m, q)
+        return _foam_quality(q)
+    sj = np.empty(max(int(m.n_cells), 1), np.float64)
     buf = ffi.from_buffer("double[]", sj)
     ctx.call(lib.cm_mesh_quality, m, buf)
     all_ = ffi.new("cm_quality_stats *")
