@@ -14,6 +14,8 @@ from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, Mis
 from .mesh import Mesh, read_mesh, write_mesh
 from .quality import FoamQuality, Quality, quality
 from .geometry import Comparison, Counts, Edge, Face, Geometry, model, model_names, read_step
+from .morph import Morpher, MorpherInfo, MorphStep, SurfaceStats, morph
+from .warp import Warp, warp
 
 __version__: str = _ffi.string(_lib.cm_version()).decode()
 
@@ -22,6 +24,8 @@ __all__ = [
     "InterruptedCall", "CadmorphWarning",
     "Mesh", "read_mesh", "write_mesh",
     "Quality", "quality",
+    "Morpher", "MorphStep", "MorpherInfo", "SurfaceStats", "morph",
+    "Warp", "warp",
     "__version__",
     "FoamQuality",
     "Geometry", "Face", "Edge", "Counts", "Comparison", "read_step", "model", "model_names",

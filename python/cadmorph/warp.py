@@ -1,0 +1,165 @@
+"""Warp: a volume warp of a mesh, factorised once (cm_warp_create), applied to any motion of
+its constrained nodes (cm_warp_apply); warp(): the one-shot form.
+
+A warp carries a prescribed displacement of some nodes (by default the boundary nodes) into
+every other node of the volume cells, by one of the library's methods (docs/DESIGN.md, "The
+warp interface"): "rbf" (triharmonic RBF, the method), "rbf-biharmonic", "femwarp",
+"lbwarp", "simplex", "dmffd", "mls".
+"""
+from typing import Any, Optional
+
+import numpy as np
+
+from ._capi import ffi, lib
+from ._context import Context, Progress
+from ._options import WarpSettings, node_indices, points
+from .mesh import Mesh
+
+
+def _destroy_warp(ptr) -> None:
+    lib.cm_warp_destroy(ffi.new("cm_warp *[1]", [ptr]))
+
+
+def _destroy_boundary(ptr) -> None:
+    lib.cm_mesh_boundary_destroy(ffi.new("cm_mesh_boundary *[1]", [ptr]))
+
+
+class Warp:
+    """A warp of mesh whose constrained nodes are `nodes` (None: the boundary nodes, those of
+    faces used by one volume cell), made once: `apply` then maps any displacement of those
+    nodes to the displacement of every node, sharing the factorisation.
+
+    Arguments (the options of `cadmorph warp`, with its defaults):
+        mesh: a cadmorph.Mesh with volume cells; copied what the warp needs (the Mesh may be
+            changed or closed afterwards, the warp stays that of the mesh as it was).
+        nodes: 1-D integer array-like of distinct node indices (0-based, any order), or None
+            for the boundary nodes. `cadmorph warp` constrains the boundary nodes and the
+            nodes of its D.csv: pass their union for the same warp.
+        method: "rbf" (default: phi = r^3 + linear, one interpolant per connected component),
+            "rbf-biharmonic", "femwarp", "lbwarp", "simplex", "dmffd", "mls" (the CLI's
+            --method); kernel: "triharmonic" or "biharmonic", the CLI's --kernel (another
+            name for method "rbf" / "rbf-biharmonic").
+        solver: RBF methods: "auto" (dense below a measured size, iterative above), "dense",
+            "iterative", "petsc" (only in a build with PETSc).
+        tolerance: RBF, iterative solvers: the CLI's --rbf-tol, in [0, 0.5]; 0 = the
+            library's 1e-10.
+        lattice: dmffd: control points per axis, 4..200 (None: 10); clamp: dmffd: singular
+            values <= clamp x the largest are dropped, in (0, 1) (None: 1e-10).
+        samples, cubature (None: automatic), cover (1..64), stretch, bend, blend (>= 0),
+            graded (0..1): the MLS options of the CLI (mls.h).
+        threads: the library's threads for this warp's calls, 0 = all.
+        progress: a callable (stage, done, total) receiving the library's progress reports,
+            None for the CLI's progress line on a terminal, False for none. Raising in it
+            (or Ctrl-C) stops the call and is raised from it.
+
+    Raises ValueError/TypeError for bad arguments, BadInputError and its subclasses for what
+    the library refuses (e.g. a mesh without volume cells, a flat boundary of an RBF
+    component), with the library's message. One Warp is used by one thread at a time; two
+    Warp objects may run in two threads.
+    """
+
+    def __init__(self, mesh: Mesh, nodes: Any = None, *, method: str = "rbf",
+                 kernel: Optional[str] = None, solver: str = "auto", tolerance: float = 0.0,
+                 lattice: Optional[int] = None, clamp: Optional[float] = None,
+                 samples: Optional[int] = None, cubature: Optional[int] = None, cover: int = 5,
+                 stretch: float = 1.0, bend: float = 1.0, blend: float = 1.5,
+                 graded: float = 0.0, threads: int = 0, progress: Progress = None) -> None:
+        what = "cadmorph.Warp"
+        self._warp = None
+        if not isinstance(mesh, Mesh):
+            raise TypeError("%s: mesh must be a cadmorph.Mesh, not %s"
+                            % (what, type(mesh).__name__))
+        m = mesh._ptr
+        n = int(m.n_nodes)
+        settings = WarpSettings(what, method=method, kernel=kernel, solver=solver,
+                                tolerance=tolerance, lattice=lattice, clamp=clamp,
+                                samples=samples, cubature=cubature, cover=cover,
+                                stretch=stretch, bend=bend, blend=blend, graded=graded)
+        self._ctx = ctx = Context(threads, progress, what)
+        opt = ffi.new("cm_warp_options *")
+        settings.fill(opt)
+        bp = ffi.new("cm_mesh_boundary *[1]")
+        ctx.call(lib.cm_mesh_boundary_create, m, bp)
+        b = ffi.gc(bp[0], _destroy_boundary)
+        if nodes is None:
+            self._nodes = np.array(ffi.unpack(b.nodes, int(b.n_nodes)) if b.n_nodes else [],
+                                   dtype=np.int64)
+            constrained = ffi.NULL
+        else:
+            self._nodes = node_indices(what, "nodes", nodes, n).copy()
+            flags = np.zeros(max(n, 1), np.uint8)
+            flags[self._nodes] = 1
+            constrained = ffi.from_buffer("unsigned char[]", flags)
+        self._nodes.flags.writeable = False
+        out = ffi.new("cm_warp *[1]")
+        holder = []
+
+        def create(ctx_ptr, *args):
+            s = lib.cm_warp_create(ctx_ptr, *args)
+            if out[0] != ffi.NULL:  # owned at once: whatever is raised next frees it
+                holder.append(ffi.gc(out[0], _destroy_warp))
+            return s
+
+        ctx.call(create, m, b, constrained, opt, out)
+        self._warp = holder[0]
+        self._n = n
+        self._settings = settings
+
+    @property
+    def nodes(self) -> np.ndarray:
+        """The constrained nodes (read-only int64 array), in the order the rows of apply's D
+        refer to: as given, or the boundary nodes ascending."""
+        return self._nodes
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of nodes of the mesh (rows of apply's result)."""
+        return self._n
+
+    @property
+    def method(self) -> str:
+        """The warp's method name ("rbf", "femwarp", ...)."""
+        return ffi.string(lib.cm_warp_method_name(lib.cm_warp_get_method(self._warp))).decode()
+
+    @property
+    def residual(self) -> float:
+        """Largest |displacement - prescribed| at the constrained nodes after the last apply:
+        0 for the interpolating methods (RBF, FEMWARP); what DM-FFD and MLS miss by."""
+        return float(lib.cm_warp_residual(self._warp))
+
+    @property
+    def fallback_nodes(self) -> int:
+        """Nodes the method treated by its documented fallback (LBWARP: no positive
+        log-barrier weights; simplex: outside every Delaunay tet); 0 for the others."""
+        return int(lib.cm_warp_fallback_nodes(self._warp))
+
+    def apply(self, D: Any) -> np.ndarray:
+        """The displacement of every node, (n_nodes, 3) float64, for the displacements D of
+        the constrained nodes: an array-like of shape (len(nodes), 3), row k for nodes[k]
+        (for a displacement of every node, pass D_all[w.nodes]). Constrained nodes get their
+        row of D exactly; nodes of no volume cell that are not constrained get 0.
+
+        The result is a new array the library fills in place; on an exception (Ctrl-C, the
+        progress callable) nothing is returned and the warp stays usable.
+        """
+        d = points("cadmorph.Warp.apply", "D", D, len(self._nodes))
+        out = np.zeros((self._n, 3), np.float64)
+        out[self._nodes] = d
+        if self._n:
+            self._ctx.call(lib.cm_warp_apply, self._warp, ffi.from_buffer("double[]", out))
+        return out
+
+    def __repr__(self) -> str:
+        return "<cadmorph.Warp %s, %d nodes, %d constrained>" % (self.method, self._n,
+                                                                 len(self._nodes))
+
+
+def warp(mesh: Mesh, nodes: Any, D: Any, method: str = "rbf", **options: Any) -> np.ndarray:
+    """One warp, one apply: the displacement (n_nodes, 3) of every node of mesh when the
+    nodes `nodes` (None: the boundary nodes) move by D (len(nodes), 3). The options are
+    Warp's (solver, tolerance, lattice, clamp, the MLS options, threads, progress).
+
+    Equals `cadmorph warp --mesh M --displacements D.csv --method M` (its written
+    "displacement" field), with nodes = the boundary nodes and the listed ones.
+    """
+    return Warp(mesh, nodes, method=method, **options).apply(D)
