@@ -16,6 +16,11 @@ from .quality import FoamQuality, Quality, quality
 from .geometry import Comparison, Counts, Edge, Face, Geometry, model, model_names, read_step
 from .morph import Morpher, MorpherInfo, MorphStep, SurfaceStats, morph
 from .warp import Warp, warp
+from .deform import Deformer, deform
+from .ffd import FFDStats, Lattice, ffd
+from .optimize import OptimizeStats, optimize
+from .meshgen import mesh_step
+from .study import StudyResult, StudyRow, study, sweep
 
 __version__: str = _ffi.string(_lib.cm_version()).decode()
 
@@ -29,4 +34,9 @@ __all__ = [
     "__version__",
     "FoamQuality",
     "Geometry", "Face", "Edge", "Counts", "Comparison", "read_step", "model", "model_names",
+    "Deformer", "deform",
+    "Lattice", "FFDStats", "ffd",
+    "OptimizeStats", "optimize",
+    "mesh_step",
+    "StudyResult", "StudyRow", "study", "sweep",
 ]

@@ -1,0 +1,224 @@
+"""deform and Deformer: handle-based space deformations (the handle metaphor [CMLS §3]) over
+deform.h's table (cm_deform_create / cm_deform_apply), as `cadmorph deform`.
+
+Handle points move by given displacements, fixed points stay, every other point follows the
+method's space deformation: "rbf" (triharmonic RBF, exact at the constrained points), "mls"
+(constrained MLS over a mesh's cells, approximate), "shell" (the mesh-based shell of a surface
+mesh) or "dmffd" (DM-FFD on a cubic B-spline lattice enclosing the points, least squares).
+A Deformer does the work that depends only on the points and on which of them are
+constrained (factorisation, SVD, sampling) once; apply maps any number of handle
+displacements.
+"""
+from typing import Any, Dict, Optional, Union
+
+import numpy as np
+
+from ._capi import ffi, lib
+from ._context import Context, Progress
+from ._inputs import choice, index_array, integer, number, points_of, real_array, struct_dict
+from .mesh import Mesh
+
+METHODS = ("rbf", "mls", "shell", "dmffd")
+_KERNELS = {"triharmonic": lib.CM_RBF_TRIHARMONIC, "biharmonic": lib.CM_RBF_BIHARMONIC}
+_SOLVERS = {"auto": lib.CM_RBF_SOLVER_AUTO, "dense": lib.CM_RBF_SOLVER_DENSE,
+            "iterative": lib.CM_RBF_SOLVER_ITERATIVE, "petsc": lib.CM_RBF_SOLVER_PETSC}
+_FIXED_GROUP, _HANDLE_GROUP = 1, 2  # the MLS weighs the two regions apart, as the CLI
+
+
+def _destroy_deform(ptr) -> None:
+    lib.cm_deform_destroy(ffi.new("cm_deform *[1]", [ptr]))
+
+
+def _boundary_nodes(ctx: Context, mesh: Mesh) -> np.ndarray:
+    """The nodes `cadmorph deform --fix-unlisted-boundary` fixes: the boundary surface's
+    nodes of a volume mesh, the border vertices (on an edge of one face) of a surface."""
+    m = mesh._ptr
+    if lib.cm_mesh_count_dim(m, 3) > 0:
+        p = ffi.new("cm_mesh_boundary *[1]")
+        try:
+            ctx.call(lib.cm_mesh_boundary_create, m, p)
+            b = p[0]
+            return np.frombuffer(ffi.buffer(b.nodes, 8 * b.n_nodes), np.int64).copy() \
+                if b.n_nodes else np.zeros(0, np.int64)
+        finally:
+            lib.cm_mesh_boundary_destroy(p)
+    n = int(m.n_nodes)
+    H = np.empty(max(n, 1))
+    border = np.zeros(max(n, 1), np.uint8)
+    ctx.call(lib.cm_mls_mean_curvature, m, ffi.from_buffer("double[]", H),
+             ffi.from_buffer("unsigned char[]", border))
+    return np.flatnonzero(border[:n]).astype(np.int64)
+
+
+class Deformer:
+    """A deformation of points constrained at handle (moving) and fixed (still) points,
+    set up once (cm_deform_create): apply(displacements) then maps any number of handle
+    displacements to every point.
+
+    points: a Mesh (its nodes; needed by "mls" and "shell", which work on its cells) or an
+        (n, 3) array of coordinates ("rbf", "dmffd"; copied by the library).
+    handles: the indices of the handle points (or a boolean mask of length n).
+    fixed: the indices of the fixed points, or "boundary": every boundary node of the mesh
+        that is not a handle (`--fix-unlisted-boundary`: the boundary surface of a volume
+        mesh, the border edges of a surface mesh), or None.
+    method: "rbf" (default), "mls", "shell" or "dmffd". Options, as `cadmorph deform`:
+        kernel ("triharmonic" | "biharmonic"), solver ("auto" | "dense" | "iterative" |
+        "petsc") and tolerance (0: the RBF's default) for rbf; lattice (4..200 control points
+        per axis, default 10) and clamp (singular values <= clamp x the largest are dropped,
+        default 1e-10) for dmffd; samples, cubature, cover, stretch, bend, fix, blend, graded,
+        seed and exact_constraints (the handle and fixed points get their prescribed values
+        instead of the field's, default False as the CLI) for mls; stretch, bend and fix also
+        weigh the shell. None leaves the library's default.
+    threads: 0 = all; progress: see cadmorph's Context (a callable (stage, done, total),
+        None for the terminal line, False for none).
+
+    The Deformer holds the mesh it deforms (the shell borrows it); not for two threads at
+    once (the C API's rule); two Deformers in two threads run in parallel.
+    """
+
+    def __init__(self, points: Union[Mesh, np.ndarray], handles: Any,
+                 fixed: Union[None, str, Any] = None, method: str = "rbf", *,
+                 kernel: Optional[str] = None, solver: Optional[str] = None,
+                 tolerance: Optional[float] = None, lattice: Optional[int] = None,
+                 clamp: Optional[float] = None, samples: Optional[int] = None,
+                 cubature: Optional[int] = None, cover: Optional[int] = None,
+                 stretch: Optional[float] = None, bend: Optional[float] = None,
+                 fix: Optional[float] = None, blend: Optional[float] = None,
+                 graded: Optional[float] = None, seed: Optional[int] = None,
+                 exact_constraints: bool = False, threads: int = 0,
+                 progress: Progress = None) -> None:
+        what = "cadmorph.Deformer"
+        method = choice(method, METHODS, what + ": method")
+        xyz, mesh = points_of(points, what + ": points")
+        n = xyz.shape[0]
+        if method in ("mls", "shell") and mesh is None:
+            raise ValueError("%s: method %r works on a mesh's cells: points must be a "
+                             "cadmorph.Mesh" % (what, method))
+        if method == "shell" and lib.cm_mesh_count_dim(mesh._ptr, 3) > 0:
+            raise ValueError("%s: method 'shell' deforms surface meshes only" % what)
+        self._ctx = Context(threads, progress, what)
+        h = index_array(handles, n, what + ": handles")
+        if len(h) == 0:
+            raise ValueError("%s: no handle point" % what)
+        if isinstance(fixed, str):
+            choice(fixed, ("boundary",), what + ": fixed")
+            if mesh is None:
+                raise ValueError("%s: fixed='boundary' needs a cadmorph.Mesh" % what)
+            f = _boundary_nodes(self._ctx, mesh)
+            f = f[~np.isin(f, h)]
+        elif fixed is None:
+            f = np.zeros(0, np.int64)
+        else:
+            f = index_array(fixed, n, what + ": fixed")
+            both = np.intersect1d(h, f)
+            if len(both):
+                raise ValueError("%s: point %d is both a handle and fixed" % (what, both[0]))
+        con = np.zeros(max(n, 1), np.uint8)
+        con[f] = _FIXED_GROUP
+        con[h] = _HANDLE_GROUP
+        opt = ffi.new("cm_deform_options *")
+        lib.cm_deform_options_init(opt)
+        opt.method = lib.cm_deform_method_from_name(method.encode())
+        if kernel is not None:
+            opt.kernel = _KERNELS[choice(kernel, tuple(_KERNELS), what + ": kernel")]
+        if solver is not None:
+            opt.solver = _SOLVERS[choice(solver, tuple(_SOLVERS), what + ": solver")]
+        if tolerance is not None:
+            opt.tolerance = number(tolerance, what + ": tolerance", 0, 1, open_hi=True)
+        opt.lattice = integer(10 if lattice is None else lattice, what + ": lattice", 4, 200)
+        if clamp is not None:
+            opt.clamp = number(clamp, what + ": clamp", 0, 1, open_lo=True, open_hi=True)
+        mls = opt.mls
+        if samples is not None:
+            mls.samples = integer(samples, what + ": samples", 1, 2 ** 62)
+        if cubature is not None:
+            mls.cubature = integer(cubature, what + ": cubature", 1, 2 ** 62)
+        if cover is not None:
+            mls.cover = integer(cover, what + ": cover", 1, 64)
+        if stretch is not None:
+            mls.stretch = number(stretch, what + ": stretch", 0)
+        if bend is not None:
+            mls.bend = number(bend, what + ": bend", 0)
+        if fix is not None:
+            mls.fix = number(fix, what + ": fix", 0, open_lo=True)
+        if blend is not None:
+            mls.blend = number(blend, what + ": blend", 0)
+        if graded is not None:
+            mls.graded = number(graded, what + ": graded", 0, 1)
+        if seed is not None:
+            mls.seed = integer(seed, what + ": seed", 0, 2 ** 64 - 1)
+        mls.keep_constrained = bool(exact_constraints)
+        if method in ("mls", "shell") and mls.stretch + mls.bend <= 0:
+            raise ValueError("%s: stretch + bend must be > 0" % what)
+        self._mesh_owner = mesh._ptr if mesh is not None else None  # the shell borrows it
+        self._con = con
+        p = ffi.new("cm_deform *[1]")
+        self._ctx.call(lib.cm_deform_create, opt, n, ffi.from_buffer("double[]", xyz)
+                       if n else ffi.NULL, ffi.from_buffer("unsigned char[]", con),
+                       self._mesh_owner if self._mesh_owner is not None else ffi.NULL, p)
+        self._ptr = ffi.gc(p[0], _destroy_deform)
+        self._xyz = xyz.copy()  # the reference the displacements are added to
+        self.method: str = method
+        """The method's name."""
+        self.handles: np.ndarray = h
+        """The handle indices, int64, in the order apply's displacements follow."""
+        self.fixed: np.ndarray = f
+        """The fixed indices, int64 (fixed='boundary' resolved)."""
+        self.residual: float = 0.0
+        """The last apply's largest miss at the constrained points (rbf: 0)."""
+
+    @property
+    def n_points(self) -> int:
+        """Number of points."""
+        return self._xyz.shape[0]
+
+    def displacement(self, displacements: Any) -> np.ndarray:
+        """The (n, 3) displacement of every point when the handles move by displacements
+        ((len(handles), 3), in the order of handles) and the fixed points stay
+        (cm_deform_apply)."""
+        what = "cadmorph.Deformer.apply"
+        d = real_array(displacements, (len(self.handles), 3), what + ": displacements")
+        n = self.n_points
+        disp = np.zeros((max(n, 1), 3))
+        disp[self.handles] = d
+        res = ffi.new("double *")
+        self._ctx.call(lib.cm_deform_apply, self._ptr, ffi.from_buffer("double[]", disp), res)
+        self.residual = float(res[0])
+        return disp[:n]
+
+    def apply(self, displacements: Any) -> np.ndarray:
+        """The (n, 3) new coordinates of the points (points + displacement(displacements),
+        the sum `cadmorph deform` writes)."""
+        return self._xyz + self.displacement(displacements)
+
+    @property
+    def stats(self) -> Dict[str, Any]:
+        """cm_deform_get_stats as a dict: method, constrained, free, residual, t_solve,
+        t_evaluate and the method's own (rbf, dmffd, lattice, control_points, mls)."""
+        st = ffi.new("cm_deform_stats *")
+        lib.cm_deform_get_stats(self._ptr, st)
+        out = struct_dict(st)
+        out["method"] = self.method
+        return out
+
+    def __repr__(self) -> str:
+        return "<cadmorph.Deformer %s: %d points, %d handles, %d fixed>" % (
+            self.method, self.n_points, len(self.handles), len(self.fixed))
+
+
+def deform(points: Union[Mesh, np.ndarray], handles: Any, displacements: Any,
+           method: str = "rbf", fixed: Union[None, str, Any] = None, *, threads: int = 0,
+           progress: Progress = None, **options: Any) -> np.ndarray:
+    """The (n, 3) new coordinates of points (a Mesh or an (n, 3) array) when the handle
+    points move by displacements ((len(handles), 3)), the fixed points stay and the others
+    follow the method: Deformer(points, handles, fixed, method, **options).apply(
+    displacements), as `cadmorph deform --handles H.csv [--fixed F.csv |
+    --fix-unlisted-boundary] --method M` (whose default method is mls; here rbf).
+    The mesh itself is not changed."""
+    what = "cadmorph.deform"
+    # the arrays checked before the set-up, which may take long
+    xyz, _ = points_of(points, what + ": points")
+    h = index_array(handles, xyz.shape[0], what + ": handles")
+    d = real_array(displacements, (len(h), 3), what + ": displacements")
+    return Deformer(points, h, fixed, method, threads=threads, progress=progress,
+                    **options).apply(d)
