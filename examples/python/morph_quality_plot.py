@@ -10,8 +10,8 @@ Morpher.result_mesh to measure its quality with cadmorph.quality.
 
     PYTHONPATH=build/python python3 examples/python/morph_quality_plot.py OUTDIR [--size H] [--t 0.25 0.5 ...]
 
-OUTDIR (or $CADMORPH_EXAMPLE_OUT) gets M0.vtu, M1.vtu (the last target's mesh), min_sj.svg
-and min_sj.csv; one line per t is printed.
+OUTDIR (or $CADMORPH_EXAMPLE_OUT) gets M0.vtu, M1.vtu (the last target's mesh), min_sj.svg,
+min_sj.png and min_sj.csv; one line per t is printed.
 """
 import argparse
 import os
@@ -61,8 +61,9 @@ def main() -> None:
     ax.set_ylabel("min scaled Jacobian")
     ax.set_title("M0 of G(0) morphed onto G(t)")
     fig.tight_layout()
-    fig.savefig(os.path.join(a.outdir, "min_sj.svg"))
-    print("wrote", os.path.join(a.outdir, "min_sj.svg"))
+    for ext in ("svg", "png"):
+        fig.savefig(os.path.join(a.outdir, "min_sj." + ext), dpi=100)
+    print("wrote", os.path.join(a.outdir, "min_sj.svg"), "and .png")
 
 
 if __name__ == "__main__":
