@@ -12,11 +12,13 @@ usage: bench_overhead.py BUILD_DIR WORK_DIR [--model bore] [--size H] [--mesher 
            [--pygem PYGEM_DIR] [--pygem-max N]
 
 Every program runs in its own process under /usr/bin/time, one at a time, so that each peak
-resident set (its maxrss) is that program's alone; R rounds alternate them and
-the best wall time of each is kept. Inside each run, Morpher.apply (Python) and
-cm_morpher_apply (C) are timed around the call, REPEAT times onto the same G(1): the first
-call (Python: with the correspondence check of a new target, cm_cad_compare) and the best.
-The printed ratios are Python / C. Every child gets OPENBLAS_NUM_THREADS=1 (what the CLI sets
+resident set (its maxrss) is that program's alone. End to end (each process reads, makes the
+morpher, applies it once, writes): R rounds alternate the CLI, C and Python; the best wall
+time of each process and the best time of each stage are kept (Python's first apply includes
+the correspondence check of a new target, cm_cad_compare). Then the same morpher is applied
+REPEAT more times onto the same G(1): in one Python process Morpher.apply alternates with the
+bare cm_morpher_apply through cffi on the same objects (the wrapper's own cost, free of the
+noise between processes), and the C driver repeats its call. Ratios are Python / C. Every child gets OPENBLAS_NUM_THREADS=1 (what the CLI sets
 for itself before OpenBLAS loads) and the CLI's OpenBLAS core through OPENBLAS_CORETYPE, so
 all of them factorise on the same kernels.
 
@@ -62,10 +64,13 @@ def timed(cmd, env, cwd=None):
 # ---------------------------------------------------------------- children (one per process)
 
 def child_python(a):
-    """The package's morph: the C driver's stages through cadmorph."""
+    """The package's morph: the C driver's stages through cadmorph; then, with inproc > 0,
+    Morpher.apply against the bare library call (cffi, the same morpher, context and
+    target) alternately in this one process."""
     t0 = time.perf_counter()
     import numpy as np
     import cadmorph
+    from cadmorph._capi import ffi, lib
     t_import = time.perf_counter() - t0
     t = time.perf_counter()
     g0 = cadmorph.read_step(a["g0"])
@@ -77,11 +82,24 @@ def child_python(a):
     t = time.perf_counter()
     morpher = cadmorph.Morpher(g0, mesh, threads=a["threads"], progress=False)
     t_create = time.perf_counter() - t
-    t_apply = []
-    for _ in range(a["repeat"]):
-        t = time.perf_counter()
+    t = time.perf_counter()
+    pts = morpher.apply(g1)
+    t_apply = [time.perf_counter() - t]
+    t_lib, c_lib, c_apply = [], [], [0.0]
+    for _ in range(a["inproc"]):
+        out = np.empty((mesh.n_nodes, 3))
+        row = ffi.new("cm_morph_step *")
+        c, t = time.process_time(), time.perf_counter()
+        s = lib.cm_morpher_apply(morpher._ctx.ptr, morpher._mp, g1._ptr,
+                                 ffi.from_buffer("double[]", out), row)
+        t_lib.append(time.perf_counter() - t)
+        c_lib.append(time.process_time() - c)
+        if s < 0 or not np.array_equal(out, pts):
+            raise SystemExit("the bare call differs from Morpher.apply (status %d)" % s)
+        c, t = time.process_time(), time.perf_counter()
         pts = morpher.apply(g1)
         t_apply.append(time.perf_counter() - t)
+        c_apply.append(time.process_time() - c)
     t = time.perf_counter()
     out = morpher.mesh
     out.points = pts
@@ -89,9 +107,9 @@ def child_python(a):
     t_write = time.perf_counter() - t
     row = morpher.steps[-1]
     return dict(import_=t_import, read_cad=t_cad, read_mesh=t_mesh, create=t_create,
-                apply=t_apply, write=t_write, nodes=mesh.n_nodes,
+                apply=t_apply, lib=t_lib, apply_cpu=c_apply, lib_cpu=c_lib, write=t_write, nodes=mesh.n_nodes,
                 boundary=morpher.info.boundary_nodes, min_sj=row.min_sj,
-                inverted=row.inverted, finite=bool(np.isfinite(pts).all()))
+                inverted=row.inverted)
 
 
 def child_warp(a):
@@ -165,7 +183,7 @@ def main():
     ap.add_argument("--mesher", default="gmsh", choices=["gmsh", "tetgen"])
     ap.add_argument("--no-optimize", action="store_true")
     ap.add_argument("--hex-scale", type=float)
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--repeat", type=int, default=5)  # 0: no repeated applies
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--pygem", help="a PyGeM checkout (the directory holding pygem/)")
@@ -201,7 +219,7 @@ def main():
         print("  %.1f s" % (time.monotonic() - t), flush=True)
 
     exe = os.path.join(work, "bench_morph")
-    subprocess.run(["cc", "-O2", "-std=c11", "-I" + os.path.join(ROOT, "include"),
+    subprocess.run(["cc", "-O2", "-std=c11", "-Wall", "-Wextra", "-Werror", "-I" + os.path.join(ROOT, "include"),
                     "-I" + os.path.join(build, "include"), os.path.join(HERE, "bench_morph.c"),
                     "-o", exe, "-L" + build, "-lcadmorph", "-Wl,-rpath," + build], check=True)
 
@@ -214,59 +232,93 @@ def main():
           % (a.threads, env.get("OPENBLAS_CORETYPE", "-"), os.path.basename(m0)), flush=True)
 
     me = [sys.executable, os.path.abspath(__file__), "--child"]
-    args = dict(g0=g0, g1=g1, m0=m0, threads=a.threads, repeat=a.repeat)
-    best = {}
+    args = dict(g0=g0, g1=g1, m0=m0, threads=a.threads)
+    m1_c = os.path.join(work, "m1_c.vtu")
+    proc, stage = {}, {"c": {}, "py": {}}
 
-    def keep(key, wall, cpu_s, rss, extra=None):
-        b = best.get(key)
-        if b is None or wall < b["wall"]:
-            best[key] = dict(wall=wall, cpu=cpu_s, rss=max(rss, b["rss"] if b else 0), **(extra or {}))
+    def keep(key, wall, cpu_s, rss, stages):
+        b = proc.get(key)
+        if b is None or wall < b[0]:
+            proc[key] = (wall, cpu_s, max(rss, b[2] if b else 0))
         else:
-            b["rss"] = max(b["rss"], rss)
+            proc[key] = (b[0], b[1], max(rss, b[2]))
+        for k, v in stages.items():
+            if isinstance(v, float):
+                stage[key][k] = min(v, stage[key].get(k, v))
 
+    def c_run(repeat):
+        out, wall, cpu_s, rss = timed([exe, g0, g1, m0, m1_c, str(repeat), str(a.threads)], env)
+        w = out.split()
+        c = {k: (v if k == "blas" else [float(x) for x in v.split(",")]
+                 if k.startswith("apply") else float(v)) for k, v in zip(w[0::2], w[1::2])}
+        return c, wall, cpu_s, rss
+
+    # end to end: one apply per process, the best of R rounds
     for r in range(a.rounds):
+        walls = []
         out, wall, cpu_s, rss = timed([cli, "morph", "--from", g0, "--to", g1, "--mesh", m0,
                                        "-o", os.path.join(work, "m1_cli.vtu"), "--threads",
                                        str(a.threads)], env)
-        keep("cli", wall, cpu_s, rss)
-        out, wall, cpu_s, rss = timed([exe, g0, g1, m0, os.path.join(work, "m1_c.vtu"),
-                                       str(a.repeat), str(a.threads)], env)
-        w = out.split()
-        c = dict(zip(w[0::2], w[1::2]))
-        c["apply"] = [float(x) for x in c["apply"].split(",")]
-        keep("c", wall, cpu_s, rss, c)
+        keep("cli", wall, cpu_s, rss, {})
+        walls.append(wall)
+        c, wall, cpu_s, rss = c_run(1)
+        keep("c", wall, cpu_s, rss, dict(c, apply=c["apply"][0], apply_cpu=None))
+        walls.append(wall)
         out, wall, cpu_s, rss = timed(me + ["python", json.dumps(
-            dict(args, m1=os.path.join(work, "m1_py.vtu")))], env)
-        keep("py", wall, cpu_s, rss, json.loads(out.strip().splitlines()[-1]))
-        print("round %d: CLI %.2f s, C %.2f s, Python %.2f s" % (
-            r + 1, best["cli"]["wall"], best["c"]["wall"], best["py"]["wall"]), flush=True)
+            dict(args, inproc=0, m1=os.path.join(work, "m1_py.vtu")))], env)
+        py = json.loads(out.strip().splitlines()[-1])
+        keep("py", wall, cpu_s, rss, dict(py, apply=py["apply"][0], apply_cpu=None))
+        walls.append(wall)
+        print("round %d: CLI %.2f s, C %.2f s, Python %.2f s" % tuple([r + 1] + walls),
+              flush=True)
 
-    c, py = best["c"], best["py"]
+    c, p = stage["c"], stage["py"]
     print("\nmesh: %d nodes, %d boundary nodes; morph: min scaled Jacobian %.4f, %d inverted"
           % (py["nodes"], py["boundary"], py["min_sj"], py["inverted"]))
+    print("\nEnd to end, one apply per process, best of %d rounds per stage:" % a.rounds)
     print("\n| stage | C (library) s | Python s | Python / C |")
     print("|---|---:|---:|---:|")
-    rows = [("read G0, G1", float(c["read_cad"]), py["read_cad"]),
-            ("read M0", float(c["read_mesh"]), py["read_mesh"]),
-            ("Morpher / cm_morpher_create", float(c["create"]), py["create"]),
-            ("apply, first call", c["apply"][0], py["apply"][0]),
-            ("apply, best of %d" % a.repeat, min(c["apply"]), min(py["apply"])),
-            ("write M1", float(c["write"]), py["write"])]
-    for name, tc, tp in rows:
-        print("| %s | %.3f | %.3f | %.3f |" % (name, tc, tp, tp / tc))
-    print("| (import cadmorph) | – | %.3f | |" % py["import_"])
-    print("\n| process | wall s | CPU s | peak RSS MB | / CLI (wall, RSS) |")
+    for name, k in (("read G0, G1", "read_cad"), ("read M0", "read_mesh"),
+                    ("Morpher() / cm_morpher_create", "create"),
+                    ("Morpher.apply / cm_morpher_apply (first)", "apply"),
+                    ("write M1", "write")):
+        print("| %s | %.3f | %.3f | %.3f |" % (name, c[k], p[k], p[k] / c[k]))
+    print("| import cadmorph | – | %.3f | |" % p["import_"])
+    print("\n| process | wall s | CPU s | peak RSS MB | / CLI: wall, RSS |")
     print("|---|---:|---:|---:|---:|")
     for key, name in (("cli", "cadmorph morph"), ("c", "C (bench_morph.c)"),
                       ("py", "Python (cadmorph)")):
-        b = best[key]
+        wall, cpu_s, rss = proc[key]
         print("| %s | %.2f | %.2f | %.0f | %.3f, %.3f |" % (
-            name, b["wall"], b["cpu"], b["rss"], b["wall"] / best["cli"]["wall"],
-            b["rss"] / best["cli"]["rss"]))
+            name, wall, cpu_s, rss, wall / proc["cli"][0], rss / proc["cli"][2]))
+
+    # the same morpher applied again: the wrapper against the bare call in one process, and
+    # the C driver's repeated calls
+    if a.repeat > 0:
+        out, wall, cpu_s, rss = timed(me + ["python", json.dumps(
+            dict(args, inproc=a.repeat, m1=os.path.join(work, "m1_py.vtu")))], env)
+        py = json.loads(out.strip().splitlines()[-1])
+        c, wall, cpu_s, rss = c_run(a.repeat + 1)
+        import numpy as np
+        print("\nApplied again onto the same G(1), %d times (in the Python process the bare "
+              "call and Morpher.apply alternate); wall and the process's CPU seconds:"
+              % a.repeat)
+        print("\n| call | wall best s | wall median s | CPU median s | / bare call: wall "
+              "best, wall median, CPU median |")
+        print("|---|---:|---:|---:|---:|")
+        ref = (min(py["lib"]), np.median(py["lib"]), np.median(py["lib_cpu"]))
+        for name, t, u in (("Morpher.apply (Python)", py["apply"][1:], py["apply_cpu"][1:]),
+                           ("cm_morpher_apply through cffi, same process", py["lib"],
+                            py["lib_cpu"]),
+                           ("cm_morpher_apply from C (bench_morph.c)", c["apply"][1:],
+                            c["apply_cpu"][1:])):
+            v = (min(t), np.median(t), np.median(u))
+            print("| %s | %.4f | %.4f | %.4f | %.3f, %.3f, %.3f |" % (
+                (name,) + v + tuple(x / r for x, r in zip(v, ref))))
 
     # the warp of the same boundary motion: cadmorph.Warp against PyGeM's RBF
     npz = os.path.join(work, "warp_motion.npz")
-    wa = dict(m0=m0, m1=os.path.join(work, "m1_c.vtu"), threads=a.threads, npz=npz)
+    wa = dict(m0=m0, m1=m1_c, threads=a.threads, npz=npz)
     out, wall, cpu_s, rss = timed(me + ["warp", json.dumps(wa)], env)
     cw = json.loads(out.strip().splitlines()[-1])
     print("\nwarp of the morph's boundary motion (%d boundary nodes, %d nodes):"
