@@ -9,7 +9,7 @@ polynomial, as cadmorph's "rbf"), when a PyGeM checkout is given.
 
 usage: bench_overhead.py BUILD_DIR WORK_DIR [--model bore] [--size H] [--mesher gmsh|tetgen]
            [--no-optimize] [--hex-scale S] [--repeat N] [--rounds R] [--threads T]
-           [--pygem PYGEM_DIR] [--pygem-max N]
+           [--pygem PYGEM_DIR] [--pygem-mem GB]
 
 Every program runs in its own process under /usr/bin/time, one at a time, so that each peak
 resident set (its maxrss) is that program's alone. End to end (each process reads, makes the
@@ -25,7 +25,7 @@ all of them factorise on the same kernels.
 The mesh is WORK_DIR/M0_<model>_<size>[t].vtu from `cadmorph mesh` (made once, reused), or
 with --hex-scale the model's structured hex mesh (`cadmorph model M 0 --hex-mesh --scale S`).
 PyGeM's RBF is dense (an (n+4)^2 system, then an (N, n) distance matrix for the N points):
-it is skipped above --pygem-max boundary nodes (default 30,000) with the memory it would need.
+it is skipped, with the memory it would need, above --pygem-mem GB (default 8).
 """
 import argparse
 import json
@@ -157,6 +157,13 @@ def child_main(mode, arg):
 
 # ---------------------------------------------------------------- the parent
 
+def pygem_gb(n, big_n):
+    """What PyGeM's dense RBF holds at its peak for n centres and N points, GB: in the fit
+    the distances, the kernel matrix, the bordered system and the solver's copy (~5 n^2
+    doubles), in the evaluation the (N, n) distances, kernel values and a temporary."""
+    return 8.0 * (5.0 * n * n + 3.0 * big_n * n) / 2 ** 30
+
+
 def machine(cli, env):
     """CPU model, cores, the CLI's BLAS lines."""
     cpu = "?"
@@ -187,7 +194,8 @@ def main():
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--pygem", help="a PyGeM checkout (the directory holding pygem/)")
-    ap.add_argument("--pygem-max", type=int, default=30000)
+    ap.add_argument("--pygem-mem", type=float, default=8.0,
+                    help="GB PyGeM may need (estimate) before it is skipped (default 8)")
     a = ap.parse_args()
     build, work = os.path.abspath(a.build), os.path.abspath(a.work)
     os.makedirs(work, exist_ok=True)
@@ -329,10 +337,11 @@ def main():
           % (cw["fit"], cw["apply"], wall, cpu_s, rss))
     if not a.pygem:
         print("| PyGeM RBF | (no --pygem) | | | | |")
-    elif cw["boundary"] > a.pygem_max:
+    elif pygem_gb(cw["boundary"], cw["nodes"]) > a.pygem_mem:
         n, big_n = cw["boundary"], cw["nodes"]
-        print("| PyGeM RBF | skipped: dense, (n+4)^2 = %.1f GB to solve, then %.1f GB of "
-              "distances | | | | |" % (8.0 * (n + 4) ** 2 / 2 ** 30, 8.0 * n * big_n / 2 ** 30))
+        print("| PyGeM RBF | skipped: ~%.0f GB (an (n+4)^2 system of %.1f GB, (N, n) distances "
+              "of %.1f GB, and their copies) | | | | |" % (
+                  pygem_gb(n, big_n), 8.0 * (n + 4) ** 2 / 2 ** 30, 8.0 * n * big_n / 2 ** 30))
     else:
         pa = dict(npz=npz, pygem=os.path.abspath(a.pygem))
         out, wall, cpu_s, rss = timed(me + ["pygem", json.dumps(pa)], env)
