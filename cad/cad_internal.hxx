@@ -50,6 +50,11 @@ struct cm_cad_model {
 
 namespace cmcad {
 
+// OpenCASCADE's STEP translators read process-wide settings (Interface_Static: the session's
+// length unit, the unit written): every reader and writer sets the ones it uses under this
+// lock, so that no call sees another's (a model written after a read in metres is not scaled).
+std::mutex &xstep_lock();
+
 // Runs body() and maps exceptions to a status with the function name in the message.
 template <class F> cm_status guard(cm_context *ctx, const char *fn, F &&body) noexcept
 {

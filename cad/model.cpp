@@ -59,12 +59,17 @@ cm_status check_edge(cm_context *ctx, const cm_cad_model *m, int edge, const cha
 
 }  // namespace cmcad
 
+std::mutex &cmcad::xstep_lock()
+{
+    static std::mutex lock;
+    return lock;
+}
+
 namespace {
 
-// OpenCASCADE's translators use process-wide settings (Interface_Static) and the default
-// messenger: set them under one lock, and remove the messenger's printers once so that the
-// library never writes to stdout.
-std::mutex xstep_lock;
+// OpenCASCADE's translators use process-wide settings (Interface_Static, set under
+// cmcad::xstep_lock) and the default messenger: remove its printers once so that the library
+// never writes to stdout.
 
 void silence_opencascade()
 {
@@ -326,7 +331,7 @@ cm_status cm_cad_read(cm_context *ctx, const char *path, const cm_cad_read_optio
         silence_opencascade();
         std::unique_ptr<cm_cad_model> m(new cm_cad_model());
         {
-            std::lock_guard<std::mutex> g(xstep_lock);
+            std::lock_guard<std::mutex> g(cmcad::xstep_lock());
             STEPControl_Reader reader;
             Interface_Static::SetCVal("xstep.cascade.unit", occ);
             Interface_Static::SetIVal("read.step.product.mode", 1);
@@ -365,7 +370,7 @@ cm_status cm_cad_write(cm_context *ctx, const cm_cad_model *model, const char *p
     std::string tmp = std::string(path) + ".tmp";
     cm_status st = cmcad::guard(ctx, fn, [&]() -> cm_status {
         silence_opencascade();
-        std::lock_guard<std::mutex> g(xstep_lock);
+        std::lock_guard<std::mutex> g(cmcad::xstep_lock());
         const char *occ = occ_unit(model->unit.c_str());
         Interface_Static::SetCVal("xstep.cascade.unit", occ);
         Interface_Static::SetCVal("write.step.unit", occ);

@@ -190,9 +190,12 @@ extern "C" cm_status cm_model_write_step(cm_context *ctx, const char *model, dou
         } catch (const std::runtime_error &e) { // a boolean that did not give one solid
             return cm_error(ctx, CM_ERR_CAD, "%s: %s at t = %g: %s", fn, model, t, e.what());
         }
+        std::lock_guard<std::mutex> g(cmcad::xstep_lock());
         quiet_occ();
-        STEPControl_Writer writer;
+        // the shape is in mm whatever unit the last read or write left as the session's
+        Interface_Static::SetCVal("xstep.cascade.unit", "MM");
         Interface_Static::SetCVal("write.step.unit", "MM");
+        STEPControl_Writer writer;
         if (writer.Transfer(s, STEPControl_AsIs) != IFSelect_RetDone)
             return cm_error(ctx, CM_ERR_CAD, "%s: %s at t = %g: STEP transfer failed", fn, model, t);
         if (writer.Write(path) != IFSelect_RetDone)

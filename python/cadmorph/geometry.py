@@ -131,15 +131,15 @@ class Comparison:
 
     corresponds: bool
     message: str
-    renumbered: bool = False
-    face: Optional[np.ndarray] = None
-    face_reversed: Optional[np.ndarray] = None
-    edge: Optional[np.ndarray] = None
-    edge_flipped: Optional[np.ndarray] = None
-    vertex: Optional[np.ndarray] = None
-    wires_restarted: int = 0
-    face_type_changes: int = 0
-    edge_type_changes: int = 0
+    renumbered: bool
+    face: Optional[np.ndarray]
+    face_reversed: Optional[np.ndarray]
+    edge: Optional[np.ndarray]
+    edge_flipped: Optional[np.ndarray]
+    vertex: Optional[np.ndarray]
+    wires_restarted: int
+    face_type_changes: int
+    edge_type_changes: int
 
     def __bool__(self) -> bool:
         """corresponds."""
@@ -298,7 +298,9 @@ class Geometry:
         try:
             ctx.call(lib.cm_cad_correspond, self._ptr, other._ptr, int(max_report), out)
         except MismatchError as e:
-            return Comparison(corresponds=False, message=e.message)
+            return Comparison(corresponds=False, message=e.message, renumbered=False, face=None,
+                              face_reversed=None, edge=None, edge_flipped=None, vertex=None,
+                              wires_restarted=0, face_type_changes=0, edge_type_changes=0)
         c = out[0]
         try:
             k = c.counts

@@ -6,14 +6,21 @@ Mesh.close() or after the Mesh is gone; nothing in this package resizes a mesh, 
 never dangles.
 """
 import os
-from typing import Dict, List, Optional, Tuple, Union
+from typing import TYPE_CHECKING, Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._capi import ffi, lib
 from ._context import Context
 
 PathLike = Union[str, bytes, "os.PathLike[str]"]
+
+if TYPE_CHECKING:
+    import meshio
+
+CellBlocks = Sequence[Tuple[str, Any]]
+"""Cells as meshio keeps them: a list of (type name, array or list of cells)."""
 
 _TOKEN = object()  # Mesh objects are made here only
 _CELL_NAMES = [ffi.string(lib.cm_cell_type_info(t).name).decode()
@@ -205,8 +212,9 @@ class Mesh:
                 for g in (m.groups[i] for i in range(int(m.n_groups)))]
 
     @classmethod
-    def from_arrays(cls, points, cells, point_data: Optional[Dict[str, object]] = None,
-                    cell_data: Optional[Dict[str, object]] = None,
+    def from_arrays(cls, points: ArrayLike, cells: CellBlocks,
+                    point_data: Optional[Dict[str, ArrayLike]] = None,
+                    cell_data: Optional[Dict[str, Any]] = None,
                     groups: Optional[List[Tuple[int, int, str]]] = None,
                     threads: int = 0) -> "Mesh":
         """A mesh from arrays (copied into a new cm_mesh), checked before the library sees
@@ -291,7 +299,7 @@ class Mesh:
         return cls(m, _TOKEN)
 
     @classmethod
-    def from_meshio(cls, mesh, threads: int = 0) -> "Mesh":
+    def from_meshio(cls, mesh: "meshio.Mesh", threads: int = 0) -> "Mesh":
         """A mesh from a meshio.Mesh: points, cells (meshio's node order, see from_arrays),
         point_data and cell_data as fields, "gmsh:physical" and "gmsh:geometrical" as the
         cells' tags and field_data's {name: [tag, dim]} as groups (meshio's form of gmsh's
@@ -306,14 +314,18 @@ class Mesh:
         return cls.from_arrays(threads=threads,
                                **_convert.from_meshio_args(mesh, "cadmorph.Mesh.from_meshio"))
 
-    def to_meshio(self):
+    def to_meshio(self) -> "meshio.Mesh":
         """A meshio.Mesh with copies of the points, cells (meshio's names and node order: the
         wedge's nodes 1 and 2, 4 and 5 swapped; one block per run of one type, polygons per
         run of one size, polyhedra as "polyhedron<n>" lists of faces), point_data, cell_data
         (per block), the cells' tags as "gmsh:physical" and "gmsh:geometrical" (when any is
         set) and the groups as field_data {name: array([tag, dim])}, as meshio reads gmsh
         files; meshio.write then writes every format meshio knows."""
-        import meshio
+        try:
+            import meshio
+        except ImportError as e:
+            raise ImportError("cadmorph.Mesh.to_meshio needs meshio (Debian python3-meshio, "
+                              "pip install meshio): %s" % e) from None
         from . import _convert
         types, offset, conn = self._cell_arrays()
         blocks = _convert.meshio_blocks(types, offset, conn)

@@ -122,7 +122,8 @@ def quality(mesh: Mesh, threads: int = 0, *,
     prints on its last line (cm_mesh_quality, cm_quality_summarize): a Quality.
 
     foam=True: OpenFOAM checkMesh's geometry checks instead (cm_mesh_quality_foam), the
-    numbers `cadmorph quality --foam` prints: a FoamQuality.
+    numbers `cadmorph quality --foam` prints: a FoamQuality. Raises ValueError for a mesh
+    without volume cells.
     """
     if not isinstance(mesh, Mesh):
         raise TypeError("cadmorph.quality: mesh must be a cadmorph.Mesh, not %s"
@@ -132,6 +133,9 @@ def quality(mesh: Mesh, threads: int = 0, *,
     m = mesh._ptr
     ctx = Context(threads, False, "cadmorph.quality")
     if foam:
+        if lib.cm_mesh_count_dim(m, 3) == 0:  # as the CLI checks it
+            raise ValueError("cadmorph.quality: foam=True needs volume cells (tet, hex, wedge, "
+                             "pyramid, polyhedron); the mesh has none")
         q = ffi.new("cm_foam_quality *")
         ctx.call(lib.cm_mesh_quality_foam, m, q)
         return _foam_quality(q)

@@ -1,6 +1,9 @@
 /* Topology and volume of the benchmark models: G(t) keeps the topology of G(0) (counts,
  * surface/curve types, face-edge and edge-vertex incidence, in MapShapes order) for
- * t = 0, 0.25, 0.5, 0.75, 1, and its volume (BRepGProp) matches the closed formula. */
+ * t = 0, 0.25, 0.5, 0.75, 1, and its volume (BRepGProp) matches the closed formula. A model's
+ * STEP file is in mm whatever unit a read before it used (OpenCASCADE's session unit is
+ * process-wide). Arguments: the test data and work directories. */
+#include "cadmorph/cad.h"
 #include "cadmorph/models.h"
 
 #include <math.h>
@@ -51,9 +54,43 @@ static double bracket_volume(double t)
     return profile * p.height - 2.0 * M_PI * p.hole_radius * p.hole_radius * p.width;
 }
 
-int main(void)
+/* Reads a STEP file in metres, then writes the bore and reads it back in mm: its block is
+ * [-2,2] x [-2,2] x [0,2], not 1000 times that. */
+static void unit_after_a_read_in_metres(cm_context *ctx, const char *data, const char *work)
+{
+    char in[4096], out[4096];
+    snprintf(in, sizeof in, "%s/freecad/bracket_0.step", data);
+    snprintf(out, sizeof out, "%s/test_models_bore.step", work);
+    cm_cad_read_options opt;
+    cm_cad_read_options_init(&opt);
+    opt.unit = "m";
+    cm_cad_model *g = NULL, *bore = NULL;
+    double bb[6] = {0};
+    if (cm_cad_read(ctx, in, &opt, &g) != CM_OK ||
+        cm_model_write_step(ctx, "bore", 0, out) != CM_OK ||
+        cm_cad_read(ctx, out, NULL, &bore) != CM_OK) {
+        fprintf(stderr, "unit after a read in metres: %s\n", cm_context_message(ctx));
+        ++failed;
+    } else {
+        cm_cad_bbox(bore, bb);
+        if (!(fabs(bb[0] + 2) < 1e-6 && fabs(bb[3] - 2) < 1e-6 && fabs(bb[5] - 2) < 1e-6)) {
+            fprintf(stderr, "bore written after a read in metres: bbox x [%g, %g] z [%g, %g]\n",
+                    bb[0], bb[3], bb[2], bb[5]);
+            ++failed;
+        }
+    }
+    cm_cad_destroy(&g);
+    cm_cad_destroy(&bore);
+    remove(out);
+}
+
+int main(int argc, char **argv)
 {
     cm_context *ctx = NULL;
+    if (argc < 3) {
+        fprintf(stderr, "usage: test_models DATA_DIR WORK_DIR\n");
+        return 2;
+    }
     if (cm_context_create(&ctx) != CM_OK) return 1;
     static const char *models[] = {"bore", "pipe", "bracket"};
     static double (*const volume[])(double) = {bore_volume, pipe_volume, bracket_volume};
@@ -97,6 +134,7 @@ int main(void)
         fprintf(stderr, "t = 1.5 accepted\n");
         ++failed;
     }
+    unit_after_a_read_in_metres(ctx, argv[1], argv[2]);
     cm_context_destroy(&ctx);
     printf("%s\n", failed ? "FAILED" : "ok");
     return failed != 0;
