@@ -131,7 +131,11 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     cuv.resize(2 * ncand);
     std::vector<char> keep(ncand, 0);
     cmcad::region_error err;
-    cm_progress(ctx, "sample", 0, (double)rows.size());
+    cm_status st = cm_progress(ctx, "sample", 0, (double)rows.size());
+    if (st < 0) return st;
+    // the caller asked to stop (seen by the calling thread, which reports): every thread skips
+    // the rest of its rows
+    int stop = 0;
     std::vector<cmcad::scanline> scan((size_t)m->counts.faces);
     for (int f = 0; f < m->counts.faces; ++f) cmcad::scanline_build(m, f, scan[(size_t)f]);
 #pragma omp parallel num_threads(cm_context_threads_for(ctx, ncand, 4096)) if (ncand > 4096)
@@ -142,10 +146,18 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
         std::vector<char> in;
 #pragma omp for schedule(static)
         for (long r = 0; r < (long)rows.size(); ++r) {
+            int stopped;
+#pragma omp atomic read
+            stopped = stop;
+            if (stopped) continue;
             // the calling thread reports: with a static schedule it owns the first 1/nt rows
-            if (master && r % 64 == 0)
+            if (master && r % 64 == 0 &&
                 cm_progress(ctx, "sample", std::min((double)r * nt, (double)rows.size()),
-                            (double)rows.size());
+                            (double)rows.size()) < 0) {
+#pragma omp atomic write
+                stop = 1;
+                continue;
+            }
             try {
                 const row &rw = rows[r];
                 const double *ur = m->face_info[rw.face].uv_range;
@@ -168,7 +180,8 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
         }
     }
     if (err.status != CM_OK) return err.report(ctx, fn);
-    cm_progress(ctx, "sample", (double)rows.size(), (double)rows.size());
+    if (stop) return CM_ERR_INTERRUPTED;  // the message is cm_progress's
+    if ((st = cm_progress(ctx, "sample", (double)rows.size(), (double)rows.size())) < 0) return st;
     double clock1 = cm_wtime();
     size_t nkeep = 0;
     for (char k : keep) nkeep += (size_t)k;
@@ -223,7 +236,7 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     if (L->face.empty())
         return cm_error(ctx, CM_ERR_CAD, "%s: no sample inside any face", fn);
     double clock2 = cm_wtime();
-    cm_status st = cm_kdtree_create(ctx, L->xyz.data(), L->face.size(), &L->tree);
+    st = cm_kdtree_create(ctx, L->xyz.data(), L->face.size(), &L->tree);
     if (st == CM_OK && !L->eedge.empty())
         st = cm_kdtree_create(ctx, L->exyz.data(), L->eedge.size(), &L->etree);
     if (st == CM_OK && m->counts.vertices > 0)

@@ -14,7 +14,10 @@ enum {
     CLI_EXIT_USAGE = 1,
     CLI_EXIT_BAD_INPUT = 2,
     CLI_EXIT_REJECTED = 3,
-    CLI_EXIT_INTERNAL = 4
+    CLI_EXIT_INTERNAL = 4,
+    /* a library call stopped on request (CM_ERR_INTERRUPTED): the shell's code for a run
+     * ended by SIGINT, which is what asks for it */
+    CLI_EXIT_INTERRUPTED = 130
 };
 
 /* A context whose log goes to stderr (debug lines only when verbose), whose progress is drawn
@@ -24,7 +27,7 @@ enum {
 cm_context *cli_context_create(const char *cmd, int verbose, int threads);
 
 /* Prints "cadmorph <cmd>: <context message>" on one line to stderr, returns the exit code
- * for the status (2 for bad input, 4 for internal errors). */
+ * for the status (2 for bad input, 4 for internal errors, 130 for an interrupted call). */
 int cli_fail(cm_context *ctx, const char *cmd, cm_status s);
 
 /* Prints "cadmorph <cmd>: <message>" and the usage hint to stderr; returns CLI_EXIT_USAGE. */

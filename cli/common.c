@@ -104,6 +104,7 @@ int cli_fail(cm_context *ctx, const char *cmd, cm_status s)
     fprintf(stderr, "cadmorph %s: %s\n", cmd, msg && *msg ? msg : cm_status_name(s));
     if (s == CM_ERR_ARGUMENT) return CLI_EXIT_USAGE;
     if (s == CM_ERR_REJECTED) return CLI_EXIT_REJECTED;
+    if (s == CM_ERR_INTERRUPTED) return CLI_EXIT_INTERRUPTED;
     return cm_status_is_input_error(s) ? CLI_EXIT_BAD_INPUT : CLI_EXIT_INTERNAL;
 }
 

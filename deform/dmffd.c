@@ -218,6 +218,9 @@ cm_status cm_dmffd_create(cm_context *ctx, const cm_ffd *ffd, size_t m, const do
             goto fail;
         }
     }
+    /* the SVD is one LAPACK call that cannot stop: the points around it are where the
+     * caller can (cm_context_interrupt) */
+    if ((s = cm_progress(ctx, "dmffd svd", 0, 1)) < 0) goto fail;
     {
         int saved = openblas_get_num_threads();
         int threads = cm_context_threads(ctx);
@@ -226,6 +229,7 @@ cm_status cm_dmffd_create(cm_context *ctx, const cm_ffd *ffd, size_t m, const do
         openblas_set_num_threads(saved);
     }
     if (s < 0) goto fail;
+    if ((s = cm_progress(ctx, "dmffd svd", 1, 1)) < 0) goto fail;
     d->info.handles = m;
     d->info.active = d->n_act;
     *dm = d;

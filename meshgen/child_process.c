@@ -77,8 +77,12 @@ static void read_log_tail(int log_fd, cm_child_outcome *o)
         if (o->log[i] == '\n' || o->log[i] == '\r' || o->log[i] == '\t') o->log[i] = ' ';
 }
 
-cm_status cm_child_run(cm_context *ctx, const char *what, cm_child_work work, void *arg,
-                       double time_limit, char **data, size_t *size, cm_child_outcome *o)
+/* Seconds between two progress points while the child runs. */
+#define CM_CHILD_BEAT 0.1
+
+cm_status cm_child_run(cm_context *ctx, const char *what, const char *stage, cm_child_work work,
+                       void *arg, double time_limit, char **data, size_t *size,
+                       cm_child_outcome *o)
 {
     const char *fn = "cm_child_run";
     *data = NULL;
@@ -116,15 +120,23 @@ cm_status cm_child_run(cm_context *ctx, const char *what, cm_child_work work, vo
     size_t cap = 0, len = 0;
     char *buf = NULL;
     cm_status st = CM_OK;
+    double beat = t0;
     for (;;) {
-        int wait_ms = -1;
+        /* a progress point every CM_CHILD_BEAT s while the child works: the caller may stop
+         * it there (the child is killed, as after the time limit) */
+        const double now = cm_wtime();
+        if (now - beat >= CM_CHILD_BEAT) {
+            beat = now;
+            if ((st = cm_progress(ctx, stage, 0, 1)) < 0) break;
+        }
+        int wait_ms = (int)(CM_CHILD_BEAT * 1000);
         if (limited) {
-            const double left = deadline - cm_wtime();
+            const double left = deadline - now;
             if (left <= 0) {
                 o->timed_out = 1;
                 break;
             }
-            wait_ms = left > 3600 ? 3600000 : (int)ceil(left * 1000);
+            if (left < CM_CHILD_BEAT) wait_ms = (int)ceil(left * 1000);
         }
         struct pollfd p = {.fd = pfd[0], .events = POLLIN};
         const int r = poll(&p, 1, wait_ms);
@@ -133,7 +145,7 @@ cm_status cm_child_run(cm_context *ctx, const char *what, cm_child_work work, vo
             st = cm_error(ctx, CM_ERR_INTERNAL, "%s: %s: poll: %s", fn, what, strerror(errno));
             break;
         }
-        if (r == 0) continue; /* the deadline is checked above */
+        if (r == 0) continue; /* the deadline and the progress point are checked above */
         if (len == cap) {
             const size_t ncap = cap ? 2 * cap : 1 << 16;
             char *nb = realloc(buf, ncap);

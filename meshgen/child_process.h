@@ -31,9 +31,13 @@ typedef struct cm_child_outcome {
  * *size bytes; NULL when empty) and how it ended into *outcome. time_limit: seconds of wall
  * time (<= 0 or INFINITY: none); the child is then killed with SIGKILL. CM_OK whenever the
  * child ran (however it ended: look at *outcome); CM_ERR_NOMEM / CM_ERR_INTERNAL when no child
- * could be started or its output not read. `what` names the work in messages. */
-cm_status cm_child_run(cm_context *ctx, const char *what, cm_child_work work, void *arg,
-                       double time_limit, char **data, size_t *size, cm_child_outcome *outcome);
+ * could be started or its output not read. `what` names the work in messages. While the
+ * child runs, cm_progress(ctx, stage, 0, 1) every 0.1 s: when it returns CM_ERR_INTERRUPTED
+ * the child is killed and that is returned (the dependency itself cannot stop, its process
+ * can). */
+cm_status cm_child_run(cm_context *ctx, const char *what, const char *stage, cm_child_work work,
+                       void *arg, double time_limit, char **data, size_t *size,
+                       cm_child_outcome *outcome);
 
 /* In the child: writes all n bytes to fd; 0 on success. */
 int cm_child_write(int fd, const void *p, size_t n);

@@ -134,7 +134,7 @@ extern "C" cm_status cm_tetgen_run(cm_context *ctx, const char *what, const cm_t
     char *data = nullptr;
     size_t size = 0;
     cm_child_outcome o;
-    cm_status s = cm_child_run(ctx, "TetGen", child_work, &j, time_limit, &data, &size, &o);
+    cm_status s = cm_child_run(ctx, "TetGen", "tetgen", child_work, &j, time_limit, &data, &size, &o);
     if (s < 0) return s;
     if (o.timed_out || o.signal || o.exit_code != 0) {
         std::free(data);

@@ -254,11 +254,17 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
 
     const double limit = o.time_limit > 0 ? o.time_limit : CM_TETMESH_TIME_LIMIT;
     if (o.mesher == CM_MESHER_GMSH) {
-        cm_progress(ctx, "gmsh", 0, 1);
+        if ((s = cm_progress(ctx, "gmsh", 0, 1)) < 0) return s;
         cmvol::raw_mesh r;
         if ((s = cmvol::gmsh_mesh(ctx, model, h, limit, &r)) < 0) return s;
         s = assemble(ctx, counts.faces, r.xyz, r.tets, r.tri, r.tri_face, out);
-        if (s >= 0) cm_progress(ctx, "gmsh", 1, 1);
+        if (s >= 0) {
+            cm_status p = cm_progress(ctx, "gmsh", 1, 1);
+            if (p < 0) {
+                cm_mesh_destroy(out);
+                return p;
+            }
+        }
         return s;
     }
     if (o.mesher != CM_MESHER_TETGEN)
@@ -279,7 +285,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     const double t1 = cm_wtime();
     cm_log(ctx, CM_LOG_DEBUG, "tetmesh: surface %zu nodes, %zu triangles (%.3f s)", T.n_nodes,
            T.n_triangles, t1 - t0);
-    cm_progress(ctx, "tetgen", 0, 1);
+    if ((s = cm_progress(ctx, "tetgen", 0, 1)) < 0) return s;
 
     const cm_tetgen_plc plc = {T.n_nodes, T.n_triangles, T.xyz, T.tri, nullptr};
     std::vector<int> marker(T.n_triangles);
@@ -370,6 +376,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
         }
         int failure = 0;
         s = cm_tetgen_run(ctx, path, &in, sw, limit, &tv.r, &failure);
+        if (s == CM_ERR_INTERRUPTED) return s;  // the caller's stop: no further attempt
         if (s >= 0 && (tv.r.n_tets == 0 || tv.r.corners != 4)) {
             cm_tetgen_result_free(&tv.r);
             s = cm_error(ctx, CM_ERR_NUMERIC, "%s: TetGen made no linear tets (switches %s)", path, sw);
@@ -444,7 +451,13 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     for (size_t t = 0; t < nt; ++t)
         for (int k = 0; k < 4; ++k) tets[t][k] = tv.r.tet[4 * t + k];
     s = assemble(ctx, counts.faces, xyz, tets, tri, tri_face, out);
-    if (s >= 0) cm_progress(ctx, "tetgen", 1, 1);
+    if (s >= 0) {
+        cm_status p = cm_progress(ctx, "tetgen", 1, 1);
+        if (p < 0) {
+            cm_mesh_destroy(out);
+            return p;
+        }
+    }
     return s;
 }
 

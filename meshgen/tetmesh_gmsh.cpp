@@ -197,7 +197,7 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
     char *data = nullptr;
     size_t size = 0;
     cm_child_outcome o;
-    cm_status s = cm_child_run(ctx, "gmsh", child_work, &j, time_limit, &data, &size, &o);
+    cm_status s = cm_child_run(ctx, "gmsh", "gmsh", child_work, &j, time_limit, &data, &size, &o);
     if (s < 0) return s;
     if (o.timed_out || o.signal || o.exit_code != 0) {
         std::free(data);

@@ -468,7 +468,8 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
 {
     int n = mp->opt.steps;
     for (int k = 1; k <= n; ++k) {
-        cm_progress(ctx, "morph", k - 1, n);
+        cm_status p = cm_progress(ctx, "morph", k - 1, n);
+        if (p < 0) return p;
         cm_morph_step *row = new_row(ctx, mp);
         if (!row) return CM_ERR_NOMEM;
         cm_status s =
@@ -476,8 +477,7 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
         if (s < 0) return cm_error_prefix(ctx, s, "step %d of %d", k, n);
         memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
     }
-    cm_progress(ctx, "morph", n, n);
-    return CM_OK;
+    return cm_progress(ctx, "morph", n, n);
 }
 
 /* Adaptive steps (CM_MORPH_STEPS_AUTO), see cm_morph_options. */
@@ -490,7 +490,8 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
     while (done < 1) {
         double f = done + step;
         if (f > 1 - 1e-12) f = 1;
-        cm_progress(ctx, "morph", done, 1);
+        cm_status p = cm_progress(ctx, "morph", done, 1);
+        if (p < 0) return p;
         cm_morph_step *row = new_row(ctx, mp);
         if (!row) return CM_ERR_NOMEM;
         cm_status s = trial(ctx, mp, wo, f, done == 0, optimize, xyz, mp->next, row);
@@ -536,8 +537,7 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
                                      : "; interior optimisation (--optimize) may lift them");
         }
     }
-    cm_progress(ctx, "morph", 1, 1);
-    return CM_OK;
+    return cm_progress(ctx, "morph", 1, 1);
 }
 
 cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,

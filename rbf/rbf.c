@@ -413,12 +413,20 @@ cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const do
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < dim; ++d)
             p[(size_t)d * n + i] = (points[i * (size_t)dim + (size_t)d] - rbf->shift[d]) * rbf->scale;
+    /* in chunks with progress, so that cm_context_interrupt stops a large evaluation */
+    cm_rbf_tick tick;
+    cm_rbf_tick_init(&tick, ctx, "rbf evaluate",
+                     (double)((ncomp + 3) / 4) * (double)n * (double)rbf->m);
     if (rbf->petsc && cm_rbf_petsc_evaluate(rbf, n, p, out, cm_rbf_threads(ctx)))
         ; /* collective: each rank its block of points */
     else if (rbf->iter) /* compensated sums: see cm_rbf_iterative_evaluate */
-        cm_rbf_iterative_evaluate(rbf, n, p, out, cm_rbf_threads(ctx));
+        cm_rbf_iterative_evaluate(rbf, n, p, out, cm_rbf_threads(ctx), &tick);
     else
-        cm_rbf_kernel_sum_all(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx));
+        cm_rbf_kernel_sum_all_tick(rbf, rbf->w, ncomp, n, p, n, out, cm_rbf_threads(ctx), &tick);
+    if (cm_rbf_tick_finish(&tick) < 0) {
+        free(p);
+        return tick.status;
+    }
     for (size_t i = 0; i < n; ++i) {
         for (int c = 0; c < ncomp; ++c) {
             const double *qc = rbf->q + (size_t)c * (size_t)k;

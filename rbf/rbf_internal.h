@@ -45,6 +45,34 @@ struct cm_rbf {
 /* Threads for a leaf loop: the context's count, or all that OpenMP offers for 0. */
 int cm_rbf_threads(const cm_context *ctx);
 
+/* Progress of a long loop that runs in chunks (evaluations, assembly), so that
+ * cm_context_interrupt stops it between two chunks: cm_rbf_tick_add after each chunk
+ * reports (cm_progress) at most every CM_RBF_TICK_SECONDS, which keeps callbacks rare on
+ * large sums and absent on small ones (work of one chunk: no report at all). Chunks are
+ * whole blocks of the parallel loops, cut outside their parallel regions, so the sums are
+ * the same bits as in one pass. */
+typedef struct cm_rbf_tick {
+    cm_context *ctx;
+    const char *stage;
+    double done, total; /* units of work (point-centre pairs, batches) */
+    double last;        /* cm_wtime of the start or of the last report */
+    int reported;       /* a report was made (the last one then says done = total) */
+    cm_status status;   /* CM_ERR_INTERRUPTED once a report returned it */
+} cm_rbf_tick;
+#define CM_RBF_TICK_SECONDS 0.05
+/* point-centre pairs of one chunk of a kernel sum: ~0.02-0.05 s of one core */
+#define CM_RBF_TICK_PAIRS 3e7
+void cm_rbf_tick_init(cm_rbf_tick *t, cm_context *ctx, const char *stage, double total);
+/* Adds work done; reports when due (not when done reaches total). Nonzero: stop (t->status
+ * is CM_ERR_INTERRUPTED, with its message in the context). A NULL t never stops. */
+int cm_rbf_tick_add(cm_rbf_tick *t, double work);
+/* After the loop: reports done = total if anything was reported (so that a progress line
+ * ends at 100 %); returns t->status or that report's. */
+cm_status cm_rbf_tick_finish(cm_rbf_tick *t);
+/* Items (of per_item pairs each) in one chunk of a loop of `items` on `threads`: all of them
+ * without a tick, else about CM_RBF_TICK_PAIRS worth but at least 8 per thread. */
+long cm_rbf_tick_chunk(const cm_rbf_tick *tick, double per_item, long items, int threads);
+
 /* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (1..4), i < n.
  * p: dim x n SoA with stride ldp (p + d * ldp is coordinate d), centres as in rbf (SoA,
  * stride m). The sum over j runs in the same order for every i whatever the thread count,
@@ -59,6 +87,11 @@ void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
  * SoA), four at a time; out: n x ncomp. */
 void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
                            const double *p, size_t ldp, double *out, int threads);
+/* The same in chunks of points with tick (NULL: as cm_rbf_kernel_sum_all); nonzero when the
+ * tick said stop (out then partly written). */
+int cm_rbf_kernel_sum_all_tick(const cm_rbf *r, const double *w, int ncomp, size_t n,
+                               const double *p, size_t ldp, double *out, int threads,
+                               cm_rbf_tick *tick);
 /* "triharmonic", "biharmonic", "thin-plate" (for messages) */
 const char *cm_rbf_kernel_name(cm_rbf_kernel k);
 
@@ -66,6 +99,10 @@ const char *cm_rbf_kernel_name(cm_rbf_kernel k);
  * eps |result| instead of eps sum_j |w_j phi_ij| (rbf_sum_acc.c says why). */
 void cm_rbf_kernel_sum_acc(size_t m, const double *c, const double *w, int nc, size_t n,
                            const double *p, size_t ldp, double *out, size_t ldo, int threads);
+/* The same in chunks of points with tick (NULL: one pass); nonzero when the tick said stop. */
+int cm_rbf_kernel_sum_acc_tick(size_t m, const double *c, const double *w, int nc, size_t n,
+                               const double *p, size_t ldp, double *out, size_t ldo,
+                               int threads, cm_rbf_tick *tick);
 
 /* Which code runs the kernel sums. The library passes AUTO (the fastest this CPU runs);
  * tests and benchmarks name one to compare them: GENERIC (baseline x86-64 or any CPU), AVX2
@@ -99,6 +136,10 @@ void cm_rbf_kernel_sum_acc_isa(cm_rbf_isa isa, size_t m, const double *c, const 
 void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                                int k, const double *v, const double *z, double sign,
                                double *rfp, int threads);
+/* The same in chunks of columns with tick (NULL: one pass); nonzero when the tick said stop. */
+int cm_rbf_assemble_projected_tick(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                                   int k, const double *v, const double *z, double sign,
+                                   double *rfp, int threads, cm_rbf_tick *tick);
 
 /* Merges centres closer than tol (unit-box coordinates, dim x m_in SoA in c). Fills rep
  * (m_in) and returns the number of merged centres; first (>= that many) gets the first input
@@ -119,12 +160,15 @@ cm_status cm_rbf_dense_solve_pass(cm_context *ctx, const cm_rbf *r, size_t nc, c
 /* Cholesky factorisation of the n x n SPD matrix in a (n(n+1)/2 doubles, RFP with TRANSR 'N',
  * UPLO 'L', as dpftrf), in place, panel by panel of `block` columns (0: the default), with
  * cm_progress(ctx, "rbf factor", done, total) after every panel (done in flops, monotonic).
- * Returns dpftrf's info: 0, or i > 0 if the leading minor of order i is not positive definite.
+ * Returns dpftrf's info: 0, or i > 0 if the leading minor of order i is not positive definite,
+ * or CM_RBF_CHOLESKY_INTERRUPTED when a progress point returned CM_ERR_INTERRUPTED (its
+ * message is in ctx; a holds a partial factor).
  * BLAS threads: as the caller set them (cm_blas_threads); on T > 1 of them and n in
  * [CM_LOOKAHEAD_MIN_N, CM_LOOKAHEAD_MAX_N] outside a parallel region, the look-ahead path
  * below on T OpenMP threads, else the panel-by-panel one (both: the same factor to rounding,
  * the same info and progress). */
 int cm_rbf_cholesky_rfp(cm_context *ctx, int n, double *a, int block);
+#define CM_RBF_CHOLESKY_INTERRUPTED (-0x7fff)
 /* The two paths, for benchmarks and tests. panels (cholesky_blocked.c): one panel after the
  * other, each BLAS call on the caller's BLAS threads. lookahead (cholesky_lookahead.c):
  * `threads` OpenMP threads each calling one-thread BLAS (OpenBLAS's count is set to 1 during
@@ -174,14 +218,16 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads);
 cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
                                  double *w, double *q, int threads);
 void cm_rbf_iterative_destroy(cm_rbf_iter **it);
-/* out (n x ncomp) = sum_j w_j phi(|p_i - c_j|) by compensated sums; p: 3 x n SoA. */
-void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
-                               int threads);
+/* out (n x ncomp) = sum_j w_j phi(|p_i - c_j|) by compensated sums; p: 3 x n SoA. tick
+ * (NULL: none) reports the sums in chunks; nonzero when it said stop (out partly written). */
+int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
+                              int threads, cm_rbf_tick *tick);
 /* Its fast path alone (the treecode where n x m is large and its error is within
  * fast_eval_tol x the data scale): 1 if out holds the accepted result, 0 if direct sums must
- * do it. Deterministic for given weights, so every rank that calls it gets the same out. */
+ * do it (or tick, if not NULL, said stop: then tick->status < 0). Deterministic for given
+ * weights, so every rank that calls it gets the same out. */
 int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
-                                   int threads);
+                                   int threads, cm_rbf_tick *tick);
 /* The last evaluation's fast-sum figures (eval_fast, eval_error, eval_order, eval_theta) into
  * stats; nothing for a dense fit. */
 void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats);

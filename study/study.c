@@ -181,8 +181,12 @@ static cm_status gather_rows(cm_context *ctx, cm_study_result *r)
     return CM_OK;
 }
 
-/* Errors of a row that are not the method's or the variant's fault end the study. */
-static int fatal(cm_status s) { return s == CM_ERR_NOMEM || s == CM_ERR_IO; }
+/* Errors of a row that are not the method's or the variant's fault end the study (and so
+ * does the caller's request to stop). */
+static int fatal(cm_status s)
+{
+    return s == CM_ERR_NOMEM || s == CM_ERR_IO || s == CM_ERR_INTERRUPTED;
+}
 
 static void log_row(cm_context *ctx, const study *w, const cm_study_row *row, const char *label)
 {
@@ -218,7 +222,7 @@ static cm_status run_variant(cm_context *ctx, study *w, size_t i, cm_cad_model *
     double t_load = cm_wtime() - t0;
     if (s < 0) {
         cm_cad_destroy(&g);
-        if (s == CM_ERR_NOMEM) return s;
+        if (s == CM_ERR_NOMEM || s == CM_ERR_INTERRUPTED) return s;
         cm_log(ctx, CM_LOG_WARNING, "study: variant %s: %s", label, cm_context_message(ctx));
         for (size_t k = 0; k < w->n_series; ++k) {
             cm_study_row row = base_row;
@@ -410,7 +414,7 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
     cm_status s = setup(ctx, &w);
     for (size_t i = 0; i < family->n && s >= 0; ++i) {
         if (ranks > 1 && (int)(i % (size_t)ranks) != opt->rank) continue; /* another rank's */
-        cm_progress(ctx, "study", (double)i, (double)family->n);
+        if ((s = cm_progress(ctx, "study", (double)i, (double)family->n)) < 0) break;
         cm_cad_model *g = NULL;
         int abs_used = 0, rel_used = 0;
         s = run_variant(ctx, &w, i, &g, &abs_used, &rel_used);
@@ -420,7 +424,7 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
         }
         keep(&w, g, abs_used, rel_used);
     }
-    if (s >= 0) cm_progress(ctx, "study", (double)family->n, (double)family->n);
+    if (s >= 0) s = cm_progress(ctx, "study", (double)family->n, (double)family->n);
     study_free(&w);
     /* every rank gathers, also one that failed: the others would wait for it */
     if (ranks > 1) {

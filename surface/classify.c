@@ -219,6 +219,33 @@ static cm_status set_aside_off(cm_context *ctx, cm_surface_nodes *s, const size_
     return CM_OK;
 }
 
+/* Nodes per call of a locate in a pass: each is a Newton projection with OpenCASCADE (tens
+ * of microseconds), so 10^5 nodes are about a second; a progress point between chunks lets
+ * the caller stop there. The nodes are independent: the same results as in one call. */
+#define CM_CLASSIFY_CHUNK 8192
+
+/* cm_cad_locate_edges (pass 1: par n) or cm_cad_locate_faces (pass 2: par n x 2) of q (n x
+ * 3) in chunks, with progress "classify" between them. */
+static cm_status locate_chunks(cm_context *ctx, const cm_cad_locator *locator, int pass,
+                               const double *q, size_t n, int *ent, double *par, double *dist)
+{
+    cm_status st = CM_OK, warned = CM_OK; /* a chunk's warning stays the result */
+    for (size_t j0 = 0; j0 < n; j0 += CM_CLASSIFY_CHUNK) {
+        const size_t k = n - j0 < CM_CLASSIFY_CHUNK ? n - j0 : CM_CLASSIFY_CHUNK;
+        if (j0 > 0) {
+            cm_status p = cm_progress(ctx, "classify", pass + (double)j0 / (double)n, 3);
+            if (p < 0) return p;
+        }
+        st = pass == 1 ? cm_cad_locate_edges(ctx, locator, q + 3 * j0, k, ent + j0, par + j0,
+                                             dist + j0)
+                       : cm_cad_locate_faces(ctx, locator, q + 3 * j0, k, ent + j0,
+                                             par + 2 * j0, dist + j0, NULL);
+        if (st < 0) return st;
+        if (st > 0) warned = st;
+    }
+    return warned;
+}
+
 cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_cad_locator *locator,
                               const cm_mesh *mesh, const cm_mesh_boundary *b,
                               const cm_classify_options *opt, cm_surface_nodes **out)
@@ -260,17 +287,17 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
     for (int pass = 0; pass < 3 && nr; ++pass) {
         for (size_t j = 0; j < nr; ++j)
             memcpy(q + 3 * j, s->xyz + 3 * rest[j], 3 * sizeof(double));
-        cm_progress(ctx, "classify", pass, 3);
+        if ((st = cm_progress(ctx, "classify", pass, 3)) < 0) goto done;
         if (pass == 0 && c.vertices > 0) {
             st = cm_cad_locate_vertices(ctx, locator, q, nr, ent, dist);
             if (st < 0) goto done;
             take(s, rest, nr, tol, CM_SURFACE_ON_VERTEX, ent, par, dist);
         } else if (pass == 1 && c.edges > 0) {
-            st = cm_cad_locate_edges(ctx, locator, q, nr, ent, par, dist);
+            st = locate_chunks(ctx, locator, 1, q, nr, ent, par, dist);
             if (st < 0) goto done;
             take(s, rest, nr, tol, CM_SURFACE_ON_EDGE, ent, par, dist);
         } else if (pass == 2) {
-            st = cm_cad_locate_faces(ctx, locator, q, nr, ent, par, dist, NULL);
+            st = locate_chunks(ctx, locator, 2, q, nr, ent, par, dist);
             if (st < 0) goto done;
             take(s, rest, nr, tol, CM_SURFACE_ON_FACE, ent, par, dist);
             /* what is left is off G: report count, worst node and a unit hint */
@@ -301,7 +328,7 @@ cm_status cm_surface_classify(cm_context *ctx, const cm_cad_model *g, const cm_c
             if (s->kind[rest[j]] == 255) rest[k++] = rest[j];
         nr = k;
     }
-    cm_progress(ctx, "classify", 3, 3);
+    if ((st = cm_progress(ctx, "classify", 3, 3)) < 0) goto done;
     st = edge_arc_lengths(ctx, g, s);
     if (st < 0) goto done;
     for (size_t i = 0; i < s->n; ++i) {

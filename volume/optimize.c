@@ -572,20 +572,37 @@ cm_status cm_mesh_optimize(cm_context *ctx, cm_mesh *mesh, const unsigned char *
                 free(fill);
             }
         }
+        /* the coordinates before the sweeps, put back if the caller stops them: an
+         * interrupted call leaves the mesh as it found it */
+        double *xyz0 = s >= 0 && opt->sweeps > 0 ? malloc(3 * (nn ? nn : 1) * sizeof *xyz0) : NULL;
+        if (s >= 0 && opt->sweeps > 0 && !xyz0)
+            s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_optimize: out of memory");
+        if (xyz0) memcpy(xyz0, mesh->xyz, 3 * nn * sizeof *xyz0);
+        double last = cm_wtime();
         for (int sweep = 0; s >= 0 && sweep < opt->sweeps; ++sweep) {
             size_t moved = 0;
-            for (int c = 0; c < ncol; ++c) {
+            for (int c = 0; c < ncol && s >= 0; ++c) {
                 size_t lo = cstart[c], hi = cstart[c + 1];
                 int threads = cm_context_threads_for(ctx, hi - lo, 64);
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads) reduction(+ : moved)
                 for (size_t k = lo; k < hi; ++k)
                     moved += (size_t)optimise_node(&op, order[k]);
+                /* a sweep of a large mesh is seconds: a point between colours too, at most
+                 * every 0.05 s */
+                if (c + 1 < ncol && cm_wtime() - last >= 0.05) {
+                    last = cm_wtime();
+                    s = cm_progress(ctx, "optimize", sweep + (double)(c + 1) / ncol, opt->sweeps);
+                }
             }
+            if (s < 0) break;
             st.moves += moved;
             st.sweeps = sweep + 1;
-            cm_progress(ctx, "optimize", sweep + 1, opt->sweeps);
+            s = cm_progress(ctx, "optimize", sweep + 1, opt->sweeps);
+            last = cm_wtime();
             if (!moved) break;
         }
+        if (s < 0 && xyz0) memcpy(mesh->xyz, xyz0, 3 * nn * sizeof *xyz0);
+        free(xyz0);
         free(cstart);
     }
     if (s >= 0) s = cm_mesh_quality(ctx, mesh, op.sj);

@@ -334,7 +334,7 @@ static cm_status femwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_m
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
         goto fail;
     }
-    cm_progress(ctx, "femwarp assemble", 1, 1);
+    if ((s = cm_progress(ctx, "femwarp assemble", 1, 1)) < 0) goto fail;
 
     cholmod_l_start(&w->cc);
     w->cc_started = 1;
@@ -354,13 +354,17 @@ static cm_status femwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_m
     double t1 = cm_wtime();
     w->L = cholmod_l_analyze(kii, &w->cc);
     double t2 = cm_wtime();
-    if (w->L) cholmod_l_factorize(kii, w->L, &w->cc);
+    /* between the ordering and the factorisation, each one CHOLMOD call that cannot stop */
+    s = w->L ? cm_progress(ctx, "femwarp factorise", 0, 1) : CM_OK;
+    if (w->L && s >= 0) cholmod_l_factorize(kii, w->L, &w->cc);
     double t3 = cm_wtime();
     cholmod_l_free_sparse(&kii, &w->cc);
+    if (s < 0) goto fail;
     if (!w->L || w->cc.status < 0) {
         s = cholmod_failed(ctx, &w->cc, "factorisation");
         goto fail;
     }
+    if ((s = cm_progress(ctx, "femwarp factorise", 1, 1)) < 0) goto fail;
     if (w->cc.status == CHOLMOD_NOT_POSDEF || (size_t)w->L->minor < w->n_dof) {
         s = cm_error(ctx, CM_ERR_NUMERIC,
                      "cm_warp_create: femwarp: K_II is not positive definite (pivot %ld of %zu): "

@@ -315,7 +315,7 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
         }
         w->ib_start[i + 1] = (int64_t)ii;
     }
-    cm_progress(ctx, "lbwarp weights", 1, 1);
+    if ((s = cm_progress(ctx, "lbwarp weights", 1, 1)) < 0) goto fail;
     t1 = cm_wtime();
     if (w->n_fallback)
         cm_log(ctx, CM_LOG_WARNING,
@@ -349,6 +349,8 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
         goto fail;
     }
     t2 = cm_wtime();
+    /* UMFPACK's factorisation is one call that cannot stop: the last point before it */
+    if ((s = cm_progress(ctx, "lbwarp factorise", 0, 1)) < 0) goto fail;
     st = umfpack_dl_numeric(w->ap, w->ai, w->ax, symbolic, &w->numeric, control, info);
     if (st != UMFPACK_OK) {
         s = umfpack_failed(ctx, "factorisation", (int)st);
@@ -359,6 +361,8 @@ static cm_status lbwarp_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
            "factorisation %.3f s",
            nf, nt, info[UMFPACK_LNZ] + info[UMFPACK_UNZ], t1 - t0, t2 - t1, cm_wtime() - t2);
     umfpack_dl_free_symbolic(&symbolic);
+    symbolic = NULL;
+    if ((s = cm_progress(ctx, "lbwarp factorise", 1, 1)) < 0) goto fail;
     free(nc_start);
     free(nc_cells);
     free(stamp);
@@ -418,6 +422,8 @@ static cm_status lbwarp_apply(cm_context *ctx, void *state, double *disp, double
                             (long)st);
         for (size_t i = 0; i < nf; ++i)
             disp[3 * nd->free_nodes[i] + k] = w->x[i];
+        cm_status p = cm_progress(ctx, "warp", k + 1, 3); /* a solve per coordinate */
+        if (p < 0) return p;
     }
     return CM_OK;
 }

@@ -198,7 +198,7 @@ static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm
         if (s < 0) goto done;
         s = fit_component(ctx, mesh, kernel, solver, tolerance, k, &w->comp[k]);
         if (s < 0) goto done;
-        cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc);
+        if ((s = cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc)) < 0) goto done;
     }
     /* nodes of no volume cell and not constrained: nothing defines their motion */
     {
@@ -286,7 +286,8 @@ static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *r
         const double *out = warp->values + 3 * wc->n_fixed;
         for (size_t i = 0; i < wc->n_free; ++i)
             memcpy(disp + 3 * wc->free_nodes[i], out + 3 * i, 3 * sizeof(double));
-        cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components);
+        cm_status p = cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components);
+        if (p < 0) return p;
     }
     return CM_OK;
 }

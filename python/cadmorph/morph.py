@@ -5,6 +5,7 @@ morph(), the one-shot form that returns the mesh `cadmorph morph` writes.
 The pipeline is docs/DESIGN.md's: boundary nodes follow their CAD vertex, edge or face onto
 G' (the surface morph [SMB12 §4]), the interior follows by a warp [SMB12 §3].
 """
+import inspect
 import threading
 from dataclasses import dataclass, fields
 from typing import Any, List, Optional, Sequence, Tuple, Union
@@ -156,6 +157,72 @@ _SURFACES = {"rbf": lib.CM_SURFACE_RBF, "project": lib.CM_SURFACE_PROJECT}
 _OFF_CAD = {"refuse": lib.CM_OFF_CAD_REFUSE, "fixed": lib.CM_OFF_CAD_FIXED}
 
 
+def _morph_options(what: str, method: str = "rbf", kernel: Optional[str] = None,
+                   surface: str = "rbf", steps: Union[int, str] = 1, min_sj: float = 0.0,
+                   min_step: float = 1.0 / 256, keep_fraction: float = 0.0,
+                   escalate: bool = True, optimize: bool = False, optimize_sweeps: int = 6,
+                   optimize_target_sj: float = 0.3, optimize_newton: int = 4,
+                   solver: str = "auto", tolerance: float = 0.0,
+                   lattice: Optional[int] = None, clamp: Optional[float] = None,
+                   samples: Optional[int] = None, cubature: Optional[int] = None,
+                   cover: int = 5, stretch: float = 1.0, bend: float = 1.0,
+                   blend: float = 1.5, graded: float = 0.0, cad_tol: float = 1e-6,
+                   cad_abs_tol: float = 1e-9, off_cad: str = "refuse",
+                   keep_offset: bool = False, max_samples: Optional[int] = None,
+                   target_h_scale: float = 1.0, surface_spacing: float = 0.0,
+                   surface_min_per_edge: int = 8, surface_max_per_edge: int = 200,
+                   affine_tol: float = 1e-9) -> Tuple[Any, WarpSettings, str]:
+    """The Morpher's options checked (see Morpher), as a cm_morph_options (cffi-owned), the
+    warp settings and the surface method's name."""
+    warp = WarpSettings(what, method=method, kernel=kernel, solver=solver,
+                        tolerance=tolerance, lattice=lattice, clamp=clamp, samples=samples,
+                        cubature=cubature, cover=cover, stretch=stretch, bend=bend,
+                        blend=blend, graded=graded)
+    surface_ = choice(what, "surface", surface, list(_SURFACES))
+    o = ffi.new("cm_morph_options *")
+    lib.cm_morph_options_init(o)
+    _fill_method(ffi.addressof(o, "method"), warp, surface_)
+    if isinstance(steps, str):
+        if steps != "auto":
+            raise ValueError("%s: steps must be 1..4096 or 'auto', not %r" % (what, steps))
+        o.steps = lib.CM_MORPH_STEPS_AUTO
+    else:
+        o.steps = integer(what, "steps", steps, 1, 4096)
+    o.min_sj = number(what, "min_sj", min_sj, -1.0, 1.0, hi_open=True)
+    o.min_fraction = number(what, "min_step", min_step, 0.0, 1.0, lo_open=True,
+                            hi_open=True)
+    o.keep_fraction = number(what, "keep_fraction", keep_fraction, 0.0, 1.0)
+    o.escalate = flag(what, "escalate", escalate)
+    o.optimize = flag(what, "optimize", optimize)
+    o.optimize_options.sweeps = integer(what, "optimize_sweeps", optimize_sweeps, 0, 10000)
+    o.optimize_options.target_sj = number(what, "optimize_target_sj", optimize_target_sj,
+                                          -1.0, 1.0)
+    o.optimize_options.newton = integer(what, "optimize_newton", optimize_newton, 1, 100)
+    o.classify.rel_tol = number(what, "cad_tol", cad_tol, 0.0, 1.0, lo_open=True)
+    o.classify.abs_tol = number(what, "cad_abs_tol", cad_abs_tol, 0.0, 1.0)
+    o.off_cad = _OFF_CAD[choice(what, "off_cad", off_cad, list(_OFF_CAD))]
+    o.keep_offset = flag(what, "keep_offset", keep_offset)
+    if max_samples is not None:
+        o.max_samples = integer(what, "max_samples", max_samples, 1, 10 ** 12)
+    o.target_h_scale = number(what, "target_h_scale", target_h_scale, 1.0, 1e6)
+    o.morph.spacing = number(what, "surface_spacing", surface_spacing, 0.0)
+    o.morph.min_per_edge = integer(what, "surface_min_per_edge", surface_min_per_edge, 2,
+                                   100000)
+    o.morph.max_per_edge = integer(what, "surface_max_per_edge", surface_max_per_edge,
+                                   o.morph.min_per_edge, 100000)
+    o.morph.affine_tol = number(what, "affine_tol", affine_tol, 0.0, 1.0, hi_open=True)
+    return o, warp, surface_
+
+
+def _fill_method(c, warp: WarpSettings, surface: str) -> None:
+    """Writes a method (surface and warp) into a cm_morph_method *."""
+    c.surface = _SURFACES[surface]
+    warp.fill(ffi.addressof(c, "warp"))
+
+
+_OPTION_NAMES = frozenset(inspect.signature(_morph_options).parameters) - {"what"}
+
+
 class Morpher:
     """A mesh of the CAD model g0, ready to be morphed onto edited models of the same
     topology: `apply(g1)` returns the morphed node coordinates; the classification of the
@@ -243,48 +310,13 @@ class Morpher:
         what = "cadmorph.Morpher"
         self._mp = None
         self._lock = threading.Lock()
+        options = {k: v for k, v in locals().items() if k in _OPTION_NAMES}
         gp = _model(g0, what, "g0")
         if not isinstance(mesh, Mesh):
             raise TypeError("%s: mesh must be a cadmorph.Mesh, not %s"
                             % (what, type(mesh).__name__))
         m = mesh._ptr
-        self._warp = WarpSettings(what, method=method, kernel=kernel, solver=solver,
-                                  tolerance=tolerance, lattice=lattice, clamp=clamp,
-                                  samples=samples, cubature=cubature, cover=cover,
-                                  stretch=stretch, bend=bend, blend=blend, graded=graded)
-        self._surface = choice(what, "surface", surface, list(_SURFACES))
-        o = ffi.new("cm_morph_options *")
-        lib.cm_morph_options_init(o)
-        self._fill_method(ffi.addressof(o, "method"), self._warp, self._surface)
-        if isinstance(steps, str):
-            if steps != "auto":
-                raise ValueError("%s: steps must be 1..4096 or 'auto', not %r" % (what, steps))
-            o.steps = lib.CM_MORPH_STEPS_AUTO
-        else:
-            o.steps = integer(what, "steps", steps, 1, 4096)
-        o.min_sj = number(what, "min_sj", min_sj, -1.0, 1.0, hi_open=True)
-        o.min_fraction = number(what, "min_step", min_step, 0.0, 1.0, lo_open=True,
-                                hi_open=True)
-        o.keep_fraction = number(what, "keep_fraction", keep_fraction, 0.0, 1.0)
-        o.escalate = flag(what, "escalate", escalate)
-        o.optimize = flag(what, "optimize", optimize)
-        o.optimize_options.sweeps = integer(what, "optimize_sweeps", optimize_sweeps, 0, 10000)
-        o.optimize_options.target_sj = number(what, "optimize_target_sj", optimize_target_sj,
-                                              -1.0, 1.0)
-        o.optimize_options.newton = integer(what, "optimize_newton", optimize_newton, 1, 100)
-        o.classify.rel_tol = number(what, "cad_tol", cad_tol, 0.0, 1.0, lo_open=True)
-        o.classify.abs_tol = number(what, "cad_abs_tol", cad_abs_tol, 0.0, 1.0)
-        o.off_cad = _OFF_CAD[choice(what, "off_cad", off_cad, list(_OFF_CAD))]
-        o.keep_offset = flag(what, "keep_offset", keep_offset)
-        if max_samples is not None:
-            o.max_samples = integer(what, "max_samples", max_samples, 1, 10 ** 12)
-        o.target_h_scale = number(what, "target_h_scale", target_h_scale, 1.0, 1e6)
-        o.morph.spacing = number(what, "surface_spacing", surface_spacing, 0.0)
-        o.morph.min_per_edge = integer(what, "surface_min_per_edge", surface_min_per_edge, 2,
-                                       100000)
-        o.morph.max_per_edge = integer(what, "surface_max_per_edge", surface_max_per_edge,
-                                       o.morph.min_per_edge, 100000)
-        o.morph.affine_tol = number(what, "affine_tol", affine_tol, 0.0, 1.0, hi_open=True)
+        o, self._warp, self._surface = _morph_options(what, **options)
         self._ctx = ctx = Context(threads, progress, what)
         out = ffi.new("cm_morpher *[1]")
         holder = []
@@ -306,11 +338,6 @@ class Morpher:
         self._held: List[Tuple[Any, Any]] = []
         self._checked: Optional[Tuple[Any, Any]] = None  # (base ptr, target) known to match
         self._steps: List[MorphStep] = []
-
-    @staticmethod
-    def _fill_method(c, warp: WarpSettings, surface: str) -> None:
-        c.surface = _SURFACES[surface]
-        warp.fill(ffi.addressof(c, "warp"))
 
     def _correspond(self, g: Any, gp) -> None:
         """g numbered like G (cm_cad_match renumbers it in place when it corresponds to G
@@ -369,7 +396,7 @@ class Morpher:
             warp = self._warp.replaced(what, **method_options)
             c_method = ffi.new("cm_morph_method *")
             lib.cm_morph_method_init(c_method)
-            self._fill_method(c_method, warp, surface)
+            _fill_method(c_method, warp, surface)
         out = np.empty((self._n, 3), np.float64)
         row = ffi.new("cm_morph_step *")
         buf = ffi.from_buffer("double[]", out)

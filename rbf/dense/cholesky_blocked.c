@@ -26,11 +26,12 @@ typedef struct progress {
     double done, total;
 } progress;
 
-static void report(progress *p, double flops)
+/* Nonzero when the caller asked to stop (cm_context_interrupt). */
+static int report(progress *p, double flops)
 {
     p->done += flops;
     if (p->done > p->total) p->done = p->total;
-    cm_progress(p->ctx, "rbf factor", p->done, p->total);
+    return cm_progress(p->ctx, "rbf factor", p->done, p->total) < 0;
 }
 
 int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
@@ -57,7 +58,7 @@ int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
     double *u = a + off2; /* A22: element (i, j), i <= j, at u[i + j ld] */
     const int ild = (int)ld;
     progress pr = {ctx, 0.0, (double)n * n * n / 3.0};
-    cm_progress(ctx, "rbf factor", 0.0, pr.total);
+    if (cm_progress(ctx, "rbf factor", 0.0, pr.total) < 0) return CM_RBF_CHOLESKY_INTERRUPTED;
 
     /* 1. the first n1 columns, with their updates of A22 */
     for (int j = 0; j < n1; j += b0) {
@@ -82,8 +83,9 @@ int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
         cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, n2, b, -1.0, lp + rest, ild, 1.0, u,
                     ild);
         const double nb = b, nr = rest, n2d = n2;
-        report(&pr, nb * nb * nb / 3.0 + (double)below * nb * nb + nr * nr * nb +
-                        2.0 * n2d * nr * nb + n2d * n2d * nb);
+        if (report(&pr, nb * nb * nb / 3.0 + (double)below * nb * nb + nr * nr * nb +
+                            2.0 * n2d * nr * nb + n2d * n2d * nb))
+            return CM_RBF_CHOLESKY_INTERRUPTED;
     }
     /* 2. A22 = U'U in place (upper), its rows and columns numbered from n1 */
     for (int j = 0; j < n2; j += b0) {
@@ -100,10 +102,10 @@ int cm_rbf_cholesky_rfp_panels(cm_context *ctx, int n, double *a, int block)
                         r + b, ild);
         }
         const double nb = b, nr = rest;
-        report(&pr, nb * nb * nb / 3.0 + nr * nb * nb + nr * nr * nb);
+        if (report(&pr, nb * nb * nb / 3.0 + nr * nb * nb + nr * nr * nb))
+            return CM_RBF_CHOLESKY_INTERRUPTED;
     }
-    cm_progress(ctx, "rbf factor", pr.total, pr.total);
-    return 0;
+    return cm_progress(ctx, "rbf factor", pr.total, pr.total) < 0 ? CM_RBF_CHOLESKY_INTERRUPTED : 0;
 }
 
 /* Which of the two runs: on T > 1 BLAS threads and n from CM_LOOKAHEAD_MIN_N, the look-ahead

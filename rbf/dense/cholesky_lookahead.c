@@ -323,7 +323,7 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
 
     const double total = (double)n * n * n / 3.0;
     double done = 0.0;
-    cm_progress(ctx, "rbf factor", 0.0, total);
+    if (cm_progress(ctx, "rbf factor", 0.0, total) < 0) return CM_RBF_CHOLESKY_INTERRUPTED;
     /* one thread per BLAS call: OpenBLAS's count is process-wide, so set it around the
      * whole factorisation (the caller's count is restored below) */
     const int saved = openblas_get_num_threads();
@@ -332,8 +332,9 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
     int info = factor_block(&r, 0);
     TRACE_END(-1, 0);
     int failed = info != 0; /* read and written atomically inside the team */
+    int interrupted = 0;     /* written by the master thread only */
     if (!failed) {
-#pragma omp parallel num_threads(threads) shared(info, failed, done)
+#pragma omp parallel num_threads(threads) shared(info, failed, done, interrupted)
         for (int k = 0; k < r.nblocks; ++k) {
             /* A thread that saw a failure still passes every barrier, so none waits forever */
             int stop;
@@ -370,11 +371,18 @@ int cm_rbf_cholesky_rfp_lookahead(cm_context *ctx, int n, double *a, int block, 
 #pragma omp master
             if (!stop) {
                 done += step_flops(&r, k);
-                cm_progress(ctx, "rbf factor", done < total ? done : total, total);
+                /* the caller asked to stop: the team stops as on a failed panel */
+                if (cm_progress(ctx, "rbf factor", done < total ? done : total, total) < 0) {
+                    interrupted = 1;
+#pragma omp atomic write
+                    failed = 1;
+                }
             }
         }
     }
     openblas_set_num_threads(saved);
-    if (info == 0) cm_progress(ctx, "rbf factor", total, total);
+    if (info == 0 && interrupted) return CM_RBF_CHOLESKY_INTERRUPTED;
+    if (info == 0 && cm_progress(ctx, "rbf factor", total, total) < 0)
+        return CM_RBF_CHOLESKY_INTERRUPTED;
     return info;
 }

@@ -108,7 +108,12 @@ cm_status cm_rbf_dense_factor(cm_context *ctx, cm_rbf *r, int threads)
                 acc += wv[i * (size_t)k + (size_t)c] * t[c + b * k] - 0.5 * v[(size_t)c * m + i] * s[c * k + b];
             z[(size_t)b * m + i] = acc;
         }
-    cm_rbf_assemble_projected(r->kernel, r->dim, m, r->c, k, v, z, r->sign, r->chol, threads);
+    /* in chunks of columns with progress: at 20k centres the assembly is seconds */
+    cm_rbf_tick tick;
+    cm_rbf_tick_init(&tick, ctx, "rbf assemble", (double)n2 * (double)(n2 + 1) / 2);
+    cm_rbf_assemble_projected_tick(r->kernel, r->dim, m, r->c, k, v, z, r->sign, r->chol, threads,
+                                   &tick);
+    if ((st = cm_rbf_tick_finish(&tick)) < 0) goto done;
     double t1 = cm_wtime();
 
     int blas_n = 1;
@@ -122,7 +127,9 @@ cm_status cm_rbf_dense_factor(cm_context *ctx, cm_rbf *r, int threads)
            "cm_rbf_create: %zu centres, %d threads (BLAS %d): memory %.3f s, projection + "
            "assembly %.3f s, cholesky %.3f s",
            m, threads, blas_n, ta, t1 - t0, t2 - t1);
-    if (info > 0) {
+    if (info == CM_RBF_CHOLESKY_INTERRUPTED) {
+        st = CM_ERR_INTERRUPTED; /* the message is cm_progress's */
+    } else if (info > 0) {
         size_t a, b;
         double dist;
         if (closest_pair(r, &a, &b, &dist))

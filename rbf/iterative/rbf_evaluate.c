@@ -54,14 +54,16 @@
 #define CM_RBF_PILOT_BATCHES 32
 #define CM_RBF_PILOT_PER 16
 
-/* The treecode sums of all components at the targets of every stride-th batch (1: all). */
+/* The treecode sums of all components at the targets of every stride-th batch (1: all),
+ * reported to tick (NULL: none) in whole sums. */
 static int tree_sum_all(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
-                        size_t stride, double *out, int threads)
+                        size_t stride, double *out, int threads, cm_rbf_tick *tick)
 {
     const size_t m = r->m, nc = (size_t)r->ncomp;
     for (size_t g = 0; g < nc; g += 4) {
         int gc = nc - g < 4 ? (int)(nc - g) : 4;
-        if (cm_rbf_tree_sum_targets(t, tg, stride, r->w + g * m, gc, out + g, nc, threads))
+        if (cm_rbf_tree_sum_targets_tick(t, tg, stride, r->w + g * m, gc, out + g, nc, threads,
+                                         tick))
             return -1;
     }
     return 0;
@@ -94,13 +96,14 @@ static int pilot_passes(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree
     if (!idx) return 0;
     const size_t np =
         cm_rbf_tree_targets_pilot(tg, CM_RBF_PILOT_BATCHES, CM_RBF_PILOT_PER, idx, &stride);
-    const int pass = tree_sum_all(r, t, tg, stride, out, threads) == 0 &&
+    const int pass = tree_sum_all(r, t, tg, stride, out, threads, NULL) == 0 &&
                      CM_RBF_FAST_SAFETY * check_all(r, t, n, p, out, np, idx, threads) <= accept;
     free(idx);
     return pass;
 }
 
-static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads)
+static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads,
+                         cm_rbf_tick *tick)
 {
     cm_rbf_iter *it = r->iter;
     const size_t m = r->m, nc = (size_t)r->ncomp;
@@ -149,7 +152,9 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
         const int o = coarse ? order_c : order;
         const double th = coarse ? theta_c : theta;
         const cm_rbf_tree *t = cm_rbf_iterative_tree(r, o, th);
-        if (!t || tree_sum_all(r, t, tg, 1, out, threads)) break;
+        if (tick) /* a second row starts over */
+            cm_rbf_tick_init(tick, tick->ctx, tick->stage, (double)((nc + 3) / 4));
+        if (!t || tree_sum_all(r, t, tg, 1, out, threads, tick)) break;
         const double err = check_all(r, t, n, p, out, CM_RBF_FAST_SAMPLES, NULL, threads);
         it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
         it->eval_fast = CM_RBF_FAST_SAFETY * err <= accept;
@@ -162,26 +167,33 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
 }
 
 int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
-                                   int threads)
+                                   int threads, cm_rbf_tick *tick)
 {
     const int fs = r->opt.fast_sum;
     if (fs == 1 || (fs < 0 && (double)n * (double)r->m >= CM_RBF_FAST_EVAL_PAIRS))
-        return evaluate_fast(r, n, p, out, threads);
+        return evaluate_fast(r, n, p, out, threads, tick);
     r->iter->eval_fast = 0; /* eval_error stays that of the last evaluation that tried */
     return 0;
 }
 
 void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax) { r->iter->fmax = fmax; }
 
-void cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
-                               int threads)
+int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
+                              int threads, cm_rbf_tick *tick)
 {
-    if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads)) return;
+    if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads, tick)) return 0;
+    if (tick && tick->status < 0) return 1;
+    /* direct sums: a tick of their own, in point-centre pairs */
+    if (tick)
+        cm_rbf_tick_init(tick, tick->ctx, tick->stage,
+                         (double)((r->ncomp + 3) / 4) * (double)n * (double)r->m);
     for (int g = 0; g < r->ncomp; g += 4) {
         int nc = r->ncomp - g < 4 ? r->ncomp - g : 4;
-        cm_rbf_kernel_sum_acc(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
-                              (size_t)r->ncomp, threads);
+        if (cm_rbf_kernel_sum_acc_tick(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
+                                       (size_t)r->ncomp, threads, tick))
+            return 1;
     }
+    return 0;
 }
 
 

@@ -444,6 +444,12 @@ static cm_status solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const
                 if (!done) act[keep++] = c;
             }
             na = keep;
+            /* one preconditioned product per component and iteration: 0.1-1 s from 10^5
+             * centres, so the caller can stop here (w is the caller's scratch) */
+            int most = 0;
+            for (int c = 0; c < g; ++c) most = iters[c] > most ? iters[c] : most;
+            cm_status ps = cm_progress(ctx, "rbf solve", (double)most, (double)o->max_iterations);
+            if (ps < 0) return ps;
         }
         /* w += Z y, H y = g (upper triangular after the rotations) */
         for (int c = 0; c < g; ++c) {
@@ -565,7 +571,14 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
                          ? fmax(o->tolerance, CM_RBF_REFINE_GAIN * rn / fmax_all)
                          : o->tolerance;
         int it[4], stt[4];
-        solve_group(ctx, r, kr, rhs, fmax_all, tol, dw, adw, it, floor_rel, stt, threads);
+        cm_status sg = solve_group(ctx, r, kr, rhs, fmax_all, tol, dw, adw, it, floor_rel, stt,
+                                   threads);
+        if (sg < 0) { /* interrupted */
+            kr->tree = tree;
+            kr->relax = relax;
+            free(rhs), free(dw), free(adw), free(wl), free(soa), free(rowm);
+            return sg;
+        }
         for (size_t i = 0; i < gm; ++i) { /* w += dw + dw_lo in double-double (TwoSum) */
             double t = w[i] + dw[i], bv = t - w[i];
             wl[i] += (w[i] - (t - bv)) + (dw[i] - bv) + kr->wlo[i];
@@ -660,6 +673,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     const cm_rbf_tuning *tu = &r->tun;
     const int R = o->restart < 63 ? o->restart : 63;
     const int gmax = nc < 4 ? (int)nc : 4;
+    /* put back if the solve fails or stops: the weights stay the last solve's */
+    const double fmax_before = r->iter->fmax;
     krylov kr;
     memset(&kr, 0, sizeof kr);
     kr.m = m;
@@ -805,6 +820,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                       stagnated ? "stagnated" : maxed ? "reached max_iterations" : "stopped",
                       maxit, worst, o->tolerance, floor_max);
 done:
+    if (st < 0) cm_rbf_iterative_set_scale(r, fmax_before);
     for (int c = 0; c < 4; ++c) free(kr.v[c]), free(kr.z[c]), free(kr.h[c]);
     free(kr.soa), free(kr.rowm), free(kr.aux), free(kr.wlo), free(kr.awlo), free(aw);
     return st;

@@ -585,7 +585,7 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
      * for threaded LAPACK to pay off */
     const int saved = openblas_get_num_threads();
     openblas_set_num_threads(1);
-    int bad = 0, bad_info = 0, done = 0;
+    int bad = 0, bad_info = 0, done = 0, stop = 0; /* stop: the caller asked (its thread) */
     const int nown = p->l1 - p->l0;
 #pragma omp parallel num_threads(threads) if (threads > 1)
     {
@@ -593,6 +593,10 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
         double *g = malloc(nmax * inmax * sizeof *g);
 #pragma omp for schedule(dynamic, 1)
         for (int l = p->l0; l < p->l1; ++l) {
+            int stopped;
+#pragma omp atomic read
+            stopped = stop;
+            if (stopped) continue;
             if (!work || !g) {
 #pragma omp atomic write
                 bad = -1;
@@ -634,12 +638,16 @@ static cm_status build_local(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *p
 #ifdef _OPENMP
             if (omp_get_thread_num() == 0) /* the caller's thread: callbacks need not be reentrant */
 #endif
-                cm_progress(ctx, "rbf local solves", (double)d, (double)nown);
+                if (cm_progress(ctx, "rbf local solves", (double)d, (double)nown) < 0) {
+#pragma omp atomic write
+                    stop = 1;
+                }
         }
         free(work);
         free(g);
     }
     openblas_set_num_threads(saved);
+    if (stop) return CM_ERR_INTERRUPTED; /* the message is cm_progress's */
     if (bad < 0) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory (local solves)");
     if (bad > 0)
         return cm_error(ctx, CM_ERR_NUMERIC,

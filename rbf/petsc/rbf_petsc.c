@@ -438,7 +438,8 @@ int cm_rbf_petsc_evaluate(const cm_rbf *r, size_t n, const double *p, double *ou
     cm_parallel_rank(&rank, &size);
     const size_t nc = (size_t)r->ncomp;
     if (size < 2 || n * nc > (size_t)0x7fffffff) return 0; /* all on this rank */
-    if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads)) return 1;
+    /* collective: not cut into interruptible chunks (every rank would have to stop together) */
+    if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads, NULL)) return 1;
     int *counts = malloc(2 * (size_t)size * sizeof *counts);
     if (!counts) return 0;
     int *displs = counts + size;

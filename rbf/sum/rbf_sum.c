@@ -191,6 +191,50 @@ int cm_rbf_threads(const cm_context *ctx)
     return cm_context_threads_for(ctx, SIZE_MAX, 1);
 }
 
+void cm_rbf_tick_init(cm_rbf_tick *t, cm_context *ctx, const char *stage, double total)
+{
+    t->ctx = ctx;
+    t->stage = stage;
+    t->done = 0.0;
+    t->total = total;
+    t->last = cm_wtime();
+    t->reported = 0;
+    t->status = CM_OK;
+}
+
+int cm_rbf_tick_add(cm_rbf_tick *t, double work)
+{
+    if (!t) return 0;
+    t->done += work;
+    if (t->done > t->total) t->done = t->total;
+    const double now = cm_wtime();
+    /* not after the last chunk: a loop that ends within its first report's time reports
+     * nothing, so small sums make no callbacks at all */
+    if (t->status == CM_OK && t->done < t->total && now - t->last >= CM_RBF_TICK_SECONDS) {
+        t->last = now;
+        t->reported = 1;
+        t->status = cm_progress(t->ctx, t->stage, t->done, t->total);
+    }
+    return t->status < 0;
+}
+
+cm_status cm_rbf_tick_finish(cm_rbf_tick *t)
+{
+    if (!t || t->status < 0 || !t->reported) return t ? t->status : CM_OK;
+    return t->status = cm_progress(t->ctx, t->stage, t->total, t->total);
+}
+
+long cm_rbf_tick_chunk(const cm_rbf_tick *tick, double per_item, long items, int threads)
+{
+    if (items < 1) return 1;
+    if (!tick) return items;
+    double per = CM_RBF_TICK_PAIRS / (per_item > 1.0 ? per_item : 1.0);
+    /* enough items that a static schedule keeps every thread busy */
+    const double least = 8.0 * (threads > 1 ? threads : 1);
+    if (per < least) per = least;
+    return per >= (double)items ? items : (long)per;
+}
+
 void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                        const double *w, int nc, size_t n, const double *p, size_t ldp,
                        double *out, size_t ldo, int threads)
@@ -199,21 +243,13 @@ void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                           threads);
 }
 
-void cm_rbf_kernel_sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m,
-                           const double *c, const double *w, int nc, size_t n, const double *p,
-                           size_t ldp, double *out, size_t ldo, int threads)
+/* Points of blocks [b0, b1) of PB against all centres. */
+static void sum_blocks(block_fn fn, int kern, int dim, size_t m, const double *c,
+                       const double *w, int nc, size_t n, const double *p, size_t ldp,
+                       double *out, size_t ldo, int threads, int parallel, long b0, long b1)
 {
-    const block_fn fn = pick_block(isa);
-    const long nblocks = (long)((n + PB - 1) / PB);
-    const int kern = (int)kernel;
-    const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
-    /* the r^3 self product computes each entry once for both rows (its sums come in parts) */
-    if (fn == block_avx512_hand && kernel == CM_RBF_TRIHARMONIC && dim == 3 && p == c &&
-        ldp == m && n == m && m >= CM_RBF_SELF_MIN_M &&
-        !cm_rbf_r3_self_avx512(nc, m, c, w, NULL, out, ldo, parallel ? threads : 1))
-        return;
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
-    for (long b = 0; b < nblocks; ++b) {
+    for (long b = b0; b < b1; ++b) {
         double pt[3 * PB], acc[4 * PB];
         const size_t i0 = (size_t)b * PB;
         const size_t cnt = n - i0 < PB ? n - i0 : PB;
@@ -229,6 +265,38 @@ void cm_rbf_kernel_sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t
         for (size_t l = 0; l < cnt; ++l)
             for (int q = 0; q < nc; ++q) out[(i0 + l) * ldo + (size_t)q] = acc[q * PB + l];
     }
+}
+
+/* cm_rbf_kernel_sum_isa in chunks of blocks with tick (NULL: one chunk); nonzero when the
+ * tick said stop. */
+static int sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                   const double *w, int nc, size_t n, const double *p, size_t ldp, double *out,
+                   size_t ldo, int threads, cm_rbf_tick *tick)
+{
+    const block_fn fn = pick_block(isa);
+    const long nblocks = (long)((n + PB - 1) / PB);
+    const int kern = (int)kernel;
+    const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
+    /* the r^3 self product computes each entry once for both rows (its sums come in parts) */
+    if (fn == block_avx512_hand && kernel == CM_RBF_TRIHARMONIC && dim == 3 && p == c &&
+        ldp == m && n == m && m >= CM_RBF_SELF_MIN_M &&
+        !cm_rbf_r3_self_avx512(nc, m, c, w, NULL, out, ldo, parallel ? threads : 1))
+        return cm_rbf_tick_add(tick, (double)n * (double)m);
+    const long chunk = cm_rbf_tick_chunk(tick, (double)PB * (double)m, nblocks, threads);
+    for (long b0 = 0; b0 < nblocks; b0 += chunk) {
+        const long b1 = nblocks - b0 < chunk ? nblocks : b0 + chunk;
+        sum_blocks(fn, kern, dim, m, c, w, nc, n, p, ldp, out, ldo, threads, parallel, b0, b1);
+        const size_t i1 = (size_t)b1 * PB < n ? (size_t)b1 * PB : n;
+        if (cm_rbf_tick_add(tick, (double)(i1 - (size_t)b0 * PB) * (double)m)) return 1;
+    }
+    return 0;
+}
+
+void cm_rbf_kernel_sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m,
+                           const double *c, const double *w, int nc, size_t n, const double *p,
+                           size_t ldp, double *out, size_t ldo, int threads)
+{
+    sum_isa(isa, kernel, dim, m, c, w, nc, n, p, ldp, out, ldo, threads, NULL);
 }
 
 /* ---- assembly of the projected matrix ---- */
@@ -322,24 +390,46 @@ static stretch_fn pick_stretch(void)
  * triangle (head entries, head = col + 1 for n even, col for n odd), then column col of the
  * leading block from the diagonal down. Every RFP column has the same length, so a static
  * schedule over them is balanced. */
-void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
-                               int k, const double *v, const double *z, double sign,
-                               double *rfp, int threads)
+/* Columns [c0, c1) of the RFP array. */
+static void assemble_cols(stretch_fn fn, int kern, size_t m, const double *c, size_t kk,
+                          const double *v, const double *z, double sign, double *rfp,
+                          size_t n, int threads, int parallel, long c0, long c1)
 {
-    const stretch_fn fn = pick_stretch();
-    const size_t n = m - (size_t)k, kk = (size_t)k;
     const int even = n % 2 == 0;
     const size_t half = even ? n / 2 : (n + 1) / 2, lda = even ? n + 1 : n;
-    const int kern = (int)kernel;
-    (void)dim;
-    const int parallel = (double)n * (double)n > 2.0 * CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
-    for (long lc = 0; lc < (long)half; ++lc) {
+    for (long lc = c0; lc < c1; ++lc) {
         const size_t col = (size_t)lc, head = even ? col + 1 : col;
         double *out = rfp + col * lda;
         if (head > 0) fn(kern, m, c, v, z, sign, kk + half + head - 1, kk + half, head, out);
         fn(kern, m, c, v, z, sign, kk + col, kk + col, n - col, out + head);
     }
+}
+
+int cm_rbf_assemble_projected_tick(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                                   int k, const double *v, const double *z, double sign,
+                                   double *rfp, int threads, cm_rbf_tick *tick)
+{
+    const stretch_fn fn = pick_stretch();
+    const size_t n = m - (size_t)k, kk = (size_t)k;
+    const size_t half = n % 2 == 0 ? n / 2 : (n + 1) / 2, lda = n % 2 == 0 ? n + 1 : n;
+    (void)dim;
+    const int parallel = (double)n * (double)n > 2.0 * CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
+    /* chunks of columns, lda entries (kernel evaluations) each */
+    const long chunk = cm_rbf_tick_chunk(tick, (double)lda, (long)half, threads);
+    for (long c0 = 0; c0 < (long)half; c0 += chunk) {
+        const long c1 = (long)half - c0 < chunk ? (long)half : c0 + chunk;
+        assemble_cols(fn, (int)kernel, m, c, kk, v, z, sign, rfp, n, threads, parallel, c0, c1);
+        if (cm_rbf_tick_add(tick, (double)(c1 - c0) * (double)lda)) return 1;
+    }
+    return 0;
+}
+
+void cm_rbf_assemble_projected(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                               int k, const double *v, const double *z, double sign,
+                               double *rfp, int threads)
+{
+    cm_rbf_assemble_projected_tick(kernel, dim, m, c, k, v, z, sign, rfp, threads, NULL);
 }
 
 const char *cm_rbf_kernel_name(cm_rbf_kernel k)
@@ -356,9 +446,18 @@ const char *cm_rbf_kernel_name(cm_rbf_kernel k)
 void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
                            const double *p, size_t ldp, double *out, int threads)
 {
+    cm_rbf_kernel_sum_all_tick(r, w, ncomp, n, p, ldp, out, threads, NULL);
+}
+
+int cm_rbf_kernel_sum_all_tick(const cm_rbf *r, const double *w, int ncomp, size_t n,
+                               const double *p, size_t ldp, double *out, int threads,
+                               cm_rbf_tick *tick)
+{
     for (int g = 0; g < ncomp; g += 4) {
         int nc = ncomp - g < 4 ? ncomp - g : 4;
-        cm_rbf_kernel_sum(r->kernel, r->dim, r->m, r->c, w + (size_t)g * r->m, nc, n, p, ldp,
-                          out + g, (size_t)ncomp, threads);
+        if (sum_isa(CM_RBF_ISA_AUTO, r->kernel, r->dim, r->m, r->c, w + (size_t)g * r->m, nc, n,
+                    p, ldp, out + g, (size_t)ncomp, threads, tick))
+            return 1;
     }
+    return 0;
 }

@@ -184,27 +184,13 @@ static int fixed_binade(size_t m, const double *c, const double *w, int nc, size
     return 1;
 }
 
-void cm_rbf_kernel_sum_acc_isa(cm_rbf_isa isa, size_t m, const double *c, const double *w,
-                               int nc, size_t n, const double *p, size_t ldp, double *out,
-                               size_t ldo, int threads)
+/* Points of blocks [b0, b1) of PB against all centres. */
+static void acc_blocks(acc_fn fn, const double *big, size_t m, const double *c, const double *w,
+                       int nc, size_t n, const double *p, size_t ldp, double *out, size_t ldo,
+                       int threads, int parallel, long b0, long b1)
 {
-    if (isa == CM_RBF_ISA_AUTO) isa = cm_rbf_isa_auto();
-    acc_fn fn = pick_acc(isa);
-    double big[4] = {0.0, 0.0, 0.0, 0.0};
-    /* the fixed binade where FMA is in hardware (AVX512_AUTOVEC stays the TwoSum loops: it
-     * is the reference that benchmarks compare with) */
-    if ((isa == CM_RBF_ISA_AVX512 || isa == CM_RBF_ISA_AVX2) &&
-        fixed_binade(m, c, w, nc, n, p, ldp, big))
-        fn = isa == CM_RBF_ISA_AVX512 ? cm_rbf_r3_accf_block_avx512 : accf_avx2;
-    const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
-    /* the self product (the Krylov products) computes each entry once for both rows */
-    if (fn == cm_rbf_r3_accf_block_avx512 && p == c && ldp == m && n == m &&
-        m >= CM_RBF_SELF_MIN_M &&
-        !cm_rbf_r3_self_avx512(nc, m, c, w, big, out, ldo, parallel ? threads : 1))
-        return;
-    const long nblocks = (long)((n + PB - 1) / PB);
 #pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
-    for (long b = 0; b < nblocks; ++b) {
+    for (long b = b0; b < b1; ++b) {
         double pt[3 * PB], hi[4 * PB], lo[4 * PB];
         const size_t i0 = (size_t)b * PB;
         const size_t cnt = n - i0 < PB ? n - i0 : PB;
@@ -222,4 +208,49 @@ void cm_rbf_kernel_sum_acc_isa(cm_rbf_isa isa, size_t m, const double *c, const 
             for (int q = 0; q < nc; ++q)
                 out[(i0 + l) * ldo + (size_t)q] = (hi[q * PB + l] - big[q]) + lo[q * PB + l];
     }
+}
+
+/* cm_rbf_kernel_sum_acc_isa in chunks of blocks with tick (NULL: one chunk); the binade is
+ * that of all n points, so the chunks give the bits of one pass. */
+static int acc_isa(cm_rbf_isa isa, size_t m, const double *c, const double *w, int nc,
+                   size_t n, const double *p, size_t ldp, double *out, size_t ldo, int threads,
+                   cm_rbf_tick *tick)
+{
+    if (isa == CM_RBF_ISA_AUTO) isa = cm_rbf_isa_auto();
+    acc_fn fn = pick_acc(isa);
+    double big[4] = {0.0, 0.0, 0.0, 0.0};
+    /* the fixed binade where FMA is in hardware (AVX512_AUTOVEC stays the TwoSum loops: it
+     * is the reference that benchmarks compare with) */
+    if ((isa == CM_RBF_ISA_AVX512 || isa == CM_RBF_ISA_AVX2) &&
+        fixed_binade(m, c, w, nc, n, p, ldp, big))
+        fn = isa == CM_RBF_ISA_AVX512 ? cm_rbf_r3_accf_block_avx512 : accf_avx2;
+    const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
+    /* the self product (the Krylov products) computes each entry once for both rows */
+    if (fn == cm_rbf_r3_accf_block_avx512 && p == c && ldp == m && n == m &&
+        m >= CM_RBF_SELF_MIN_M &&
+        !cm_rbf_r3_self_avx512(nc, m, c, w, big, out, ldo, parallel ? threads : 1))
+        return cm_rbf_tick_add(tick, (double)n * (double)m);
+    const long nblocks = (long)((n + PB - 1) / PB);
+    const long chunk = cm_rbf_tick_chunk(tick, (double)PB * (double)m, nblocks, threads);
+    for (long b0 = 0; b0 < nblocks; b0 += chunk) {
+        const long b1 = nblocks - b0 < chunk ? nblocks : b0 + chunk;
+        acc_blocks(fn, big, m, c, w, nc, n, p, ldp, out, ldo, threads, parallel, b0, b1);
+        const size_t i1 = (size_t)b1 * PB < n ? (size_t)b1 * PB : n;
+        if (cm_rbf_tick_add(tick, (double)(i1 - (size_t)b0 * PB) * (double)m)) return 1;
+    }
+    return 0;
+}
+
+void cm_rbf_kernel_sum_acc_isa(cm_rbf_isa isa, size_t m, const double *c, const double *w,
+                               int nc, size_t n, const double *p, size_t ldp, double *out,
+                               size_t ldo, int threads)
+{
+    acc_isa(isa, m, c, w, nc, n, p, ldp, out, ldo, threads, NULL);
+}
+
+int cm_rbf_kernel_sum_acc_tick(size_t m, const double *c, const double *w, int nc, size_t n,
+                               const double *p, size_t ldp, double *out, size_t ldo,
+                               int threads, cm_rbf_tick *tick)
+{
+    return acc_isa(CM_RBF_ISA_AUTO, m, c, w, nc, n, p, ldp, out, ldo, threads, tick);
 }

@@ -605,7 +605,7 @@ void cm_rbf_tree_set_isa(cm_rbf_tree *t, cm_rbf_isa isa)
  * stride-th batch (stride 1: all of them). */
 static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const double *w,
                     int nc, size_t n, const double *p, size_t ldp, double *out, size_t ldo,
-                    int threads)
+                    int threads, cm_rbf_tick *tick)
 {
     const size_t m = t->m, P = (size_t)t->P, np = (size_t)t->nprox;
     double *ws = malloc((size_t)nc * (m ? m : 1) * sizeof *ws);
@@ -629,96 +629,106 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const 
     const int step = stride == 0 ? 1
                      : stride < (size_t)tg->nleaf ? (int)stride
                                                   : (tg->nleaf > 0 ? tg->nleaf : 1);
+    /* batches per chunk between two ticks: about 64 chunks of whole strides (one without a
+     * tick, or when there are too few batches to keep the threads busy in 64) */
+    int span = tg->nleaf > 0 ? tg->nleaf : 1;
+    if (tick && tg->nleaf / step >= 64 * 8 * (threads > 0 ? threads : 1))
+        span = (tg->nleaf / step + 63) / 64 * step;
+    for (int lo = 0; lo < tg->nleaf && !failed; lo += span) {
+        const int hi = tg->nleaf - lo < span ? tg->nleaf : lo + span;
 #pragma omp parallel num_threads(threads) if (threads > 1 && (double)n / step * (double)m > CM_RBF_PARALLEL_MIN_PAIRS)
-    {
-        int cap = 256;
-        seg *sg = malloc((size_t)cap * sizeof *sg);
-        int stack[512];
-        double tx[CM_TREE_BATCH + NB], ty[CM_TREE_BATCH + NB], tz[CM_TREE_BATCH + NB];
-        double acc[4 * NB], pt[3 * CM_TREE_BATCH], bacc[4 * CM_TREE_BATCH];
-        double blo[4 * CM_TREE_BATCH];
-        if (!sg) {
+        {
+            int cap = 256;
+            seg *sg = malloc((size_t)cap * sizeof *sg);
+            int stack[512];
+            double tx[CM_TREE_BATCH + NB], ty[CM_TREE_BATCH + NB], tz[CM_TREE_BATCH + NB];
+            double acc[4 * NB], pt[3 * CM_TREE_BATCH], bacc[4 * CM_TREE_BATCH];
+            double blo[4 * CM_TREE_BATCH];
+            if (!sg) {
 #pragma omp atomic write
-            failed = 1;
-        }
+                failed = 1;
+            }
 #pragma omp for schedule(dynamic, 1)
-        for (int bi = 0; bi < tg->nleaf; bi += step) {
-            if (!sg) continue;
-            const tnode *b = &tg->node[tg->leaf[bi]];
-            const size_t cnt = b->end - b->begin;
-            int ns = 0, sp = 0;
-            stack[sp++] = 0;
-            while (sp > 0 && m > 0) {
-                const tnode *u = &t->src.node[stack[--sp]];
-                double D2 = 0.0;
-                for (int d = 0; d < 3; ++d) {
-                    double dd = u->mid[d] - b->mid[d];
-                    D2 += dd * dd;
+            for (int bi = lo; bi < hi; bi += step) {
+                if (!sg) continue;
+                const tnode *b = &tg->node[tg->leaf[bi]];
+                const size_t cnt = b->end - b->begin;
+                int ns = 0, sp = 0;
+                stack[sp++] = 0;
+                while (sp > 0 && m > 0) {
+                    const tnode *u = &t->src.node[stack[--sp]];
+                    double D2 = 0.0;
+                    for (int d = 0; d < 3; ++d) {
+                        double dd = u->mid[d] - b->mid[d];
+                        D2 += dd * dd;
+                    }
+                    const double D = sqrt(D2);
+                    const int far = u->proxy >= 0 && D > b->rad && u->rad <= t->theta * (D - b->rad);
+                    if (!far && u->child[0] >= 0 && u->proxy >= 0) {
+                        stack[sp++] = u->child[1];
+                        stack[sp++] = u->child[0];
+                        continue;
+                    }
+                    if (ns + 2 > cap) { /* room for two: proxies and their low parts */
+                        seg *nsg = realloc(sg, 2 * (size_t)cap * sizeof *nsg);
+                        if (!nsg) {
+#pragma omp atomic write
+                            failed = 1;
+                            break;
+                        }
+                        sg = nsg;
+                        cap *= 2;
+                    }
+                    if (far) {
+                        const size_t o0 = (size_t)u->proxy * P;
+                        sg[ns++] = (seg){px + o0, py + o0, pz + o0, W + o0, np * P, np * P, P, 0};
+                        if (Wl) /* the low parts: the same proxies once more */
+                            sg[ns++] = (seg){px + o0, py + o0, pz + o0, Wl + o0, np * P, np * P, P, 0};
+                    } else if (ns > 0 && sg[ns - 1].direct &&
+                               sg[ns - 1].x + sg[ns - 1].n == xs + u->begin) {
+                        sg[ns - 1].n += u->end - u->begin; /* adjacent centres: one stretch */
+                    } else {
+                        const size_t o0 = u->begin;
+                        sg[ns++] = (seg){xs + o0, ys + o0, zs + o0, ws + o0, m, m, u->end - u->begin, 1};
+                    }
                 }
-                const double D = sqrt(D2);
-                const int far = u->proxy >= 0 && D > b->rad && u->rad <= t->theta * (D - b->rad);
-                if (!far && u->child[0] >= 0 && u->proxy >= 0) {
-                    stack[sp++] = u->child[1];
-                    stack[sp++] = u->child[0];
+                for (size_t l = 0; l < cnt + NB; ++l) {
+                    size_t i = tg->perm[b->begin + (l < cnt ? l : cnt - 1)];
+                    tx[l] = p[i];
+                    ty[l] = p[ldp + i];
+                    tz[l] = p[2 * ldp + i];
+                }
+                if (!fn) {
+                    for (size_t l = 0; l < CM_TREE_BATCH; ++l) {
+                        pt[l] = tx[l < cnt ? l : cnt - 1];
+                        pt[CM_TREE_BATCH + l] = ty[l < cnt ? l : cnt - 1];
+                        pt[2 * CM_TREE_BATCH + l] = tz[l < cnt ? l : cnt - 1];
+                    }
+                    if (comp) batch_acc_avx512(nc, sg, ns, cnt, pt, bacc, blo);
+                    else batch_avx512(nc, sg, ns, cnt, pt, bacc);
+                    for (size_t l = 0; l < cnt; ++l) {
+                        size_t i = tg->perm[b->begin + l];
+                        for (int q = 0; q < nc; ++q)
+                            out[i * ldo + (size_t)q] = bacc[(size_t)q * CM_TREE_BATCH + l];
+                    }
                     continue;
                 }
-                if (ns + 2 > cap) { /* room for two: proxies and their low parts */
-                    seg *nsg = realloc(sg, 2 * (size_t)cap * sizeof *nsg);
-                    if (!nsg) {
-#pragma omp atomic write
-                        failed = 1;
-                        break;
+                for (size_t l0 = 0; l0 < cnt; l0 += NB) {
+                    fn(nc, sg, ns, tx + l0, ty + l0, tz + l0, acc);
+                    for (size_t l = l0; l < cnt && l < l0 + NB; ++l) {
+                        size_t i = tg->perm[b->begin + l];
+                        for (int q = 0; q < nc; ++q) out[i * ldo + (size_t)q] = acc[q * NB + (l - l0)];
                     }
-                    sg = nsg;
-                    cap *= 2;
-                }
-                if (far) {
-                    const size_t o0 = (size_t)u->proxy * P;
-                    sg[ns++] = (seg){px + o0, py + o0, pz + o0, W + o0, np * P, np * P, P, 0};
-                    if (Wl) /* the low parts: the same proxies once more */
-                        sg[ns++] = (seg){px + o0, py + o0, pz + o0, Wl + o0, np * P, np * P, P, 0};
-                } else if (ns > 0 && sg[ns - 1].direct &&
-                           sg[ns - 1].x + sg[ns - 1].n == xs + u->begin) {
-                    sg[ns - 1].n += u->end - u->begin; /* adjacent centres: one stretch */
-                } else {
-                    const size_t o0 = u->begin;
-                    sg[ns++] = (seg){xs + o0, ys + o0, zs + o0, ws + o0, m, m, u->end - u->begin, 1};
                 }
             }
-            for (size_t l = 0; l < cnt + NB; ++l) {
-                size_t i = tg->perm[b->begin + (l < cnt ? l : cnt - 1)];
-                tx[l] = p[i];
-                ty[l] = p[ldp + i];
-                tz[l] = p[2 * ldp + i];
-            }
-            if (!fn) {
-                for (size_t l = 0; l < CM_TREE_BATCH; ++l) {
-                    pt[l] = tx[l < cnt ? l : cnt - 1];
-                    pt[CM_TREE_BATCH + l] = ty[l < cnt ? l : cnt - 1];
-                    pt[2 * CM_TREE_BATCH + l] = tz[l < cnt ? l : cnt - 1];
-                }
-                if (comp) batch_acc_avx512(nc, sg, ns, cnt, pt, bacc, blo);
-                else batch_avx512(nc, sg, ns, cnt, pt, bacc);
-                for (size_t l = 0; l < cnt; ++l) {
-                    size_t i = tg->perm[b->begin + l];
-                    for (int q = 0; q < nc; ++q)
-                        out[i * ldo + (size_t)q] = bacc[(size_t)q * CM_TREE_BATCH + l];
-                }
-                continue;
-            }
-            for (size_t l0 = 0; l0 < cnt; l0 += NB) {
-                fn(nc, sg, ns, tx + l0, ty + l0, tz + l0, acc);
-                for (size_t l = l0; l < cnt && l < l0 + NB; ++l) {
-                    size_t i = tg->perm[b->begin + l];
-                    for (int q = 0; q < nc; ++q) out[i * ldo + (size_t)q] = acc[q * NB + (l - l0)];
-                }
-            }
+            free(sg);
         }
-        free(sg);
+        /* in units of whole sums */
+        if (cm_rbf_tick_add(tick, (double)(hi - lo) / (double)tg->nleaf)) break;
     }
     free(ws);
     free(W);
-    return failed ? -1 : 0;
+    return failed ? -1 : tick && tick->status < 0 ? -2 : 0;
 }
 
 struct cm_rbf_tree_targets {
@@ -763,7 +773,15 @@ int cm_rbf_tree_sum_targets(const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
                             int threads)
 {
     if (tg->n == 0) return 0;
-    return tree_sum(t, &tg->o, stride, w, nc, tg->n, tg->p, tg->ldp, out, ldo, threads);
+    return tree_sum(t, &tg->o, stride, w, nc, tg->n, tg->p, tg->ldp, out, ldo, threads, NULL);
+}
+
+int cm_rbf_tree_sum_targets_tick(const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
+                                 size_t stride, const double *w, int nc, double *out,
+                                 size_t ldo, int threads, cm_rbf_tick *tick)
+{
+    if (tg->n == 0) return 0;
+    return tree_sum(t, &tg->o, stride, w, nc, tg->n, tg->p, tg->ldp, out, ldo, threads, tick);
 }
 
 int cm_rbf_tree_sum(const cm_rbf_tree *t, const double *w, int nc, size_t n, const double *p,
@@ -779,7 +797,7 @@ int cm_rbf_tree_sum(const cm_rbf_tree *t, const double *w, int nc, size_t n, con
 int cm_rbf_tree_sum_self(const cm_rbf_tree *t, const double *w, int nc, double *out,
                          size_t ldo, int threads)
 {
-    return tree_sum(t, &t->self, 1, w, nc, t->m, t->c, t->m, out, ldo, threads);
+    return tree_sum(t, &t->self, 1, w, nc, t->m, t->c, t->m, out, ldo, threads, NULL);
 }
 
 void cm_rbf_tree_check(const cm_rbf_tree *t, const double *w, int nc, size_t n,

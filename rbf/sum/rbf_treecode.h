@@ -58,6 +58,11 @@ size_t cm_rbf_tree_targets_pilot(const cm_rbf_tree_targets *tg, size_t batches, 
 int cm_rbf_tree_sum_targets(const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
                             size_t stride, const double *w, int nc, double *out, size_t ldo,
                             int threads);
+/* The same in chunks of batches with tick (NULL: one pass; rbf_internal.h), whose work is
+ * counted in whole sums (1 for this one); -2 when the tick said stop (out partly written). */
+int cm_rbf_tree_sum_targets_tick(const cm_rbf_tree *t, const cm_rbf_tree_targets *tg,
+                                 size_t stride, const double *w, int nc, double *out,
+                                 size_t ldo, int threads, cm_rbf_tick *tick);
 /* The same with the targets = the centres of the tree (their batches are cached). */
 int cm_rbf_tree_sum_self(const cm_rbf_tree *t, const double *w, int nc, double *out,
                          size_t ldo, int threads);

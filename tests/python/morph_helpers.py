@@ -1,8 +1,13 @@
 """Shared by test_morph.py and test_warp.py: STEP models as Geometry objects, the bore's
 files made by the CLI, and the CLI's own runs."""
+import json
+import os
 import pathlib
 import subprocess
+import sys
 from typing import List
+
+import numpy as np
 
 import cadmorph
 from cadmorph._capi import ffi, lib
@@ -45,3 +50,82 @@ def bore(cli: str, work: pathlib.Path, ts: List[float], scale: float = 0.5) -> L
         run(cli, "model", "bore", t, p)
         out.append(p)
     return out
+
+
+def child_env() -> dict:
+    """The environment of a child Python that runs OpenBLAS as the CLI does: the cadmorph
+    program starts it with OPENBLAS_NUM_THREADS=1 (include/cadmorph/blas.h), and the sparse
+    methods' (CHOLMOD's) sums depend on OpenBLAS's thread count."""
+    env = dict(os.environ)
+    env["OPENBLAS_NUM_THREADS"] = "1"
+    env["PYTHONPATH"] = os.pathsep.join(p for p in [os.path.dirname(os.path.dirname(
+        cadmorph.__file__)), env.get("PYTHONPATH", "")] if p)
+    return env
+
+
+def in_child(*args) -> None:
+    """Runs this file's main() in a child Python with child_env()."""
+    r = subprocess.run([sys.executable, __file__] + [str(a) for a in args], env=child_env(),
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def two_threads(m0, g0, targets, repeats: int = 4) -> dict:
+    """One Morpher per target in its own thread (threads=1 each), each applied `repeats`
+    times, while this thread counts loop turns: whether each result equals the serial one,
+    how long both threads were in their loops at once, and how many turns this thread made
+    meanwhile (none if the calls held the GIL)."""
+    import threading
+    import time
+    mesh = cadmorph.read_mesh(m0)
+    jobs = [(read_step(g0), read_step(g)) for g in targets]
+    serial = [cadmorph.Morpher(a, mesh, threads=1, progress=False).apply(b) for a, b in jobs]
+    results, window = [None] * len(jobs), [None] * len(jobs)
+    ready = threading.Barrier(len(jobs) + 1)
+
+    def work(k):
+        a, b = jobs[k]
+        m = cadmorph.Morpher(a, mesh, threads=1, progress=False)
+        ready.wait()
+        t0 = time.perf_counter()
+        for _ in range(repeats):
+            results[k] = m.apply(b)
+        window[k] = (t0, time.perf_counter())
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(len(jobs))]
+    for t in threads:
+        t.start()
+    ready.wait()
+    ticks = []
+    while any(t.is_alive() for t in threads):
+        ticks.append(time.perf_counter())
+    for t in threads:
+        t.join()
+    lo, hi = max(w[0] for w in window), min(w[1] for w in window)
+    return {"equal": [bool(np.array_equal(r, s)) for r, s in zip(results, serial)],
+            "overlap": hi - lo, "ticks": sum(lo < x < hi for x in ticks),
+            "calls": [w[1] - w[0] for w in window]}
+
+
+def main(argv: List[str]) -> None:
+    """morph OUT.npy G0 G1 M0 OPTIONS_JSON: Morpher(G0, M0, **options).apply(G1);
+    warp OUT.npy M0 NODES.npy D.npy OPTIONS_JSON: Warp(M0, nodes, **options).apply(D);
+    threads OUT.json M0 G0 TARGET...: two_threads."""
+    kind, out = argv[0], argv[1]
+    if kind == "morph":
+        g0, g1, m0, options = argv[2:6]
+        m = cadmorph.Morpher(read_step(g0), cadmorph.read_mesh(m0), **json.loads(options))
+        np.save(out, m.apply(read_step(g1)))
+    elif kind == "warp":
+        m0, nodes, D, options = argv[2:6]
+        w = cadmorph.Warp(cadmorph.read_mesh(m0), np.load(nodes), **json.loads(options))
+        np.save(out, w.apply(np.load(D)))
+    elif kind == "threads":
+        with open(out, "w") as f:
+            json.dump(two_threads(argv[2], argv[3], argv[4:]), f)
+    else:
+        raise SystemExit("unknown command %r" % kind)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -25,3 +25,7 @@ add_test(NAME warp_staten_setup
 set_tests_properties(warp_staten_setup PROPERTIES FIXTURES_SETUP warp_staten LABELS "unit;volume")
 cm_add_unit_test(test_warp_staten test_warp_staten.c LIBS cm_volume_internal LABELS volume)
 set_tests_properties(test_warp_staten PROPERTIES FIXTURES_REQUIRED warp_staten)
+
+# Stopping on request (cm_context_interrupt): every warp method and the optimiser on the
+# bore's O-grid, stopped at each progress point, then run again (cm_hexmesh_bore: study/)
+cm_add_unit_test(test_warp_interrupt test_warp_interrupt.c LIBS cm_volume cm_study)
