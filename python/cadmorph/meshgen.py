@@ -9,6 +9,7 @@ from typing import Any, Optional
 from ._capi import ffi, lib
 from ._context import Context, Progress
 from ._inputs import choice, number
+from .geometry import Geometry
 from .mesh import _TOKEN, Mesh, _destroy_mesh
 
 _MESHERS = {"tetgen": lib.CM_MESHER_TETGEN, "gmsh": lib.CM_MESHER_GMSH}
@@ -16,18 +17,16 @@ _MESHERS = {"tetgen": lib.CM_MESHER_TETGEN, "gmsh": lib.CM_MESHER_GMSH}
 
 def _model_ptr(geometry: Any, what: str):
     """The cm_cad_model of a cadmorph.Geometry."""
-    ptr = getattr(geometry, "_ptr", None)
-    if ptr is None or not isinstance(ptr, ffi.CData) or \
-            ffi.typeof(ptr) is not ffi.typeof("cm_cad_model *") or ptr == ffi.NULL:
+    if not isinstance(geometry, Geometry):
         raise TypeError("%s: a cadmorph.Geometry, not %s" % (what, type(geometry).__name__))
-    return ptr
+    return geometry._ptr
 
 
 def _destroy_model(ptr) -> None:
     lib.cm_cad_destroy(ffi.new("cm_cad_model *[1]", [ptr]))
 
 
-def mesh_step(geometry: Any, size: Optional[float] = None, mesher: Optional[str] = None, *,
+def mesh_step(geometry: Geometry, size: Optional[float] = None, mesher: Optional[str] = None, *,
               quality: Optional[float] = None, min_dihedral: Optional[float] = None,
               preserve_surface: bool = False, optimize: bool = True, force: bool = False,
               time_limit: Optional[float] = None, threads: int = 0,

@@ -11,6 +11,7 @@ from ._capi import ffi, lib
 from ._context import Context, Progress
 from ._inputs import choice, integer, number, path_bytes
 from .mesh import Mesh, PathLike
+from .geometry import Geometry
 from .meshgen import _model_ptr
 
 _MODES = {"absolute": lib.CM_STUDY_ABSOLUTE, "relative": lib.CM_STUDY_RELATIVE,
@@ -178,7 +179,7 @@ def _stem(path: bytes) -> str:
     return os.fsdecode(stem or base)
 
 
-def study(g0: Any, mesh: Mesh, targets: Sequence[Any],
+def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]],
           methods: Union[None, str, Sequence[str]] = None, mode: str = "absolute",
           steps: Union[int, str] = 1, optimize: bool = False, write_meshes: str = "none",
           out_dir: Optional[PathLike] = None, model_name: Optional[str] = None,
@@ -209,6 +210,8 @@ def study(g0: Any, mesh: Mesh, targets: Sequence[Any],
     if isinstance(targets, (str, bytes, os.PathLike)):
         raise TypeError("%s: targets is a list (of paths and/or Geometry objects)" % what)
     targets = list(targets)
+    if not targets:
+        raise ValueError("%s: no target" % what)
     ctx = Context(threads, progress, what)
     so = ffi.new("cm_study_options *")
     lib.cm_study_options_init(so)
@@ -293,6 +296,8 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
     """
     what = "cadmorph.sweep"
     choice(model, ("bore", "pipe", "bracket"), what + ": model")
+    if out_dir is None and (write_step or write_meshes):
+        raise ValueError("%s: write_step and write_meshes need out_dir" % what)
     if isinstance(mesh, str) and mesh in ("tet", "hex"):
         mesh_b = mesh.encode()
         if mesh == "hex" and model == "bracket":

@@ -158,3 +158,17 @@ def test_docstrings():
                 cadmorph.Deformer.displacement, cadmorph.Deformer.stats,
                 cadmorph.Deformer.n_points):
         assert obj.__doc__ and obj.__doc__.strip()
+
+
+def test_deformer_keeps_its_mesh(work):
+    # the shell borrows the mesh until the deformation is destroyed: the Deformer holds it
+    import gc
+    path, centre = plate(work)
+    mesh = cadmorph.read_mesh(path)
+    disp = np.tile([0.0, 0.0, 0.1], (len(centre), 1))
+    d = cadmorph.Deformer(mesh, centre, "boundary", "shell", progress=False)
+    ref = d.apply(disp)
+    mesh.close()
+    del mesh
+    gc.collect()
+    assert np.array_equal(d.apply(disp), ref)
