@@ -18,11 +18,12 @@ time of each process and the best time of each stage are kept (Python's first ap
 the correspondence check of a new target, cm_cad_compare). Then the same morpher is applied
 REPEAT more times onto the same G(1): in one Python process Morpher.apply alternates with the
 bare cm_morpher_apply through cffi on the same objects (the wrapper's own cost, free of the
-noise between processes), and the C driver repeats its call. Ratios are Python / C. Every child gets OPENBLAS_NUM_THREADS=1 (what the CLI sets
-for itself before OpenBLAS loads) and the CLI's OpenBLAS core through OPENBLAS_CORETYPE, so
-all of them factorise on the same kernels.
+noise between processes), and the C driver repeats its call. Ratios are Python / C. Every
+child gets OPENBLAS_NUM_THREADS=1 (what the CLI sets for itself before OpenBLAS loads) and
+the CLI's OpenBLAS core through OPENBLAS_CORETYPE, so all of them factorise on the same
+kernels.
 
-The mesh is WORK_DIR/M0_<model>_<size>[t].vtu from `cadmorph mesh` (made once, reused), or
+The mesh is WORK_DIR/M0_<model>_<size><g|t>[n].vtu from `cadmorph mesh` (made once, reused), or
 with --hex-scale the model's structured hex mesh (`cadmorph model M 0 --hex-mesh --scale S`).
 PyGeM's RBF is dense (an (n+4)^2 system, then an (N, n) distance matrix for the N points):
 it is skipped, with the memory it would need, above --pygem-mem GB (default 8).
@@ -107,7 +108,8 @@ def child_python(a):
     t_write = time.perf_counter() - t
     row = morpher.steps[-1]
     return dict(import_=t_import, read_cad=t_cad, read_mesh=t_mesh, create=t_create,
-                apply=t_apply, lib=t_lib, apply_cpu=c_apply, lib_cpu=c_lib, write=t_write, nodes=mesh.n_nodes,
+                apply=t_apply, lib=t_lib, apply_cpu=c_apply, lib_cpu=c_lib, write=t_write,
+                nodes=mesh.n_nodes,
                 boundary=morpher.info.boundary_nodes, min_sj=row.min_sj,
                 inverted=row.inverted)
 
@@ -227,7 +229,8 @@ def main():
         print("  %.1f s" % (time.monotonic() - t), flush=True)
 
     exe = os.path.join(work, "bench_morph")
-    subprocess.run(["cc", "-O2", "-std=c11", "-Wall", "-Wextra", "-Werror", "-I" + os.path.join(ROOT, "include"),
+    subprocess.run(["cc", "-O2", "-std=c11", "-Wall", "-Wextra", "-Werror",
+                    "-I" + os.path.join(ROOT, "include"),
                     "-I" + os.path.join(build, "include"), os.path.join(HERE, "bench_morph.c"),
                     "-o", exe, "-L" + build, "-lcadmorph", "-Wl,-rpath," + build], check=True)
 
