@@ -1,4 +1,5 @@
-"""Mesh: a cm_mesh owned by Python, its arrays as NumPy views; read_mesh and write_mesh.
+"""Mesh: a cm_mesh owned by Python, its arrays as NumPy views; read_mesh and write_mesh;
+Mesh.from_arrays, from_meshio and to_meshio (their checks and meshio's names in _convert.py).
 
 Views (points, fields, connectivity) point into the library's memory. Each holds, through
 its `.base`, the owner of the cm_mesh, so the memory lives while any view does, also after
