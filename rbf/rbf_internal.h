@@ -58,11 +58,18 @@ typedef struct cm_rbf_tick {
     double last;        /* cm_wtime of the start or of the last report */
     int reported;       /* a report was made (the last one then says done = total) */
     cm_status status;   /* CM_ERR_INTERRUPTED once a report returned it */
+    double chunk_pairs; /* pairs in a chunk of a kernel sum (CM_RBF_TICK_PAIRS) */
+    int tree_chunks;    /* chunks of a treecode sum (CM_RBF_TICK_TREE_CHUNKS); tests set
+                           both lower to cut small sums into many chunks */
 } cm_rbf_tick;
 #define CM_RBF_TICK_SECONDS 0.05
 /* point-centre pairs of one chunk of a kernel sum: ~0.02-0.05 s of one core */
 #define CM_RBF_TICK_PAIRS 3e7
+/* chunks of batches of a treecode sum (each batch costs differently: a fraction of the sum) */
+#define CM_RBF_TICK_TREE_CHUNKS 64
 void cm_rbf_tick_init(cm_rbf_tick *t, cm_context *ctx, const char *stage, double total);
+/* Starts over with another total (another pass over the work), keeping the rest. */
+void cm_rbf_tick_restart(cm_rbf_tick *t, double total);
 /* Adds work done; reports when due (not when done reaches total). Nonzero: stop (t->status
  * is CM_ERR_INTERRUPTED, with its message in the context). A NULL t never stops. */
 int cm_rbf_tick_add(cm_rbf_tick *t, double work);

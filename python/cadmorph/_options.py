@@ -108,6 +108,8 @@ class WarpSettings:
     def replaced(self, what: str, **changes: Any) -> "WarpSettings":
         """These settings with some replaced (checked again); method= alone keeps the rest."""
         values = {k: getattr(self, k) for k in self.NAMES if k != "kernel"}
+        if "kernel" in changes and "method" not in changes:
+            values["method"] = "rbf"  # kernel= names the method by itself
         values.update(changes)
         return WarpSettings(what, **values)
 
@@ -132,9 +134,14 @@ class WarpSettings:
         w.mls.graded = self.graded
 
 
-def points(what: str, name: str, value: Any, n: int) -> np.ndarray:
-    """value as an (n, 3) C-contiguous float64 array of finite numbers (a copy only when it
-    is not one already)."""
+# The largest displacement component `cadmorph warp` reads from a table: beyond it, squares
+# in the warp overflow (volume/displacement_csv.c, CM_WARP_MAX_DISPLACEMENT)
+MAX_DISPLACEMENT = 1e150
+
+
+def points(what: str, name: str, value: Any, n: int, limit: float = math.inf) -> np.ndarray:
+    """value as an (n, 3) C-contiguous float64 array of finite numbers of magnitude at most
+    limit (a copy only when it is not one already)."""
     a = np.asarray(value)
     if a.dtype.kind not in "fiu" or a.dtype.kind == "b":
         raise TypeError("%s: %s must hold real numbers, not dtype %s" % (what, name, a.dtype))
@@ -144,6 +151,10 @@ def points(what: str, name: str, value: Any, n: int) -> np.ndarray:
     if not np.isfinite(a).all():
         bad = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
         raise ValueError("%s: %s row %d is not finite: %s" % (what, name, bad, a[bad]))
+    if a.size and np.abs(a).max() > limit:
+        bad = int(np.flatnonzero((np.abs(a) > limit).any(axis=1))[0])
+        raise ValueError("%s: %s row %d is %s, beyond any mesh (|d| <= %g)"
+                         % (what, name, bad, a[bad], limit))
     return a
 
 

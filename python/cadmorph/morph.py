@@ -16,6 +16,7 @@ from ._capi import ffi, lib
 from ._context import Context, Progress
 from ._options import WarpSettings, choice, flag, integer, number, points
 from .errors import MismatchError, RejectedError
+from .geometry import Geometry
 from .mesh import _TOKEN, Mesh, _destroy_mesh
 
 # cm_cad_match renumbers a target in place: one at a time, so that a Morpher in another
@@ -286,13 +287,16 @@ class Morpher:
     those Geometry objects, so deleting them while the Morpher lives is safe.
     Threads: one Morpher is used by one thread at a time (calls from several threads wait
     for each other); two Morphers run in parallel in two threads (the GIL is released in
-    the library).
+    the library). Results are bit for bit those of `cadmorph morph` with the same options
+    and threads when OpenBLAS runs as in the CLI (started with OPENBLAS_NUM_THREADS=1):
+    the sparse methods' sums, and dense factorisations in concurrent threads, depend on its
+    thread count.
 
     Raises TypeError/ValueError for bad arguments, MismatchError (the library's message)
     when the mesh is not a mesh of g0, BadInputError for other input the library refuses.
     """
 
-    def __init__(self, g0: Any, mesh: Mesh, *, method: str = "rbf",
+    def __init__(self, g0: Geometry, mesh: Mesh, *, method: str = "rbf",
                  kernel: Optional[str] = None, surface: str = "rbf",
                  steps: Union[int, str] = 1, min_sj: float = 0.0, min_step: float = 1.0 / 256,
                  keep_fraction: float = 0.0, escalate: bool = True, optimize: bool = False,
@@ -359,7 +363,8 @@ class Morpher:
         rows = lib.cm_morpher_steps(self._mp, n)
         return [_record(MorphStep, rows[i]) for i in range(int(n[0]))]
 
-    def apply(self, g1: Any, method: Optional[str] = None, **method_options: Any) -> np.ndarray:
+    def apply(self, g1: Geometry, method: Optional[str] = None,
+              **method_options: Any) -> np.ndarray:
         """The mesh morphed onto g1: node coordinates, a new (n_nodes, 3) float64 array the
         library fills in place. Boundary nodes lie on g1 (exactly where the surface morph
         sent them), the interior follows by the warp.
@@ -418,7 +423,7 @@ class Morpher:
                 self._steps = self._rows()
         return out
 
-    def rebase(self, g: Any, pts: Any) -> None:
+    def rebase(self, g: Geometry, pts: Any) -> None:
         """Relative morphing: the Morpher now starts from the mesh at pts (n_nodes, 3),
         e.g. the last apply's result, lying on g (e.g. that apply's target): its boundary is
         classified on g again and the warps are refactorised when next used. g is renumbered
@@ -491,15 +496,15 @@ class Morpher:
         p = points("cadmorph.Morpher.result_mesh", "pts", pts, self._n)
         with self._lock:
             mesh = _copy_mesh(self._ctx, lib.cm_morpher_mesh(self._mp))
-        m = mesh._ptr
-        # as cm_morph_run: the quality field before the displacement field
-        self._ctx.call(lib.cm_mesh_add_field, m, b"scaled_jacobian", lib.CM_FIELD_CELL, 1,
-                       ffi.NULL)
-        x = mesh.points
-        disp = p - x
-        x[...] = p
-        self._ctx.call(lib.cm_mesh_apply_displacement, m, ffi.from_buffer("double[]", disp),
-                       lib.CM_DISPLACEMENT_QUALITY, ffi.NULL)
+            m = mesh._ptr
+            # as cm_morph_run: the quality field before the displacement field
+            self._ctx.call(lib.cm_mesh_add_field, m, b"scaled_jacobian", lib.CM_FIELD_CELL, 1,
+                           ffi.NULL)
+            x = mesh.points
+            disp = p - x
+            x[...] = p
+            self._ctx.call(lib.cm_mesh_apply_displacement, m, ffi.from_buffer("double[]", disp),
+                           lib.CM_DISPLACEMENT_QUALITY, ffi.NULL)
         return mesh
 
     def __repr__(self) -> str:
@@ -521,7 +526,8 @@ def _copy_mesh(ctx: Context, m) -> Mesh:
     return Mesh(holder[0], _TOKEN)
 
 
-def morph(g0: Any, g1: Any, mesh: Mesh, *, via: Sequence[Any] = (), **options: Any) -> Mesh:
+def morph(g0: Geometry, g1: Geometry, mesh: Mesh, *, via: Sequence[Geometry] = (),
+          **options: Any) -> Mesh:
     """`cadmorph morph` in memory: mesh (a mesh of g0) morphed onto g1, returned as a new
     Mesh with the fields the CLI writes ("displacement" per node, "scaled_jacobian" per
     cell); write_mesh writes what `cadmorph morph -o` would. Options: those of Morpher.

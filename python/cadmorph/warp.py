@@ -6,13 +6,14 @@ every other node of the volume cells, by one of the library's methods (docs/DESI
 warp interface"): "rbf" (triharmonic RBF, the method), "rbf-biharmonic", "femwarp",
 "lbwarp", "simplex", "dmffd", "mls".
 """
+import threading
 from typing import Any, Optional
 
 import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._options import WarpSettings, node_indices, points
+from ._options import MAX_DISPLACEMENT, WarpSettings, node_indices, points
 from .mesh import Mesh
 
 
@@ -54,8 +55,10 @@ class Warp:
 
     Raises ValueError/TypeError for bad arguments, BadInputError and its subclasses for what
     the library refuses (e.g. a mesh without volume cells, a flat boundary of an RBF
-    component), with the library's message. One Warp is used by one thread at a time; two
-    Warp objects may run in two threads.
+    component), with the library's message. Calls on one Warp from several threads wait for
+    each other; two Warp objects run in parallel in two threads (the GIL is released in the
+    library). Bit for bit what `cadmorph warp` computes when OpenBLAS runs as in the CLI
+    (started with OPENBLAS_NUM_THREADS=1): the sparse methods' sums depend on its threads.
     """
 
     def __init__(self, mesh: Mesh, nodes: Any = None, *, method: str = "rbf",
@@ -66,6 +69,7 @@ class Warp:
                  graded: float = 0.0, threads: int = 0, progress: Progress = None) -> None:
         what = "cadmorph.Warp"
         self._warp = None
+        self._lock = threading.Lock()  # the C API: one call at a time on a warp
         if not isinstance(mesh, Mesh):
             raise TypeError("%s: mesh must be a cadmorph.Mesh, not %s"
                             % (what, type(mesh).__name__))
@@ -82,8 +86,9 @@ class Warp:
         ctx.call(lib.cm_mesh_boundary_create, m, bp)
         b = ffi.gc(bp[0], _destroy_boundary)
         if nodes is None:
-            self._nodes = np.array(ffi.unpack(b.nodes, int(b.n_nodes)) if b.n_nodes else [],
-                                   dtype=np.int64)
+            k = int(b.n_nodes)
+            self._nodes = (np.frombuffer(ffi.buffer(b.nodes, 8 * k), np.int64).copy() if k
+                           else np.zeros(0, np.int64))
             constrained = ffi.NULL
         else:
             self._nodes = node_indices(what, "nodes", nodes, n).copy()
@@ -136,17 +141,20 @@ class Warp:
     def apply(self, D: Any) -> np.ndarray:
         """The displacement of every node, (n_nodes, 3) float64, for the displacements D of
         the constrained nodes: an array-like of shape (len(nodes), 3), row k for nodes[k]
-        (for a displacement of every node, pass D_all[w.nodes]). Constrained nodes get their
-        row of D exactly; nodes of no volume cell that are not constrained get 0.
+        (for a displacement of every node, pass D_all[w.nodes]); finite, each component at
+        most 1e150 in magnitude, as in `cadmorph warp`'s table (else ValueError). Constrained
+        nodes get their row of D exactly; nodes of no volume cell that are not constrained
+        get 0.
 
         The result is a new array the library fills in place; on an exception (Ctrl-C, the
         progress callable) nothing is returned and the warp stays usable.
         """
-        d = points("cadmorph.Warp.apply", "D", D, len(self._nodes))
+        d = points("cadmorph.Warp.apply", "D", D, len(self._nodes), MAX_DISPLACEMENT)
         out = np.zeros((self._n, 3), np.float64)
         out[self._nodes] = d
         if self._n:
-            self._ctx.call(lib.cm_warp_apply, self._warp, ffi.from_buffer("double[]", out))
+            with self._lock:
+                self._ctx.call(lib.cm_warp_apply, self._warp, ffi.from_buffer("double[]", out))
         return out
 
     def __repr__(self) -> str:

@@ -152,8 +152,8 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
         const int o = coarse ? order_c : order;
         const double th = coarse ? theta_c : theta;
         const cm_rbf_tree *t = cm_rbf_iterative_tree(r, o, th);
-        if (tick) /* a second row starts over */
-            cm_rbf_tick_init(tick, tick->ctx, tick->stage, (double)((nc + 3) / 4));
+        if (tick) /* in whole sums; a second row starts over */
+            cm_rbf_tick_restart(tick, (double)((nc + 3) / 4));
         if (!t || tree_sum_all(r, t, tg, 1, out, threads, tick)) break;
         const double err = check_all(r, t, n, p, out, CM_RBF_FAST_SAMPLES, NULL, threads);
         it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
@@ -184,9 +184,7 @@ int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double
     if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads, tick)) return 0;
     if (tick && tick->status < 0) return 1;
     /* direct sums: a tick of their own, in point-centre pairs */
-    if (tick)
-        cm_rbf_tick_init(tick, tick->ctx, tick->stage,
-                         (double)((r->ncomp + 3) / 4) * (double)n * (double)r->m);
+    if (tick) cm_rbf_tick_restart(tick, (double)((r->ncomp + 3) / 4) * (double)n * (double)r->m);
     for (int g = 0; g < r->ncomp; g += 4) {
         int nc = r->ncomp - g < 4 ? r->ncomp - g : 4;
         if (cm_rbf_kernel_sum_acc_tick(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,

@@ -200,6 +200,16 @@ void cm_rbf_tick_init(cm_rbf_tick *t, cm_context *ctx, const char *stage, double
     t->last = cm_wtime();
     t->reported = 0;
     t->status = CM_OK;
+    t->chunk_pairs = CM_RBF_TICK_PAIRS;
+    t->tree_chunks = CM_RBF_TICK_TREE_CHUNKS;
+}
+
+void cm_rbf_tick_restart(cm_rbf_tick *t, double total)
+{
+    t->done = 0.0;
+    t->total = total;
+    t->last = cm_wtime();
+    t->reported = 0;
 }
 
 int cm_rbf_tick_add(cm_rbf_tick *t, double work)
@@ -228,7 +238,7 @@ long cm_rbf_tick_chunk(const cm_rbf_tick *tick, double per_item, long items, int
 {
     if (items < 1) return 1;
     if (!tick) return items;
-    double per = CM_RBF_TICK_PAIRS / (per_item > 1.0 ? per_item : 1.0);
+    double per = tick->chunk_pairs / (per_item > 1.0 ? per_item : 1.0);
     /* enough items that a static schedule keeps every thread busy */
     const double least = 8.0 * (threads > 1 ? threads : 1);
     if (per < least) per = least;

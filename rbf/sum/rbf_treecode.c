@@ -629,11 +629,12 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const 
     const int step = stride == 0 ? 1
                      : stride < (size_t)tg->nleaf ? (int)stride
                                                   : (tg->nleaf > 0 ? tg->nleaf : 1);
-    /* batches per chunk between two ticks: about 64 chunks of whole strides (one without a
-     * tick, or when there are too few batches to keep the threads busy in 64) */
+    /* batches per chunk between two ticks: tick->tree_chunks chunks of whole strides (one
+     * without a tick, or when there are too few batches to keep the threads busy in each) */
     int span = tg->nleaf > 0 ? tg->nleaf : 1;
-    if (tick && tg->nleaf / step >= 64 * 8 * (threads > 0 ? threads : 1))
-        span = (tg->nleaf / step + 63) / 64 * step;
+    const int nch = tick && tick->tree_chunks > 1 ? tick->tree_chunks : 1;
+    if (nch > 1 && tg->nleaf / step >= nch * 8 * (threads > 0 ? threads : 1))
+        span = (tg->nleaf / step + nch - 1) / nch * step;
     for (int lo = 0; lo < tg->nleaf && !failed; lo += span) {
         const int hi = tg->nleaf - lo < span ? tg->nleaf : lo + span;
 #pragma omp parallel num_threads(threads) if (threads > 1 && (double)n / step * (double)m > CM_RBF_PARALLEL_MIN_PAIRS)

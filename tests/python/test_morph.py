@@ -6,6 +6,7 @@ import ctypes
 import gc
 import inspect
 import json
+import re
 import sys
 import threading
 import time
@@ -71,16 +72,69 @@ def test_morph_options_equal_cli_bit_for_bit(cli, bore_files, work, options, arg
     assert np.array_equal(np.load(work / "pts.npy"), ref.points)
 
 
+@pytest.mark.parametrize("options,args", [
+    ({"kernel": "biharmonic", "steps": 2}, ["--kernel", "biharmonic", "--steps", "2"]),
+    ({"keep_offset": True, "cad_tol": 1e-3, "off_cad": "fixed"},
+     ["--keep-offset", "--cad-tol", "1e-3", "--off-cad", "fixed"]),
+    ({"method": "dmffd", "lattice": 6, "clamp": 1e-3}, ["--method", "dmffd", "--lattice", "6",
+                                                       "--clamp", "1e-3"]),
+], ids=["biharmonic-steps2", "keep-offset-fixed", "dmffd"])
+def test_morph_cli_option_names_in_process(cli, bore_files, work, options, args):
+    """The CLI's options under their Python names, in this process (the RBF and DM-FFD
+    paths set OpenBLAS's threads themselves or use none)."""
+    m0, g0_path, g1_path, _ = bore_files
+    ref = cli_morph(cli, work, g0_path, g1_path, m0, *args)
+    m = cadmorph.Morpher(read_step(g0_path), cadmorph.read_mesh(m0), threads=1,
+                         progress=False, **options)
+    assert np.array_equal(m.apply(read_step(g1_path)), ref.points)
+    if options.get("keep_offset"):  # G' = G moves nothing
+        assert np.array_equal(m.apply(read_step(g0_path)), cadmorph.read_mesh(m0).points)
+
+
+@pytest.fixture(scope="module")
+def fixture_meshes(cli, data, tmp_path_factory):
+    """Tet meshes (gmsh, through `cadmorph mesh`) of the held-in STEP fixtures bore_a
+    (tests/data/cad) and hole_a (tests/data/surface), by name."""
+    work = tmp_path_factory.mktemp("fixture_meshes")
+    out = {}
+    for folder, name in [("cad", "bore_a"), ("surface", "hole_a")]:
+        out[name] = work / (name + ".vtu")
+        run(cli, "mesh", data / folder / (name + ".step"), "-o", out[name], "--threads", 1)
+    return out
+
+
 @pytest.mark.parametrize("folder,a,b", [("cad", "bore_a", "bore_b"),
                                         ("surface", "hole_a", "hole_b")])
-def test_morph_equals_cli_on_held_in_fixtures(cli, data, work, folder, a, b):
+def test_morph_equals_cli_on_held_in_fixtures(cli, data, work, fixture_meshes, folder, a, b):
     g0_path, g1_path = data / folder / (a + ".step"), data / folder / (b + ".step")
-    m0 = work / "M0.vtu"
-    run(cli, "mesh", g0_path, "-o", m0, "--threads", 1)  # a tet mesh of G0 (gmsh)
+    m0 = fixture_meshes[a]
     ref = cli_morph(cli, work, g0_path, g1_path, m0)
     pts = cadmorph.Morpher(read_step(g0_path), cadmorph.read_mesh(m0), threads=1,
                            progress=False).apply(read_step(g1_path))
     assert np.array_equal(pts, ref.points)
+
+
+def reversed_shell(src, dst):
+    """src with the faces of its closed shell listed the other way round: the same model,
+    numbered otherwise (OpenCASCADE numbers faces in the shell's order)."""
+    text = src.read_text()
+    m = re.search(r"CLOSED_SHELL\('',\(([^)]*)\)\)", text)
+    ids = m.group(1).split(",")
+    dst.write_text(text[:m.start(1)] + ",".join(reversed(ids)) + text[m.end(1):])
+
+
+def test_target_numbered_otherwise_is_renumbered_as_the_cli_does(cli, data, work,
+                                                                 fixture_meshes):
+    g0_path = data / "cad" / "bore_a.step"
+    reversed_shell(data / "cad" / "bore_b.step", work / "bore_b_rev.step")
+    m0 = fixture_meshes["bore_a"]
+    ref = cli_morph(cli, work, g0_path, work / "bore_b_rev.step", m0)
+    g0, g1 = read_step(g0_path), read_step(work / "bore_b_rev.step")
+    assert g0.compare(g1).renumbered
+    m = cadmorph.Morpher(g0, cadmorph.read_mesh(m0), threads=1, progress=False)
+    assert np.array_equal(m.apply(g1), ref.points)
+    comparison = g0.compare(g1)  # g1 now numbered like G, in place
+    assert comparison.corresponds and not comparison.renumbered
 
 
 def test_relative_morph_equals_cli(cli, bore_files, work):
@@ -191,6 +245,8 @@ def test_apply_with_another_method(bore_files):
     assert np.array_equal(proj, cadmorph.Morpher(g0, mesh, surface="project",
                                                  progress=False).apply(g1))
     assert np.array_equal(m.apply(g1), rbf)  # the Morpher's own method again, unchanged
+    fem_m = cadmorph.Morpher(g0, mesh, method="femwarp", progress=False)
+    assert np.array_equal(fem_m.apply(g1, kernel="triharmonic"), rbf)  # kernel: a method
     with pytest.raises(ValueError, match="method must be one of"):
         m.apply(g1, method="spline")
     with pytest.raises(TypeError, match="unknown option steps"):
@@ -380,7 +436,7 @@ def test_bad_arguments_raise_before_the_library(bore_files):
         cadmorph.morph(g0, g1, mesh, via=g1)
 
 
-def test_mismatches_carry_the_library_message(cli, data, bore_files, work):
+def test_mismatches_carry_the_library_message(cli, data, bore_files, fixture_meshes, work):
     m0, g0_path, g1_path, _ = bore_files
     mesh = cadmorph.read_mesh(m0)
     # a mesh that is not a mesh of G: the held-in bore fixture is another solid
@@ -392,18 +448,23 @@ def test_mismatches_carry_the_library_message(cli, data, bore_files, work):
     assert r.returncode == 2 and e.value.message in r.stderr
     # a target of another topology: the differences named
     g_a = read_step(data / "cad" / "bore_a.step")
-    m = cadmorph.Morpher(g_a, cadmorph.read_mesh(run_mesh(cli, data, work)), progress=False)
+    m = cadmorph.Morpher(g_a, cadmorph.read_mesh(fixture_meshes["bore_a"]), progress=False)
     with pytest.raises(cadmorph.MismatchError, match="faces: 9 in G, 10 in G'|faces"):
         m.apply(read_step(data / "cad" / "bore_2holes.step"))
     # and the Morpher still works on a right one
     m.apply(read_step(data / "cad" / "bore_b.step"))
     assert m.steps[-1].accepted
-
-
-def run_mesh(cli, data, work):
-    path = work / "bore_a.vtu"
-    run(cli, "mesh", data / "cad" / "bore_a.step", "-o", path, "--threads", 1)
-    return path
+    # hostile: G' in metres (one changed unit in the STEP file), 1000x the mesh's G
+    text = g0_path.read_text()
+    assert "SI_UNIT(.MILLI.,.METRE.)" in text
+    (work / "metres.step").write_text(text.replace("SI_UNIT(.MILLI.,.METRE.)",
+                                                   "SI_UNIT($,.METRE.)"))
+    r = run_status(cli, "morph", "--from", g0_path, "--to", work / "metres.step", "--mesh", m0,
+                   "-o", work / "m.vtu")
+    m = cadmorph.Morpher(read_step(g0_path), mesh, progress=False)
+    with pytest.raises(cadmorph.MismatchError, match=r"differ in size by 1e\+03x") as e:
+        m.apply(read_step(work / "metres.step"))
+    assert r.returncode == 2 and e.value.message in r.stderr
 
 
 def test_keyboard_interrupt_stops_a_long_morph(cli, tmp_path_factory):

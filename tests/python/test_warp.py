@@ -131,6 +131,13 @@ def test_warp_bad_arrays_raise_before_the_library(bore_mesh):
     bad[7, 1] = np.inf
     with pytest.raises(ValueError, match="row 7 is not finite"):
         w.apply(bad)
+    # the hostile table's displacement, refused as `cadmorph warp` refuses it (squares of it
+    # overflow in the warp: LAPACK's error for the RBF, inf in the DM-FFD's result)
+    bad[7, 1] = 1.7e308
+    with pytest.raises(ValueError, match=r"row 7 is .* beyond any mesh \(\|d\| <= 1e\+150\)"):
+        w.apply(bad)
+    bad[7, 1] = -1e150
+    assert np.isfinite(w.apply(bad)).all()  # the bound itself is fine
     for nodes, kind, msg in [([0, n], ValueError, r"nodes\[1\] = %d is not a node index" % n),
                              ([-1, 3], ValueError, "is not a node index"),
                              ([3, 5, 3], ValueError, "lists node 3 2 times"),
@@ -226,3 +233,23 @@ def test_warp_releases_the_gil(bore_mesh):
     inside = [x for x in ticks if t0 < x < t1]
     assert t1 - t0 > 0.01
     assert len(inside) > 100, (len(inside), t1 - t0)
+
+
+def test_keyboard_interrupt_stops_a_long_warp(cli, tmp_path_factory):
+    """Ctrl-C (SIGINT from a timer thread) during the dense factorisation of a warp of the
+    bore's 6912 boundary nodes (about 6 s on one thread): KeyboardInterrupt from the call
+    within a second, nothing made, and the next call runs."""
+    import _thread
+    m0 = bore(cli, tmp_path_factory.mktemp("warp_interrupt"), [], scale=1)[0]
+    mesh = cadmorph.read_mesh(m0)
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    t0 = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        cadmorph.Warp(mesh, solver="dense", threads=1, progress=False)
+    elapsed = time.perf_counter() - t0
+    timer.join()
+    assert elapsed < 1.5, elapsed
+    w = cadmorph.Warp(mesh, method="simplex", threads=1, progress=False)
+    D = motion(mesh.points[w.nodes])
+    assert np.array_equal(w.apply(D)[w.nodes], D)

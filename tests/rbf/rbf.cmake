@@ -52,3 +52,6 @@ cm_add_unit_test(test_rbf_treecode ${CMAKE_CURRENT_LIST_DIR}/test_rbf_treecode.c
 cm_add_unit_test(test_rbf_sum ${CMAKE_CURRENT_LIST_DIR}/test_rbf_sum.c LIBS cm_rbf_internal LABELS rbf)
 # AUTO's cost model: probe rates, growth of the costs, one crossover
 cm_add_unit_test(test_rbf_auto ${CMAKE_CURRENT_LIST_DIR}/test_rbf_auto.c LIBS cm_rbf_internal LABELS rbf)
+# stopping on request (cm_context_interrupt): sums in chunks are the bits of one pass;
+# create, solve and evaluate stopped at progress points
+cm_add_unit_test(test_rbf_interrupt ${CMAKE_CURRENT_LIST_DIR}/test_rbf_interrupt.c LIBS cm_rbf_internal LABELS rbf)
