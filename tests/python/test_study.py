@@ -33,7 +33,7 @@ def bore(cli, tmp_path_factory):
     d = tmp_path_factory.mktemp("study_bore")
     for t in ("0", "0.5", "1"):
         run(cli, "model", "bore", t, d / ("bore_%s.step" % t))
-    run(cli, "mesh", d / "bore_0.step", "-o", d / "M0.vtu", "--size", "0.7")
+    run(cli, "mesh", d / "bore_0.step", "-o", d / "M0.vtu", "--size", "0.9")
     return d
 
 
