@@ -236,7 +236,11 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     if (L->face.empty())
         return cm_error(ctx, CM_ERR_CAD, "%s: no sample inside any face", fn);
     double clock2 = cm_wtime();
+    // the edges and the kD-trees take as long as the grid at 10^6 samples: points between
+    // them (the sampling's stage, at its end)
+    if ((st = cm_progress(ctx, "sample", (double)rows.size(), (double)rows.size())) < 0) return st;
     st = cm_kdtree_create(ctx, L->xyz.data(), L->face.size(), &L->tree);
+    if (st == CM_OK) st = cm_progress(ctx, "sample", (double)rows.size(), (double)rows.size());
     if (st == CM_OK && !L->eedge.empty())
         st = cm_kdtree_create(ctx, L->exyz.data(), L->eedge.size(), &L->etree);
     if (st == CM_OK && m->counts.vertices > 0)

@@ -549,6 +549,9 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     if ((int)method->warp.method < 0 || method->warp.method >= CM_WARP_N_METHODS)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_apply: unknown warp method %d",
                         (int)method->warp.method);
+    if (!mp->nodes)
+        return cm_error(ctx, CM_ERR_ARGUMENT,
+                        "cm_morpher_apply: the last cm_morpher_rebase failed; rebase again first");
     mp->n_rows = 0;
     double t_sample = 0;
     cm_status s = use_target(ctx, mp, target, &t_sample);
@@ -632,7 +635,12 @@ cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
     drop_warps(mp);
     held_warnings held = {0};
     cm_status s = classify(ctx, mp, &held);
-    if (s < 0) return s;
+    if (s < 0) {
+        /* half re-based (stopped by the caller, or g not under the mesh): no apply until a
+         * rebase succeeds */
+        cm_surface_nodes_destroy(&mp->nodes);
+        return s;
+    }
     return release(ctx, &held);
 }
 

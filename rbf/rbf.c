@@ -365,6 +365,11 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
         if (first < 0.0) first = e;
         if (e <= CM_RBF_REFINE_TOL || !(e < 0.5 * prev) || steps == CM_RBF_REFINE_STEPS) break;
         prev = e;
+        /* a pass of a large fit streams the factor and sums m^2 pairs (20k centres: ~1 s):
+         * the caller may stop between passes (the weights stay the last solve's) */
+        if ((double)m * (double)m * (double)nc >= CM_RBF_TICK_PAIRS &&
+            (st = cm_progress(ctx, "rbf solve", steps + 1, CM_RBF_REFINE_STEPS + 1)) < 0)
+            break;
         st = cm_rbf_dense_solve_pass(ctx, rbf, nc, res, dw, dq, adw, g, threads);
         if (st != CM_OK) break;
         for (size_t i = 0; i < m * nc; ++i) {

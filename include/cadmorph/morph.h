@@ -160,7 +160,8 @@ CM_API const cm_morph_step *cm_morpher_steps(const cm_morpher *morpher, size_t *
 
 /* Relative morphing: the morpher's mesh becomes xyz (#nodes x 3, e.g. the last apply's
  * result), lying on g (e.g. that apply's target); the boundary is classified on g again and
- * the warps are refactorised when next used. */
+ * the warps are refactorised when next used. After a failed rebase (CM_ERR_INTERRUPTED too)
+ * apply refuses (CM_ERR_ARGUMENT) until a rebase succeeds. */
 CM_API cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *g,
                             const double *xyz);
 

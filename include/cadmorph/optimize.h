@@ -40,7 +40,8 @@ typedef struct cm_optimize_stats {
 /* Optimises mesh->xyz in place. fixed: #nodes flags, non-zero = never moved; NULL = the
  * boundary nodes. Nodes of cells other than tet4, hex8, wedge6 and pyr5 (higher order,
  * polyhedra) are never moved either. stats and opt may be NULL. Errors: CM_ERR_NOMEM,
- * CM_ERR_UNSUPPORTED for a mesh without volume cells. */
+ * CM_ERR_UNSUPPORTED for a mesh without volume cells, CM_ERR_INTERRUPTED (core.h; the mesh
+ * is then as it was given). */
 CM_API cm_status cm_mesh_optimize(cm_context *ctx, cm_mesh *mesh, const unsigned char *fixed,
                            const cm_optimize_options *opt, cm_optimize_stats *stats);
 

@@ -68,7 +68,7 @@ CM_API void cm_study_method_help(char *buf, size_t size);
 typedef struct cm_study_family {
     size_t n; /* variants 0 .. n-1 (the morph targets; G0 is given separately) */
     /* G of variant i into *g (the study destroys it). Any error becomes variant i's rows
-     * (its message with them); only CM_ERR_NOMEM ends the study. */
+     * (its message with them); only CM_ERR_NOMEM (and CM_ERR_INTERRUPTED) ends the study. */
     cm_status (*load)(cm_context *ctx, void *user, size_t i, cm_cad_model **g);
     /* A short name of variant i for file names and the CSV (the STEP file's stem, "050"). */
     void (*label)(void *user, size_t i, char *buf, size_t size);
@@ -177,7 +177,8 @@ typedef struct cm_study_result {
 
 /* Morphs mesh (of g0; both borrowed for the call) onto every variant of family. Errors that
  * end the study: M not a mesh of G0 and the other errors of cm_morpher_create, out of memory,
- * a mesh that cannot be written. Returns CM_WARNING (message: the first failed row) when rows
+ * a mesh that cannot be written, CM_ERR_INTERRUPTED (no result; the meshes of the variants
+ * finished before stay written). Returns CM_WARNING (message: the first failed row) when rows
  * failed; their errors also go to the log as warnings. */
 CM_API cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *mesh,
                        const cm_study_family *family, const cm_study_options *opt,

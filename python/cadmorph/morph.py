@@ -430,7 +430,8 @@ class Morpher:
         like G when needed, as in apply.
 
         Raises MismatchError when g does not correspond to G or the mesh at pts is not on
-        g; ValueError for pts of another shape or not finite.
+        g; ValueError for pts of another shape or not finite. After a failed or interrupted
+        rebase, apply raises cadmorph.Error until a rebase succeeds.
         """
         what = "cadmorph.Morpher.rebase"
         gp = _model(g, what, "g")

@@ -83,8 +83,16 @@ class Warp:
         opt = ffi.new("cm_warp_options *")
         settings.fill(opt)
         bp = ffi.new("cm_mesh_boundary *[1]")
-        ctx.call(lib.cm_mesh_boundary_create, m, bp)
-        b = ffi.gc(bp[0], _destroy_boundary)
+        owned = []
+
+        def boundary(ctx_ptr, *args):
+            s = lib.cm_mesh_boundary_create(ctx_ptr, *args)
+            if bp[0] != ffi.NULL:  # owned at once: a warning raised as an error frees it
+                owned.append(ffi.gc(bp[0], _destroy_boundary))
+            return s
+
+        ctx.call(boundary, m, bp)
+        b = owned[0]
         if nodes is None:
             k = int(b.n_nodes)
             self._nodes = (np.frombuffer(ffi.buffer(b.nodes, 8 * k), np.int64).copy() if k

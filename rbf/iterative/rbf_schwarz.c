@@ -683,6 +683,8 @@ static cm_status build_coarse(cm_context *ctx, const cm_rbf *r, cm_rbf_schwarz *
         if (st == CM_OK) p->bytes += cm_rbf_coarse_inner_bytes(p->inner);
         goto done;
     }
+    /* between choosing the coarse centres and their dense factor (one LAPACK sequence) */
+    if ((st = cm_progress(ctx, "rbf coarse", 0.5, 1)) < 0) goto done;
     const int saved = openblas_get_num_threads();
     openblas_set_num_threads(threads);
     int info = cm_rbf_projected_factor(r->c, m, p->c_idx, nc, p->gc, &p->c_rk, p->c_tau);
@@ -715,10 +717,15 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
     }
     /* the coarse space first: its fill distance sets the overlap when measured in distance */
     double t0 = cm_wtime();
-    cm_status st = build_coarse(ctx, r, p, threads);
+    /* progress points around the coarse level (its dense factor is one LAPACK call) and the
+     * subdomains: where the caller can stop before the local solves report */
+    cm_status st = cm_progress(ctx, "rbf coarse", 0, 1);
+    if (st == CM_OK) st = build_coarse(ctx, r, p, threads);
+    if (st == CM_OK) st = cm_progress(ctx, "rbf coarse", 1, 1);
     double t1 = cm_wtime();
     if (st == CM_OK) st = build_subdomains(ctx, r, p, threads);
     if (st == CM_OK) split_parts(p, r->pc_part, r->pc_parts);
+    if (st == CM_OK) st = cm_progress(ctx, "rbf subdomains", 1, 1);
     double t2 = cm_wtime();
     if (st == CM_OK) st = build_local(ctx, r, p, threads);
     double t3 = cm_wtime();

@@ -4,7 +4,8 @@
  * overlapping boxes are, reproduces that crash every time. It must come back as a status with
  * the signal, and the test process must go on; so must its assertion (abort) on points
  * without extent in one direction: the same run with -d lists the intersecting
- * triangles; a clean box meshes (volume 1); a time limit far below the work kills the child;
+ * triangles; a clean box meshes (volume 1); a time limit far below the work kills the child,
+ * and so does the caller's request to stop (cm_context_interrupt at a progress point);
  * none of TetGen's printing and none of the parent's buffered output reaches stdout twice;
  * OpenMP's thread pool works before and after the forks. */
 #include "test_util.h"
@@ -36,6 +37,23 @@ static void add_box(double *xyz, size_t *np, int64_t *tri, size_t *nt, int *mark
             marker[*nt] = mark + f;
             ++*nt;
         }
+    }
+}
+
+/* Asks to stop on progress call `at`, noting when. */
+typedef struct stopper {
+    cm_context *ctx;
+    int calls, at;
+    double asked;
+} stopper;
+
+static void on_progress(void *user, const char *stage, double done, double total)
+{
+    (void)stage, (void)done, (void)total;
+    stopper *s = user;
+    if (++s->calls == s->at) {
+        s->asked = cm_wtime();
+        cm_context_interrupt(s->ctx);
     }
 }
 
@@ -136,6 +154,24 @@ int main(int argc, char **argv)
     CHECK_MSG(strstr(msg, "TetGen did not finish in 0.05 s") != NULL, "message: %s", msg);
     CHECK_MSG(dt < 5, "killed after %g s", dt); /* the limit plus the kill, loaded machine */
     CHECK(r.xyz == NULL);
+
+    /* 5b. the same work without a limit, the caller asking to stop at the third progress
+     * point while the child runs: killed at once, no result, CM_ERR_INTERRUPTED */
+    stopper st = {ctx, 0, 3, 0.0};
+    cm_context_set_progress(ctx, on_progress, &st);
+    const double t1 = cm_wtime();
+    s = cm_tetgen_run(ctx, "fine box", &box, "pq1.2a1e-7Q", 0, &r, &failure);
+    const double after = cm_wtime() - st.asked;
+    msg = cm_context_message(ctx);
+    CHECK_MSG(s == CM_ERR_INTERRUPTED && failure == 0 && r.xyz == NULL,
+              "status %d failure %d: %s", (int)s, failure, msg);
+    CHECK_MSG(strstr(msg, "tetgen: interrupted") != NULL, "message: %s", msg);
+    CHECK_MSG(st.calls == 3 && after < 1.0, "%d progress points, returned %.3f s after the request",
+              st.calls, after);
+    /* stdout is captured here: the figures go to stderr */
+    fprintf(stderr, "TetGen stopped after %.3f s, %.3f s after the request\n", cm_wtime() - t1,
+            after);
+    cm_context_set_progress(ctx, NULL, NULL);
 
     /* 6. OpenMP still works after the forks, in the parent */
     CHECK_NEAR(omp_sum(1000), 1000, 0);

@@ -3,7 +3,8 @@
  * progress point gives no morpher; cm_morpher_apply stopped at its first, middle and last
  * point returns CM_ERR_INTERRUPTED and the same morpher then applies to the bits of an
  * uninterrupted apply and of a fresh morpher; a request made before the call stops it at the
- * first point; cm_context_clear drops one.
+ * first point; cm_context_clear drops one; a rebase stopped leaves the morpher refusing to
+ * apply until it is re-based.
  * usage: test_morph_interrupt DATA WORK */
 #include "cadmorph/models.h"
 #include "cadmorph/morph.h"
@@ -114,6 +115,43 @@ static void test_morpher(cm_context *ctx, stopper *st, const cm_cad_model *g0,
     free(got);
 }
 
+/* A rebase stopped at its first point: apply refuses until a rebase succeeds, then the chain
+ * G0 -> G1 -> G0 gives the bits of an uninterrupted one. */
+static void test_rebase(cm_context *ctx, stopper *st, const cm_cad_model *g0,
+                        const cm_cad_model *g1, const cm_mesh *m)
+{
+    const size_t n3 = 3 * m->n_nodes;
+    double *mid = malloc(n3 * sizeof *mid), *want = malloc(n3 * sizeof *want);
+    double *got = malloc(n3 * sizeof *got);
+    cm_morpher *a = NULL, *b = NULL;
+    arm(st, 0);
+    cm_status s = cm_morpher_create(ctx, g0, m, NULL, &a);
+    if (s >= 0) s = cm_morpher_create(ctx, g0, m, NULL, &b);
+    if (s >= 0) s = cm_morpher_apply(ctx, a, g1, mid, NULL);
+    if (s >= 0) s = cm_morpher_rebase(ctx, a, g1, mid);
+    if (s >= 0) s = cm_morpher_apply(ctx, a, g0, want, NULL);
+    if (s >= 0) s = cm_morpher_apply(ctx, b, g1, mid, NULL);
+    CHECK_MSG(s >= 0, "%s", cm_context_message(ctx));
+    if (s >= 0) {
+        arm(st, 1);
+        s = cm_morpher_rebase(ctx, b, g1, mid);
+        CHECK_MSG(interrupted(ctx, s), "rebase stopped at 1: status %d", (int)s);
+        arm(st, 0);
+        s = cm_morpher_apply(ctx, b, g0, got, NULL);
+        CHECK_MSG(s == CM_ERR_ARGUMENT, "apply after a stopped rebase: status %d", (int)s);
+        s = cm_morpher_rebase(ctx, b, g1, mid);
+        if (s >= 0) s = cm_morpher_apply(ctx, b, g0, got, NULL);
+        CHECK_MSG(s >= 0 && !memcmp(got, want, n3 * sizeof *got),
+                  "chain after a stopped rebase differs: status %d, %s", (int)s,
+                  cm_context_message(ctx));
+    }
+    cm_morpher_destroy(&a);
+    cm_morpher_destroy(&b);
+    free(mid);
+    free(want);
+    free(got);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) {
@@ -137,6 +175,7 @@ int main(int argc, char **argv)
     CHECK_MSG(s >= 0, "%s", cm_context_message(ctx));
     cm_context_set_progress(ctx, on_progress, &st);
     if (s >= 0) test_morpher(ctx, &st, g0, g1, m);
+    if (s >= 0) test_rebase(ctx, &st, g0, g1, m);
     cm_mesh_destroy(&m);
     cm_cad_destroy(&g0);
     cm_cad_destroy(&g1);

@@ -52,6 +52,44 @@ def bore(cli: str, work: pathlib.Path, ts: List[float], scale: float = 0.5) -> L
     return out
 
 
+class CtrlC:
+    """Ctrl-C from a timer thread after `delay` seconds (_thread.interrupt_main: SIGINT's
+    KeyboardInterrupt), and a progress callable that records every report with its time:
+    `after()` lists the reports recorded once the signal was sent. A call that stops at
+    its next progress point records none: the KeyboardInterrupt is raised in the callback
+    of that point before the callable runs (at most one, if the signal lands inside it)."""
+
+    def __init__(self, delay: float = 0.3) -> None:
+        import threading
+        import time
+        import _thread
+        self.reports = []
+        self.sent = None
+        self._time = time.perf_counter
+
+        def fire():
+            self.sent = self._time()
+            _thread.interrupt_main()
+
+        self.timer = threading.Timer(delay, fire)
+
+    def __call__(self, stage: str, done: float, total: float) -> None:
+        self.reports.append((self._time(), stage, done, total))
+
+    def __enter__(self) -> "CtrlC":
+        self.timer.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        # a call that ended first must not leave the signal to hit the test runner
+        self.timer.cancel()
+        self.timer.join()
+
+    def after(self) -> list:
+        """(stage, done, total) of the reports made after the signal was sent."""
+        return [r[1:] for r in self.reports if self.sent is not None and r[0] >= self.sent]
+
+
 def child_env() -> dict:
     """The environment of a child Python that runs OpenBLAS as the CLI does: the cadmorph
     program starts it with OPENBLAS_NUM_THREADS=1 (include/cadmorph/blas.h), and the sparse
