@@ -10,8 +10,9 @@ packages=(
   libflann-dev libtet1.5-dev liblapacke-dev libopenblas-dev zlib1g-dev libsuitesparse-dev
   gmsh libgmsh-dev python3-gmsh python3-numpy python3-scipy python3-vtk9 python3-meshio
   python3-cffi python3-pytest  # the Python package (python/cadmorph) and its tests
+  python3-pip python3-venv python3-setuptools  # `pip install ./python` into a venv (install test)
   openfoam  # blockMesh, snappyHexMesh, checkMesh: polyMesh test meshes and the checkMesh cross-check
-  python3-matplotlib  # imported by PyGeM, for tests/data/deform/make_pygem_fixture.py
+  python3-matplotlib  # examples/python (plots); imported by PyGeM (make_pygem_fixture.py)
   clang libclang-rt-14-dev  # make fuzz (libFuzzer); make check-asan uses gcc's sanitizers
 )
 # Optional, needed only for -DCADMORPH_WITH_PETSC=ON (the distributed solver, --solver petsc):

@@ -40,7 +40,8 @@ def _load():
             return ffi.dlopen(path), path
         except OSError as e:
             errors.append(str(e))
-    raise ImportError("cadmorph: cannot load libcadmorph (%s)" % "; ".join(errors))
+    raise ImportError("cadmorph: cannot load libcadmorph (%s); set CADMORPH_LIBRARY to its "
+                      "path, or put its directory on LD_LIBRARY_PATH" % "; ".join(errors))
 
 
 lib, LIBRARY_PATH = _load()

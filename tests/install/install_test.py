@@ -7,14 +7,18 @@ build run on the plate-with-a-hole STEP fixtures (tests/data/surface) and gmsh's
 (fixture surface_meshes).
 
   install_test.py --cmake CMAKE --build BUILD_DIR --examples SRC_DIR --data TESTS_DATA
-                  --mesh HOLE_A_MESH --work DIR
+                  --mesh HOLE_A_MESH --python PYTHON_SRC_DIR --work DIR
 
 Also checked: the exported symbols of libcadmorph.so are exactly the functions the installed
 headers declare (CM_API), `cadmorph --version`, cadmorph.pc and the config version agree, and
 the installed program writes a built-in model that it reads back (`cadmorph model bore 0
 b.step`, then `cadmorph info b.step`: the README's first step), and the installed Python
 package imports from the prefix's site directory and reads a mesh through the installed
-libcadmorph.so.
+libcadmorph.so; and the README's pip route: a copy of python/ (so that pip's in-place build
+does not write into the sources) installed by pip into a fresh venv that sees the system's
+cffi, setuptools and NumPy (`--system-site-packages --no-build-isolation`, no network), where
+the package opens the prefix's library by its soname (LD_LIBRARY_PATH) or by
+CADMORPH_LIBRARY, and reads a mesh.
 """
 import argparse
 import glob
@@ -57,9 +61,62 @@ def declared_functions(include_dir):
     return names
 
 
+# prints the library the process mapped (the soname route gives no path), the distribution's
+# version, the library's, the mesh's node count and cell count, and whether the package holds
+# a compiled module (it must not: ABI mode)
+PIP_CHECK = """
+import glob, importlib.metadata, os, sys
+import cadmorph
+lib = [l.split()[-1] for l in open("/proc/self/maps") if "libcadmorph.so" in l][0]
+m = cadmorph.read_mesh(sys.argv[1])
+so = glob.glob(os.path.join(os.path.dirname(cadmorph.__file__), "*.so"))
+print(lib, importlib.metadata.version("cadmorph"), cadmorph.__version__, m.points.shape[0],
+      cadmorph.quality(m).cells, len(so))
+"""
+
+
+def pip_route(a, prefix, libdir, version):
+    """`pip install --no-build-isolation ./python` into a venv with the system's site packages,
+    against the installed libcadmorph (README, section Python; python/README.md)."""
+    src = os.path.join(a.work, "python_src")
+    shutil.copytree(a.python, src, ignore=shutil.ignore_patterns("build", "*.egg-info",
+                                                                  "__pycache__"))
+    venv = os.path.join(a.work, "venv")
+    run([sys.executable, "-m", "venv", "--system-site-packages", venv])
+    py = os.path.join(venv, "bin", "python")
+    # --no-index: the machine may have no network; everything comes from the system
+    run([os.path.join(venv, "bin", "pip"), "install", "--no-build-isolation", "--no-index",
+         "--disable-pip-version-check", src])
+    if not ok:
+        return
+    base = {k: v for k, v in os.environ.items()
+            if not k.startswith(("PYTHON", "CADMORPH", "LD_LIBRARY"))}
+    base.update(PYTHONDONTWRITEBYTECODE="1")
+    soname = os.path.basename(os.path.realpath(os.path.join(libdir, "libcadmorph.so")))
+    for how, extra in (("LD_LIBRARY_PATH", {"LD_LIBRARY_PATH": libdir}),
+                       ("CADMORPH_LIBRARY",
+                        {"CADMORPH_LIBRARY": os.path.join(libdir, "libcadmorph.so")})):
+        # from the work directory: the source tree's python/ must not be what is imported
+        r = subprocess.run([py, "-c", PIP_CHECK, a.mesh], capture_output=True, text=True,
+                           env=dict(base, **extra), cwd=a.work)
+        print("$ %s=... %s -c PIP_CHECK" % (how, py), flush=True)
+        words = r.stdout.split()
+        if r.returncode != 0 or len(words) != 6:
+            fail("pip route, %s: %s%s" % (how, r.stdout, r.stderr))
+            continue
+        lib, dist_version, lib_version, nodes, cells, so = words
+        if os.path.realpath(lib) != os.path.join(os.path.realpath(libdir), soname):
+            fail("pip route, %s: opened %s, not the prefix's %s" % (how, lib, soname))
+        if not dist_version == lib_version == version:
+            fail("pip route: the distribution is %s, the library %s, cadmorph.pc %s" %
+                 (dist_version, lib_version, version))
+        if int(nodes) <= 0 or int(cells) <= 0 or so != "0":
+            fail("pip route, %s: %r" % (how, r.stdout))
+
+
 def main():
     ap = argparse.ArgumentParser()
-    for a in ("cmake", "build", "examples", "data", "mesh", "work"):
+    for a in ("cmake", "build", "examples", "data", "mesh", "python", "work"):
         ap.add_argument("--" + a, required=True)
     a = ap.parse_args()
     prefix = os.path.join(a.work, "prefix")
@@ -117,6 +174,7 @@ def main():
         if len(words) != 3 or not os.path.realpath(words[0]).startswith(os.path.realpath(prefix)) \
                 or int(words[1]) <= 0 or int(words[2]) <= 0:
             fail("the installed Python package: %r" % r.stdout)
+    pip_route(a, prefix, libdir, pc)
     if not ok:
         return 1
 
