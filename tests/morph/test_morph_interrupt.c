@@ -8,39 +8,11 @@
  * usage: test_morph_interrupt DATA WORK */
 #include "cadmorph/models.h"
 #include "cadmorph/morph.h"
+#include "test_stopper.h"
 #include "test_util.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct stopper {
-    cm_context *ctx;
-    int calls, at;
-    char stage[64];
-} stopper;
-
-static void on_progress(void *user, const char *stage, double done, double total)
-{
-    (void)done;
-    (void)total;
-    stopper *s = user;
-    if (++s->calls == s->at) {
-        snprintf(s->stage, sizeof s->stage, "%s", stage);
-        cm_context_interrupt(s->ctx);
-    }
-}
-
-static void arm(stopper *s, int at)
-{
-    s->calls = 0;
-    s->at = at;
-    s->stage[0] = 0;
-}
-
-static int interrupted(cm_context *ctx, cm_status s)
-{
-    return s == CM_ERR_INTERRUPTED && strstr(cm_context_message(ctx), "interrupted") != NULL;
-}
 
 static void test_morpher(cm_context *ctx, stopper *st, const cm_cad_model *g0,
                          const cm_cad_model *g1, const cm_mesh *m)

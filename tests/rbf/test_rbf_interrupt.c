@@ -10,39 +10,11 @@
 #include "rbf_internal.h"
 #include "sum/rbf_treecode.h"
 #include "test_rng.h"
+#include "test_stopper.h"
 #include "test_util.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct stopper {
-    cm_context *ctx;
-    int calls, at;
-    char stage[64];
-} stopper;
-
-static void on_progress(void *user, const char *stage, double done, double total)
-{
-    (void)done;
-    (void)total;
-    stopper *s = user;
-    if (++s->calls == s->at) {
-        snprintf(s->stage, sizeof s->stage, "%s", stage);
-        cm_context_interrupt(s->ctx);
-    }
-}
-
-static void arm(stopper *s, int at)
-{
-    s->calls = 0;
-    s->at = at;
-    s->stage[0] = 0;
-}
-
-static int interrupted(cm_context *ctx, cm_status s)
-{
-    return s == CM_ERR_INTERRUPTED && strstr(cm_context_message(ctx), "interrupted") != NULL;
-}
 
 /* n points in [-1, 1]^3, n x 3 (AoS) */
 static double *random_points(size_t n, uint64_t seed)

@@ -6,29 +6,13 @@
  * usage: test_study_interrupt DATA WORK */
 #include "cadmorph/models.h"
 #include "cadmorph/study.h"
+#include "test_stopper.h"
 #include "test_util.h"
 
 #include <dirent.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-
-typedef struct stopper {
-    cm_context *ctx;
-    int calls, at;
-    char stage[64];
-} stopper;
-
-static void on_progress(void *user, const char *stage, double done, double total)
-{
-    (void)done;
-    (void)total;
-    stopper *s = user;
-    if (++s->calls == s->at) {
-        snprintf(s->stage, sizeof s->stage, "%s", stage);
-        cm_context_interrupt(s->ctx);
-    }
-}
 
 /* Files in dir (not . and ..). */
 static int count_files(const char *dir)

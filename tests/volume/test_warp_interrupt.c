@@ -8,40 +8,11 @@
 #include "cadmorph/models.h"
 #include "cadmorph/optimize.h"
 #include "cadmorph/warp.h"
+#include "test_stopper.h"
 #include "test_util.h"
 
 #include <stdlib.h>
 #include <string.h>
-
-/* The callback: counts calls, asks to stop on call `at` (0: never), keeps that stage. */
-typedef struct stopper {
-    cm_context *ctx;
-    int calls, at;
-    char stage[64];
-} stopper;
-
-static void on_progress(void *user, const char *stage, double done, double total)
-{
-    (void)done;
-    (void)total;
-    stopper *s = user;
-    if (++s->calls == s->at) {
-        snprintf(s->stage, sizeof s->stage, "%s", stage);
-        cm_context_interrupt(s->ctx);
-    }
-}
-
-static void arm(stopper *s, int at)
-{
-    s->calls = 0;
-    s->at = at;
-    s->stage[0] = 0;
-}
-
-static int interrupted(cm_context *ctx, cm_status s)
-{
-    return s == CM_ERR_INTERRUPTED && strstr(cm_context_message(ctx), "interrupted") != NULL;
-}
 
 /* A smooth motion of the boundary nodes (zero elsewhere). */
 static void boundary_motion(const cm_mesh *m, const cm_mesh_boundary *b, double *disp)
