@@ -21,6 +21,7 @@ from .ffd import FFDStats, Lattice, ffd
 from .optimize import OptimizeStats, optimize
 from .meshgen import mesh_step
 from .study import StudyResult, StudyRow, study, sweep
+from .blas import BlasInfo, blas_info
 
 __version__: str = _ffi.string(_lib.cm_version()).decode()
 
@@ -37,5 +38,6 @@ __all__ = [
     "OptimizeStats", "optimize",
     "mesh_step",
     "StudyResult", "StudyRow", "study", "sweep",
+    "BlasInfo", "blas_info",
     "__version__",
 ]
