@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 
 from ._capi import ffi, lib
 from ._context import Context
+from . import _inputs
 
 PathLike = Union[str, bytes, "os.PathLike[str]"]
 
@@ -47,16 +48,6 @@ def _array(owner, ptr, shape: Tuple[int, ...], dtype, writable: bool = True) -> 
         return a
     address = int(ffi.cast("uintptr_t", ptr))
     return np.asarray(_View(owner, address, shape, dtype.str, writable))
-
-
-def _path(path: PathLike, what: str) -> bytes:
-    if not isinstance(path, (str, bytes, os.PathLike)):
-        raise TypeError("%s: a path (str, bytes or os.PathLike), not %s"
-                        % (what, type(path).__name__))
-    b = os.fsencode(path)
-    if not b or b"\0" in b:
-        raise ValueError("%s: an empty path or one with a NUL byte: %r" % (what, path))
-    return b
 
 
 def _destroy_mesh(ptr) -> None:
@@ -122,13 +113,8 @@ class Mesh:
     def points(self, value) -> None:
         """Sets every node's coordinates (copied into the mesh): an array-like of shape
         (n_nodes, 3) of real numbers."""
-        m = self._ptr
-        n = int(m.n_nodes)
-        a = np.asarray(value)
-        if a.dtype.kind not in "fiu":
-            raise TypeError("cadmorph.Mesh.points: real numbers, not dtype %s" % a.dtype)
-        if a.shape != (n, 3):
-            raise ValueError("cadmorph.Mesh.points: shape (%d, 3), not %s" % (n, a.shape))
+        a = _inputs.real_array("cadmorph.Mesh.points", "value", value, (self.n_nodes, 3),
+                               finite=False)
         self.points[...] = a
 
     def _cell_arrays(self) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -243,8 +229,10 @@ class Mesh:
         """
         from . import _convert
         what = "cadmorph.Mesh.from_arrays"
-        xyz = _convert.points_array(points, what)
+        xyz = _inputs.points(what, "points", points, planar=True)
         n = len(xyz)
+        if n == 0:
+            raise ValueError("%s: no points" % what)
         blocks = _convert.cell_blocks(cells, n, what)
         n_cells = sum(b.count for b in blocks)
         fields, tags = [], {}
@@ -256,7 +244,7 @@ class Mesh:
                 raise TypeError("%s: point_data and cell_data must be dicts, not %s"
                                 % (what, type(data).__name__))
             for name, value in data.items():
-                key = _convert._name(name, what)
+                key = _inputs.text(what, "field name", name)
                 if bl is not None and name in _convert.TAGS:
                     tags[name] = _convert.tag_array(name, value, count, bl, what)
                 else:
@@ -359,7 +347,7 @@ def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
     Raises BadInputError (with the library's message naming the file, and the line or the
     byte offset) for a file that is missing, unreadable or malformed.
     """
-    p = _path(path, "cadmorph.read_mesh")
+    p = _inputs.path_bytes("cadmorph.read_mesh", "path", path)
     ctx = Context(threads, False, "cadmorph.read_mesh")
     out = ffi.new("cm_mesh *[1]")
     ctx.call(lib.cm_mesh_read, p, out)
@@ -375,10 +363,8 @@ def write_mesh(path: PathLike, mesh: Mesh, binary: Optional[bool] = None,
     binary: msh, vtk, stl binary, vtu base64 (library default when None); msh_version: 22 or
     41 (default 41); compress: vtu zlib compression (default on).
     """
-    if not isinstance(mesh, Mesh):
-        raise TypeError("cadmorph.write_mesh: mesh must be a cadmorph.Mesh, not %s"
-                        % type(mesh).__name__)
-    p = _path(path, "cadmorph.write_mesh")
+    _inputs.mesh_of("cadmorph.write_mesh", "mesh", mesh)
+    p = _inputs.path_bytes("cadmorph.write_mesh", "path", path)
     opt = ffi.new("cm_mesh_write_options *")
     lib.cm_mesh_write_options_init(opt)
     if msh_version is not None:
