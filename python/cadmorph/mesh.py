@@ -1,5 +1,6 @@
 """Mesh: a cm_mesh owned by Python, its arrays as NumPy views; read_mesh and write_mesh;
-Mesh.from_arrays, from_meshio and to_meshio (their checks and meshio's names in _convert.py).
+Mesh.from_arrays, from_meshio and to_meshio (meshio's names and cell blocks in _convert.py, the
+generic argument checks in _inputs.py).
 
 Views (points, fields, connectivity) point into the library's memory. Each holds, through
 its `.base`, the owner of the cm_mesh, so the memory lives while any view does, also after
