@@ -15,9 +15,8 @@ import time
 import warnings
 from typing import Any, Callable, Optional, Union
 
-import numpy as np
-
 from ._capi import ffi, lib
+from ._inputs import integer
 from .errors import CadmorphWarning, ResourceError, error_class
 
 ProgressFn = Callable[[str, float, float], Any]
@@ -78,15 +77,6 @@ def _progress_fn(progress: Progress) -> Optional[ProgressFn]:
     return progress
 
 
-def _threads(threads: Any, what: str) -> int:
-    """threads checked: an int from 0 (all the machine has) to 4096."""
-    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)):
-        raise TypeError("%s: threads must be an int, not %s" % (what, type(threads).__name__))
-    if not 0 <= threads <= 4096:
-        raise ValueError("%s: threads must be 0 (all) to 4096, not %d" % (what, threads))
-    return int(threads)
-
-
 class Context:
     """A cm_context for one call or for one object's calls (a Morpher, a Warp): not shared
     between threads, as the C API requires.
@@ -103,7 +93,8 @@ class Context:
         if s != lib.CM_OK:
             raise ResourceError(s, "cm_context_create failed")
         self.ptr = ffi.gc(p[0], _destroy_context)
-        lib.cm_context_set_threads(self.ptr, _threads(threads, what))
+        # 0: all the machine has
+        lib.cm_context_set_threads(self.ptr, integer(what, "threads", threads, 0, 4096))
         state = self._state = _State(_progress_fn(progress))
         state.ptr = self.ptr
 

@@ -19,12 +19,12 @@ cell_sets are read when there is no "gmsh:physical" (each set a group, tags 1, 2
 sets' order; a cell in two sets cannot be represented and raises ValueError); to_meshio does
 not write them.
 """
-import warnings
 from typing import Any, Dict, List, Optional, Tuple
 
 import numpy as np
 
 from ._capi import ffi, lib
+from ._inputs import asarray, index_array, integer, text
 
 CELL_NAMES = [ffi.string(lib.cm_cell_type_info(t).name).decode()
               for t in range(lib.CM_CELL_TYPE_COUNT)]
@@ -46,73 +46,8 @@ _FROM_MESHIO = {v: k for k, v in MESHIO_NAME.items()}
 # inverse)
 MESHIO_ORDER = {"wedge6": np.array([0, 2, 1, 3, 5, 4])}
 
-# NumPy < 1.24 warns on ragged nested sequences instead of raising
-_RAGGED = getattr(np, "VisibleDeprecationWarning", None) or np.exceptions.VisibleDeprecationWarning
 TAGS = ("gmsh:physical", "gmsh:geometrical")
 _I32 = np.iinfo(np.int32)
-
-
-def _name(name: Any, what: str) -> bytes:
-    """A field or group name as bytes for the library."""
-    if not isinstance(name, str):
-        raise TypeError("%s: names must be str, not %s" % (what, type(name).__name__))
-    if not name or "\0" in name:
-        raise ValueError("%s: an empty name or one with a NUL character: %r" % (what, name))
-    return name.encode("utf-8")
-
-
-def _asarray(value: Any, what: str) -> np.ndarray:
-    """np.asarray, a ragged or otherwise unconvertible value as ValueError/TypeError."""
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error", _RAGGED)
-            return np.asarray(value)
-    except (ValueError, _RAGGED) as e:
-        raise ValueError("%s: not a rectangular array (%s)" % (what, e)) from None
-    except TypeError as e:
-        raise TypeError("%s: not an array (%s)" % (what, e)) from None
-
-
-def _int_array(value: Any, what: str) -> np.ndarray:
-    a = _asarray(value, what)
-    if a.dtype.kind not in "iu":
-        if a.size == 0 and a.dtype.kind == "f":  # [] is float64: an empty block
-            return a.astype(np.int64)
-        raise TypeError("%s: node indices must be integers, not dtype %s" % (what, a.dtype))
-    return a
-
-
-def _check_range(a: np.ndarray, n_nodes: int, what: str) -> None:
-    """Every entry of the int array a (rows = cells) is a node index in [0, n_nodes)."""
-    if a.size == 0:
-        return
-    bad = (a < 0) | (a >= n_nodes)
-    if bad.any():
-        flat = int(np.flatnonzero(bad.reshape(len(a), -1).any(axis=1))[0]) if a.ndim > 1 \
-            else int(np.flatnonzero(bad)[0])
-        row = a[flat]
-        value = int(row[bad[flat]][0]) if a.ndim > 1 else int(row)
-        raise ValueError("%s row %d: node index %d out of range [0, %d)"
-                         % (what, flat, value, n_nodes))
-
-
-def points_array(points: Any, what: str) -> np.ndarray:
-    """(n, 3) float64 C-contiguous from (n, 3) or (n, 2) real numbers, all finite, n > 0."""
-    a = _asarray(points, what + ": points")
-    if a.dtype.kind not in "fiu":
-        raise TypeError("%s: points must be real numbers, not dtype %s" % (what, a.dtype))
-    if a.ndim != 2 or a.shape[1] not in (2, 3):
-        raise ValueError("%s: points must have shape (n, 3) or (n, 2), not %s"
-                         % (what, a.shape))
-    if len(a) == 0:
-        raise ValueError("%s: no points" % what)
-    out = np.zeros((len(a), 3), np.float64)
-    out[:, :a.shape[1]] = a
-    finite = np.isfinite(out).all(axis=1)
-    if not finite.all():
-        row = int(np.flatnonzero(~finite)[0])
-        raise ValueError("%s: points row %d is not finite: %s" % (what, row, out[row].tolist()))
-    return out
 
 
 def _poly_stream(stream: np.ndarray, n_nodes: int, what: str) -> None:
@@ -169,7 +104,8 @@ def cell_blocks(cells: Any, n_nodes: int, what: str) -> List[Block]:
         if not isinstance(name, str):
             raise TypeError("%s: cells[%d]: the type name must be a str, not %s"
                             % (what, i, type(name).__name__))
-        where = "%s: cells block %d (%s)" % (what, i, name)
+        block = "cells block %d (%s)" % (i, name)
+        where = "%s: %s" % (what, block)
         meshio_poly = name.startswith("polyhedron") and name[10:].isdigit()
         if name in _TYPE:
             t, order = _TYPE[name], None
@@ -184,14 +120,12 @@ def cell_blocks(cells: Any, n_nodes: int, what: str) -> List[Block]:
                                 ", ".join(sorted(_FROM_MESHIO))))
         nodes = CELL_NODES[t]
         if nodes > 0:
-            a = _int_array(data, where)
+            a = index_array(what, block, data, n_nodes, ndim=None)
             if a.size == 0:
                 blocks.append(Block(t, np.zeros((0, nodes), np.int64), 0))
                 continue
             if a.ndim != 2 or a.shape[1] != nodes:
                 raise ValueError("%s: shape (k, %d) expected, not %s" % (where, nodes, a.shape))
-            _check_range(a, n_nodes, where)
-            a = a.astype(np.int64)
             if order is not None:
                 a = a[:, order]
             blocks.append(Block(t, np.ascontiguousarray(a), len(a)))
@@ -199,30 +133,29 @@ def cell_blocks(cells: Any, n_nodes: int, what: str) -> List[Block]:
             rows = _ragged(data, where)
             out = []
             for r, row in enumerate(rows):
-                a = _int_array(row, "%s row %d" % (where, r))
+                a = index_array(what, "%s row %d" % (block, r), row, n_nodes, ndim=None)
                 if a.ndim != 1 or len(a) < 3:
                     raise ValueError("%s row %d: a polygon is 3 node indices or more, not "
                                      "shape %s" % (where, r, a.shape))
-                _check_range(a[None, :], n_nodes, "%s row %d:" % (where, r))
-                out.append(a.astype(np.int64))
+                out.append(a)
             blocks.append(Block(t, out, len(out)))
         else:
             out = []
             for r, cell in enumerate(_ragged(data, where)):
-                w = "%s row %d" % (where, r)
+                row_name = "%s row %d" % (block, r)
+                w = "%s: %s" % (what, row_name)
                 if meshio_poly or (name == "polyhedron" and _is_face_list(cell)):
-                    faces = [_int_array(f, w) for f in cell]
+                    faces = [index_array(what, row_name, f, ndim=None) for f in cell]
                     if any(f.ndim != 1 for f in faces):
                         raise ValueError("%s: each face must be a 1-D list of node indices" % w)
                     stream = np.concatenate([[len(faces)]] + [
                         np.concatenate(([len(f)], f)) for f in faces]).astype(np.int64) \
                         if faces else np.zeros(1, np.int64)
                 else:
-                    stream = _int_array(cell, w)
+                    stream = index_array(what, row_name, cell, ndim=None)
                     if stream.ndim != 1:
                         raise ValueError("%s: a polyhedron's face stream is 1-D, not shape %s"
                                          % (w, stream.shape))
-                    stream = stream.astype(np.int64)
                 _poly_stream(stream, n_nodes, w)
                 out.append(stream)
             blocks.append(Block(t, out, len(out)))
@@ -256,7 +189,7 @@ def field_array(name: str, value: Any, count: int, blocks: Optional[List[Block]]
     where = "%s: field %r" % (what, name)
     if blocks is not None and isinstance(value, (list, tuple)) and len(value) == len(blocks) \
             and all(np.ndim(v) >= 1 for v in value):
-        parts = [_asarray(v, where) for v in value]
+        parts = [asarray(what, "field %r" % name, v) for v in value]
         if all(len(p) == b.count for p, b in zip(parts, blocks)):
             shapes = {p.shape[1:] for p in parts if len(p)}
             if len(shapes) > 1:
@@ -266,7 +199,7 @@ def field_array(name: str, value: Any, count: int, blocks: Optional[List[Block]]
                 if p.dtype.kind not in "fiub":
                     raise TypeError("%s: real numbers, not dtype %s" % (where, p.dtype))
             value = np.concatenate(parts) if parts else np.zeros(0)
-    a = _asarray(value, where)
+    a = asarray(what, "field %r" % name, value)
     if a.dtype.kind not in "fiub":
         raise TypeError("%s: real numbers, not dtype %s" % (where, a.dtype))
     if a.ndim == 0 or a.shape[0] != count:
@@ -305,14 +238,9 @@ def groups_list(groups: Any, what: str) -> List[Tuple[int, int, bytes]]:
         if not isinstance(g, (list, tuple)) or len(g) != 3:
             raise TypeError("%s: groups[%d] must be (dim, tag, name)" % (what, i))
         dim, tag, name = g
-        for v, label in ((dim, "dim"), (tag, "tag")):
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
-                raise TypeError("%s: groups[%d]: %s must be an int" % (what, i, label))
-        if not 0 <= dim <= 3:
-            raise ValueError("%s: groups[%d]: dim must be 0 to 3, not %d" % (what, i, dim))
-        if not _I32.min <= tag <= _I32.max:
-            raise ValueError("%s: groups[%d]: tag %d is not a 32-bit integer" % (what, i, tag))
-        out.append((int(dim), int(tag), _name(name, "%s: groups[%d]" % (what, i))))
+        out.append((integer(what, "groups[%d]: dim" % i, dim, 0, 3),
+                    integer(what, "groups[%d]: tag" % i, tag, int(_I32.min), int(_I32.max)),
+                    text(what, "groups[%d]: name" % i, name)))
     return out
 
 

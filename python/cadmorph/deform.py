@@ -16,12 +16,11 @@ import numpy as np
 from ._capi import ffi, lib
 from ._context import Context, Progress
 from ._inputs import choice, index_array, integer, number, points_of, real_array, struct_dict
+from ._options import SOLVERS
 from .mesh import Mesh
 
 METHODS = ("rbf", "mls", "shell", "dmffd")
 _KERNELS = {"triharmonic": lib.CM_RBF_TRIHARMONIC, "biharmonic": lib.CM_RBF_BIHARMONIC}
-_SOLVERS = {"auto": lib.CM_RBF_SOLVER_AUTO, "dense": lib.CM_RBF_SOLVER_DENSE,
-            "iterative": lib.CM_RBF_SOLVER_ITERATIVE, "petsc": lib.CM_RBF_SOLVER_PETSC}
 _FIXED_GROUP, _HANDLE_GROUP = 1, 2  # the MLS weighs the two regions apart, as the CLI
 
 
@@ -88,8 +87,8 @@ class Deformer:
                  exact_constraints: bool = False, threads: int = 0,
                  progress: Progress = None) -> None:
         what = "cadmorph.Deformer"
-        method = choice(method, METHODS, what + ": method")
-        xyz, mesh = points_of(points, what + ": points")
+        method = choice(what, "method", method, METHODS)
+        xyz, mesh = points_of(what, "points", points)
         n = xyz.shape[0]
         if method in ("mls", "shell") and mesh is None:
             raise ValueError("%s: method %r works on a mesh's cells: points must be a "
@@ -97,11 +96,9 @@ class Deformer:
         if method == "shell" and lib.cm_mesh_count_dim(mesh._ptr, 3) > 0:
             raise ValueError("%s: method 'shell' deforms surface meshes only" % what)
         self._ctx = Context(threads, progress, what)
-        h = index_array(handles, n, what + ": handles")
-        if len(h) == 0:
-            raise ValueError("%s: no handle point" % what)
+        h = index_array(what, "handles", handles, n, mask=True, unique=True, empty=False)
         if isinstance(fixed, str):
-            choice(fixed, ("boundary",), what + ": fixed")
+            choice(what, "fixed", fixed, ("boundary",))
             if mesh is None:
                 raise ValueError("%s: fixed='boundary' needs a cadmorph.Mesh" % what)
             f = _boundary_nodes(self._ctx, mesh)
@@ -109,7 +106,7 @@ class Deformer:
         elif fixed is None:
             f = np.zeros(0, np.int64)
         else:
-            f = index_array(fixed, n, what + ": fixed")
+            f = index_array(what, "fixed", fixed, n, mask=True, unique=True)
             both = np.intersect1d(h, f)
             if len(both):
                 raise ValueError("%s: point %d is both a handle and fixed" % (what, both[0]))
@@ -120,33 +117,33 @@ class Deformer:
         lib.cm_deform_options_init(opt)
         opt.method = lib.cm_deform_method_from_name(method.encode())
         if kernel is not None:
-            opt.kernel = _KERNELS[choice(kernel, tuple(_KERNELS), what + ": kernel")]
+            opt.kernel = _KERNELS[choice(what, "kernel", kernel, tuple(_KERNELS))]
         if solver is not None:
-            opt.solver = _SOLVERS[choice(solver, tuple(_SOLVERS), what + ": solver")]
+            opt.solver = SOLVERS[choice(what, "solver", solver, tuple(SOLVERS))]
         if tolerance is not None:
-            opt.tolerance = number(tolerance, what + ": tolerance", 0, 1, open_hi=True)
-        opt.lattice = integer(10 if lattice is None else lattice, what + ": lattice", 4, 200)
+            opt.tolerance = number(what, "tolerance", tolerance, 0, 1, hi_open=True)
+        opt.lattice = integer(what, "lattice", 10 if lattice is None else lattice, 4, 200)
         if clamp is not None:
-            opt.clamp = number(clamp, what + ": clamp", 0, 1, open_lo=True, open_hi=True)
+            opt.clamp = number(what, "clamp", clamp, 0, 1, lo_open=True, hi_open=True)
         mls = opt.mls
         if samples is not None:
-            mls.samples = integer(samples, what + ": samples", 1, 2 ** 62)
+            mls.samples = integer(what, "samples", samples, 1, 2 ** 62)
         if cubature is not None:
-            mls.cubature = integer(cubature, what + ": cubature", 1, 2 ** 62)
+            mls.cubature = integer(what, "cubature", cubature, 1, 2 ** 62)
         if cover is not None:
-            mls.cover = integer(cover, what + ": cover", 1, 64)
+            mls.cover = integer(what, "cover", cover, 1, 64)
         if stretch is not None:
-            mls.stretch = number(stretch, what + ": stretch", 0)
+            mls.stretch = number(what, "stretch", stretch, 0)
         if bend is not None:
-            mls.bend = number(bend, what + ": bend", 0)
+            mls.bend = number(what, "bend", bend, 0)
         if fix is not None:
-            mls.fix = number(fix, what + ": fix", 0, open_lo=True)
+            mls.fix = number(what, "fix", fix, 0, lo_open=True)
         if blend is not None:
-            mls.blend = number(blend, what + ": blend", 0)
+            mls.blend = number(what, "blend", blend, 0)
         if graded is not None:
-            mls.graded = number(graded, what + ": graded", 0, 1)
+            mls.graded = number(what, "graded", graded, 0, 1)
         if seed is not None:
-            mls.seed = integer(seed, what + ": seed", 0, 2 ** 64 - 1)
+            mls.seed = integer(what, "seed", seed, 0, 2 ** 64 - 1)
         mls.keep_constrained = bool(exact_constraints)
         if method in ("mls", "shell") and mls.stretch + mls.bend <= 0:
             raise ValueError("%s: stretch + bend must be > 0" % what)
@@ -177,7 +174,7 @@ class Deformer:
         ((len(handles), 3), in the order of handles) and the fixed points stay
         (cm_deform_apply)."""
         what = "cadmorph.Deformer.apply"
-        d = real_array(displacements, (len(self.handles), 3), what + ": displacements")
+        d = real_array(what, "displacements", displacements, (len(self.handles), 3))
         n = self.n_points
         disp = np.zeros((max(n, 1), 3))
         disp[self.handles] = d
@@ -217,8 +214,9 @@ def deform(points: Union[Mesh, np.ndarray], handles: Any, displacements: Any,
     The mesh itself is not changed."""
     what = "cadmorph.deform"
     # the arrays checked before the set-up, which may take long
-    xyz, _ = points_of(points, what + ": points")
-    h = index_array(handles, xyz.shape[0], what + ": handles")
-    d = real_array(displacements, (len(h), 3), what + ": displacements")
+    xyz, _ = points_of(what, "points", points)
+    h = index_array(what, "handles", handles, xyz.shape[0], mask=True, unique=True,
+                    empty=False)
+    d = real_array(what, "displacements", displacements, (len(h), 3))
     return Deformer(points, h, fixed, method, threads=threads, progress=progress,
                     **options).apply(d)

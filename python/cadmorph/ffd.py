@@ -70,20 +70,20 @@ class Lattice:
         lib.cm_ffd_desc_init(desc)
         if isinstance(n, (str, bytes)) or len(n) != 3:
             raise ValueError("%s: n is three counts of control points, not %r" % (what, n))
-        desc.n = [integer(v, what + ": n", 2, 1 << 20) for v in n]
-        desc.basis = _BASES[choice(basis, tuple(_BASES), what + ": basis")]
-        desc.origin = list(real_array(origin, (3,), what + ": origin"))
+        desc.n = [integer(what, "n", v, 2, 1 << 20) for v in n]
+        desc.basis = _BASES[choice(what, "basis", basis, tuple(_BASES))]
+        desc.origin = list(real_array(what, "origin", origin, (3,)))
         if axes is not None:
-            desc.axes = list(real_array(axes, (3, 3), what + ": axes").ravel())
+            desc.axes = list(real_array(what, "axes", axes, (3, 3)).ravel())
         keep = []
         if isinstance(knots, str):
-            desc.knots = _KNOTS[choice(knots, tuple(_KNOTS), what + ": knots")]
+            desc.knots = _KNOTS[choice(what, "knots", knots, tuple(_KNOTS))]
         else:
             if len(knots) != 3:
                 raise ValueError("%s: knots: three arrays (one per axis)" % what)
             desc.knots = lib.CM_FFD_KNOTS_CUSTOM
             for a in range(3):
-                k = real_array(knots[a], (desc.n[a] + 4,), "%s: knots[%d]" % (what, a))
+                k = real_array(what, "knots[%d]" % a, knots[a], (desc.n[a] + 4,))
                 keep.append(k)
                 desc.knot[a] = ffi.from_buffer("double[]", k)
         self._create(desc, what)
@@ -113,8 +113,8 @@ class Lattice:
         """PyGeM's box: origin + R diag(length) [0,1]^3, R = Rx Ry Rz of the angles in
         degrees about the origin (cm_ffd_box_axes)."""
         what = "cadmorph.Lattice.box"
-        L = real_array(length, (3,), what + ": length")
-        A = real_array(angles, (3,), what + ": angles")
+        L = real_array(what, "length", length, (3,))
+        A = real_array(what, "angles", angles, (3,))
         axes = np.empty(9)
         lib.cm_ffd_box_axes(ffi.from_buffer("double[]", L), ffi.from_buffer("double[]", A),
                             ffi.from_buffer("double[]", axes))
@@ -128,8 +128,8 @@ class Lattice:
         BadInputError naming path:line for a malformed file, a missing one, or a lattice
         the library refuses."""
         what = "cadmorph.Lattice.from_prm"
-        p = path_bytes(path, what)
-        b = _BASES[choice(basis, tuple(_BASES), what + ": basis")]
+        p = path_bytes(what, "path", path)
+        b = _BASES[choice(what, "basis", basis, tuple(_BASES))]
         ctx = Context(0, False, what)
         prm = ffi.new("cm_ffd_prm *")
         ctx.call(lib.cm_ffd_prm_read, p, prm)
@@ -166,20 +166,20 @@ class Lattice:
         if xyz is None:
             ctx.call(lib.cm_ffd_set_control_points, self._ptr, ffi.NULL)
             return
-        a = real_array(xyz, (self.n_control, 3), what)
+        a = real_array(what, "xyz", xyz, (self.n_control, 3))
         ctx.call(lib.cm_ffd_set_control_points, self._ptr, ffi.from_buffer("double[]", a))
 
     def set_local(self, mode: str) -> None:
         """How points find their local coordinates: "auto", "affine" or "newton"."""
-        lib.cm_ffd_set_local(self._ptr, _LOCAL[choice(mode, tuple(_LOCAL),
-                                                      "cadmorph.Lattice.set_local")])
+        mode = choice("cadmorph.Lattice.set_local", "mode", mode, tuple(_LOCAL))
+        lib.cm_ffd_set_local(self._ptr, _LOCAL[mode])
 
     def read_displacements(self, path: PathLike) -> np.ndarray:
         """The (n_control, 3) control displacements of a CSV `i,j,k,dx,dy,dz` (physical,
         world frame; unlisted points 0), as `cadmorph ffd --displacements`
         (cm_ffd_read_displacements)."""
         what = "cadmorph.Lattice.read_displacements"
-        p = path_bytes(path, what)
+        p = path_bytes(what, "path", path)
         dc = np.zeros((self.n_control, 3))
         Context(0, False, what).call(lib.cm_ffd_read_displacements, p, list(self.n),
                                      ffi.from_buffer("double[]", dc), ffi.NULL)
@@ -190,7 +190,7 @@ class Lattice:
         """Local coordinates u ((n, 3)) of the points and a flag per point: 1 inside, 0
         outside, 2 not located by Newton (cm_ffd_local_coords)."""
         what = "cadmorph.Lattice.local_coords"
-        x, _ = points_of(points, what + ": points")
+        x, _ = points_of(what, "points", points)
         n = x.shape[0]
         u = np.zeros((max(n, 1), 3))
         flags = np.zeros(max(n, 1), np.uint8)
@@ -206,12 +206,12 @@ class Lattice:
         control displacements dc ((n_control, 3); None: .weights) and the counts
         (cm_ffd_deform)."""
         what = "cadmorph.Lattice.displacement"
-        x, _ = points_of(points, what + ": points")
+        x, _ = points_of(what, "points", points)
         if dc is None:
             if self.weights is None:
                 raise ValueError("%s: dc is needed (the lattice has no .prm weights)" % what)
             dc = self.weights
-        c = real_array(dc, (self.n_control, 3), what + ": dc")
+        c = real_array(what, "dc", dc, (self.n_control, 3))
         n = x.shape[0]
         d = np.zeros((max(n, 1), 3))
         st = ffi.new("cm_ffd_stats *")
@@ -239,6 +239,6 @@ def ffd(points: Union[Mesh, np.ndarray], lattice: Union[Lattice, PathLike],
         lattice = Lattice.from_prm(lattice, basis)
     if isinstance(displacements, (str, bytes, os.PathLike)):
         displacements = lattice.read_displacements(displacements)
-    x, _ = points_of(points, "cadmorph.ffd: points")
+    x, _ = points_of("cadmorph.ffd", "points", points)
     d, _ = lattice.displacement(x, displacements, threads, progress)
     return x + d

@@ -16,8 +16,9 @@ import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context
+from ._inputs import integer, model_of, number, path_bytes, text
 from .errors import Error, MismatchError
-from .mesh import PathLike, _path
+from .mesh import PathLike
 
 _TOKEN = object()  # Geometry objects are made here only
 
@@ -284,15 +285,9 @@ class Geometry:
         max_report differences, never an exception. Raises TypeError when other is not a
         Geometry, cadmorph.Error for anything else the library reports.
         """
-        if not isinstance(other, Geometry):
-            raise TypeError("cadmorph.Geometry.compare: other must be a cadmorph.Geometry, "
-                            "not %s" % type(other).__name__)
-        if isinstance(max_report, bool) or not isinstance(max_report, (int, np.integer)):
-            raise TypeError("cadmorph.Geometry.compare: max_report must be an int, not %s"
-                            % type(max_report).__name__)
-        if not 0 <= max_report <= 1_000_000:
-            raise ValueError("cadmorph.Geometry.compare: max_report must be 0 to 1000000, "
-                             "not %d" % max_report)
+        model_of("cadmorph.Geometry.compare", "other", other)
+        max_report = integer("cadmorph.Geometry.compare", "max_report", max_report, 0,
+                             1_000_000)
         ctx = Context(threads, False, "cadmorph.Geometry.compare")
         out = ffi.new("cm_cad_correspondence *[1]")
         try:
@@ -317,7 +312,7 @@ class Geometry:
     def write_step(self, path: PathLike, threads: int = 0) -> None:
         """Writes the model as STEP (AP214) in its unit (cm_cad_write), through a temporary
         file renamed at the end. Raises BadInputError when path cannot be written."""
-        p = _path(path, "cadmorph.Geometry.write_step")
+        p = path_bytes("cadmorph.Geometry.write_step", "path", path)
         Context(threads, False, "cadmorph.Geometry.write_step").call(lib.cm_cad_write,
                                                                      self._ptr, p)
 
@@ -325,15 +320,6 @@ class Geometry:
         c = self.counts
         return "<cadmorph.Geometry %s: %d faces, %d edges, %d vertices (%s)>" % (
             self.path or "?", c.faces, c.edges, c.vertices, self.unit)
-
-
-def _unit(unit: str, what: str) -> bytes:
-    if not isinstance(unit, str):
-        raise TypeError("%s: unit must be a str such as \"mm\", not %s"
-                        % (what, type(unit).__name__))
-    if "\0" in unit:
-        raise ValueError("%s: unit with a NUL character: %r" % (what, unit))
-    return unit.encode()
 
 
 def read_step(path: PathLike, unit: str = "mm", threads: int = 0) -> Geometry:
@@ -345,8 +331,8 @@ def read_step(path: PathLike, unit: str = "mm", threads: int = 0) -> Geometry:
     BadInputError for a file that is missing, unreadable, not STEP or without a face.
     """
     what = "cadmorph.read_step"
-    p = _path(path, what)
-    u = _unit(unit, what)
+    p = path_bytes(what, "path", path)
+    u = text(what, "unit", unit, empty=True)
     opt = ffi.new("cm_cad_read_options *")
     lib.cm_cad_read_options_init(opt)
     keep = ffi.new("char[]", u)
@@ -379,20 +365,14 @@ def model(name: str, t: float, path: Optional[PathLike] = None, unit: str = "mm"
     an unknown name or a t outside [0, 1].
     """
     what = "cadmorph.model"
-    if not isinstance(name, str):
-        raise TypeError("%s: name must be a str, not %s" % (what, type(name).__name__))
-    if "\0" in name or not lib.cm_model_known(name.encode()):
+    if not lib.cm_model_known(text(what, "name", name, empty=True)):
         raise ValueError("%s: unknown model %r (known: %s)"
                          % (what, name, _text(lib.cm_model_list())))
-    if isinstance(t, bool) or not isinstance(t, (int, float, np.integer, np.floating)):
-        raise TypeError("%s: t must be a real number, not %s" % (what, type(t).__name__))
-    t = float(t)
-    if not 0.0 <= t <= 1.0:  # also NaN
-        raise ValueError("%s: t must be in [0, 1], not %r" % (what, t))
-    _unit(unit, what)
+    t = number(what, "t", t, 0.0, 1.0)
+    text(what, "unit", unit, empty=True)
     ctx = Context(threads, False, what)
     if path is not None:
-        p = _path(path, what)
+        p = path_bytes(what, "path", path)
         ctx.call(lib.cm_model_write_step, name.encode(), t, p)
         return read_step(path, unit, threads)
     with tempfile.TemporaryDirectory(prefix="cadmorph_model_") as d:

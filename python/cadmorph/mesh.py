@@ -1,5 +1,6 @@
 """Mesh: a cm_mesh owned by Python, its arrays as NumPy views; read_mesh and write_mesh;
-Mesh.from_arrays, from_meshio and to_meshio (their checks and meshio's names in _convert.py).
+Mesh.from_arrays, from_meshio and to_meshio (meshio's names and cell blocks in _convert.py, the
+generic argument checks in _inputs.py).
 
 Views (points, fields, connectivity) point into the library's memory. Each holds, through
 its `.base`, the owner of the cm_mesh, so the memory lives while any view does, also after
@@ -14,6 +15,7 @@ from numpy.typing import ArrayLike
 
 from ._capi import ffi, lib
 from ._context import Context
+from . import _inputs
 
 PathLike = Union[str, bytes, "os.PathLike[str]"]
 
@@ -47,16 +49,6 @@ def _array(owner, ptr, shape: Tuple[int, ...], dtype, writable: bool = True) -> 
         return a
     address = int(ffi.cast("uintptr_t", ptr))
     return np.asarray(_View(owner, address, shape, dtype.str, writable))
-
-
-def _path(path: PathLike, what: str) -> bytes:
-    if not isinstance(path, (str, bytes, os.PathLike)):
-        raise TypeError("%s: a path (str, bytes or os.PathLike), not %s"
-                        % (what, type(path).__name__))
-    b = os.fsencode(path)
-    if not b or b"\0" in b:
-        raise ValueError("%s: an empty path or one with a NUL byte: %r" % (what, path))
-    return b
 
 
 def _destroy_mesh(ptr) -> None:
@@ -122,13 +114,8 @@ class Mesh:
     def points(self, value) -> None:
         """Sets every node's coordinates (copied into the mesh): an array-like of shape
         (n_nodes, 3) of real numbers."""
-        m = self._ptr
-        n = int(m.n_nodes)
-        a = np.asarray(value)
-        if a.dtype.kind not in "fiu":
-            raise TypeError("cadmorph.Mesh.points: real numbers, not dtype %s" % a.dtype)
-        if a.shape != (n, 3):
-            raise ValueError("cadmorph.Mesh.points: shape (%d, 3), not %s" % (n, a.shape))
+        a = _inputs.real_array("cadmorph.Mesh.points", "value", value, (self.n_nodes, 3),
+                               finite=False)
         self.points[...] = a
 
     def _cell_arrays(self) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -243,8 +230,10 @@ class Mesh:
         """
         from . import _convert
         what = "cadmorph.Mesh.from_arrays"
-        xyz = _convert.points_array(points, what)
+        xyz = _inputs.points(what, "points", points, planar=True)
         n = len(xyz)
+        if n == 0:
+            raise ValueError("%s: no points" % what)
         blocks = _convert.cell_blocks(cells, n, what)
         n_cells = sum(b.count for b in blocks)
         fields, tags = [], {}
@@ -256,7 +245,7 @@ class Mesh:
                 raise TypeError("%s: point_data and cell_data must be dicts, not %s"
                                 % (what, type(data).__name__))
             for name, value in data.items():
-                key = _convert._name(name, what)
+                key = _inputs.text(what, "field name", name)
                 if bl is not None and name in _convert.TAGS:
                     tags[name] = _convert.tag_array(name, value, count, bl, what)
                 else:
@@ -359,7 +348,7 @@ def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
     Raises BadInputError (with the library's message naming the file, and the line or the
     byte offset) for a file that is missing, unreadable or malformed.
     """
-    p = _path(path, "cadmorph.read_mesh")
+    p = _inputs.path_bytes("cadmorph.read_mesh", "path", path)
     ctx = Context(threads, False, "cadmorph.read_mesh")
     out = ffi.new("cm_mesh *[1]")
     ctx.call(lib.cm_mesh_read, p, out)
@@ -375,10 +364,8 @@ def write_mesh(path: PathLike, mesh: Mesh, binary: Optional[bool] = None,
     binary: msh, vtk, stl binary, vtu base64 (library default when None); msh_version: 22 or
     41 (default 41); compress: vtu zlib compression (default on).
     """
-    if not isinstance(mesh, Mesh):
-        raise TypeError("cadmorph.write_mesh: mesh must be a cadmorph.Mesh, not %s"
-                        % type(mesh).__name__)
-    p = _path(path, "cadmorph.write_mesh")
+    _inputs.mesh_of("cadmorph.write_mesh", "mesh", mesh)
+    p = _inputs.path_bytes("cadmorph.write_mesh", "path", path)
     opt = ffi.new("cm_mesh_write_options *")
     lib.cm_mesh_write_options_init(opt)
     if msh_version is not None:

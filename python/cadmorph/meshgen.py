@@ -4,26 +4,15 @@ mesher in a child process whose crash or hang is an error, never a signal here."
 import math
 import os
 import tempfile
-from typing import Any, Optional
+from typing import Optional
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._inputs import choice, number
-from .geometry import Geometry
+from ._inputs import choice, model_of, number
+from .geometry import Geometry, _destroy_model
 from .mesh import _TOKEN, Mesh, _destroy_mesh
 
 _MESHERS = {"tetgen": lib.CM_MESHER_TETGEN, "gmsh": lib.CM_MESHER_GMSH}
-
-
-def _model_ptr(geometry: Any, what: str):
-    """The cm_cad_model of a cadmorph.Geometry."""
-    if not isinstance(geometry, Geometry):
-        raise TypeError("%s: a cadmorph.Geometry, not %s" % (what, type(geometry).__name__))
-    return geometry._ptr
-
-
-def _destroy_model(ptr) -> None:
-    lib.cm_cad_destroy(ffi.new("cm_cad_model *[1]", [ptr]))
 
 
 def mesh_step(geometry: Geometry, size: Optional[float] = None, mesher: Optional[str] = None, *,
@@ -50,23 +39,23 @@ def mesh_step(geometry: Geometry, size: Optional[float] = None, mesher: Optional
     ResourceError beyond the tet limit.
     """
     what = "cadmorph.mesh_step"
-    model = _model_ptr(geometry, what)
+    model = model_of(what, "geometry", geometry)
     opt = ffi.new("cm_tetmesh_options *")
     lib.cm_tetmesh_options_init(opt)
     tetgen_options = quality is not None or min_dihedral is not None or bool(preserve_surface)
     if mesher is None:
         mesher = "tetgen" if tetgen_options else "gmsh"
-    mesher = choice(mesher, tuple(_MESHERS), what + ": mesher")
+    mesher = choice(what, "mesher", mesher, tuple(_MESHERS))
     if mesher == "gmsh" and tetgen_options:
         raise ValueError("%s: quality, min_dihedral and preserve_surface are TetGen's: not "
                          "with mesher='gmsh'" % what)
     opt.mesher = _MESHERS[mesher]
     if size is not None:
-        opt.size = number(size, what + ": size", 0, open_lo=True)
+        opt.size = number(what, "size", size, 0, lo_open=True)
     if quality is not None:
-        opt.quality = number(quality, what + ": quality", 1)
+        opt.quality = number(what, "quality", quality, 1)
     if min_dihedral is not None:
-        opt.min_dihedral = number(min_dihedral, what + ": min_dihedral", 0, 20)
+        opt.min_dihedral = number(what, "min_dihedral", min_dihedral, 0, 20)
     if preserve_surface:
         opt.preserve_surface = 1
     if not optimize:
@@ -74,7 +63,7 @@ def mesh_step(geometry: Geometry, size: Optional[float] = None, mesher: Optional
     if force:
         opt.max_tets = math.inf
     if time_limit is not None:
-        opt.time_limit = number(time_limit, what + ": time_limit", 0, open_lo=True)
+        opt.time_limit = number(what, "time_limit", time_limit, 0, lo_open=True)
     ctx = Context(threads, progress, what)
     out = ffi.new("cm_mesh *[1]")
     path = ffi.string(lib.cm_cad_path(model)) if lib.cm_cad_path(model) != ffi.NULL else b""

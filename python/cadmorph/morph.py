@@ -14,7 +14,8 @@ import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._options import WarpSettings, choice, flag, integer, number, points
+from ._inputs import choice, flag, integer, mesh_of, model_of, number, points
+from ._options import WarpSettings
 from .errors import MismatchError, RejectedError
 from .geometry import Geometry
 from .mesh import _TOKEN, Mesh, _destroy_mesh
@@ -138,16 +139,6 @@ def _record(cls: type, c: Any) -> Any:
             v = tuple(int(x) for x in v)
         values[f.name] = v
     return cls(**values)
-
-
-def _model(g: Any, what: str, name: str):
-    """The cm_cad_model * of a Geometry (its `_ptr`), checked."""
-    p = getattr(g, "_ptr", None)
-    if not isinstance(p, ffi.CData) or ffi.typeof(p) is not ffi.typeof("cm_cad_model *") \
-            or p == ffi.NULL:
-        raise TypeError("%s: %s must be a cadmorph.Geometry (cadmorph.read_step or "
-                        "cadmorph.model), not %s" % (what, name, type(g).__name__))
-    return p
 
 
 def _destroy_morpher(ptr) -> None:
@@ -315,11 +306,8 @@ class Morpher:
         self._mp = None
         self._lock = threading.Lock()
         options = {k: v for k, v in locals().items() if k in _OPTION_NAMES}
-        gp = _model(g0, what, "g0")
-        if not isinstance(mesh, Mesh):
-            raise TypeError("%s: mesh must be a cadmorph.Mesh, not %s"
-                            % (what, type(mesh).__name__))
-        m = mesh._ptr
+        gp = model_of(what, "g0", g0)
+        m = mesh_of(what, "mesh", mesh)._ptr
         o, self._warp, self._surface = _morph_options(what, **options)
         self._ctx = ctx = Context(threads, progress, what)
         out = ffi.new("cm_morpher *[1]")
@@ -386,7 +374,7 @@ class Morpher:
         rejected ones included. A CadmorphWarning when face nodes left their trimmed face.
         """
         what = "cadmorph.Morpher.apply"
-        tp = _model(g1, what, "g1")
+        tp = model_of(what, "g1", g1)
         c_method = None
         if method is not None or method_options:
             unknown = set(method_options) - (set(WarpSettings.NAMES) | {"surface"})
@@ -434,7 +422,7 @@ class Morpher:
         rebase, apply raises cadmorph.Error until a rebase succeeds.
         """
         what = "cadmorph.Morpher.rebase"
-        gp = _model(g, what, "g")
+        gp = model_of(what, "g", g)
         p = points(what, "pts", pts, self._n)
         with self._lock:
             self._correspond(g, gp)

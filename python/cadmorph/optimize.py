@@ -2,13 +2,13 @@
 `cadmorph optimize`: untangles inverted cells and raises the worst ones without moving the
 boundary (Knupp's inverse mean ratio, optimize.h)."""
 from dataclasses import dataclass
-from typing import Any, Optional, Tuple
+from typing import Any, Tuple
 
 import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._inputs import index_array, integer, number
+from ._inputs import index_array, integer, mesh_of, number
 from .mesh import Mesh, _array, _destroy_mesh
 
 
@@ -53,18 +53,17 @@ def optimize(mesh: Mesh, fixed: Any = None, sweeps: int = 6, target_sj: float = 
     Raises BadInputError (CM_ERR_UNSUPPORTED) for a mesh without volume cells.
     """
     what = "cadmorph.optimize"
-    if not isinstance(mesh, Mesh):
-        raise TypeError("%s: mesh must be a cadmorph.Mesh, not %s" % (what, type(mesh).__name__))
+    mesh_of(what, "mesh", mesh)
     opt = ffi.new("cm_optimize_options *")
     lib.cm_optimize_options_init(opt)
-    opt.sweeps = integer(sweeps, what + ": sweeps", 1, 1000)
-    opt.target_sj = number(target_sj, what + ": target_sj", -1, 1, open_lo=True)
-    opt.newton = integer(newton, what + ": newton", 1, 100)
+    opt.sweeps = integer(what, "sweeps", sweeps, 1, 1000)
+    opt.target_sj = number(what, "target_sj", target_sj, -1, 1, lo_open=True)
+    opt.newton = integer(what, "newton", newton, 1, 100)
     n = mesh.n_nodes
     flags = ffi.NULL
     if fixed is not None:
         mask = np.zeros(max(n, 1), np.uint8)
-        mask[index_array(fixed, n, what + ": fixed", unique=False)] = 1
+        mask[index_array(what, "fixed", fixed, n, mask=True)] = 1
         flags = ffi.from_buffer("unsigned char[]", mask)
     ctx = Context(threads, progress, what)
     if in_place:

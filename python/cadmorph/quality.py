@@ -7,6 +7,7 @@ import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context
+from ._inputs import flag, mesh_of
 from .mesh import Mesh
 
 
@@ -125,12 +126,8 @@ def quality(mesh: Mesh, threads: int = 0, *,
     numbers `cadmorph quality --foam` prints: a FoamQuality. Raises ValueError for a mesh
     without volume cells.
     """
-    if not isinstance(mesh, Mesh):
-        raise TypeError("cadmorph.quality: mesh must be a cadmorph.Mesh, not %s"
-                        % type(mesh).__name__)
-    if not isinstance(foam, (bool, np.bool_)):
-        raise TypeError("cadmorph.quality: foam must be a bool, not %s" % type(foam).__name__)
-    m = mesh._ptr
+    m = mesh_of("cadmorph.quality", "mesh", mesh)._ptr
+    foam = flag("cadmorph.quality", "foam", foam)
     ctx = Context(threads, False, "cadmorph.quality")
     if foam:
         if lib.cm_mesh_count_dim(m, 3) == 0:  # as the CLI checks it

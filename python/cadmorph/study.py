@@ -9,10 +9,9 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._inputs import choice, integer, number, path_bytes
+from ._inputs import choice, integer, mesh_of, model_of, number, path_bytes, text
 from .mesh import Mesh, PathLike
 from .geometry import Geometry
-from .meshgen import _model_ptr
 
 _MODES = {"absolute": lib.CM_STUDY_ABSOLUTE, "relative": lib.CM_STUDY_RELATIVE,
           "both": lib.CM_STUDY_BOTH}
@@ -133,14 +132,15 @@ class StudyResult:
         what = "cadmorph.StudyResult.write_csv"
         fmt = self._csv_format if format is None else \
             {"full": lib.CM_STUDY_CSV_FULL, "sweep": lib.CM_STUDY_CSV_SWEEP}[
-                choice(format, ("full", "sweep"), what + ": format")]
+                choice(what, "format", format, ("full", "sweep"))]
         Context(0, False, what).call(lib.cm_study_write_csv, self._ptr,
-                                     path_bytes(path, what), fmt)
+                                     path_bytes(what, "path", path), fmt)
 
     def write_svg(self, path: PathLike) -> None:
         """Writes the plot of the min scaled Jacobian per variant (cm_study_write_svg)."""
         what = "cadmorph.StudyResult.write_svg"
-        Context(0, False, what).call(lib.cm_study_write_svg, self._ptr, path_bytes(path, what))
+        p = path_bytes(what, "path", path)
+        Context(0, False, what).call(lib.cm_study_write_svg, self._ptr, p)
 
     def __repr__(self) -> str:
         return "<cadmorph.StudyResult %s: %d variants, %d rows, %d failed>" % (
@@ -168,9 +168,9 @@ def _methods(ctx: Context, methods: Union[None, str, Sequence[str]], default: st
 
 def _steps(steps: Union[int, str], what: str) -> int:
     if isinstance(steps, str):
-        choice(steps, ("auto",), what + ": steps")
+        choice(what, "steps", steps, ("auto",))
         return lib.CM_MORPH_STEPS_AUTO
-    return integer(steps, what + ": steps", 1, 1000)
+    return integer(what, "steps", steps, 1, 1000)
 
 
 def _stem(path: bytes) -> str:
@@ -204,9 +204,8 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     CadmorphWarning and rows with status < 0.
     """
     what = "cadmorph.study"
-    model = _model_ptr(g0, what + ": g0")
-    if not isinstance(mesh, Mesh):
-        raise TypeError("%s: mesh must be a cadmorph.Mesh, not %s" % (what, type(mesh).__name__))
+    model = model_of(what, "g0", g0)
+    mesh_of(what, "mesh", mesh)
     if isinstance(targets, (str, bytes, os.PathLike)):
         raise TypeError("%s: targets is a list (of paths and/or Geometry objects)" % what)
     targets = list(targets)
@@ -215,17 +214,17 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     ctx = Context(threads, progress, what)
     so = ffi.new("cm_study_options *")
     lib.cm_study_options_init(so)
-    so.modes = _MODES[choice(mode, tuple(_MODES), what + ": mode")]
+    so.modes = _MODES[choice(what, "mode", mode, tuple(_MODES))]
     ms, nm = _methods(ctx, methods, "rbf-s", what)
     so.methods, so.n_methods = ms, nm
     so.morph.steps = _steps(steps, what)
     so.morph.optimize = bool(optimize)
-    so.write_meshes = _WRITE[choice(write_meshes, tuple(_WRITE), what + ": write_meshes")]
+    so.write_meshes = _WRITE[choice(what, "write_meshes", write_meshes, tuple(_WRITE))]
     keep = [ms]
     if so.write_meshes != lib.CM_STUDY_WRITE_NONE:
         if out_dir is None:
             raise ValueError("%s: write_meshes=%r needs out_dir" % (what, write_meshes))
-        d = path_bytes(out_dir, what + ": out_dir")
+        d = path_bytes(what, "out_dir", out_dir)
         os.makedirs(d, exist_ok=True)
         c = ffi.new("char[]", d)
         keep.append(c)
@@ -237,9 +236,7 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     for name, value, default in (("model", model_name, os.path.basename(g0_path) or b"G0"),
                                  ("mesh", mesh_name, None)):
         if value is not None:
-            if not isinstance(value, str) or "\0" in value:
-                raise TypeError("%s: %s_name: a str without NUL bytes" % (what, name))
-            value = value.encode()
+            value = text(what, name + "_name", value, empty=True)
         else:
             value = default
         if value is not None:
@@ -253,9 +250,9 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
         paths = []
         for i, t in enumerate(targets):
             if isinstance(t, (str, bytes, os.PathLike)):
-                paths.append(path_bytes(t, "%s: targets[%d]" % (what, i)))
+                paths.append(path_bytes(what, "targets[%d]" % i, t))
                 continue
-            g = _model_ptr(t, "%s: targets[%d]" % (what, i))
+            g = model_of(what, "targets[%d]" % i, t)
             gp = lib.cm_cad_path(g)
             gp = ffi.string(gp) if gp != ffi.NULL else b""
             label = _stem(gp) if gp else "G%d" % (i + 1)
@@ -295,7 +292,7 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
     meshes at 50 % and 100 %; None: a temporary directory (nothing kept).
     """
     what = "cadmorph.sweep"
-    choice(model, ("bore", "pipe", "bracket"), what + ": model")
+    choice(what, "model", model, ("bore", "pipe", "bracket"))
     if out_dir is None and (write_step or write_meshes):
         raise ValueError("%s: write_step and write_meshes need out_dir" % what)
     if isinstance(mesh, str) and mesh in ("tet", "hex"):
@@ -303,16 +300,16 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
         if mesh == "hex" and model == "bracket":
             raise ValueError("%s: no hex mesh of the bracket (bore, pipe only)" % what)
     else:
-        mesh_b = path_bytes(mesh, what + ": mesh")
+        mesh_b = path_bytes(what, "mesh", mesh)
     ctx = Context(threads, progress, what)
     so = ffi.new("cm_sweep_options *")
     lib.cm_sweep_options_init(so)
     model_c, mesh_c = ffi.new("char[]", model.encode()), ffi.new("char[]", mesh_b)
     so.model, so.mesh = model_c, mesh_c
-    so.steps = integer(steps, what + ": steps", 1, 1000)
-    so.modes = _MODES[choice(mode, tuple(_MODES), what + ": mode")]
+    so.steps = integer(what, "steps", steps, 1, 1000)
+    so.modes = _MODES[choice(what, "mode", mode, tuple(_MODES))]
     if size is not None:
-        so.size = number(size, what + ": size", 0, 1e6, open_lo=True)
+        so.size = number(what, "size", size, 0, 1e6, lo_open=True)
     ms = None
     if methods is not None:
         ms, nm = _methods(ctx, methods, "", what)
@@ -330,7 +327,7 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
     so.write_meshes = bool(write_meshes)
     out = ffi.new("cm_study_result *[1]")
     with tempfile.TemporaryDirectory(prefix="cadmorph_sweep_") as tmp:
-        d = path_bytes(tmp if out_dir is None else out_dir, what + ": out_dir")
+        d = path_bytes(what, "out_dir", tmp if out_dir is None else out_dir)
         os.makedirs(d, exist_ok=True)
         dir_c = ffi.new("char[]", d)
         so.out_dir = dir_c

@@ -13,7 +13,8 @@ import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._options import MAX_DISPLACEMENT, WarpSettings, node_indices, points
+from ._inputs import index_array, mesh_of, points
+from ._options import MAX_DISPLACEMENT, WarpSettings
 from .mesh import Mesh
 
 
@@ -70,10 +71,7 @@ class Warp:
         what = "cadmorph.Warp"
         self._warp = None
         self._lock = threading.Lock()  # the C API: one call at a time on a warp
-        if not isinstance(mesh, Mesh):
-            raise TypeError("%s: mesh must be a cadmorph.Mesh, not %s"
-                            % (what, type(mesh).__name__))
-        m = mesh._ptr
+        m = mesh_of(what, "mesh", mesh)._ptr
         n = int(m.n_nodes)
         settings = WarpSettings(what, method=method, kernel=kernel, solver=solver,
                                 tolerance=tolerance, lattice=lattice, clamp=clamp,
@@ -99,7 +97,7 @@ class Warp:
                            else np.zeros(0, np.int64))
             constrained = ffi.NULL
         else:
-            self._nodes = node_indices(what, "nodes", nodes, n).copy()
+            self._nodes = index_array(what, "nodes", nodes, n, unique=True, empty=False).copy()
             flags = np.zeros(max(n, 1), np.uint8)
             flags[self._nodes] = 1
             constrained = ffi.from_buffer("unsigned char[]", flags)
