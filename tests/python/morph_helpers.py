@@ -1,8 +1,9 @@
-"""Shared by test_morph.py and test_warp.py: STEP models as Geometry objects, the bore's
-files made by the CLI, and the CLI's own runs."""
+"""Shared by the tests of the package: STEP models as Geometry objects, a model numbered
+otherwise, the bore's files made by the CLI, and the CLI's own runs."""
 import json
 import os
 import pathlib
+import re
 import subprocess
 import sys
 from typing import List
@@ -10,25 +11,20 @@ from typing import List
 import numpy as np
 
 import cadmorph
-from cadmorph._capi import ffi, lib
-
-
-class _Model:
-    """A STEP model owned by Python, for a package without cadmorph.read_step: what Morpher
-    needs of a Geometry (its cm_cad_model * as `_ptr`)."""
-
-    def __init__(self, path) -> None:
-        ctx = cadmorph._context.Context(1, False, "test read_step")
-        out = ffi.new("cm_cad_model *[1]")
-        ctx.call(lib.cm_cad_read, str(path).encode(), ffi.NULL, out)
-        self._ptr = ffi.gc(out[0], lambda p: lib.cm_cad_destroy(ffi.new("cm_cad_model *[1]", [p])))
 
 
 def read_step(path):
-    """cadmorph.read_step(path) (millimetre), or the stand-in above where it is missing."""
-    if hasattr(cadmorph, "read_step"):
-        return cadmorph.read_step(str(path))
-    return _Model(path)
+    """cadmorph.read_step of a path (millimetre)."""
+    return cadmorph.read_step(str(path))
+
+
+def reversed_shell(src, dst):
+    """src with the faces of its closed shell listed the other way round: the same model,
+    numbered otherwise (OpenCASCADE numbers faces in the shell's order)."""
+    text = src.read_text()
+    m = re.search(r"CLOSED_SHELL\('',\(([^)]*)\)\)", text)
+    ids = m.group(1).split(",")
+    dst.write_text(text[:m.start(1)] + ",".join(reversed(ids)) + text[m.end(1):])
 
 
 def run(cli: str, *args) -> str:

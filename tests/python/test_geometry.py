@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import cadmorph
+from morph_helpers import reversed_shell
 
 STEPS = ["cad/bore_a.step", "cad/bore_2holes.step", "freecad/bracket_0.step",
          "freecad/shaft_1.step", "models/bore_0.step"]
@@ -135,15 +136,6 @@ def test_bad_files(cli, data, work):
         cadmorph.read_step(None)
     with pytest.raises(ValueError):
         cadmorph.read_step("")
-
-
-def reversed_shell(src, dst):
-    """src with the faces of its closed shell listed the other way round: the same model,
-    numbered otherwise (OpenCASCADE numbers faces in the shell's order)."""
-    text = src.read_text()
-    m = re.search(r"CLOSED_SHELL\('',\(([^)]*)\)\)", text)
-    ids = m.group(1).split(",")
-    dst.write_text(text[:m.start(1)] + ",".join(reversed(ids)) + text[m.end(1):])
 
 
 def test_compare_equals_cli_map(cli, data, work):

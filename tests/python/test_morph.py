@@ -6,7 +6,6 @@ import ctypes
 import gc
 import inspect
 import json
-import re
 import sys
 import time
 import tracemalloc
@@ -17,7 +16,7 @@ import pytest
 
 import cadmorph
 from cadmorph._capi import ffi, lib
-from morph_helpers import CtrlC, bore, in_child, read_step, run
+from morph_helpers import CtrlC, bore, in_child, read_step, reversed_shell, run
 
 MORPH = sys.modules["cadmorph.morph"]  # the module (cadmorph.morph is the function)
 
@@ -111,15 +110,6 @@ def test_morph_equals_cli_on_held_in_fixtures(cli, data, work, fixture_meshes, f
     pts = cadmorph.Morpher(read_step(g0_path), cadmorph.read_mesh(m0), threads=1,
                            progress=False).apply(read_step(g1_path))
     assert np.array_equal(pts, ref.points)
-
-
-def reversed_shell(src, dst):
-    """src with the faces of its closed shell listed the other way round: the same model,
-    numbered otherwise (OpenCASCADE numbers faces in the shell's order)."""
-    text = src.read_text()
-    m = re.search(r"CLOSED_SHELL\('',\(([^)]*)\)\)", text)
-    ids = m.group(1).split(",")
-    dst.write_text(text[:m.start(1)] + ",".join(reversed(ids)) + text[m.end(1):])
 
 
 def test_target_numbered_otherwise_is_renumbered_as_the_cli_does(cli, data, work,
