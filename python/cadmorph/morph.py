@@ -275,7 +275,9 @@ class Morpher:
     "cadmorph" logger).
 
     Lifetimes: the library borrows G and the last target; the Morpher holds references to
-    those Geometry objects, so deleting them while the Morpher lives is safe.
+    those Geometry objects, so deleting them while the Morpher lives is safe. The mesh is
+    copied: a caller who no longer needs `mesh` may drop it (`del mesh`, with its views) to
+    free that copy before a large morph.
     Threads: one Morpher is used by one thread at a time (calls from several threads wait
     for each other); two Morphers run in parallel in two threads (the GIL is released in
     the library). Results are bit for bit those of `cadmorph morph` with the same options
