@@ -83,7 +83,7 @@ cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_qua
     memset(q, 0, sizeof *q);
     cm_foam_poly *p = NULL;
     cm_status s = cm_foam_of_mesh(ctx, mesh, &p);
-    if (s != CM_OK) return s;
+    if (s != CM_OK) return cm_error_prefix(ctx, s, "cm_mesh_quality_foam");
     const double *xyz = mesh->xyz;
     const int64_t nf = p->n_faces, ni = p->n_internal, nc = p->n_cells;
     double *fc = malloc((size_t)(nf ? nf : 1) * 3 * sizeof *fc);

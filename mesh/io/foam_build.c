@@ -85,17 +85,17 @@ static cm_status topology_fault(cm_context *ctx, const cm_topology *t, const cm_
     const int64_t third = cm_topology_first_overshared(t);
     if (third >= 0)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
-                        "cm_mesh_write: cell %zu: a face shared by three or more cells cannot be written as a polyMesh",
+                        "cell %zu: a face shared by three or more cells cannot be written as a polyMesh",
                         (size_t)t->inst_cell[third]);
     switch (why->what) {
     case CM_TOPOLOGY_BAD_FACE:
-        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: cell %zu: face %d has %s nodes for a polyMesh",
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cell %zu: face %d has %s nodes for a polyMesh",
                         why->cell, why->face, why->n < 0 ? "too many" : "fewer than 3");
     case CM_TOPOLOGY_BAD_NODE:
-        return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_write: cell %zu: node %lld out of range (%zu nodes)", why->cell,
+        return cm_error(ctx, CM_ERR_FORMAT, "cell %zu: node %lld out of range (%zu nodes)", why->cell,
                         (long long)why->node, why->n_nodes);
     case CM_TOPOLOGY_TOO_LARGE:
-        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: %zu nodes, %zu cells, %zu faces: more than 2^31-1",
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "%zu nodes, %zu cells, %zu faces: more than 2^31-1",
                         why->n_nodes, why->n_cells, why->n_inst);
     default: return CM_OK;
     }
@@ -119,7 +119,7 @@ cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out
     if (nvol == 0) {
         cm_foam_poly_release(&p);
         return cm_error(ctx, CM_ERR_ARGUMENT,
-                        "cm_mesh_write: an OpenFOAM polyMesh needs volume cells; the mesh has none");
+                        "an OpenFOAM polyMesh needs volume cells; the mesh has none");
     }
     cm_topology_problem why;
     s = cm_topology_build(mesh, MAX_FACE, cm_context_threads_for(ctx, mesh->n_cells, 1), &t, &why);
@@ -224,7 +224,7 @@ cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out
     *out = p;
     return CM_OK;
 nomem:
-    s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory building the face addressing");
+    s = cm_error(ctx, CM_ERR_NOMEM, "out of memory building the face addressing");
 fail:
     cm_topology_free(&t);
     free(patch);

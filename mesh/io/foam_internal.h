@@ -60,7 +60,8 @@ int cm_foam_is_path(const char *path);
 
 /* Face addressing of the volume cells of any mesh (faces matched by their node sets,
  * upper-triangular order, boundary faces in patches by the physical group of 2D cells that
- * cover them, the rest in "defaultFaces"). On success *out has refs 1. */
+ * cover them, the rest in "defaultFaces"). On success *out has refs 1. Its messages name no
+ * function: the caller (writer, quality) puts its own in front. */
 cm_status cm_foam_build(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out);
 
 /* The addressing to use for a mesh: its own (retained) when it was read from a polyMesh with

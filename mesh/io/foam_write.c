@@ -258,7 +258,7 @@ static cm_status write_converted(cm_context *ctx, const cm_mesh *mesh, const cha
 {
     cm_foam_poly *p = NULL;
     cm_status s = cm_foam_build(ctx, mesh, &p);
-    if (s != CM_OK) return s;
+    if (s != CM_OK) return cm_error_prefix(ctx, s, "cm_mesh_write");
     char note[200];
     snprintf(note, sizeof note, "nPoints:%lld  nCells:%lld  nFaces:%lld  nInternalFaces:%lld", (long long)p->n_points,
              (long long)p->n_cells, (long long)p->n_faces, (long long)p->n_internal);

@@ -168,3 +168,15 @@ def test_foam_needs_volume_cells(cli, work):
     r = subprocess.run([cli, "quality", "--foam", str(work / "tri.vtu")], capture_output=True,
                        text=True)
     assert r.returncode == 2 and "no volume cells" in r.stderr
+
+
+def test_foam_quality_message_names_itself():
+    """The library's own refusal (the package refuses first) names cm_mesh_quality_foam, not
+    the polyMesh writer whose face addressing it shares."""
+    from cadmorph._capi import ffi, lib
+    from cadmorph._context import Context
+    tri = cadmorph.Mesh.from_arrays(np.eye(3), [("triangle", [[0, 1, 2]])])
+    q = ffi.new("cm_foam_quality *")
+    with pytest.raises(cadmorph.Error, match=r"^cm_mesh_quality_foam: an OpenFOAM polyMesh "
+                                             r"needs volume cells"):
+        Context(1, False).call(lib.cm_mesh_quality_foam, tri._ptr, q)
