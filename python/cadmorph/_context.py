@@ -92,7 +92,7 @@ class Context:
         s = lib.cm_context_create(p)
         if s != lib.CM_OK:
             raise ResourceError(s, "cm_context_create failed")
-        self.ptr = ffi.gc(p[0], _destroy_context)
+        self.ptr = owned(p[0], lib.cm_context_destroy)
         # 0: all the machine has
         lib.cm_context_set_threads(self.ptr, integer(what, "threads", threads, 0, 4096))
         state = self._state = _State(_progress_fn(progress))
@@ -137,6 +137,24 @@ class Context:
             raise pending
         return self.check(status)
 
+    def create(self, fn: Callable[..., int], ctype: str, destroy: Callable[[Any], None],
+               *args: Any) -> Any:
+        """fn(ctx, *args, &out) for a function of the C API that makes an object of type
+        ctype ("cm_mesh", ...): the object is owned by Python (owned(out, destroy)) as soon as
+        fn returns, so that whatever call raises next (a Ctrl-C that came after the last
+        progress point, a warning turned into an error) frees it; returns the owned pointer."""
+        out = ffi.new(ctype + " *[1]")
+        made = []
+
+        def run(ctx_ptr, *a):
+            status = fn(ctx_ptr, *a)
+            if out[0] != ffi.NULL:
+                made.append(owned(out[0], destroy))
+            return status
+
+        self.call(run, *args, out)
+        return made[0]
+
     def check(self, status: int) -> int:
         """Raises the exception of an error status; a warning status becomes a
         CadmorphWarning unless the log gave the same message already; returns status."""
@@ -147,5 +165,8 @@ class Context:
         return status
 
 
-def _destroy_context(ptr) -> None:
-    lib.cm_context_destroy(ffi.new("cm_context *[1]", [ptr]))
+def owned(ptr: Any, destroy: Callable[[Any], None]) -> Any:
+    """ptr, a `T *` the library made, freed by destroy (its cm_T_destroy, which takes the
+    address of the pointer) once Python holds no reference to it (ffi.gc)."""
+    slot = ffi.getctype(ffi.typeof(ptr), "[1]")
+    return ffi.gc(ptr, lambda p: destroy(ffi.new(slot, [p])))

@@ -24,23 +24,15 @@ _KERNELS = {"triharmonic": lib.CM_RBF_TRIHARMONIC, "biharmonic": lib.CM_RBF_BIHA
 _FIXED_GROUP, _HANDLE_GROUP = 1, 2  # the MLS weighs the two regions apart, as the CLI
 
 
-def _destroy_deform(ptr) -> None:
-    lib.cm_deform_destroy(ffi.new("cm_deform *[1]", [ptr]))
-
-
 def _boundary_nodes(ctx: Context, mesh: Mesh) -> np.ndarray:
     """The nodes `cadmorph deform --fix-unlisted-boundary` fixes: the boundary surface's
     nodes of a volume mesh, the border vertices (on an edge of one face) of a surface."""
     m = mesh._ptr
     if lib.cm_mesh_count_dim(m, 3) > 0:
-        p = ffi.new("cm_mesh_boundary *[1]")
-        try:
-            ctx.call(lib.cm_mesh_boundary_create, m, p)
-            b = p[0]
-            return np.frombuffer(ffi.buffer(b.nodes, 8 * b.n_nodes), np.int64).copy() \
-                if b.n_nodes else np.zeros(0, np.int64)
-        finally:
-            lib.cm_mesh_boundary_destroy(p)
+        b = ctx.create(lib.cm_mesh_boundary_create, "cm_mesh_boundary",
+                       lib.cm_mesh_boundary_destroy, m)
+        return np.frombuffer(ffi.buffer(b.nodes, 8 * b.n_nodes), np.int64).copy() \
+            if b.n_nodes else np.zeros(0, np.int64)
     n = int(m.n_nodes)
     H = np.empty(max(n, 1))
     border = np.zeros(max(n, 1), np.uint8)
@@ -149,11 +141,11 @@ class Deformer:
             raise ValueError("%s: stretch + bend must be > 0" % what)
         self._mesh_owner = mesh._ptr if mesh is not None else None  # the shell borrows it
         self._con = con
-        p = ffi.new("cm_deform *[1]")
-        self._ctx.call(lib.cm_deform_create, opt, n, ffi.from_buffer("double[]", xyz)
-                       if n else ffi.NULL, ffi.from_buffer("unsigned char[]", con),
-                       self._mesh_owner if self._mesh_owner is not None else ffi.NULL, p)
-        self._ptr = ffi.gc(p[0], _destroy_deform)
+        self._ptr = self._ctx.create(
+            lib.cm_deform_create, "cm_deform", lib.cm_deform_destroy, opt, n,
+            ffi.from_buffer("double[]", xyz) if n else ffi.NULL,
+            ffi.from_buffer("unsigned char[]", con),
+            self._mesh_owner if self._mesh_owner is not None else ffi.NULL)
         self._xyz = xyz.copy()  # the reference the displacements are added to
         self.method: str = method
         """The method's name."""

@@ -13,7 +13,7 @@ from typing import Any, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from ._capi import ffi, lib
-from ._context import Context, Progress
+from ._context import Context, Progress, owned
 from ._inputs import choice, integer, path_bytes, points_of, real_array
 from .errors import BadInputError
 from .mesh import Mesh, PathLike
@@ -39,10 +39,6 @@ class FFDStats:
     outside: int
     failed: int
     max_iterations: int
-
-
-def _destroy_ffd(ptr) -> None:
-    lib.cm_ffd_destroy(ffi.new("cm_ffd *[1]", [ptr]))
 
 
 class Lattice:
@@ -98,7 +94,7 @@ class Lattice:
             raise BadInputError(lib.CM_ERR_FORMAT, "%s: %s" % (path.decode("utf-8", "replace"),
                                                                ctx.message()))
         ctx.check(status)
-        self._ptr = ffi.gc(p[0], _destroy_ffd)
+        self._ptr = owned(p[0], lib.cm_ffd_destroy)
         self.n: Tuple[int, int, int] = (int(desc.n[0]), int(desc.n[1]), int(desc.n[2]))
         """Control points per axis."""
         self.basis: str = "bspline" if desc.basis == lib.CM_FFD_BSPLINE else "bernstein"

@@ -23,10 +23,6 @@ from .mesh import PathLike
 _TOKEN = object()  # Geometry objects are made here only
 
 
-def _destroy_model(ptr) -> None:
-    lib.cm_cad_destroy(ffi.new("cm_cad_model *[1]", [ptr]))
-
-
 def _text(p) -> str:
     return ffi.string(p).decode("utf-8", "replace") if p != ffi.NULL else ""
 
@@ -337,15 +333,14 @@ def read_step(path: PathLike, unit: str = "mm", threads: int = 0) -> Geometry:
     lib.cm_cad_read_options_init(opt)
     keep = ffi.new("char[]", u)
     opt.unit = keep
-    out = ffi.new("cm_cad_model *[1]")
     ctx = Context(threads, False, what)
     try:
-        ctx.call(lib.cm_cad_read, p, opt, out)
+        return Geometry(ctx.create(lib.cm_cad_read, "cm_cad_model", lib.cm_cad_destroy, p, opt),
+                        _TOKEN)
     except Error as e:
         if e.status == lib.CM_ERR_ARGUMENT:  # the unit: a wrong argument, not bad input
             raise ValueError(e.message) from None
         raise
-    return Geometry(ffi.gc(out[0], _destroy_model), _TOKEN)
 
 
 def model_names() -> Tuple[str, ...]:

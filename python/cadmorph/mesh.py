@@ -51,10 +51,6 @@ def _array(owner, ptr, shape: Tuple[int, ...], dtype, writable: bool = True) -> 
     return np.asarray(_View(owner, address, shape, dtype.str, writable))
 
 
-def _destroy_mesh(ptr) -> None:
-    lib.cm_mesh_destroy(ffi.new("cm_mesh *[1]", [ptr]))
-
-
 class Mesh:
     """A mixed-cell mesh held by libcadmorph (a cm_mesh), as read by read_mesh.
 
@@ -254,9 +250,7 @@ class Mesh:
         group_list = _convert.groups_list(groups, what)
 
         ctx = Context(threads, False, what)
-        out = ffi.new("cm_mesh *[1]")
-        ctx.call(lib.cm_mesh_create, out)
-        m = ffi.gc(out[0], _destroy_mesh)
+        m = ctx.create(lib.cm_mesh_create, "cm_mesh", lib.cm_mesh_destroy)
         ctx.call(lib.cm_mesh_resize_nodes, m, n, 0)
         _array(m, m.xyz, (n, 3), np.float64)[...] = xyz
         n_conn = sum(b.data.size if isinstance(b.data, np.ndarray) else
@@ -350,9 +344,7 @@ def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
     """
     p = _inputs.path_bytes("cadmorph.read_mesh", "path", path)
     ctx = Context(threads, False, "cadmorph.read_mesh")
-    out = ffi.new("cm_mesh *[1]")
-    ctx.call(lib.cm_mesh_read, p, out)
-    return Mesh(ffi.gc(out[0], _destroy_mesh), _TOKEN)
+    return Mesh(ctx.create(lib.cm_mesh_read, "cm_mesh", lib.cm_mesh_destroy, p), _TOKEN)
 
 
 def write_mesh(path: PathLike, mesh: Mesh, binary: Optional[bool] = None,

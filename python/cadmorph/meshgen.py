@@ -9,8 +9,8 @@ from typing import Optional
 from ._capi import ffi, lib
 from ._context import Context, Progress
 from ._inputs import choice, model_of, number
-from .geometry import Geometry, _destroy_model
-from .mesh import _TOKEN, Mesh, _destroy_mesh
+from .geometry import Geometry
+from .mesh import _TOKEN, Mesh
 
 _MESHERS = {"tetgen": lib.CM_MESHER_TETGEN, "gmsh": lib.CM_MESHER_GMSH}
 
@@ -65,7 +65,6 @@ def mesh_step(geometry: Geometry, size: Optional[float] = None, mesher: Optional
     if time_limit is not None:
         opt.time_limit = number(what, "time_limit", time_limit, 0, lo_open=True)
     ctx = Context(threads, progress, what)
-    out = ffi.new("cm_mesh *[1]")
     path = ffi.string(lib.cm_cad_path(model)) if lib.cm_cad_path(model) != ffi.NULL else b""
     if mesher == "gmsh" and not os.path.isfile(path):
         with tempfile.TemporaryDirectory(prefix="cadmorph_") as d:
@@ -75,13 +74,11 @@ def mesh_step(geometry: Geometry, size: Optional[float] = None, mesher: Optional
             lib.cm_cad_read_options_init(ro)
             unit = lib.cm_cad_unit(model)
             ro.unit = unit
-            g = ffi.new("cm_cad_model *[1]")
-            ctx.call(lib.cm_cad_read, step, ro, g)
-            copy = ffi.gc(g[0], _destroy_model)
-            ctx.call(lib.cm_tetmesh_create, copy, opt, out)
+            copy = ctx.create(lib.cm_cad_read, "cm_cad_model", lib.cm_cad_destroy, step, ro)
+            m = ctx.create(lib.cm_tetmesh_create, "cm_mesh", lib.cm_mesh_destroy, copy, opt)
     else:
-        ctx.call(lib.cm_tetmesh_create, model, opt, out)
-    mesh = Mesh(ffi.gc(out[0], _destroy_mesh), _TOKEN)
+        m = ctx.create(lib.cm_tetmesh_create, "cm_mesh", lib.cm_mesh_destroy, model, opt)
+    mesh = Mesh(m, _TOKEN)
     sj = ffi.new("double **")
     ctx.call(lib.cm_mesh_add_field, mesh._ptr, b"scaled_jacobian", lib.CM_FIELD_CELL, 1, sj)
     ctx.call(lib.cm_mesh_quality, mesh._ptr, sj[0])

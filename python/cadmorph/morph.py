@@ -18,7 +18,7 @@ from ._inputs import choice, flag, integer, mesh_of, model_of, number, points
 from ._options import WarpSettings
 from .errors import MismatchError, RejectedError
 from .geometry import Geometry
-from .mesh import _TOKEN, Mesh, _destroy_mesh
+from .mesh import _TOKEN, Mesh
 
 # cm_cad_match renumbers a target in place: one at a time, so that a Morpher in another
 # thread never compares against a model being renumbered
@@ -139,10 +139,6 @@ def _record(cls: type, c: Any) -> Any:
             v = tuple(int(x) for x in v)
         values[f.name] = v
     return cls(**values)
-
-
-def _destroy_morpher(ptr) -> None:
-    lib.cm_morpher_destroy(ffi.new("cm_morpher *[1]", [ptr]))
 
 
 _SURFACES = {"rbf": lib.CM_SURFACE_RBF, "project": lib.CM_SURFACE_PROJECT}
@@ -312,17 +308,8 @@ class Morpher:
         m = mesh_of(what, "mesh", mesh)._ptr
         o, self._warp, self._surface = _morph_options(what, **options)
         self._ctx = ctx = Context(threads, progress, what)
-        out = ffi.new("cm_morpher *[1]")
-        holder = []
-
-        def create(ctx_ptr, *args):
-            s = lib.cm_morpher_create(ctx_ptr, *args)
-            if out[0] != ffi.NULL:  # owned at once: whatever is raised next frees it
-                holder.append(ffi.gc(out[0], _destroy_morpher))
-            return s
-
-        ctx.call(create, gp, m, o, out)
-        self._mp = holder[0]
+        self._mp = ctx.create(lib.cm_morpher_create, "cm_morpher", lib.cm_morpher_destroy,
+                              gp, m, o)
         self._n = int(m.n_nodes)
         # what the library borrows: G (the Geometry and its pointer object) and, after an
         # apply, the last target; a failed rebase may have switched G, so its model is held
@@ -504,17 +491,7 @@ class Morpher:
 
 
 def _copy_mesh(ctx: Context, m) -> Mesh:
-    out = ffi.new("cm_mesh *[1]")
-    holder = []
-
-    def copy(ctx_ptr, *args):
-        s = lib.cm_mesh_copy(ctx_ptr, *args)
-        if out[0] != ffi.NULL:
-            holder.append(ffi.gc(out[0], _destroy_mesh))
-        return s
-
-    ctx.call(copy, m, out)
-    return Mesh(holder[0], _TOKEN)
+    return Mesh(ctx.create(lib.cm_mesh_copy, "cm_mesh", lib.cm_mesh_destroy, m), _TOKEN)
 
 
 def morph(g0: Geometry, g1: Geometry, mesh: Mesh, *, via: Sequence[Geometry] = (),

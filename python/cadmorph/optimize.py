@@ -9,7 +9,7 @@ import numpy as np
 from ._capi import ffi, lib
 from ._context import Context, Progress
 from ._inputs import index_array, integer, mesh_of, number
-from .mesh import Mesh, _array, _destroy_mesh
+from .mesh import Mesh, _array
 
 
 @dataclass(frozen=True)
@@ -69,9 +69,7 @@ def optimize(mesh: Mesh, fixed: Any = None, sweeps: int = 6, target_sj: float = 
     if in_place:
         target = mesh._ptr
     else:
-        p = ffi.new("cm_mesh *[1]")
-        ctx.call(lib.cm_mesh_copy, mesh._ptr, p)
-        target = ffi.gc(p[0], _destroy_mesh)
+        target = ctx.create(lib.cm_mesh_copy, "cm_mesh", lib.cm_mesh_destroy, mesh._ptr)
     st = ffi.new("cm_optimize_stats *")
     ctx.call(lib.cm_mesh_optimize, target, flags, opt, st)
     stats = OptimizeStats(float(st.min_sj_before), float(st.min_sj_after),

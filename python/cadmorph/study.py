@@ -71,10 +71,6 @@ class StudyRow:
         return self.status >= 0
 
 
-def _destroy_result(ptr) -> None:
-    lib.cm_study_result_destroy(ffi.new("cm_study_result *[1]", [ptr]))
-
-
 def _str(chars) -> str:
     return ffi.string(chars).decode("utf-8", "replace")
 
@@ -266,11 +262,11 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
         fam = ffi.new("cm_study_family *")
         ctx.call(lib.cm_study_family_files, arr, len(cpaths), ro, fam)
         try:
-            out = ffi.new("cm_study_result *[1]")
-            ctx.call(lib.cm_study_run, model, mesh._ptr, fam, so, out)
+            result = ctx.create(lib.cm_study_run, "cm_study_result",
+                                lib.cm_study_result_destroy, model, mesh._ptr, fam, so)
         finally:
             lib.cm_study_family_release(fam)
-    return StudyResult(ffi.gc(out[0], _destroy_result), lib.CM_STUDY_CSV_FULL)
+    return StudyResult(result, lib.CM_STUDY_CSV_FULL)
 
 
 def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 10,
@@ -325,11 +321,10 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
     so.optimize = bool(optimize)
     so.write_step = bool(write_step)
     so.write_meshes = bool(write_meshes)
-    out = ffi.new("cm_study_result *[1]")
     with tempfile.TemporaryDirectory(prefix="cadmorph_sweep_") as tmp:
         d = path_bytes(what, "out_dir", tmp if out_dir is None else out_dir)
         os.makedirs(d, exist_ok=True)
         dir_c = ffi.new("char[]", d)
         so.out_dir = dir_c
-        ctx.call(lib.cm_sweep_run, so, out)
-    return StudyResult(ffi.gc(out[0], _destroy_result), lib.CM_STUDY_CSV_SWEEP)
+        result = ctx.create(lib.cm_sweep_run, "cm_study_result", lib.cm_study_result_destroy, so)
+    return StudyResult(result, lib.CM_STUDY_CSV_SWEEP)

@@ -18,14 +18,6 @@ from ._options import MAX_DISPLACEMENT, WarpSettings
 from .mesh import Mesh
 
 
-def _destroy_warp(ptr) -> None:
-    lib.cm_warp_destroy(ffi.new("cm_warp *[1]", [ptr]))
-
-
-def _destroy_boundary(ptr) -> None:
-    lib.cm_mesh_boundary_destroy(ffi.new("cm_mesh_boundary *[1]", [ptr]))
-
-
 class Warp:
     """A warp of mesh whose constrained nodes are `nodes` (None: the boundary nodes, those of
     faces used by one volume cell), made once: `apply` then maps any displacement of those
@@ -80,17 +72,8 @@ class Warp:
         self._ctx = ctx = Context(threads, progress, what)
         opt = ffi.new("cm_warp_options *")
         settings.fill(opt)
-        bp = ffi.new("cm_mesh_boundary *[1]")
-        owned = []
-
-        def boundary(ctx_ptr, *args):
-            s = lib.cm_mesh_boundary_create(ctx_ptr, *args)
-            if bp[0] != ffi.NULL:  # owned at once: a warning raised as an error frees it
-                owned.append(ffi.gc(bp[0], _destroy_boundary))
-            return s
-
-        ctx.call(boundary, m, bp)
-        b = owned[0]
+        b = ctx.create(lib.cm_mesh_boundary_create, "cm_mesh_boundary",
+                       lib.cm_mesh_boundary_destroy, m)
         if nodes is None:
             k = int(b.n_nodes)
             self._nodes = (np.frombuffer(ffi.buffer(b.nodes, 8 * k), np.int64).copy() if k
@@ -102,17 +85,8 @@ class Warp:
             flags[self._nodes] = 1
             constrained = ffi.from_buffer("unsigned char[]", flags)
         self._nodes.flags.writeable = False
-        out = ffi.new("cm_warp *[1]")
-        holder = []
-
-        def create(ctx_ptr, *args):
-            s = lib.cm_warp_create(ctx_ptr, *args)
-            if out[0] != ffi.NULL:  # owned at once: whatever is raised next frees it
-                holder.append(ffi.gc(out[0], _destroy_warp))
-            return s
-
-        ctx.call(create, m, b, constrained, opt, out)
-        self._warp = holder[0]
+        self._warp = ctx.create(lib.cm_warp_create, "cm_warp", lib.cm_warp_destroy, m, b,
+                                constrained, opt)
         self._n = n
         self._settings = settings
 
