@@ -19,6 +19,9 @@ import sys
 import meshio
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "helpers"))
+from pygem_prm import write_prm  # noqa: E402
+
 CM, DATA, WORK = sys.argv[1], sys.argv[2], os.path.join(sys.argv[3], "ffd_cli")
 os.makedirs(WORK, exist_ok=True)
 failures = 0
@@ -33,20 +36,6 @@ def check(cond, what):
 def run(*args):
     p = subprocess.run([CM, "ffd", *args], capture_output=True, text=True)
     return p.returncode, p.stdout, p.stderr
-
-
-def write_prm(path, n, origin, length, angle, mu):
-    with open(path, "w") as f:
-        f.write("[Box info]\n")
-        for key, v in (("n control points", n), ("box length", length),
-                       ("box origin", origin), ("rotation angle", angle)):
-            for a, c in enumerate("xyz"):
-                f.write("%s %s: %r\n" % (key, c, v[a]))
-        f.write("\n[Parameters weights]\n")
-        for a, c in enumerate("xyz"):
-            lines = ["%d %d %d %r" % (i, j, k, mu[a][i, j, k])
-                     for i in range(n[0]) for j in range(n[1]) for k in range(n[2])]
-            f.write("parameter %s: %s\n" % (c, ("\n    ").join(lines)))
 
 
 # 1. PyGeM's numbers

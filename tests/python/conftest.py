@@ -4,10 +4,13 @@ CADMORPH_CLI=build/cli/cadmorph PYTHONPATH=build/python python3 -m pytest -q tes
 """
 import os
 import pathlib
+import sys
 
 import pytest
 
 HERE = pathlib.Path(__file__).resolve().parent
+# the test code shared with the CLI tests (tests/helpers: pygem_prm.py)
+sys.path.insert(0, str(HERE.parent / "helpers"))
 
 
 @pytest.fixture(scope="session")

@@ -8,25 +8,12 @@ import numpy as np
 import pytest
 
 import cadmorph
+from pygem_prm import write_prm
 
 
 def run_ffd(cli, *args):
     r = subprocess.run([cli, "ffd", *map(str, args)], capture_output=True, text=True)
     return r.returncode, r.stdout, r.stderr
-
-
-def write_prm(path, n, origin, length, angle, mu):
-    with open(path, "w") as f:
-        f.write("[Box info]\n")
-        for key, v in (("n control points", n), ("box length", length),
-                       ("box origin", origin), ("rotation angle", angle)):
-            for a, c in enumerate("xyz"):
-                f.write("%s %s: %r\n" % (key, c, v[a]))
-        f.write("\n[Parameters weights]\n")
-        for a, c in enumerate("xyz"):
-            lines = ["%d %d %d %r" % (i, j, k, mu[a][i, j, k])
-                     for i in range(n[0]) for j in range(n[1]) for k in range(n[2])]
-            f.write("parameter %s: %s\n" % (c, "\n    ".join(lines)))
 
 
 @pytest.mark.parametrize("name", ["bern222", "bern333_rot", "bern444_rot", "bern534_rot"])
