@@ -21,6 +21,9 @@ import xml.etree.ElementTree as ET
 
 import vtk
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "helpers"))
+from vtk_quality import vtk_min_sj  # noqa: E402
+
 failures = []
 
 
@@ -28,21 +31,6 @@ def check(cond, msg):
     if not cond:
         failures.append(msg)
         print("FAIL:", msg)
-
-
-def vtk_quality(path):
-    r = vtk.vtkXMLUnstructuredGridReader()
-    r.SetFileName(path)
-    r.Update()
-    grid = r.GetOutput()
-    q = vtk.vtkMeshQuality()
-    q.SetInputData(grid)
-    q.SetTetQualityMeasureToScaledJacobian()
-    q.Update()
-    arr = q.GetOutput().GetCellData().GetArray("Quality")
-    vals = [0.0 if abs(arr.GetValue(i)) >= 1e30 else arr.GetValue(i)
-            for i in range(grid.GetNumberOfCells()) if grid.GetCellType(i) == vtk.VTK_TETRA]
-    return min(vals), sum(1 for v in vals if v <= 0), len(vals)
 
 
 def main():
@@ -91,7 +79,7 @@ def main():
         complete.setdefault((r["mode"], r["method"]), []).append(r)
         check(os.path.exists(mesh), f"{mesh} missing")
         if os.path.exists(mesh) and r["variant"] == labels[-1]:
-            vmin, vinv, vcells = vtk_quality(mesh)
+            vmin, vinv, vcells = vtk_min_sj(mesh, (vtk.VTK_TETRA,))
             check(vcells == int(r["cells"]), f"{mesh}: {vcells} cells vs CSV")
             check(abs(vmin - lo) <= 1e-6, f"{mesh}: VTK min scaled Jacobian {vmin} vs CSV {lo}")
             check(vinv == int(r["inverted"]), f"{mesh}: VTK {vinv} inverted vs CSV")

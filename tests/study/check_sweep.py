@@ -17,7 +17,8 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
-import vtk
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "helpers"))
+from vtk_quality import vtk_min_sj  # noqa: E402
 
 failures = []
 
@@ -26,24 +27,6 @@ def check(cond, msg):
     if not cond:
         failures.append(msg)
         print("FAIL:", msg)
-
-
-def vtk_min_sj(path):
-    r = vtk.vtkXMLUnstructuredGridReader()
-    r.SetFileName(path)
-    r.Update()
-    grid = r.GetOutput()
-    q = vtk.vtkMeshQuality()
-    q.SetInputData(grid)
-    q.SetTetQualityMeasureToScaledJacobian()
-    q.SetHexQualityMeasureToScaledJacobian()
-    q.Update()
-    arr = q.GetOutput().GetCellData().GetArray("Quality")
-    # Verdict's +-1e30 marks a collapsed cell; cadmorph's summary counts it as 0 (inverted)
-    vals = [0.0 if abs(arr.GetValue(i)) >= 1e30 else arr.GetValue(i)
-            for i in range(grid.GetNumberOfCells())
-            if grid.GetCellType(i) in (vtk.VTK_TETRA, vtk.VTK_HEXAHEDRON)]
-    return min(vals), sum(1 for v in vals if v <= 0), len(vals)
 
 
 def main():
