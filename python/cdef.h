@@ -793,6 +793,8 @@ const unsigned char *constrained, const cm_warp_options *opt,
 cm_warp **warp);
 void cm_warp_destroy(cm_warp **warp);
 cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
+cm_status cm_warp_apply_transpose(cm_context *ctx, cm_warp *warp, const double *v,
+double *out);
 cm_warp_method cm_warp_get_method(const cm_warp *warp);
 double cm_warp_residual(const cm_warp *warp);
 size_t cm_warp_fallback_nodes(const cm_warp *warp);

@@ -21,6 +21,7 @@ struct cm_warp {
     cm_warp_method method;
     const cm_warp_method_ops *ops;
     void *state;
+    size_t n_nodes;
     double residual;
 };
 
@@ -91,6 +92,7 @@ cm_status cm_warp_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_bou
     }
     w->method = opt->method;
     w->ops = methods[opt->method];
+    w->n_nodes = mesh->n_nodes;
     cm_status s = w->ops->create(ctx, mesh, b, constrained, opt, &w->state);
     free(own_mask);
     if (s < 0) {
@@ -114,6 +116,22 @@ cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp)
     if (!warp || !disp)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply: warp or disp is NULL");
     return warp->ops->apply(ctx, warp->state, disp, &warp->residual);
+}
+
+cm_status cm_warp_apply_transpose(cm_context *ctx, cm_warp *warp, const double *v, double *out)
+{
+    if (!warp || !v || !out)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply_transpose: warp, v or out is NULL");
+    if (!warp->ops->apply_transpose)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "cm_warp_apply_transpose: method %s is not linear in the prescribed "
+                        "displacement, so it has no transpose",
+                        warp->ops->name);
+    size_t n3 = 3 * warp->n_nodes;
+    if ((v < out + n3 && out < v + n3))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply_transpose: v and out overlap");
+    memset(out, 0, n3 * sizeof *out);
+    return warp->ops->apply_transpose(ctx, warp->state, v, out);
 }
 
 cm_warp_method cm_warp_get_method(const cm_warp *warp) { return warp->method; }

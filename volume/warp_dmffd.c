@@ -148,4 +148,4 @@ static cm_status dmffd_apply(cm_context *ctx, void *state, double *disp, double 
 }
 
 const cm_warp_method_ops cm_warp_dmffd = {"dmffd", dmffd_create, dmffd_apply, dmffd_destroy,
-                                          NULL};
+                                          NULL, NULL};

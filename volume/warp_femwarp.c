@@ -416,4 +416,4 @@ static cm_status femwarp_apply(cm_context *ctx, void *state, double *disp, doubl
 }
 
 const cm_warp_method_ops cm_warp_femwarp = {"femwarp", femwarp_create, femwarp_apply,
-                                            femwarp_destroy, NULL};
+                                            femwarp_destroy, NULL, NULL};

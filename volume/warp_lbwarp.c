@@ -429,4 +429,4 @@ static cm_status lbwarp_apply(cm_context *ctx, void *state, double *disp, double
 }
 
 const cm_warp_method_ops cm_warp_lbwarp = {"lbwarp", lbwarp_create, lbwarp_apply, lbwarp_destroy,
-                                           lbwarp_fallback_nodes};
+                                           lbwarp_fallback_nodes, NULL};

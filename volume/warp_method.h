@@ -17,6 +17,9 @@ typedef struct cm_warp_method_ops {
     /* Nodes the method could not treat by its rule and gave its documented fallback (may be
      * NULL: none ever). */
     size_t (*fallback_nodes)(const void *state);
+    /* cm_warp_apply_transpose: out (#nodes x 3) is zeroed by warp.c; the method adds J^T v
+     * at the constrained nodes. NULL: the method's apply is not linear in disp. */
+    cm_status (*apply_transpose)(cm_context *ctx, void *state, const double *v, double *out);
 } cm_warp_method_ops;
 
 /* The RBF methods (warp_rbf.c). */

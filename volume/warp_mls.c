@@ -47,4 +47,4 @@ static void mls_destroy(void *state)
     cm_deform_destroy(&d);
 }
 
-const cm_warp_method_ops cm_warp_mls = {"mls", mls_create, mls_apply, mls_destroy, NULL};
+const cm_warp_method_ops cm_warp_mls = {"mls", mls_create, mls_apply, mls_destroy, NULL, NULL};

@@ -309,6 +309,6 @@ static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
 }
 
 const cm_warp_method_ops cm_warp_rbf_triharmonic = {"rbf", triharmonic_create, rbf_apply,
-                                                    rbf_destroy, NULL};
+                                                    rbf_destroy, NULL, NULL};
 const cm_warp_method_ops cm_warp_rbf_biharmonic = {"rbf-biharmonic", biharmonic_create,
-                                                   rbf_apply, rbf_destroy, NULL};
+                                                   rbf_apply, rbf_destroy, NULL, NULL};

@@ -364,4 +364,4 @@ cm_status simplex_apply(cm_context *, void *state, double *disp, double *residua
 } // namespace
 
 extern "C" const cm_warp_method_ops cm_warp_simplex = {"simplex", simplex_create, simplex_apply,
-                                                       simplex_destroy, simplex_fallback_nodes};
+                                                       simplex_destroy, simplex_fallback_nodes, NULL};
