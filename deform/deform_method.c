@@ -32,6 +32,10 @@ typedef struct deform_row {
     int needs_mesh;
     cm_status (*create)(cm_context *ctx, cm_deform *d, const double *xyz);
     cm_status (*apply)(cm_context *ctx, cm_deform *d, double *disp, double *residual);
+    /* cm_deform_apply_transpose: out (n x 3) is zeroed by the caller; NULL: none (why_not
+     * says why) */
+    cm_status (*apply_transpose)(cm_context *ctx, cm_deform *d, const double *v, double *out);
+    const char *why_not;
 } deform_row;
 
 /* ---- shared by rbf and dmffd: the points split into constrained and free ones ---- */
@@ -158,6 +162,38 @@ static cm_status dmffd_apply(cm_context *ctx, cm_deform *d, double *disp, double
     return s;
 }
 
+/* J^T v: the free points' v back through the evaluation (the FFD transposed) and the solve
+ * (the pseudo-inverse transposed) onto the constrained points, which keep their own v. */
+static cm_status dmffd_apply_transpose(cm_context *ctx, cm_deform *d, const double *v, double *out)
+{
+    size_t nc = d->n_constrained, nf = d->n_free, nctrl = cm_ffd_control_count(d->ffd);
+    double *vf = malloc((nf ? nf : 1) * 3 * sizeof *vf);
+    double *gdc = malloc(nctrl * 3 * sizeof *gdc), *gh = malloc(nc * 3 * sizeof *gh);
+    cm_status s = vf && gdc && gh
+                      ? CM_OK
+                      : cm_error(ctx, CM_ERR_NOMEM, "cm_deform_apply_transpose: out of memory");
+    if (s >= 0) {
+        for (size_t i = 0, b = 0; i < d->n; ++i)
+            if (!d->constrained[i]) memcpy(vf + 3 * b++, v + 3 * i, 3 * sizeof *vf);
+        s = cm_ffd_deform_transpose(ctx, d->ffd, nf, d->free_xyz, vf, gdc, NULL);
+    }
+    if (s >= 0) {
+        cm_status t = cm_dmffd_solve_transpose(ctx, d->dm, gdc, gh);
+        if (t < 0) s = t; /* else a warning of the location stays */
+    }
+    if (s >= 0)
+        for (size_t i = 0, a = 0; i < d->n; ++i)
+            if (d->constrained[i]) {
+                for (int k = 0; k < 3; ++k)
+                    out[3 * i + k] = v[3 * i + k] + gh[3 * a + k];
+                ++a;
+            }
+    free(vf);
+    free(gdc);
+    free(gh);
+    return s;
+}
+
 /* ---- mls: the constrained MLS over the mesh's cells ---- */
 
 static cm_status mls_create(cm_context *ctx, cm_deform *d, const double *xyz)
@@ -172,6 +208,11 @@ static cm_status mls_apply(cm_context *ctx, cm_deform *d, double *disp, double *
     cm_status s = cm_mls_apply(ctx, d->mls, disp, residual);
     d->t_solve = cm_wtime() - t0;
     return s;
+}
+
+static cm_status mls_apply_transpose(cm_context *ctx, cm_deform *d, const double *v, double *out)
+{
+    return cm_mls_apply_transpose(ctx, d->mls, v, out);
 }
 
 /* ---- shell: nothing to precompute; each apply solves the shell's system ---- */
@@ -194,10 +235,12 @@ static cm_status shell_apply(cm_context *ctx, cm_deform *d, double *disp, double
 
 /* One row per cm_deform_method, in enum order. */
 static const deform_row rows[CM_DEFORM_N_METHODS] = {
-    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply},
-    [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply},
-    [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply},
-    [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply},
+    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply, NULL,
+                       "its reverse product is not implemented at this level"},
+    [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply, mls_apply_transpose, NULL},
+    [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply, NULL,
+                         "its reverse product is not implemented"},
+    [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply, dmffd_apply_transpose, NULL},
 };
 
 const char *cm_deform_method_name(cm_deform_method method)
@@ -288,6 +331,20 @@ cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double 
     def->residual = r;
     if (residual) *residual = r;
     return s;
+}
+
+cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v, double *out)
+{
+    if (!def || !v || !out)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_transpose: def, v or out is NULL");
+    if (!def->row->apply_transpose)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_deform_apply_transpose: %s: %s",
+                        def->row->name, def->row->why_not);
+    size_t n3 = 3 * def->n;
+    if (v < out + n3 && out < v + n3)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_transpose: v and out overlap");
+    memset(out, 0, n3 * sizeof *out);
+    return def->row->apply_transpose(ctx, def, v, out);
 }
 
 void cm_deform_get_stats(const cm_deform *def, cm_deform_stats *stats)

@@ -296,6 +296,34 @@ cm_status cm_dmffd_solve(cm_context *ctx, cm_dmffd *d, const double *h, double *
     return CM_OK;
 }
 
+cm_status cm_dmffd_solve_transpose(cm_context *ctx, const cm_dmffd *d, const double *gdc,
+                                   double *gh)
+{
+    if (!d || !gdc || !gh)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_dmffd_solve_transpose: NULL input");
+    size_t m = d->m, n = d->n_act, r = d->r;
+    double *t = malloc((r ? r : 1) * 3 * sizeof *t);
+    double *c = malloc((n ? n : 1) * 3 * sizeof *c);
+    if (!t || !c) {
+        free(t);
+        free(c);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_dmffd_solve_transpose: out of memory");
+    }
+    for (size_t j = 0; j < n; ++j)
+        memcpy(c + 3 * j, gdc + 3 * d->act[j], 3 * sizeof *c);
+    /* (V diag(sinv) U^T)^T = U diag(sinv) V^T, the same factors as solve */
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, (int)r, 3, (int)n, 1.0, d->vt, (int)n, c,
+                3, 0.0, t, 3);
+    for (size_t i = 0; i < r; ++i)
+        for (int k = 0; k < 3; ++k)
+            t[3 * i + k] *= d->sinv[i];
+    cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasNoTrans, (int)m, 3, (int)r, 1.0, d->u, (int)r, t,
+                3, 0.0, gh, 3);
+    free(t);
+    free(c);
+    return CM_OK;
+}
+
 void cm_dmffd_get_info(const cm_dmffd *dm, cm_dmffd_info *info)
 {
     if (dm && info) *info = dm->info;

@@ -3,6 +3,7 @@
  * bit (PyGeM's position form leaves ~1e-15). */
 #include "ffd_internal.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* d = sum_p dc_p N_p(u) over the support of u. */
@@ -65,4 +66,55 @@ cm_status cm_ffd_deform(cm_context *ctx, const cm_ffd *ffd, const double *dc, si
                         "they are not moved",
                         nfail, n);
     return CM_OK;
+}
+
+/* gdc += sum_p N_p(u) v over the support of u: eval_point's loops, the product turned round. */
+static void scatter_point(const cm_ffd *f, const double v[3], const double u[3], double *gdc)
+{
+    double nv[3][CM_FFD_MAX_AXIS];
+    int first[3], cnt[3];
+    for (int a = 0; a < 3; ++a)
+        first[a] = cm_ffd_axis_basis(f, a, u[a], nv[a], NULL, &cnt[a]);
+    for (int i = 0; i < cnt[0]; ++i)
+        for (int j = 0; j < cnt[1]; ++j) {
+            double wij = nv[0][i] * nv[1][j];
+            double *c =
+                gdc + 3 * (((size_t)(first[0] + i) * f->n[1] + first[1] + j) * f->n[2] + first[2]);
+            for (int k = 0; k < cnt[2]; ++k) {
+                double w = wij * nv[2][k];
+                c[3 * k] += w * v[0];
+                c[3 * k + 1] += w * v[1];
+                c[3 * k + 2] += w * v[2];
+            }
+        }
+}
+
+cm_status cm_ffd_deform_transpose(cm_context *ctx, const cm_ffd *ffd, size_t n, const double *x,
+                                  const double *v, double *gdc, cm_ffd_stats *stats)
+{
+    if (!ffd || !gdc || (n && (!x || !v)))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_ffd_deform_transpose: NULL input");
+    double *u = malloc((n ? n : 1) * 3 * sizeof *u);
+    unsigned char *in = malloc(n ? n : 1);
+    if (!u || !in) {
+        free(u);
+        free(in);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_ffd_deform_transpose: out of memory");
+    }
+    /* the location in parallel (Newton on a moved lattice is the cost), the scatter in point
+     * order: many points share a control point, and the sum does not depend on threads */
+    cm_ffd_stats st;
+    cm_status s = cm_ffd_local_coords(ctx, ffd, n, x, u, in, &st);
+    memset(gdc, 0, ffd->n_ctrl * 3 * sizeof *gdc);
+    for (size_t i = 0; i < n && s >= 0; ++i)
+        if (in[i] == 1) scatter_point(ffd, v + 3 * i, u + 3 * i, gdc);
+    free(u);
+    free(in);
+    if (s == CM_WARNING)
+        s = cm_error(ctx, CM_WARNING,
+                     "cm_ffd_deform_transpose: Newton did not invert %zu of %zu points (folded "
+                     "lattice?); they send nothing",
+                     st.failed, n);
+    if (stats) *stats = st;
+    return s;
 }

@@ -505,3 +505,55 @@ cm_status cm_mls_apply(cm_context *ctx, cm_mls *m, double *disp, double *residua
     m->stats.c_apply = cpu_seconds() - c0;
     return CM_OK;
 }
+
+/* apply's steps turned round, in reverse order: the blend, the evaluation, the solve (the
+ * normal equations are symmetric), the right-hand side. */
+cm_status cm_mls_apply_transpose(cm_context *ctx, cm_mls *m, const double *v, double *out)
+{
+    if (!m || !v || !out)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mls_apply_transpose: NULL argument");
+    size_t k = m->k, n = m->n_nodes;
+    cholmod_dense *g = cholmod_zeros(k, 3, CHOLMOD_REAL, &m->cc);
+    if (!g) return cm_error(ctx, CM_ERR_NOMEM, "cm_mls_apply_transpose: out of memory");
+    double *gx = g->x;
+    memset(out, 0, 3 * n * sizeof *out);
+    /* the blend: disp_j += sum_b w_jb rc_b, rc = prescribed - field at the constrained nodes */
+    if (m->keep_constrained && m->blend.n) {
+        memset(m->rc, 0, 3 * m->n_con * sizeof *m->rc);
+        const mls_blend *b = &m->blend;
+        for (size_t j = 0; j < b->n; ++j)
+            for (int64_t p = b->row[j]; p < b->row[j + 1]; ++p)
+                for (int a = 0; a < 3; ++a)
+                    m->rc[3 * (size_t)b->col[p] + a] += b->val[p] * v[3 * (size_t)b->node[j] + a];
+    }
+    /* the evaluation d_i = Phi_i coef at the nodes that get the field's value */
+    for (size_t i = 0; i < n; ++i) {
+        if (m->is_con[i] && m->keep_constrained) continue;
+        for (int64_t p = m->row[i]; p < m->row[i + 1]; ++p)
+            for (int d = 0; d < 3; ++d)
+                gx[d * k + (size_t)m->col[p]] += m->val[p] * v[3 * i + d];
+    }
+    if (m->keep_constrained)
+        for (size_t c = 0; c < m->n_con; ++c) {
+            int64_t vc = m->con[c];
+            for (int d = 0; d < 3; ++d) {
+                double r = m->blend.n ? m->rc[3 * c + d] : 0;
+                out[3 * vc + d] += v[3 * vc + d] + r;
+                for (int64_t p = m->row[vc]; p < m->row[vc + 1] && r != 0; ++p)
+                    gx[d * k + (size_t)m->col[p]] -= m->val[p] * r;
+            }
+        }
+    cholmod_dense *y = cholmod_solve(CHOLMOD_A, m->factor, g, &m->cc);
+    cholmod_free_dense(&g, &m->cc);
+    if (!y) return cm_error(ctx, CM_ERR_NOMEM, "cm_mls_apply_transpose: CHOLMOD solve failed");
+    const double *yx = y->x;
+    /* the right-hand side b = sum_c wf_c Phi_c^T D_c */
+    for (size_t c = 0; c < m->n_con; ++c) {
+        int64_t vc = m->con[c];
+        for (int64_t p = m->row[vc]; p < m->row[vc + 1]; ++p)
+            for (int d = 0; d < 3; ++d)
+                out[3 * vc + d] += m->wf[c] * m->val[p] * yx[d * k + (size_t)m->col[p]];
+    }
+    cholmod_free_dense(&y, &m->cc);
+    return CM_OK;
+}

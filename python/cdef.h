@@ -445,6 +445,7 @@ cm_status cm_mls_create(cm_context *ctx, const cm_mesh *mesh, const unsigned cha
 const cm_mls_options *opt, cm_mls **mls);
 void cm_mls_destroy(cm_mls **mls);
 cm_status cm_mls_apply(cm_context *ctx, cm_mls *mls, double *disp, double *residual);
+cm_status cm_mls_apply_transpose(cm_context *ctx, cm_mls *mls, const double *v, double *out);
 typedef struct cm_mls_stats {
 size_t samples, surface_samples, cubature, constrained;
 size_t phi_nonzeros;
@@ -558,6 +559,9 @@ size_t cm_ffd_support_size(const cm_ffd *ffd);
 size_t cm_ffd_basis_eval(const cm_ffd *ffd, const double u[3], int64_t *idx, double *w);
 cm_status cm_ffd_deform(cm_context *ctx, const cm_ffd *ffd, const double *dc, size_t n,
 const double *x, double *d, cm_ffd_stats *stats);
+cm_status cm_ffd_deform_transpose(cm_context *ctx, const cm_ffd *ffd, size_t n,
+const double *x, const double *v, double *gdc,
+cm_ffd_stats *stats);
 typedef struct cm_dmffd_options {
 double eps;
 int floor;
@@ -578,6 +582,8 @@ cm_status cm_dmffd_create(cm_context *ctx, const cm_ffd *ffd, size_t m, const do
 const cm_dmffd_options *opt, cm_dmffd **dm);
 void cm_dmffd_destroy(cm_dmffd **dm);
 cm_status cm_dmffd_solve(cm_context *ctx, cm_dmffd *dm, const double *h, double *dc);
+cm_status cm_dmffd_solve_transpose(cm_context *ctx, const cm_dmffd *dm, const double *gdc,
+double *gh);
 void cm_dmffd_get_info(const cm_dmffd *dm, cm_dmffd_info *info);
 cm_status cm_dmffd_precompute(cm_context *ctx, const cm_dmffd *dm, size_t k, const double *x,
 double **b);
@@ -616,6 +622,8 @@ const double *xyz, const unsigned char *constrained,
 const cm_mesh *mesh, cm_deform **def);
 void cm_deform_destroy(cm_deform **def);
 cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double *residual);
+cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
+double *out);
 typedef struct cm_deform_stats {
 cm_deform_method method;
 size_t constrained, free;

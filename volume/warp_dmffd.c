@@ -3,7 +3,12 @@
  * lattice whose valid domain is their bounding box. The SVD is done once in create; apply is
  * C = Phi^+ H and one sparse product per node. Least squares, not interpolation: the
  * constrained nodes keep their prescribed displacement (the interface contract) and the
- * residual says how far the space deformation itself misses them. */
+ * residual says how far the space deformation itself misses them.
+ * Reverse product (docs/DESIGN.md, "Gradients"): apply is linear in the prescribed
+ * displacement - the truncation of the singular values is fixed by create (the handle
+ * positions and the clamp), not by the data, and the constrained nodes keep their value - so
+ * J^T v is deform.h's transposed DM-FFD: the free nodes' v through the transposed FFD and
+ * the transposed pseudo-inverse onto the constrained nodes. */
 #include "warp_method.h"
 
 #include "cadmorph/deform.h"
@@ -147,5 +152,25 @@ static cm_status dmffd_apply(cm_context *ctx, void *state, double *disp, double 
     return CM_OK;
 }
 
-const cm_warp_method_ops cm_warp_dmffd = {"dmffd", dmffd_create, dmffd_apply, dmffd_destroy,
-                                          NULL, NULL};
+static cm_status dmffd_apply_transpose(cm_context *ctx, void *state, const double *v, double *out)
+{
+    dmffd_warp *w = state;
+    size_t np = w->n_fixed + w->n_free;
+    double *op = malloc(np * 3 * sizeof *op);
+    if (!op) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_apply_transpose: out of memory");
+    /* the deformation's point order (apply's scratch holds v) */
+    for (size_t i = 0; i < w->n_fixed; ++i)
+        memcpy(w->pts + 3 * i, v + 3 * w->fixed[i], 3 * sizeof(double));
+    for (size_t i = 0; i < w->n_free; ++i)
+        memcpy(w->pts + 3 * (w->n_fixed + i), v + 3 * w->free_nodes[i], 3 * sizeof(double));
+    cm_status s = cm_deform_apply_transpose(ctx, w->def, w->pts, op);
+    if (s >= 0)
+        for (size_t i = 0; i < w->n_fixed; ++i)
+            for (int k = 0; k < 3; ++k)
+                out[3 * w->fixed[i] + k] += op[3 * i + k];
+    free(op);
+    return s < 0 ? cm_error_prefix(ctx, s, "cm_warp_apply_transpose: dmffd") : s;
+}
+
+const cm_warp_method_ops cm_warp_dmffd = {"dmffd",       dmffd_create, dmffd_apply,
+                                          dmffd_destroy, NULL,         dmffd_apply_transpose};

@@ -14,7 +14,10 @@
  * triangle with the cell's centroid (mean of its distinct nodes) gives a P1 tet; the
  * centroid is an extra unknown of the system, dropped after the solve.
  * Quadratic cells (tet10, hex20, ...) are not supported: their mid-side nodes are in no
- * linear element. */
+ * linear element.
+ * Reverse product (docs/DESIGN.md, "Gradients"): J_f = -K_II^-1 K_IB and K_II is symmetric,
+ * so J^T v = v_B - K_IB^T K_II^-1 v_I: one solve with the kept factor, all three components
+ * as the columns of one right-hand side, and one transposed product with the kept K_IB. */
 #include "warp_method.h"
 
 #include <cholmod.h>
@@ -415,5 +418,38 @@ static cm_status femwarp_apply(cm_context *ctx, void *state, double *disp, doubl
     return CM_OK;
 }
 
-const cm_warp_method_ops cm_warp_femwarp = {"femwarp", femwarp_create, femwarp_apply,
-                                            femwarp_destroy, NULL, NULL};
+static cm_status femwarp_apply_transpose(cm_context *ctx, void *state, const double *v, double *out)
+{
+    femwarp *w = state;
+    const cm_warp_nodes *n = w->nodes;
+    cm_warp_nodes_add_identity(n, v, out);
+    if (w->n_dof == 0) return CM_OK;
+    size_t nb = n->n_fixed ? n->n_fixed : 1;
+    /* apply's buffers: the two products never run at once on one warp (warp.h) */
+    if (!w->db) w->db = cholmod_l_zeros(nb, 3, CHOLMOD_REAL, &w->cc);
+    if (!w->rhs) w->rhs = cholmod_l_zeros(w->n_dof, 3, CHOLMOD_REAL, &w->cc);
+    int ok = w->db && w->rhs;
+    if (ok) {
+        double *r = w->rhs->x;
+        /* the polyhedron centroids are dropped by apply: nothing of v reaches them */
+        memset(r, 0, 3 * w->n_dof * sizeof *r);
+        for (size_t i = 0; i < n->n_free; ++i)
+            for (int k = 0; k < 3; ++k)
+                r[i + k * w->n_dof] = v[3 * n->free_nodes[i] + k];
+        double minus_one[2] = {-1, 0}, zero[2] = {0, 0};
+        ok = cholmod_l_solve2(CHOLMOD_A, w->L, w->rhs, NULL, &w->x, NULL, &w->y, &w->e, &w->cc) &&
+             cholmod_l_sdmult(w->kib, 1, minus_one, zero, w->x, w->db, &w->cc);
+    }
+    if (!ok)
+        return cm_error(ctx, w->cc.status == CHOLMOD_OUT_OF_MEMORY ? CM_ERR_NOMEM : CM_ERR_NUMERIC,
+                        "cm_warp_apply_transpose: femwarp: CHOLMOD solve failed (status %d)",
+                        w->cc.status);
+    const double *g = w->db->x;
+    for (size_t j = 0; j < n->n_fixed; ++j)
+        for (int k = 0; k < 3; ++k)
+            out[3 * n->fixed_nodes[j] + k] += g[j + k * nb];
+    return CM_OK;
+}
+
+const cm_warp_method_ops cm_warp_femwarp = {
+    "femwarp", femwarp_create, femwarp_apply, femwarp_destroy, NULL, femwarp_apply_transpose};

@@ -21,7 +21,12 @@
  * is not symmetric, so CHOLMOD does not apply), with a METIS ordering. A preconditioned Krylov
  * method (BiCGSTAB with ILU) would need less memory on very large meshes but a tolerance and an
  * iteration count per step; at the sizes of the paper's benchmarks the direct factor is cheaper
- * over a study. */
+ * over a study.
+ * Reverse product (docs/DESIGN.md, "Gradients"): apply is d_I = (I - W_II)^-1 W_IB d_B, linear
+ * in d_B (the fallback nodes only change which weights enter the matrices), so
+ * J^T v = v_B + W_IB^T (I - W_II)^-T v_I: a transposed solve with the kept LU factor per
+ * component, then each free node hands its result back to its constrained neighbours with
+ * its weights. */
 #include "warp_method.h"
 
 #include <umfpack.h>
@@ -428,5 +433,36 @@ static cm_status lbwarp_apply(cm_context *ctx, void *state, double *disp, double
     return CM_OK;
 }
 
-const cm_warp_method_ops cm_warp_lbwarp = {"lbwarp", lbwarp_create, lbwarp_apply, lbwarp_destroy,
-                                           lbwarp_fallback_nodes, NULL};
+static cm_status lbwarp_apply_transpose(cm_context *ctx, void *state, const double *v, double *out)
+{
+    lbwarp *w = state;
+    const cm_warp_nodes *nd = w->nodes;
+    cm_warp_nodes_add_identity(nd, v, out);
+    size_t nf = nd->n_free;
+    if (nf == 0) return CM_OK;
+    double control[UMFPACK_CONTROL], info[UMFPACK_INFO];
+    umfpack_dl_defaults(control);
+    control[UMFPACK_PRL] = 0;
+    control[UMFPACK_IRSTEP] = 0; /* as apply: the factor alone, so the two stay transposes */
+    for (int k = 0; k < 3; ++k) {
+        for (size_t i = 0; i < nf; ++i)
+            w->b[i] = v[3 * nd->free_nodes[i] + k];
+        /* UMFPACK_At solves A^T x = b with the factor of A (real: the same as UMFPACK_Aat) */
+        SuiteSparse_long st = umfpack_dl_solve(UMFPACK_At, w->ap, w->ai, w->ax, w->x, w->b,
+                                               w->numeric, control, info);
+        if (st != UMFPACK_OK)
+            return cm_error(ctx, CM_ERR_NUMERIC,
+                            "cm_warp_apply_transpose: lbwarp: UMFPACK solve failed (status %ld)",
+                            (long)st);
+        for (size_t i = 0; i < nf; ++i)
+            for (int64_t p = w->ib_start[i]; p < w->ib_start[i + 1]; ++p)
+                out[3 * w->ib_node[p] + k] += w->ib_w[p] * w->x[i];
+        cm_status p = cm_progress(ctx, "warp transpose", k + 1, 3);
+        if (p < 0) return p;
+    }
+    return CM_OK;
+}
+
+const cm_warp_method_ops cm_warp_lbwarp = {
+    "lbwarp",       lbwarp_create,         lbwarp_apply,
+    lbwarp_destroy, lbwarp_fallback_nodes, lbwarp_apply_transpose};

@@ -61,11 +61,19 @@ typedef struct cm_warp_nodes {
     int64_t *fixed_index; /* #nodes: index among the fixed nodes, -1 for the others */
     int64_t *free_nodes;  /* n_free node ids, ascending */
     int64_t *fixed_nodes; /* n_fixed node ids, ascending */
+    /* constrained nodes of no volume cell: apply leaves them as they are, so the warp is the
+     * identity there and its transpose hands v back */
+    size_t n_loose;
+    int64_t *loose_nodes;
 } cm_warp_nodes;
 
 cm_status cm_warp_nodes_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                                const unsigned char *constrained, cm_warp_nodes **nodes);
 void cm_warp_nodes_destroy(cm_warp_nodes **nodes);
+
+/* The part of J^T v that every mesh-based method shares: apply keeps the prescribed value
+ * at every constrained node (fixed and loose), so out += v there. */
+void cm_warp_nodes_add_identity(const cm_warp_nodes *nodes, const double *v, double *out);
 
 /* Whether cell c is a volume cell (dimension 3). */
 int cm_warp_is_volume_cell(const cm_mesh *mesh, size_t c);

@@ -1,7 +1,11 @@
 /* The MLS warp method: deform.h's mls deformation, one constrained MLS space deformation
  * (mls.h) over the whole mesh, every component at once, with the options of
  * cm_warp_options.mls. Approximate: the constrained nodes keep their prescribed displacement
- * and the apply reports how far the field missed them. */
+ * and the apply reports how far the field missed them.
+ * Reverse product (docs/DESIGN.md, "Gradients"): the constrained MLS is linear in the
+ * prescribed displacement (a penalty, not a hard constraint: eq. 14's right-hand side is
+ * linear in it, its matrix, Phi and the residual blend depend only on the positions), so
+ * J^T v is deform.h's transposed MLS: one solve with the kept factor. */
 #include "warp_method.h"
 
 #include "cadmorph/deform.h"
@@ -47,4 +51,13 @@ static void mls_destroy(void *state)
     cm_deform_destroy(&d);
 }
 
-const cm_warp_method_ops cm_warp_mls = {"mls", mls_create, mls_apply, mls_destroy, NULL, NULL};
+/* MLS writes every node (warp.h: v is read where apply writes), so deform.h's J^T v over all
+ * nodes is the warp's */
+static cm_status mls_apply_transpose(cm_context *ctx, void *state, const double *v, double *out)
+{
+    cm_status s = cm_deform_apply_transpose(ctx, state, v, out);
+    return s < 0 ? cm_error_prefix(ctx, s, "cm_warp_apply_transpose") : s;
+}
+
+const cm_warp_method_ops cm_warp_mls = {"mls",       mls_create, mls_apply,
+                                        mls_destroy, NULL,       mls_apply_transpose};

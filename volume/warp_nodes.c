@@ -42,6 +42,7 @@ void cm_warp_nodes_destroy(cm_warp_nodes **nodes)
     free((*nodes)->fixed_index);
     free((*nodes)->free_nodes);
     free((*nodes)->fixed_nodes);
+    free((*nodes)->loose_nodes);
     free(*nodes);
     *nodes = NULL;
 }
@@ -92,17 +93,24 @@ cm_status cm_warp_nodes_create(cm_context *ctx, const cm_mesh *mesh, const cm_me
                 ++w->n_free;
         } else if (!constrained[v]) {
             ++stray;
+        } else {
+            ++w->n_loose;
         }
     }
     w->free_index = malloc((nn ? nn : 1) * sizeof *w->free_index);
     w->fixed_index = malloc((nn ? nn : 1) * sizeof *w->fixed_index);
     w->free_nodes = malloc((w->n_free ? w->n_free : 1) * sizeof *w->free_nodes);
     w->fixed_nodes = malloc((w->n_fixed ? w->n_fixed : 1) * sizeof *w->fixed_nodes);
-    if (!w->free_index || !w->fixed_index || !w->free_nodes || !w->fixed_nodes) goto nomem;
-    size_t nf = 0, nx = 0;
+    w->loose_nodes = malloc((w->n_loose ? w->n_loose : 1) * sizeof *w->loose_nodes);
+    if (!w->free_index || !w->fixed_index || !w->free_nodes || !w->fixed_nodes || !w->loose_nodes)
+        goto nomem;
+    size_t nf = 0, nx = 0, nl = 0;
     for (size_t v = 0; v < nn; ++v) {
         w->free_index[v] = w->fixed_index[v] = -1;
-        if (!in_cell[v]) continue;
+        if (!in_cell[v]) {
+            if (constrained[v]) w->loose_nodes[nl++] = (int64_t)v;
+            continue;
+        }
         if (constrained[v]) {
             w->fixed_index[v] = (int64_t)nx;
             w->fixed_nodes[nx++] = (int64_t)v;
@@ -127,4 +135,14 @@ nomem:
     free(buf);
     cm_warp_nodes_destroy(&w);
     return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+}
+
+void cm_warp_nodes_add_identity(const cm_warp_nodes *nodes, const double *v, double *out)
+{
+    for (size_t j = 0; j < nodes->n_fixed; ++j)
+        for (int k = 0; k < 3; ++k)
+            out[3 * nodes->fixed_nodes[j] + k] += v[3 * nodes->fixed_nodes[j] + k];
+    for (size_t j = 0; j < nodes->n_loose; ++j)
+        for (int k = 0; k < 3; ++k)
+            out[3 * nodes->loose_nodes[j] + k] += v[3 * nodes->loose_nodes[j] + k];
 }

@@ -8,6 +8,9 @@
 // coordinates are >= 0. A query beyond a hull face is outside every tet; it gets
 // the tet with the largest smallest coordinate, used with its (partly negative) coordinates:
 // counted, logged (CM_LOG_DEBUG), cm_warp_fallback_nodes. Exceptions stop here (STYLE 8).
+// Reverse product (docs/DESIGN.md, "Gradients"): a free node is a fixed combination of four
+// constrained ones, so J^T v hands each free node's v back to its corners with the same
+// barycentric weights (the fallback's negative ones included).
 #include "cadmorph/kdtree.h"
 
 extern "C" {
@@ -361,7 +364,25 @@ cm_status simplex_apply(cm_context *, void *state, double *disp, double *residua
     return CM_OK;
 }
 
+// Nothing here allocates or throws: no try block is needed at this boundary.
+cm_status simplex_apply_transpose(cm_context *, void *state, const double *v, double *out)
+{
+    const simplex_warp *w = static_cast<const simplex_warp *>(state);
+    const cm_warp_nodes &n = *w->nodes;
+    cm_warp_nodes_add_identity(&n, v, out);
+    for (size_t i = 0; i < n.n_free; ++i) {
+        const double *vi = v + 3 * n.free_nodes[i];
+        for (int k = 0; k < 4; ++k) {
+            double *oc = out + 3 * w->corner[4 * i + k];
+            for (int j = 0; j < 3; ++j)
+                oc[j] += w->bary[4 * i + k] * vi[j];
+        }
+    }
+    return CM_OK;
+}
+
 } // namespace
 
-extern "C" const cm_warp_method_ops cm_warp_simplex = {"simplex", simplex_create, simplex_apply,
-                                                       simplex_destroy, simplex_fallback_nodes, NULL};
+extern "C" const cm_warp_method_ops cm_warp_simplex = {
+    "simplex",       simplex_create,         simplex_apply,
+    simplex_destroy, simplex_fallback_nodes, simplex_apply_transpose};

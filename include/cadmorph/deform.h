@@ -111,6 +111,14 @@ CM_API size_t cm_ffd_basis_eval(const cm_ffd *ffd, const double u[3], int64_t *i
 CM_API cm_status cm_ffd_deform(cm_context *ctx, const cm_ffd *ffd, const double *dc, size_t n,
                         const double *x, double *d, cm_ffd_stats *stats);
 
+/* The transpose of cm_ffd_deform in dc, for reverse products: gdc (#ctrl x 3, overwritten) =
+ * sum_i N_p(u(x_i)) v_i over the points inside the lattice (v: n x 3); outside and failed
+ * points send nothing, as they get 0 from cm_ffd_deform (failed ones counted, CM_WARNING).
+ * stats may be NULL. */
+CM_API cm_status cm_ffd_deform_transpose(cm_context *ctx, const cm_ffd *ffd, size_t n,
+                                         const double *x, const double *v, double *gdc,
+                                         cm_ffd_stats *stats);
+
 /* ---- DM-FFD ---- */
 
 typedef struct cm_dmffd_options {
@@ -145,6 +153,13 @@ CM_API void cm_dmffd_destroy(cm_dmffd **dm);
  * (exactly 0 for control points no handle touches). Least norm when under-determined, least
  * squares when over-determined; the residual goes into the info. */
 CM_API cm_status cm_dmffd_solve(cm_context *ctx, cm_dmffd *dm, const double *h, double *dc);
+
+/* The transpose of cm_dmffd_solve, for reverse products: gh (m x 3) = (Phi^+)^T gdc, gdc:
+ * #ctrl x 3 (control points no handle touches do not enter, as solve gives them 0). Phi^+
+ * is the truncated pseudo-inverse of create, fixed by the handle positions and eps: solve
+ * is linear in h, and this is its exact transpose. The info is left as it is. */
+CM_API cm_status cm_dmffd_solve_transpose(cm_context *ctx, const cm_dmffd *dm, const double *gdc,
+                                          double *gh);
 
 CM_API void cm_dmffd_get_info(const cm_dmffd *dm, cm_dmffd_info *info);
 
@@ -255,6 +270,16 @@ CM_API void cm_deform_destroy(cm_deform **def);
  * A CM_WARNING of the method (dmffd: points Newton could not locate) is returned after the
  * work is done. Not concurrently on one deformation. */
 CM_API cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double *residual);
+
+/* The reverse product of apply (docs/DESIGN.md, "Gradients"), for the methods whose apply is
+ * linear in the prescribed displacements: out = J^T v, <v, apply(D)> = <out, D> for every D.
+ * v: n x 3, read at the points apply writes; out: n x 3, written everywhere (for dmffd: at a
+ * constrained point v there plus what the free points send back, 0 at the free points).
+ * v and out must not overlap. dmffd: its solve (a fixed truncated pseudo-inverse) and its
+ * evaluation are linear. CM_ERR_UNSUPPORTED for a method without one (the message says why);
+ * a CM_WARNING as apply's. */
+CM_API cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
+                                           double *out);
 
 typedef struct cm_deform_stats {
     cm_deform_method method;

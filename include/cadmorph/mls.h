@@ -89,6 +89,14 @@ CM_API void cm_mls_destroy(cm_mls **mls);
  * nodes (may be NULL). One factorisation, any number of calls (not concurrently). */
 CM_API cm_status cm_mls_apply(cm_context *ctx, cm_mls *mls, double *disp, double *residual);
 
+/* The reverse product of apply (docs/DESIGN.md, "Gradients"): apply is linear in the
+ * prescribed values (the right-hand side of eq. 14 is, the factor, Phi and the blend's
+ * weights depend only on the positions), so out = J^T v, <v, apply(D)> = <out, D> for every
+ * D. v: #nodes x 3, read everywhere; out: #nodes x 3, written everywhere (0 at free nodes).
+ * One solve with the kept factor, all three components at once. Not concurrently with apply
+ * on one MLS. */
+CM_API cm_status cm_mls_apply_transpose(cm_context *ctx, cm_mls *mls, const double *v, double *out);
+
 typedef struct cm_mls_stats {
     size_t samples, surface_samples, cubature, constrained;
     size_t phi_nonzeros;    /* shape-function values stored for the nodes */

@@ -97,12 +97,14 @@ CM_API cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
 
 /* The reverse product of apply, for adjoint gradients (docs/DESIGN.md, "Gradients"). For the
  * methods whose apply is linear in the prescribed displacement D (rbf, rbf-biharmonic,
- * femwarp, lbwarp, simplex), apply computes J D: D itself at the constrained nodes, J_f D at
- * the other nodes it writes. This computes the transpose: out = J^T v, that is
- * <v, apply(D)> = <out, D> for every D.
+ * femwarp, lbwarp, simplex; dmffd, whose truncated pseudo-inverse is fixed by create; mls,
+ * whose constraints are a quadratic penalty), apply computes J D: D itself at the constrained
+ * nodes, J_f D at the other nodes it writes. This computes the transpose: out = J^T v, that
+ * is <v, apply(D)> = <out, D> for every D.
  * v: #nodes x 3, read at the nodes apply writes (constrained nodes, and unconstrained nodes
- * of volume cells). out: #nodes x 3, written everywhere: at a constrained node v there plus
- * what the other nodes' v sends back to it through the warp, 0 at every other node. The
+ * of volume cells; mls: every node). out: #nodes x 3, written everywhere: at a constrained
+ * node v there plus what the other nodes' v sends back to it through the warp (mls with
+ * keep_constrained = 0: only the latter), 0 at every other node. The
  * three components in one call, with the factorisation (or preconditioner) of create; v and
  * out must not overlap. An iterative RBF solve is exact to the warp's tolerance, like apply.
  * CM_ERR_UNSUPPORTED for a method whose apply is not linear in D (the message says why). */
