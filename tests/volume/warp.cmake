@@ -29,3 +29,9 @@ set_tests_properties(test_warp_staten PROPERTIES FIXTURES_REQUIRED warp_staten)
 # Stopping on request (cm_context_interrupt): every warp method and the optimiser on the
 # bore's O-grid, stopped at each progress point, then run again (cm_hexmesh_bore: study/)
 cm_add_unit_test(test_warp_interrupt test_warp_interrupt.c LIBS cm_volume cm_study)
+
+# The reverse product of the mesh-based warps and of dmffd and mls (cm_warp_apply_transpose):
+# the dot-product test and the linearity it rests on, on blocks, two components, polyhedra,
+# the bore's O-grid (cm_hexmesh_bore: study/) and the mixed mesh of warp_staten.py setup
+cm_add_unit_test(test_warp_transpose test_warp_transpose.c LIBS cm_volume cm_study LABELS volume)
+set_tests_properties(test_warp_transpose PROPERTIES FIXTURES_REQUIRED warp_staten)
