@@ -1,5 +1,6 @@
 """Warp: a volume warp of a mesh, factorised once (cm_warp_create), applied to any motion of
-its constrained nodes (cm_warp_apply); warp(): the one-shot form.
+its constrained nodes (cm_warp_apply) and, for adjoint gradients, its reverse product
+(cm_warp_apply_transpose); warp(): the one-shot form.
 
 A warp carries a prescribed displacement of some nodes (by default the boundary nodes) into
 every other node of the volume cells, by one of the library's methods (docs/DESIGN.md, "The
@@ -136,6 +137,32 @@ class Warp:
             with self._lock:
                 self._ctx.call(lib.cm_warp_apply, self._warp, ffi.from_buffer("double[]", out))
         return out
+
+    def apply_transpose(self, V: Any) -> np.ndarray:
+        """The reverse product of apply, for adjoint gradients (docs/DESIGN.md, "Gradients"):
+        apply is a linear map J from D (len(nodes), 3) to the displacement of every node
+        (n_nodes, 3); this is its transpose, J^T V, a (len(nodes), 3) float64 array whose row
+        k belongs to nodes[k] (apply's D layout), such that
+
+            np.vdot(V, w.apply(D)) == np.vdot(w.apply_transpose(V), D)
+
+        for every D (to round-off). V: an array-like (n_nodes, 3), e.g. the sensitivity dJ/dX
+        of an objective at every node (then J^T V is dJ/dD, the sensitivity to the motion of
+        the constrained nodes); finite (else ValueError). Rows of nodes that apply leaves at 0
+        (nodes of no volume cell that are not constrained) are not read. One solve with the
+        factorisation of the warp, the three components at once; a float64 C-contiguous V is
+        passed to the library without a copy.
+
+        Raises BadInputError (the library's CM_ERR_UNSUPPORTED, its message naming the
+        method and why) for a method whose apply is not linear in D.
+        """
+        v = points("cadmorph.Warp.apply_transpose", "V", V, self._n)
+        out = np.zeros((self._n, 3), np.float64)
+        if self._n:
+            with self._lock:
+                self._ctx.call(lib.cm_warp_apply_transpose, self._warp,
+                               ffi.from_buffer("double[]", v), ffi.from_buffer("double[]", out))
+        return out[self._nodes]
 
     def __repr__(self) -> str:
         return "<cadmorph.Warp %s, %d nodes, %d constrained>" % (self.method, self._n,
