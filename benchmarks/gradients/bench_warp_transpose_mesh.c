@@ -1,0 +1,164 @@
+/* The reverse product of the mesh-based warps against their forward product: for one mesh and
+ * each method, one warp is created on M0 (assembly + factorisation), then apply (J D, a smooth
+ * boundary motion) and apply_transpose (J^T V, a random V at every node) run alternately
+ * `reps` times on it, so that both see the same load; the figure is the ratio of the medians
+ * (RESULTS.md, "Gradients"). A dot-product line checks that the two are transposes on this
+ * mesh. BENCH_VERBOSE=1 shows the library's log on stderr.
+ * usage: bench_warp_transpose_mesh MESH [reps=10] [threads=2] [methods=femwarp,lbwarp]
+ * One line per method: key=value pairs. */
+#define _POSIX_C_SOURCE 200809L
+#include "blas_reexec.h"
+#include "cadmorph/mesh.h"
+#include "cadmorph/warp.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    return clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts)
+               ? 0
+               : (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *t, int n)
+{
+    qsort(t, (size_t)n, sizeof *t, cmp_double);
+    return n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]);
+}
+
+static void log_stderr(void *user, cm_log_level level, const char *message)
+{
+    (void)user;
+    (void)level;
+    fprintf(stderr, "  %s\n", message);
+}
+
+static int run(cm_context *ctx, const cm_mesh *m, const cm_mesh_boundary *b, const char *path,
+               cm_warp_method method, int reps)
+{
+    size_t nn = m->n_nodes, n3 = 3 * nn;
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+    for (size_t v = 0; v < nn; ++v)
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = fmin(lo[d], m->xyz[3 * v + d]);
+            hi[d] = fmax(hi[d], m->xyz[3 * v + d]);
+        }
+    /* bench_warp's motion: smooth, non-affine, 3 % of the diagonal */
+    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double *d0 = calloc(n3, sizeof *d0), *d = malloc(n3 * sizeof *d);
+    double *v = malloc(n3 * sizeof *v), *out = malloc(n3 * sizeof *out);
+    for (size_t i = 0; i < b->n_nodes; ++i) {
+        const double *x = m->xyz + 3 * b->nodes[i];
+        double u[3];
+        for (int k = 0; k < 3; ++k)
+            u[k] = (x[k] - lo[k]) / (hi[k] - lo[k] > 0 ? hi[k] - lo[k] : 1);
+        double *o = d0 + 3 * b->nodes[i];
+        o[0] = 0.03 * diag * sin(3.14159265358979323846 * u[1]) * u[2];
+        o[1] = 0.03 * diag * sin(3.14159265358979323846 * u[2]) * u[0];
+        o[2] = 0.03 * diag * sin(3.14159265358979323846 * u[0]) * u[1];
+    }
+    uint64_t s64 = 12345;
+    for (size_t i = 0; i < n3; ++i) { /* xorshift: a V that every node's row sees */
+        s64 ^= s64 << 13, s64 ^= s64 >> 7, s64 ^= s64 << 17;
+        v[i] = (double)(s64 >> 11) / 9007199254740992.0 - 0.5;
+    }
+    cm_warp_options opt;
+    cm_warp_options_init(&opt);
+    opt.method = method;
+    cm_warp *w = NULL;
+    double t0 = cm_wtime();
+    cm_status s = cm_warp_create(ctx, m, b, NULL, &opt, &w);
+    double t_create = cm_wtime() - t0;
+    double *ta = malloc((size_t)reps * sizeof *ta), *tt = malloc((size_t)reps * sizeof *tt);
+    double *ca = malloc((size_t)reps * sizeof *ca), *ct = malloc((size_t)reps * sizeof *ct);
+    /* one of each first: CHOLMOD allocates its solve workspace on the first call */
+    memcpy(d, d0, n3 * sizeof *d);
+    if (s >= 0) s = cm_warp_apply(ctx, w, d);
+    if (s >= 0) s = cm_warp_apply_transpose(ctx, w, v, out);
+    for (int r = 0; r < reps && s >= 0; ++r) {
+        memcpy(d, d0, n3 * sizeof *d);
+        double a = cm_wtime(), ac = cpu_seconds();
+        s = cm_warp_apply(ctx, w, d);
+        ta[r] = cm_wtime() - a, ca[r] = cpu_seconds() - ac;
+        if (s < 0) break;
+        a = cm_wtime(), ac = cpu_seconds();
+        s = cm_warp_apply_transpose(ctx, w, v, out);
+        tt[r] = cm_wtime() - a, ct[r] = cpu_seconds() - ac;
+    }
+    if (s < 0) {
+        fprintf(stderr, "bench_warp_transpose_mesh: %s: %s\n", cm_warp_method_name(method),
+                cm_context_message(ctx));
+    } else {
+        /* <V, J D> against <J^T V, D> (D is d0: zero off the boundary) */
+        double lhs = 0, rhs = 0, scale = 0;
+        for (size_t i = 0; i < n3; ++i) {
+            lhs += v[i] * d[i];
+            rhs += out[i] * d0[i];
+            scale += fabs(v[i] * d[i]);
+        }
+        double apply_s = median(ta, reps), vjp_s = median(tt, reps);
+        double apply_cpu = median(ca, reps), vjp_cpu = median(ct, reps);
+        printf("mesh=%s nodes=%zu constrained=%zu method=%s create_s=%.3f apply_s=%.5f "
+               "vjp_s=%.5f ratio=%.3f apply_cpu=%.5f vjp_cpu=%.5f cpu_ratio=%.3f "
+               "dot_err=%.1e reps=%d\n",
+               path, nn, b->n_nodes, cm_warp_method_name(method), t_create, apply_s, vjp_s,
+               vjp_s / apply_s, apply_cpu, vjp_cpu, vjp_cpu / apply_cpu, fabs(lhs - rhs) / scale,
+               reps);
+        fflush(stdout);
+    }
+    cm_warp_destroy(&w);
+    free(d0), free(d), free(v), free(out), free(ta), free(tt), free(ca), free(ct);
+    return s < 0 ? 2 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
+    if (argc < 2) {
+        fprintf(stderr, "usage: bench_warp_transpose_mesh MESH [reps] [threads] [methods]\n");
+        return 1;
+    }
+    int reps = argc > 2 ? atoi(argv[2]) : 10, threads = argc > 3 ? atoi(argv[3]) : 2;
+    if (reps < 1) reps = 1;
+    char methods[256];
+    snprintf(methods, sizeof methods, "%s", argc > 4 ? argv[4] : "femwarp,lbwarp");
+    cm_context *ctx = NULL;
+    cm_context_create(&ctx);
+    cm_context_set_threads(ctx, threads);
+    if (getenv("BENCH_VERBOSE")) cm_context_set_log(ctx, log_stderr, NULL);
+    cm_mesh *m = NULL;
+    cm_mesh_boundary *b = NULL;
+    cm_status s = cm_mesh_read(ctx, argv[1], &m);
+    if (s >= 0) s = cm_mesh_boundary_create(ctx, m, &b);
+    if (s < 0) {
+        fprintf(stderr, "bench_warp_transpose_mesh: %s\n", cm_context_message(ctx));
+        return 2;
+    }
+    int rc = 0;
+    for (char *tok = strtok(methods, ","); tok; tok = strtok(NULL, ",")) {
+        int mth = cm_warp_method_from_name(tok);
+        if (mth < 0) {
+            fprintf(stderr, "bench_warp_transpose_mesh: unknown method '%s' (%s)\n", tok,
+                    cm_warp_method_list());
+            rc = 1;
+            break;
+        }
+        if (run(ctx, m, b, argv[1], (cm_warp_method)mth, reps)) rc = 2;
+    }
+    cm_mesh_boundary_destroy(&b);
+    cm_mesh_destroy(&m);
+    cm_context_destroy(&ctx);
+    return rc;
+}
