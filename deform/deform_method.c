@@ -32,10 +32,9 @@ typedef struct deform_row {
     int needs_mesh;
     cm_status (*create)(cm_context *ctx, cm_deform *d, const double *xyz);
     cm_status (*apply)(cm_context *ctx, cm_deform *d, double *disp, double *residual);
-    /* cm_deform_apply_transpose: out (n x 3) is zeroed by the caller; NULL: none (why_not
-     * says why) */
+    /* cm_deform_apply_transpose: out (n x 3) is zeroed by the dispatcher; the row adds J^T v
+     * at the constrained points. NULL: no transpose (apply not linear, or not written). */
     cm_status (*apply_transpose)(cm_context *ctx, cm_deform *d, const double *v, double *out);
-    const char *why_not;
 } deform_row;
 
 /* ---- shared by rbf and dmffd: the points split into constrained and free ones ---- */
@@ -185,7 +184,7 @@ static cm_status dmffd_apply_transpose(cm_context *ctx, cm_deform *d, const doub
         for (size_t i = 0, a = 0; i < d->n; ++i)
             if (d->constrained[i]) {
                 for (int k = 0; k < 3; ++k)
-                    out[3 * i + k] = v[3 * i + k] + gh[3 * a + k];
+                    out[3 * i + k] += v[3 * i + k] + gh[3 * a + k];
                 ++a;
             }
     free(vf);
@@ -235,12 +234,10 @@ static cm_status shell_apply(cm_context *ctx, cm_deform *d, double *disp, double
 
 /* One row per cm_deform_method, in enum order. */
 static const deform_row rows[CM_DEFORM_N_METHODS] = {
-    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply, NULL,
-                       "its reverse product is not implemented at this level"},
-    [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply, mls_apply_transpose, NULL},
-    [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply, NULL,
-                         "its reverse product is not implemented"},
-    [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply, dmffd_apply_transpose, NULL},
+    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply, NULL},
+    [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply, mls_apply_transpose},
+    [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply, NULL},
+    [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply, dmffd_apply_transpose},
 };
 
 const char *cm_deform_method_name(cm_deform_method method)
@@ -333,15 +330,16 @@ cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double 
     return s;
 }
 
-cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v, double *out)
+cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
+                                    double *out)
 {
     if (!def || !v || !out)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_transpose: def, v or out is NULL");
     if (!def->row->apply_transpose)
-        return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_deform_apply_transpose: %s: %s",
-                        def->row->name, def->row->why_not);
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "cm_deform_apply_transpose: method %s has no transpose", def->row->name);
     size_t n3 = 3 * def->n;
-    if (v < out + n3 && out < v + n3)
+    if (n3 && v < out + n3 && out < v + n3)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_transpose: v and out overlap");
     memset(out, 0, n3 * sizeof *out);
     return def->row->apply_transpose(ctx, def, v, out);

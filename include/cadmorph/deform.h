@@ -271,13 +271,16 @@ CM_API void cm_deform_destroy(cm_deform **def);
  * work is done. Not concurrently on one deformation. */
 CM_API cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double *residual);
 
-/* The reverse product of apply (docs/DESIGN.md, "Gradients"), for the methods whose apply is
- * linear in the prescribed displacements: out = J^T v, <v, apply(D)> = <out, D> for every D.
- * v: n x 3, read at the points apply writes; out: n x 3, written everywhere (for dmffd: at a
- * constrained point v there plus what the free points send back, 0 at the free points).
- * v and out must not overlap. dmffd: its solve (a fixed truncated pseudo-inverse) and its
- * evaluation are linear. CM_ERR_UNSUPPORTED for a method without one (the message says why);
- * a CM_WARNING as apply's. */
+/* The reverse product of apply, for adjoint gradients (docs/DESIGN.md, "Gradients"), for a
+ * method whose apply is linear in the constrained values D: apply maps D to J D (D at the
+ * constrained points, J_f D at the free ones); this computes out = J^T v, so that
+ * <v, apply(D)> = <out, D>. v: n x 3, read at every point; out: n x 3, written everywhere:
+ * v plus J_f^T v_free at the constrained points, 0 at the free ones (mls with
+ * keep_constrained = 0, whose apply gives the constrained points the field's value: J^T v
+ * of that map). dmffd: the transposed FFD and pseudo-inverse (cm_ffd_deform_transpose,
+ * cm_dmffd_solve_transpose: the truncation is fixed by create, so apply is linear); mls:
+ * cm_mls_apply_transpose (its constraints are a penalty: linear). Other methods:
+ * CM_ERR_UNSUPPORTED. v and out must not overlap. Not concurrently on one deformation. */
 CM_API cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
                                            double *out);
 
