@@ -119,6 +119,18 @@ x0 = foam_case.read_points(base)
 walls = foam_case.patch_points(base, foam_case.WALLS)
 ends = foam_case.patch_points(base, ("inlet", "outlet"))
 n_cells = int(open(os.path.join(base, "log.checkMesh")).read().split("cells:")[1].split()[0])
+# dJdXs.csv numbers nodes by OpenFOAM point label: cadmorph must read a polyMesh's nodes in
+# the order of its points file. Checked with the build's Python package when it is there.
+pkg = os.path.join(os.path.dirname(os.path.dirname(cli)), "python")
+node_order = "not checked (no Python package beside the CLI)"
+if os.path.isfile(os.path.join(pkg, "cadmorph", "__init__.py")):
+    sys.path.insert(0, pkg)
+    import cadmorph  # noqa: E402
+
+    if not np.array_equal(np.asarray(cadmorph.read_mesh(base).points), x0):
+        sys.exit(print("run_adjoint_example: cadmorph's nodes are not the polyMesh's points in "
+                       "file order", file=sys.stderr) or 2)
+    node_order = "cadmorph's node i is OpenFOAM's point i (checked)"
 
 # 2. the adjoint on M0 (its own primal first)
 run(["adjointOptimisationFoam"], cwd=base, log="log.adjointOptimisationFoam")
@@ -191,6 +203,7 @@ print("adjointOptimisationFoam: converged in %s iterations (primal, adjoint); la
                                                     adj_res["Uax"], adj_res["pa"]))
 print("J(M0): adjointOptimisationFoam %.12g, simpleFoam %.12g (rel. diff %.1e)"
       % (j0_adjoint, j0, abs(j0 - j0_adjoint) / abs(j0)))
+print("node numbering: " + node_order)
 hdr = ("parameter", "delta", "J(p-d)", "J(p+d)", "FD dJ/dp", "adjoint S.V", "adjoint Sn.V",
        "cadmorph sensitivity", "rel.diff S.V vs FD")
 print(" | ".join(hdr))
