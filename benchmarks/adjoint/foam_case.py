@@ -22,7 +22,7 @@ writeFormat ascii; writePrecision 17; writeCompression off; timeFormat general;
 timePrecision 6; runTimeModifiable false;
 functions {
   ptot { type pressure; libs ("libfieldFunctionObjects.so"); mode total; rho rhoInf;
-         rhoInf 1; pRef 0; result ptot; log false; }
+         rhoInf 1; pRef 0; result ptot; log false; writeControl writeTime; }
   inletPt { type surfaceFieldValue; libs ("libfieldFunctionObjects.so"); regionType patch;
             name inlet; operation weightedAreaIntegrate; weightField U; fields (ptot);
             writeFields false; log false; }
