@@ -149,6 +149,7 @@ def _list_body(text: str, start: int = 0):
 
 
 def _vectors(n: int, body: str) -> np.ndarray:
+    """The n vectors "(x y z)" of a list body as an (n, 3) array."""
     v = np.array(body.replace("(", " ").replace(")", " ").split(), dtype=float).reshape(-1, 3)
     if v.shape[0] != n:
         raise ValueError("expected %d vectors, read %d" % (n, v.shape[0]))
@@ -194,7 +195,7 @@ def patch_points(case: str, names) -> np.ndarray:
     return np.array(sorted(pts), dtype=np.int64)
 
 
-def last_row(path: str):
+def last_row(path: str) -> list:
     """The numbers of the last row of an OpenFOAM .dat file."""
     with open(path) as f:
         rows = [r.split() for r in f if r.strip() and not r.startswith("#")]
@@ -212,7 +213,7 @@ def primal_objective(case: str) -> float:
     return -(vals["inletPt"] + vals["outletPt"])
 
 
-def final_residuals(log: str, fields):
+def final_residuals(log: str, fields) -> tuple:
     """The iteration count and each field's last initial residual in a solver log."""
     with open(log) as f:
         t = f.read()

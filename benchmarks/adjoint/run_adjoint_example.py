@@ -68,8 +68,9 @@ os.makedirs(work)
 seconds = {}
 
 
-def run(cmd, cwd=work, log=None, what=None):
-    """Runs cmd (stdout to log when given); exits 2 with the log's tail on failure."""
+def run(cmd: list, cwd: str = work, log: str = None, what: str = None) -> str:
+    """Runs cmd in cwd, its output to the file log there (or returned); adds its wall seconds
+    to seconds[what]; exits 2 with the output's tail on failure."""
     t0 = time.time()
     out = open(os.path.join(cwd, log), "w") if log else subprocess.PIPE
     p = subprocess.run(cmd, cwd=cwd, env=ENV, stdout=out, stderr=subprocess.STDOUT, text=True)
@@ -84,13 +85,15 @@ def run(cmd, cwd=work, log=None, what=None):
     return p.stdout if not log else None
 
 
-def geometry(h, w, name):
+def geometry(h: float, w: float, name: str) -> str:
+    """Writes the duct at (h, w) as the STEP file name in work; returns name."""
     run([sys.executable, os.path.join(HERE, "bump_duct.py"), "step", repr(h), repr(w), name],
         what="gmsh")
     return name
 
 
-def case_dicts(case):
+def case_dicts(case: str) -> None:
+    """The dictionaries and initial fields of every case of this run."""
     foam_case.write_dicts(case, a.nu, 1.0, a.iters, a.res)
 
 
