@@ -32,6 +32,9 @@ typedef struct deform_row {
     int needs_mesh;
     cm_status (*create)(cm_context *ctx, cm_deform *d, const double *xyz);
     cm_status (*apply)(cm_context *ctx, cm_deform *d, double *disp, double *residual);
+    /* cm_deform_apply_transpose: out (n x 3) is zeroed by the dispatcher; the row adds J^T v
+     * at the constrained points. NULL: no transpose (apply not linear, or not written). */
+    cm_status (*apply_transpose)(cm_context *ctx, cm_deform *d, const double *v, double *out);
 } deform_row;
 
 /* ---- shared by rbf and dmffd: the points split into constrained and free ones ---- */
@@ -100,6 +103,30 @@ static cm_status rbf_apply(cm_context *ctx, cm_deform *d, double *disp, double *
     *residual = 0;
     free(v);
     free(out);
+    return s;
+}
+
+/* J^T v: v at the constrained points plus the RBF's reverse product of the free ones. */
+static cm_status rbf_apply_transpose(cm_context *ctx, cm_deform *d, const double *v, double *out)
+{
+    size_t nc = d->n_constrained, nf = d->n_free;
+    double *vf = malloc((nf ? nf : 1) * 3 * sizeof *vf);
+    double *oc = malloc((nc ? nc : 1) * 3 * sizeof *oc);
+    cm_status s = vf && oc ? CM_OK
+                           : cm_error(ctx, CM_ERR_NOMEM, "cm_deform_apply_transpose: out of memory");
+    for (size_t i = 0, b = 0; s >= 0 && i < d->n; ++i)
+        if (!d->constrained[i]) memcpy(vf + 3 * b++, v + 3 * i, 3 * sizeof *vf);
+    double t0 = cm_wtime();
+    if (s >= 0) s = cm_rbf_evaluate_transpose(ctx, d->rbf, nf, d->free_xyz, 3, vf, oc);
+    d->t_solve = cm_wtime() - t0;
+    d->t_evaluate = 0;
+    for (size_t i = 0, a = 0; s >= 0 && i < d->n; ++i)
+        if (d->constrained[i]) {
+            for (int c = 0; c < 3; ++c) out[3 * i + c] += v[3 * i + c] + oc[3 * a + c];
+            ++a;
+        }
+    free(vf);
+    free(oc);
     return s;
 }
 
@@ -193,11 +220,13 @@ static cm_status shell_apply(cm_context *ctx, cm_deform *d, double *disp, double
 }
 
 /* One row per cm_deform_method, in enum order. */
+/* apply_transpose: rbf's; NULL for the others, which have none yet (the dmffd slot is where
+ * its transpose, of the least squares and then the lattice, goes). */
 static const deform_row rows[CM_DEFORM_N_METHODS] = {
-    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply},
-    [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply},
-    [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply},
-    [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply},
+    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply, rbf_apply_transpose},
+    [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply, NULL},
+    [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply, NULL},
+    [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply, NULL},
 };
 
 const char *cm_deform_method_name(cm_deform_method method)
@@ -288,6 +317,21 @@ cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double 
     def->residual = r;
     if (residual) *residual = r;
     return s;
+}
+
+cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
+                                    double *out)
+{
+    if (!def || !v || !out)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_transpose: def, v or out is NULL");
+    if (!def->row->apply_transpose)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "cm_deform_apply_transpose: method %s has no transpose", def->row->name);
+    size_t n3 = 3 * def->n;
+    if (n3 && v < out + n3 && out < v + n3)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_transpose: v and out overlap");
+    memset(out, 0, n3 * sizeof *out);
+    return def->row->apply_transpose(ctx, def, v, out);
 }
 
 void cm_deform_get_stats(const cm_deform *def, cm_deform_stats *stats)

@@ -256,6 +256,17 @@ CM_API void cm_deform_destroy(cm_deform **def);
  * work is done. Not concurrently on one deformation. */
 CM_API cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double *residual);
 
+/* The reverse product of apply, for adjoint gradients (docs/DESIGN.md, "Gradients"), for a
+ * method whose apply is linear in the constrained values D: apply maps D to J D (D at the
+ * constrained points, J_f D at the free ones); this computes out = J^T v, so that
+ * <v, apply(D)> = <out, D>. v: n x 3, read at every point; out: n x 3, written everywhere:
+ * v plus J_f^T v_free at the constrained points, 0 at the free ones. rbf: one solve with the
+ * factorisation or preconditioner of create (cm_rbf_evaluate_transpose); its iterative
+ * solve is exact to the tolerance, as apply's. Other methods: CM_ERR_UNSUPPORTED. v and out
+ * must not overlap. Not concurrently on one deformation. */
+CM_API cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
+                                           double *out);
+
 typedef struct cm_deform_stats {
     cm_deform_method method;
     size_t constrained, free;   /* the points, split */
