@@ -514,6 +514,9 @@ void cm_rbf_destroy(cm_rbf **rbf);
 cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values);
 cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const double *points,
 double *out);
+cm_status cm_rbf_evaluate_transpose(cm_context *ctx, cm_rbf *rbf, size_t n,
+const double *points, int ncomp, const double *v,
+double *out);
 size_t cm_rbf_centre_count(const cm_rbf *rbf);
 typedef enum cm_ffd_basis {
 CM_FFD_BSPLINE = 0,
@@ -616,6 +619,8 @@ const double *xyz, const unsigned char *constrained,
 const cm_mesh *mesh, cm_deform **def);
 void cm_deform_destroy(cm_deform **def);
 cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double *residual);
+cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
+double *out);
 typedef struct cm_deform_stats {
 cm_deform_method method;
 size_t constrained, free;

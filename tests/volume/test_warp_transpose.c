@@ -1,9 +1,11 @@
 /* cm_warp_apply_transpose of the RBF methods: the dot-product test <V, J D> = <J^T V, D> with
  * random D and V on tets and hexes, several components, a pinned interior node, r^3 and r,
  * the dense and the iterative solver (tight tolerance), and a gmsh mesh from tests/data; the
- * iterative reverse product against the dense one; 0 at unconstrained nodes. */
+ * iterative reverse product against the dense one; 0 at unconstrained nodes; stopped on
+ * request at each of its progress points, then the bits of an uninterrupted call. */
 #include "cadmorph/warp.h"
 #include "test_mesh.h"
+#include "test_stopper.h"
 #include "test_util.h"
 
 #include <math.h>
@@ -146,12 +148,54 @@ static void test_file(const char *data)
     cm_mesh_destroy(&m);
 }
 
+/* Stopped on request (cm_context_interrupt) at its k-th progress point: CM_ERR_INTERRUPTED,
+ * and the next call on the same warp gives the bits of the first. */
+static void test_interrupt(void)
+{
+    uint64_t seed = 3;
+    cm_mesh *m = NULL;
+    cm_mesh_create(ctx, &m);
+    test_block b1 = {5, 4, 3, {0.0, 0.0, 0.0}, {0.25, 0.3, 0.2}, 1, 0.2};
+    test_block b2 = {3, 3, 4, {3.0, 0.0, 0.0}, {0.2, 0.2, 0.15}, 0, 0.1};
+    test_add_block(ctx, m, &b1, &seed);
+    test_add_block(ctx, m, &b2, &seed);
+    cm_mesh_boundary *b = NULL;
+    cm_warp *w = NULL;
+    CHECK(cm_mesh_boundary_create(ctx, m, &b) == CM_OK);
+    CHECK(b && cm_warp_create(ctx, m, b, NULL, NULL, &w) == CM_OK);
+    const size_t n3 = 3 * m->n_nodes;
+    double *v = malloc(n3 * sizeof *v), *want = malloc(n3 * sizeof *want);
+    double *got = malloc(n3 * sizeof *got);
+    for (size_t i = 0; i < n3; ++i) v[i] = test_rand(&seed);
+    stopper st = {ctx, 0, 0, ""};
+    cm_context_set_progress(ctx, on_progress, &st);
+    arm(&st, 0);
+    CHECK(w && cm_warp_apply_transpose(ctx, w, v, want) == CM_OK);
+    const int calls = st.calls;
+    CHECK_MSG(calls >= 2, "%d progress points", calls);
+    for (int k = 1; w && k <= calls; ++k) {
+        arm(&st, k);
+        cm_status s = cm_warp_apply_transpose(ctx, w, v, got);
+        CHECK_MSG(interrupted(ctx, s), "stopped at %d (%s): status %d", k, st.stage, (int)s);
+        cm_context_clear(ctx);
+        arm(&st, 0);
+        CHECK(cm_warp_apply_transpose(ctx, w, v, got) == CM_OK &&
+              !memcmp(got, want, n3 * sizeof *got));
+    }
+    cm_context_set_progress(ctx, NULL, NULL);
+    cm_warp_destroy(&w);
+    cm_mesh_boundary_destroy(&b);
+    cm_mesh_destroy(&m);
+    free(v), free(want), free(got);
+}
+
 int main(int argc, char **argv)
 {
     if (cm_context_create(&ctx) != CM_OK) return 1;
     test_blocks(1);
     test_blocks(0);
     if (argc > 1) test_file(argv[1]);
+    test_interrupt();
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }
