@@ -142,6 +142,7 @@ cm_status cm_rbf_evaluate_transpose(cm_context *ctx, cm_rbf *rbf, size_t n, cons
             for (int d = 0; d < dim; ++d) h[c * k + 1 + (size_t)d] += x * p[(size_t)d * n + i];
         }
     /* g = E' v, in chunks with progress as evaluate */
+    const double t0 = cm_wtime();
     cm_rbf_tick tick;
     cm_rbf_tick_init(&tick, ctx, "rbf evaluate", (double)((nc + 3) / 4) * (double)n * (double)m);
     if (rbf->petsc && cm_rbf_petsc_evaluate_transpose(rbf, n, p, ncomp, vs, g, threads))
@@ -157,6 +158,7 @@ cm_status cm_rbf_evaluate_transpose(cm_context *ctx, cm_rbf *rbf, size_t n, cons
         }
     if ((st = cm_rbf_tick_finish(&tick)) < 0) goto done;
     st = CM_OK;
+    const double t_sum = cm_wtime() - t0;
 
     /* the particular solution w0 (P' w0 = h) on the support s */
     size_t s[4];
@@ -202,6 +204,14 @@ cm_status cm_rbf_evaluate_transpose(cm_context *ctx, cm_rbf *rbf, size_t n, cons
     st = cm_rbf_solve_merged(ctx, rbf, nc, f, CM_RBF_TRANSPOSE_REFINE_TOL, w, q);
     if (rbf->iter) cm_rbf_iterative_set_scale(rbf, fmax);
     if (st < 0) goto done;
+    cm_log(ctx, CM_LOG_DEBUG,
+           "cm_rbf_evaluate_transpose: %zu points x %zu centres: transposed sums %.3f s (%s), "
+           "solve %.3f s",
+           n, m, t_sum,
+           rbf->iter && cm_rbf_iterative_transpose_was_fast(rbf) ? "treecode"
+           : rbf->iter                                         ? "compensated"
+                                                               : "plain",
+           rbf->stats.solve_seconds);
     for (size_t c = 0; c < nc; ++c)
         for (size_t j = 0; j < k; ++j) w[c * m + s[j]] += h[c * k + j];
     /* merged duplicates: the solve took the value of the first input centre of each */
