@@ -106,6 +106,30 @@ static cm_status rbf_apply(cm_context *ctx, cm_deform *d, double *disp, double *
     return s;
 }
 
+/* J^T v: v at the constrained points plus the RBF's reverse product of the free ones. */
+static cm_status rbf_apply_transpose(cm_context *ctx, cm_deform *d, const double *v, double *out)
+{
+    size_t nc = d->n_constrained, nf = d->n_free;
+    double *vf = malloc((nf ? nf : 1) * 3 * sizeof *vf);
+    double *oc = malloc((nc ? nc : 1) * 3 * sizeof *oc);
+    cm_status s = vf && oc ? CM_OK
+                           : cm_error(ctx, CM_ERR_NOMEM, "cm_deform_apply_transpose: out of memory");
+    for (size_t i = 0, b = 0; s >= 0 && i < d->n; ++i)
+        if (!d->constrained[i]) memcpy(vf + 3 * b++, v + 3 * i, 3 * sizeof *vf);
+    double t0 = cm_wtime();
+    if (s >= 0) s = cm_rbf_evaluate_transpose(ctx, d->rbf, nf, d->free_xyz, 3, vf, oc);
+    d->t_solve = cm_wtime() - t0;
+    d->t_evaluate = 0;
+    for (size_t i = 0, a = 0; s >= 0 && i < d->n; ++i)
+        if (d->constrained[i]) {
+            for (int c = 0; c < 3; ++c) out[3 * i + c] += v[3 * i + c] + oc[3 * a + c];
+            ++a;
+        }
+    free(vf);
+    free(oc);
+    return s;
+}
+
 /* ---- dmffd: one lattice enclosing every point, DM-FFD through the constrained ones ---- */
 
 static cm_status dmffd_create(cm_context *ctx, cm_deform *d, const double *xyz)
@@ -233,8 +257,10 @@ static cm_status shell_apply(cm_context *ctx, cm_deform *d, double *disp, double
 }
 
 /* One row per cm_deform_method, in enum order. */
+/* apply_transpose: NULL for shell, which assembles and solves its system anew in each apply
+ * (nothing kept to transpose). */
 static const deform_row rows[CM_DEFORM_N_METHODS] = {
-    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply, NULL},
+    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply, rbf_apply_transpose},
     [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply, mls_apply_transpose},
     [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply, NULL},
     [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply, dmffd_apply_transpose},

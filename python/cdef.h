@@ -515,6 +515,9 @@ void cm_rbf_destroy(cm_rbf **rbf);
 cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values);
 cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const double *points,
 double *out);
+cm_status cm_rbf_evaluate_transpose(cm_context *ctx, cm_rbf *rbf, size_t n,
+const double *points, int ncomp, const double *v,
+double *out);
 size_t cm_rbf_centre_count(const cm_rbf *rbf);
 typedef enum cm_ffd_basis {
 CM_FFD_BSPLINE = 0,

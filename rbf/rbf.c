@@ -321,34 +321,24 @@ static double residual(const cm_rbf *r, size_t nc, const double *f, const double
 #define CM_RBF_REFINE_TOL 1e-11
 #define CM_RBF_REFINE_STEPS 3
 
-cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values)
+cm_status cm_rbf_solve_merged(cm_context *ctx, cm_rbf *rbf, size_t nc, const double *f,
+                              double refine_tol, double *w, double *q)
 {
-    if (!rbf || !values || ncomp < 1)
-        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_solve: %s",
-                        !rbf ? "rbf is NULL" : !values ? "values is NULL" : "ncomp < 1");
-    cm_status st = check_merged_values(ctx, rbf, ncomp, values);
-    if (st != CM_OK) return st;
-
-    const size_t m = rbf->m, nc = (size_t)ncomp, k = (size_t)rbf->k;
+    const size_t m = rbf->m, k = (size_t)rbf->k;
     const int threads = cm_rbf_threads(ctx);
-    double *f = malloc(m * nc * sizeof *f); /* m x nc col-major */
+    cm_status st = CM_OK;
     double *res = malloc(m * nc * sizeof *res);
     double *g = malloc(m * nc * sizeof *g);
-    double *w = malloc(m * nc * sizeof *w);
     double *dw = malloc(m * nc * sizeof *dw);
     double *aw = malloc(m * nc * sizeof *aw); /* row-major m x nc */
     double *adw = malloc(m * nc * sizeof *adw);
-    double *q = malloc(k * nc * sizeof *q), *dq = malloc(k * nc * sizeof *dq);
-    if (!f || !res || !g || !w || !dw || !aw || !adw || !q || !dq) {
+    double *dq = malloc(k * nc * sizeof *dq);
+    if (!res || !g || !dw || !aw || !adw || !dq) {
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_solve: out of memory");
         goto done;
     }
     double fmaxabs = 0.0;
-    for (size_t u = 0; u < m; ++u)
-        for (size_t c = 0; c < nc; ++c) {
-            f[c * m + u] = values[rbf->first[u] * nc + c];
-            fmaxabs = fmax(fmaxabs, fabs(f[c * m + u]));
-        }
+    for (size_t i = 0; i < m * nc; ++i) fmaxabs = fmax(fmaxabs, fabs(f[i]));
     const int saved_blas_threads = openblas_get_num_threads();
     blas_threads(1);
     const double t_start = cm_wtime();
@@ -363,7 +353,7 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
     for (; st == CM_OK && !rbf->iter; ++steps) {
         e = residual(rbf, nc, f, aw, q, res) / (fmaxabs > 0.0 ? fmaxabs : 1.0);
         if (first < 0.0) first = e;
-        if (e <= CM_RBF_REFINE_TOL || !(e < 0.5 * prev) || steps == CM_RBF_REFINE_STEPS) break;
+        if (e <= refine_tol || !(e < 0.5 * prev) || steps == CM_RBF_REFINE_STEPS) break;
         prev = e;
         /* a pass of a large fit streams the factor and sums m^2 pairs (20k centres: ~1 s):
          * the caller may stop between passes (the weights stay the last solve's) */
@@ -388,6 +378,31 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
                "cm_rbf_solve: relative residual at the centres %.2g, after %d refinement "
                "steps %.2g",
                first, steps, e);
+    openblas_set_num_threads(saved_blas_threads);
+done:
+    free(res), free(g), free(dw), free(aw), free(adw), free(dq);
+    return st;
+}
+
+cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values)
+{
+    if (!rbf || !values || ncomp < 1)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_rbf_solve: %s",
+                        !rbf ? "rbf is NULL" : !values ? "values is NULL" : "ncomp < 1");
+    cm_status st = check_merged_values(ctx, rbf, ncomp, values);
+    if (st != CM_OK) return st;
+
+    const size_t m = rbf->m, nc = (size_t)ncomp, k = (size_t)rbf->k;
+    double *f = malloc(m * nc * sizeof *f); /* m x nc col-major */
+    double *w = malloc(m * nc * sizeof *w);
+    double *q = malloc(k * nc * sizeof *q);
+    if (!f || !w || !q) {
+        st = cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_solve: out of memory");
+        goto done;
+    }
+    for (size_t u = 0; u < m; ++u)
+        for (size_t c = 0; c < nc; ++c) f[c * m + u] = values[rbf->first[u] * nc + c];
+    st = cm_rbf_solve_merged(ctx, rbf, nc, f, CM_RBF_REFINE_TOL, w, q);
     if (st >= CM_OK) { /* a warning keeps the weights: the message says how good they are */
         free(rbf->w);
         free(rbf->q);
@@ -396,9 +411,8 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
         rbf->ncomp = ncomp;
         w = q = NULL;
     }
-    openblas_set_num_threads(saved_blas_threads);
 done:
-    free(f), free(res), free(g), free(w), free(dw), free(aw), free(adw), free(q), free(dq);
+    free(f), free(w), free(q);
     return st;
 }
 

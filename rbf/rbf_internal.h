@@ -99,6 +99,12 @@ void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n
 int cm_rbf_kernel_sum_all_tick(const cm_rbf *r, const double *w, int ncomp, size_t n,
                                const double *p, size_t ldp, double *out, int threads,
                                cm_rbf_tick *tick);
+/* cm_rbf_kernel_sum in chunks of points with tick (NULL: one pass), for any sources c (m of
+ * them, dim x m SoA with stride m): the transposed evaluation sums with the points as
+ * sources and the centres as targets. Nonzero when the tick said stop. */
+int cm_rbf_kernel_sum_tick(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                           const double *w, int nc, size_t n, const double *p, size_t ldp,
+                           double *out, size_t ldo, int threads, cm_rbf_tick *tick);
 /* "triharmonic", "biharmonic", "thin-plate" (for messages) */
 const char *cm_rbf_kernel_name(cm_rbf_kernel k);
 
@@ -153,6 +159,14 @@ int cm_rbf_assemble_projected_tick(cm_rbf_kernel kernel, int dim, size_t m, cons
  * index of each. -1 on allocation failure. */
 long cm_rbf_merge_duplicates(int dim, size_t m_in, const double *c, double tol, size_t *rep,
                              size_t *first);
+
+/* The solve of cm_rbf_solve on data at the merged centres (f: m x nc col-major) by r's
+ * solver (dense with its refinement, iterative or PETSc) into w (nc x m SoA) and q (nc x k);
+ * fills the solve's figures in r->stats. The weights kept in r are not touched. The dense
+ * refinement stops once the relative residual is within refine_tol (cm_rbf_solve: 1e-11),
+ * when a step no longer halves it, or after three steps. */
+cm_status cm_rbf_solve_merged(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
+                              double refine_tol, double *w, double *q);
 
 /* ---- the dense path (dense/) ---- */
 
@@ -229,6 +243,21 @@ void cm_rbf_iterative_destroy(cm_rbf_iter **it);
  * (NULL: none) reports the sums in chunks; nonzero when it said stop (out partly written). */
 int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
                               int threads, cm_rbf_tick *tick);
+/* The transposed evaluation of an iterative fit: out (m x nc row-major) = sum_i phi(|c_j -
+ * p_i|) v[q * n + i] for the n points p (3 x n SoA) with weights v (nc x n SoA): the
+ * treecode over the points where cm_rbf_iterative_evaluate would take it and its sampled
+ * error is within the solve's tolerance x max |out| (rbf_evaluate.c says why), else
+ * compensated direct sums. tick as there; nonzero when it said stop. */
+int cm_rbf_iterative_evaluate_transpose(const cm_rbf *r, size_t n, const double *p, int nc,
+                                        const double *v, double *out, int threads,
+                                        cm_rbf_tick *tick);
+/* 1 if the last transposed evaluation of r took the treecode (tests). */
+int cm_rbf_iterative_transpose_was_fast(const cm_rbf *r);
+/* Its fast path alone: 1 if out holds the accepted treecode result, 0 if direct sums must do
+ * it (or tick said stop), as cm_rbf_iterative_evaluate_fast. */
+int cm_rbf_iterative_transpose_fast(const cm_rbf *r, size_t n, const double *p, int nc,
+                                    const double *v, double *out, int threads,
+                                    cm_rbf_tick *tick);
 /* Its fast path alone (the treecode where n x m is large and its error is within
  * fast_eval_tol x the data scale): 1 if out holds the accepted result, 0 if direct sums must
  * do it (or tick, if not NULL, said stop: then tick->status < 0). Deterministic for given
@@ -361,5 +390,9 @@ void cm_rbf_petsc_destroy(cm_rbf_petsc **ps);
  * result for these weights), else each rank summing its block of points directly, gathered
  * to all; returns 1, or 0 if it did nothing (one rank). */
 int cm_rbf_petsc_evaluate(const cm_rbf *r, size_t n, const double *p, double *out, int threads);
+/* The same for cm_rbf_iterative_evaluate_transpose (out: m x nc, the centres split over the
+ * ranks): 1, or 0 if it did nothing (one rank). */
+int cm_rbf_petsc_evaluate_transpose(const cm_rbf *r, size_t n, const double *p, int nc,
+                                    const double *v, double *out, int threads);
 
 #endif

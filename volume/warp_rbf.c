@@ -25,6 +25,7 @@ typedef struct rbf_warp {
     size_t n_components;
     warp_component *comp;
     double *values; /* scratch: max (n_fixed + n_free) x 3, one component's points */
+    unsigned char *constrained; /* #nodes: the caller's flags (apply keeps those nodes) */
 } rbf_warp;
 
 static void rbf_destroy(void *state)
@@ -38,6 +39,7 @@ static void rbf_destroy(void *state)
     }
     free(w->comp);
     free(w->values);
+    free(w->constrained);
     free(w);
 }
 
@@ -250,10 +252,12 @@ static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
         if (w->comp[k].n_fixed + w->comp[k].n_free > max_points)
             max_points = w->comp[k].n_fixed + w->comp[k].n_free;
     w->values = malloc(max_points * 3 * sizeof *w->values);
-    if (!w->values) {
+    w->constrained = malloc(w->n_nodes ? w->n_nodes : 1);
+    if (!w->values || !w->constrained) {
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
         goto fail;
     }
+    if (w->n_nodes) memcpy(w->constrained, constrained, w->n_nodes);
     *state = w;
     return CM_OK;
 fail:
@@ -292,6 +296,51 @@ static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *r
     return CM_OK;
 }
 
+/* J^T v: apply keeps every constrained node's value (v back once), and each component's
+ * free nodes send theirs back to its fixed nodes through the deformation's reverse product
+ * (which adds v at the fixed nodes too: taken off again, so that a node fixed in several
+ * components counts it once). */
+static cm_status rbf_apply_transpose(cm_context *ctx, void *state, const double *v, double *out)
+{
+    rbf_warp *warp = state;
+    for (size_t i = 0; i < warp->n_nodes; ++i)
+        if (warp->constrained[i]) memcpy(out + 3 * i, v + 3 * i, 3 * sizeof *out);
+    size_t max_points = 1;
+    for (size_t k = 0; k < warp->n_components; ++k)
+        if (warp->comp[k].n_fixed + warp->comp[k].n_free > max_points)
+            max_points = warp->comp[k].n_fixed + warp->comp[k].n_free;
+    double *po = malloc(max_points * 3 * sizeof *po);
+    if (!po) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_apply_transpose: out of memory");
+    double *pv = warp->values;
+    cm_status s = CM_OK;
+    for (size_t k = 0; k < warp->n_components; ++k) {
+        warp_component *wc = &warp->comp[k];
+        if (!wc->def) continue;
+        for (size_t i = 0; i < wc->n_fixed; ++i)
+            memcpy(pv + 3 * i, v + 3 * wc->fixed[i], 3 * sizeof(double));
+        for (size_t i = 0; i < wc->n_free; ++i)
+            memcpy(pv + 3 * (wc->n_fixed + i), v + 3 * wc->free_nodes[i], 3 * sizeof(double));
+        s = cm_deform_apply_transpose(ctx, wc->def, pv, po);
+        if (s < 0) {
+            s = cm_error_prefix(ctx, s, "cm_warp_apply_transpose: component %zu", k);
+            break;
+        }
+        cm_deform_stats st;
+        cm_deform_get_stats(wc->def, &st);
+        cm_log(ctx, CM_LOG_DEBUG,
+               "cm_warp_apply_transpose: component %zu: %zu centres, %zu free nodes, "
+               "transposed evaluation and solve %.3f s (%s, %d iterations)",
+               k, wc->n_fixed, wc->n_free, st.t_solve,
+               st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" : "iterative", st.rbf.iterations);
+        for (size_t i = 0; i < wc->n_fixed; ++i)
+            for (int c = 0; c < 3; ++c) out[3 * wc->fixed[i] + c] += po[3 * i + c] - pv[3 * i + c];
+        if ((s = cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components)) < 0)
+            break;
+    }
+    free(po);
+    return s;
+}
+
 static cm_status triharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                     const cm_mesh_boundary *b, const unsigned char *constrained,
                                     const cm_warp_options *opt, void **state)
@@ -308,7 +357,7 @@ static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                       state);
 }
 
-const cm_warp_method_ops cm_warp_rbf_triharmonic = {"rbf", triharmonic_create, rbf_apply,
-                                                    rbf_destroy, NULL, NULL};
-const cm_warp_method_ops cm_warp_rbf_biharmonic = {"rbf-biharmonic", biharmonic_create,
-                                                   rbf_apply, rbf_destroy, NULL, NULL};
+const cm_warp_method_ops cm_warp_rbf_triharmonic = {
+    "rbf", triharmonic_create, rbf_apply, rbf_destroy, NULL, rbf_apply_transpose};
+const cm_warp_method_ops cm_warp_rbf_biharmonic = {
+    "rbf-biharmonic", biharmonic_create, rbf_apply, rbf_destroy, NULL, rbf_apply_transpose};

@@ -277,9 +277,11 @@ CM_API cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, 
  * <v, apply(D)> = <out, D>. v: n x 3, read at every point; out: n x 3, written everywhere:
  * v plus J_f^T v_free at the constrained points, 0 at the free ones (mls with
  * keep_constrained = 0, whose apply gives the constrained points the field's value: J^T v
- * of that map). dmffd: the transposed FFD and pseudo-inverse (cm_ffd_deform_transpose,
+ * of that map). rbf: one solve with the factorisation or preconditioner of create
+ * (cm_rbf_evaluate_transpose); its iterative solve is exact to the tolerance, as apply's.
+ * dmffd: the transposed FFD and pseudo-inverse (cm_ffd_deform_transpose,
  * cm_dmffd_solve_transpose: the truncation is fixed by create, so apply is linear); mls:
- * cm_mls_apply_transpose (its constraints are a penalty: linear). Other methods:
+ * cm_mls_apply_transpose (its constraints are a penalty: linear). shell:
  * CM_ERR_UNSUPPORTED. v and out must not overlap. Not concurrently on one deformation. */
 CM_API cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
                                            double *out);

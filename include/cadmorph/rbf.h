@@ -153,6 +153,24 @@ CM_API cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const dou
 CM_API cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, const double *points,
                           double *out);
 
+/* The reverse product of "solve at the centres, then evaluate at n points", for adjoint
+ * gradients (docs/DESIGN.md, "Gradients"). J is the linear map from values d at the m
+ * centres given to create (m x ncomp) to what cm_rbf_evaluate gives at points (n x dim)
+ * after cm_rbf_solve(d); this computes out = J^T v (out: m x ncomp, v: n x ncomp, both
+ * row-major), so that <v, J d> = <out, d> for every d. One solve of the same system with
+ * the factorisation or preconditioner of create, the right-hand side [E^T v; P^T v] (E: the
+ * kernel values from the centres to the points) summed as evaluate sums (an iterative fit:
+ * compensated sums, or the treecode where its checked error is within the tolerance).
+ * Exact as cm_rbf_solve is: to rounding (dense), to the tolerance (iterative, PETSc).
+ * Merged duplicate centres: all of a merged centre's share goes to the first of its input
+ * centres (the one whose value the solve takes), 0 to the others.
+ * Keeps the weights of the last cm_rbf_solve (evaluate still uses them; none are needed
+ * here); the solve figures of cm_rbf_stats become this solve's. PETSC: collective, as
+ * solve. A solve that stagnates returns CM_WARNING with out written, as cm_rbf_solve. */
+CM_API cm_status cm_rbf_evaluate_transpose(cm_context *ctx, cm_rbf *rbf, size_t n,
+                                           const double *points, int ncomp, const double *v,
+                                           double *out);
+
 /* Centres after merging duplicates. */
 CM_API size_t cm_rbf_centre_count(const cm_rbf *rbf);
 

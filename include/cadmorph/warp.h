@@ -106,7 +106,9 @@ CM_API cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
  * node v there plus what the other nodes' v sends back to it through the warp (mls with
  * keep_constrained = 0: only the latter), 0 at every other node. The
  * three components in one call, with the factorisation (or preconditioner) of create; v and
- * out must not overlap. An iterative RBF solve is exact to the warp's tolerance, like apply.
+ * out must not overlap. An iterative RBF solve is exact to the warp's tolerance, like apply:
+ * as a gradient, <out, D> for a smooth D, to about that tolerance; entry by entry, to the
+ * tolerance times the growth of the RBF weights (docs/DESIGN.md, "Gradients").
  * CM_ERR_UNSUPPORTED for a method whose apply is not linear in D (the message says why). */
 CM_API cm_status cm_warp_apply_transpose(cm_context *ctx, cm_warp *warp, const double *v,
                                          double *out);

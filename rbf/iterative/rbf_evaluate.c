@@ -195,6 +195,98 @@ int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double
 }
 
 
+/* The transposed evaluation (cm_rbf_evaluate_transpose): the same sums with the roles
+ * swapped, sources at the n points with weights v, targets the m centres. Its result is the
+ * right-hand side of a solve, not an output: an error e in it moves the reverse product by
+ * A^-1 e, and <A^-1 e, D> = <e, A^-1 D> for any prescribed D, so it acts like a residual of
+ * that solve. The treecode (a tree over the points, made for this call) is therefore taken
+ * only where its sampled error, x CM_RBF_FAST_SAFETY, is within the smaller of the
+ * evaluation's and the solve's tolerance x max |out| (or within the direct sums' own
+ * rounding), by the same size rule as the evaluation; direct sums are compensated, as
+ * there. */
+static int transpose_fast(const cm_rbf *r, size_t n, const double *p, int ncomp,
+                          const double *v, double *out, int threads, cm_rbf_tick *tick)
+{
+    const size_t m = r->m, nc = (size_t)ncomp;
+    const size_t ns = m < 64 ? m : 64;
+    double *sp = malloc(3 * ns * sizeof *sp), *av = malloc(nc * n * sizeof *av);
+    double *ab = malloc(2 * ns * nc * sizeof *ab);
+    int ok = sp && av && ab;
+    double smax = 0.0, gmax = 0.0;
+    if (ok) { /* the scales at a few centres: max |out| and sum_i |v_i| phi_ij */
+        for (size_t k = 0; k < ns; ++k)
+            for (int d = 0; d < 3; ++d)
+                sp[(size_t)d * ns + k] = r->c[(size_t)d * m + (size_t)((double)k * (double)m / (double)ns)];
+        for (size_t j = 0; j < nc * n; ++j) av[j] = fabs(v[j]);
+        for (size_t g = 0; g < nc; g += 4) {
+            int gc = nc - g < 4 ? (int)(nc - g) : 4;
+            cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, n, p, av + g * n, gc, ns, sp, ns, ab + g,
+                              nc, threads);
+            cm_rbf_kernel_sum_acc(n, p, v + g * n, gc, ns, sp, ns, ab + ns * nc + g, nc, threads);
+        }
+        for (size_t i = 0; i < ns * nc; ++i) {
+            smax = fmax(smax, ab[i]);
+            gmax = fmax(gmax, fabs(ab[ns * nc + i]));
+        }
+    }
+    free(sp), free(av), free(ab);
+    if (!ok || !(smax > 0.0)) return 0;
+    const double accept = fmax(fmin(r->tun.fast_eval_tol, r->opt.tolerance) * gmax,
+                               CM_RBF_PHI_ROUND * DBL_EPSILON * smax);
+    const double tau = fmax(accept / (smax * CM_RBF_FAST_SAFETY), CM_RBF_TREE_TOL_MIN);
+    int order;
+    double theta;
+    cm_rbf_tree_params(tau, &order, &theta);
+    cm_rbf_tree *t = cm_rbf_tree_create(n, p, order, theta);
+    cm_rbf_tree_targets *tg = t ? cm_rbf_tree_targets_create(m, r->c, m) : NULL;
+    int fast = tg != NULL;
+    if (tick) cm_rbf_tick_restart(tick, (double)((nc + 3) / 4));
+    double err = 0.0;
+    for (size_t g = 0; fast && g < nc; g += 4) {
+        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+        if (cm_rbf_tree_sum_targets_tick(t, tg, 1, v + g * n, gc, out + g, nc, threads, tick)) {
+            fast = 0;
+            break;
+        }
+        double e;
+        cm_rbf_tree_check(t, v + g * n, gc, m, r->c, m, out + g, nc, CM_RBF_FAST_SAMPLES, NULL,
+                          &e, NULL, threads);
+        err = fmax(err, e);
+    }
+    cm_rbf_tree_targets_destroy(&tg);
+    cm_rbf_tree_destroy(&t);
+    return fast && CM_RBF_FAST_SAFETY * err <= accept;
+}
+
+int cm_rbf_iterative_transpose_fast(const cm_rbf *r, size_t n, const double *p, int nc,
+                                    const double *v, double *out, int threads,
+                                    cm_rbf_tick *tick)
+{
+    const int fs = r->opt.fast_sum;
+    r->iter->transpose_fast =
+        (fs == 1 || (fs < 0 && (double)n * (double)r->m >= CM_RBF_FAST_EVAL_PAIRS)) &&
+        transpose_fast(r, n, p, nc, v, out, threads, tick);
+    return r->iter->transpose_fast;
+}
+
+int cm_rbf_iterative_transpose_was_fast(const cm_rbf *r) { return r->iter ? r->iter->transpose_fast : 0; }
+
+int cm_rbf_iterative_evaluate_transpose(const cm_rbf *r, size_t n, const double *p, int nc,
+                                        const double *v, double *out, int threads,
+                                        cm_rbf_tick *tick)
+{
+    if (cm_rbf_iterative_transpose_fast(r, n, p, nc, v, out, threads, tick)) return 0;
+    if (tick && tick->status < 0) return 1;
+    if (tick) cm_rbf_tick_restart(tick, (double)((nc + 3) / 4) * (double)n * (double)r->m);
+    for (int g = 0; g < nc; g += 4) {
+        int gc = nc - g < 4 ? nc - g : 4;
+        if (cm_rbf_kernel_sum_acc_tick(n, p, v + (size_t)g * n, gc, r->m, r->c, r->m, out + g,
+                                       (size_t)nc, threads, tick))
+            return 1;
+    }
+    return 0;
+}
+
 void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats)
 {
     if (!r->iter) return;

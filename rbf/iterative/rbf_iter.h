@@ -19,6 +19,7 @@ struct cm_rbf_iter {
     double eval_error;
     int eval_order;    /* the row it took */
     double eval_theta;
+    int transpose_fast; /* the last transposed evaluation took the treecode (for tests) */
     cm_rbf_tree *rtree[3]; /* loose treecodes for relaxed products (relax_tree_tol) */
 };
 

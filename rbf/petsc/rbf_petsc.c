@@ -460,3 +460,33 @@ int cm_rbf_petsc_evaluate(const cm_rbf *r, size_t n, const double *p, double *ou
     free(counts);
     return ok;
 }
+
+int cm_rbf_petsc_evaluate_transpose(const cm_rbf *r, size_t n, const double *p, int nc,
+                                    const double *v, double *out, int threads)
+{
+    int rank, size;
+    cm_parallel_rank(&rank, &size);
+    const size_t m = r->m, ncs = (size_t)nc;
+    if (size < 2 || m * ncs > (size_t)0x7fffffff) return 0; /* all on this rank */
+    /* as cm_rbf_petsc_evaluate: the treecode on every rank if it is taken (deterministic),
+     * else each rank its block of the targets, here the centres, gathered to all */
+    if (cm_rbf_iterative_transpose_fast(r, n, p, nc, v, out, threads, NULL)) return 1;
+    int *counts = malloc(2 * (size_t)size * sizeof *counts);
+    if (!counts) return 0;
+    int *displs = counts + size;
+    for (int q = 0; q < size; ++q) {
+        size_t lo = m * (size_t)q / (size_t)size, hi = m * (size_t)(q + 1) / (size_t)size;
+        counts[q] = (int)((hi - lo) * ncs);
+        displs[q] = (int)(lo * ncs);
+    }
+    const size_t lo = m * (size_t)rank / (size_t)size, hi = m * (size_t)(rank + 1) / (size_t)size;
+    for (int g = 0; g < nc; g += 4) {
+        int ng = nc - g < 4 ? nc - g : 4;
+        cm_rbf_kernel_sum_acc(n, p, v + (size_t)g * n, ng, hi - lo, r->c + lo, m,
+                              out + lo * ncs + (size_t)g, ncs, threads);
+    }
+    int ok = MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, out, counts, displs, MPI_DOUBLE,
+                            PETSC_COMM_WORLD) == MPI_SUCCESS;
+    free(counts);
+    return ok;
+}

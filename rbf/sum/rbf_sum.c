@@ -471,3 +471,10 @@ int cm_rbf_kernel_sum_all_tick(const cm_rbf *r, const double *w, int ncomp, size
     }
     return 0;
 }
+
+int cm_rbf_kernel_sum_tick(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
+                           const double *w, int nc, size_t n, const double *p, size_t ldp,
+                           double *out, size_t ldo, int threads, cm_rbf_tick *tick)
+{
+    return sum_isa(CM_RBF_ISA_AUTO, kernel, dim, m, c, w, nc, n, p, ldp, out, ldo, threads, tick);
+}

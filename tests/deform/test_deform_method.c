@@ -293,6 +293,58 @@ static void test_table(void)
     CHECK(cm_deform_create(ctx, &o, 5, flat, all, NULL, &d) == CM_ERR_NUMERIC && !d);
 }
 
+/* The reverse product (cm_deform_apply_transpose) of the rbf row: <v, apply(D)> =
+ * <J^T v, D> with random D and v, J^T v = 0 at the free points and, for a row without a
+ * transpose (shell), CM_ERR_UNSUPPORTED. */
+static void test_transpose(cm_rbf_kernel kernel)
+{
+    size_t n = 400;
+    double *xyz = malloc(n * 3 * sizeof *xyz), *disp = malloc(n * 3 * sizeof *disp);
+    double *out = malloc(n * 3 * sizeof *out), *v = malloc(n * 3 * sizeof *v);
+    double *jtv = malloc(n * 3 * sizeof *jtv);
+    unsigned char *con = malloc(n);
+    make_points(n, xyz, con, disp);
+    for (size_t i = 0; i < n * 3; ++i) v[i] = test_rand(&seed);
+    cm_deform_options o;
+    cm_deform_options_init(&o);
+    o.kernel = kernel;
+    cm_deform *d = NULL;
+    CHECK(cm_deform_create(ctx, &o, n, xyz, con, NULL, &d) == CM_OK);
+    memcpy(out, disp, n * 3 * sizeof *out);
+    CHECK(cm_deform_apply(ctx, d, out, NULL) == CM_OK);
+    CHECK(cm_deform_apply_transpose(ctx, d, v, jtv) == CM_OK);
+    CHECK(cm_deform_apply_transpose(ctx, d, v, v + 3) == CM_ERR_ARGUMENT);
+    long double a = 0.0L, b = 0.0L;
+    double scale = 0.0;
+    int zero = 1;
+    for (size_t i = 0; i < n * 3; ++i) {
+        a += (long double)v[i] * out[i];
+        scale += fabs(v[i] * out[i]);
+        if (con[i / 3])
+            b += (long double)jtv[i] * disp[i];
+        else
+            zero &= jtv[i] == 0.0;
+    }
+    CHECK(zero);
+    CHECK_MSG(fabs((double)(a - b)) <= 1e-10 * scale, "kernel %d: %.17g vs %.17g", (int)kernel,
+              (double)a, (double)b);
+    cm_deform_destroy(&d);
+    if (kernel == CM_RBF_TRIHARMONIC) { /* a row without one */
+        double *d2 = NULL;
+        unsigned char *c2 = NULL;
+        cm_mesh *m = block_mesh(&d2, &c2);
+        free(d2);
+        o.method = CM_DEFORM_SHELL;
+        CHECK(cm_deform_create(ctx, &o, m->n_nodes, NULL, c2, m, &d) >= 0);
+        double *v2 = calloc(m->n_nodes * 3, sizeof *v2), *o2 = malloc(m->n_nodes * 3 * sizeof *o2);
+        CHECK(cm_deform_apply_transpose(ctx, d, v2, o2) == CM_ERR_UNSUPPORTED);
+        cm_deform_destroy(&d);
+        cm_mesh_destroy(&m);
+        free(c2), free(v2), free(o2);
+    }
+    free(xyz), free(disp), free(out), free(v), free(jtv), free(con);
+}
+
 int main(void)
 {
     CHECK(cm_context_create(&ctx) == CM_OK);
@@ -302,6 +354,8 @@ int main(void)
     test_dmffd();
     test_mls();
     test_shell();
+    test_transpose(CM_RBF_TRIHARMONIC);
+    test_transpose(CM_RBF_BIHARMONIC);
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }

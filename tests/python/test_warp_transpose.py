@@ -44,17 +44,20 @@ def test_apply_transpose_is_the_transpose_of_apply(bore_mesh, method):
     assert dot_error(w, 2) <= 1e-10
 
 
-# The RBF rows' reverse product is implemented apart from the mesh-based ones; until it is
-# there the library refuses it (BadInputError, CM_ERR_UNSUPPORTED) and this test is an
-# expected failure. strict: the day the library has it, the mark fails the run, and removing
-# the mark turns this into the dot-product test of the RBF warps.
-@pytest.mark.xfail(raises=cadmorph.BadInputError, strict=True,
-                   reason="the RBF warps' apply_transpose is not in this build yet")
+# The RBF warps: dense, and iterative at a tolerance tight enough for the dot-product test to
+# hold at 1e-10 (the reverse product is the weights of a solve: docs/DESIGN.md, "Gradients").
 @pytest.mark.parametrize("method", ["rbf", "rbf-biharmonic"])
 def test_apply_transpose_rbf(bore_mesh, method):
     mesh = cadmorph.read_mesh(bore_mesh)
-    w = cadmorph.Warp(mesh, pinned_nodes(mesh), method=method, progress=False)
+    w = cadmorph.Warp(mesh, pinned_nodes(mesh), method=method, solver="dense", progress=False)
     assert dot_error(w, 3) <= 1e-10
+
+
+def test_apply_transpose_rbf_iterative(bore_mesh):
+    mesh = cadmorph.read_mesh(bore_mesh)
+    w = cadmorph.Warp(mesh, pinned_nodes(mesh), solver="iterative", tolerance=1e-13,
+                      progress=False)
+    assert dot_error(w, 4) <= 1e-10
 
 
 def test_apply_transpose_layout_and_array_likes(bore_mesh):

@@ -55,3 +55,6 @@ cm_add_unit_test(test_rbf_auto ${CMAKE_CURRENT_LIST_DIR}/test_rbf_auto.c LIBS cm
 # stopping on request (cm_context_interrupt): sums in chunks are the bits of one pass;
 # create, solve and evaluate stopped at progress points
 cm_add_unit_test(test_rbf_interrupt ${CMAKE_CURRENT_LIST_DIR}/test_rbf_interrupt.c LIBS cm_rbf_internal LABELS rbf)
+# the reverse product of solve-then-evaluate: the dot-product test (dense r^3, r, thin plate;
+# iterative with direct and treecode sums; merged duplicates), iterative against dense
+cm_add_unit_test(test_rbf_transpose ${CMAKE_CURRENT_LIST_DIR}/test_rbf_transpose.c LIBS cm_rbf_internal LABELS rbf)

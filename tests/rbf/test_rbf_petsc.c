@@ -118,6 +118,54 @@ int main(int argc, char **argv)
     cm_rbf_destroy(&rs);
     cm_rbf_destroy(&rp);
 
+    /* the reverse product (cm_rbf_evaluate_transpose) at a tight tolerance: the dot-product
+     * test with a random v (the same on every rank: a fixed sequence), the same on every
+     * rank, and against the serial iterative one as a functional of d */
+    {
+        o.fast_sum = -1;
+        o.tolerance = 1e-13;
+        o.max_iterations = 600;
+        double *v = malloc(np * 3 * sizeof *v), *jp = malloc(m * 3 * sizeof *jp);
+        double *js = malloc(m * 3 * sizeof *js);
+        for (size_t i = 0; i < np * 3; ++i) v[i] = sin(1.7 * (double)i + 0.3) + 0.2;
+        o.solver = CM_RBF_SOLVER_PETSC;
+        cm_status t = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &rp);
+        if (t >= 0) t = cm_rbf_solve(ctx, rp, 3, d);
+        if (t >= 0) t = cm_rbf_evaluate(ctx, rp, np, p, sp);
+        if (t >= 0) t = cm_rbf_evaluate_transpose(ctx, rp, np, p, 3, v, jp);
+        o.solver = CM_RBF_SOLVER_ITERATIVE;
+        if (t >= 0) t = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &rs);
+        if (t >= 0) t = cm_rbf_evaluate_transpose(ctx, rs, np, p, 3, v, js);
+        CHECK_MSG(t >= 0, "transpose: %s", cm_context_message(ctx));
+        long double a = 0.0L, b = 0.0L, ds = 0.0L;
+        double scale = 0.0, sd = 0.0;
+        for (size_t i = 0; i < np * 3; ++i) a += (long double)v[i] * sp[i], scale += fabs(v[i] * sp[i]);
+        for (size_t i = 0; i < m * 3; ++i) {
+            b += (long double)jp[i] * d[i];
+            ds += (long double)(jp[i] - js[i]) * d[i];
+            sd += fabs(js[i] * d[i]);
+        }
+        const double gap = fabs((double)(a - b)) / scale, dual = fabs((double)ds) / sd;
+        /* every rank holds the whole J^T v, the same bits */
+        void *all = NULL;
+        size_t n_all = 0;
+        int same = cm_parallel_allgather(ctx, jp, m * 3, sizeof *jp, &all, &n_all) == CM_OK &&
+                   n_all == m * 3 * (size_t)size;
+        for (int q = 1; same && q < size; ++q)
+            same = memcmp(all, (double *)all + (size_t)q * m * 3, m * 3 * sizeof *jp) == 0;
+        free(all);
+        if (rank == 0)
+            printf("reverse product, %d ranks: <v, J d> = %.15g, <J^T v, d> = %.15g, gap %.3g; "
+                   "against serial %.3g\n",
+                   size, (double)a, (double)b, gap, dual);
+        CHECK_MSG(gap <= 1e-10, "rank %d: gap %.3g", rank, gap);
+        CHECK_MSG(dual <= 1e-11, "rank %d: %.3g", rank, dual);
+        CHECK_MSG(same, "rank %d: J^T v differs from rank 0's", rank);
+        cm_rbf_destroy(&rs);
+        cm_rbf_destroy(&rp);
+        free(v), free(jp), free(js);
+    }
+
     /* the kernels it does not handle: a clear error, on every rank */
     cm_rbf *rb = NULL;
     cm_status e = cm_rbf_create_opt(ctx, CM_RBF_BIHARMONIC, 3, m, x, &o, &rb);

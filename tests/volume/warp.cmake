@@ -1,6 +1,9 @@
 # Tests of the volume warp (volume/warp.c, volume/displacement_csv.c).
 cm_add_unit_test(test_warp_csv test_warp_csv.c LIBS cm_volume)
 cm_add_unit_test(test_warp test_warp.c LIBS cm_volume)
+# the reverse product of the RBF warps: the dot-product test on tets, hexes, several
+# components, dense and iterative, and a gmsh mesh; iterative against dense
+cm_add_unit_test(test_warp_transpose_rbf test_warp_transpose_rbf.c LIBS cm_volume)
 
 # Cross-check on a real mesh: gmsh meshes a sphere cut out of a box (setup, also used by the
 # CLI tests), cadmorph warps it (test_warp_sphere), scipy's RBFInterpolator redoes it (scipy).

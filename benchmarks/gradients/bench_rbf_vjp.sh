@@ -1,0 +1,26 @@
+#!/bin/sh
+# The RBF warp's reverse product against one apply (RESULTS.md, "Gradients"): the bore and
+# pipe tet meshes of "Benchmark models", their hex O-grids, and the bracket at size 0.0528
+# (102,890 boundary nodes, 3.3M tets: TetGen takes ~3.5 minutes, the warp several more).
+# usage: bench_rbf_vjp.sh BUILD_DIR [WORK_DIR] [THREADS]
+set -eu
+build=${1:?usage: bench_rbf_vjp.sh BUILD_DIR [WORK_DIR] [THREADS]}
+work=${2:-$build/bench/gradients}
+threads=${3:-2}
+mkdir -p "$work"
+cd "$work"
+echo "# $(date -u '+%Y-%m-%d %H:%M UTC')  $(lscpu | sed -n 's/^Model name: *//p')  nproc=$(nproc)  threads=$threads  load=$(cut -d' ' -f1-3 /proc/loadavg)"
+export OPENBLAS_VERBOSE=2  # OpenBLAS names its core kernel ("Core: ...") once per process
+cm="$build/cli/cadmorph"
+for m in bore pipe bracket; do
+    [ -f $m.step ] || "$cm" model $m 0 $m.step >/dev/null
+done
+[ -f bore_0.173.vtu ] || "$cm" mesh bore.step -o bore_0.173.vtu --size 0.173 --mesher tetgen >/dev/null
+[ -f pipe_0.118.vtu ] || "$cm" mesh pipe.step -o pipe_0.118.vtu --size 0.118 --mesher tetgen >/dev/null
+[ -f bore_hex.msh ] || "$cm" model bore 0 --hex-mesh bore_hex.msh >/dev/null
+[ -f pipe_hex.msh ] || "$cm" model pipe 0 --hex-mesh pipe_hex.msh >/dev/null
+[ -f bracket_0.0528.vtu ] || "$cm" mesh bracket.step -o bracket_0.0528.vtu --size 0.0528 --mesher tetgen --no-optimize >/dev/null
+for f in bore_0.173.vtu pipe_0.118.vtu bore_hex.msh pipe_hex.msh; do
+    "$build/benchmarks/gradients/bench_rbf_vjp" $f 5 "$threads"
+done
+"$build/benchmarks/gradients/bench_rbf_vjp" bracket_0.0528.vtu 1 "$threads"
