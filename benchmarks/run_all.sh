@@ -23,6 +23,6 @@ echo "== models, tet meshes";  sh "$here/models/bench_models.sh" "$build" "$work
 echo "== sweeps (20 steps, all models)"; sh "$here/sweep/run_sweeps.sh" "$build" "$work/sweeps" 2
 echo "== study: 20 bore variants vs one"; sh "$here/study/bench_study.sh" "$build" "$work/study" 2
 echo "== warp methods side by side"; sh "$here/warp/bench_warp.sh" "$build" "$work/warp" 2
-echo "== gradients: the RBF warp's reverse product against one apply"; sh "$here/gradients/bench_rbf_vjp.sh" "$build" "$work/gradients" 2
+echo "== gradients: the warps' reverse product against one apply"; sh "$here/gradients/bench_warp_vjp.sh" "$build" "$work/gradients" 2
 echo "== warp methods in the sweeps"; sh "$here/warp/bench_warp_sweep.sh" "$build" "$work/wsweep" 2
 echo "== Python binding";      /usr/bin/python3 "$here/python/bench_binding.py" "$build" "$work/python"

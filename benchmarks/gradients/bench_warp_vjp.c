@@ -1,11 +1,13 @@
-/* The reverse product of the mesh-based warps against their forward product: for one mesh and
- * each method, one warp is created on M0 (assembly + factorisation), then apply (J D, a smooth
- * boundary motion) and apply_transpose (J^T V, a random V at every node) run alternately
- * `reps` times on it, so that both see the same load; the figure is the ratio of the medians
- * (RESULTS.md, "Gradients"). A dot-product line checks that the two are transposes on this
- * mesh. BENCH_VERBOSE=1 shows the library's log on stderr.
- * usage: bench_warp_transpose_mesh MESH [reps=10] [threads=2] [methods=femwarp,lbwarp]
- * One line per method: key=value pairs. */
+/* The warp's reverse product against its forward product (RESULTS.md, "Gradients"): for one
+ * mesh and each method, one warp is created on M0 (assembly, factorisation or preconditioner),
+ * then one untimed round (first touch of the scratch, CHOLMOD's solve workspace, treecodes),
+ * then `reps` rounds of apply (J D, bench_warp's smooth boundary motion) and apply_transpose
+ * (J^T v, a smooth field at every node) alternating in one process, so that the machine's
+ * load falls on both alike; the figure is the ratio of the medians. dot_gap checks on the
+ * figures' own data that the two are transposes: |<v, J D> - <J^T v, D>| / sum |v J D|.
+ * usage: bench_warp_vjp MESH [reps=5] [threads=2] [methods=rbf] [solver=auto|dense|iterative]
+ * One line of key=value pairs per method. BENCH_VERBOSE=1: the library's log on stderr (the
+ * RBF warp's per-component split of solve and sums). */
 #define _POSIX_C_SOURCE 200809L
 #include "blas_reexec.h"
 #include "cadmorph/mesh.h"
@@ -45,7 +47,7 @@ static void log_stderr(void *user, cm_log_level level, const char *message)
 }
 
 static int run(cm_context *ctx, const cm_mesh *m, const cm_mesh_boundary *b, const char *path,
-               cm_warp_method method, int reps)
+               cm_warp_method method, cm_rbf_solver solver, int reps)
 {
     size_t nn = m->n_nodes, n3 = 3 * nn;
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
@@ -69,21 +71,24 @@ static int run(cm_context *ctx, const cm_mesh *m, const cm_mesh_boundary *b, con
         o[1] = 0.03 * diag * sin(3.14159265358979323846 * u[2]) * u[0];
         o[2] = 0.03 * diag * sin(3.14159265358979323846 * u[0]) * u[1];
     }
-    uint64_t s64 = 12345;
-    for (size_t i = 0; i < n3; ++i) { /* xorshift: a V that every node's row sees */
-        s64 ^= s64 << 13, s64 ^= s64 >> 7, s64 ^= s64 << 17;
-        v[i] = (double)(s64 >> 11) / 9007199254740992.0 - 0.5;
+    for (size_t i = 0; i < nn; ++i) { /* a smooth sensitivity field at every node */
+        double u[3];
+        for (int k = 0; k < 3; ++k)
+            u[k] = (m->xyz[3 * i + k] - lo[k]) / (hi[k] - lo[k] > 0 ? hi[k] - lo[k] : 1);
+        for (int k = 0; k < 3; ++k)
+            v[3 * i + k] = cos(2.0 * u[k] + u[(k + 1) % 3]) + 0.3 * u[(k + 2) % 3];
     }
     cm_warp_options opt;
     cm_warp_options_init(&opt);
     opt.method = method;
+    opt.solver = solver;
     cm_warp *w = NULL;
     double t0 = cm_wtime();
     cm_status s = cm_warp_create(ctx, m, b, NULL, &opt, &w);
     double t_create = cm_wtime() - t0;
     double *ta = malloc((size_t)reps * sizeof *ta), *tt = malloc((size_t)reps * sizeof *tt);
     double *ca = malloc((size_t)reps * sizeof *ca), *ct = malloc((size_t)reps * sizeof *ct);
-    /* one of each first: CHOLMOD allocates its solve workspace on the first call */
+    /* the untimed round */
     memcpy(d, d0, n3 * sizeof *d);
     if (s >= 0) s = cm_warp_apply(ctx, w, d);
     if (s >= 0) s = cm_warp_apply_transpose(ctx, w, v, out);
@@ -98,7 +103,7 @@ static int run(cm_context *ctx, const cm_mesh *m, const cm_mesh_boundary *b, con
         tt[r] = cm_wtime() - a, ct[r] = cpu_seconds() - ac;
     }
     if (s < 0) {
-        fprintf(stderr, "bench_warp_transpose_mesh: %s: %s\n", cm_warp_method_name(method),
+        fprintf(stderr, "bench_warp_vjp: %s: %s\n", cm_warp_method_name(method),
                 cm_context_message(ctx));
     } else {
         /* <V, J D> against <J^T V, D> (D is d0: zero off the boundary) */
@@ -110,10 +115,14 @@ static int run(cm_context *ctx, const cm_mesh *m, const cm_mesh_boundary *b, con
         }
         double apply_s = median(ta, reps), vjp_s = median(tt, reps);
         double apply_cpu = median(ca, reps), vjp_cpu = median(ct, reps);
-        printf("mesh=%s nodes=%zu constrained=%zu method=%s create_s=%.3f apply_s=%.5f "
-               "vjp_s=%.5f ratio=%.3f apply_cpu=%.5f vjp_cpu=%.5f cpu_ratio=%.3f "
-               "dot_err=%.1e reps=%d\n",
-               path, nn, b->n_nodes, cm_warp_method_name(method), t_create, apply_s, vjp_s,
+        printf("mesh=%s nodes=%zu constrained=%zu components=%zu method=%s solver=%s "
+               "create_s=%.3f apply_s=%.5f vjp_s=%.5f ratio=%.3f apply_cpu=%.5f vjp_cpu=%.5f "
+               "cpu_ratio=%.3f dot_gap=%.1e reps=%d\n",
+               path, nn, b->n_nodes, b->n_components, cm_warp_method_name(method),
+               solver == CM_RBF_SOLVER_DENSE       ? "dense"
+               : solver == CM_RBF_SOLVER_ITERATIVE ? "iterative"
+                                                   : "auto",
+               t_create, apply_s, vjp_s,
                vjp_s / apply_s, apply_cpu, vjp_cpu, vjp_cpu / apply_cpu, fabs(lhs - rhs) / scale,
                reps);
         fflush(stdout);
@@ -127,13 +136,18 @@ int main(int argc, char **argv)
 {
     cli_blas_setup(argc, argv); /* the right OpenBLAS core, as cadmorph */
     if (argc < 2) {
-        fprintf(stderr, "usage: bench_warp_transpose_mesh MESH [reps] [threads] [methods]\n");
+        fprintf(stderr, "usage: bench_warp_vjp MESH [reps=5] [threads=2] [methods=rbf] "
+                        "[solver=auto|dense|iterative]\n");
         return 1;
     }
-    int reps = argc > 2 ? atoi(argv[2]) : 10, threads = argc > 3 ? atoi(argv[3]) : 2;
+    int reps = argc > 2 ? atoi(argv[2]) : 5, threads = argc > 3 ? atoi(argv[3]) : 2;
     if (reps < 1) reps = 1;
     char methods[256];
-    snprintf(methods, sizeof methods, "%s", argc > 4 ? argv[4] : "femwarp,lbwarp");
+    snprintf(methods, sizeof methods, "%s", argc > 4 ? argv[4] : "rbf");
+    const char *sname = argc > 5 ? argv[5] : "auto";
+    cm_rbf_solver solver = !strcmp(sname, "dense")       ? CM_RBF_SOLVER_DENSE
+                           : !strcmp(sname, "iterative") ? CM_RBF_SOLVER_ITERATIVE
+                                                         : CM_RBF_SOLVER_AUTO;
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
     cm_context_set_threads(ctx, threads);
@@ -143,19 +157,19 @@ int main(int argc, char **argv)
     cm_status s = cm_mesh_read(ctx, argv[1], &m);
     if (s >= 0) s = cm_mesh_boundary_create(ctx, m, &b);
     if (s < 0) {
-        fprintf(stderr, "bench_warp_transpose_mesh: %s\n", cm_context_message(ctx));
+        fprintf(stderr, "bench_warp_vjp: %s\n", cm_context_message(ctx));
         return 2;
     }
     int rc = 0;
     for (char *tok = strtok(methods, ","); tok; tok = strtok(NULL, ",")) {
         int mth = cm_warp_method_from_name(tok);
         if (mth < 0) {
-            fprintf(stderr, "bench_warp_transpose_mesh: unknown method '%s' (%s)\n", tok,
+            fprintf(stderr, "bench_warp_vjp: unknown method '%s' (%s)\n", tok,
                     cm_warp_method_list());
             rc = 1;
             break;
         }
-        if (run(ctx, m, b, argv[1], (cm_warp_method)mth, reps)) rc = 2;
+        if (run(ctx, m, b, argv[1], (cm_warp_method)mth, solver, reps)) rc = 2;
     }
     cm_mesh_boundary_destroy(&b);
     cm_mesh_destroy(&m);
