@@ -8,6 +8,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -401,6 +402,17 @@ static int same_value(double a, double b)
     return fabs(a - b) <= 1e-12 * fmax(1.0, fmax(fabs(a), fabs(b)));
 }
 
+/* The one parameter row i changes relative to row base, or SIZE_MAX (none, several, i = base). */
+static size_t single_change(const cm_design_table *t, size_t base, size_t i)
+{
+    if (i == base) return SIZE_MAX;
+    const double *v = t->values + i * t->n_par, *b = t->values + base * t->n_par;
+    size_t changed = 0, which = SIZE_MAX;
+    for (size_t j = 0; j < t->n_par; ++j)
+        if (!same_value(v[j], b[j])) ++changed, which = j;
+    return changed == 1 ? which : SIZE_MAX;
+}
+
 cm_status cm_design_plan(cm_context *ctx, const cm_design_table *t, size_t base,
                          cm_design_difference *out)
 {
@@ -430,6 +442,26 @@ cm_status cm_design_plan(cm_context *ctx, const cm_design_table *t, size_t base,
         double dp = v[which] - b[which];
         if (dp > 0 && (!(d->dp_plus > 0) || dp < d->dp_plus)) d->plus = i, d->dp_plus = dp;
         if (dp < 0 && (!(d->dp_minus < 0) || dp > d->dp_minus)) d->minus = i, d->dp_minus = dp;
+    }
+    /* both sides: a symmetric pair, where there is one, makes the difference second order
+     * (the smallest such pair, even when a nearer row on one side has no partner) */
+    for (size_t j = 0; j < np; ++j) {
+        cm_design_difference *d = &out[j];
+        if (!(d->dp_plus > 0 && d->dp_minus < 0)) continue;
+        double best = INFINITY;
+        for (size_t i = 0; i < t->n_rows; ++i) {
+            size_t k = single_change(t, base, i);
+            double dp = t->values[i * np + j] - b[j];
+            if (k != j || !(dp > 0) || dp >= best) continue;
+            for (size_t m = 0; m < t->n_rows; ++m)
+                if (single_change(t, base, m) == j &&
+                    same_value(t->values[m * np + j] - b[j], -dp)) {
+                    best = dp;
+                    d->plus = i, d->dp_plus = dp;
+                    d->minus = m, d->dp_minus = t->values[m * np + j] - b[j];
+                    break;
+                }
+        }
     }
     size_t used = 0;
     char skipped[512] = "";
