@@ -1020,11 +1020,19 @@ void *user;
 const char *x_label;
 double x_max;
 double x_tick;
+double x_min, x0;
+size_t n_values;
+const char *const *value_names;
+const double *(*values)(void *user, size_t i);
 } cm_study_family;
 cm_status cm_study_family_files(cm_context *ctx, const char *const *paths, size_t n,
 const cm_cad_read_options *opt, cm_study_family *family);
 void cm_study_family_release(cm_study_family *family);
 cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n);
+typedef struct cm_design_table cm_design_table;
+cm_status cm_study_family_design(cm_context *ctx, const cm_design_table *table,
+size_t base, const cm_cad_read_options *opt,
+cm_study_family *family);
 void cm_study_paths_free(char ***paths, size_t n);
 enum {
 CM_STUDY_WRITE_NONE = 0,
@@ -1073,6 +1081,10 @@ cm_study_method *methods;
 size_t n_variants;
 char x_label[64];
 double x_max, x_tick;
+double x_min, x0;
+size_t n_values;
+char (*value_names)[64];
+double *values;
 size_t n_rows, cap_rows;
 cm_study_row *rows;
 size_t n_failed;
@@ -1106,7 +1118,6 @@ size_t n_series;
 const cm_plot_series *series;
 } cm_plot;
 cm_status cm_plot_write_svg(cm_context *ctx, const cm_plot *p, const char *path);
-typedef struct cm_design_table cm_design_table;
 cm_status cm_design_table_read(cm_context *ctx, const char *path, cm_design_table **table);
 void cm_design_table_destroy(cm_design_table **table);
 size_t cm_design_table_n_parameters(const cm_design_table *table);

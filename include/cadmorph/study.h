@@ -80,6 +80,14 @@ typedef struct cm_study_family {
     const char *x_label; /* the plot's x axis; NULL: "variant" */
     double x_max;        /* the plot's x range [0, x_max]; 0: n */
     double x_tick;       /* its tick spacing; 0: 1, 2 or 5 x 10^k for about 6 ticks */
+    /* The x range is [x_min, x_max] (x_min default 0: x = t * x_max) and M0 sits at x0
+     * (default 0): a design table's sweep of one parameter plots against its values. */
+    double x_min, x0;
+    /* Named values of each variant for extra CSV columns (a design table's parameters):
+     * n_values names, and values(user, i) the n_values of variant i. 0 / NULL: none. */
+    size_t n_values;
+    const char *const *value_names;
+    const double *(*values)(void *user, size_t i);
 } cm_study_family;
 
 /* A family of STEP files: variant i is paths[i] read by cm_cad_read (opt may be NULL), its
@@ -97,6 +105,18 @@ CM_API void cm_study_family_release(cm_study_family *family);
  * CM_ERR_FORMAT "LIST: no STEP paths" for an empty list, CM_ERR_IO for a glob matching no
  * file. *paths: *n strings, free with cm_study_paths_free. */
 CM_API cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n);
+
+/* The variants of a design table (a `--variants T.csv` whose header is `step,<p1>,...`,
+ * cm_design_table_detect): every row but row base (G0's), in table order, read by cm_cad_read
+ * (opt may be NULL), labelled by the file name without extension, with the parameters as
+ * named values (CSV columns). When exactly one parameter differs between the rows (a
+ * one-parameter sweep) the plot's x is that parameter (x_label its name, range its values,
+ * M0 at the base row's value); otherwise the row (x = variant). table is borrowed while the
+ * family lives. */
+typedef struct cm_design_table cm_design_table;
+CM_API cm_status cm_study_family_design(cm_context *ctx, const cm_design_table *table,
+                                        size_t base, const cm_cad_read_options *opt,
+                                        cm_study_family *family);
 CM_API void cm_study_paths_free(char ***paths, size_t n);
 
 /* ---- running a study ---- */
@@ -169,6 +189,10 @@ typedef struct cm_study_result {
     size_t n_variants;
     char x_label[64];
     double x_max, x_tick;
+    double x_min, x0;   /* the plot's x range starts at x_min, M0 sits at x0 */
+    size_t n_values;    /* named values per variant (cm_study_family.n_values) */
+    char (*value_names)[64];
+    double *values;     /* n_variants x n_values */
     size_t n_rows, cap_rows;
     cm_study_row *rows; /* variant-major: per variant, the absolute rows then the relative */
     size_t n_failed;    /* rows with status < 0 */
@@ -196,7 +220,8 @@ enum {
  * Columns: model,mesh,mode,method,step,t,percent,min_scaled_jacobian,mean_scaled_jacobian,
  * inverted,cells,max_distance,max_distance_rel,outside,nodes,boundary_nodes,threads,t_sample,
  * t_classify,t_surface,t_volume_solve,t_evaluation,t_quality,t_distance,t_write and, FULL,
- * variant (label),status (cm_status_name),message (RFC 4180 quoting). */
+ * variant (label),status (cm_status_name),message (RFC 4180 quoting), then FULL, one column
+ * per named value of the family (a design table's parameters, by their names). */
 CM_API cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const char *path,
                              int format);
 
@@ -236,8 +261,6 @@ CM_API cm_status cm_plot_write_svg(cm_context *ctx, const cm_plot *p, const char
  * that change it alone (cm_design_plan); cm_design_velocity gives dX/dp of every node for
  * every parameter, cm_design_gradient dJ/dp = sum over nodes of S . dX/dp for a sensitivity
  * S = dJ/dX. Velocities are in mesh units per parameter unit. */
-typedef struct cm_design_table cm_design_table;
-
 /* Reads a design table: the header `step,<p1>,...` (the first column's name "step" in any
  * case; an UTF-8 byte order mark, blank lines, CRLF line ends, blanks around fields and
  * RFC 4180 quoting - "a, b" and "" for a quote - as spreadsheet and CAD exports write them),

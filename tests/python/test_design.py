@@ -237,3 +237,29 @@ def test_reverse_product_with_the_shared_factorisation(block):
     lhs, rhs = float((v * jd).sum()), float((jtv * d).sum())
     assert abs(lhs - rhs) <= 1e-10 * abs(lhs)
     assert np.all(jtv[~flags] == 0)
+
+
+def test_study_accepts_a_design_table(cli, block, work):
+    """`cadmorph study --variants T.csv`: every row but G0's is a variant, study.csv gains the
+    parameter columns; two parameters vary: the plot is against the variant; with one, against
+    that parameter (its name on the x axis, M0 at G0's value)."""
+    run(cli, "study", "--from", block / "base.step", "--mesh", block / "M0.vtu", "--variants",
+        block / "T.csv", "-o", work / "two", "--write-meshes", "none", "--threads", 1)
+    rows = list(csv.DictReader(open(work / "two" / "study.csv")))
+    assert [r["variant"] for r in rows] == ["lx_p", "lx_m", "r_p", "both"]
+    assert [(float(r["lx"]), float(r["r"])) for r in rows] == \
+        [(10.1, 2.0), (9.9, 2.0), (10.0, 2.05), (10.1, 2.05)]
+    assert all(r["status"] == "ok" for r in rows)
+    assert ">variant</text>" in (work / "two" / "study.svg").read_text()
+    one = work / "one.csv"
+    one.write_text('step,lx,r\n"%s",10,2\n"%s",10.1,2\n"%s",9.9,2\n'
+                   % (block / "base.step", block / "lx_p.step", block / "lx_m.step"))
+    run(cli, "study", "--from", block / "base.step", "--mesh", block / "M0.vtu", "--variants",
+        one, "-o", work / "one", "--write-meshes", "none", "--threads", 1)
+    svg = (work / "one" / "study.svg").read_text()
+    assert ">lx</text>" in svg and "over the sweep" in svg
+    # the polyline runs in the order of lx: 9.9, M0 at 10, 10.1
+    import re
+    pts = re.search(r'<polyline[^>]*points="([^"]*)"', svg).group(1).split()
+    xs = [float(p.split(",")[0]) for p in pts]
+    assert len(xs) == 3 and xs[0] < xs[1] < xs[2]
