@@ -189,6 +189,14 @@ def test_cli_outputs_and_errors(cli, block, work):
         assert abs(float(r["dJdp"]) - ref) <= 1e-10 * abs(ref)
     m = cadmorph.read_mesh(out / "velocity.vtu")
     assert np.array_equal(m.point_data["dX_dlx"], vel[:, 4:7])
+    # the same sensitivity as the point field dJdX of a mesh of M0's nodes
+    m0 = cadmorph.read_mesh(block / "M0.vtu")
+    cadmorph.write_mesh(work / "S.vtu", cadmorph.Mesh.from_arrays(m0.points, m0.cells,
+                                                                   point_data={"dJdX": c}))
+    run(cli, "sensitivity", "--from", block / "base.step", "--mesh", block / "M0.vtu",
+        "--design-table", block / "T.csv", "-o", work / "out_vtu", "--dJdX", work / "S.vtu",
+        "--threads", 1)
+    assert (work / "out_vtu" / "gradient.csv").read_text() == (out / "gradient.csv").read_text()
     # a bad sensitivity file: exit 2 naming path:line, no output directory made
     (work / "bad.csv").write_text("node,gx,gy,gz\n0,1,2\n")
     r = subprocess.run([cli, "sensitivity", "--from", block / "base.step", "--mesh",
