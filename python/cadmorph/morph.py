@@ -498,7 +498,7 @@ class Morpher:
                 raise ValueError("%s: the Morpher's geometry has no file: give base, the row "
                                  "of the table it is" % what)
             row = table.row_of(g0.path)
-        elif isinstance(base, (int,)) and not isinstance(base, bool):
+        elif isinstance(base, (int, np.integer)) and not isinstance(base, bool):
             row = integer(what, "base", base, 0, len(table.rows) - 1)
         else:
             row = table.row_of(path_bytes(what, "base", base).decode())
