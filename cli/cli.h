@@ -88,5 +88,6 @@ int cli_cmd_optimize(int argc, char **argv);
 int cli_cmd_ffd(int argc, char **argv);
 int cli_cmd_detect(int argc, char **argv);
 int cli_cmd_model(int argc, char **argv);
+int cli_cmd_sensitivity(int argc, char **argv);
 
 #endif

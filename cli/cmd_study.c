@@ -63,8 +63,12 @@ static const cli_option options[] = {
      .help = "volume mesh of G0 (.msh .vtu .vtk .mesh)"},
     {.name = "--variants", .kind = CLI_STRING, .dest = &args.variants, .label = "--variants LIST",
      .help = "a text file of STEP paths, one per line ('#' comments; relative\n"
-             "paths are relative to the list file), or a quoted glob pattern\n"
-             "such as 'designs/*.step' (sorted)"},
+             "paths are relative to the list file), a quoted glob pattern\n"
+             "such as 'designs/*.step' (sorted), or a design table: a CSV with\n"
+             "the header step,<p1>,<p2>,... (as CAD programs export; G0 must be\n"
+             "one of its rows, the others are the variants): study.csv gains\n"
+             "a column per parameter, study.svg plots against the parameter\n"
+             "when only one varies"},
     {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
      .label = "-o, --output DIR", .help = "output directory (created if missing)"},
     {.name = "--mode", .kind = CLI_ENUM, .dest = &args.modes, .names = cli_study_mode_names,
@@ -175,12 +179,20 @@ static int run(cm_context *ctx, const study_args *a)
     cm_cad_read_options ro;
     cm_cad_read_options_init(&ro);
     if (a->unit) ro.unit = a->unit;
-    cm_status s = cm_study_read_list(ctx, a->variants, &paths, &n);
+    /* a design table (header step,<p1>,...) or a plain list of STEP paths */
+    cm_design_table *table = NULL;
+    size_t base = 0;
+    const int design = cm_design_table_detect(a->variants);
+    cm_status s = design ? cm_design_table_read(ctx, a->variants, &table)
+                         : cm_study_read_list(ctx, a->variants, &paths, &n);
+    if (s >= 0 && design) s = cm_design_table_find(ctx, table, a->from, &base);
     int rc = s < 0 ? cli_fail(ctx, "study", s) : cli_make_dir("study", a->out);
     if (rc == 0) {
         s = cm_cad_read(ctx, a->from, &ro, &g0);
         if (s >= 0) s = cm_mesh_read(ctx, a->mesh, &mesh);
-        if (s >= 0) s = cm_study_family_files(ctx, (const char *const *)paths, n, &ro, &fam);
+        if (s >= 0)
+            s = design ? cm_study_family_design(ctx, table, base, &ro, &fam)
+                       : cm_study_family_files(ctx, (const char *const *)paths, n, &ro, &fam);
         if (s >= 0) {
             cm_study_options so;
             cm_study_options_init(&so);
@@ -222,6 +234,7 @@ static int run(cm_context *ctx, const study_args *a)
     cm_mesh_destroy(&mesh);
     cm_cad_destroy(&g0);
     cm_study_paths_free(&paths, n);
+    cm_design_table_destroy(&table);
     return rc;
 }
 

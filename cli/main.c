@@ -17,6 +17,7 @@ typedef struct cli_command {
 static const cli_command commands[] = {
     {"morph", cli_cmd_morph, "morph a mesh of G0.step onto G1.step (surface on the CAD, interior by RBF)"},
     {"study", cli_cmd_study, "morph a mesh onto every STEP file of a list (a design table), compare methods"},
+    {"sensitivity", cli_cmd_sensitivity, "design velocities dX/dp of a mesh for a CAD design table, gradients dJ/dp"},
     {"sweep", cli_cmd_sweep, "Staten-style study: morph a benchmark model over its parameter change"},
     {"demo", cli_cmd_demo, "the embedded example: bore model, tet mesh, 10-step absolute sweep"},
     {"quality", cli_cmd_quality, "scaled Jacobian report of a mesh; --foam: OpenFOAM checkMesh's metrics"},

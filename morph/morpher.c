@@ -3,49 +3,12 @@
  * by a warp [SMB12 §3] whose factorisation depends only on M, kept per method. */
 #include "cadmorph/morph.h"
 
-#include "off_cad.h"
+#include "morpher_internal.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define CM_MORPHER_MAX_WARPS 16
-
-struct cm_morpher {
-    cm_morph_options opt;
-    const cm_cad_model *g; /* borrowed: the geometry the start mesh lies on */
-    cm_mesh *mesh;         /* the start mesh (own copy) */
-    cm_mesh_boundary *b;
-    cm_cad_locator *loc; /* on g */
-    cm_surface_nodes *nodes;
-    /* warps on mesh, made when first used, one per set of warp options (a study may compare
-     * one method with several settings, e.g. lattice sizes) */
-    struct {
-        cm_warp_options opt;
-        cm_warp *warp;
-    } warps[CM_MORPHER_MAX_WARPS];
-    int n_warps;
-    const cm_cad_model *target; /* the last target (borrowed), its bounding box (so that another
-                                   model read at the same address is not taken for it) and
-                                   its locator */
-    double target_bb[6];
-    cm_cad_locator *target_loc;
-    cm_mesh *work; /* a copy of mesh whose coordinates are the result being measured */
-    double *sj;    /* work's scaled_jacobian field */
-    double *disp;  /* #nodes x 3 */
-    double *bnew;  /* #boundary x 3: the surface morph's positions on the target */
-    double *bxyz;  /* #boundary x 3: the positions of the current increment */
-    double *next;  /* #nodes x 3: the step being tried */
-    double *offset; /* keep_offset: #boundary x 3, each node minus its point on g */
-    unsigned char *fixed; /* #nodes: the boundary nodes, which optimisation never moves */
-    cm_off_cad_contact contact; /* off_cad fixed: nodes on G touching the fixed surface */
-    double min_sj0;       /* M's minimum scaled Jacobian (keep_fraction) */
-    cm_morph_step *rows;  /* the last apply's steps */
-    size_t n_rows, cap_rows;
-    cm_surface_morph_stats surface;
-    cm_morpher_info info;
-};
 
 void cm_morph_method_init(cm_morph_method *m)
 {
@@ -302,8 +265,8 @@ static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
 
 /* The warp with options wo on the start mesh, made on first use (options compared bytewise:
  * cm_warp_options_init zeroes them first); *t: its factorisation time. */
-static cm_status shared_warp(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
-                             cm_warp **warp, double *t)
+cm_status cm_morpher_shared_warp(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
+                                 cm_warp **warp, double *t)
 {
     for (int i = 0; i < mp->n_warps; ++i)
         if (!memcmp(&mp->warps[i].opt, wo, sizeof *wo)) {
@@ -324,6 +287,25 @@ static cm_status shared_warp(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
     mp->warps[mp->n_warps++].warp = w;
     *warp = w;
     return CM_OK;
+}
+
+cm_status cm_morpher_surface_positions(cm_context *ctx, cm_morpher *mp,
+                                       const cm_cad_model *target, cm_surface_method surface,
+                                       double *bnew)
+{
+    cm_surface_morph_options mo = mp->opt.morph;
+    mo.method = surface;
+    memset(&mp->surface, 0, sizeof mp->surface);
+    cm_status s = cm_surface_morph(ctx, mp->g, target, mp->nodes, &mo, bnew, &mp->surface);
+    if (s < 0) return s;
+    if (mp->opt.keep_offset)
+        for (size_t i = 0; i < 3 * mp->nodes->n; ++i)
+            bnew[i] += mp->offset[i];
+    if (mp->contact.n) {
+        cm_status c = cm_morph_off_cad_contact_check(ctx, mp->mesh, mp->nodes, &mp->contact, bnew);
+        if (c < 0) return c;
+    }
+    return s;
 }
 
 /* A new row of the last apply (zeroed); NULL when out of memory. Rows move when the array
@@ -368,7 +350,7 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     double t0 = cm_wtime();
     cm_status s;
     if (shared) {
-        s = shared_warp(ctx, mp, wo, &w, &row->t_volume_solve);
+        s = cm_morpher_shared_warp(ctx, mp, wo, &w, &row->t_volume_solve);
     } else {
         memcpy(mp->work->xyz, from, 3 * nn * sizeof *from);
         s = cm_warp_create(ctx, mp->work, mp->b, NULL, wo, &own);
@@ -556,19 +538,9 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     double t_sample = 0;
     cm_status s = use_target(ctx, mp, target, &t_sample);
     if (s < 0) return s;
-    cm_surface_morph_options mo = mp->opt.morph;
-    mo.method = method->surface;
     double t0 = cm_wtime();
-    memset(&mp->surface, 0, sizeof mp->surface);
-    s = cm_surface_morph(ctx, mp->g, target, mp->nodes, &mo, mp->bnew, &mp->surface);
+    s = cm_morpher_surface_positions(ctx, mp, target, method->surface, mp->bnew);
     if (s < 0) return s;
-    if (mp->opt.keep_offset)
-        for (size_t i = 0; i < 3 * mp->nodes->n; ++i)
-            mp->bnew[i] += mp->offset[i];
-    if (s >= 0 && mp->contact.n) {
-        cm_status c = cm_morph_off_cad_contact_check(ctx, mp->mesh, mp->nodes, &mp->contact, mp->bnew);
-        if (c < 0) return c;
-    }
     double t_surface = cm_wtime() - t0;
     char warning[1024] = "";
     if (s == CM_WARNING) {

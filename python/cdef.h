@@ -806,6 +806,7 @@ void cm_warp_destroy(cm_warp **warp);
 cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
 cm_status cm_warp_apply_transpose(cm_context *ctx, cm_warp *warp, const double *v,
 double *out);
+int cm_warp_method_is_linear(cm_warp_method method);
 cm_warp_method cm_warp_get_method(const cm_warp *warp);
 double cm_warp_residual(const cm_warp *warp);
 size_t cm_warp_fallback_nodes(const cm_warp *warp);
@@ -888,6 +889,15 @@ const cm_morpher_info *cm_morpher_get_info(const cm_morpher *morpher);
 const cm_mesh *cm_morpher_mesh(const cm_morpher *morpher);
 const double *cm_morpher_quality(const cm_morpher *morpher);
 const cm_surface_morph_stats *cm_morpher_surface_stats(const cm_morpher *morpher);
+cm_status cm_morpher_boundary(cm_context *ctx, cm_morpher *morpher,
+const cm_cad_model *target, double *out_xyz);
+cm_status cm_morpher_velocity(cm_context *ctx, cm_morpher *morpher, const double *plus,
+double dp_plus, const double *minus, double dp_minus,
+int interior, double *out);
+cm_status cm_morpher_warp_forward(cm_context *ctx, cm_morpher *morpher, double *disp);
+cm_status cm_morpher_warp_transpose(cm_context *ctx, cm_morpher *morpher, const double *v,
+double *out);
+const unsigned char *cm_morpher_boundary_flags(const cm_morpher *morpher);
 typedef struct cm_morph_result {
 cm_mesh *mesh;
 double *sj;
@@ -1022,11 +1032,19 @@ void *user;
 const char *x_label;
 double x_max;
 double x_tick;
+double x_min, x0;
+size_t n_values;
+const char *const *value_names;
+const double *(*values)(void *user, size_t i);
 } cm_study_family;
 cm_status cm_study_family_files(cm_context *ctx, const char *const *paths, size_t n,
 const cm_cad_read_options *opt, cm_study_family *family);
 void cm_study_family_release(cm_study_family *family);
 cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n);
+typedef struct cm_design_table cm_design_table;
+cm_status cm_study_family_design(cm_context *ctx, const cm_design_table *table,
+size_t base, const cm_cad_read_options *opt,
+cm_study_family *family);
 void cm_study_paths_free(char ***paths, size_t n);
 enum {
 CM_STUDY_WRITE_NONE = 0,
@@ -1075,6 +1093,10 @@ cm_study_method *methods;
 size_t n_variants;
 char x_label[64];
 double x_max, x_tick;
+double x_min, x0;
+size_t n_values;
+char (*value_names)[64];
+double *values;
 size_t n_rows, cap_rows;
 cm_study_row *rows;
 size_t n_failed;
@@ -1108,6 +1130,51 @@ size_t n_series;
 const cm_plot_series *series;
 } cm_plot;
 cm_status cm_plot_write_svg(cm_context *ctx, const cm_plot *p, const char *path);
+cm_status cm_design_table_read(cm_context *ctx, const char *path, cm_design_table **table);
+void cm_design_table_destroy(cm_design_table **table);
+size_t cm_design_table_n_parameters(const cm_design_table *table);
+size_t cm_design_table_n_rows(const cm_design_table *table);
+const char *cm_design_table_parameter(const cm_design_table *table, size_t j);
+const char *cm_design_table_path(const cm_design_table *table, size_t i);
+const double *cm_design_table_values(const cm_design_table *table, size_t i);
+long cm_design_table_line(const cm_design_table *table, size_t i);
+cm_status cm_design_table_find(cm_context *ctx, const cm_design_table *table,
+const char *path, size_t *row);
+int cm_design_table_detect(const char *path);
+typedef enum cm_design_scheme {
+CM_DESIGN_NONE = 0,
+CM_DESIGN_CENTRAL = 1,
+CM_DESIGN_FORWARD = 2,
+CM_DESIGN_BACKWARD = 3
+} cm_design_scheme;
+const char *cm_design_scheme_name(cm_design_scheme scheme);
+typedef struct cm_design_difference {
+cm_design_scheme scheme;
+size_t plus, minus;
+double dp_plus, dp_minus;
+} cm_design_difference;
+cm_status cm_design_plan(cm_context *ctx, const cm_design_table *table, size_t base,
+cm_design_difference *out);
+typedef struct cm_design_velocities {
+size_t n_parameters;
+size_t n_nodes;
+size_t base;
+int interior;
+cm_design_difference *diff;
+double *v;
+size_t surface_morphs;
+double t_read, t_surface, t_warp;
+} cm_design_velocities;
+cm_status cm_design_velocity(cm_context *ctx, cm_morpher *mp, const cm_cad_model *g0,
+const cm_design_table *table, size_t base,
+const cm_cad_read_options *ro, int interior,
+cm_design_velocities **out);
+void cm_design_velocities_destroy(cm_design_velocities **v);
+cm_status cm_design_gradient(cm_context *ctx, cm_morpher *mp, const cm_design_velocities *v,
+const double *sens, int boundary_only, double *dJdp,
+int *reverse);
+cm_status cm_design_read_sensitivity(cm_context *ctx, const char *path, size_t n_nodes,
+double *sens, unsigned char *listed);
 typedef struct cm_sweep_options {
 const char *model;
 const char *mesh;

@@ -32,8 +32,13 @@ cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const ch
     fprintf(f, "model,mesh,mode,method,step,t,percent,min_scaled_jacobian,"
                "mean_scaled_jacobian,inverted,cells,max_distance,max_distance_rel,outside,"
                "nodes,boundary_nodes,threads,t_sample,t_classify,t_surface,t_volume_solve,"
-               "t_evaluation,t_quality,t_distance,t_write%s\n",
+               "t_evaluation,t_quality,t_distance,t_write%s",
             full ? ",variant,status,message" : "");
+    for (size_t k = 0; full && k < r->n_values; ++k) {
+        fputc(',', f);
+        field(f, r->value_names[k]);
+    }
+    fputc('\n', f);
     for (size_t i = 0; i < r->n_rows; ++i) {
         const cm_study_row *w = &r->rows[i];
         if (!full && w->status < 0) continue; /* the sweep's series end where they fail */
@@ -55,6 +60,8 @@ cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const ch
             field(f, w->label);
             fprintf(f, ",%s,", cm_status_name(w->status));
             field(f, w->message);
+            for (size_t k = 0; k < r->n_values; ++k)
+                fprintf(f, ",%.17g", r->values[w->variant * r->n_values + k]);
         }
         fputc('\n', f);
     }

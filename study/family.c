@@ -3,6 +3,8 @@
 #include "cadmorph/study.h"
 
 #include <errno.h>
+#include <math.h>
+#include <stdint.h>
 #include <glob.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -191,4 +193,101 @@ void cm_study_family_release(cm_study_family *family)
     if (!family) return;
     if (family->destroy) family->destroy(family->user);
     memset(family, 0, sizeof *family);
+}
+
+/* ---- the family over a design table's rows ---- */
+
+typedef struct design_rows {
+    files f;           /* the rows' paths (every row but the base) */
+    const cm_design_table *t;
+    size_t *row;       /* variant -> table row */
+    const char **names;
+    double lo, hi;     /* the varying parameter's range (one-parameter sweeps) */
+    size_t varying;    /* its index, or SIZE_MAX */
+} design_rows;
+
+static const double *design_values(void *user, size_t i)
+{
+    const design_rows *d = user;
+    return cm_design_table_values(d->t, d->row[i]);
+}
+
+static double design_param(void *user, size_t i)
+{
+    const design_rows *d = user;
+    if (d->varying == SIZE_MAX) return (double)(i + 1) / (double)d->f.n;
+    return (cm_design_table_values(d->t, d->row[i])[d->varying] - d->lo) / (d->hi - d->lo);
+}
+
+static void design_destroy(void *user)
+{
+    design_rows *d = user;
+    cm_study_paths_free(&d->f.paths, d->f.n);
+    free(d->row);
+    free(d->names);
+    free(d);
+}
+
+cm_status cm_study_family_design(cm_context *ctx, const cm_design_table *t, size_t base,
+                                 const cm_cad_read_options *opt, cm_study_family *family)
+{
+    if (family) memset(family, 0, sizeof *family);
+    if (!t || !family) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_family_design: NULL input");
+    const size_t nr = cm_design_table_n_rows(t), np = cm_design_table_n_parameters(t);
+    if (base >= nr || nr < 2)
+        return cm_error(ctx, nr < 2 ? CM_ERR_FORMAT : CM_ERR_ARGUMENT,
+                        "cm_study_family_design: base row %zu of %zu rows (a study needs a row "
+                        "besides G0's)", base, nr);
+    design_rows *d = calloc(1, sizeof *d);
+    if (d) {
+        d->f.paths = calloc(nr, sizeof *d->f.paths);
+        d->row = calloc(nr, sizeof *d->row);
+        d->names = calloc(np ? np : 1, sizeof *d->names);
+    }
+    if (!d || !d->f.paths || !d->row || !d->names) {
+        if (d) free(d->f.paths), free(d->row), free(d->names);
+        free(d);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_study_family_design: out of memory");
+    }
+    d->t = t;
+    for (size_t i = 0; i < nr; ++i) {
+        if (i == base) continue;
+        d->row[d->f.n] = i;
+        if (!(d->f.paths[d->f.n] = strdup(cm_design_table_path(t, i)))) {
+            design_destroy(d);
+            return cm_error(ctx, CM_ERR_NOMEM, "cm_study_family_design: out of memory");
+        }
+        ++d->f.n;
+    }
+    if (opt) d->f.opt = *opt, d->f.has_opt = 1;
+    for (size_t j = 0; j < np; ++j)
+        d->names[j] = cm_design_table_parameter(t, j);
+    /* a one-parameter sweep: the only parameter whose value is not the same in every row */
+    d->varying = SIZE_MAX;
+    size_t n_varying = 0;
+    for (size_t j = 0; j < np; ++j) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < nr; ++i) {
+            const double v = cm_design_table_values(t, i)[j];
+            lo = fmin(lo, v), hi = fmax(hi, v);
+        }
+        if (hi > lo) ++n_varying, d->varying = j, d->lo = lo, d->hi = hi;
+    }
+    if (n_varying != 1) d->varying = SIZE_MAX;
+    family->n = d->f.n;
+    family->load = files_load;
+    family->label = files_label;
+    family->destroy = design_destroy;
+    family->user = d;
+    family->param = design_param;
+    family->n_values = np;
+    family->value_names = d->names;
+    family->values = design_values;
+    if (d->varying != SIZE_MAX) {
+        family->x_label = d->names[d->varying];
+        family->x_min = d->lo;
+        family->x_max = d->hi;
+        family->x0 = cm_design_table_values(t, base)[d->varying];
+    }
+    return CM_OK;
 }

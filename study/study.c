@@ -23,6 +23,8 @@ void cm_study_result_destroy(cm_study_result **r)
     if (!r || !*r) return;
     free((*r)->rows);
     free((*r)->methods);
+    free((*r)->value_names);
+    free((*r)->values);
     free(*r);
     *r = NULL;
 }
@@ -403,8 +405,25 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
     r->cells = cm_mesh_count_dim(mesh, 3);
     r->n_variants = family->n;
     snprintf(r->x_label, sizeof r->x_label, "%s", family->x_label ? family->x_label : "variant");
-    r->x_max = family->x_max > 0 ? family->x_max : (double)family->n;
+    r->x_max = family->x_max > 0 || family->x_min < family->x_max ? family->x_max
+                                                                  : (double)family->n;
     r->x_tick = family->x_tick;
+    r->x_min = family->x_min < r->x_max ? family->x_min : 0;
+    r->x0 = family->x0;
+    if (family->n_values && family->value_names && family->values) {
+        r->value_names = calloc(family->n_values, sizeof *r->value_names);
+        r->values = calloc(family->n_values * (family->n ? family->n : 1), sizeof *r->values);
+        if (!r->value_names || !r->values) {
+            cm_study_result_destroy(&w.r);
+            return cm_error(ctx, CM_ERR_NOMEM, "cm_study_run: out of memory");
+        }
+        r->n_values = family->n_values;
+        for (size_t k = 0; k < r->n_values; ++k)
+            snprintf(r->value_names[k], sizeof r->value_names[k], "%s", family->value_names[k]);
+        for (size_t i = 0; i < family->n; ++i)
+            memcpy(r->values + i * r->n_values, family->values(family->user, i),
+                   r->n_values * sizeof *r->values);
+    }
     double bb[6];
     cm_cad_bbox(g0, bb);
     r->diagonal = cm_bbox_diagonal(bb);

@@ -41,11 +41,18 @@ typedef struct frame {
     double ylo, yhi;
     double xmax, xtick;
     int clipped; /* some value lies below ylo = SVG_Y_CLIP */
+    double xmin, x0; /* x range [xmin, xmax]; M0 at x0 */
 } frame;
 
 static double px(const frame *fr, double x)
 {
-    return PX0 + (PX1 - PX0) * x / fr->xmax;
+    return PX0 + (PX1 - PX0) * (x - fr->xmin) / (fr->xmax - fr->xmin);
+}
+
+/* A row's x: t in [0, 1] across the range. */
+static double row_x(const frame *fr, const cm_study_row *w)
+{
+    return fr->xmin + w->t * (fr->xmax - fr->xmin);
 }
 static double py(const frame *fr, double y)
 {
@@ -56,8 +63,10 @@ static double py(const frame *fr, double y)
 static void axes(FILE *f, const frame *fr, const char *x_label)
 {
     fprintf(f, "<g font-family=\"sans-serif\" font-size=\"13\" fill=\"#222\">\n");
-    for (int k = 0; k * fr->xtick <= fr->xmax * (1 + 1e-9); ++k) {
-        double x = k * fr->xtick;
+    const double k0 = ceil(fr->xmin / fr->xtick - 1e-9);
+    for (int k = 0; (k0 + k) * fr->xtick <= fr->xmax + 1e-9 * fabs(fr->xmax); ++k) {
+        double x = (k0 + k) * fr->xtick;
+        if (fabs(x) < 1e-9 * fr->xtick) x = 0;
         fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#e4e4e4\"/>\n",
                 px(fr, x), PY0, px(fr, x), PY1);
         fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#222\"/>\n",
@@ -112,20 +121,34 @@ static int curve(FILE *f, const cm_study_result *r, const frame *fr, int mode, s
     for (size_t i = 0; i < r->n_rows; ++i)
         n += complete(&r->rows[i], mode, method);
     if (n == 0) return 0;
-    fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"%g\"%s points=\"%.2f,%.2f",
+    fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"%g\"%s points=\"",
             colour(r, method), width(r, method),
-            mode == CM_STUDY_RELATIVE ? " stroke-dasharray=\"7,4\"" : "", px(fr, 0),
-            py(fr, r->min_sj0));
-    for (size_t i = 0; i < r->n_rows; ++i) {
-        const cm_study_row *w = &r->rows[i];
-        if (complete(w, mode, method))
-            fprintf(f, " %.2f,%.2f", px(fr, w->t * fr->xmax), py(fr, w->min_sj));
+            mode == CM_STUDY_RELATIVE ? " stroke-dasharray=\"7,4\"" : "");
+    /* M0 and the rows in the order of x (a sweep of a parameter around G0's value); rows
+     * of equal x keep their order */
+    int m0_drawn = 0, drawn = 0;
+    double last = -INFINITY;
+    for (;;) {
+        double next = INFINITY;
+        for (size_t i = 0; i < r->n_rows; ++i)
+            if (complete(&r->rows[i], mode, method) && row_x(fr, &r->rows[i]) > last)
+                next = fmin(next, row_x(fr, &r->rows[i]));
+        if (!m0_drawn && fr->x0 <= next) {
+            fprintf(f, "%s%.2f,%.2f", drawn++ ? " " : "", px(fr, fr->x0), py(fr, r->min_sj0));
+            m0_drawn = 1;
+        }
+        if (next == INFINITY) break;
+        for (size_t i = 0; i < r->n_rows; ++i)
+            if (complete(&r->rows[i], mode, method) && row_x(fr, &r->rows[i]) == next)
+                fprintf(f, "%s%.2f,%.2f", drawn++ ? " " : "", px(fr, next),
+                        py(fr, r->rows[i].min_sj));
+        last = next;
     }
     fprintf(f, "\"/>\n");
     for (size_t i = 0; i < r->n_rows; ++i) {
         const cm_study_row *w = &r->rows[i];
         if (!complete(w, mode, method)) continue;
-        double x = px(fr, w->t * fr->xmax), y = py(fr, w->min_sj);
+        double x = px(fr, row_x(fr, w)), y = py(fr, w->min_sj);
         if (w->min_sj < fr->ylo)
             fprintf(f,
                     "<path d=\"M%.2f %.2f l5 0 l-5 8 l-5 -8 z\" fill=\"%s\"><title>%.4g"
@@ -151,7 +174,7 @@ static void failed_marks(FILE *f, const cm_study_result *r, const frame *fr)
         for (size_t j = 0; j < i && first; ++j)
             first = r->rows[j].variant != w->variant;
         if (any || !first) continue;
-        double x = px(fr, w->t * fr->xmax);
+        double x = px(fr, row_x(fr, w));
         fprintf(f,
                 "<path d=\"M%.1f %.1f l8 8 m0 -8 l-8 8\" stroke=\"#888\" stroke-width=\"2\">"
                 "<title>",
@@ -166,9 +189,12 @@ static void failed_marks(FILE *f, const cm_study_result *r, const frame *fr)
 cm_status cm_study_write_svg(cm_context *ctx, const cm_study_result *r, const char *path)
 {
     if (!r || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_write_svg: NULL input");
-    frame fr = {r->min_sj0, r->min_sj0, r->x_max > 0 ? r->x_max : 1, r->x_tick, 0};
+    frame fr = {r->min_sj0, r->min_sj0, r->x_max > 0 || r->x_min < r->x_max ? r->x_max : 1,
+                r->x_tick, 0, 0, 0};
+    if (r->x_min < fr.xmax) fr.xmin = r->x_min;
+    fr.x0 = r->x0;
     if (!(fr.xtick > 0)) {
-        fr.xtick = cm_svg_tick_step(fr.xmax);
+        fr.xtick = cm_svg_tick_step(fr.xmax - fr.xmin);
         if (fr.xtick < 1 && fr.xmax >= 1) fr.xtick = 1; /* variants are counted */
     }
     for (size_t i = 0; i < r->n_rows; ++i) {

@@ -134,6 +134,11 @@ cm_status cm_warp_apply_transpose(cm_context *ctx, cm_warp *warp, const double *
     return warp->ops->apply_transpose(ctx, warp->state, v, out);
 }
 
+int cm_warp_method_is_linear(cm_warp_method method)
+{
+    return (int)method >= 0 && method < CM_WARP_N_METHODS && methods[method]->apply_transpose;
+}
+
 cm_warp_method cm_warp_get_method(const cm_warp *warp) { return warp->method; }
 
 double cm_warp_residual(const cm_warp *warp) { return warp ? warp->residual : 0; }

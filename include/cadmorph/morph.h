@@ -173,6 +173,56 @@ CM_API const double *cm_morpher_quality(const cm_morpher *morpher);
 /* Surface-morph statistics of the last apply. */
 CM_API const cm_surface_morph_stats *cm_morpher_surface_stats(const cm_morpher *morpher);
 
+/* ---- derivatives: design velocities (docs/DESIGN.md, "Gradients") ----
+ * The absolute morph of one increment (steps = 1, no optimisation) is
+ * X(G') = X_M + J (B(G') - B_M): B(G') the boundary positions of the surface morph onto G',
+ * J the warp, linear in the boundary motion (cm_warp_method_is_linear). The design velocity dX/dp of a CAD parameter p is then J applied to dB/dp, and
+ * dB/dp a difference quotient of surface morphs onto geometries at perturbed p: no volume
+ * morph is differenced, and the warp's products use the factorisation apply shares (made
+ * once per set of warp options: velocities after a morph cost no factorisation). The
+ * options' steps and optimize do not enter: the velocity is that of the one-increment morph.
+ * The surface and warp methods are the options' (opt.method). */
+
+/* The boundary positions of the surface morph onto target, as apply places them (same
+ * classification, keep_offset, contact check of boundaries partly off G), without a volume
+ * morph: out_xyz (#nodes x 3) = the morpher's mesh with every boundary node on G moved there;
+ * interior nodes and boundary nodes off G keep their coordinates. Errors: CM_ERR_MISMATCH
+ * when target does not correspond to G. Returns CM_WARNING when face nodes left their trimmed
+ * face (cm_morpher_surface_stats). */
+CM_API cm_status cm_morpher_boundary(cm_context *ctx, cm_morpher *morpher,
+                                     const cm_cad_model *target, double *out_xyz);
+
+/* The design velocity of every node: out (#nodes x 3) = dX/dp, the boundary part by the
+ * difference quotient (plus - minus) / (dp_plus - dp_minus) of two cm_morpher_boundary
+ * results (read at boundary nodes on G: 0 at those off G), the rest by the warp's forward
+ * product of it (cm_morpher_warp_forward) when interior is non-zero, else 0.
+ * dp_plus, dp_minus: the parameter values of plus and minus minus the base value (central
+ * differences: dp_plus > 0 > dp_minus; second order when dp_minus = -dp_plus).
+ * minus NULL: the morpher's mesh itself (the base geometry G, dp_minus = 0 then): one-sided
+ * differences, forward for dp_plus > 0, backward for dp_plus < 0. Unit: mesh unit per
+ * parameter unit. Errors: CM_ERR_ARGUMENT when dp_plus = dp_minus; CM_ERR_UNSUPPORTED
+ * (interior) for a warp method that is not linear (cm_warp_method_is_linear). */
+CM_API cm_status cm_morpher_velocity(cm_context *ctx, cm_morpher *morpher, const double *plus,
+                                     double dp_plus, const double *minus, double dp_minus,
+                                     int interior, double *out);
+
+/* The warp's forward product with the shared factorisation of the options' warp method:
+ * disp (#nodes x 3) read at the boundary nodes (cm_morpher_boundary_flags), written at every
+ * other node of a volume cell: J disp (cm_warp_apply). CM_ERR_UNSUPPORTED for a method that
+ * is not linear in the boundary motion. */
+CM_API cm_status cm_morpher_warp_forward(cm_context *ctx, cm_morpher *morpher, double *disp);
+
+/* The reverse product with the same factorisation: out (#nodes x 3) = J^T v (v #nodes x 3,
+ * e.g. dJ/dX of an objective at every node), non-zero at boundary nodes only
+ * (cm_warp_apply_transpose). Then dJ/dp = <out, dX_b/dp> for every parameter: one reverse
+ * product serves them all. CM_ERR_UNSUPPORTED for a method that is not linear. */
+CM_API cm_status cm_morpher_warp_transpose(cm_context *ctx, cm_morpher *morpher, const double *v,
+                                           double *out);
+
+/* #nodes flags, 1 at the boundary nodes (the warp's constrained nodes: on G and off it). Valid
+ * while the morpher lives. */
+CM_API const unsigned char *cm_morpher_boundary_flags(const cm_morpher *morpher);
+
 /* ---- the file-level wrapper ---- */
 
 typedef struct cm_morph_result {

@@ -80,6 +80,14 @@ typedef struct cm_study_family {
     const char *x_label; /* the plot's x axis; NULL: "variant" */
     double x_max;        /* the plot's x range [0, x_max]; 0: n */
     double x_tick;       /* its tick spacing; 0: 1, 2 or 5 x 10^k for about 6 ticks */
+    /* The x range is [x_min, x_max] (x_min default 0: x = t * x_max) and M0 sits at x0
+     * (default 0): a design table's sweep of one parameter plots against its values. */
+    double x_min, x0;
+    /* Named values of each variant for extra CSV columns (a design table's parameters):
+     * n_values names, and values(user, i) the n_values of variant i. 0 / NULL: none. */
+    size_t n_values;
+    const char *const *value_names;
+    const double *(*values)(void *user, size_t i);
 } cm_study_family;
 
 /* A family of STEP files: variant i is paths[i] read by cm_cad_read (opt may be NULL), its
@@ -97,6 +105,18 @@ CM_API void cm_study_family_release(cm_study_family *family);
  * CM_ERR_FORMAT "LIST: no STEP paths" for an empty list, CM_ERR_IO for a glob matching no
  * file. *paths: *n strings, free with cm_study_paths_free. */
 CM_API cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n);
+
+/* The variants of a design table (a `--variants T.csv` whose header is `step,<p1>,...`,
+ * cm_design_table_detect): every row but row base (G0's), in table order, read by cm_cad_read
+ * (opt may be NULL), labelled by the file name without extension, with the parameters as
+ * named values (CSV columns). When exactly one parameter differs between the rows (a
+ * one-parameter sweep) the plot's x is that parameter (x_label its name, range its values,
+ * M0 at the base row's value); otherwise the row (x = variant). table is borrowed while the
+ * family lives. */
+typedef struct cm_design_table cm_design_table;
+CM_API cm_status cm_study_family_design(cm_context *ctx, const cm_design_table *table,
+                                        size_t base, const cm_cad_read_options *opt,
+                                        cm_study_family *family);
 CM_API void cm_study_paths_free(char ***paths, size_t n);
 
 /* ---- running a study ---- */
@@ -169,6 +189,10 @@ typedef struct cm_study_result {
     size_t n_variants;
     char x_label[64];
     double x_max, x_tick;
+    double x_min, x0;   /* the plot's x range starts at x_min, M0 sits at x0 */
+    size_t n_values;    /* named values per variant (cm_study_family.n_values) */
+    char (*value_names)[64];
+    double *values;     /* n_variants x n_values */
     size_t n_rows, cap_rows;
     cm_study_row *rows; /* variant-major: per variant, the absolute rows then the relative */
     size_t n_failed;    /* rows with status < 0 */
@@ -196,7 +220,8 @@ enum {
  * Columns: model,mesh,mode,method,step,t,percent,min_scaled_jacobian,mean_scaled_jacobian,
  * inverted,cells,max_distance,max_distance_rel,outside,nodes,boundary_nodes,threads,t_sample,
  * t_classify,t_surface,t_volume_solve,t_evaluation,t_quality,t_distance,t_write and, FULL,
- * variant (label),status (cm_status_name),message (RFC 4180 quoting). */
+ * variant (label),status (cm_status_name),message (RFC 4180 quoting), then FULL, one column
+ * per named value of the family (a design table's parameters, by their names). */
 CM_API cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const char *path,
                              int format);
 
@@ -228,6 +253,120 @@ typedef struct cm_plot {
 
 /* Writes the plot as SVG (atomically, like the meshes). */
 CM_API cm_status cm_plot_write_svg(cm_context *ctx, const cm_plot *p, const char *path);
+
+/* ---- design tables, design velocities and gradients (docs/DESIGN.md, "Gradients") ----
+ * A design table is the CSV a CAD program exports for a family of designs: a header
+ * `step,<p1>,<p2>,...` and one row per STEP file with its parameter values. For a base row
+ * (G0, the geometry the morpher's mesh lies on) each parameter is differenced over the rows
+ * that change it alone (cm_design_plan); cm_design_velocity gives dX/dp of every node for
+ * every parameter, cm_design_gradient dJ/dp = sum over nodes of S . dX/dp for a sensitivity
+ * S = dJ/dX. Velocities are in mesh units per parameter unit. */
+/* Reads a design table: the header `step,<p1>,...` (the first column's name "step" in any
+ * case; an UTF-8 byte order mark, blank lines, CRLF line ends, blanks around fields and
+ * RFC 4180 quoting - "a, b" and "" for a quote - as spreadsheet and CAD exports write them),
+ * then rows `<STEP path>,<value>,...`, a relative path relative to the table's directory.
+ * Errors name path:line and what was expected: CM_ERR_FORMAT for another header, a parameter
+ * named twice or without a name, a row with another column count, a value that is not a
+ * finite number, no rows; CM_ERR_IO for a STEP file that cannot be read. */
+CM_API cm_status cm_design_table_read(cm_context *ctx, const char *path, cm_design_table **table);
+CM_API void cm_design_table_destroy(cm_design_table **table);
+CM_API size_t cm_design_table_n_parameters(const cm_design_table *table);
+CM_API size_t cm_design_table_n_rows(const cm_design_table *table);
+/* Name of parameter j (header order), NULL out of range. */
+CM_API const char *cm_design_table_parameter(const cm_design_table *table, size_t j);
+/* STEP path of row i (resolved against the table's directory), NULL out of range. */
+CM_API const char *cm_design_table_path(const cm_design_table *table, size_t i);
+/* Parameter values of row i (#parameters), NULL out of range. */
+CM_API const double *cm_design_table_values(const cm_design_table *table, size_t i);
+/* The line of row i in the file (1-based), 0 out of range. */
+CM_API long cm_design_table_line(const cm_design_table *table, size_t i);
+/* The row whose STEP file is path (the same file: device and inode), in *row; CM_ERR_MISMATCH
+ * naming the table when no row is. */
+CM_API cm_status cm_design_table_find(cm_context *ctx, const cm_design_table *table,
+                                      const char *path, size_t *row);
+/* 1 when the file's first non-blank line is a design table's header (first field "step"),
+ * 0 otherwise (a plain list of STEP paths, an unreadable file). */
+CM_API int cm_design_table_detect(const char *path);
+
+typedef enum cm_design_scheme {
+    CM_DESIGN_NONE = 0,     /* no row changes the parameter alone: skipped */
+    CM_DESIGN_CENTRAL = 1,  /* rows on both sides: (X(plus) - X(minus)) / (dp_plus - dp_minus) */
+    CM_DESIGN_FORWARD = 2,  /* only above: (X(plus) - X(base)) / dp_plus */
+    CM_DESIGN_BACKWARD = 3  /* only below: (X(plus) - X(base)) / dp_plus, dp_plus < 0 */
+} cm_design_scheme;
+
+/* "none", "central", "forward", "backward". */
+CM_API const char *cm_design_scheme_name(cm_design_scheme scheme);
+
+/* How one parameter is differenced: rows of the table and their value minus the base's. */
+typedef struct cm_design_difference {
+    cm_design_scheme scheme;
+    size_t plus, minus; /* rows: plus for every scheme but NONE (for BACKWARD the row below),
+                           minus for CENTRAL only */
+    double dp_plus, dp_minus; /* value - base value (dp_minus 0 unless CENTRAL) */
+} cm_design_difference;
+
+/* For each parameter the rows that change it alone relative to row base (values equal to
+ * 1e-12 relative), the nearest on each side: both sides central differences, one side
+ * one-sided. out: #parameters. Rows that change several parameters (or none) are ignored,
+ * each with a CM_LOG_INFO note naming its line. A parameter no row changes alone is skipped
+ * (scheme NONE): the return is CM_WARNING naming those parameters (a table may list
+ * constants). CM_ERR_FORMAT when no parameter can be differenced. */
+CM_API cm_status cm_design_plan(cm_context *ctx, const cm_design_table *table, size_t base,
+                                cm_design_difference *out);
+
+/* The design velocities of every parameter. */
+typedef struct cm_design_velocities {
+    size_t n_parameters;       /* of the table (skipped ones: scheme NONE, velocity 0) */
+    size_t n_nodes;            /* of the morpher's mesh */
+    size_t base;               /* the base row */
+    int interior;              /* 1: v holds every node; 0: boundary nodes only (interior 0) */
+    cm_design_difference *diff; /* n_parameters */
+    double *v;                 /* n_parameters x n_nodes x 3: dX/dp_j, mesh unit per
+                                  parameter unit */
+    size_t surface_morphs;     /* rows morphed (each STEP read once) */
+    double t_read, t_surface, t_warp; /* seconds: reading and matching the rows, their
+                                         surface morphs, the differences and forward products */
+} cm_design_velocities;
+
+/* Design velocities of the mesh of mp for every parameter of table at row base: the rows of
+ * cm_design_plan read once each (ro: the unit of the mesh coordinates, as the morph's; may
+ * be NULL), numbered like g0 (cm_cad_match), their boundary positions made by
+ * cm_morpher_boundary and differenced (cm_morpher_velocity); with interior the warp's
+ * forward product carries them into the interior (one apply per parameter with the shared
+ * factorisation). g0: the geometry of row base, the one mp was created on (borrowed). The
+ * velocity is that of the one-increment absolute morph with mp's method (morph.h).
+ * Errors: cm_design_plan's, a row that cannot be read or does not correspond to g0 (its
+ * path in the message), CM_ERR_UNSUPPORTED for a warp that is not linear (interior).
+ * Returns CM_WARNING when parameters were skipped or face nodes left their trimmed face.
+ * Progress: stage "design velocities", done/total = parameters. */
+CM_API cm_status cm_design_velocity(cm_context *ctx, cm_morpher *mp, const cm_cad_model *g0,
+                                    const cm_design_table *table, size_t base,
+                                    const cm_cad_read_options *ro, int interior,
+                                    cm_design_velocities **out);
+CM_API void cm_design_velocities_destroy(cm_design_velocities **v);
+
+/* dJdp (#parameters) = sum over nodes of sens . dX/dp_j. sens: #nodes x 3, dJ/dX.
+ * boundary_only 0: sens at every node; computed as <J^T sens, V_b> with one reverse product
+ * (cm_morpher_warp_transpose) for all parameters, or, where the warp has no reverse product,
+ * as sum sens . V with the forward velocities (made here when v stops at the boundary);
+ * *reverse (may be NULL) says which (1 reverse). boundary_only 1: sens is read at the
+ * boundary nodes only (a surface sensitivity): sum_b sens_b . V_b, no warp product.
+ * Skipped parameters get 0. */
+CM_API cm_status cm_design_gradient(cm_context *ctx, cm_morpher *mp, const cm_design_velocities *v,
+                                    const double *sens, int boundary_only, double *dJdp,
+                                    int *reverse);
+
+/* A sensitivity field dJ/dX of n_nodes nodes into sens (#nodes x 3, zeroed first): a CSV
+ * `node,gx,gy,gz` (a path ending in .csv: 0-based node indices in the mesh's order; blank
+ * lines and CRLF accepted; unlisted nodes 0) or a mesh file of the same nodes with a
+ * 3-component point field "dJdX" (or, without one, its only 3-component point field).
+ * listed (may be NULL): #nodes flags of the nodes the CSV lists (every node for a mesh).
+ * Errors name path:line: CM_ERR_FORMAT for a bad header, column count or value;
+ * CM_ERR_MISMATCH for a node out of range or twice, a mesh of another node count or without
+ * such a field. */
+CM_API cm_status cm_design_read_sensitivity(cm_context *ctx, const char *path, size_t n_nodes,
+                                            double *sens, unsigned char *listed);
 
 /* ---- sweeps of the built-in models (models.h): `cadmorph sweep` and `demo` ---- */
 

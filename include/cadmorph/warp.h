@@ -113,6 +113,10 @@ CM_API cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
 CM_API cm_status cm_warp_apply_transpose(cm_context *ctx, cm_warp *warp, const double *v,
                                          double *out);
 
+/* 1 when the method's apply is linear in the prescribed displacement (it then has
+ * cm_warp_apply_transpose: every method today), 0 otherwise or out of range. */
+CM_API int cm_warp_method_is_linear(cm_warp_method method);
+
 /* The method of a warp. */
 CM_API cm_warp_method cm_warp_get_method(const cm_warp *warp);
 

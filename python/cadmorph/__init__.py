@@ -14,6 +14,7 @@ from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, Mis
 from .mesh import Mesh, read_mesh, write_mesh
 from .quality import FoamQuality, Quality, quality
 from .geometry import Comparison, Counts, Edge, Face, Geometry, model, model_names, read_step
+from .design import DesignRow, DesignTable
 from .morph import Morpher, MorpherInfo, MorphStep, SurfaceStats, morph
 from .warp import Warp, warp
 from .deform import Deformer, deform
@@ -32,6 +33,7 @@ __all__ = [
     "Quality", "FoamQuality", "quality",
     "Geometry", "Face", "Edge", "Counts", "Comparison", "read_step", "model", "model_names",
     "Morpher", "MorphStep", "MorpherInfo", "SurfaceStats", "morph",
+    "DesignTable", "DesignRow",
     "Warp", "warp",
     "Deformer", "deform",
     "Lattice", "FFDStats", "ffd",

@@ -8,15 +8,16 @@ G' (the surface morph [SMB12 §4]), the interior follows by a warp [SMB12 §3].
 import inspect
 import threading
 from dataclasses import dataclass, fields
-from typing import Any, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._inputs import choice, flag, integer, mesh_of, model_of, number, points
+from ._inputs import choice, flag, integer, mesh_of, model_of, number, path_bytes, points, real_array
 from ._options import WarpSettings
 from .errors import MismatchError, RejectedError
+from .design import DesignTable, differences
 from .geometry import Geometry
 from .mesh import _TOKEN, Mesh
 
@@ -484,6 +485,87 @@ class Morpher:
             self._ctx.call(lib.cm_mesh_apply_displacement, m, ffi.from_buffer("double[]", disp),
                            lib.CM_DISPLACEMENT_QUALITY, ffi.NULL)
         return mesh
+
+    def _velocities(self, what: str, table: DesignTable, base: Union[None, int, Any],
+                    interior: bool) -> Any:
+        """cm_design_velocity on this Morpher's mesh (owned cm_design_velocities *)."""
+        if not isinstance(table, DesignTable):
+            raise TypeError("%s: table must be a cadmorph.DesignTable, not %s"
+                            % (what, type(table).__name__))
+        g0, gp = self._base
+        if base is None:
+            if not g0.path:
+                raise ValueError("%s: the Morpher's geometry has no file: give base, the row "
+                                 "of the table it is" % what)
+            row = table.row_of(g0.path)
+        elif isinstance(base, (int, np.integer)) and not isinstance(base, bool):
+            row = integer(what, "base", base, 0, len(table.rows) - 1)
+        else:
+            row = table.row_of(path_bytes(what, "base", base).decode())
+        ro = ffi.new("cm_cad_read_options *")
+        lib.cm_cad_read_options_init(ro)
+        unit = ffi.new("char[]", g0.unit.encode())
+        ro.unit = unit
+        with self._lock:
+            return self._ctx.create(lib.cm_design_velocity, "cm_design_velocities",
+                                    lib.cm_design_velocities_destroy, self._mp, gp, table._ptr,
+                                    row, ro, 1 if interior else 0)
+
+    def design_velocity(self, table: DesignTable,
+                        base: Union[None, int, str] = None) -> Dict[str, np.ndarray]:
+        """Design velocities dX/dp of every node for each parameter of a design table
+        (cm_design_velocity): parameter name -> (n_nodes, 3) float64 array, in mesh unit
+        per parameter unit. The boundary part is a difference of the surface morphs onto the
+        table's rows that change the parameter alone (central where rows lie on both sides,
+        else one-sided: `design_differences`), the interior the warp's forward product with
+        this Morpher's factorisation. Parameters that no row changes alone are left out (a
+        CadmorphWarning names them).
+
+        table: a cadmorph.DesignTable whose rows are variants of this Morpher's G.
+        base: the row of G: its index, or its STEP path; None: the row whose file is the
+        one G was read from.
+
+        Raises MismatchError when no row is G's file or a row does not correspond to G,
+        BadInputError (FormatError) when no parameter can be differenced, cadmorph.Error
+        (unsupported) for a warp that is not linear in the boundary motion.
+        """
+        v = self._velocities("cadmorph.Morpher.design_velocity", table, base, True)
+        self._differences = dict(zip(table.parameters, differences(v)))
+        n, nn = int(v.n_parameters), int(v.n_nodes)
+        data = np.frombuffer(ffi.buffer(v.v, 8 * n * nn * 3), np.float64).reshape(n, nn, 3)
+        return {name: data[j].copy() for j, name in enumerate(table.parameters)
+                if v.diff[j].scheme != lib.CM_DESIGN_NONE}
+
+    @property
+    def design_differences(self) -> Dict[str, Tuple[str, float, float]]:
+        """For the last design_velocity or gradient: parameter -> (difference, dp_plus,
+        dp_minus), difference "central", "forward", "backward" or "none" (skipped), dp_* the
+        rows' values minus the base row's."""
+        return dict(getattr(self, "_differences", {}))
+
+    def gradient(self, table: DesignTable, dJdX: Any, base: Union[None, int, str] = None,
+                 boundary_only: bool = False) -> Dict[str, float]:
+        """dJ/dp = sum over nodes of dJdX . dX/dp for each parameter of a design table
+        (cm_design_gradient): parameter name -> float (skipped parameters left out).
+
+        dJdX: (n_nodes, 3) sensitivity of an objective J to the node coordinates.
+        boundary_only: dJdX is read at the boundary nodes only (a surface sensitivity map);
+        else the sum runs over every node, computed as <J^T dJdX, dX_b/dp> with one reverse
+        product of the warp for all parameters where the warp has one (forward products
+        otherwise). base: as design_velocity.
+        """
+        what = "cadmorph.Morpher.gradient"
+        s = real_array(what, "dJdX", dJdX, (self._n, 3))
+        flag(what, "boundary_only", boundary_only)
+        v = self._velocities(what, table, base, False)
+        self._differences = dict(zip(table.parameters, differences(v)))
+        n = int(v.n_parameters)
+        out = ffi.new("double[]", max(n, 1))
+        with self._lock:
+            self._ctx.call(lib.cm_design_gradient, self._mp, v, ffi.from_buffer("double[]", s),
+                           1 if boundary_only else 0, out, ffi.NULL)
+        return {name: float(out[j]) for j, name in enumerate(table.parameters)
+                if v.diff[j].scheme != lib.CM_DESIGN_NONE}
 
     def __repr__(self) -> str:
         i = self.info

@@ -1,0 +1,62 @@
+/* The morph engine's state, shared by the files of the morph module (morpher.c: create,
+ * apply, rebase; velocity.c: the boundary positions and warp products behind the design
+ * velocities, docs/DESIGN.md "Gradients"). Private to the morph module. */
+#ifndef CM_MORPH_MORPHER_INTERNAL_H
+#define CM_MORPH_MORPHER_INTERNAL_H
+
+#include "cadmorph/morph.h"
+
+#include "off_cad.h"
+
+#define CM_MORPHER_MAX_WARPS 16
+
+struct cm_morpher {
+    cm_morph_options opt;
+    const cm_cad_model *g; /* borrowed: the geometry the start mesh lies on */
+    cm_mesh *mesh;         /* the start mesh (own copy) */
+    cm_mesh_boundary *b;
+    cm_cad_locator *loc; /* on g */
+    cm_surface_nodes *nodes;
+    /* warps on mesh, made when first used, one per set of warp options (a study may compare
+     * one method with several settings, e.g. lattice sizes) */
+    struct {
+        cm_warp_options opt;
+        cm_warp *warp;
+    } warps[CM_MORPHER_MAX_WARPS];
+    int n_warps;
+    const cm_cad_model *target; /* the last target (borrowed), its bounding box (so that another
+                                   model read at the same address is not taken for it) and
+                                   its locator */
+    double target_bb[6];
+    cm_cad_locator *target_loc;
+    cm_mesh *work; /* a copy of mesh whose coordinates are the result being measured */
+    double *sj;    /* work's scaled_jacobian field */
+    double *disp;  /* #nodes x 3 */
+    double *bnew;  /* #boundary x 3: the surface morph's positions on the target */
+    double *bxyz;  /* #boundary x 3: the positions of the current increment */
+    double *next;  /* #nodes x 3: the step being tried */
+    double *offset; /* keep_offset: #boundary x 3, each node minus its point on g */
+    unsigned char *fixed; /* #nodes: the boundary nodes, which optimisation never moves */
+    cm_off_cad_contact contact; /* off_cad fixed: nodes on G touching the fixed surface */
+    double min_sj0;       /* M's minimum scaled Jacobian (keep_fraction) */
+    cm_morph_step *rows;  /* the last apply's steps */
+    size_t n_rows, cap_rows;
+    cm_surface_morph_stats surface;
+    cm_morpher_info info;
+};
+
+/* The warp with options wo on the start mesh, made on first use and kept (up to
+ * CM_MORPHER_MAX_WARPS, the oldest dropped beyond); *t: its factorisation time (untouched
+ * when the warp was already made). */
+cm_status cm_morpher_shared_warp(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
+                                 cm_warp **warp, double *t);
+
+/* The surface morph onto target as apply makes it (its classification, keep_offset, the
+ * contact check of boundaries partly off G): bnew (nodes->n x 3) the positions of the
+ * boundary nodes on G; mp->surface its statistics. CM_WARNING when face nodes left their
+ * trimmed face. target must correspond to G (checked by the caller). */
+cm_status cm_morpher_surface_positions(cm_context *ctx, cm_morpher *mp,
+                                       const cm_cad_model *target, cm_surface_method surface,
+                                       double *bnew);
+
+#endif
