@@ -15,7 +15,7 @@ PS=${5:-"1 2 4"}
 REPEATS=${6:-3}
 MESH_OPTIONS=${MESH_OPTIONS:-}   # e.g. "--no-optimize --force" for the largest mesh
 C=$BUILD/cli/cadmorph
-B=$BUILD/benchmarks/bench_design_velocity
+B=$BUILD/benchmarks/gradients/bench_design_velocity
 mkdir -p "$WORK"
 cd "$WORK"
 for ms in $MODELS; do
