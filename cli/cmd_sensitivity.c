@@ -28,8 +28,6 @@ static int print_help(void);
 
 static const char *const surface_names[] = {"rbf", "project", NULL};
 static const int surface_methods[] = {CM_SURFACE_RBF, CM_SURFACE_PROJECT};
-static const char *linear_methods(void) { return "rbf, rbf-biharmonic, femwarp, lbwarp, simplex"; }
-
 static const cli_option options[] = {
     {.name = "--help", .alias = "-h", .kind = CLI_HELP},
     {.name = "--from", .kind = CLI_STRING, .dest = &args.from, .label = "--from G0.step",
@@ -55,8 +53,7 @@ static const cli_option options[] = {
      .label = "--surface S", .help = "rbf (default: parameter-space warp) or project"},
     {.name = "--method", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_warp_method,
      .dest = &args.opt.method.warp.method, .label = "--method M",
-     .help = "interior warp, linear in the boundary motion: %s (default rbf)",
-     .help_arg = linear_methods},
+     .help = "interior warp: %s (default rbf)", .help_arg = cm_warp_method_list},
     {CLI_SOLVER_OPTION, .dest = &args.opt.method.warp.solver},
     {CLI_RBF_TOL_OPTION, .dest = &args.opt.method.warp.tolerance},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &args.unit, .label = "--cad-unit U",

@@ -10,11 +10,13 @@ of a bump on the duct's floor (bump_duct.py).
      written as dJdXs.csv (`node,gx,gy,gz`, node = OpenFOAM point label = cadmorph node).
   3. `cadmorph morph` of M0 onto each perturbed STEP (a polyMesh in, its points out); the
      design velocity of parameter p_i is V_i = (X(p_i + d) - X(p_i - d)) / 2d per point.
-  4. adjoint dJ/dp_i = sum over the wall points of S . V_i (and `cadmorph sensitivity
-     --dJdXs`, when the CLI has it);
+  4. adjoint dJ/dp_i = sum over the wall points of S . V_i, and `cadmorph sensitivity
+     --dJdXs` on the design table: its velocities and gradient must equal those of the two
+     morphs (a one-step morph is linear in the boundary motion);
   5. finite difference: simpleFoam on both morphed meshes, (J+ - J-) / 2d.
 Prints the table and writes it to WORK/results.csv; exits 1 when an adjoint gradient and its
-finite difference differ by more than --tol (relative), 2 when a tool is missing or fails.
+finite difference differ by more than --tol (relative) or cadmorph sensitivity disagrees with
+the morphs, 2 when a tool is missing or fails.
 
 usage: run_adjoint_example.py CADMORPH WORK [--h 0.3 --w 0.8 --dh 0.01 --dw 0.02]
 CADMORPH is the `cadmorph` program or a build directory holding cli/cadmorph."""
@@ -188,14 +190,23 @@ with open(os.path.join(work, "velocity_fd.csv"), "w", newline="") as f:
     for i in range(len(x0)):
         wr.writerow([i] + ["%.17g" % velocity[p][i, k] for p in params for k in range(3)])
 
-# `cadmorph sensitivity`, when this build has it
+# `cadmorph sensitivity` on the same table: its boundary velocities are the same differences
+# of surface morphs as the morphs' boundary positions, and a one-step morph is linear in the
+# boundary motion, so its velocities equal the finite differences of the two morphs (to the
+# warp's solve tolerance) and its gradient from the boundary sensitivity equals S.V
+run([cli, "sensitivity", "--from", g0, "--mesh", base, "--design-table", "design_table.csv",
+     "-o", "sensitivity", "--dJdXs", "dJdXs.csv", "--threads", a.threads],
+    what="cadmorph sensitivity")
 cm_grad = {}
-if subprocess.run([cli, "sensitivity", "--help"], capture_output=True).returncode == 0:
-    run([cli, "sensitivity", "--from", g0, "--mesh", base, "--design-table", "design_table.csv",
-         "-o", "sensitivity", "--dJdXs", "dJdXs.csv"], what="cadmorph sensitivity")
-    with open(os.path.join(work, "sensitivity", "gradient.csv")) as f:
-        for r in csv.DictReader(f):
-            cm_grad[r["parameter"]] = float(r["dJdp"])
+with open(os.path.join(work, "sensitivity", "gradient.csv")) as f:
+    for r in csv.DictReader(f):
+        cm_grad[r["parameter"]] = float(r["dJdp"])
+cm_vel = np.loadtxt(os.path.join(work, "sensitivity", "velocity.csv"), delimiter=",",
+                    skiprows=1)
+vel_gap = {}
+for k, name in enumerate(params):
+    v = cm_vel[:, 4 + 3 * k:7 + 3 * k]
+    vel_gap[name] = float(np.abs(v - velocity[name]).max() / np.abs(velocity[name]).max())
 
 # the table
 print("case: duct 6 x 1 x 1 with a B-spline bump (h=%g, w=%g), %d hexes, %d points (%d on the "
@@ -218,7 +229,11 @@ for name, (val, d) in params.items():
     gn = float(np.sum(sens_n[walls] * velocity[name][walls]))
     rel = abs(g - fd) / abs(fd)
     worst = max(worst, rel)
-    cmg = cm_grad.get(name, float("nan"))
+    cmg = cm_grad[name]
+    if abs(cmg - g) > 1e-8 * abs(g) or vel_gap[name] > 1e-6:
+        sys.exit(print("run_adjoint_example: cadmorph sensitivity's %s differs from the morphs' "
+                       "differences: gradient %.12g against %.12g, velocity %.1e of its largest"
+                       % (name, cmg, g, vel_gap[name]), file=sys.stderr) or 1)
     row = (name, d, jpm[(name, -1)], jpm[(name, 1)], fd, g, gn, cmg, rel)
     table.append(row)
     print("%s | %g | %.10g | %.10g | %.6g | %.6g | %.6g | %.6g | %.2f%%"
@@ -233,9 +248,8 @@ with open(os.path.join(work, "results.csv"), "w", newline="") as f:
     wr.writerow(("parameter", "delta", "J_minus", "J_plus", "dJdp_fd", "dJdp_adjoint",
                  "dJdp_adjoint_normal", "dJdp_cadmorph", "rel_diff"))
     wr.writerows(table)
-if not cm_grad:
-    print("(no `cadmorph sensitivity` in this build: the velocities are central differences of "
-          "two `cadmorph morph` runs)")
+print("cadmorph sensitivity against the morphs' central differences: velocities within "
+      + ", ".join("%s %.1e" % kv for kv in vel_gap.items()) + " of the largest")
 if worst > a.tol:
     print("run_adjoint_example: adjoint and finite difference differ by %.1f%% > %.1f%%"
           % (100 * worst, 100 * a.tol), file=sys.stderr)
