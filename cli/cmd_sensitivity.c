@@ -115,100 +115,6 @@ static int parse_args(int argc, char **argv, sens_args *a)
     return -1;
 }
 
-/* A CSV field, quoted when needed (RFC 4180). */
-static void field(FILE *f, const char *s)
-{
-    if (!strpbrk(s, ",\"\r\n")) {
-        fputs(s, f);
-        return;
-    }
-    fputc('"', f);
-    for (; *s; ++s) {
-        if (*s == '"') fputc('"', f);
-        fputc(*s, f);
-    }
-    fputc('"', f);
-}
-
-static void prefixed(FILE *f, const char *prefix, const char *name)
-{
-    char buf[512];
-    snprintf(buf, sizeof buf, "%s%s", prefix, name);
-    fputc(',', f);
-    field(f, buf);
-}
-
-static cm_status write_velocity_csv(cm_context *ctx, const char *path, const cm_mesh *m,
-                                    const cm_design_table *t, const cm_design_velocities *v)
-{
-    cm_outfile out;
-    cm_status s = cm_outfile_open(ctx, path, &out);
-    if (s < 0) return s;
-    FILE *f = out.f;
-    fputs("node,x,y,z", f);
-    for (size_t j = 0; j < v->n_parameters; ++j) {
-        if (v->diff[j].scheme == CM_DESIGN_NONE) continue;
-        const char *name = cm_design_table_parameter(t, j);
-        prefixed(f, "dx_d", name);
-        prefixed(f, "dy_d", name);
-        prefixed(f, "dz_d", name);
-    }
-    fputc('\n', f);
-    for (size_t k = 0; k < m->n_nodes; ++k) {
-        fprintf(f, "%zu,%.17g,%.17g,%.17g", k, m->xyz[3 * k], m->xyz[3 * k + 1], m->xyz[3 * k + 2]);
-        for (size_t j = 0; j < v->n_parameters; ++j) {
-            if (v->diff[j].scheme == CM_DESIGN_NONE) continue;
-            const double *x = v->v + (j * v->n_nodes + k) * 3;
-            fprintf(f, ",%.17g,%.17g,%.17g", x[0], x[1], x[2]);
-        }
-        fputc('\n', f);
-    }
-    return cm_outfile_commit(ctx, &out);
-}
-
-static cm_status write_velocity_vtu(cm_context *ctx, const char *path, const cm_mesh *m0,
-                                    const cm_design_table *t, const cm_design_velocities *v)
-{
-    cm_mesh *m = NULL;
-    cm_status s = cm_mesh_copy(ctx, m0, &m);
-    for (size_t j = 0; j < v->n_parameters && s >= 0; ++j) {
-        if (v->diff[j].scheme == CM_DESIGN_NONE) continue;
-        char name[512];
-        snprintf(name, sizeof name, "dX_d%s", cm_design_table_parameter(t, j));
-        double *data = NULL;
-        s = cm_mesh_add_field(ctx, m, name, CM_FIELD_NODE, 3, &data);
-        if (s >= 0) memcpy(data, v->v + j * v->n_nodes * 3, 3 * v->n_nodes * sizeof *data);
-    }
-    if (s >= 0) s = cm_mesh_write(ctx, m, path, NULL);
-    cm_mesh_destroy(&m);
-    return s;
-}
-
-static const char *row_path(const cm_design_table *t, size_t i) { return cm_design_table_path(t, i); }
-
-static cm_status write_gradient_csv(cm_context *ctx, const char *path, const cm_design_table *t,
-                                    const cm_design_velocities *v, const double *g,
-                                    const char *product)
-{
-    cm_outfile out;
-    cm_status s = cm_outfile_open(ctx, path, &out);
-    if (s < 0) return s;
-    FILE *f = out.f;
-    fputs("parameter,dJdp,difference,dp_plus,dp_minus,step_plus,step_minus,product\n", f);
-    for (size_t j = 0; j < v->n_parameters; ++j) {
-        const cm_design_difference *d = &v->diff[j];
-        if (d->scheme == CM_DESIGN_NONE) continue;
-        field(f, cm_design_table_parameter(t, j));
-        fprintf(f, ",%.17g,%s,%.17g,%.17g,", g[j], cm_design_scheme_name(d->scheme), d->dp_plus,
-                d->dp_minus);
-        field(f, row_path(t, d->plus));
-        fputc(',', f);
-        field(f, row_path(t, d->scheme == CM_DESIGN_CENTRAL ? d->minus : v->base));
-        fprintf(f, ",%s\n", product);
-    }
-    return cm_outfile_commit(ctx, &out);
-}
-
 static void print_summary(const cm_design_table *t, const cm_design_velocities *v,
                           const double *g, const char *product, double seconds)
 {
@@ -286,9 +192,10 @@ static int run(cm_context *ctx, const sens_args *a)
         snprintf(paths[k], len, "%s/%s", a->out, names[k]);
     }
     if (rc == 0 && s >= 0) {
-        s = write_velocity_vtu(ctx, paths[0], mesh, t, v);
-        if (s >= 0) ++written, s = write_velocity_csv(ctx, paths[1], mesh, t, v);
-        if (s >= 0 && grad) ++written, s = write_gradient_csv(ctx, paths[2], t, v, grad, product);
+        s = cm_design_write_velocity_mesh(ctx, t, v, mesh, paths[0]);
+        if (s >= 0) ++written, s = cm_design_write_velocity_csv(ctx, t, v, mesh, paths[1]);
+        if (s >= 0 && grad)
+            ++written, s = cm_design_write_gradient_csv(ctx, t, v, grad, product, paths[2]);
         if (s >= 0 && grad) ++written;
         if (s < 0)
             for (int k = 0; k < written; ++k)

@@ -1175,6 +1175,15 @@ const double *sens, int boundary_only, double *dJdp,
 int *reverse);
 cm_status cm_design_read_sensitivity(cm_context *ctx, const char *path, size_t n_nodes,
 double *sens, unsigned char *listed);
+cm_status cm_design_write_velocity_csv(cm_context *ctx, const cm_design_table *table,
+const cm_design_velocities *v, const cm_mesh *m0,
+const char *path);
+cm_status cm_design_write_velocity_mesh(cm_context *ctx, const cm_design_table *table,
+const cm_design_velocities *v,
+const cm_mesh *m0, const char *path);
+cm_status cm_design_write_gradient_csv(cm_context *ctx, const cm_design_table *table,
+const cm_design_velocities *v, const double *dJdp,
+const char *product, const char *path);
 typedef struct cm_sweep_options {
 const char *model;
 const char *mesh;

@@ -1,12 +1,12 @@
 /* study.csv / sweep.csv: one row per variant x method x mode, written through a temporary
  * file (cm_outfile) like every output of cadmorph. */
 #include "cadmorph/study.h"
+#include "study_internal.h"
 
 #include <stdio.h>
 #include <string.h>
 
-/* A CSV field, quoted when it holds a comma, quote or line break (RFC 4180). */
-static void field(FILE *f, const char *s)
+void cm_csv_field(FILE *f, const char *s)
 {
     if (!strpbrk(s, ",\"\r\n")) {
         fputs(s, f);
@@ -36,17 +36,17 @@ cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const ch
             full ? ",variant,status,message" : "");
     for (size_t k = 0; full && k < r->n_values; ++k) {
         fputc(',', f);
-        field(f, r->value_names[k]);
+        cm_csv_field(f, r->value_names[k]);
     }
     fputc('\n', f);
     for (size_t i = 0; i < r->n_rows; ++i) {
         const cm_study_row *w = &r->rows[i];
         if (!full && w->status < 0) continue; /* the sweep's series end where they fail */
-        field(f, r->model);
+        cm_csv_field(f, r->model);
         fputc(',', f);
-        field(f, r->mesh);
+        cm_csv_field(f, r->mesh);
         fprintf(f, ",%s,", cm_study_mode_name(w->mode));
-        field(f, r->methods[w->method].name);
+        cm_csv_field(f, r->methods[w->method].name);
         fprintf(f,
                 ",%zu,%.6g,%.4g,%.9g,%.9g,%zu,%zu,%.6g,%.6g,%zu,%zu,%zu,%d,%.6f,%.6f,%.6f,%.6f,"
                 "%.6f,%.6f,%.6f,%.6f",
@@ -57,9 +57,9 @@ cm_status cm_study_write_csv(cm_context *ctx, const cm_study_result *r, const ch
                 w->t_write);
         if (full) {
             fputc(',', f);
-            field(f, w->label);
+            cm_csv_field(f, w->label);
             fprintf(f, ",%s,", cm_status_name(w->status));
-            field(f, w->message);
+            cm_csv_field(f, w->message);
             for (size_t k = 0; k < r->n_values; ++k)
                 fprintf(f, ",%.17g", r->values[w->variant * r->n_values + k]);
         }

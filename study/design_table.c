@@ -4,6 +4,7 @@
  * it relative to a base row: the finite differences behind the design velocities
  * (docs/DESIGN.md, "Gradients"). */
 #include "cadmorph/study.h"
+#include "study_internal.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -159,16 +160,6 @@ static int same_name(const char *a, const char *b)
     return *a == *b;
 }
 
-static const char *unreadable(const char *path)
-{
-    struct stat st;
-    if (stat(path, &st) != 0) return strerror(errno);
-    if (S_ISDIR(st.st_mode)) return "is a directory";
-    FILE *f = fopen(path, "rb");
-    if (!f) return strerror(errno);
-    fclose(f);
-    return NULL;
-}
 
 /* The header's first field is "step" (any case), after an optional UTF-8 byte order mark. */
 static const char *skip_bom(const char *s)
@@ -303,7 +294,7 @@ static cm_status parse(cm_context *ctx, const char *path, const char *text, cm_d
             t->values[i * t->n_par + j] = x;
         }
         if (s < 0) break;
-        const char *why = unreadable(full);
+        const char *why = cm_study_unreadable(full);
         if (why) s = cm_error(ctx, CM_ERR_IO, "%s:%ld: %s: %s", path, at, full, why);
     }
     record_clear(&r);

@@ -1,6 +1,7 @@
 /* Families of STEP files (study.h): the variant list of `cadmorph study` (a list file or a
  * glob pattern) and the family that reads its files one at a time. */
 #include "cadmorph/study.h"
+#include "study_internal.h"
 
 #include <errno.h>
 #include <math.h>
@@ -46,17 +47,6 @@ static cm_status push(cm_context *ctx, path_list *l, const char *dir, size_t dir
     return CM_OK;
 }
 
-/* A readable regular file, else the reason. */
-static const char *unreadable(const char *path)
-{
-    struct stat st;
-    if (stat(path, &st) != 0) return strerror(errno);
-    if (S_ISDIR(st.st_mode)) return "is a directory";
-    FILE *f = fopen(path, "rb");
-    if (!f) return strerror(errno);
-    fclose(f);
-    return NULL;
-}
 
 static cm_status read_file(cm_context *ctx, const char *list, path_list *l)
 {
@@ -79,7 +69,7 @@ static cm_status read_file(cm_context *ctx, const char *list, path_list *l)
         *e = 0;
         s = push(ctx, l, list, dir_len, b, (size_t)(e - b));
         if (s < 0) break;
-        const char *why = unreadable(l->v[l->n - 1]);
+        const char *why = cm_study_unreadable(l->v[l->n - 1]);
         if (why)
             s = cm_error(ctx, CM_ERR_IO, "%s:%ld: %s: %s", list, lineno, l->v[l->n - 1], why);
     }
@@ -100,7 +90,7 @@ static cm_status read_glob(cm_context *ctx, const char *pattern, path_list *l)
     cm_status s = CM_OK;
     for (size_t i = 0; i < g.gl_pathc && s >= 0; ++i) {
         s = push(ctx, l, NULL, 0, g.gl_pathv[i], strlen(g.gl_pathv[i]));
-        const char *why = s >= 0 ? unreadable(g.gl_pathv[i]) : NULL;
+        const char *why = s >= 0 ? cm_study_unreadable(g.gl_pathv[i]) : NULL;
         if (why) s = cm_error(ctx, CM_ERR_IO, "%s: %s: %s", pattern, g.gl_pathv[i], why);
     }
     globfree(&g);

@@ -368,6 +368,25 @@ CM_API cm_status cm_design_gradient(cm_context *ctx, cm_morpher *mp, const cm_de
 CM_API cm_status cm_design_read_sensitivity(cm_context *ctx, const char *path, size_t n_nodes,
                                             double *sens, unsigned char *listed);
 
+/* The outputs of `cadmorph sensitivity`, each through a temporary file (never partial).
+ * m0: the morpher's mesh (cm_morpher_mesh); parameters with scheme NONE are left out.
+ * velocity CSV: `node,x,y,z` (m0's coordinates) then `dx_d<p>,dy_d<p>,dz_d<p>` per parameter,
+ * one row per node (0-based). velocity mesh: m0 with a 3-component point field `dX_d<p>` per
+ * parameter, in any format cm_mesh_write takes (.vtu for ParaView). gradient CSV:
+ * `parameter,dJdp,difference,dp_plus,dp_minus,step_plus,step_minus,product`: dJdp from
+ * cm_design_gradient, difference central|forward|backward, dp_* the rows' values minus the
+ * base's, step_* their STEP paths (step_minus the base row for one-sided differences),
+ * product the way it was computed ("reverse", "forward" or "boundary"). */
+CM_API cm_status cm_design_write_velocity_csv(cm_context *ctx, const cm_design_table *table,
+                                              const cm_design_velocities *v, const cm_mesh *m0,
+                                              const char *path);
+CM_API cm_status cm_design_write_velocity_mesh(cm_context *ctx, const cm_design_table *table,
+                                               const cm_design_velocities *v,
+                                               const cm_mesh *m0, const char *path);
+CM_API cm_status cm_design_write_gradient_csv(cm_context *ctx, const cm_design_table *table,
+                                              const cm_design_velocities *v, const double *dJdp,
+                                              const char *product, const char *path);
+
 /* ---- sweeps of the built-in models (models.h): `cadmorph sweep` and `demo` ---- */
 
 typedef struct cm_sweep_options {
