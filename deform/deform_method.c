@@ -35,6 +35,9 @@ typedef struct deform_row {
     /* cm_deform_apply_transpose: out (n x 3) is zeroed by the dispatcher; the row adds J^T v
      * at the constrained points. NULL: no transpose (apply not linear, or not written). */
     cm_status (*apply_transpose)(cm_context *ctx, cm_deform *d, const double *v, double *out);
+    /* cm_deform_apply_many: k blocks of n x 3 at once. NULL: the dispatcher loops over apply. */
+    cm_status (*apply_many)(cm_context *ctx, cm_deform *d, size_t k, double *disp,
+                            double *residual);
 } deform_row;
 
 /* ---- shared by rbf and dmffd: the points split into constrained and free ones ---- */
@@ -103,6 +106,65 @@ static cm_status rbf_apply(cm_context *ctx, cm_deform *d, double *disp, double *
     *residual = 0;
     free(v);
     free(out);
+    return s;
+}
+
+/* k fields in one solve and one evaluation of 3k columns: the kernel passes serve every
+ * column (cm_rbf_solve, cm_rbf_evaluate). Each block is scaled to a largest constrained value
+ * in [1/2, 1) first, so that the iterative solver's tolerance (relative to the largest value of all
+ * columns) and the check of merged duplicates (relative to the largest value) mean for each
+ * block what they mean in its own apply (to a factor 2); the scaling is undone after the
+ * evaluation. */
+static cm_status rbf_apply_many(cm_context *ctx, cm_deform *d, size_t k, double *disp,
+                                double *residual)
+{
+    const size_t nc = d->n_constrained, nf = d->n_free, w = 3 * k, n3 = 3 * d->n;
+    *residual = 0;
+    if (w > (size_t)(~0u >> 1))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_many: %zu fields are too many", k);
+    double *v = malloc((nc ? nc : 1) * w * sizeof *v);
+    double *out = malloc((nf ? nf : 1) * w * sizeof *out);
+    double *scale = malloc(k * sizeof *scale);
+    cm_status s = v && out && scale
+                      ? CM_OK
+                      : cm_error(ctx, CM_ERR_NOMEM, "cm_deform_apply_many: out of memory for %zu "
+                                 "fields of %zu points", k, d->n);
+    for (size_t j = 0; s >= 0 && j < k; ++j) {
+        const double *dj = disp + j * n3;
+        double mx = 0;
+        for (size_t i = 0; i < d->n; ++i)
+            if (d->constrained[i])
+                for (int c = 0; c < 3; ++c)
+                    mx = fmax(mx, fabs(dj[3 * i + c]));
+        /* a power of 2: exact, so a block's values reach the solver as in its own apply */
+        int e = 0;
+        if (mx > 0 && isfinite(mx)) frexp(mx, &e);
+        scale[j] = ldexp(1.0, e);
+        for (size_t i = 0, a = 0; i < d->n; ++i)
+            if (d->constrained[i]) {
+                for (int c = 0; c < 3; ++c)
+                    v[a * w + 3 * j + c] = dj[3 * i + c] / scale[j];
+                ++a;
+            }
+    }
+    double t0 = cm_wtime();
+    if (s >= 0) s = cm_rbf_solve(ctx, d->rbf, (int)w, v);
+    double t1 = cm_wtime();
+    if (s >= 0 && nf) s = cm_rbf_evaluate(ctx, d->rbf, nf, d->free_xyz, out);
+    d->t_solve = t1 - t0;
+    d->t_evaluate = cm_wtime() - t1;
+    for (size_t j = 0; s >= 0 && j < k; ++j) {
+        double *dj = disp + j * n3;
+        for (size_t i = 0, b = 0; i < d->n; ++i)
+            if (!d->constrained[i]) {
+                for (int c = 0; c < 3; ++c)
+                    dj[3 * i + c] = out[b * w + 3 * j + c] * scale[j];
+                ++b;
+            }
+    }
+    free(v);
+    free(out);
+    free(scale);
     return s;
 }
 
@@ -260,10 +322,10 @@ static cm_status shell_apply(cm_context *ctx, cm_deform *d, double *disp, double
 /* apply_transpose: NULL for shell, which assembles and solves its system anew in each apply
  * (nothing kept to transpose). */
 static const deform_row rows[CM_DEFORM_N_METHODS] = {
-    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply, rbf_apply_transpose},
-    [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply, mls_apply_transpose},
-    [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply, NULL},
-    [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply, dmffd_apply_transpose},
+    [CM_DEFORM_RBF] = {"rbf", 0, rbf_create, rbf_apply, rbf_apply_transpose, rbf_apply_many},
+    [CM_DEFORM_MLS] = {"mls", 1, mls_create, mls_apply, mls_apply_transpose, NULL},
+    [CM_DEFORM_SHELL] = {"shell", 1, shell_create, shell_apply, NULL, NULL},
+    [CM_DEFORM_DMFFD] = {"dmffd", 0, dmffd_create, dmffd_apply, dmffd_apply_transpose, NULL},
 };
 
 const char *cm_deform_method_name(cm_deform_method method)
@@ -354,6 +416,31 @@ cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double 
     def->residual = r;
     if (residual) *residual = r;
     return s;
+}
+
+cm_status cm_deform_apply_many(cm_context *ctx, cm_deform *def, size_t k, double *disp,
+                               double *residual)
+{
+    if (!def || (k && !disp))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_many: def or disp is NULL");
+    if (residual) *residual = 0;
+    if (k == 0) return CM_OK;
+    double r = 0;
+    cm_status s = CM_OK, warn = CM_OK;
+    if (def->row->apply_many) {
+        s = def->row->apply_many(ctx, def, k, disp, &r);
+    } else {
+        /* the largest residual of the blocks; a warning of one block lets the others run */
+        for (size_t j = 0; j < k && s >= 0; ++j) {
+            double rj = 0;
+            s = def->row->apply(ctx, def, disp + j * 3 * def->n, &rj);
+            if (s == CM_WARNING) warn = s;
+            if (rj > r || rj != rj) r = rj;
+        }
+    }
+    def->residual = r;
+    if (residual) *residual = r;
+    return s < 0 ? s : s == CM_WARNING ? s : warn;
 }
 
 cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,

@@ -39,6 +39,11 @@ cm_status cm_morpher_boundary(cm_context *ctx, cm_morpher *mp, const cm_cad_mode
 
 cm_status cm_morpher_warp_forward(cm_context *ctx, cm_morpher *mp, double *disp)
 {
+    return cm_morpher_warp_forward_many(ctx, mp, 1, disp);
+}
+
+cm_status cm_morpher_warp_forward_many(cm_context *ctx, cm_morpher *mp, size_t k, double *disp)
+{
     if (!mp || !disp) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_warp_forward: NULL input");
     cm_status s = usable(ctx, mp, "cm_morpher_warp_forward");
     if (s < 0) return s;
@@ -54,7 +59,7 @@ cm_status cm_morpher_warp_forward(cm_context *ctx, cm_morpher *mp, double *disp)
     double t = 0;
     s = cm_morpher_shared_warp(ctx, mp, wo, &w, &t);
     if (s < 0) return s;
-    return cm_warp_apply(ctx, w, disp);
+    return k == 1 ? cm_warp_apply(ctx, w, disp) : cm_warp_apply_many(ctx, w, k, disp);
 }
 
 cm_status cm_morpher_warp_transpose(cm_context *ctx, cm_morpher *mp, const double *v, double *out)

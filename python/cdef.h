@@ -625,6 +625,8 @@ const double *xyz, const unsigned char *constrained,
 const cm_mesh *mesh, cm_deform **def);
 void cm_deform_destroy(cm_deform **def);
 cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double *residual);
+cm_status cm_deform_apply_many(cm_context *ctx, cm_deform *def, size_t k, double *disp,
+double *residual);
 cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const double *v,
 double *out);
 typedef struct cm_deform_stats {
@@ -804,6 +806,7 @@ const unsigned char *constrained, const cm_warp_options *opt,
 cm_warp **warp);
 void cm_warp_destroy(cm_warp **warp);
 cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
+cm_status cm_warp_apply_many(cm_context *ctx, cm_warp *warp, size_t k, double *disp);
 cm_status cm_warp_apply_transpose(cm_context *ctx, cm_warp *warp, const double *v,
 double *out);
 int cm_warp_method_is_linear(cm_warp_method method);
@@ -895,6 +898,8 @@ cm_status cm_morpher_velocity(cm_context *ctx, cm_morpher *morpher, const double
 double dp_plus, const double *minus, double dp_minus,
 int interior, double *out);
 cm_status cm_morpher_warp_forward(cm_context *ctx, cm_morpher *morpher, double *disp);
+cm_status cm_morpher_warp_forward_many(cm_context *ctx, cm_morpher *morpher, size_t k,
+double *disp);
 cm_status cm_morpher_warp_transpose(cm_context *ctx, cm_morpher *morpher, const double *v,
 double *out);
 const unsigned char *cm_morpher_boundary_flags(const cm_morpher *morpher);

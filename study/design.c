@@ -2,11 +2,15 @@
  * for each parameter of a design table the rows chosen by cm_design_plan are read once, their
  * boundary positions made by the surface morph (cm_morpher_boundary), differenced, and
  * carried into the interior by the warp's forward product with the morpher's shared
- * factorisation; a gradient is <J^T S, V_b> with one reverse product for every parameter. */
+ * factorisation, for a batch of parameters in one call; a gradient is <J^T S, V_b> with one reverse product for every parameter. */
 #include "cadmorph/study.h"
 
 #include <stdlib.h>
 #include <string.h>
+
+/* Parameters whose interior velocities one warp apply computes together: 3 values per point
+ * and parameter of scratch in the RBF warp, so a bound keeps large tables in memory. */
+#define CM_DESIGN_WARP_BATCH 16
 
 void cm_design_velocities_destroy(cm_design_velocities **v)
 {
@@ -92,16 +96,36 @@ cm_status cm_design_velocity(cm_context *ctx, cm_morpher *mp, const cm_cad_model
         if (s >= 0 && d->scheme == CM_DESIGN_CENTRAL)
             s = boundary_of(ctx, mp, t, d->minus, g0, ro, minus, r);
         if (s < 0) break;
-        double t0 = cm_wtime();
+        /* the boundary part only here: the interior follows for a batch of parameters */
         s = cm_morpher_velocity(ctx, mp, plus, d->dp_plus,
-                                d->scheme == CM_DESIGN_CENTRAL ? minus : NULL, d->dp_minus,
-                                interior, r->v + j * nn * 3);
-        r->t_warp += cm_wtime() - t0;
+                                d->scheme == CM_DESIGN_CENTRAL ? minus : NULL, d->dp_minus, 0,
+                                r->v + j * nn * 3);
         if (s < 0) s = cm_error_prefix(ctx, s, "parameter %s", cm_design_table_parameter(t, j));
         cm_log(ctx, CM_LOG_DEBUG, "design velocity of %s: %s differences, rows %ld and %ld",
                cm_design_table_parameter(t, j), cm_design_scheme_name(d->scheme),
                cm_design_table_line(t, d->plus),
                cm_design_table_line(t, d->scheme == CM_DESIGN_CENTRAL ? d->minus : base));
+    }
+    /* the interior by the warp's forward product of runs of consecutive parameters with a
+     * velocity, in place: one cm_warp_apply_many per batch shares the RBF's kernel passes
+     * between them (the per-parameter applies cost a solve and an evaluation each) */
+    for (size_t j = 0; interior && j < np && s >= 0;) {
+        if (r->diff[j].scheme == CM_DESIGN_NONE) {
+            ++j;
+            continue;
+        }
+        size_t e = j + 1;
+        while (e < np && e - j < CM_DESIGN_WARP_BATCH && r->diff[e].scheme != CM_DESIGN_NONE)
+            ++e;
+        double t0 = cm_wtime();
+        s = cm_morpher_warp_forward_many(ctx, mp, e - j, r->v + j * nn * 3);
+        r->t_warp += cm_wtime() - t0;
+        if (s < 0)
+            s = e - j == 1 ? cm_error_prefix(ctx, s, "parameter %s", cm_design_table_parameter(t, j))
+                           : cm_error_prefix(ctx, s, "parameters %s to %s",
+                                             cm_design_table_parameter(t, j),
+                                             cm_design_table_parameter(t, e - 1));
+        j = e;
     }
     if (s >= 0) s = cm_progress(ctx, "design velocities", (double)np, (double)np);
     free(plus);

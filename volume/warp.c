@@ -3,6 +3,7 @@
 #include "warp_method.h"
 
 #include <stdio.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -116,6 +117,27 @@ cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp)
     if (!warp || !disp)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply: warp or disp is NULL");
     return warp->ops->apply(ctx, warp->state, disp, &warp->residual);
+}
+
+cm_status cm_warp_apply_many(cm_context *ctx, cm_warp *warp, size_t k, double *disp)
+{
+    if (!warp || (k && !disp))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply_many: warp or disp is NULL");
+    warp->residual = 0;
+    if (k == 0) return CM_OK;
+    if (warp->n_nodes && k > SIZE_MAX / (3 * sizeof(double) * warp->n_nodes))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply_many: %zu fields are too many", k);
+    if (warp->ops->apply_many) return warp->ops->apply_many(ctx, warp->state, k, disp, &warp->residual);
+    double r = 0;
+    cm_status s = CM_OK, warn = CM_OK;
+    for (size_t j = 0; j < k && s >= 0; ++j) {
+        double rj = 0;
+        s = warp->ops->apply(ctx, warp->state, disp + j * 3 * warp->n_nodes, &rj);
+        if (s == CM_WARNING) warn = s;
+        if (rj > r || rj != rj) r = rj;
+    }
+    warp->residual = r;
+    return s < 0 ? s : s == CM_WARNING ? s : warn;
 }
 
 cm_status cm_warp_apply_transpose(cm_context *ctx, cm_warp *warp, const double *v, double *out)

@@ -172,5 +172,5 @@ static cm_status dmffd_apply_transpose(cm_context *ctx, void *state, const doubl
     return s < 0 ? cm_error_prefix(ctx, s, "cm_warp_apply_transpose: dmffd") : s;
 }
 
-const cm_warp_method_ops cm_warp_dmffd = {"dmffd",       dmffd_create, dmffd_apply,
-                                          dmffd_destroy, NULL,         dmffd_apply_transpose};
+const cm_warp_method_ops cm_warp_dmffd = {
+    "dmffd", dmffd_create, dmffd_apply, dmffd_destroy, NULL, dmffd_apply_transpose, NULL};

@@ -59,5 +59,5 @@ static cm_status mls_apply_transpose(cm_context *ctx, void *state, const double 
     return s < 0 ? cm_error_prefix(ctx, s, "cm_warp_apply_transpose") : s;
 }
 
-const cm_warp_method_ops cm_warp_mls = {"mls",       mls_create, mls_apply,
-                                        mls_destroy, NULL,       mls_apply_transpose};
+const cm_warp_method_ops cm_warp_mls = {
+    "mls", mls_create, mls_apply, mls_destroy, NULL, mls_apply_transpose, NULL};

@@ -6,6 +6,7 @@
 
 #include "cadmorph/deform.h"
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -296,6 +297,58 @@ static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *r
     return CM_OK;
 }
 
+/* k fields: per component, the k blocks of its points side by side for one
+ * cm_deform_apply_many (3k columns in one solve and one evaluation). */
+static cm_status rbf_apply_many(cm_context *ctx, void *state, size_t k, double *disp,
+                                double *residual)
+{
+    rbf_warp *warp = state;
+    *residual = 0;
+    size_t max_points = 1;
+    for (size_t c = 0; c < warp->n_components; ++c)
+        if (warp->comp[c].def && warp->comp[c].n_fixed + warp->comp[c].n_free > max_points)
+            max_points = warp->comp[c].n_fixed + warp->comp[c].n_free;
+    if (k > SIZE_MAX / (3 * sizeof(double) * max_points))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply_many: %zu fields are too many", k);
+    double *pv = malloc(k * max_points * 3 * sizeof *pv);
+    if (!pv)
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_apply_many: out of memory for %zu fields of "
+                        "%zu points", k, max_points);
+    const size_t n3 = 3 * warp->n_nodes;
+    cm_status s = CM_OK;
+    for (size_t c = 0; c < warp->n_components; ++c) {
+        warp_component *wc = &warp->comp[c];
+        if (!wc->def) continue;
+        const size_t np3 = 3 * (wc->n_fixed + wc->n_free);
+        for (size_t j = 0; j < k; ++j)
+            for (size_t i = 0; i < wc->n_fixed; ++i)
+                memcpy(pv + j * np3 + 3 * i, disp + j * n3 + 3 * wc->fixed[i], 3 * sizeof *pv);
+        double r = 0;
+        s = cm_deform_apply_many(ctx, wc->def, k, pv, &r);
+        if (s < 0) {
+            s = cm_error_prefix(ctx, s, "cm_warp_apply_many: component %zu", c);
+            break;
+        }
+        cm_deform_stats st;
+        cm_deform_get_stats(wc->def, &st);
+        cm_log(ctx, CM_LOG_DEBUG,
+               "cm_warp_apply_many: component %zu: %zu fields, %zu centres, solve %.3f s (%s, "
+               "%d iterations), evaluation at %zu nodes %.3f s",
+               c, k, wc->n_fixed, st.t_solve,
+               st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" : "iterative", st.rbf.iterations,
+               wc->n_free, st.t_evaluate);
+        for (size_t j = 0; j < k; ++j) {
+            const double *out = pv + j * np3 + 3 * wc->n_fixed;
+            for (size_t i = 0; i < wc->n_free; ++i)
+                memcpy(disp + j * n3 + 3 * wc->free_nodes[i], out + 3 * i, 3 * sizeof *pv);
+        }
+        if ((s = cm_progress(ctx, "warp", (double)(c + 1), (double)warp->n_components)) < 0)
+            break;
+    }
+    free(pv);
+    return s;
+}
+
 /* J^T v: apply keeps every constrained node's value (v back once), and each component's
  * free nodes send theirs back to its fixed nodes through the deformation's reverse product
  * (which adds v at the fixed nodes too: taken off again, so that a node fixed in several
@@ -358,6 +411,8 @@ static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
 }
 
 const cm_warp_method_ops cm_warp_rbf_triharmonic = {
-    "rbf", triharmonic_create, rbf_apply, rbf_destroy, NULL, rbf_apply_transpose};
+    "rbf", triharmonic_create, rbf_apply, rbf_destroy, NULL, rbf_apply_transpose,
+    rbf_apply_many};
 const cm_warp_method_ops cm_warp_rbf_biharmonic = {
-    "rbf-biharmonic", biharmonic_create, rbf_apply, rbf_destroy, NULL, rbf_apply_transpose};
+    "rbf-biharmonic", biharmonic_create, rbf_apply, rbf_destroy, NULL, rbf_apply_transpose,
+    rbf_apply_many};

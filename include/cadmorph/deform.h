@@ -271,6 +271,16 @@ CM_API void cm_deform_destroy(cm_deform **def);
  * work is done. Not concurrently on one deformation. */
 CM_API cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double *residual);
 
+/* k fields at once: disp holds k blocks of n x 3 (block j at disp + 3 n j, each as disp of
+ * cm_deform_apply), each transformed as cm_deform_apply would. rbf: one solve and one
+ * evaluation of 3k columns, which share the kernel passes (each block scaled to a largest
+ * constrained value of 1 for them: the same tolerance per block as its own apply, to the
+ * iterative solver's tolerance; dense: to rounding); the other methods: apply per block.
+ * residual (may be NULL): the largest over the blocks. A CM_WARNING of a block is returned
+ * after every block is done. Memory (rbf): 3k (constrained + free) values besides disp. */
+CM_API cm_status cm_deform_apply_many(cm_context *ctx, cm_deform *def, size_t k, double *disp,
+                                      double *residual);
+
 /* The reverse product of apply, for adjoint gradients (docs/DESIGN.md, "Gradients"), for a
  * method whose apply is linear in the constrained values D: apply maps D to J D (D at the
  * constrained points, J_f D at the free ones); this computes out = J^T v, so that

@@ -212,6 +212,12 @@ CM_API cm_status cm_morpher_velocity(cm_context *ctx, cm_morpher *morpher, const
  * is not linear in the boundary motion. */
 CM_API cm_status cm_morpher_warp_forward(cm_context *ctx, cm_morpher *morpher, double *disp);
 
+/* The same for k fields at once: disp holds k blocks of #nodes x 3, each as disp above
+ * (cm_warp_apply_many: the RBF warps solve and evaluate all 3k columns together, equal to k
+ * calls of cm_morpher_warp_forward to rounding or the iterative solver's tolerance). */
+CM_API cm_status cm_morpher_warp_forward_many(cm_context *ctx, cm_morpher *morpher, size_t k,
+                                              double *disp);
+
 /* The reverse product with the same factorisation: out (#nodes x 3) = J^T v (v #nodes x 3,
  * e.g. dJ/dX of an objective at every node), non-zero at boundary nodes only
  * (cm_warp_apply_transpose). Then dJ/dp = <out, dX_b/dp> for every parameter: one reverse

@@ -95,6 +95,16 @@ CM_API void cm_warp_destroy(cm_warp **warp);
  * entries are not written). One warp, many calls (not concurrently on the same warp). */
 CM_API cm_status cm_warp_apply(cm_context *ctx, cm_warp *warp, double *disp);
 
+/* The forward product for k displacement fields in one call: disp holds k blocks of
+ * #nodes x 3 (block j at disp + 3 #nodes j, each laid out as cm_warp_apply's disp), each
+ * transformed as cm_warp_apply would. rbf, rbf-biharmonic: per component one solve and one
+ * evaluation of 3k columns (cm_deform_apply_many), which share the kernel passes; equal to k
+ * applies to rounding (dense) or to the iterative solver's tolerance. The other methods
+ * apply block by block. cm_warp_residual: the largest over the blocks. Memory: 3k values per
+ * point of the largest component besides disp, so k up to tens; the caller chooses k.
+ * Stops with CM_ERR_INTERRUPTED as apply does (blocks then partly written). */
+CM_API cm_status cm_warp_apply_many(cm_context *ctx, cm_warp *warp, size_t k, double *disp);
+
 /* The reverse product of apply, for adjoint gradients (docs/DESIGN.md, "Gradients"). For the
  * methods whose apply is linear in the prescribed displacement D (rbf, rbf-biharmonic,
  * femwarp, lbwarp, simplex; dmffd, whose truncated pseudo-inverse is fixed by create; mls,

@@ -4,6 +4,9 @@ cm_add_unit_test(test_warp test_warp.c LIBS cm_volume)
 # the reverse product of the RBF warps: the dot-product test on tets, hexes, several
 # components, dense and iterative, and a gmsh mesh; iterative against dense
 cm_add_unit_test(test_warp_transpose_rbf test_warp_transpose_rbf.c LIBS cm_volume)
+# the forward product of k fields in one call against k applies: the RBF's many-column solve
+# (dense, iterative), FEMWARP's loop over apply, stopping on request
+cm_add_unit_test(test_warp_apply_many test_warp_apply_many.c LIBS cm_volume)
 
 # Cross-check on a real mesh: gmsh meshes a sphere cut out of a box (setup, also used by the
 # CLI tests), cadmorph warps it (test_warp_sphere), scipy's RBFInterpolator redoes it (scipy).
