@@ -269,3 +269,27 @@ def test_study_accepts_a_design_table(cli, block, work):
     pts = re.search(r'<polyline[^>]*points="([^"]*)"', svg).group(1).split()
     xs = [float(p.split(",")[0]) for p in pts]
     assert len(xs) == 3 and xs[0] < xs[1] < xs[2]
+
+
+def test_velocities_of_several_parameters_in_one_forward_product(block):
+    """design_velocity carries the parameters' boundary velocities into the interior together
+    (cm_morpher_warp_forward_many): each equals its own forward product (cm_morpher_warp_forward)
+    of the same boundary velocity, to rounding (dense solve)."""
+    from cadmorph._capi import ffi, lib
+    t = cadmorph.DesignTable.read(block / "T.csv")
+    g0, m0 = read_step(block / "base.step"), cadmorph.read_mesh(block / "M0.vtu")
+    mp = cadmorph.Morpher(g0, m0, threads=1, progress=False)
+    with _no_warning():
+        v = mp.design_velocity(t)
+        vb = mp._velocities("test", t, None, False)
+    n, nn = int(vb.n_parameters), int(vb.n_nodes)
+    data = np.frombuffer(ffi.buffer(vb.v, 8 * n * nn * 3), np.float64).reshape(n, nn, 3)
+    assert len(v) == 2
+    for j, name in enumerate(t.parameters):
+        if name not in v:
+            continue
+        one = data[j].copy()
+        mp._ctx.call(lib.cm_morpher_warp_forward, mp._mp, ffi.from_buffer("double[]", one))
+        scale = np.abs(one).max()
+        assert scale > 0
+        assert np.abs(v[name] - one).max() <= 1e-10 * scale, name
