@@ -111,9 +111,9 @@ static cm_status rbf_apply(cm_context *ctx, cm_deform *d, double *disp, double *
 
 /* k fields in one solve and one evaluation of 3k columns: the kernel passes serve every
  * column (cm_rbf_solve, cm_rbf_evaluate). Each block is scaled to a largest constrained value
- * in [1/2, 1) first, so that the iterative solver's tolerance (relative to the largest value of all
- * columns) and the check of merged duplicates (relative to the largest value) mean for each
- * block what they mean in its own apply (to a factor 2); the scaling is undone after the
+ * in [1/2, 1) first, so that the iterative solver's tolerance (relative to the largest value
+ * of all columns) and the check of merged duplicates (relative to the largest value) mean for
+ * each block what they mean in its own apply (to a factor 2); the scaling is undone after the
  * evaluation. */
 static cm_status rbf_apply_many(cm_context *ctx, cm_deform *d, size_t k, double *disp,
                                 double *residual)

@@ -2,7 +2,8 @@
  * for each parameter of a design table the rows chosen by cm_design_plan are read once, their
  * boundary positions made by the surface morph (cm_morpher_boundary), differenced, and
  * carried into the interior by the warp's forward product with the morpher's shared
- * factorisation, for a batch of parameters in one call; a gradient is <J^T S, V_b> with one reverse product for every parameter. */
+ * factorisation, for a batch of parameters in one call; a gradient is <J^T S, V_b> with one
+ * reverse product for every parameter. */
 #include "cadmorph/study.h"
 
 #include <stdlib.h>
@@ -121,10 +122,11 @@ cm_status cm_design_velocity(cm_context *ctx, cm_morpher *mp, const cm_cad_model
         s = cm_morpher_warp_forward_many(ctx, mp, e - j, r->v + j * nn * 3);
         r->t_warp += cm_wtime() - t0;
         if (s < 0)
-            s = e - j == 1 ? cm_error_prefix(ctx, s, "parameter %s", cm_design_table_parameter(t, j))
-                           : cm_error_prefix(ctx, s, "parameters %s to %s",
-                                             cm_design_table_parameter(t, j),
-                                             cm_design_table_parameter(t, e - 1));
+            s = e - j == 1
+                    ? cm_error_prefix(ctx, s, "parameter %s", cm_design_table_parameter(t, j))
+                    : cm_error_prefix(ctx, s, "parameters %s to %s",
+                                      cm_design_table_parameter(t, j),
+                                      cm_design_table_parameter(t, e - 1));
         j = e;
     }
     if (s >= 0) s = cm_progress(ctx, "design velocities", (double)np, (double)np);

@@ -127,7 +127,8 @@ cm_status cm_warp_apply_many(cm_context *ctx, cm_warp *warp, size_t k, double *d
     if (k == 0) return CM_OK;
     if (warp->n_nodes && k > SIZE_MAX / (3 * sizeof(double) * warp->n_nodes))
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply_many: %zu fields are too many", k);
-    if (warp->ops->apply_many) return warp->ops->apply_many(ctx, warp->state, k, disp, &warp->residual);
+    if (warp->ops->apply_many)
+        return warp->ops->apply_many(ctx, warp->state, k, disp, &warp->residual);
     double r = 0;
     cm_status s = CM_OK, warn = CM_OK;
     for (size_t j = 0; j < k && s >= 0; ++j) {

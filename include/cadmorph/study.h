@@ -334,7 +334,8 @@ typedef struct cm_design_velocities {
  * be NULL), numbered like g0 (cm_cad_match), their boundary positions made by
  * cm_morpher_boundary and differenced (cm_morpher_velocity); with interior the warp's
  * forward product carries them into the interior (cm_morpher_warp_forward_many with the
- * shared factorisation, up to 16 parameters per call: the RBF warps solve for them together). g0: the geometry of row base, the one mp was created on (borrowed). The
+ * shared factorisation, up to 16 parameters per call: the RBF warps solve for them
+ * together). g0: the geometry of row base, the one mp was created on (borrowed). The
  * velocity is that of the one-increment absolute morph with mp's method (morph.h).
  * Errors: cm_design_plan's, a row that cannot be read or does not correspond to g0 (its
  * path in the message), CM_ERR_UNSUPPORTED for a warp that is not linear (interior).

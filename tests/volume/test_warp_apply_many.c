@@ -1,9 +1,9 @@
 /* cm_warp_apply_many against k separate cm_warp_apply calls, k = 1, 2, 5, with blocks of
  * very different sizes (1e-3 to 1e3): the RBF warp (its own many-column path) with the dense
- * solver to rounding (bit for bit for k = 1) and the iterative one to its tolerance, FEMWARP through the loop
- * over apply (bit for bit); on tets and hexes with several components; cm_warp_residual the
- * largest over the blocks; stopped on request at each of its progress points, then the bits
- * of an uninterrupted call. */
+ * solver to rounding (bit for bit for k = 1) and the iterative one to its tolerance, FEMWARP
+ * through the loop over apply (bit for bit); on tets and hexes with several components;
+ * cm_warp_residual the largest over the blocks; stopped on request at each of its progress
+ * points, then the bits of an uninterrupted call. */
 #include "cadmorph/warp.h"
 #include "test_mesh.h"
 #include "test_stopper.h"
@@ -53,7 +53,7 @@ static double compare(cm_warp_method method, cm_rbf_solver solver, double tol, s
     for (size_t j = 0; j < k; ++j) {
         const double size = pow(10.0, (double)(3 * (int)j) / 2.0 - 3.0);
         for (size_t i = 0; i < n3; ++i)
-            many[j * n3 + i] = con[i / 3] ? /* apply reads no other */ size * test_rand(&seed) : NAN;
+            many[j * n3 + i] = con[i / 3] ? size * test_rand(&seed) : NAN; /* NaN: not read */
     }
     /* every block by itself first: the largest residual, the results */
     double *want = malloc(k * n3 * sizeof *want), rmax = 0;
