@@ -266,54 +266,23 @@ fail:
     return s;
 }
 
-static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *residual)
+/* k displacement fields (cm_warp_apply: k = 1; cm_warp_apply_many): per component, the k
+ * blocks of its points side by side for one cm_deform_apply_many (3k columns in one solve and
+ * one evaluation; k = 1 goes through cm_deform_apply in the warp's own scratch). fn names the
+ * caller in messages. */
+static cm_status apply_fields(cm_context *ctx, rbf_warp *warp, size_t k, double *disp,
+                              const char *fn)
 {
-    rbf_warp *warp = state;
-    *residual = 0;
-    for (size_t k = 0; k < warp->n_components; ++k) {
-        warp_component *wc = &warp->comp[k];
-        if (!wc->def) continue;
-        for (size_t i = 0; i < wc->n_fixed; ++i)
-            memcpy(warp->values + 3 * i, disp + 3 * wc->fixed[i], 3 * sizeof(double));
-        double r = 0;
-        cm_status s = cm_deform_apply(ctx, wc->def, warp->values, &r);
-        if (s < 0) return cm_error_prefix(ctx, s, "cm_warp_apply: component %zu", k);
-        /* the split that says where a large warp's time goes: an iterative fit's solve (its
-         * Krylov matvecs, m^2 kernel pairs each) or the evaluation (n_free x m pairs) */
-        cm_deform_stats st;
-        cm_deform_get_stats(wc->def, &st);
-        cm_log(ctx, CM_LOG_DEBUG,
-               "cm_warp_apply: component %zu: %zu centres, solve %.3f s (%s, %d iterations), "
-               "evaluation at %zu nodes %.3f s",
-               k, wc->n_fixed, st.t_solve,
-               st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" : "iterative", st.rbf.iterations,
-               wc->n_free, st.t_evaluate);
-        const double *out = warp->values + 3 * wc->n_fixed;
-        for (size_t i = 0; i < wc->n_free; ++i)
-            memcpy(disp + 3 * wc->free_nodes[i], out + 3 * i, 3 * sizeof(double));
-        cm_status p = cm_progress(ctx, "warp", (double)(k + 1), (double)warp->n_components);
-        if (p < 0) return p;
-    }
-    return CM_OK;
-}
-
-/* k fields: per component, the k blocks of its points side by side for one
- * cm_deform_apply_many (3k columns in one solve and one evaluation). */
-static cm_status rbf_apply_many(cm_context *ctx, void *state, size_t k, double *disp,
-                                double *residual)
-{
-    rbf_warp *warp = state;
-    *residual = 0;
     size_t max_points = 1;
     for (size_t c = 0; c < warp->n_components; ++c)
         if (warp->comp[c].def && warp->comp[c].n_fixed + warp->comp[c].n_free > max_points)
             max_points = warp->comp[c].n_fixed + warp->comp[c].n_free;
     if (k > SIZE_MAX / (3 * sizeof(double) * max_points))
-        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_apply_many: %zu fields are too many", k);
-    double *pv = malloc(k * max_points * 3 * sizeof *pv);
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: %zu fields are too many", fn, k);
+    double *pv = k == 1 ? warp->values : malloc(k * max_points * 3 * sizeof *pv);
     if (!pv)
-        return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_apply_many: out of memory for %zu fields of "
-                        "%zu points", k, max_points);
+        return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory for %zu fields of %zu points", fn,
+                        k, max_points);
     const size_t n3 = 3 * warp->n_nodes;
     cm_status s = CM_OK;
     for (size_t c = 0; c < warp->n_components; ++c) {
@@ -324,17 +293,20 @@ static cm_status rbf_apply_many(cm_context *ctx, void *state, size_t k, double *
             for (size_t i = 0; i < wc->n_fixed; ++i)
                 memcpy(pv + j * np3 + 3 * i, disp + j * n3 + 3 * wc->fixed[i], 3 * sizeof *pv);
         double r = 0;
-        s = cm_deform_apply_many(ctx, wc->def, k, pv, &r);
+        s = k == 1 ? cm_deform_apply(ctx, wc->def, pv, &r)
+                   : cm_deform_apply_many(ctx, wc->def, k, pv, &r);
         if (s < 0) {
-            s = cm_error_prefix(ctx, s, "cm_warp_apply_many: component %zu", c);
+            s = cm_error_prefix(ctx, s, "%s: component %zu", fn, c);
             break;
         }
+        /* the split that says where a large warp's time goes: an iterative fit's solve (its
+         * Krylov matvecs, m^2 kernel pairs each) or the evaluation (n_free x m pairs) */
         cm_deform_stats st;
         cm_deform_get_stats(wc->def, &st);
         cm_log(ctx, CM_LOG_DEBUG,
-               "cm_warp_apply_many: component %zu: %zu fields, %zu centres, solve %.3f s (%s, "
-               "%d iterations), evaluation at %zu nodes %.3f s",
-               c, k, wc->n_fixed, st.t_solve,
+               "%s: component %zu: %zu field(s), %zu centres, solve %.3f s (%s, %d iterations), "
+               "evaluation at %zu nodes %.3f s",
+               fn, c, k, wc->n_fixed, st.t_solve,
                st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" : "iterative", st.rbf.iterations,
                wc->n_free, st.t_evaluate);
         for (size_t j = 0; j < k; ++j) {
@@ -345,8 +317,22 @@ static cm_status rbf_apply_many(cm_context *ctx, void *state, size_t k, double *
         if ((s = cm_progress(ctx, "warp", (double)(c + 1), (double)warp->n_components)) < 0)
             break;
     }
-    free(pv);
+    if (pv != warp->values) free(pv);
     return s;
+}
+
+/* Exact at the centres: the residual is 0. */
+static cm_status rbf_apply(cm_context *ctx, void *state, double *disp, double *residual)
+{
+    *residual = 0;
+    return apply_fields(ctx, state, 1, disp, "cm_warp_apply");
+}
+
+static cm_status rbf_apply_many(cm_context *ctx, void *state, size_t k, double *disp,
+                                double *residual)
+{
+    *residual = 0;
+    return apply_fields(ctx, state, k, disp, "cm_warp_apply_many");
 }
 
 /* J^T v: apply keeps every constrained node's value (v back once), and each component's
