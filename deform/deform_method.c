@@ -92,23 +92,6 @@ static cm_status rbf_create(cm_context *ctx, cm_deform *d, const double *xyz)
     return s;
 }
 
-static cm_status rbf_apply(cm_context *ctx, cm_deform *d, double *disp, double *residual)
-{
-    double *v = NULL, *out = NULL;
-    cm_status s = apply_scratch(ctx, d, disp, &v, &out);
-    double t0 = cm_wtime();
-    if (s >= 0) s = cm_rbf_solve(ctx, d->rbf, 3, v);
-    double t1 = cm_wtime();
-    if (s >= 0 && d->n_free) s = cm_rbf_evaluate(ctx, d->rbf, d->n_free, d->free_xyz, out);
-    d->t_solve = t1 - t0;
-    d->t_evaluate = cm_wtime() - t1;
-    if (s >= 0) scatter_free(d, out, disp);
-    *residual = 0;
-    free(v);
-    free(out);
-    return s;
-}
-
 /* k fields in one solve and one evaluation of 3k columns: the kernel passes serve every
  * column (cm_rbf_solve, cm_rbf_evaluate). Each block is scaled to a largest constrained value
  * in [1/2, 1) first, so that the iterative solver's tolerance (relative to the largest value
@@ -166,6 +149,13 @@ static cm_status rbf_apply_many(cm_context *ctx, cm_deform *d, size_t k, double 
     free(out);
     free(scale);
     return s;
+}
+
+/* One field: the same solve and evaluation as k fields (the scaling by a power of 2 changes
+ * no bit). */
+static cm_status rbf_apply(cm_context *ctx, cm_deform *d, double *disp, double *residual)
+{
+    return rbf_apply_many(ctx, d, 1, disp, residual);
 }
 
 /* J^T v: v at the constrained points plus the RBF's reverse product of the free ones. */

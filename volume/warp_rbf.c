@@ -268,8 +268,7 @@ fail:
 
 /* k displacement fields (cm_warp_apply: k = 1; cm_warp_apply_many): per component, the k
  * blocks of its points side by side for one cm_deform_apply_many (3k columns in one solve and
- * one evaluation; k = 1 goes through cm_deform_apply in the warp's own scratch). fn names the
- * caller in messages. */
+ * one evaluation; k = 1 in the warp's own scratch). fn names the caller in messages. */
 static cm_status apply_fields(cm_context *ctx, rbf_warp *warp, size_t k, double *disp,
                               const char *fn)
 {
@@ -293,8 +292,7 @@ static cm_status apply_fields(cm_context *ctx, rbf_warp *warp, size_t k, double 
             for (size_t i = 0; i < wc->n_fixed; ++i)
                 memcpy(pv + j * np3 + 3 * i, disp + j * n3 + 3 * wc->fixed[i], 3 * sizeof *pv);
         double r = 0;
-        s = k == 1 ? cm_deform_apply(ctx, wc->def, pv, &r)
-                   : cm_deform_apply_many(ctx, wc->def, k, pv, &r);
+        s = cm_deform_apply_many(ctx, wc->def, k, pv, &r);
         if (s < 0) {
             s = cm_error_prefix(ctx, s, "%s: component %zu", fn, c);
             break;
