@@ -9,6 +9,7 @@
  * One line of key=value pairs per method. BENCH_VERBOSE=1: the library's log on stderr (the
  * RBF warp's per-component split of solve and sums). */
 #define _POSIX_C_SOURCE 200809L
+#include "bench_motion.h"
 #include "blas_reexec.h"
 #include "cadmorph/mesh.h"
 #include "cadmorph/warp.h"
@@ -50,31 +51,13 @@ static int run(cm_context *ctx, const cm_mesh *m, const cm_mesh_boundary *b, con
                cm_warp_method method, cm_rbf_solver solver, int reps)
 {
     size_t nn = m->n_nodes, n3 = 3 * nn;
-    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-    for (size_t v = 0; v < nn; ++v)
-        for (int d = 0; d < 3; ++d) {
-            lo[d] = fmin(lo[d], m->xyz[3 * v + d]);
-            hi[d] = fmax(hi[d], m->xyz[3 * v + d]);
-        }
-    /* bench_warp's motion: smooth, non-affine, 3 % of the diagonal */
-    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    const bench_box box = bench_box_of(m);
     double *d0 = calloc(n3, sizeof *d0), *d = malloc(n3 * sizeof *d);
     double *v = malloc(n3 * sizeof *v), *out = malloc(n3 * sizeof *out);
-    for (size_t i = 0; i < b->n_nodes; ++i) {
-        const double *x = m->xyz + 3 * b->nodes[i];
-        double u[3];
-        for (int k = 0; k < 3; ++k)
-            u[k] = (x[k] - lo[k]) / (hi[k] - lo[k] > 0 ? hi[k] - lo[k] : 1);
-        double *o = d0 + 3 * b->nodes[i];
-        o[0] = 0.03 * diag * sin(3.14159265358979323846 * u[1]) * u[2];
-        o[1] = 0.03 * diag * sin(3.14159265358979323846 * u[2]) * u[0];
-        o[2] = 0.03 * diag * sin(3.14159265358979323846 * u[0]) * u[1];
-    }
+    bench_smooth_motion(m, b, &box, d0);
     for (size_t i = 0; i < nn; ++i) { /* a smooth sensitivity field at every node */
         double u[3];
-        for (int k = 0; k < 3; ++k)
-            u[k] = (m->xyz[3 * i + k] - lo[k]) / (hi[k] - lo[k] > 0 ? hi[k] - lo[k] : 1);
+        bench_unit(&box, m->xyz + 3 * i, u);
         for (int k = 0; k < 3; ++k)
             v[3 * i + k] = cos(2.0 * u[k] + u[(k + 1) % 3]) + 0.3 * u[(k + 2) % 3];
     }

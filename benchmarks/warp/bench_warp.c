@@ -4,6 +4,7 @@
  * BENCH_VERBOSE=1 in the environment shows the library's log (stage timings) on stderr.
  * usage: bench_warp MESH [steps=20] [threads=2] [methods=rbf,rbf-biharmonic,femwarp,lbwarp,simplex]
  * One line per method: key=value pairs (RESULTS.md, "Warp methods"). */
+#include "bench_motion.h"
 #include "blas_reexec.h"
 #include "cadmorph/mesh.h"
 #include "cadmorph/warp.h"
@@ -53,26 +54,9 @@ static int run(const char *path, cm_warp_method method, int steps, int threads)
         return 2;
     }
     size_t nn = m->n_nodes;
-    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-    for (size_t v = 0; v < nn; ++v)
-        for (int d = 0; d < 3; ++d) {
-            lo[d] = fmin(lo[d], m->xyz[3 * v + d]);
-            hi[d] = fmax(hi[d], m->xyz[3 * v + d]);
-        }
-    double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    /* a smooth, non-affine motion of the boundary: 3 % of the diagonal */
+    const bench_box box = bench_box_of(m);
     double *d0 = calloc(3 * nn, sizeof *d0), *d = malloc(3 * nn * sizeof *d);
-    for (size_t i = 0; i < b->n_nodes; ++i) {
-        const double *x = m->xyz + 3 * b->nodes[i];
-        double u[3];
-        for (int k = 0; k < 3; ++k)
-            u[k] = (x[k] - lo[k]) / (hi[k] - lo[k] > 0 ? hi[k] - lo[k] : 1);
-        double *o = d0 + 3 * b->nodes[i];
-        o[0] = 0.03 * diag * sin(3.14159265358979323846 * u[1]) * u[2];
-        o[1] = 0.03 * diag * sin(3.14159265358979323846 * u[2]) * u[0];
-        o[2] = 0.03 * diag * sin(3.14159265358979323846 * u[0]) * u[1];
-    }
+    bench_smooth_motion(m, b, &box, d0);
     double base = peak_mb();
     cm_warp_options opt;
     cm_warp_options_init(&opt);

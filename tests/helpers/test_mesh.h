@@ -100,4 +100,30 @@ static inline int64_t test_add_block(cm_context *ctx, cm_mesh *m, const test_blo
     return (int64_t)first;
 }
 
+/* The hex mesh h (hex8 cells only) with every hex written as a polyhedron (VTK face stream,
+ * outward faces), on the same nodes; NULL if out of memory. */
+static inline cm_mesh *test_hexes_as_polyhedra(cm_context *ctx, const cm_mesh *h)
+{
+    static const int face[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                   {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    cm_mesh *m = NULL;
+    if (cm_mesh_create(ctx, &m) < 0 || cm_mesh_resize_nodes(ctx, m, h->n_nodes, 0) < 0) {
+        cm_mesh_destroy(&m);
+        return NULL;
+    }
+    memcpy(m->xyz, h->xyz, 3 * h->n_nodes * sizeof *m->xyz);
+    for (size_t c = 0; c < h->n_cells; ++c) {
+        const int64_t *n = h->conn + h->offset[c];
+        int64_t s[31], p = 0;
+        s[p++] = 6;
+        for (int f = 0; f < 6; ++f) {
+            s[p++] = 4;
+            for (int k = 0; k < 4; ++k)
+                s[p++] = n[face[f][k]];
+        }
+        cm_mesh_add_cell(ctx, m, CM_CELL_POLYHEDRON, s, (size_t)p, 0, 0, 0);
+    }
+    return m;
+}
+
 #endif

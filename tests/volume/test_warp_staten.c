@@ -153,26 +153,10 @@ static cm_mesh *block_mesh(int tets, int lshape)
     return m;
 }
 
-/* The hex block with every hex written as a polyhedron (VTK face stream, outward faces). */
+/* The hex block with every hex written as a polyhedron. */
 static cm_mesh *polyhedron_mesh(void)
 {
-    cm_mesh *h = block_mesh(0, 0), *m = NULL;
-    cm_mesh_create(ctx, &m);
-    cm_mesh_resize_nodes(ctx, m, h->n_nodes, 0);
-    memcpy(m->xyz, h->xyz, 3 * h->n_nodes * sizeof *m->xyz);
-    static const int face[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
-                                   {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-    for (size_t c = 0; c < h->n_cells; ++c) {
-        const int64_t *n = h->conn + h->offset[c];
-        int64_t s[31], p = 0;
-        s[p++] = 6;
-        for (int f = 0; f < 6; ++f) {
-            s[p++] = 4;
-            for (int k = 0; k < 4; ++k)
-                s[p++] = n[face[f][k]];
-        }
-        cm_mesh_add_cell(ctx, m, CM_CELL_POLYHEDRON, s, (size_t)p, 0, 0, 0);
-    }
+    cm_mesh *h = block_mesh(0, 0), *m = test_hexes_as_polyhedra(ctx, h);
     cm_mesh_destroy(&h);
     return m;
 }
