@@ -86,8 +86,8 @@ static int print_help(void)
         "                 step_plus,step_minus,product: dJ/dp = sum over nodes of\n"
         "                 S . dX/dp, in the unit of J per unit of p (S in J per mesh unit);\n"
         "                 difference central|forward|backward, dp_* the rows' values minus\n"
-        "                 G0's, product reverse (J^T S, one solve for all parameters), forward\n"
-        "                 (per parameter) or boundary (--dJdXs: no warp product)\n\n"
+        "                 G0's, product reverse (J^T S, one solve for all parameters) or\n"
+        "                 boundary (--dJdXs: no warp product)\n\n"
         "options:\n");
     cli_print_options(stdout, options, 24);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (G0, M0, the table or S: one line\n"
@@ -154,8 +154,8 @@ static int run(cm_context *ctx, const sens_args *a)
     cm_design_velocities *v = NULL;
     double *sens = NULL, *grad = NULL;
     char *paths[3] = {NULL, NULL, NULL};
-    int written = 0, reverse = 0;
-    const char *product = a->dJdXs ? "boundary" : "forward";
+    int written = 0;
+    const char *product = a->dJdXs ? "boundary" : "reverse";
     cm_cad_read_options ro;
     cm_cad_read_options_init(&ro);
     if (a->unit) ro.unit = a->unit;
@@ -176,8 +176,7 @@ static int run(cm_context *ctx, const sens_args *a)
         grad = calloc(v->n_parameters ? v->n_parameters : 1, sizeof *grad);
         s = sens && grad ? cm_design_read_sensitivity(ctx, spath, mesh->n_nodes, sens, NULL)
                          : cm_error(ctx, CM_ERR_NOMEM, "out of memory");
-        if (s >= 0) s = cm_design_gradient(ctx, mp, v, sens, a->dJdXs != NULL, grad, &reverse);
-        if (reverse) product = "reverse";
+        if (s >= 0) s = cm_design_gradient(ctx, mp, v, sens, a->dJdXs != NULL, grad, NULL);
     }
     /* every result is made: now the outputs, each through a temporary file; a failed one
      * removes those written before it */

@@ -140,64 +140,46 @@ cm_status cm_design_velocity(cm_context *ctx, cm_morpher *mp, const cm_cad_model
     return warning[0] ? cm_error(ctx, CM_WARNING, "%s", warning) : CM_OK;
 }
 
+/* dJdp[j] = sum over the boundary nodes of f . V_j (f: #nodes x 3). */
+static void boundary_dots(const cm_morpher *mp, const cm_design_velocities *v, const double *f,
+                          double *dJdp)
+{
+    const unsigned char *bnd = cm_morpher_boundary_flags(mp);
+    const size_t nn = v->n_nodes;
+    for (size_t j = 0; j < v->n_parameters; ++j) {
+        const double *vj = v->v + j * nn * 3;
+        double acc = 0;
+        for (size_t k = 0; k < nn; ++k)
+            if (bnd[k])
+                acc += f[3 * k] * vj[3 * k] + f[3 * k + 1] * vj[3 * k + 1] +
+                       f[3 * k + 2] * vj[3 * k + 2];
+        dJdp[j] = acc;
+    }
+}
+
 cm_status cm_design_gradient(cm_context *ctx, cm_morpher *mp, const cm_design_velocities *v,
                              const double *sens, int boundary_only, double *dJdp, int *reverse)
 {
     if (reverse) *reverse = 0;
     if (!mp || !v || !sens || !dJdp)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_design_gradient: NULL input");
-    const size_t nn = v->n_nodes, np = v->n_parameters;
+    const size_t nn = v->n_nodes;
     if (cm_morpher_mesh(mp)->n_nodes != nn)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_design_gradient: velocities of %zu nodes, "
                         "morpher of %zu", nn, cm_morpher_mesh(mp)->n_nodes);
-    const unsigned char *bnd = cm_morpher_boundary_flags(mp);
-    for (size_t j = 0; j < np; ++j)
-        dJdp[j] = 0;
     if (boundary_only) { /* S on the boundary only: sum_b S_b . V_b */
-        for (size_t j = 0; j < np; ++j) {
-            const double *vj = v->v + j * nn * 3;
-            double acc = 0;
-            for (size_t k = 0; k < nn; ++k)
-                if (bnd[k])
-                    acc += sens[3 * k] * vj[3 * k] + sens[3 * k + 1] * vj[3 * k + 1] +
-                           sens[3 * k + 2] * vj[3 * k + 2];
-            dJdp[j] = acc;
-        }
+        boundary_dots(mp, v, sens, dJdp);
         return CM_OK;
     }
+    /* J^T S once, then <J^T S, V_b> per parameter: the reverse product serves them all. A
+     * warp without a reverse product is not linear (cm_warp_method_is_linear), and had no
+     * forward product for the velocities either. */
     double *w = malloc(3 * (nn ? nn : 1) * sizeof *w);
     if (!w) return cm_error(ctx, CM_ERR_NOMEM, "cm_design_gradient: out of memory");
-    /* J^T S once, then <J^T S, V_b> per parameter: the reverse product serves them all */
     cm_status s = cm_morpher_warp_transpose(ctx, mp, sens, w);
     if (s >= 0) {
         if (reverse) *reverse = 1;
-        for (size_t j = 0; j < np; ++j) {
-            const double *vj = v->v + j * nn * 3;
-            double acc = 0;
-            for (size_t k = 0; k < nn; ++k)
-                if (bnd[k])
-                    acc += w[3 * k] * vj[3 * k] + w[3 * k + 1] * vj[3 * k + 1] +
-                           w[3 * k + 2] * vj[3 * k + 2];
-            dJdp[j] = acc;
-        }
-    } else if (s == CM_ERR_UNSUPPORTED) {
-        /* no reverse product for this warp: sum S . V over every node with the forward
-         * velocities (made here when the velocities stop at the boundary) */
-        cm_log(ctx, CM_LOG_DEBUG, "gradient by forward products: %s", cm_context_message(ctx));
-        s = CM_OK;
-        for (size_t j = 0; j < np && s >= 0; ++j) {
-            if (v->diff[j].scheme == CM_DESIGN_NONE) continue;
-            const double *vj = v->v + j * nn * 3;
-            if (!v->interior) {
-                memcpy(w, vj, 3 * nn * sizeof *w);
-                s = cm_morpher_warp_forward(ctx, mp, w);
-                vj = w;
-            }
-            double acc = 0;
-            for (size_t k = 0; k < 3 * nn; ++k)
-                acc += sens[k] * vj[k];
-            dJdp[j] = acc;
-        }
+        boundary_dots(mp, v, w, dJdp);
     }
     free(w);
     return s;

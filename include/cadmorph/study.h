@@ -349,9 +349,9 @@ CM_API void cm_design_velocities_destroy(cm_design_velocities **v);
 
 /* dJdp (#parameters) = sum over nodes of sens . dX/dp_j. sens: #nodes x 3, dJ/dX.
  * boundary_only 0: sens at every node; computed as <J^T sens, V_b> with one reverse product
- * (cm_morpher_warp_transpose) for all parameters, or, where the warp has no reverse product,
- * as sum sens . V with the forward velocities (made here when v stops at the boundary);
- * *reverse (may be NULL) says which (1 reverse). boundary_only 1: sens is read at the
+ * (cm_morpher_warp_transpose) for all parameters (every linear warp has one: the velocities
+ * need a linear warp anyway); *reverse (may be NULL) is then 1, and 0 for boundary_only or
+ * an error. boundary_only 1: sens is read at the
  * boundary nodes only (a surface sensitivity): sum_b sens_b . V_b, no warp product.
  * Skipped parameters get 0. */
 CM_API cm_status cm_design_gradient(cm_context *ctx, cm_morpher *mp, const cm_design_velocities *v,

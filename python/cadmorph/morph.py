@@ -551,8 +551,7 @@ class Morpher:
         dJdX: (n_nodes, 3) sensitivity of an objective J to the node coordinates.
         boundary_only: dJdX is read at the boundary nodes only (a surface sensitivity map);
         else the sum runs over every node, computed as <J^T dJdX, dX_b/dp> with one reverse
-        product of the warp for all parameters where the warp has one (forward products
-        otherwise). base: as design_velocity.
+        product of the warp for all parameters. base: as design_velocity.
         """
         what = "cadmorph.Morpher.gradient"
         s = real_array(what, "dJdX", dJdX, (self._n, 3))
