@@ -30,12 +30,12 @@ static int help(void)
 {
     printf("usage: %s\n\n"
            "Scaled Jacobian (as Verdict / VTK's vtkMeshQuality define it) of every volume cell of\n"
-           "MESH (.msh, .vtu, .vtk, .mesh, an OpenFOAM case or polyMesh directory). Prints one row\n"
+           "MESH (%s). Prints one row\n"
            "per cell type - cells, minimum, mean, 1st percentile, inverted (scaled Jacobian <= 0) -\n"
            "and ends with the line\n"
            "  min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k> cells=<n>\n\n"
            "options:\n",
-           usage);
+           usage, cm_mesh_format_list());
     cli_print_options(stdout, options, 16);
     return CLI_EXIT_OK;
 }

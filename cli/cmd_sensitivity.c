@@ -33,7 +33,7 @@ static const cli_option options[] = {
     {.name = "--from", .kind = CLI_STRING, .dest = &args.from, .label = "--from G0.step",
      .help = "the base geometry: a row of the design table, the one M0 lies on"},
     {.name = "--mesh", .kind = CLI_STRING, .dest = &args.mesh, .label = "--mesh M0",
-     .help = "volume mesh of G0 (.msh .vtu .vtk .mesh, OpenFOAM case)"},
+     .help = "volume mesh of G0: %s", .help_arg = cm_mesh_format_list},
     {.name = "--design-table", .kind = CLI_STRING, .dest = &args.table,
      .label = "--design-table T.csv",
      .help = "CSV exported by the CAD program: header step,<p1>,<p2>,...,\n"

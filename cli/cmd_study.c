@@ -60,7 +60,7 @@ static const cli_option options[] = {
     {.name = "--from", .kind = CLI_STRING, .dest = &args.from, .label = "--from G0.step",
      .help = "the geometry M0 is a mesh of"},
     {.name = "--mesh", .kind = CLI_STRING, .dest = &args.mesh, .label = "--mesh M0",
-     .help = "volume mesh of G0 (.msh .vtu .vtk .mesh)"},
+     .help = "volume mesh of G0: %s", .help_arg = cm_mesh_format_list},
     {.name = "--variants", .kind = CLI_STRING, .dest = &args.variants, .label = "--variants LIST",
      .help = "a text file of STEP paths, one per line ('#' comments; relative\n"
              "paths are relative to the list file), a quoted glob pattern\n"

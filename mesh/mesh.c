@@ -1,6 +1,6 @@
 /* The mesh container: type table, growth, fields, groups, entities, copy, validation. */
 #include "cadmorph/mesh.h"
-#include "io/foam_internal.h"
+#include "io/origin.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -91,7 +91,7 @@ void cm_mesh_destroy(cm_mesh **mesh)
     free(m->groups);
     for (size_t i = 0; i < m->n_entities; ++i) free_entity(&m->entities[i]);
     free(m->entities);
-    cm_foam_poly_release(&m->foam);
+    cm_mesh_origin_release(&m->origin);
     free(m);
     *mesh = NULL;
 }
@@ -305,7 +305,7 @@ cm_status cm_mesh_copy(cm_context *ctx, const cm_mesh *mesh, cm_mesh **copy)
         cm_mesh_destroy(&m);
         return s;
     }
-    m->foam = cm_foam_poly_retain(mesh->foam);
+    m->origin = cm_mesh_origin_retain(mesh->origin);
     *copy = m;
     return CM_OK;
 }

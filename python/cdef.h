@@ -303,7 +303,7 @@ cm_mesh_group *groups;
 size_t n_entities;
 cm_mesh_entity *entities;
 size_t cap_nodes, cap_cells, cap_conn;
-struct cm_foam_poly *foam;
+struct cm_mesh_origin *origin;
 } cm_mesh;
 cm_status cm_mesh_create(cm_context *ctx, cm_mesh **mesh);
 void cm_mesh_destroy(cm_mesh **mesh);
@@ -342,7 +342,13 @@ CM_FORMAT_MEDIT,
 CM_FORMAT_OBJ,
 CM_FORMAT_OFF,
 CM_FORMAT_STL,
-CM_FORMAT_FOAM
+CM_FORMAT_FOAM,
+CM_FORMAT_CGNS,
+CM_FORMAT_SU2,
+CM_FORMAT_FLUENT,
+CM_FORMAT_ABAQUS,
+CM_FORMAT_NASTRAN,
+CM_FORMAT_EXODUS
 } cm_mesh_format;
 cm_mesh_format cm_mesh_format_from_path(const char *path);
 const char *cm_mesh_format_list(void);

@@ -105,9 +105,11 @@ typedef struct cm_mesh {
 
     /* private: allocated lengths */
     size_t cap_nodes, cap_cells, cap_conn;
-    /* private: the OpenFOAM polyMesh the mesh was read from (faces, owner, patches, how
-     * `points` was stored), shared by copies; NULL for other formats */
-    struct cm_foam_poly *foam;
+    /* private: what the file the mesh was read from holds beyond the mesh (an OpenFOAM
+     * polyMesh's faces and patches, where a text file keeps its coordinates, ...), so that
+     * writing the mesh back into that format changes only coordinates; shared by copies; NULL
+     * for a mesh built in memory */
+    struct cm_mesh_origin *origin;
 } cm_mesh;
 
 CM_API cm_status cm_mesh_create(cm_context *ctx, cm_mesh **mesh);
@@ -219,7 +221,13 @@ typedef enum cm_mesh_format {
     CM_FORMAT_OBJ, /* surface formats: faces (and, in .obj, lines) only */
     CM_FORMAT_OFF,
     CM_FORMAT_STL,
-    CM_FORMAT_FOAM /* OpenFOAM polyMesh: a case directory or its constant/polyMesh */
+    CM_FORMAT_FOAM,    /* OpenFOAM polyMesh: a case directory or its constant/polyMesh */
+    CM_FORMAT_CGNS,    /* CGNS (ADF or HDF5) */
+    CM_FORMAT_SU2,     /* SU2 native, ASCII */
+    CM_FORMAT_FLUENT,  /* Fluent mesh or case (.msh shared with gmsh: told apart by content) */
+    CM_FORMAT_ABAQUS,  /* Abaqus input deck */
+    CM_FORMAT_NASTRAN, /* Nastran bulk data */
+    CM_FORMAT_EXODUS   /* Exodus II */
 } cm_mesh_format;
 
 CM_API cm_mesh_format cm_mesh_format_from_path(const char *path);

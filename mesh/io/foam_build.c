@@ -5,6 +5,7 @@
  * The faces are matched by the topology builder (topology.h); this file only orders them. */
 #define _POSIX_C_SOURCE 200809L
 #include "foam_internal.h"
+#include "origin.h"
 
 #include "cell_faces.h"
 #include "topology.h"
@@ -238,9 +239,9 @@ fail:
 cm_status cm_foam_of_mesh(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly **out)
 {
     *out = NULL;
-    if (mesh->foam && (size_t)mesh->foam->n_points == mesh->n_nodes &&
-        (size_t)mesh->foam->n_cells == cm_mesh_count_dim(mesh, 3)) {
-        *out = cm_foam_poly_retain(mesh->foam);
+    cm_foam_poly *own = cm_mesh_origin_state(mesh, CM_FORMAT_FOAM);
+    if (own) {
+        *out = cm_foam_poly_retain(own);
         return CM_OK;
     }
     return cm_foam_build(ctx, mesh, out);

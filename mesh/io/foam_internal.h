@@ -1,6 +1,6 @@
 /* OpenFOAM polyMesh support shared by the reader, the writer, the face addressing of any mesh
  * and checkMesh's metrics (not public). A mesh read from a polyMesh keeps the face-addressed
- * original here (cm_mesh.foam), so that writing it back changes `points` only and the
+ * original as its origin (origin.h), so that writing it back changes `points` only and the
  * metrics run on OpenFOAM's own faces. */
 #ifndef CADMORPH_MESH_IO_FOAM_INTERNAL_H
 #define CADMORPH_MESH_IO_FOAM_INTERNAL_H
@@ -49,6 +49,8 @@ typedef struct cm_foam_poly {
 
 cm_foam_poly *cm_foam_poly_retain(cm_foam_poly *p);
 void cm_foam_poly_release(cm_foam_poly **p);
+/* cm_foam_poly_release for the mesh's origin record (origin.h). */
+void cm_foam_poly_free(void *p);
 /* An empty one (refs 1). */
 cm_foam_poly *cm_foam_poly_new(void);
 

@@ -1,6 +1,5 @@
 /* The shared polyMesh record (foam_internal.h): created by the reader and the face addressing,
- * retained by every copy of a mesh read from a polyMesh, released by cm_mesh_destroy. A leaf:
- * the mesh container uses it without depending on the reader. */
+ * held by the origin of a mesh read from a polyMesh (origin.h) and by the metrics. A leaf. */
 #include "foam_internal.h"
 
 #include <stdlib.h>
@@ -21,6 +20,12 @@ cm_foam_poly *cm_foam_poly_retain(cm_foam_poly *p)
     /* atomic: copies of one mesh may be made and destroyed on several threads */
     if (p) __atomic_add_fetch(&p->refs, 1, __ATOMIC_RELAXED);
     return p;
+}
+
+void cm_foam_poly_free(void *p)
+{
+    cm_foam_poly *q = p;
+    cm_foam_poly_release(&q);
 }
 
 void cm_foam_poly_release(cm_foam_poly **pp)

@@ -561,7 +561,9 @@ cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh)
             m->physical[zn->ids[i]] = m->entity[zn->ids[i]] = (int)(r.p->n_patches + k);
     }
     if (s != CM_OK) goto fail;
-    m->foam = r.p;
+    s = cm_mesh_set_origin(ctx, m, CM_FORMAT_FOAM, r.p, cm_foam_poly_free);
+    r.p = NULL; /* the origin owns it, or has freed it */
+    if (s != CM_OK) goto fail;
     free(r.xyz);
     free(r.dir);
     *mesh = m;

@@ -188,9 +188,8 @@ static int is_points(const char *name)
     return !strcmp(name, "points") || !strcmp(name, "points.gz");
 }
 
-static cm_status write_points_only(cm_context *ctx, const cm_mesh *mesh, const char *dir)
+static cm_status write_points_only(cm_context *ctx, const cm_mesh *mesh, const cm_foam_poly *p, const char *dir)
 {
-    const cm_foam_poly *p = mesh->foam;
     if (same_dir(p->dir, dir))
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: %s is the polyMesh the mesh was read from; refusing to overwrite it", dir);
     DIR *d = opendir(p->dir);
@@ -312,11 +311,11 @@ cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *p
     char *dir = cm_foam_polymesh_dir(path);
     if (!dir) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
     cm_status s = CM_OK;
+    const cm_foam_poly *own = cm_mesh_origin_state(mesh, CM_FORMAT_FOAM);
     if (mkdirs(dir) != 0) {
         s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno));
-    } else if (mesh->foam && mesh->foam->dir && (size_t)mesh->foam->n_points == mesh->n_nodes &&
-               (size_t)mesh->foam->n_cells == cm_mesh_count_dim(mesh, 3)) {
-        s = write_points_only(ctx, mesh, dir);
+    } else if (own && own->dir) {
+        s = write_points_only(ctx, mesh, own, dir);
     } else {
         s = write_converted(ctx, mesh, dir);
     }

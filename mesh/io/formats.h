@@ -6,6 +6,7 @@
 #define CADMORPH_MESH_IO_FORMATS_H
 
 #include "cadmorph/mesh.h"
+#include "origin.h"
 
 /* The frame of a reader that parses a file held in memory: reads path whole, gives parse the
  * bytes and an empty mesh, and returns the mesh in *mesh (destroyed on failure, *mesh NULL).
@@ -67,6 +68,11 @@ typedef struct cm_mesh_format_row {
     cm_mesh_read_fn read;
     cm_mesh_write_fn write;
     unsigned holds; /* CM_MESH_IO_* */
+    /* For an extension that two formats share (Fluent's and gmsh's .msh): whether the first
+     * bytes of a file (n of them, NUL-terminated) are this format's. The row without a test
+     * is the default: it reads what no test claims and writes new files. NULL for a format
+     * whose extensions are its own. */
+    int (*sniff)(const char *head, size_t n);
 } cm_mesh_format_row;
 
 /* The rows, in the order cm_mesh_format_list names them; the row of a format, NULL for
@@ -75,7 +81,7 @@ extern const cm_mesh_format_row cm_mesh_format_rows[];
 extern const size_t cm_mesh_format_row_count;
 const cm_mesh_format_row *cm_mesh_format_row_of(cm_mesh_format format);
 /* The format a path's extension names (CM_FORMAT_UNKNOWN for none or another), without asking
- * the directory formats. */
+ * the directory formats or the file's content: the default row of a shared extension. */
 cm_mesh_format cm_mesh_format_of_extension(const char *path);
 
 #endif

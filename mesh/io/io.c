@@ -7,27 +7,30 @@
 
 #include <ctype.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 
 /* The registry: one row per format. A directory format is asked first (it claims paths by
  * what they name on disk), then the extension decides. */
 const cm_mesh_format_row cm_mesh_format_rows[] = {
-    {CM_FORMAT_MSH, "gmsh", "msh", NULL, NULL, cm_mesh_read_msh, cm_mesh_write_msh,
-     CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
-    {CM_FORMAT_VTU, "VTK XML", "vtu", NULL, NULL, cm_mesh_read_vtu, cm_mesh_write_vtu,
-     CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
-    {CM_FORMAT_VTK, "VTK legacy", "vtk", NULL, NULL, cm_mesh_read_vtk, cm_mesh_write_vtk,
-     CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
-    {CM_FORMAT_MEDIT, "Medit", "mesh", NULL, NULL, cm_mesh_read_medit, cm_mesh_write_medit,
-     CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
-    {CM_FORMAT_OBJ, "Wavefront", "obj", NULL, NULL, cm_mesh_read_obj, cm_mesh_write_obj,
-     CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
-    {CM_FORMAT_OFF, "OFF", "off", NULL, NULL, cm_mesh_read_off, cm_mesh_write_off, CM_MESH_IO_SURFACE},
-    {CM_FORMAT_STL, "STL", "stl", NULL, NULL, cm_mesh_read_stl, cm_mesh_write_stl,
-     CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
-    {CM_FORMAT_FOAM, "OpenFOAM polyMesh", NULL, cm_foam_is_path, "an OpenFOAM case directory", cm_mesh_read_foam,
-     cm_mesh_write_foam, CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_MSH, .name = "gmsh", .extensions = "msh", .read = cm_mesh_read_msh,
+     .write = cm_mesh_write_msh, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_VTU, .name = "VTK XML", .extensions = "vtu", .read = cm_mesh_read_vtu,
+     .write = cm_mesh_write_vtu, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_VTK, .name = "VTK legacy", .extensions = "vtk", .read = cm_mesh_read_vtk,
+     .write = cm_mesh_write_vtk, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_FIELDS | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_MEDIT, .name = "Medit", .extensions = "mesh", .read = cm_mesh_read_medit,
+     .write = cm_mesh_write_medit, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_OBJ, .name = "Wavefront", .extensions = "obj", .read = cm_mesh_read_obj,
+     .write = cm_mesh_write_obj, .holds = CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_OFF, .name = "OFF", .extensions = "off", .read = cm_mesh_read_off,
+     .write = cm_mesh_write_off, .holds = CM_MESH_IO_SURFACE},
+    {.format = CM_FORMAT_STL, .name = "STL", .extensions = "stl", .read = cm_mesh_read_stl,
+     .write = cm_mesh_write_stl, .holds = CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_FOAM, .name = "OpenFOAM polyMesh", .claims = cm_foam_is_path,
+     .described = "an OpenFOAM case directory", .read = cm_mesh_read_foam, .write = cm_mesh_write_foam,
+     .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},
 };
 const size_t cm_mesh_format_row_count = sizeof cm_mesh_format_rows / sizeof cm_mesh_format_rows[0];
 
@@ -52,14 +55,48 @@ static int in_list(const char *list, const char *ext, size_t n)
     return 0;
 }
 
-cm_mesh_format cm_mesh_format_of_extension(const char *path)
+/* Whether row i claims path's extension. */
+static int has_extension(size_t i, const char *path)
 {
     const char *dot = path ? strrchr(path, '.') : NULL;
-    if (!dot || strchr(dot, '/')) return CM_FORMAT_UNKNOWN;
-    const size_t n = strlen(dot + 1);
+    if (!dot || strchr(dot, '/')) return 0;
+    return in_list(cm_mesh_format_rows[i].extensions, dot + 1, strlen(dot + 1));
+}
+
+cm_mesh_format cm_mesh_format_of_extension(const char *path)
+{
     for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
-        if (in_list(cm_mesh_format_rows[i].extensions, dot + 1, n)) return cm_mesh_format_rows[i].format;
+        if (has_extension(i, path) && !cm_mesh_format_rows[i].sniff) return cm_mesh_format_rows[i].format;
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
+        if (has_extension(i, path)) return cm_mesh_format_rows[i].format;
     return CM_FORMAT_UNKNOWN;
+}
+
+/* The format of an existing file: the first row with the extension whose content test
+ * accepts the file's first bytes, else the extension's default row. A file that cannot be
+ * read goes to the default row, whose reader reports why. */
+static cm_mesh_format format_of_content(const char *path)
+{
+    char head[4097];
+    size_t n = 0;
+    struct stat st;
+    int have = 0;
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i) {
+        const cm_mesh_format_row *r = &cm_mesh_format_rows[i];
+        if (!r->sniff || !has_extension(i, path)) continue;
+        if (!have) {
+            have = 1;
+            /* regular files only: opening a FIFO would block (cm_file_read has the same rule) */
+            FILE *f = stat(path, &st) == 0 && S_ISREG(st.st_mode) ? fopen(path, "rb") : NULL;
+            if (f) {
+                n = fread(head, 1, sizeof head - 1, f);
+                fclose(f);
+            }
+            head[n] = '\0';
+        }
+        if (n && r->sniff(head, n)) return r->format;
+    }
+    return cm_mesh_format_of_extension(path);
 }
 
 /* An OpenFOAM case or polyMesh directory: a trailing '/', or (unless the name ends in a mesh
@@ -83,12 +120,25 @@ cm_mesh_format cm_mesh_format_from_path(const char *path)
 {
     for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
         if (cm_mesh_format_rows[i].claims && cm_mesh_format_rows[i].claims(path)) return cm_mesh_format_rows[i].format;
+    return format_of_content(path);
+}
+
+/* The format to write a mesh in: the format it was read from when that format claims the
+ * path (so that a Fluent .msh is written back as Fluent, changing only its nodes), else the
+ * path's format as for reading, without looking into an existing file of that name. */
+static cm_mesh_format format_to_write(const cm_mesh *mesh, const char *path)
+{
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
+        if (cm_mesh_format_rows[i].claims && cm_mesh_format_rows[i].claims(path)) return cm_mesh_format_rows[i].format;
+    const cm_mesh_format origin = cm_mesh_origin_format(mesh);
+    for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
+        if (cm_mesh_format_rows[i].format == origin && has_extension(i, path)) return origin;
     return cm_mesh_format_of_extension(path);
 }
 
 /* ".msh .vtu ... .stl, or an OpenFOAM case directory": the extensions of the rows in order,
- * then the directory formats. */
-static char format_list[256];
+ * each once, then the directory formats. */
+static char format_list[512];
 static pthread_once_t format_list_once = PTHREAD_ONCE_INIT;
 
 static void add_text(size_t *at, const char *text, size_t n)
@@ -104,9 +154,13 @@ static void compose_format_list(void)
         for (const char *w = cm_mesh_format_rows[i].extensions; w && *w;) {
             const char *e = strchr(w, ' ');
             const size_t len = e ? (size_t)(e - w) : strlen(w);
-            if (at) add_text(&at, " ", 1);
-            add_text(&at, ".", 1);
-            add_text(&at, w, len);
+            int earlier = 0; /* an extension two formats share is named once */
+            for (size_t j = 0; j < i; ++j) earlier |= in_list(cm_mesh_format_rows[j].extensions, w, len);
+            if (!earlier) {
+                if (at) add_text(&at, " ", 1);
+                add_text(&at, ".", 1);
+                add_text(&at, w, len);
+            }
             w = e ? e + 1 : NULL;
         }
     for (size_t i = 0; i < cm_mesh_format_row_count; ++i)
@@ -154,7 +208,7 @@ cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
     cm_mesh_write_options_init(&defaults);
     if (!opt) opt = &defaults;
     if (!mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: mesh is NULL");
-    const cm_mesh_format_row *row = cm_mesh_format_row_of(cm_mesh_format_from_path(path));
+    const cm_mesh_format_row *row = cm_mesh_format_row_of(format_to_write(mesh, path));
     if (!row || !row->write) return unknown_extension(ctx, "cm_mesh_write", path);
     return row->write(ctx, mesh, path, opt);
 }

@@ -2,7 +2,7 @@
 # OpenFOAM needed), and the cross-check against the real blockMesh / snappyHexMesh /
 # checkMesh and VTK's vtkOpenFOAMReader (label foam; skipped with exit 77 only when the
 # openfoam package is absent - scripts/setup.sh installs it).
-cm_add_unit_test(test_foam_io test_foam_io.c LIBS cm_mesh ZLIB::ZLIB LABELS foam)
+cm_add_unit_test(test_foam_io test_foam_io.c LIBS cm_mesh_internal ZLIB::ZLIB LABELS foam)
 add_test(NAME test_foam_crosscheck
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_foam_crosscheck.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
 set_tests_properties(test_foam_crosscheck PROPERTIES LABELS "foam;cli" SKIP_RETURN_CODE 77 TIMEOUT 300)

@@ -6,6 +6,7 @@
  * (The cross-check against the real OpenFOAM is test_foam_crosscheck.py.) */
 #define _POSIX_C_SOURCE 200809L
 #include "cadmorph/mesh.h"
+#include "origin.h"
 #include "test_mesh.h"
 #include "test_util.h"
 
@@ -332,7 +333,7 @@ static char *binary_case(const cm_mesh *m, const char *name, int truncate)
     mkdir(pm, 0777);
     snprintf(pm, sizeof pm, "%s/constant/polyMesh", dir);
     mkdir(pm, 0777);
-    const struct cm_foam_poly *p = m->foam;
+    const struct cm_foam_poly *p = cm_mesh_origin_state(m, CM_FORMAT_FOAM);
     (void)p;
     char f[2600];
     /* points */

@@ -37,7 +37,7 @@ int main(void)
     FIELD(cm_mesh, fields);
     FIELD(cm_mesh, n_groups);
     FIELD(cm_mesh, groups);
-    FIELD(cm_mesh, foam);
+    FIELD(cm_mesh, origin);
     SIZE(cm_mesh_write_options);
     FIELD(cm_mesh_write_options, appended);
     SIZE(cm_quality_stats);

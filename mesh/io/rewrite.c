@@ -1,0 +1,282 @@
+/* Writing a mesh back into the files it was read from, coordinates only (rewrite.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "rewrite.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+cm_rewrite_source *cm_rewrite_source_new(void)
+{
+    return calloc(1, sizeof(cm_rewrite_source));
+}
+
+void cm_rewrite_source_free(void *source)
+{
+    cm_rewrite_source *src = source;
+    if (!src) return;
+    for (size_t i = 0; i < src->n_files; ++i) {
+        free(src->files[i].path);
+        free(src->files[i].name);
+        free(src->files[i].spans);
+    }
+    free(src->files);
+    if (src->free_format) src->free_format(src->format);
+    free(src);
+}
+
+static char *dup_text(const char *s)
+{
+    if (!s) return NULL;
+    size_t n = strlen(s) + 1;
+    char *d = malloc(n);
+    if (d) memcpy(d, s, n);
+    return d;
+}
+
+static int identity(const char *path, int64_t *size, int64_t *sec, int64_t *nsec)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return -1;
+    *size = (int64_t)st.st_size;
+    *sec = (int64_t)st.st_mtim.tv_sec;
+    *nsec = (int64_t)st.st_mtim.tv_nsec;
+    return 0;
+}
+
+cm_status cm_rewrite_add_file(cm_context *ctx, cm_rewrite_source *src, const char *path,
+                              const char *name, size_t *index)
+{
+    cm_rewrite_file *files = realloc(src->files, (src->n_files + 1) * sizeof *files);
+    if (!files) return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", path);
+    src->files = files;
+    cm_rewrite_file *f = &files[src->n_files];
+    memset(f, 0, sizeof *f);
+    f->path = dup_text(path);
+    f->name = dup_text(name);
+    if (!f->path || (name && !f->name)) {
+        free(f->path);
+        free(f->name);
+        return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", path);
+    }
+    if (identity(path, &f->size, &f->mtime_sec, &f->mtime_nsec) != 0) {
+        cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot stat: %s", path, strerror(errno));
+        free(f->path);
+        free(f->name);
+        return s;
+    }
+    if (index) *index = src->n_files;
+    ++src->n_files;
+    return CM_OK;
+}
+
+cm_status cm_rewrite_add_span(cm_context *ctx, cm_rewrite_source *src, size_t file, int64_t offset,
+                              int64_t length, int64_t node, int64_t aux)
+{
+    cm_rewrite_file *f = &src->files[file];
+    const cm_rewrite_span *last = f->n_spans ? &f->spans[f->n_spans - 1] : NULL;
+    if (offset < 0 || length < 0 || offset + length > f->size || (last && offset < last->offset + last->length))
+        return cm_error(ctx, CM_ERR_INTERNAL, "%s: coordinate span at byte %lld out of order", f->path,
+                        (long long)offset);
+    if (f->n_spans == f->cap_spans) {
+        size_t cap = f->cap_spans ? 2 * f->cap_spans : 1024;
+        cm_rewrite_span *spans = realloc(f->spans, cap * sizeof *spans);
+        if (!spans) return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory for %zu coordinate places", f->path, cap);
+        f->spans = spans;
+        f->cap_spans = cap;
+    }
+    f->spans[f->n_spans++] = (cm_rewrite_span){offset, length, node, aux};
+    return CM_OK;
+}
+
+void cm_rewrite_put(cm_rewrite_buf *b, const char *s, size_t n)
+{
+    if (b->fail) return;
+    if (b->n + n + 1 > b->cap) {
+        size_t cap = b->cap ? b->cap : 256;
+        while (b->n + n + 1 > cap) cap *= 2;
+        char *d = realloc(b->d, cap);
+        if (!d) {
+            b->fail = 1;
+            return;
+        }
+        b->d = d;
+        b->cap = cap;
+    }
+    memcpy(b->d + b->n, s, n);
+    b->n += n;
+    b->d[b->n] = '\0';
+}
+
+void cm_rewrite_putf(cm_rewrite_buf *b, const char *fmt, ...)
+{
+    char small[256];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(small, sizeof small, fmt, ap);
+    va_end(ap);
+    if (n < 0) {
+        b->fail = 1;
+        return;
+    }
+    if ((size_t)n < sizeof small) {
+        cm_rewrite_put(b, small, (size_t)n);
+        return;
+    }
+    char *big = malloc((size_t)n + 1);
+    if (!big) {
+        b->fail = 1;
+        return;
+    }
+    va_start(ap, fmt);
+    vsnprintf(big, (size_t)n + 1, fmt, ap);
+    va_end(ap);
+    cm_rewrite_put(b, big, (size_t)n);
+    free(big);
+}
+
+int cm_rewrite_number(char *out, size_t cap, double v, const char *original, size_t n)
+{
+    if (original && n > 0 && n < cap) {
+        /* the original must be a number and nothing else (no Fortran exponent, no blank) */
+        memcpy(out, original, n);
+        out[n] = '\0';
+        char *end = NULL;
+        const double was = strtod(out, &end);
+        if (end == out + n && was == v && (v != 0 || signbit(was) == signbit(v))) return (int)n;
+    }
+    int len = 0;
+    for (int digits = 15; digits <= 17; ++digits) {
+        len = snprintf(out, cap, "%.*g", digits, v);
+        if (strtod(out, NULL) == v) break;
+    }
+    return len;
+}
+
+/* The output path of file f of a rewrite whose main output is path: path itself, or the
+ * included file's name beside it. */
+static char *target_of(const cm_rewrite_file *f, const char *path)
+{
+    if (!f->name) return dup_text(path);
+    if (f->name[0] == '/') return dup_text(f->name);
+    const char *slash = strrchr(path, '/');
+    const size_t dir = slash ? (size_t)(slash - path) + 1 : 0, n = strlen(f->name);
+    char *t = malloc(dir + n + 1);
+    if (!t) return NULL;
+    memcpy(t, path, dir);
+    memcpy(t + dir, f->name, n + 1);
+    return t;
+}
+
+static int same_file(const char *a, const char *b)
+{
+    struct stat x, y;
+    return stat(a, &x) == 0 && stat(b, &y) == 0 && x.st_dev == y.st_dev && x.st_ino == y.st_ino;
+}
+
+/* Copies n bytes of in to out (n < 0: to the end), through buf. */
+static int copy_bytes(FILE *in, FILE *out, int64_t n, char *buf, size_t cap)
+{
+    while (n != 0) {
+        const size_t want = n < 0 || (uint64_t)n > cap ? cap : (size_t)n;
+        const size_t got = fread(buf, 1, want, in);
+        if (got && fwrite(buf, 1, got, out) != got) return -1;
+        if (n > 0) n -= (int64_t)got;
+        if (got < want) return n > 0 || ferror(in) ? -1 : 0;
+    }
+    return 0;
+}
+
+static cm_status rewrite_one(cm_context *ctx, const cm_rewrite_source *src, const cm_rewrite_file *f,
+                             const cm_mesh *mesh, FILE *out, cm_rewrite_emit_fn emit)
+{
+    int64_t size, sec, nsec;
+    if (identity(f->path, &size, &sec, &nsec) != 0 || size != f->size || sec != f->mtime_sec || nsec != f->mtime_nsec)
+        return cm_error(ctx, CM_ERR_IO, "%s: the file the mesh was read from has changed or gone since; "
+                                        "read it again before writing the mesh back into it", f->path);
+    FILE *in = fopen(f->path, "rb");
+    if (!in) return cm_error(ctx, CM_ERR_IO, "%s: cannot open: %s", f->path, strerror(errno));
+    enum { CHUNK = 1 << 16 };
+    char *buf = malloc(CHUNK);
+    cm_rewrite_buf span_text = {0}, text = {0};
+    cm_status s = buf ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
+    int64_t at = 0;
+    for (size_t i = 0; s == CM_OK && i < f->n_spans; ++i) {
+        const cm_rewrite_span *sp = &f->spans[i];
+        if (copy_bytes(in, out, sp->offset - at, buf, CHUNK) != 0) {
+            s = cm_error(ctx, CM_ERR_IO, "%s: read or write failed near byte %lld", f->path, (long long)at);
+            break;
+        }
+        span_text.n = text.n = 0;
+        cm_rewrite_put(&span_text, "", 0);
+        for (int64_t left = sp->length; left > 0 && !span_text.fail;) {
+            const size_t want = left > CHUNK ? CHUNK : (size_t)left;
+            const size_t got = fread(buf, 1, want, in);
+            cm_rewrite_put(&span_text, buf, got);
+            if (got < want) {
+                s = cm_error(ctx, CM_ERR_IO, "%s: ends inside the coordinates of node %lld", f->path, (long long)sp->node + 1);
+                break;
+            }
+            left -= (int64_t)got;
+        }
+        if (s != CM_OK) break;
+        if (span_text.fail) {
+            s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
+            break;
+        }
+        if (sp->node < 0 || (size_t)sp->node >= mesh->n_nodes) {
+            s = cm_error(ctx, CM_ERR_INTERNAL, "%s: coordinate span of node %lld outside the mesh", f->path, (long long)sp->node);
+            break;
+        }
+        s = emit(ctx, src, f, sp, span_text.d, mesh->xyz + 3 * sp->node, &text);
+        if (s == CM_OK && text.fail) s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
+        if (s == CM_OK && text.n && fwrite(text.d, 1, text.n, out) != text.n)
+            s = cm_error(ctx, CM_ERR_IO, "%s: write failed", f->path);
+        at = sp->offset + sp->length;
+    }
+    if (s == CM_OK && copy_bytes(in, out, -1, buf, CHUNK) != 0)
+        s = cm_error(ctx, CM_ERR_IO, "%s: read or write failed near byte %lld", f->path, (long long)at);
+    free(buf);
+    free(span_text.d);
+    free(text.d);
+    fclose(in);
+    return s;
+}
+
+cm_status cm_rewrite_write(cm_context *ctx, const cm_rewrite_source *src, const cm_mesh *mesh,
+                           const char *path, cm_rewrite_emit_fn emit)
+{
+    /* which files to write: the main one always, an included one when it holds coordinates */
+    cm_outfile *outs = calloc(src->n_files ? src->n_files : 1, sizeof *outs);
+    if (!outs) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
+    cm_status s = CM_OK;
+    for (size_t i = 0; s == CM_OK && i < src->n_files; ++i) {
+        const cm_rewrite_file *f = &src->files[i];
+        if (i > 0 && f->n_spans == 0) continue;
+        char *target = target_of(f, path);
+        if (!target) {
+            s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
+            break;
+        }
+        if (i > 0 && same_file(target, f->path))
+            s = cm_error(ctx, CM_ERR_ARGUMENT,
+                         "cm_mesh_write: %s: the included file %s holds node coordinates and would be "
+                         "overwritten, which changes the original deck too; write into another directory",
+                         path, f->path);
+        if (s == CM_OK) s = cm_outfile_open(ctx, target, &outs[i]);
+        free(target);
+        if (s == CM_OK) s = rewrite_one(ctx, src, f, mesh, outs[i].f, emit);
+    }
+    /* included files first, the main file last: a reader of the output never finds a main file
+     * whose included coordinates are still the old ones */
+    for (size_t k = src->n_files; s == CM_OK && k-- > 0;)
+        if (outs[k].f) s = cm_outfile_commit(ctx, &outs[k]);
+    for (size_t i = 0; i < src->n_files; ++i) cm_outfile_abort(&outs[i]);
+    free(outs);
+    return s;
+}
