@@ -75,12 +75,11 @@ static int help(void)
            "TetGen fills the solid with tets of bounded radius-edge ratio). The mesher runs in a\n"
            "child process under a time limit: its crash or hang is an error message; when\n"
            "TetGen fails, -Y, a looser quality bound and a perturbed surface are tried. Every\n"
-           "boundary node lies on the CAD model. MESH\n"
-           "(%s)\n"
-           "gets the tets and\n"
-           "the boundary triangles, each tagged with its CAD face (face index + 1, as in\n"
-           "'cadmorph info'), and the cell field scaled_jacobian. Prints the counts, then the\n"
-           "quality report ending with\n"
+           "boundary node lies on the CAD model. MESH gets the tets and the boundary\n"
+           "triangles, each tagged with its CAD face (face index + 1, as in 'cadmorph info'),\n"
+           "and the cell field scaled_jacobian, in the format of its extension:\n"
+           "%s.\n"
+           "Prints the counts, then the quality report ending with\n"
            "  min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k> cells=<n>\n\n"
            "options:\n",
            usage, cm_mesh_format_list());
