@@ -277,16 +277,17 @@ static void test_hostile(cm_context *ctx)
 {
     size_t n = 0, nb = 0, ne = 0;
     char *box = slurp(fixture("box.msh"), &n), *bin = slurp(fixture("box_double.msh"), &nb);
-    /* every truncation fails cleanly (or reads: a cut in trailing blanks) */
+    /* truncations (every 29th / 11th byte: the files are written to disk) fail cleanly, or
+     * read: a cut in trailing blanks */
     int crashes = 0;
-    for (size_t k = 0; k < n; k += 7) {
+    for (size_t k = 0; k < n; k += 29) {
         spill(work("cut.msh"), box, k);
         cm_mesh *m = NULL;
         cm_status s = cm_mesh_read(ctx, work("cut.msh"), &m);
         crashes += s < 0 ? m != NULL || strchr(cm_context_message(ctx), '\n') != NULL : m == NULL;
         cm_mesh_destroy(&m);
     }
-    for (size_t k = 0; k < nb; ++k) {
+    for (size_t k = 0; k < nb; k += 11) {
         spill(work("cutb.msh"), bin, k);
         cm_mesh *m = NULL;
         cm_status s = cm_mesh_read(ctx, work("cutb.msh"), &m);
