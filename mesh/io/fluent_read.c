@@ -583,15 +583,13 @@ static cm_status sections(parser *ps)
             /* every other section keeps its bytes and is skipped: binary ones by their trailer */
             if (index >= 2000 && index < 4000) {
                 int64_t h[8];
-                int nh = 0, has = 0;
+                int nh = 0, has = 1;
                 const size_t save = ps->pos;
                 skip_space(ps);
-                if (peek(ps) == '(' && header(ps, h, &nh) == CM_OK && body(ps, &has) == CM_OK) {
-                    s = has ? skip_binary(ps, index) : CM_OK;
-                } else {
-                    ps->pos = save;
-                    s = skip_lists(ps, 1);
-                }
+                /* a header of hexadecimal numbers, then the data up to the trailer; a section
+                 * without data ends after its header */
+                if (peek(ps) != '(' || header(ps, h, &nh) != CM_OK || body(ps, &has) != CM_OK) ps->pos = save;
+                s = has ? skip_binary(ps, index) : CM_OK;
             } else {
                 s = skip_lists(ps, 1);
             }

@@ -56,8 +56,9 @@ cm_status cm_mesh_write_fluent(cm_context *ctx, const cm_mesh *mesh, const char 
     if (!src)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
                         "cm_mesh_write: %s: cadmorph writes Fluent files only back into the file a mesh was read from "
-                        "(node coordinates only), and this mesh was %s; write it as .msh (gmsh) or another format",
-                        path, cm_mesh_origin_format(mesh) == CM_FORMAT_FLUENT ? "read from one but its nodes or cells changed"
-                                                                               : "not read from a Fluent file");
+                        "(node coordinates only), and this mesh was %s",
+                        path, cm_mesh_origin_format(mesh) == CM_FORMAT_FLUENT
+                                  ? "read from one but its nodes or cells changed since; write it as .vtu or another format"
+                                  : "not read from a Fluent file; write it as .msh (gmsh) or another format");
     return cm_rewrite_write(ctx, src, mesh, path, emit);
 }

@@ -333,6 +333,37 @@ static void test_hostile(cm_context *ctx)
     free(bin);
 }
 
+/* A case file's other sections (header, rp variables with parentheses in strings, periodic
+ * shadow faces, an unknown binary section whose data holds parentheses) are skipped and kept. */
+static void test_case_sections(cm_context *ctx)
+{
+    size_t n = 0;
+    char *box = slurp(fixture("box.msh"), &n);
+    static const char extra[] = "(1 \"header (with a parenthesis\")\n"
+                                "(37 ((\"rp\" \"a string ) with \\\" quote\" (nested (list)))))\n"
+                                "(18 (1 2 3 4)(\n1 2\n))\n"
+                                "(2064 (1 2)(\x01()(\n))\nEnd of Binary Section   2064)\n";
+    const size_t ne = sizeof extra - 1;
+    char *cas = malloc(n + ne);
+    memcpy(cas, extra, ne);
+    memcpy(cas + ne, box, n);
+    spill(work("case.cas"), cas, n + ne);
+    cm_mesh *a = read_ok(ctx, fixture("box.msh")), *b = read_ok(ctx, work("case.cas"));
+    if (a && b) {
+        CHECK(a->n_cells == b->n_cells && !memcmp(a->xyz, b->xyz, 3 * a->n_nodes * sizeof *a->xyz));
+        for (size_t i = 0; i < 3 * b->n_nodes; ++i) b->xyz[i] *= 2;
+        CHECK(cm_mesh_write(ctx, b, work("case2.cas"), NULL) == CM_OK);
+        CHECK(same_outside_spans(ctx, work("case.cas"), work("case2.cas")));
+        cm_mesh *c = read_ok(ctx, work("case2.cas"));
+        for (size_t i = 0; c && i < 3 * c->n_nodes; ++i) CHECK(c->xyz[i] == 2 * a->xyz[i]);
+        cm_mesh_destroy(&c);
+    }
+    cm_mesh_destroy(&a);
+    cm_mesh_destroy(&b);
+    free(cas);
+    free(box);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) {
@@ -351,6 +382,7 @@ int main(int argc, char **argv)
     test_write_back(ctx, "box_double.msh", 0);
     test_write_back(ctx, "poly_double.msh", 0);
     test_write_back(ctx, "mixed_single.msh", 6e-8); /* single precision: float rounding */
+    test_case_sections(ctx);
     test_hostile(ctx);
     cm_context_destroy(&ctx);
     return TEST_REPORT();
