@@ -13,6 +13,20 @@
 
 enum { BC_INTERIOR = 2 };
 
+long cm_fluent_line_of(const cm_fluent_parsed *p, size_t at)
+{
+    long line = 1;
+    for (size_t i = 0; i < at && i < p->size; ++i) line += p->data[i] == '\n';
+    return line;
+}
+
+void cm_fluent_where(const cm_fluent_parsed *p, size_t f, char *out, size_t cap)
+{
+    const int64_t w = p->faces.where[f];
+    if (w >= 0) snprintf(out, cap, "%s:%ld", p->path, cm_fluent_line_of(p, (size_t)w));
+    else snprintf(out, cap, "%s: byte %lld", p->path, (long long)(-1 - w));
+}
+
 typedef struct cell_face {
     const int64_t *nodes;
     int n;
