@@ -3,6 +3,7 @@
  * readers and writers share is in frame.c, below this file. */
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
+#include "fluent_internal.h"
 #include "foam_internal.h"
 
 #include <ctype.h>
@@ -28,6 +29,11 @@ const cm_mesh_format_row cm_mesh_format_rows[] = {
      .write = cm_mesh_write_off, .holds = CM_MESH_IO_SURFACE},
     {.format = CM_FORMAT_STL, .name = "STL", .extensions = "stl", .read = cm_mesh_read_stl,
      .write = cm_mesh_write_stl, .holds = CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    /* Fluent: a .msh whose content starts with a section "(N ..." (gmsh's with $MeshFormat);
+     * written only back into the file it was read from, node coordinates only */
+    {.format = CM_FORMAT_FLUENT, .name = "Fluent", .extensions = "msh cas", .read = cm_mesh_read_fluent,
+     .write = cm_mesh_write_fluent, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS,
+     .sniff = cm_fluent_sniff},
     {.format = CM_FORMAT_FOAM, .name = "OpenFOAM polyMesh", .claims = cm_foam_is_path,
      .described = "an OpenFOAM case directory", .read = cm_mesh_read_foam, .write = cm_mesh_write_foam,
      .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},

@@ -415,6 +415,24 @@ def msh_many_blocks():
     run(["quality", p], 0, None, lines=0)
 
 
+# ---- 15. Fluent files: huge declared counts, deep lists, missing cells (file:line named) ----
+@case
+def fluent_hostile():
+    with open(os.path.join(DATA, "fluent", "box.msh")) as f:
+        box = f.read()
+    deep = "(64 " + "(" * 100000 + ")" * 100000 + ")\n"
+    p = write("fl_deep.msh", deep + box)
+    run(["quality", p], 0, None, lines=0)
+    p = write("fl_open.msh", box + "(64 " + "(" * 100000)
+    run(["quality", p], 2, r"fl_open\.msh:\d+: unterminated section", ["fl_open.msh"])
+    p = write("fl_cells.cas", box.replace("(12 (0 1 c 0 0))", "(12 (0 1 3fffffffffffffff 0 0))"))
+    run(["quality", p], 2, r"fl_cells\.cas: .* cells, but only \d+ faces", ["fl_cells.cas"], max_mb=200)
+    p = write("fl_nodes.cas", box.replace("(10 (1 1 24 1 3)", "(10 (1 1 3fffffffffffffff 1 3)"))
+    run(["quality", p], 2, r"fl_nodes\.cas:11: the node section holds more nodes", ["fl_nodes.cas"], max_mb=200)
+    p = write("fl_c1.msh", box.replace(" 2 1\n", " 2 ff\n", 1))
+    run(["quality", p], 2, r"fl_c1\.msh:53: face names a missing cell c1 ff", ["fl_c1.msh"])
+
+
 if __name__ == "__main__":
     if CASE == "list":
         print("\n".join(cases))
