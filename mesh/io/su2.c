@@ -188,13 +188,16 @@ static int parse_real(const char *b, const char *e, double *v)
 static cm_status expected_token(su2_reader *r, const char *what, const char *tb, const char *te)
 {
     if (!tb) return fail(r, "expected %s, got the end of the line", what);
-    const int n = (int)(te - tb > 40 ? 40 : te - tb);
-    return fail(r, "expected %s, got '%.*s'", what, n, tb);
+    char got[44];
+    size_t n = 0;
+    for (; tb + n < te && n < 40; ++n) got[n] = isprint((unsigned char)tb[n]) ? tb[n] : '?';
+    got[n] = '\0';
+    return fail(r, "expected %s, got '%s'", what, got);
 }
 
 /* The count after a keyword (the first token of value; *rest after it), no larger than the
- * items the rest of the file can hold at min_bytes each: a huge count is refused before
- * anything is allocated for it. */
+ * items the rest of the file can hold at min_bytes each (0: a number, not a count): a huge
+ * count is refused before anything is allocated for it. */
 static cm_status read_count(su2_reader *r, const char *value, const char *key, size_t min_bytes,
                             int64_t *n, const char **rest)
 {
@@ -202,9 +205,11 @@ static cm_status read_count(su2_reader *r, const char *value, const char *key, s
     char what[64];
     snprintf(what, sizeof what, "a count after %s=", key);
     if (!token(&p, r->e, &tb, &te) || !parse_int(tb, te, n) || *n < 0) return expected_token(r, what, tb, te);
-    if ((uint64_t)*n > (r->size - r->pos) / min_bytes + 1)
-        return fail(r, "expected at most %llu items after %s= in the rest of the file, got %lld (truncated?)",
-                    (unsigned long long)((r->size - r->pos) / min_bytes + 1), key, (long long)*n);
+    if (min_bytes && (uint64_t)*n > (r->size - r->pos) / min_bytes + 1)
+        return fail(r, "expected at most %llu %s after %s= in the rest of the file, got %lld (truncated?)",
+                    (unsigned long long)((r->size - r->pos) / min_bytes + 1),
+                    key[1] == 'P' ? "points" : key[1] == 'M' ? "markers" : key[1] == 'Z' ? "zones" : "elements", key,
+                    (long long)*n);
     if (rest) *rest = p;
     else if (token(&p, r->e, &tb, &te)) return expected_token(r, "the end of the line", tb, te);
     return CM_OK;
@@ -320,16 +325,17 @@ static cm_status read_markers(su2_reader *r, int64_t k)
     const char *value = NULL;
     for (int64_t i = 0; i < k; ++i) {
         if (!next_line(r) || !keyword(r, key, sizeof key, &value) || strcmp(key, "MARKER_TAG"))
-            return fail(r, "expected MARKER_TAG= of marker %lld of the %lld after NMARK=, got '%s'", (long long)i,
-                        (long long)k, r->b < r->e ? shown(r, buf) : "the end of the file");
+            return fail(r, "expected MARKER_TAG= of marker %lld of the %lld after NMARK=, got %s%s%s", (long long)i,
+                        (long long)k, r->b < r->e ? "'" : "", r->b < r->e ? shown(r, buf) : "the end of the file",
+                        r->b < r->e ? "'" : "");
         while (value < r->e && blank(*value)) ++value;
         if (value == r->e) return fail(r, "expected a marker name after MARKER_TAG=");
         int tag = 0;
         cm_status s = marker_group(r, value, (size_t)(r->e - value), &tag);
         if (s != CM_OK) return s;
         if (!next_line(r) || !keyword(r, key, sizeof key, &value) || strcmp(key, "MARKER_ELEMS"))
-            return fail(r, "expected MARKER_ELEMS= after MARKER_TAG=, got '%s'",
-                        r->b < r->e ? shown(r, buf) : "the end of the file");
+            return fail(r, "expected MARKER_ELEMS= after MARKER_TAG=, got %s%s%s", r->b < r->e ? "'" : "",
+                        r->b < r->e ? shown(r, buf) : "the end of the file", r->b < r->e ? "'" : "");
         int64_t n = 0;
         const long at = r->line;
         s = read_count(r, value, "MARKER_ELEMS", 6, &n, NULL);
@@ -383,12 +389,12 @@ static cm_status parse_su2(cm_context *ctx, const char *path, const char *data, 
         int64_t n = 0;
         if (!strcmp(key, "NZONE")) {
             if (any || nzone >= 0) s = fail(&r, "expected NZONE= first in the file, once");
-            else s = read_count(&r, value, key, 16, &nzone, NULL);
+            else s = read_count(&r, value, key, 8, &nzone, NULL);
             if (s == CM_OK && nzone < 1) s = fail(&r, "expected NZONE= 1 or more, got %lld", (long long)nzone);
         } else if (!strcmp(key, "IZONE")) {
             if (nzone < 0) s = fail(&r, "expected NZONE= before IZONE=");
             else if (any) s = end_zone(&r);
-            if (s == CM_OK) s = read_count(&r, value, key, 1, &n, NULL);
+            if (s == CM_OK) s = read_count(&r, value, key, 0, &n, NULL);
             if (s == CM_OK && n != r.zones + 1)
                 s = fail(&r, "expected IZONE= %d (the zones in order), got %lld", r.zones + 1, (long long)n);
             if (s == CM_OK && n > nzone)
@@ -401,7 +407,7 @@ static cm_status parse_su2(cm_context *ctx, const char *path, const char *data, 
         } else if (!strcmp(key, "NDIME")) {
             if (nzone > 1 && !r.zones) s = fail(&r, "expected IZONE= before NDIME= in a file of %lld zones", (long long)nzone);
             else if (r.dim) s = fail(&r, "expected one NDIME= per zone, got another");
-            else s = read_count(&r, value, key, 1, &n, NULL);
+            else s = read_count(&r, value, key, 0, &n, NULL);
             if (s == CM_OK && n != 2 && n != 3) s = fail(&r, "expected NDIME= 2 or 3, got %lld", (long long)n);
             if (s != CM_OK) break;
             r.dim = (int)n;
