@@ -1,4 +1,14 @@
 # SU2 native .su2: the reader, the write back and new files on files written in the test
-# (hostile ones too), and against gmsh's and meshio's .su2 (su2_crosscheck.py).
+# (hostile ones too); against the .su2 that gmsh and meshio write (su2_crosscheck.py: the
+# cadmorph Python package of the build tree); the CLI's commands on the gmsh-meshed bore
+# written to .su2 by gmsh (su2_cli.py).
 cm_add_unit_test(test_su2 test_su2.c LIBS cm_mesh)
 set_tests_properties(test_su2 PROPERTIES LABELS "unit;hostile")
+add_test(NAME test_su2_crosscheck
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/su2_crosscheck.py ${CM_TEST_WORK})
+set_tests_properties(test_su2_crosscheck PROPERTIES LABELS "unit;python" TIMEOUT 120
+  ENVIRONMENT "PYTHONPATH=${PROJECT_BINARY_DIR}/python;PYTHONDONTWRITEBYTECODE=1")
+add_test(NAME test_su2_cli
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/su2_cli.py $<TARGET_FILE:cadmorph> ${CM_TEST_DATA}
+          ${CM_TEST_WORK})
+set_tests_properties(test_su2_cli PROPERTIES LABELS "cli" TIMEOUT 300)
