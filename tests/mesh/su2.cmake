@@ -12,3 +12,9 @@ add_test(NAME test_su2_cli
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/su2_cli.py $<TARGET_FILE:cadmorph> ${CM_TEST_DATA}
           ${CM_TEST_WORK})
 set_tests_properties(test_su2_cli PROPERTIES LABELS "cli" TIMEOUT 300)
+# an SU2 user's CFD case (body in a box, gmsh's markers and the FFD block SU2_DEF appends):
+# the wall moved and the volume warped into mesh_out.su2 as SU2_DEF does, twice; the case's
+# .msh with volume and boundary groups written to a new .su2
+add_test(NAME test_su2_cfd
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/su2_cfd.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
+set_tests_properties(test_su2_cfd PROPERTIES LABELS "cli" TIMEOUT 300)
