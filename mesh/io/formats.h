@@ -44,6 +44,9 @@ cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *p
 cm_status cm_mesh_read_fluent(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_fluent(cm_context *ctx, const cm_mesh *mesh, const char *path,
                                const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_su2(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_su2(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                            const cm_mesh_write_options *opt);
 
 /* ---- the registry ---- */
 

@@ -336,7 +336,7 @@ class Mesh:
 
 def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
     """Reads a mesh; the format is chosen by the name (.msh, .vtu, .vtk, .mesh, .obj, .off,
-    .stl, or an OpenFOAM case directory), as in the CLI. threads: for the library's OpenMP
+    .stl, .su2, or an OpenFOAM case directory), as in the CLI. threads: for the library's OpenMP
     loops, 0 = all the machine has.
 
     Raises BadInputError (with the library's message naming the file, and the line or the
