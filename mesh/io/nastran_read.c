@@ -283,7 +283,7 @@ static cm_status include(reader *r, size_t file, const char *data, size_t size, 
         for (;;) {
             const char *end = memchr(data + b, q, l.e - b);
             size_t e = end ? (size_t)(end - data) : l.e;
-            while (b < e && n == 0 && isspace((unsigned char)data[b])) ++b;
+            while (b < e && isspace((unsigned char)data[b])) ++b;
             size_t t = e;
             if (!end)
                 while (t > b && isspace((unsigned char)data[t - 1])) --t;

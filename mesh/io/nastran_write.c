@@ -112,7 +112,14 @@ static cm_status emit_grid(cm_context *ctx, const cm_rewrite_source *src, const 
         }
     }
     if (need_large) {
-        /* GRID* ID CP X1 X2 / * X3 CD PS SEID, the other fields as they were */
+        /* GRID* ID CP X1 X2 / * X3 CD PS SEID, the other fields as they were, the moved
+         * coordinates in 16 columns */
+        for (int k = 0; k < 3; ++k) {
+            size_t len;
+            const char *s = nas_field_text(t, &c, 2 + (size_t)k, &len);
+            if (changed[k] && !nas_format_fit(nt[k], sizeof nt[k], local[k], 16, len ? nas_text_digits(s, len) : pmax))
+                nas_format_fit(nt[k], sizeof nt[k], local[k], 16, 1);
+        }
         const size_t start = out->n;
         cm_rewrite_put(out, "GRID*   ", 8);
         for (size_t i = 0; i < 8; ++i) {
@@ -145,7 +152,7 @@ static cm_status emit_grid(cm_context *ctx, const cm_rewrite_source *src, const 
                     if (out->fail) break;
                     char *dst = out->d + line_start + col;
                     /* the side the old value was on */
-                    const int left = f->e > f->b && t[f->b] != ' ';
+                    const int left = f->e == f->b || t[f->b] != ' ';
                     memset(dst, ' ', w);
                     memcpy(dst + (left ? 0 : w - len), nt[k], len);
                 }
