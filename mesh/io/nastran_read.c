@@ -1,6 +1,7 @@
 /* Nastran bulk data reader: GRID (small, large, free field; CP systems CORD2R/C/S, chained,
  * and GRDSET's default), CTETRA/CHEXA/CPENTA/CPYRAM (linear and quadratic) and
- * CTRIA3/CTRIA6/CQUAD4/CQUAD8 (CTRIAR/CQUADR) with their PID as physical group "PID <n>",
+ * CTRIA3/CTRIA6/CQUAD4/CQUAD8 (CTRIAR/CQUADR), CBAR/CBEAM/CROD as lines, with their PID as
+ * physical group "PID <n>",
  * INCLUDE (relative to the including file; recursion refused). Executive and case control
  * before BEGIN BULK are skipped; ENDDATA ends the deck; other cards are ignored.
  *
@@ -181,6 +182,9 @@ static const elem_kind kinds[] = {
     {"CTRIAR", CM_CELL_TRI3, CM_CELL_TRI3, 3, 3, 1},    {"CTRIA6", CM_CELL_TRI6, CM_CELL_TRI6, 6, 6, 1},
     {"CQUAD4", CM_CELL_QUAD4, CM_CELL_QUAD4, 4, 4, 1},  {"CQUADR", CM_CELL_QUAD4, CM_CELL_QUAD4, 4, 4, 1},
     {"CQUAD8", CM_CELL_QUAD8, CM_CELL_QUAD8, 8, 8, 1},
+    /* beams and rods as lines (their end grids; a CBAR's orientation fields are not nodes) */
+    {"CBAR", CM_CELL_LINE2, CM_CELL_LINE2, 2, 2, 1},   {"CBEAM", CM_CELL_LINE2, CM_CELL_LINE2, 2, 2, 1},
+    {"CROD", CM_CELL_LINE2, CM_CELL_LINE2, 2, 2, 1},
 };
 
 /* Nastran's CHEXA20 / CPENTA15 node i is VTK's node perm[i]'s source: vtk[j] = nas[perm[j]] */
