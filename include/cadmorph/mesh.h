@@ -208,6 +208,8 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
  * extension (a case directory: its constant/polyMesh is read or written; ASCII / binary,
  * plain / .gz). A polyMesh read and written back changes `points` only: the other files are
  * copied byte for byte.
+ * Nastran bulk data: .bdf, .nas, .dat (GRID small / large / free field, CORD2R/C/S, solids,
+ * shells, INCLUDE; PIDs as groups); a deck read and written back changes GRID coordinates only.
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */

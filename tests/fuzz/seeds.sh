@@ -4,11 +4,14 @@
 set -eu
 src=$1/tests/data
 out=$2
-for d in msh vtu vtk medit dcsv step_scan; do mkdir -p "$out/$d"; done
+for d in msh vtu vtk medit nastran dcsv step_scan; do mkdir -p "$out/$d"; done
 find "$src" -name '*.msh' -size -200k -exec cp {} "$out/msh/" \;
 find "$src" -name '*.vtu' -size -200k -exec cp {} "$out/vtu/" \;
 find "$src" -name '*.vtk' -size -200k -exec cp {} "$out/vtk/" \;
 find "$src" -name '*.mesh' -size -200k -exec cp {} "$out/medit/" \;
+find "$src" -name '*.bdf' -size -200k -exec cp {} "$out/nastran/" \;
 find "$src" -name '*.csv' -size -200k -exec cp {} "$out/dcsv/" \;
 find "$src" -name '*.step' -size -200k -exec cp {} "$out/step_scan/" \;
 printf 'node,dx,dy,dz\n0,1,2,3\n5,-1e-3,0,1.5\n' > "$out/dcsv/seed.csv"
+# Nastran: small, large and free field, a system, continuations (no .bdf fixtures in tests/data)
+printf 'BEGIN BULK\nGRID    1       2       0.      0.      0.\nGRID*   2                               1.5-1           1.\n*       0.\nGRID,3,,0.,1.,0.\nGRID    4               0.      0.      1.\nCORD2R  2               0.      0.      0.      0.      0.      1.      +\n+       1.      0.      0.\nCTETRA  1       1       1       2       3       4\nCHEXA   2       1       1       2       3       4       1       2       +\n+       3       4\nENDDATA\n' > "$out/nastran/seed.bdf"
