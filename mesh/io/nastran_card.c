@@ -97,8 +97,9 @@ static int fixed_index(int large, size_t col)
     return col < 80 ? 5 : -1;
 }
 
-/* The data fields of line l (index li of the card): free fields split at commas, fixed ones
- * by columns. first: the card's first line (its field 1 is the name). */
+/* The data fields of line li of the card (its slots, padded with empty fields): free fields
+ * split at commas, fixed ones by columns; field 1 (the name or the continuation mark) and the
+ * last field (the continuation marker) are not data. */
 static int split_line(const char *data, nas_card *c, int li)
 {
     nas_line *l = &c->lines[li];
