@@ -209,8 +209,10 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
  * plain / .gz). A polyMesh read and written back changes `points` only: the other files are
  * copied byte for byte. Fluent .msh (told from gmsh's by its content) and .cas: 3-D, ASCII and
  * binary sections, zones as groups; written only back into the file read (node coordinates).
- * copied byte for byte. SU2 .su2 (ASCII; 2-D files at z = 0, zones as one mesh): markers are
+ * SU2 .su2 (ASCII; 2-D files at z = 0, zones as one mesh): markers are
  * groups; written back, only the coordinate numbers of its point lines change.
+ * Nastran bulk data: .bdf, .nas, .dat (GRID small / large / free field, CORD2R/C/S, solids,
+ * shells, INCLUDE; PIDs as groups); a deck read and written back changes GRID coordinates only.
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */

@@ -47,6 +47,11 @@ cm_status cm_mesh_write_fluent(cm_context *ctx, const cm_mesh *mesh, const char 
 cm_status cm_mesh_read_su2(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_su2(cm_context *ctx, const cm_mesh *mesh, const char *path,
                             const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_nastran(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_nastran(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                                const cm_mesh_write_options *opt);
+/* Whether a file's first bytes look like Nastran bulk data (for .dat, a generic name). */
+int cm_nastran_sniff(const char *head, size_t n);
 
 /* ---- the registry ---- */
 

@@ -39,6 +39,11 @@ const cm_mesh_format_row cm_mesh_format_rows[] = {
      .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},
     {.format = CM_FORMAT_SU2, .name = "SU2", .extensions = "su2", .read = cm_mesh_read_su2,
      .write = cm_mesh_write_su2, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    /* .dat is anyone's name: the content test makes Nastran the reader of a .dat only when no
+     * other row takes the extension without one, or when the content is bulk data */
+    {.format = CM_FORMAT_NASTRAN, .name = "Nastran bulk data", .extensions = "bdf nas dat",
+     .read = cm_mesh_read_nastran, .write = cm_mesh_write_nastran, .sniff = cm_nastran_sniff,
+     .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
 };
 const size_t cm_mesh_format_row_count = sizeof cm_mesh_format_rows / sizeof cm_mesh_format_rows[0];
 

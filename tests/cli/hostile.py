@@ -258,6 +258,23 @@ def names_round_trip():
 
 
 @case
+def nastran_recursive_include():
+    # a.bdf includes b.bdf which includes a.bdf: refused at the INCLUDE, not a loop
+    write("nas_b.bdf", "GRID    2               1.      0.      0.\nINCLUDE 'nas_a.bdf'\n")
+    a = write("nas_a.bdf", "BEGIN BULK\nGRID    1               0.      0.      0.\nINCLUDE 'nas_b.bdf'\nENDDATA\n")
+    run(["quality", a], 2, r"nas_b\.bdf:2: INCLUDE of .*nas_a\.bdf includes itself", ["nas_b.bdf"], max_mb=200)
+
+
+@case
+def nastran_huge_ids():
+    # ids near 10^17 are numbers, never sizes: read in little memory; an undefined one is named
+    a = write("nas_ids.bdf", "GRID,99999999999999999,,0.,0.,0.\nGRID,88888888888888888,,1.,0.,0.\n"
+                             "GRID,77777777777777777,,0.,1.,0.\nGRID,66666666666666666,,0.,0.,1.\n"
+                             "CTETRA,5,1,99999999999999999,88888888888888888,77777777777777777,55555555555555555\n")
+    run(["quality", a], 2, r"nas_ids\.bdf:5: CTETRA 5: GRID 55555555555555555 is not defined", ["nas_ids.bdf"], max_mb=200)
+
+
+@case
 def msh_duplicate_tags():
     p = write("dup.msh", """$MeshFormat
 4.1 0 8
