@@ -251,19 +251,25 @@ static cm_status rewrite_one(cm_context *ctx, const cm_rewrite_source *src, cons
 cm_status cm_rewrite_write(cm_context *ctx, const cm_rewrite_source *src, const cm_mesh *mesh,
                            const char *path, cm_rewrite_emit_fn emit)
 {
-    /* which files to write: the main one always, an included one when it holds coordinates */
+    /* The main file always; an included one unless it is its own target already (written
+     * beside its source, or named by an absolute path), which is fine without coordinates in
+     * it and refused with them. */
     cm_outfile *outs = calloc(src->n_files ? src->n_files : 1, sizeof *outs);
     if (!outs) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
     cm_status s = CM_OK;
     for (size_t i = 0; s == CM_OK && i < src->n_files; ++i) {
         const cm_rewrite_file *f = &src->files[i];
-        if (i > 0 && f->n_spans == 0) continue;
         char *target = target_of(f, path);
         if (!target) {
             s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
             break;
         }
-        if (i > 0 && same_file(target, f->path))
+        const int in_place = i > 0 && same_file(target, f->path);
+        if (in_place && f->n_spans == 0) {
+            free(target);
+            continue;
+        }
+        if (in_place)
             s = cm_error(ctx, CM_ERR_ARGUMENT,
                          "cm_mesh_write: %s: the included file %s holds node coordinates and would be "
                          "overwritten, which changes the original deck too; write into another directory",

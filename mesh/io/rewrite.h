@@ -5,10 +5,10 @@
  * the spans and lets the format write each span anew from the node's new coordinates. A file
  * that changed since it was read is refused.
  *
- * Included files (Abaqus *INCLUDE, Nastran INCLUDE) that hold spans are written beside the
- * output under the name the including file gives them, so that the written deck reads as the
- * original did; one that would land on its own source is refused (the original deck would
- * silently change). */
+ * Included files (Abaqus *INCLUDE, Nastran INCLUDE) are written beside the output under the
+ * name the including file gives them, so that the written deck reads as the original did; one
+ * that would land on its own source is left alone when it holds no coordinates and refused
+ * when it does (the original deck would silently change). */
 #ifndef CADMORPH_MESH_IO_REWRITE_H
 #define CADMORPH_MESH_IO_REWRITE_H
 
@@ -68,7 +68,8 @@ typedef cm_status (*cm_rewrite_emit_fn)(cm_context *ctx, const cm_rewrite_source
                                         cm_rewrite_buf *out);
 
 /* Writes the mesh's coordinates into copies of the source's files: the main file to path, the
- * others beside it. Each goes through a temporary file renamed only when all are written. */
+ * included ones beside it. Each goes through a temporary file renamed only when all are
+ * written. */
 cm_status cm_rewrite_write(cm_context *ctx, const cm_rewrite_source *src, const cm_mesh *mesh,
                            const char *path, cm_rewrite_emit_fn emit);
 

@@ -82,15 +82,20 @@ static void test_main_and_include(cm_context *ctx)
     snprintf(inc_in, sizeof inc_in, "%s/nodes.txt", in_dir);
     snprintf(main_out, sizeof main_out, "%s/deck.txt", out_dir);
     snprintf(inc_out, sizeof inc_out, "%s/nodes.txt", out_dir);
-    const char *main_text = "# deck\nv 0 0 0\ninclude nodes.txt\nv 1.000 2 3\nend\n";
+    const char *main_text = "# deck\nv 0 0 0\ninclude nodes.txt\ninclude cells.txt\nv 1.000 2 3\nend\n";
     const char *inc_text = "v 4 5 6\n  trailing text\n";
+    char cells_in[160], cells_out[160];
+    snprintf(cells_in, sizeof cells_in, "%s/cells.txt", in_dir);
+    snprintf(cells_out, sizeof cells_out, "%s/cells.txt", out_dir);
     put_file(main_in, main_text);
     put_file(inc_in, inc_text);
+    put_file(cells_in, "c 0 1 2\n");
 
     cm_rewrite_source *src = cm_rewrite_source_new();
     size_t f0 = 9, f1 = 9;
     CHECK(cm_rewrite_add_file(ctx, src, main_in, NULL, &f0) == CM_OK && f0 == 0);
     CHECK(cm_rewrite_add_file(ctx, src, inc_in, "nodes.txt", &f1) == CM_OK && f1 == 1);
+    CHECK(cm_rewrite_add_file(ctx, src, cells_in, "cells.txt", NULL) == CM_OK); /* no coordinates */
     int64_t node = 0;
     add_spans(ctx, src, 0, main_text, &node);
     add_spans(ctx, src, 1, inc_text, &node);
@@ -113,11 +118,13 @@ static void test_main_and_include(cm_context *ctx)
     CHECK(!strcmp(get_file(inc_in), inc_text));
 
     CHECK(cm_rewrite_write(ctx, src, m, main_out, emit_xyz) == CM_OK);
-    CHECK_MSG(!strcmp(get_file(main_out), "# deck\nv 0 0 0\ninclude nodes.txt\nv 1.000 2 3.25\nend\n"), "%s", get_file(main_out));
+    CHECK_MSG(!strcmp(get_file(main_out), "# deck\nv 0 0 0\ninclude nodes.txt\ninclude cells.txt\nv 1.000 2 3.25\nend\n"), "%s", get_file(main_out));
     CHECK_MSG(!strcmp(get_file(inc_out), "v 4 5.5 6\n  trailing text\n"), "%s", get_file(inc_out));
+    /* an included file without coordinates is copied too: the written deck is complete */
+    CHECK_MSG(get_file(cells_out) && !strcmp(get_file(cells_out), "c 0 1 2\n"), "%s", cells_out);
 
     /* the source changed since it was read: refused */
-    put_file(main_in, "# deck\nv 0 0 0\ninclude nodes.txt\nv 1.000 2 3\nend\n\n");
+    put_file(main_in, "# deck\nv 0 0 0\ninclude nodes.txt\ninclude cells.txt\nv 1.000 2 3\nend\n\n");
     CHECK(cm_rewrite_write(ctx, src, m, main_out, emit_xyz) == CM_ERR_IO);
     CHECK(strstr(cm_context_message(ctx), "changed") != NULL);
     cm_mesh_destroy(&m);
