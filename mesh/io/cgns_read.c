@@ -30,7 +30,8 @@ int cm_cgns_magic_ok(const char *path)
     fclose(f);
     static const unsigned char hdf5[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
     if (n >= 8 && memcmp(b, hdf5, 8) == 0) return 1;
-    return n >= 25 && memcmp(b, "@(#)ADF Database Version", 24) == 0;
+    /* ADF: four bytes (the "@(#)" of old files) and the text below */
+    return n >= 24 && memcmp(b + 4, "ADF Database Version", 20) == 0;
 }
 
 void cm_cgns_state_free(void *state)
@@ -92,11 +93,16 @@ static cm_status group_tag(reader *r, int dim, const char *name, int *tag)
 
 /* ---- coordinates and the merging of zones' vertices ---- */
 
+/* Vertices are compared at the precision both zones store: the hash is of the coordinates
+ * rounded to float, so that a RealSingle zone meets a RealDouble one at their interface (and
+ * still does after a motion written back in each zone's precision). */
 static uint64_t hash_xyz(const double *p)
 {
-    uint64_t h = 1469598103934665603ull, w;
+    uint64_t h = 1469598103934665603ull;
     for (int k = 0; k < 3; ++k) {
-        double v = p[k] == 0 ? 0.0 : p[k]; /* -0 and +0 are one point */
+        float v = (float)p[k];
+        uint32_t w;
+        if (v == 0) v = 0; /* -0 and +0 are one point */
         memcpy(&w, &v, sizeof w);
         h = (h ^ w) * 1099511628211ull;
         h ^= h >> 29;
@@ -104,8 +110,9 @@ static uint64_t hash_xyz(const double *p)
     return h;
 }
 
-static int same_xyz(const double *a, const double *b)
+static int same_xyz(const double *a, const double *b, int single)
 {
+    if (single) return (float)a[0] == (float)b[0] && (float)a[1] == (float)b[1] && (float)a[2] == (float)b[2];
     return a[0] == b[0] && a[1] == b[1] && a[2] == b[2];
 }
 
@@ -167,11 +174,18 @@ static cm_status merge_vertices(reader *r, double **xyz)
     int64_t *table = r->st->n_zones > 1 ? malloc(cap * sizeof *table) : NULL;
     if (r->st->n_zones > 1 && !table) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", r->path);
     for (size_t i = 0; table && i < cap; ++i) table[i] = -1;
+    /* the zone of each node, for the precision of a comparison */
+    int *zone_of = table ? malloc((total + 1) * sizeof *zone_of) : NULL;
+    if (table && !zone_of) {
+        free(table);
+        return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", r->path);
+    }
     cm_status s = cm_mesh_resize_nodes(r->ctx, r->m, total, 0);
     size_t n = 0;
     for (size_t z = 0; s == CM_OK && z < r->st->n_zones; ++z) {
         cm_cgns_zone *zn = &r->st->zones[z];
         const size_t first = n;
+        const int single = zn->single[0] || zn->single[1] || zn->single[2];
         zn->node = malloc(((size_t)zn->n_vertices + 1) * sizeof *zn->node);
         if (!zn->node) {
             s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", r->path);
@@ -183,7 +197,10 @@ static cm_status merge_vertices(reader *r, double **xyz)
             size_t h = table ? (size_t)hash_xyz(p) & (cap - 1) : 0;
             if (table)
                 for (; table[h] >= 0; h = (h + 1) & (cap - 1))
-                    if ((size_t)table[h] < first && same_xyz(r->m->xyz + 3 * table[h], p)) {
+                    if ((size_t)table[h] < first) {
+                        const cm_cgns_zone *o = &r->st->zones[zone_of[table[h]]];
+                        if (!same_xyz(r->m->xyz + 3 * table[h], p, single || o->single[0] || o->single[1] || o->single[2]))
+                            continue;
                         found = table[h];
                         break;
                     }
@@ -194,6 +211,7 @@ static cm_status merge_vertices(reader *r, double **xyz)
             memcpy(r->m->xyz + 3 * n, p, 3 * sizeof *p);
             zn->node[i] = (int64_t)n;
             if (table) {
+                zone_of[n] = (int)z;
                 /* a vertex of this zone at a point already in the table is not entered twice */
                 while (table[h] >= 0) h = (h + 1) & (cap - 1);
                 table[h] = (int64_t)n;
@@ -202,6 +220,7 @@ static cm_status merge_vertices(reader *r, double **xyz)
         }
     }
     free(table);
+    free(zone_of);
     if (s == CM_OK) s = cm_mesh_resize_nodes(r->ctx, r->m, n, 0);
     return s;
 }
