@@ -9,3 +9,8 @@ set_tests_properties(test_cgns PROPERTIES FIXTURES_SETUP cgns_files)
 add_test(NAME test_cgns_tree
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_cgns_tree.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK}/cgns)
 set_tests_properties(test_cgns_tree PROPERTIES LABELS "unit;cgns" FIXTURES_REQUIRED cgns_files SKIP_RETURN_CODE 77)
+# the CLI (quality, morph, warp with an affine motion of every node, optimize, deform with a
+# constraint on a BC family) on the bore model's hex mesh as CGNS and on the two-zone file
+add_test(NAME test_cgns_cli
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_cgns_cli.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
+set_tests_properties(test_cgns_cli PROPERTIES LABELS "cli;cgns" FIXTURES_REQUIRED cgns_files TIMEOUT 300)
