@@ -208,6 +208,7 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
  * extension (a case directory: its constant/polyMesh is read or written; ASCII / binary,
  * plain / .gz). A polyMesh read and written back changes `points` only: the other files are
  * copied byte for byte.
+ * .cgns (CGNS, ADF / HDF5): unstructured zones as one mesh; written back, only GridCoordinates.
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */
