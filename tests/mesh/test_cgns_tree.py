@@ -67,6 +67,55 @@ def cgnscheck_clean(path):
     check(out.returncode == 0 and "ERROR" not in out.stdout, f"cgnscheck {path}: {out.stdout[-500:]}")
 
 
+def independent_writers(cli, work):
+    """A gmsh tet mesh through CGNS's own tetgen_to_cgns, read by cadmorph (gmsh's Debian
+    build has no CGNS writer); meshio's .cgns (HDF5 without CGNS labels) refused clearly."""
+    import gmsh
+    import meshio
+
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Verbosity", 1)
+    gmsh.model.occ.addBox(0, 0, 0, 1, 2, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.4)
+    gmsh.model.mesh.generate(3)
+    _, x, _ = gmsh.model.mesh.getNodes()
+    x = np.asarray(x).reshape(-1, 3)
+    _, _, conn = gmsh.model.mesh.getElements(3)
+    tets = np.asarray(conn[0], dtype=np.int64).reshape(-1, 4) - 1  # gmsh tags are 1..n here
+    gmsh.finalize()
+    base = os.path.join(work, "tg")
+    with open(base + ".node", "w") as f:
+        f.write(f"{len(x)} 3 0 0\n")
+        f.writelines(f"{i + 1} {p[0]!r} {p[1]!r} {p[2]!r}\n" for i, p in enumerate(x))
+    with open(base + ".ele", "w") as f:
+        f.write(f"{len(tets)} 4 0\n")
+        f.writelines(f"{i + 1} {t[0] + 1} {t[1] + 1} {t[2] + 1} {t[3] + 1}\n" for i, t in enumerate(tets))
+    faces = np.sort(np.concatenate([tets[:, [0, 2, 1]], tets[:, [0, 1, 3]], tets[:, [1, 2, 3]], tets[:, [0, 3, 2]]]), axis=1)
+    u, n = np.unique(faces, axis=0, return_counts=True)
+    with open(base + ".face", "w") as f:
+        f.write(f"{(n == 1).sum()} 1\n")
+        f.writelines(f"{i + 1} {t[0] + 1} {t[1] + 1} {t[2] + 1} 1\n" for i, t in enumerate(u[n == 1]))
+    with open(base + "_zero.csv", "w") as f:
+        f.write("node,dx,dy,dz\n0,0,0,0\n")
+    r = subprocess.run(["tetgen_to_cgns", base, base + ".cgns"], capture_output=True, text=True)
+    check(r.returncode == 0, "tetgen_to_cgns")
+    # a warp by zero: the mesh as read
+    r = subprocess.run([cli, "warp", "--mesh", base + ".cgns", "--displacements", base + "_zero.csv",
+                        "-o", base + "_out.vtu"], capture_output=True, text=True)
+    check(r.returncode == 0, f"cadmorph reads tetgen_to_cgns's file: {r.stderr[-300:]}")
+    if os.path.exists(base + "_out.vtu"):
+        m = meshio.read(base + "_out.vtu")
+        # tetgen_to_cgns stores RealSingle
+        check(np.allclose(m.points, x.astype(np.float32), rtol=0, atol=1e-12), "tetgen_to_cgns: the points")
+        t = [c.data for c in m.cells if c.type == "tetra"]
+        check(len(t) == 1 and np.array_equal(t[0], tets), "tetgen_to_cgns: the tetrahedra")
+    mio = os.path.join(work, "meshio.cgns")
+    meshio.write(mio, meshio.Mesh(x, [("tetra", tets)]))
+    r = subprocess.run([cli, "quality", mio], capture_output=True, text=True)
+    check(r.returncode == 2 and "meshio.cgns: /: not a CGNS file" in r.stderr, f"meshio's file: {r.stderr}")
+
+
 def main():
     cli, work = sys.argv[1], sys.argv[2]
     if not shutil.which("cgnsdiff") or not shutil.which("cgnscheck"):
@@ -99,6 +148,7 @@ def main():
         check(np.allclose(m.points, pts), "meshio: points")
         check(len(m.cells) == 1 and m.cells[0].type == "tetra"
               and np.array_equal(np.sort(m.cells[0].data, axis=1), np.sort(tets, axis=1)), "meshio: tetrahedra")
+    independent_writers(cli, work)
     print(f"{len(failures)} failures")
     return 1 if failures else 0
 
