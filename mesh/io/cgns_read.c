@@ -71,7 +71,12 @@ static cm_status fail(reader *r, cm_status code, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    return cm_error(r->ctx, code, "cm_mesh_read: %s: %s: %s", r->path, r->where[0] ? r->where : "/", msg);
+    /* node names are the file's bytes: one printable line in the message */
+    char where[sizeof r->where];
+    snprintf(where, sizeof where, "%s", r->where[0] ? r->where : "/");
+    for (char *c = where; *c; ++c) *c = (unsigned char)*c < 0x20 || (unsigned char)*c >= 0x7f ? '?' : *c;
+    for (char *c = msg; *c; ++c) *c = (unsigned char)*c < 0x20 || (unsigned char)*c >= 0x7f ? '?' : *c;
+    return cm_error(r->ctx, code, "cm_mesh_read: %s: %s: %s", r->path, where, msg);
 }
 
 static cm_status lib_fail(reader *r, const char *call)
@@ -669,7 +674,10 @@ cm_status cm_mesh_read_cgns(cm_context *ctx, const char *path, cm_mesh **mesh)
     }
     cm_cgns_lock();
     if (cg_open(path, CG_MODE_READ, &r.fn) != CG_OK) {
-        s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: /: not a CGNS file the CGNS library opens: %s", path, cg_get_error());
+        char why[256];
+        snprintf(why, sizeof why, "%s", cg_get_error());
+        for (char *c = why; *c; ++c) *c = (unsigned char)*c < 0x20 || (unsigned char)*c >= 0x7f ? '?' : *c;
+        s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: /: not a CGNS file the CGNS library opens: %s", path, why);
         r.fn = -1;
     } else {
         s = read_file(&r);
