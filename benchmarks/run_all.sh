@@ -26,3 +26,4 @@ echo "== warp methods side by side"; sh "$here/warp/bench_warp.sh" "$build" "$wo
 echo "== gradients: the warps' reverse product against one apply"; sh "$here/gradients/bench_warp_vjp.sh" "$build" "$work/gradients" 2
 echo "== warp methods in the sweeps"; sh "$here/warp/bench_warp_sweep.sh" "$build" "$work/wsweep" 2
 echo "== Python binding";      /usr/bin/python3 "$here/python/bench_binding.py" "$build" "$work/python"
+echo "== mesh formats against .vtu (1M tets)"; sh "$here/formats/bench_formats.sh" "$build/cli/cadmorph" "$work/formats"

@@ -14,7 +14,7 @@ packages=(
   openfoam  # blockMesh, snappyHexMesh, checkMesh: polyMesh test meshes and the checkMesh cross-check
   python3-matplotlib  # examples/python (plots); imported by PyGeM (make_pygem_fixture.py)
   clang libclang-rt-14-dev  # make fuzz (libFuzzer); make check-asan uses gcc's sanitizers
-  libcgns-dev  # CGNS meshes (mesh/io/cgns.c), ADF and HDF5
+  libcgns-dev  # CGNS meshes (mesh/io/cgns_read.c, cgns_write.c), ADF and HDF5
   cgns-convert calculix-ccx python3-h5py  # cross-checks: cgnscheck, ccx runs a morphed .inp, h5py reads CGNS trees
 )
 # Optional, needed only for -DCADMORPH_WITH_PETSC=ON (the distributed solver, --solver petsc):

@@ -213,6 +213,7 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
  * groups; written back, only the coordinate numbers of its point lines change.
  * Nastran bulk data: .bdf, .nas, .dat (GRID small / large / free field, CORD2R/C/S, solids,
  * shells, INCLUDE; PIDs as groups); a deck read and written back changes GRID coordinates only.
+ * .cgns (CGNS, ADF / HDF5): unstructured zones as one mesh; written back, only GridCoordinates.
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */

@@ -37,6 +37,9 @@ cm_status cm_mesh_write_off(cm_context *ctx, const cm_mesh *mesh, const char *pa
 cm_status cm_mesh_read_stl(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_stl(cm_context *ctx, const cm_mesh *mesh, const char *path,
                             const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_cgns(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_cgns(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                             const cm_mesh_write_options *opt);
 cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *path,
                              const cm_mesh_write_options *opt);

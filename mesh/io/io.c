@@ -34,6 +34,8 @@ const cm_mesh_format_row cm_mesh_format_rows[] = {
     {.format = CM_FORMAT_FLUENT, .name = "Fluent", .extensions = "msh cas", .read = cm_mesh_read_fluent,
      .write = cm_mesh_write_fluent, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS,
      .sniff = cm_fluent_sniff},
+    {.format = CM_FORMAT_CGNS, .name = "CGNS", .extensions = "cgns", .read = cm_mesh_read_cgns,
+     .write = cm_mesh_write_cgns, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
     {.format = CM_FORMAT_FOAM, .name = "OpenFOAM polyMesh", .claims = cm_foam_is_path,
      .described = "an OpenFOAM case directory", .read = cm_mesh_read_foam, .write = cm_mesh_write_foam,
      .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},

@@ -4,7 +4,7 @@
 set -eu
 src=$1/tests/data
 out=$2
-for d in msh vtu vtk medit fluent su2 nastran dcsv step_scan; do mkdir -p "$out/$d"; done
+for d in msh vtu vtk medit fluent su2 nastran cgns dcsv step_scan; do mkdir -p "$out/$d"; done
 find "$src" -name '*.msh' -size -200k -exec cp {} "$out/msh/" \;
 find "$src" -name '*.vtu' -size -200k -exec cp {} "$out/vtu/" \;
 find "$src" -name '*.vtk' -size -200k -exec cp {} "$out/vtk/" \;
@@ -12,6 +12,7 @@ find "$src" -name '*.mesh' -size -200k -exec cp {} "$out/medit/" \;
 # Fluent: the ASCII and binary fixtures (their .msh content read through the driver's .cas)
 find "$src/fluent" -name '*.msh' -size -200k -exec cp {} "$out/fluent/" \;
 find "$src" -name '*.su2' -size -200k -exec cp {} "$out/su2/" \;
+find "$src" -name '*.cgns' -size -200k -exec cp {} "$out/cgns/" \;
 find "$src" -name '*.csv' -size -200k -exec cp {} "$out/dcsv/" \;
 find "$src" -name '*.step' -size -200k -exec cp {} "$out/step_scan/" \;
 printf 'node,dx,dy,dz\n0,1,2,3\n5,-1e-3,0,1.5\n' > "$out/dcsv/seed.csv"
