@@ -28,6 +28,8 @@ const cm_mesh_format_row cm_mesh_format_rows[] = {
      .write = cm_mesh_write_off, .holds = CM_MESH_IO_SURFACE},
     {.format = CM_FORMAT_STL, .name = "STL", .extensions = "stl", .read = cm_mesh_read_stl,
      .write = cm_mesh_write_stl, .holds = CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_ABAQUS, .name = "Abaqus", .extensions = "inp", .read = cm_mesh_read_abaqus,
+     .write = cm_mesh_write_abaqus, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
     {.format = CM_FORMAT_FOAM, .name = "OpenFOAM polyMesh", .claims = cm_foam_is_path,
      .described = "an OpenFOAM case directory", .read = cm_mesh_read_foam, .write = cm_mesh_write_foam,
      .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},
