@@ -39,8 +39,10 @@ int abq_element_type(const char *name, abq_type *t)
     t->perm = NULL;
     if (!strcmp(name, "STRI3")) return t->nodes = 3, t->type = CM_CELL_TRI3, 1;
     if (!strcmp(name, "STRI65")) return t->nodes = 6, t->type = CM_CELL_TRI6, 1;
-    if (!strcmp(name, "B31") || !strcmp(name, "B31H")) return t->nodes = 2, t->type = CM_CELL_LINE2, 1;
-    if (!strcmp(name, "B32") || !strcmp(name, "B32H")) return t->nodes = 3, t->type = CM_CELL_LINE3, 1;
+    /* beams: B21, B31H, the cubic B23, B33 (2 nodes); B22, B32H (3 nodes) */
+    if (name[0] == 'B' && (name[1] == '2' || name[1] == '3') && name[2] >= '1' && name[2] <= '3' &&
+        (!name[3] || !strcmp(name + 3, "H")))
+        return name[2] != '2' ? (t->nodes = 2, t->type = CM_CELL_LINE2, 1) : (t->nodes = 3, t->type = CM_CELL_LINE3, 1);
     for (size_t i = 0; i < sizeof families / sizeof *families; ++i) {
         const size_t l = strlen(families[i].prefix);
         if (strncmp(name, families[i].prefix, l) || !isdigit((unsigned char)name[l])) continue;

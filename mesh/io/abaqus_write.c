@@ -1,7 +1,8 @@
 /* Abaqus decks written (abaqus_internal.h). A mesh read from a deck is written back through
  * rewrite.h: only the coordinate numbers of *NODE data lines change (the node id, separators,
  * fields after the third and every other line stay byte for byte; an included file that holds
- * nodes is written beside the output). A node of an instanced part goes back through the
+ * nodes is written beside the output). A changed number is the shortest text that reads back
+ * as the new value, within 20 characters (CalculiX reads no more of a field). A node of an instanced part goes back through the
  * inverse of its instance's placement; a part placed by several instances holds one position
  * per node, so instances moved differently are refused. Any other mesh is written as a plain
  * new deck: *NODE, one *ELEMENT block per type and group (ELSET= the group's name), point
@@ -62,6 +63,18 @@ static double field_value(const span_field *f)
     return strtod(buf, NULL);
 }
 
+/* CalculiX reads 20 characters of a field (f20.0): a number longer than that gets the most
+ * significant digits that fit (at least 14 with an exponent), unless its bytes are kept. */
+enum { FIELD_CHARS = 20 };
+
+static int number(char *out, size_t cap, double v, const char *original, size_t n)
+{
+    int len = cm_rewrite_number(out, cap, v, original, n);
+    if (len <= FIELD_CHARS || (original && (size_t)len == n && !memcmp(out, original, n))) return len;
+    for (int digits = 16; digits > 0 && len > FIELD_CHARS; --digits) len = snprintf(out, cap, "%.*g", digits, v);
+    return len;
+}
+
 static cm_status emit(cm_context *ctx, const cm_rewrite_source *src, const cm_rewrite_file *file,
                       const cm_rewrite_span *span, const char *original, const double xyz[3], cm_rewrite_buf *out)
 {
@@ -95,14 +108,14 @@ static cm_status emit(cm_context *ctx, const cm_rewrite_source *src, const cm_re
                 at = f[k].e;
                 continue;
             }
-            const int len = cm_rewrite_number(num, sizeof num, v[k], n ? f[k].b : NULL, n);
+            const int len = number(num, sizeof num, v[k], n ? f[k].b : NULL, n);
             cm_rewrite_put(out, num, (size_t)len);
             at = f[k].e;
         } else if (v[k] != 0 || signbit(v[k])) {
             /* a coordinate the line leaves out (0) that is not 0 any more */
             cm_rewrite_put(out, at, (size_t)(end - at));
             at = end;
-            const int len = cm_rewrite_number(num, sizeof num, v[k], NULL, 0);
+            const int len = number(num, sizeof num, v[k], NULL, 0);
             cm_rewrite_put(out, ", ", 2);
             cm_rewrite_put(out, num, (size_t)len);
         }
