@@ -207,7 +207,8 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
  * OpenFOAM polyMesh for a path that is a directory, ends in '/', is named polyMesh or has no
  * extension (a case directory: its constant/polyMesh is read or written; ASCII / binary,
  * plain / .gz). A polyMesh read and written back changes `points` only: the other files are
- * copied byte for byte.
+ * copied byte for byte. Abaqus .inp decks (with *INCLUDE, parts and instances; sets and
+ * surfaces as groups) written back to .inp change only the numbers of *NODE lines.
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */

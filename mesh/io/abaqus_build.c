@@ -197,13 +197,17 @@ static cm_status drop_unplaced(abq_build_state *b)
         map[i] = (int64_t)nn++;
     }
     /* cells: whole ranges of the dropped parts go */
+    unsigned char *gone = calloc(m->n_cells ? m->n_cells : 1, 1);
+    if (!gone) {
+        free(map);
+        return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    }
+    for (size_t p = 1; p < r->n_parts; ++p)
+        if (!kept(r, p)) memset(gone + r->parts[p].cell0, 1, r->parts[p].cell1 - r->parts[p].cell0);
     size_t nc = 0;
     int64_t at = 0;
     for (size_t c = 0; c < m->n_cells; ++c) {
-        int drop = 0;
-        for (size_t p = 1; p < r->n_parts && !drop; ++p)
-            drop = !kept(r, p) && c >= r->parts[p].cell0 && c < r->parts[p].cell1;
-        if (drop) continue;
+        if (gone[c]) continue;
         const int64_t o = m->offset[c], n = m->offset[c + 1] - o;
         memmove(m->conn + at, m->conn + o, (size_t)n * sizeof(int64_t));
         m->type[nc] = m->type[c];
@@ -214,6 +218,7 @@ static cm_status drop_unplaced(abq_build_state *b)
         at += n;
         m->offset[++nc] = at;
     }
+    free(gone);
     /* the ranges of the parts kept, in their new places */
     size_t nshift = 0, cshift = 0;
     for (size_t p = 1; p < r->n_parts; ++p) {
