@@ -67,6 +67,8 @@ typedef struct abq_reader {
     size_t n_insts;
     abq_set *sets;
     size_t n_sets;
+    int *set_slots;          /* a hash of (part, kind, name ignoring case) -> set, -1 empty */
+    size_t set_mask;
     int depth;
     dev_t dev[ABQ_MAX_DEPTH];
     ino_t ino[ABQ_MAX_DEPTH];

@@ -304,23 +304,69 @@ cm_status abq_set_add(abq_reader *r, abq_set *s, int64_t inst, int64_t id, int f
     return CM_OK;
 }
 
+/* Room for item n of an array of n: grown when n is 0 or a power of 2 (to 2n + 1), so that
+ * appending one at a time costs amortised linear time. */
+static void *grow(void *a, size_t n, size_t size)
+{
+    if (n && (n & (n - 1))) return a;
+    return realloc(a, (2 * n + 1) * size);
+}
+
+static size_t set_hash(int part, int kind, const char *name)
+{
+    uint64_t h = 1469598103934665603ull ^ (uint64_t)(part * 4 + kind);
+    for (const char *p = name; *p; ++p) h = (h ^ (unsigned char)toupper((unsigned char)*p)) * 1099511628211ull;
+    return (size_t)(h ^ (h >> 29));
+}
+
+/* The set of (part, kind, name) or -1, through the hash. */
+static int lookup_set(const abq_reader *r, int part, int kind, const char *name)
+{
+    if (!r->set_slots) return -1;
+    for (size_t i = set_hash(part, kind, name) & r->set_mask;; i = (i + 1) & r->set_mask) {
+        const int k = r->set_slots[i];
+        if (k < 0) return -1;
+        if (r->sets[k].part == part && r->sets[k].kind == kind && abq_name_eq(r->sets[k].name, name)) return k;
+    }
+}
+
+/* Set k entered in the hash (grown to twice the sets and more). */
+static int hash_set(abq_reader *r, int k)
+{
+    if (!r->set_slots || 2 * (size_t)(k + 1) > r->set_mask + 1) {
+        const size_t cap = r->set_slots ? 2 * (r->set_mask + 1) : 64;
+        int *slots = malloc(cap * sizeof *slots);
+        if (!slots) return 0;
+        for (size_t i = 0; i < cap; ++i) slots[i] = -1;
+        free(r->set_slots);
+        r->set_slots = slots;
+        r->set_mask = cap - 1;
+        for (int j = 0; j < k; ++j) {
+            size_t i = set_hash(r->sets[j].part, r->sets[j].kind, r->sets[j].name) & r->set_mask;
+            while (slots[i] >= 0) i = (i + 1) & r->set_mask;
+            slots[i] = j;
+        }
+    }
+    size_t i = set_hash(r->sets[k].part, r->sets[k].kind, r->sets[k].name) & r->set_mask;
+    while (r->set_slots[i] >= 0) i = (i + 1) & r->set_mask;
+    r->set_slots[i] = k;
+    return 1;
+}
+
 int abq_find_set(const abq_reader *r, int part, int kind, const char *name, int64_t *inst)
 {
     *inst = -1;
-    for (size_t i = 0; i < r->n_sets; ++i)
-        if (r->sets[i].part == part && r->sets[i].kind == kind && abq_name_eq(r->sets[i].name, name)) return (int)i;
-    if (part != 0) return -1;
+    const int k = lookup_set(r, part, kind, name);
+    if (k >= 0 || part != 0) return k;
     /* "instance.set" from the assembly: the set of the instance's part */
     const char *dot = strrchr(name, '.');
     if (!dot) return -1;
-    for (size_t k = 0; k < r->n_insts; ++k) {
-        const char *in = r->insts[k].name;
+    for (size_t j = 0; j < r->n_insts; ++j) {
+        const char *in = r->insts[j].name;
         if (strlen(in) != (size_t)(dot - name) || strncasecmp(in, name, (size_t)(dot - name))) continue;
-        for (size_t i = 0; i < r->n_sets; ++i)
-            if (r->sets[i].part == r->insts[k].part && r->sets[i].kind == kind && abq_name_eq(r->sets[i].name, dot + 1)) {
-                *inst = (int64_t)k;
-                return (int)i;
-            }
+        const int s = lookup_set(r, r->insts[j].part, kind, dot + 1);
+        if (s >= 0) *inst = (int64_t)j;
+        return s;
     }
     return -1;
 }
@@ -329,12 +375,13 @@ int abq_find_set(const abq_reader *r, int part, int kind, const char *name, int6
 static cm_status get_set(abq_reader *r, abq_file *f, int part, int kind, const char *name, int *index)
 {
     if (!*name) return err(r, f, "expected a set name");
-    for (size_t i = 0; i < r->n_sets; ++i)
-        if (r->sets[i].part == part && r->sets[i].kind == kind && abq_name_eq(r->sets[i].name, name)) {
-            *index = (int)i;
-            return CM_OK;
-        }
-    abq_set *sets = realloc(r->sets, (r->n_sets + 1) * sizeof *sets);
+    const int k = lookup_set(r, part, kind, name);
+    if (k >= 0) {
+        *index = k;
+        return CM_OK;
+    }
+    if (r->n_sets >= INT32_MAX / 4) return err(r, f, "expected fewer sets");
+    abq_set *sets = grow(r->sets, r->n_sets, sizeof *sets);
     if (!sets) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
     r->sets = sets;
     memset(&sets[r->n_sets], 0, sizeof *sets);
@@ -343,6 +390,7 @@ static cm_status get_set(abq_reader *r, abq_file *f, int part, int kind, const c
     sets[r->n_sets].kind = kind;
     sets[r->n_sets].part = part;
     *index = (int)r->n_sets++;
+    if (!hash_set(r, *index)) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
     return CM_OK;
 }
 
@@ -756,7 +804,7 @@ static cm_status keyword_line(abq_reader *r, abq_file *f, abq_block *blk, const 
         else if (find_part(r, name) >= 0) s = err(r, f, "part %s defined twice", name);
         else if (r->parts[0].used && !r->any_part) s = err(r, f, "expected *PART before any *NODE or *ELEMENT of the model");
         if (s != CM_OK) goto done;
-        abq_part *parts = realloc(r->parts, (r->n_parts + 1) * sizeof *parts);
+        abq_part *parts = grow(r->parts, r->n_parts, sizeof *parts);
         if (!parts) {
             s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
             goto done;
@@ -796,7 +844,7 @@ static cm_status keyword_line(abq_reader *r, abq_file *f, abq_block *blk, const 
                 s = err(r, f, "instance %s defined twice", name);
                 goto done;
             }
-        abq_inst *insts = realloc(r->insts, (r->n_insts + 1) * sizeof *insts);
+        abq_inst *insts = grow(r->insts, r->n_insts, sizeof *insts);
         if (!insts) {
             s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
             goto done;
@@ -887,6 +935,7 @@ void abq_reader_free(abq_reader *r)
         free(r->sets[i].face);
     }
     free(r->sets);
+    free(r->set_slots);
     cm_rewrite_source_free(r->src);
 }
 
