@@ -22,7 +22,23 @@
 typedef struct abq_hash {
     size_t mask;
     int64_t *key, *val;
+    /* ids first, first + 1, ... of values v0, v0 + 1, ... (the usual deck): no table */
+    int dense;
+    int64_t first, v0, n;
 } abq_hash;
+
+/* A map of the n ids at ids (values base + i): dense when they count up by one. */
+static int dense_map(abq_hash *h, const int64_t *ids, size_t n, int64_t base)
+{
+    for (size_t i = 1; i < n; ++i)
+        if (ids[i] != ids[0] + (int64_t)i) return 0;
+    memset(h, 0, sizeof *h);
+    h->dense = 1;
+    h->first = n ? ids[0] : 1;
+    h->v0 = base;
+    h->n = (int64_t)n;
+    return 1;
+}
 
 static size_t mix(int64_t k)
 {
@@ -70,6 +86,7 @@ static int hash_put(abq_hash *h, int64_t k, int64_t v, int64_t *old)
 
 static int64_t hash_get(const abq_hash *h, int64_t k)
 {
+    if (h->dense) return k >= h->first && k - h->first < h->n ? h->v0 + (k - h->first) : -1;
     if (!h->key) return -1;
     for (size_t i = mix(k) & h->mask;; i = (i + 1) & h->mask) {
         if (h->key[i] == 0) return -1;
@@ -260,13 +277,16 @@ static cm_status resolve(abq_build_state *b)
         const abq_part *q = &r->parts[p];
         if (!kept(r, p)) continue;
         const char *what = p ? q->name : "the model";
-        if (!hash_init(&b->nodes[p], q->node1 - q->node0) || !hash_init(&b->cells[p], q->cell1 - q->cell0))
+        const int dn = dense_map(&b->nodes[p], m->node_tag + q->node0, q->node1 - q->node0, (int64_t)q->node0);
+        const int dc = q->cell1 == q->cell0 ||
+                       dense_map(&b->cells[p], m->cell_tag + q->cell0, q->cell1 - q->cell0, (int64_t)q->cell0);
+        if ((!dn && !hash_init(&b->nodes[p], q->node1 - q->node0)) || (!dc && !hash_init(&b->cells[p], q->cell1 - q->cell0)))
             return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
-        for (size_t i = q->node0; i < q->node1; ++i)
+        for (size_t i = q->node0; !dn && i < q->node1; ++i)
             if (hash_put(&b->nodes[p], m->node_tag[i], (int64_t)i, &old))
                 return fail(b, "node %lld of %s is defined twice", (long long)m->node_tag[i], what);
         for (size_t c = q->cell0; c < q->cell1; ++c) {
-            if (hash_put(&b->cells[p], m->cell_tag[c], (int64_t)c, &old))
+            if (!dc && hash_put(&b->cells[p], m->cell_tag[c], (int64_t)c, &old))
                 return fail(b, "element %lld of %s is defined twice", (long long)m->cell_tag[c], what);
             for (int64_t k = m->offset[c]; k < m->offset[c + 1]; ++k) {
                 const int64_t i = hash_get(&b->nodes[p], m->conn[k]);
@@ -408,9 +428,11 @@ static cm_status one_set(abq_build_state *b, const abq_set *s, int64_t k, int *t
             cstamp[x] = t;
             const int d = cm_cell_type_info((cm_cell_type)m->type[x])->dim;
             if (d > dim) dim = d;
-            int64_t *cells = realloc(g->cells, (g->n + 1 + g->n / 2) * sizeof *cells);
-            if (!cells) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
-            g->cells = cells;
+            if (!(g->n & (g->n + 1)) || !g->cells) { /* n + 1 a power of 2: full */
+                int64_t *cells = realloc(g->cells, (2 * g->n + 2) * sizeof *cells);
+                if (!cells) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+                g->cells = cells;
+            }
             g->cells[g->n++] = x;
         } else {
             /* a face of a solid, or a shell's side */
@@ -553,6 +575,7 @@ cm_status abq_build(abq_reader *r, const char *path)
     if (s == CM_OK) s = resolve(&b);
     if (s == CM_OK) s = place(&b);
     if (s == CM_OK) s = mark_spans(&b);
+    const size_t elements = m->n_cells;
     if (s == CM_OK) s = groups(&b);
     for (size_t p = 0; b.nodes && b.cells && p < r->n_parts; ++p) {
         hash_free(&b.nodes[p]);
@@ -560,14 +583,17 @@ cm_status abq_build(abq_reader *r, const char *path)
     }
     free(b.nodes);
     free(b.cells);
-    /* ids repeated by instances (or parts) cannot be the mesh's ids: index + 1 then */
+    /* ids repeated by instances (or parts) cannot be the mesh's ids: index + 1 then (a deck
+     * without parts has its ids checked already, and the cells' too when no group added any) */
     int ok = 1;
-    if (s == CM_OK && !distinct(m->node_tag, m->n_nodes, &ok)) s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    const int one_scope = r->n_parts == 1 && r->n_insts == 0;
+    if (s == CM_OK && !one_scope && !distinct(m->node_tag, m->n_nodes, &ok)) s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
     if (s == CM_OK && !ok) {
         free(m->node_tag);
         m->node_tag = NULL;
     }
-    if (s == CM_OK && m->cell_tag && !distinct(m->cell_tag, m->n_cells, &ok)) s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    ok = 1;
+    if (s == CM_OK && m->cell_tag && !(one_scope && m->n_cells == elements) && !distinct(m->cell_tag, m->n_cells, &ok)) s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
     if (s == CM_OK && m->cell_tag && !ok) {
         free(m->cell_tag);
         m->cell_tag = NULL;

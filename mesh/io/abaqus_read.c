@@ -147,18 +147,19 @@ static cm_status err(abq_reader *r, const abq_file *f, const char *fmt, ...)
     return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: %s", f->path, f->line, msg);
 }
 
+/* An integer: an optional sign and digits, no overflow. */
 static int parse_int(const char *b, const char *e, int64_t *v)
 {
-    char buf[32], *end;
-    const size_t n = (size_t)(e - b);
-    if (n == 0 || n >= sizeof buf) return 0;
-    memcpy(buf, b, n);
-    buf[n] = '\0';
-    if (!isdigit((unsigned char)buf[buf[0] == '+' || buf[0] == '-']) ) return 0;
-    errno = 0;
-    const long long x = strtoll(buf, &end, 10);
-    if (*end || errno) return 0;
-    *v = (int64_t)x;
+    int neg = 0;
+    if (b < e && (*b == '+' || *b == '-')) neg = *b++ == '-';
+    if (b == e) return 0;
+    uint64_t x = 0;
+    for (; b < e; ++b) {
+        const unsigned d = (unsigned)(*b - '0');
+        if (d > 9 || x > (UINT64_C(9223372036854775807) - d) / 10) return 0;
+        x = 10 * x + d;
+    }
+    *v = neg ? -(int64_t)x : (int64_t)x;
     return 1;
 }
 
