@@ -1,6 +1,7 @@
-/* Abaqus input decks (.inp), shared by the reader (abaqus_read.c: lines, keywords, data),
- * the model builder (abaqus_build.c: parts instanced, sets and surfaces as groups) and the
- * writer (abaqus_write.c: back into the deck, or a plain new deck). Not public. */
+/* Abaqus input decks (.inp), shared by the reader (abaqus_lex.c: lines, fields, keywords,
+ * sets; abaqus_read.c: the keywords' data), the model builder (abaqus_build.c: parts
+ * instanced, sets and surfaces as groups) and the writer (abaqus_write.c: back into the deck,
+ * or a plain new deck). Not public. */
 #ifndef CADMORPH_MESH_IO_ABAQUS_INTERNAL_H
 #define CADMORPH_MESH_IO_ABAQUS_INTERNAL_H
 
@@ -62,7 +63,7 @@ typedef struct abq_reader {
     abq_part *parts;         /* parts[0]: the model (a flat deck) or the assembly level */
     size_t n_parts;
     int cur;                 /* the scope being read */
-    int in_assembly, in_instance, any_part;
+    int in_assembly, in_instance, any_part, assembled;
     abq_inst *insts;
     size_t n_insts;
     abq_set *sets;
@@ -96,6 +97,47 @@ cm_status abq_set_add(abq_reader *r, abq_set *s, int64_t inst, int64_t id, int f
 /* The set named name (case-insensitive) of kind in scope part, or "inst.name" from the
  * assembly; -1 when none. *inst receives the instance of a qualified name (else -1). */
 int abq_find_set(const abq_reader *r, int part, int kind, const char *name, int64_t *inst);
+
+/* ---- lines, fields, numbers, keywords (abaqus_lex.c) ---- */
+
+typedef struct abq_file {
+    const char *path;
+    const char *d;
+    size_t n, pos;
+    long line;      /* of the line last taken */
+    size_t index;   /* in the rewrite source */
+    const char *name; /* relative to the main file's directory (NULL: the main file) */
+} abq_file;
+
+enum { KW_MAX_PARAMS = 24, KW_VALUE = 1024 };
+
+typedef struct abq_keyword {
+    char key[48]; /* upper case, blanks removed, without '*' */
+    int n;
+    char name[KW_MAX_PARAMS][32];
+    char value[KW_MAX_PARAMS][KW_VALUE];
+    int has_value[KW_MAX_PARAMS];
+} abq_keyword;
+
+int abq_next_line(abq_file *f, const char **b, const char **e);
+int abq_blank(char c);
+/* The next comma-separated field of [*p, e), trimmed: 0 when none is left. A trailing comma
+ * ends the fields (it continues the line). */
+int abq_next_field(const char **p, const char *e, const char **fb, const char **fe);
+int abq_ends_with_comma(const char *b, const char *e);
+/* "cm_mesh_read: FILE:LINE: message", CM_ERR_FORMAT. */
+cm_status abq_err(abq_reader *r, const abq_file *f, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+int abq_parse_int(const char *b, const char *e, int64_t *v);
+int abq_parse_coord(const char *b, const char *e, double *v);
+const char *abq_show(const char *b, const char *e, char *buf, size_t cap);
+void abq_upper(char *dst, size_t cap, const char *b, const char *e);
+cm_status abq_parse_keyword(abq_reader *r, abq_file *f, const char *b, const char *e, abq_keyword *kw);
+/* A parameter's value ("" without one), NULL when absent. */
+const char *abq_param(const abq_keyword *kw, const char *name);
+char *abq_dup(const char *s);
+void *abq_grow(void *a, size_t n, size_t size);
+cm_status abq_get_set(abq_reader *r, abq_file *f, int part, int kind, const char *name, int *index);
+cm_status abq_copy_set(abq_reader *r, abq_file *f, int to, int from, int64_t inst, int face);
 
 /* After the last line: instances placed, ids resolved, groups made; the origin hung. */
 cm_status abq_build(abq_reader *r, const char *path);

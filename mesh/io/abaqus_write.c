@@ -287,6 +287,14 @@ cm_status cm_mesh_write_abaqus(cm_context *ctx, const cm_mesh *mesh, const char 
     if (!mesh || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write_abaqus: NULL argument");
     const cm_rewrite_source *src = cm_mesh_origin_state(mesh, CM_FORMAT_ABAQUS);
     if (!src) return write_new(ctx, mesh, path);
+    /* a file with nodes included twice (into two parts, say) would be written twice, the
+     * second copy over the first: refused */
+    for (size_t i = 1; i < src->n_files; ++i)
+        for (size_t j = 1; j < i && src->files[i].n_spans; ++j)
+            if (src->files[j].n_spans && !strcmp(src->files[i].path, src->files[j].path))
+                return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                                "cm_mesh_write: %s: %s holds nodes and is included more than once; the deck "
+                                "cannot be written back (write a new file: .vtu, .msh)", path, src->files[i].path);
     cm_status s = check_instances(ctx, src->format, mesh, path);
     if (s == CM_OK) s = cm_rewrite_write(ctx, src, mesh, path, emit);
     return s;

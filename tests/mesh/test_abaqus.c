@@ -285,6 +285,18 @@ static void test_write_back(void)
     cm_mesh *back = read_ok("wb_out/deck.inp");
     for (size_t i = 0; back && i < 15; ++i) CHECK_MSG(back->xyz[i] == want[i], "%zu: %.17g vs %.17g", i, back->xyz[i], want[i]);
     cm_mesh_destroy(&back);
+    /* a file with nodes included into two parts: refused (each copy could move differently) */
+    put("wb_in/twice.inp", "*PART, NAME=A\n*INCLUDE, INPUT=inc.inp\n*END PART\n*PART, NAME=B\n*INCLUDE, INPUT=inc.inp\n"
+                           "*END PART\n*ASSEMBLY\n*INSTANCE, NAME=A1, PART=A\n*END INSTANCE\n"
+                           "*INSTANCE, NAME=B1, PART=B\n*END INSTANCE\n*END ASSEMBLY\n");
+    put("wb_in/inc.inp", "*NODE\n5,\t1.5E+00 , 2.5D0,3.5 , 7, 8\n");
+    cm_mesh *twice = read_ok("wb_in/twice.inp");
+    if (twice) {
+        CHECK(twice->n_nodes == 2);
+        CHECK(cm_mesh_write(ctx, twice, at("wb_out/twice.inp"), NULL) == CM_ERR_UNSUPPORTED);
+        CHECK_MSG(strstr(cm_context_message(ctx), "included more than once"), "%s", cm_context_message(ctx));
+    }
+    cm_mesh_destroy(&twice);
     /* the source changed since it was read: refused */
     put("wb_in/deck.inp", "*NODE\n1, 0, 0, 0\n");
     CHECK(cm_mesh_write(ctx, m, at("wb_out/late.inp"), NULL) == CM_ERR_IO);
@@ -367,6 +379,7 @@ static void test_hostile(void)
         {"*PART, NAME=P\n*NODE\n1, 0, 0, 0\n", "expected *END PART"},
         {"*ASSEMBLY\n*INSTANCE, NAME=I, PART=NOPE\n*END INSTANCE\n*END ASSEMBLY\n", "bad.inp:2: expected NAME= and PART="},
         {"*NODE, SYSTEM=C\n1, 1, 0, 0\n", "bad.inp:1: *NODE, SYSTEM=C is not supported"},
+        {"*ASSEMBLY\n*NODE\n1, 0, 0, 0\n*END ASSEMBLY\n*PART, NAME=P\n", "bad.inp:5: expected every *PART before *ASSEMBLY"},
         {"*NODE\n1, 0, 0, 0\n*SURFACE, NAME=S\nNOSET, S1\n", "bad.inp:4: expected an element id or the name"},
         {"*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*ELEMENT, TYPE=C3D4, ELSET=E\n1, 1, 2, 3, 4\n*SURFACE, NAME=S\nE, S5\n",
          "*SURFACE S: element 1 (tet4) has no face S5"},
