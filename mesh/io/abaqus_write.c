@@ -69,6 +69,13 @@ enum { FIELD_CHARS = 20 };
 
 static int number(char *out, size_t cap, double v, const char *original, size_t n)
 {
+    /* an unchanged number keeps its bytes, a Fortran exponent (2.5D0) too */
+    double was;
+    if (original && n < cap && abq_parse_coord(original, original + n, &was) && was == v && signbit(was) == signbit(v)) {
+        memcpy(out, original, n);
+        out[n] = '\0';
+        return (int)n;
+    }
     int len = cm_rewrite_number(out, cap, v, original, n);
     if (len <= FIELD_CHARS || (original && (size_t)len == n && !memcmp(out, original, n))) return len;
     for (int digits = 16; digits > 0 && len > FIELD_CHARS; --digits) len = snprintf(out, cap, "%.*g", digits, v);

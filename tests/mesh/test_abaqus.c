@@ -256,6 +256,9 @@ static void test_write_back(void)
     char *a = get(at("wb_in/deck.inp")), *b = get(at("wb_out/same.inp"));
     CHECK(a && b && !strcmp(a, b));
     free(b);
+    b = get(at("wb_out/inc.inp"));
+    CHECK_MSG(b && !strcmp(b, "5,\t1.5E+00 , 2.5D0,3.5 , 7, 8\n"), "%s", b ? b : "(none)");
+    free(b);
     /* written beside the source, the include would overwrite its own source: refused */
     CHECK(cm_mesh_write(ctx, m, at("wb_in/other.inp"), NULL) == CM_ERR_ARGUMENT);
     /* an affine motion of every node: the affine image, separators and ids byte for byte */
