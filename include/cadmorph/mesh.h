@@ -214,6 +214,8 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
  * Nastran bulk data: .bdf, .nas, .dat (GRID small / large / free field, CORD2R/C/S, solids,
  * shells, INCLUDE; PIDs as groups); a deck read and written back changes GRID coordinates only.
  * .cgns (CGNS, ADF / HDF5): unstructured zones as one mesh; written back, only GridCoordinates.
+ * Abaqus .inp decks (with *INCLUDE, parts and instances; sets and
+ * surfaces as groups) written back to .inp change only the numbers of *NODE lines.
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */

@@ -55,6 +55,9 @@ cm_status cm_mesh_write_nastran(cm_context *ctx, const cm_mesh *mesh, const char
                                 const cm_mesh_write_options *opt);
 /* Whether a file's first bytes look like Nastran bulk data (for .dat, a generic name). */
 int cm_nastran_sniff(const char *head, size_t n);
+cm_status cm_mesh_read_abaqus(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_abaqus(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                               const cm_mesh_write_options *opt);
 
 /* ---- the registry ---- */
 

@@ -36,6 +36,8 @@ const cm_mesh_format_row cm_mesh_format_rows[] = {
      .sniff = cm_fluent_sniff},
     {.format = CM_FORMAT_CGNS, .name = "CGNS", .extensions = "cgns", .read = cm_mesh_read_cgns,
      .write = cm_mesh_write_cgns, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_ABAQUS, .name = "Abaqus", .extensions = "inp", .read = cm_mesh_read_abaqus,
+     .write = cm_mesh_write_abaqus, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
     {.format = CM_FORMAT_FOAM, .name = "OpenFOAM polyMesh", .claims = cm_foam_is_path,
      .described = "an OpenFOAM case directory", .read = cm_mesh_read_foam, .write = cm_mesh_write_foam,
      .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},

@@ -449,6 +449,28 @@ def fluent_hostile():
     p = write("fl_c1.msh", box.replace(" 2 1\n", " 2 ff\n", 1))
     run(["quality", p], 2, r"fl_c1\.msh:53: face names a missing cell c1 ff", ["fl_c1.msh"])
 
+# ---- 16. Abaqus decks: an include loop, a GENERATE range of 2^62 ids, many sets (linear) ----
+@case
+def inp_include_loop():
+    write("loop_b.inp", "** b\n*INCLUDE, INPUT=loop.inp\n")
+    p = write("loop.inp", "*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=loop_b.inp\n")
+    run(["quality", p], 2, r"loop_b\.inp:2: the included file .*loop\.inp includes itself", ["loop_b.inp"], max_mb=150)
+
+
+@case
+def inp_huge_generate():
+    p = write("generate.inp", "*NODE\n1, 0, 0, 0\n*NSET, NSET=ALL, GENERATE\n1, 4611686018427387904, 1\n")
+    run(["quality", p], 2, r"generate\.inp:4: expected a GENERATE range", ["generate.inp"], max_mb=150)
+
+
+@case
+def inp_many_sets():
+    n = 50000
+    nodes = "*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n"
+    sets = "".join(f"*NSET, NSET=S{i}\n{i % 4 + 1}\n" for i in range(n))
+    p = write("sets.inp", nodes + sets)
+    run(["quality", p], 0, None, lines=0)
+
 
 if __name__ == "__main__":
     if CASE == "list":
