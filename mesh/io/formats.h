@@ -40,6 +40,9 @@ cm_status cm_mesh_write_stl(cm_context *ctx, const cm_mesh *mesh, const char *pa
 cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *path,
                              const cm_mesh_write_options *opt);
+cm_status cm_mesh_read_exodus(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_exodus(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                               const cm_mesh_write_options *opt);
 
 /* ---- the registry ---- */
 

@@ -31,6 +31,9 @@ const cm_mesh_format_row cm_mesh_format_rows[] = {
     {.format = CM_FORMAT_FOAM, .name = "OpenFOAM polyMesh", .claims = cm_foam_is_path,
      .described = "an OpenFOAM case directory", .read = cm_mesh_read_foam, .write = cm_mesh_write_foam,
      .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_EXODUS, .name = "Exodus II", .extensions = "exo e ex2 g",
+     .read = cm_mesh_read_exodus, .write = cm_mesh_write_exodus,
+     .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
 };
 const size_t cm_mesh_format_row_count = sizeof cm_mesh_format_rows / sizeof cm_mesh_format_rows[0];
 
