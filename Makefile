@@ -50,7 +50,7 @@ check-asan: setup
 fuzz: setup
 	cmake -S . -B $(BUILD)-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCADMORPH_FUZZ=ON \
 	  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++
-	cmake --build $(BUILD)-fuzz -j $(JOBS) --target fuzz_msh fuzz_vtu fuzz_vtk fuzz_medit fuzz_dcsv fuzz_step_scan
+	cmake --build $(BUILD)-fuzz -j $(JOBS) --target fuzz_msh fuzz_vtu fuzz_vtk fuzz_medit fuzz_exodus fuzz_dcsv fuzz_step_scan
 	sh tests/fuzz/seeds.sh $(CURDIR) $(BUILD)-fuzz/corpus
 
 clean:

@@ -3,7 +3,7 @@
  * (its name, else "block <id>"), node sets CM_CELL_POINT cells with a group per set, side sets
  * the faces (edges in a 2-D file) they name with a group per set; node and element number maps
  * become node_tag and cell_tag. A mesh read from Exodus and written to an Exodus path is
- * written back: the file is copied and only its coordinates are replaced (ex_put_coord, in the
+ * written back: the file is copied and only its coordinate variables are replaced (in the
  * file's own float word size), so every other variable and attribute stays (docs/DESIGN.md,
  * "Writing back into the file a mesh came from"). Any other mesh is refused: writing a new
  * Exodus file is not implemented.
@@ -46,15 +46,19 @@ static void exo_state_free(void *p)
     free(st);
 }
 
-/* Why the last library call failed: the library's own message (netCDF's calls are the
- * library's business: cadmorph links only libexoIIv2c, which brings its netCDF build). */
+/* Why the last library call failed: the library's own message, on one line (called under
+ * exo_lock, and copied by cm_error at once). */
 static const char *exo_reason(int rc)
 {
+    static char line[256];
     const char *msg = NULL, *func = NULL;
     int code = 0;
     ex_get_err(&msg, &func, &code);
     (void)rc;
-    return msg && *msg ? msg : "the Exodus II library reports an error";
+    snprintf(line, sizeof line, "%s", msg && *msg ? msg : "the Exodus II library reports an error");
+    for (char *p = line; *p; ++p)
+        if (*p == '\n' || *p == '\r') *p = ' ';
+    return line;
 }
 
 /* ---- element types ---- */
@@ -649,40 +653,44 @@ static cm_status copy_into(cm_context *ctx, const char *src, FILE *out)
     return err ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: copy failed", src) : CM_OK;
 }
 
+/* The coordinates go in through netCDF itself, not ex_open(EX_WRITE): opening for writing,
+ * the Exodus library adds what older writers (meshio) leave out (the len_name dimension, the
+ * maximum_name_length attribute), which would change more than the coordinates. netCDF
+ * converts the doubles to the variable's own type (float files stay float). */
 static cm_status put_coordinates(cm_context *ctx, const cm_mesh *mesh, const exo_state *st,
                                  const char *path, const char *tmp)
 {
     const int64_t n = st->num_nodes;
-    double *c = malloc((size_t)(n > 0 ? n : 1) * 3 * sizeof *c);
+    double *c = malloc((size_t)(n > 0 ? n : 1) * sizeof *c);
     if (!c) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: %s: out of memory", path);
-    for (int64_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) c[k * n + i] = mesh->xyz[3 * i + k];
-    int comp_ws = 8, io_ws = 0;
-    float version = 0.0f;
     cm_status s = CM_OK;
     pthread_mutex_lock(&exo_lock);
-    ex_opts(0);
-    const int exoid = ex_open(tmp, EX_WRITE, &comp_ws, &io_ws, &version);
-    if (exoid < 0) {
-        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot open the copy of %s: %s", path,
-                     st->path, exo_reason(exoid));
-    } else {
-        ex_set_int64_status(exoid, EX_ALL_INT64_API);
-        ex_init_params p;
-        int rc = ex_get_init_ext(exoid, &p);
-        if (rc < 0 || p.num_nodes != n || p.num_elem != st->num_elem || p.num_dim != st->num_dim)
-            s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: %s no longer holds the mesh that was "
-                         "read from it", path, st->path);
-        if (s == CM_OK && n > 0) {
-            rc = ex_put_coord(exoid, c, c + n, st->num_dim == 3 ? c + 2 * n : NULL);
-            if (rc < 0)
-                s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot write the coordinates: %s",
-                             path, exo_reason(rc));
-        }
-        rc = ex_close(exoid);
-        if (s == CM_OK && rc < 0)
-            s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: %s", path, exo_reason(rc));
+    int ncid = -1, rc = nc_open(tmp, NC_WRITE, &ncid);
+    int dim_nodes = -1, var = -1, split = 0;
+    size_t len = 0;
+    if (rc == NC_NOERR) rc = nc_inq_dimid(ncid, "num_nodes", &dim_nodes);
+    if (rc == NC_NOERR) rc = nc_inq_dimlen(ncid, dim_nodes, &len);
+    if (rc == NC_NOERR && (int64_t)len != n) rc = NC_EDIMSIZE;
+    if (rc == NC_NOERR) {
+        split = nc_inq_varid(ncid, "coordx", &var) == NC_NOERR;
+        if (!split) rc = nc_inq_varid(ncid, "coord", &var);
     }
+    static const char *const names[3] = {"coordx", "coordy", "coordz"};
+    for (int k = 0; rc == NC_NOERR && n > 0 && k < st->num_dim; ++k) {
+        for (int64_t i = 0; i < n; ++i) c[i] = mesh->xyz[3 * i + k];
+        if (split) {
+            rc = nc_inq_varid(ncid, names[k], &var);
+            if (rc == NC_NOERR) rc = nc_put_var_double(ncid, var, c);
+        } else {
+            const size_t start[2] = {(size_t)k, 0}, count[2] = {1, (size_t)n};
+            rc = nc_put_vara_double(ncid, var, start, count, c);
+        }
+    }
+    const int rc_close = ncid >= 0 ? nc_close(ncid) : NC_NOERR;
+    if (rc == NC_NOERR) rc = rc_close;
+    if (rc != NC_NOERR)
+        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot write the coordinates into the copy "
+                     "of %s: %s", path, st->path, nc_strerror(rc));
     pthread_mutex_unlock(&exo_lock);
     free(c);
     return s;

@@ -1,5 +1,5 @@
 /* libFuzzer driver for one mesh reader (CM_FUZZ_EXT picks it: ".msh", ".vtu", ".vtk",
- * ".mesh"). The readers take paths, so each input goes to a file of that extension first
+ * ".mesh", ".exo"). The readers take paths, so each input goes to a file of that extension first
  * (in /dev/shm when there is one). A reader may refuse anything, but must not crash, leak,
  * hang or let a message span lines. */
 #include "cadmorph/mesh.h"
