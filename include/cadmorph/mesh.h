@@ -207,7 +207,8 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
  * OpenFOAM polyMesh for a path that is a directory, ends in '/', is named polyMesh or has no
  * extension (a case directory: its constant/polyMesh is read or written; ASCII / binary,
  * plain / .gz). A polyMesh read and written back changes `points` only: the other files are
- * copied byte for byte.
+ * copied byte for byte. Exodus II .exo/.e/.ex2/.g (blocks, node sets, side sets as groups) is
+ * written only back into the file it was read from: its coordinates, nothing else.
  * Readers report the file, the line (text) or byte offset (binary) and what was expected.
  * Writers write a temporary file beside the target and rename it: a failed write leaves
  * no partial file. */
