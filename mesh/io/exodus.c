@@ -232,6 +232,35 @@ typedef struct exo_reader {
 /* Largest count taken from a file (entries of one array). */
 #define EXO_MAX_COUNT ((int64_t)1 << 40)
 
+/* Whether the netCDF variable `name`, if the file has one, holds exactly `want` values. The
+ * library reads whole variables into arrays sized by the entity's own dimensions, so a hostile
+ * file that declares a variable over other dimensions would overrun them (an Exodus id is the
+ * file's netCDF id). */
+static cm_status check_var(exo_reader *r, const char *name, int64_t want, const char *what)
+{
+    int var = -1, nd = 0;
+    if (nc_inq_varid(r->exoid, name, &var) != NC_NOERR) return CM_OK;
+    int dims[NC_MAX_VAR_DIMS];
+    uint64_t total = 1;
+    int ok = nc_inq_varndims(r->exoid, var, &nd) == NC_NOERR && nd >= 0 && nd <= NC_MAX_VAR_DIMS &&
+             nc_inq_vardimid(r->exoid, var, dims) == NC_NOERR;
+    for (int i = 0; ok && i < nd; ++i) {
+        size_t len = 0;
+        ok = nc_inq_dimlen(r->exoid, dims[i], &len) == NC_NOERR && (len == 0 || total <= UINT64_MAX / len);
+        total *= len;
+    }
+    if (!ok || total != (uint64_t)want)
+        return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %s: variable %s holds %llu values, "
+                        "expected %lld", r->path, what, name, (unsigned long long)total, (long long)want);
+    return CM_OK;
+}
+
+static int compare_id(const void *a, const void *b)
+{
+    const int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+    return (x > y) - (x < y);
+}
+
 /* ids and names of the entities of one kind; names[i] is "" where the file has none. */
 static cm_status entity_list(exo_reader *r, ex_entity_type kind, const char *what, int64_t n,
                              int64_t **ids, char ***names)
@@ -248,10 +277,24 @@ static cm_status entity_list(exo_reader *r, ex_entity_type kind, const char *wha
                         r->path, (long long)n, what);
     }
     for (int64_t i = 0; i < n; ++i) (*names)[i] = buf + 256 * i;
+    const char *prop = kind == EX_ELEM_BLOCK ? "eb_prop1" : kind == EX_NODE_SET ? "ns_prop1" : "ss_prop1";
+    cm_status s = check_var(r, prop, n, what);
+    if (s != CM_OK) return s;
     int rc = ex_get_ids(r->exoid, kind, *ids);
     if (rc < 0)
         return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: cannot read the %s ids: %s",
                         r->path, what, exo_reason(rc));
+    /* the library finds an entity's variables by its id: two with one id would mix them up */
+    int64_t *sorted = malloc((size_t)n * sizeof *sorted);
+    if (!sorted) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", r->path);
+    memcpy(sorted, *ids, (size_t)n * sizeof *sorted);
+    qsort(sorted, (size_t)n, sizeof *sorted, compare_id);
+    for (int64_t i = 1; s == CM_OK && i < n; ++i)
+        if (sorted[i] == sorted[i - 1])
+            s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: two %ss have the id %lld", r->path,
+                         what, (long long)sorted[i]);
+    free(sorted);
+    if (s != CM_OK) return s;
     rc = ex_get_names(r->exoid, kind, *names);
     if (rc < 0)
         for (int64_t i = 0; i < n; ++i) (*names)[i][0] = '\0';
@@ -285,6 +328,14 @@ static cm_status read_nodes(exo_reader *r)
     if (!c) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory for %lld nodes",
                             r->path, (long long)n);
     for (int64_t i = 0; i < 3 * n; ++i) c[i] = 0.0;
+    static const char *const names[3] = {"coordx", "coordy", "coordz"};
+    for (int k = 0; s == CM_OK && k < r->par.num_dim; ++k) s = check_var(r, names[k], n, "coordinates");
+    if (s == CM_OK) s = check_var(r, "coord", n * r->par.num_dim, "coordinates");
+    if (s == CM_OK) s = check_var(r, "node_num_map", n, "node number map");
+    if (s != CM_OK) {
+        free(c);
+        return s;
+    }
     int rc = ex_get_coord(r->exoid, c, c + n, r->par.num_dim == 3 ? c + 2 * n : NULL);
     if (rc < 0) {
         free(c);
@@ -358,6 +409,9 @@ static cm_status read_blocks(exo_reader *r, int64_t *elem_map)
                          r->path, gname);
             break;
         }
+        char var[32];
+        snprintf(var, sizeof var, "connect%lld", (long long)(b + 1));
+        if ((s = check_var(r, var, n_el * n_per, "element block")) != CM_OK) break;
         rc = ex_get_conn(r->exoid, EX_ELEM_BLOCK, ids[b], conn, NULL, NULL);
         if (rc < 0) {
             s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: element block \"%s\": cannot read "
@@ -420,7 +474,10 @@ static cm_status read_node_sets(exo_reader *r)
                          r->path, gname);
             break;
         }
-        rc = ex_get_set(r->exoid, EX_NODE_SET, ids[k], list, NULL);
+        char var[32];
+        snprintf(var, sizeof var, "node_ns%lld", (long long)(k + 1));
+        s = check_var(r, var, n, "node set");
+        rc = s == CM_OK ? ex_get_set(r->exoid, EX_NODE_SET, ids[k], list, NULL) : 0;
         if (rc < 0)
             s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: node set \"%s\": %s", r->path,
                          gname, exo_reason(rc));
@@ -479,7 +536,12 @@ static cm_status read_side_sets(exo_reader *r)
             break;
         }
         int64_t *side = elem + n;
-        rc = ex_get_set(r->exoid, EX_SIDE_SET, ids[k], elem, side);
+        char var[32];
+        snprintf(var, sizeof var, "elem_ss%lld", (long long)(k + 1));
+        s = check_var(r, var, n, "side set");
+        snprintf(var, sizeof var, "side_ss%lld", (long long)(k + 1));
+        if (s == CM_OK) s = check_var(r, var, n, "side set");
+        rc = s == CM_OK ? ex_get_set(r->exoid, EX_SIDE_SET, ids[k], elem, side) : 0;
         if (rc < 0)
             s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: side set \"%s\": %s", r->path,
                          gname, exo_reason(rc));
@@ -575,6 +637,10 @@ static cm_status read_locked(exo_reader *r, const struct stat *fst)
         if (!elem_map)
             return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory for %lld elements",
                             path, (long long)p->num_elem);
+        if ((s = check_var(r, "elem_num_map", p->num_elem, "element number map")) != CM_OK) {
+            free(elem_map);
+            return s;
+        }
         rc = ex_get_id_map(r->exoid, EX_ELEM_MAP, elem_map);
         int identity = 1;
         for (int64_t i = 0; rc >= 0 && i < p->num_elem; ++i) {

@@ -97,6 +97,42 @@ for ws in (8, 4):
     assert np.array_equal(coordinates(out), want), f"word size {ws}: not the affine image"
     # (meshio 5 knows no WEDGE15: it reads the bore's files below)
 
+
+# ---- hostile variants of the fixture: a connectivity declared over other dimensions than its
+# block's (the library would read 400 values into room for 4), two blocks with one id ----
+def variant(src, out, bogus_connect=False, dup_id=False):
+    with netCDF4.Dataset(src) as a, netCDF4.Dataset(out, "w", format=a.data_model) as b:
+        a.set_auto_maskandscale(False)
+        b.setncatts(attrs(a))
+        for name, dim in a.dimensions.items():
+            b.createDimension(name, None if dim.isunlimited() else len(dim))
+        b.createDimension("bogus", 100)
+        for name, va in a.variables.items():
+            dims = va.dimensions
+            if bogus_connect and name == "connect5":
+                dims = ("bogus", dims[1])
+            vb = b.createVariable(name, va.dtype, dims)
+            vb.set_auto_maskandscale(False)
+            vb.setncatts(attrs(va))
+            data = np.asarray(va[...])
+            if bogus_connect and name == "connect5":
+                data = np.resize(data, (100, data.shape[1]))
+            if dup_id and name == "eb_prop1":
+                data = data.copy()
+                data[1] = data[0]
+            vb[...] = data
+
+
+for kind, needle in (("bogus_connect", "variable connect5 holds 400 values, expected 4"),
+                     ("dup_id", "two element blocks have the id 10")):
+    bad = os.path.join(work, f"{kind}.exo")
+    variant(os.path.join(work, "mixed_8.exo"), bad, **{kind: True})
+    try:
+        cadmorph.read_mesh(bad)
+        raise AssertionError(f"{bad}: read")
+    except cadmorph.Error as e:
+        assert bad in str(e) and needle in str(e), str(e)
+
 # ---- meshio's file of the bore's hex mesh, with a node set ----
 run("model", "bore", "0", "bore_0.step", "--hex-mesh", "bore_0.vtu", "--scale", "0.5")
 run("model", "bore", "1", "bore_1.step")
