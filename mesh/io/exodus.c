@@ -18,6 +18,8 @@
 
 #include <exodusII.h>
 
+#include <dlfcn.h>
+
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -27,6 +29,70 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+
+/* The library is opened (dlopen) when an Exodus file is first read or written, not linked:
+ * with its MPI build of netCDF it brings OpenMPI, HDF5, libxml2 and ICU, whose address space
+ * every run of cadmorph would otherwise map (tests/cli/ulimit.sh runs under ulimit -v). The
+ * netCDF calls are looked up through it, so they reach the netCDF the library itself uses. */
+#define EXO_FUNCTIONS(X)                                                                         \
+    X(ex_open_int) X(ex_close) X(ex_get_err) X(ex_opts) X(ex_set_int64_status) X(ex_get_init_ext) \
+    X(ex_set_max_name_length) X(ex_get_coord) X(ex_get_id_map) X(ex_get_ids) X(ex_get_names)    \
+    X(ex_get_block) X(ex_get_conn) X(ex_get_set_param) X(ex_get_set) X(nc_inq_varid)            \
+    X(nc_inq_varndims) X(nc_inq_vardimid) X(nc_inq_dimlen) X(nc_open) X(nc_inq_dimid)           \
+    X(nc_put_var_double) X(nc_put_vara_double) X(nc_close) X(nc_strerror)
+#define EXO_POINTER(f) __typeof__(&f) f;
+static struct { EXO_FUNCTIONS(EXO_POINTER) } exo_fn;
+static pthread_once_t exo_once = PTHREAD_ONCE_INIT;
+static char exo_load_error[512];
+
+static void exo_load_once(void)
+{
+    void *h = dlopen(CM_EXODUS_SONAME, RTLD_NOW | RTLD_LOCAL);
+    if (!h) {
+        const char *e = dlerror();
+        snprintf(exo_load_error, sizeof exo_load_error, "%s", e ? e : CM_EXODUS_SONAME);
+        return;
+    }
+#define EXO_LOOKUP(f)                                                                            \
+    if (!exo_load_error[0] && !(*(void **)(&exo_fn.f) = dlsym(h, #f)))                            \
+        snprintf(exo_load_error, sizeof exo_load_error, "%s: no symbol %s", CM_EXODUS_SONAME, #f);
+    EXO_FUNCTIONS(EXO_LOOKUP)
+#undef EXO_LOOKUP
+}
+
+static cm_status exo_load(cm_context *ctx, const char *fn, const char *path)
+{
+    pthread_once(&exo_once, exo_load_once);
+    if (!exo_load_error[0]) return CM_OK;
+    return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: %s: cannot load the Exodus II library: %s", fn,
+                    path, exo_load_error);
+}
+
+#define ex_open_int(...) exo_fn.ex_open_int(__VA_ARGS__)
+#define ex_close(...) exo_fn.ex_close(__VA_ARGS__)
+#define ex_get_err(...) exo_fn.ex_get_err(__VA_ARGS__)
+#define ex_opts(...) exo_fn.ex_opts(__VA_ARGS__)
+#define ex_set_int64_status(...) exo_fn.ex_set_int64_status(__VA_ARGS__)
+#define ex_get_init_ext(...) exo_fn.ex_get_init_ext(__VA_ARGS__)
+#define ex_set_max_name_length(...) exo_fn.ex_set_max_name_length(__VA_ARGS__)
+#define ex_get_coord(...) exo_fn.ex_get_coord(__VA_ARGS__)
+#define ex_get_id_map(...) exo_fn.ex_get_id_map(__VA_ARGS__)
+#define ex_get_ids(...) exo_fn.ex_get_ids(__VA_ARGS__)
+#define ex_get_names(...) exo_fn.ex_get_names(__VA_ARGS__)
+#define ex_get_block(...) exo_fn.ex_get_block(__VA_ARGS__)
+#define ex_get_conn(...) exo_fn.ex_get_conn(__VA_ARGS__)
+#define ex_get_set_param(...) exo_fn.ex_get_set_param(__VA_ARGS__)
+#define ex_get_set(...) exo_fn.ex_get_set(__VA_ARGS__)
+#define nc_inq_varid(...) exo_fn.nc_inq_varid(__VA_ARGS__)
+#define nc_inq_varndims(...) exo_fn.nc_inq_varndims(__VA_ARGS__)
+#define nc_inq_vardimid(...) exo_fn.nc_inq_vardimid(__VA_ARGS__)
+#define nc_inq_dimlen(...) exo_fn.nc_inq_dimlen(__VA_ARGS__)
+#define nc_open(...) exo_fn.nc_open(__VA_ARGS__)
+#define nc_inq_dimid(...) exo_fn.nc_inq_dimid(__VA_ARGS__)
+#define nc_put_var_double(...) exo_fn.nc_put_var_double(__VA_ARGS__)
+#define nc_put_vara_double(...) exo_fn.nc_put_vara_double(__VA_ARGS__)
+#define nc_close(...) exo_fn.nc_close(__VA_ARGS__)
+#define nc_strerror(...) exo_fn.nc_strerror(__VA_ARGS__)
 
 /* The library keeps its open files, options and last error in globals: one call at a time. */
 static pthread_mutex_t exo_lock = PTHREAD_MUTEX_INITIALIZER;
@@ -680,6 +746,7 @@ cm_status cm_mesh_read_exodus(cm_context *ctx, const char *path, cm_mesh **mesh)
     *mesh = NULL;
     struct stat fst;
     cm_status s = check_signature(ctx, path, &fst);
+    if (s == CM_OK) s = exo_load(ctx, "cm_mesh_read", path);
     if (s != CM_OK) return s;
     exo_reader r;
     memset(&r, 0, sizeof r);
@@ -784,8 +851,10 @@ cm_status cm_mesh_write_exodus(cm_context *ctx, const cm_mesh *mesh, const char 
         now.st_mtim.tv_sec != st->mtime.tv_sec || now.st_mtim.tv_nsec != st->mtime.tv_nsec)
         return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: %s changed (or went) since the mesh "
                         "was read from it", path, st->path);
+    cm_status s = exo_load(ctx, "cm_mesh_write", path);
+    if (s != CM_OK) return s;
     cm_outfile out;
-    cm_status s = cm_outfile_open(ctx, path, &out);
+    s = cm_outfile_open(ctx, path, &out);
     if (s != CM_OK) return s;
     s = copy_into(ctx, st->path, out.f);
     if (s == CM_OK) s = put_coordinates(ctx, mesh, st, path, out.tmp);
