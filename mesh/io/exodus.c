@@ -838,8 +838,8 @@ cm_status cm_mesh_write_exodus(cm_context *ctx, const cm_mesh *mesh, const char 
     if (!st)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
                         "cm_mesh_write: %s: Exodus II is written only back into the file a mesh "
-                        "was read from (with the same nodes and cells); write this mesh as one of "
-                        "%s", path, cm_mesh_format_list());
+                        "was read from (with the same nodes and cells); write this mesh in "
+                        "another format", path);
     if (st->num_dim == 2)
         for (size_t i = 0; i < mesh->n_nodes; ++i)
             if (mesh->xyz[3 * i + 2] != 0.0)
