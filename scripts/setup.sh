@@ -16,6 +16,10 @@ packages=(
   clang libclang-rt-14-dev  # make fuzz (libFuzzer); make check-asan uses gcc's sanitizers
   libcgns-dev  # CGNS meshes (mesh/io/cgns_read.c, cgns_write.c), ADF and HDF5
   cgns-convert calculix-ccx python3-h5py  # cross-checks: cgnscheck, ccx runs a morphed .inp, h5py reads CGNS trees
+  # Exodus II meshes (mesh/io/exodus.c), and netCDF4 for its cross-check. Its library links the
+  # MPI build of netCDF; the OpenMPI and HDF5-OpenMPI it needs already come with libflann-dev,
+  # python3-vtk9 and openfoam above, so it adds no MPI (14 packages: netCDF, serial HDF5 dev)
+  libexodusii-dev python3-netcdf4
 )
 # Optional, needed only for -DCADMORPH_WITH_PETSC=ON (the distributed solver, --solver petsc):
 # CADMORPH_WITH_PETSC=1 bash scripts/setup.sh. Not in the default list: with OpenMPI, hypre,

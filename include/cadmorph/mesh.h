@@ -201,24 +201,19 @@ static inline void cm_polyhedron_next(cm_polyhedron_face *f)
 }
 
 /* ---- files ----
- * Formats by extension: .msh (gmsh 2.2 / 4.1, ASCII / binary little-endian), .vtu (VTK XML),
- * .vtk (legacy UNSTRUCTURED_GRID, ASCII / binary), .mesh (Medit ASCII); surface meshes also
- * .obj (Wavefront), .off and .stl (binary / ASCII; corners merged into nodes when read); and
- * OpenFOAM polyMesh for a path that is a directory, ends in '/', is named polyMesh or has no
- * extension (a case directory: its constant/polyMesh is read or written; ASCII / binary,
- * plain / .gz). A polyMesh read and written back changes `points` only: the other files are
- * copied byte for byte. Fluent .msh (told from gmsh's by its content) and .cas: 3-D, ASCII and
- * binary sections, zones as groups; written only back into the file read (node coordinates).
- * SU2 .su2 (ASCII; 2-D files at z = 0, zones as one mesh): markers are
- * groups; written back, only the coordinate numbers of its point lines change.
- * Nastran bulk data: .bdf, .nas, .dat (GRID small / large / free field, CORD2R/C/S, solids,
- * shells, INCLUDE; PIDs as groups); a deck read and written back changes GRID coordinates only.
- * .cgns (CGNS, ADF / HDF5): unstructured zones as one mesh; written back, only GridCoordinates.
- * Abaqus .inp decks (with *INCLUDE, parts and instances; sets and
- * surfaces as groups) written back to .inp change only the numbers of *NODE lines.
- * Readers report the file, the line (text) or byte offset (binary) and what was expected.
- * Writers write a temporary file beside the target and rename it: a failed write leaves
- * no partial file. */
+ * Formats by name (cm_mesh_format_list; docs/DESIGN.md, "Mesh formats"): .msh (gmsh 2.2 / 4.1,
+ * ASCII / binary little-endian), .vtu (VTK XML), .vtk (legacy UNSTRUCTURED_GRID), .mesh
+ * (Medit); surface meshes also .obj, .off, .stl (corners merged into nodes when read); .cgns
+ * (ADF / HDF5), .su2, Fluent .msh (told from gmsh's by its content) and .cas, Abaqus .inp,
+ * Nastran .bdf / .nas / .dat, Exodus II .exo / .e / .ex2 / .g; and OpenFOAM polyMesh for a
+ * path that is a directory, ends in '/', is named polyMesh or has no extension (a case
+ * directory: its constant/polyMesh is read or written).
+ * A mesh read from a file and written back to a path of the same format, with the nodes and
+ * cells it was read with, changes the node coordinates only: every other byte of the file (of
+ * the polyMesh's other files, of an included deck) stays as it was.
+ * Readers report the file, the line (text), byte offset (binary) or node path (CGNS) and what
+ * was expected. Writers write a temporary file beside the target and rename it: a failed
+ * write leaves no partial file. */
 
 typedef enum cm_mesh_format {
     CM_FORMAT_UNKNOWN = 0,

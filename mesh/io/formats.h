@@ -57,6 +57,8 @@ cm_status cm_mesh_write_nastran(cm_context *ctx, const cm_mesh *mesh, const char
 int cm_nastran_sniff(const char *head, size_t n);
 cm_status cm_mesh_read_abaqus(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_abaqus(cm_context *ctx, const cm_mesh *mesh, const char *path,
+cm_status cm_mesh_read_exodus(cm_context *ctx, const char *path, cm_mesh **mesh);
+cm_status cm_mesh_write_exodus(cm_context *ctx, const cm_mesh *mesh, const char *path,
                                const cm_mesh_write_options *opt);
 
 /* ---- the registry ---- */

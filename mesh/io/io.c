@@ -47,6 +47,8 @@ const cm_mesh_format_row cm_mesh_format_rows[] = {
      * other row takes the extension without one, or when the content is bulk data */
     {.format = CM_FORMAT_NASTRAN, .name = "Nastran bulk data", .extensions = "bdf nas dat",
      .read = cm_mesh_read_nastran, .write = cm_mesh_write_nastran, .sniff = cm_nastran_sniff,
+    {.format = CM_FORMAT_EXODUS, .name = "Exodus II", .extensions = "exo e ex2 g",
+     .read = cm_mesh_read_exodus, .write = cm_mesh_write_exodus,
      .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
 };
 const size_t cm_mesh_format_row_count = sizeof cm_mesh_format_rows / sizeof cm_mesh_format_rows[0];
