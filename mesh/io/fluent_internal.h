@@ -50,7 +50,5 @@ void cm_fluent_where(const cm_fluent_parsed *p, size_t f, char *out, size_t cap)
  * otherwise), the boundary faces as 2-D cells, the zones as groups. */
 cm_status cm_fluent_build(cm_context *ctx, cm_fluent_parsed *p, cm_mesh *m);
 
-/* Whether the first bytes of a .msh are a Fluent file's (formats.h's sniff). */
-int cm_fluent_sniff(const char *head, size_t n);
 
 #endif

@@ -47,6 +47,8 @@ cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *p
 cm_status cm_mesh_read_fluent(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_fluent(cm_context *ctx, const cm_mesh *mesh, const char *path,
                                const cm_mesh_write_options *opt);
+/* Whether the first bytes of a .msh are a Fluent file's rather than gmsh's. */
+int cm_fluent_sniff(const char *head, size_t n);
 cm_status cm_mesh_read_su2(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_su2(cm_context *ctx, const cm_mesh *mesh, const char *path,
                             const cm_mesh_write_options *opt);
@@ -57,6 +59,7 @@ cm_status cm_mesh_write_nastran(cm_context *ctx, const cm_mesh *mesh, const char
 int cm_nastran_sniff(const char *head, size_t n);
 cm_status cm_mesh_read_abaqus(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_abaqus(cm_context *ctx, const cm_mesh *mesh, const char *path,
+                               const cm_mesh_write_options *opt);
 cm_status cm_mesh_read_exodus(cm_context *ctx, const char *path, cm_mesh **mesh);
 cm_status cm_mesh_write_exodus(cm_context *ctx, const cm_mesh *mesh, const char *path,
                                const cm_mesh_write_options *opt);

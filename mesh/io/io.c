@@ -3,7 +3,6 @@
  * readers and writers share is in frame.c, below this file. */
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
-#include "fluent_internal.h"
 #include "foam_internal.h"
 
 #include <ctype.h>
@@ -29,27 +28,26 @@ const cm_mesh_format_row cm_mesh_format_rows[] = {
      .write = cm_mesh_write_off, .holds = CM_MESH_IO_SURFACE},
     {.format = CM_FORMAT_STL, .name = "STL", .extensions = "stl", .read = cm_mesh_read_stl,
      .write = cm_mesh_write_stl, .holds = CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    /* the solvers' own files: written back, only coordinates change (docs/DESIGN.md) */
+    {.format = CM_FORMAT_CGNS, .name = "CGNS", .extensions = "cgns", .read = cm_mesh_read_cgns,
+     .write = cm_mesh_write_cgns, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_SU2, .name = "SU2", .extensions = "su2", .read = cm_mesh_read_su2,
+     .write = cm_mesh_write_su2, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
     /* Fluent: a .msh whose content starts with a section "(N ..." (gmsh's with $MeshFormat);
      * written only back into the file it was read from, node coordinates only */
     {.format = CM_FORMAT_FLUENT, .name = "Fluent", .extensions = "msh cas", .read = cm_mesh_read_fluent,
-     .write = cm_mesh_write_fluent, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS,
-     .sniff = cm_fluent_sniff},
-    {.format = CM_FORMAT_CGNS, .name = "CGNS", .extensions = "cgns", .read = cm_mesh_read_cgns,
-     .write = cm_mesh_write_cgns, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+     .write = cm_mesh_write_fluent, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS, .sniff = cm_fluent_sniff},
     {.format = CM_FORMAT_ABAQUS, .name = "Abaqus", .extensions = "inp", .read = cm_mesh_read_abaqus,
      .write = cm_mesh_write_abaqus, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
-    {.format = CM_FORMAT_FOAM, .name = "OpenFOAM polyMesh", .claims = cm_foam_is_path,
-     .described = "an OpenFOAM case directory", .read = cm_mesh_read_foam, .write = cm_mesh_write_foam,
-     .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},
-    {.format = CM_FORMAT_SU2, .name = "SU2", .extensions = "su2", .read = cm_mesh_read_su2,
-     .write = cm_mesh_write_su2, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
     /* .dat is anyone's name: the content test makes Nastran the reader of a .dat only when no
      * other row takes the extension without one, or when the content is bulk data */
     {.format = CM_FORMAT_NASTRAN, .name = "Nastran bulk data", .extensions = "bdf nas dat",
-     .read = cm_mesh_read_nastran, .write = cm_mesh_write_nastran, .sniff = cm_nastran_sniff,
+     .read = cm_mesh_read_nastran, .write = cm_mesh_write_nastran, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS, .sniff = cm_nastran_sniff},
     {.format = CM_FORMAT_EXODUS, .name = "Exodus II", .extensions = "exo e ex2 g",
-     .read = cm_mesh_read_exodus, .write = cm_mesh_write_exodus,
-     .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+     .read = cm_mesh_read_exodus, .write = cm_mesh_write_exodus, .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_SURFACE | CM_MESH_IO_GROUPS},
+    {.format = CM_FORMAT_FOAM, .name = "OpenFOAM polyMesh", .claims = cm_foam_is_path,
+     .described = "an OpenFOAM case directory", .read = cm_mesh_read_foam, .write = cm_mesh_write_foam,
+     .holds = CM_MESH_IO_VOLUME | CM_MESH_IO_GROUPS},
 };
 const size_t cm_mesh_format_row_count = sizeof cm_mesh_format_rows / sizeof cm_mesh_format_rows[0];
 
