@@ -5,6 +5,7 @@
 #define CADMORPH_MESH_IO_CGNS_INTERNAL_H
 
 #include "cadmorph/mesh.h"
+#include "rewrite.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -21,6 +22,7 @@ typedef struct cm_cgns_zone {
 
 typedef struct cm_cgns_state {
     char *path;          /* the file read: written back by copying it */
+    cm_file_stamp stamp; /* its identity when read (a changed file is not written back) */
     size_t n_zones;
     cm_cgns_zone *zones;
 } cm_cgns_state;

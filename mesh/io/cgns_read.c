@@ -672,6 +672,13 @@ cm_status cm_mesh_read_cgns(cm_context *ctx, const char *path, cm_mesh **mesh)
         cm_mesh_destroy(&r.m);
         return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", path);
     }
+    /* the stamp before the read: a file changed while it is read is not written back either */
+    s = cm_file_stamp_take(ctx, path, &r.st->stamp);
+    if (s != CM_OK) {
+        cm_cgns_state_free(r.st);
+        cm_mesh_destroy(&r.m);
+        return s;
+    }
     cm_cgns_lock();
     if (cg_open(path, CG_MODE_READ, &r.fn) != CG_OK) {
         char why[256];

@@ -8,6 +8,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cgns_internal.h"
 #include "formats.h"
+#include "rewrite.h"
 
 #include <cgns_io.h>
 #include <cgnslib.h>
@@ -15,20 +16,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static cm_status copy_file(cm_context *ctx, const char *from, FILE *to, const char *target)
-{
-    FILE *f = fopen(from, "rb");
-    if (!f) return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot open the file the mesh was read from, %s", target, from);
-    char buf[1 << 16];
-    size_t n;
-    int bad = 0;
-    while (!bad && (n = fread(buf, 1, sizeof buf, f)) > 0) bad = fwrite(buf, 1, n, to) != n;
-    bad |= ferror(f);
-    fclose(f);
-    bad |= fflush(to) != 0;
-    return bad ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: copying %s failed", target, from) : CM_OK;
-}
 
 static cm_status cgio_fail(cm_context *ctx, const char *target, const char *node, const char *what)
 {
@@ -87,10 +74,9 @@ static cm_status rewrite_zones(cm_context *ctx, const cm_mesh *mesh, const cm_cg
 static cm_status write_back(cm_context *ctx, const cm_mesh *mesh, const cm_cgns_state *st, const char *path)
 {
     cm_outfile out;
-    cm_status s = cm_outfile_open(ctx, path, &out);
+    cm_status s = cm_rewrite_copy_open(ctx, st->path, &st->stamp, path, &out);
     if (s != CM_OK) return s;
-    s = copy_file(ctx, st->path, out.f, path);
-    if (s == CM_OK) {
+    {
         int type = 0, cg = -1;
         cm_cgns_lock();
         if (cgio_check_file(out.tmp, &type) || cgio_open_file(out.tmp, CGIO_MODE_MODIFY, type, &cg)) {

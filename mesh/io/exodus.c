@@ -15,6 +15,7 @@
  * tables ex_get_side_set_node_list uses), outward for an element of positive volume. */
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
+#include "rewrite.h"
 
 #include <exodusII.h>
 
@@ -101,8 +102,7 @@ static pthread_mutex_t exo_lock = PTHREAD_MUTEX_INITIALIZER;
 typedef struct exo_state {
     char *path;
     int64_t num_dim, num_nodes, num_elem;
-    off_t size;
-    struct timespec mtime;
+    cm_file_stamp stamp;
 } exo_state;
 
 static void exo_state_free(void *p)
@@ -734,8 +734,7 @@ static cm_status read_locked(exo_reader *r, const struct stat *fst)
     st->num_dim = p->num_dim;
     st->num_nodes = p->num_nodes;
     st->num_elem = p->num_elem;
-    st->size = fst->st_size;
-    st->mtime = fst->st_mtim;
+    st->stamp = (cm_file_stamp){(int64_t)fst->st_size, (int64_t)fst->st_mtim.tv_sec, (int64_t)fst->st_mtim.tv_nsec};
     return cm_mesh_set_origin(ctx, r->m, CM_FORMAT_EXODUS, st, exo_state_free);
 }
 
@@ -770,21 +769,6 @@ cm_status cm_mesh_read_exodus(cm_context *ctx, const char *path, cm_mesh **mesh)
 }
 
 /* ---- the writer: back into the file the mesh was read from ---- */
-
-static cm_status copy_into(cm_context *ctx, const char *src, FILE *out)
-{
-    FILE *in = fopen(src, "rb");
-    if (!in)
-        return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot open the file the mesh was "
-                        "read from: %s", src, strerror(errno));
-    char chunk[1 << 16];
-    size_t got;
-    while ((got = fread(chunk, 1, sizeof chunk, in)) > 0)
-        if (fwrite(chunk, 1, got, out) != got) break;
-    const int err = ferror(in) || ferror(out) || fflush(out) != 0;
-    fclose(in);
-    return err ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: copy failed", src) : CM_OK;
-}
 
 /* The coordinates go in through netCDF itself, not ex_open(EX_WRITE): opening for writing,
  * the Exodus library adds what older writers (meshio) leave out (the len_name dimension, the
@@ -846,18 +830,12 @@ cm_status cm_mesh_write_exodus(cm_context *ctx, const cm_mesh *mesh, const char 
                 return cm_error(ctx, CM_ERR_UNSUPPORTED,
                                 "cm_mesh_write: %s: %s is a 2-D Exodus II file, but node %zu has "
                                 "z = %g", path, st->path, i, mesh->xyz[3 * i + 2]);
-    struct stat now;
-    if (stat(st->path, &now) != 0 || now.st_size != st->size ||
-        now.st_mtim.tv_sec != st->mtime.tv_sec || now.st_mtim.tv_nsec != st->mtime.tv_nsec)
-        return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: %s changed (or went) since the mesh "
-                        "was read from it", path, st->path);
     cm_status s = exo_load(ctx, "cm_mesh_write", path);
     if (s != CM_OK) return s;
     cm_outfile out;
-    s = cm_outfile_open(ctx, path, &out);
+    s = cm_rewrite_copy_open(ctx, st->path, &st->stamp, path, &out);
     if (s != CM_OK) return s;
-    s = copy_into(ctx, st->path, out.f);
-    if (s == CM_OK) s = put_coordinates(ctx, mesh, st, path, out.tmp);
+    s = put_coordinates(ctx, mesh, st, path, out.tmp);
     if (s != CM_OK) {
         cm_outfile_abort(&out);
         return s;

@@ -39,14 +39,27 @@ static char *dup_text(const char *s)
     return d;
 }
 
-static int identity(const char *path, int64_t *size, int64_t *sec, int64_t *nsec)
+cm_status cm_file_stamp_take(cm_context *ctx, const char *path, cm_file_stamp *stamp)
 {
     struct stat st;
-    if (stat(path, &st) != 0) return -1;
-    *size = (int64_t)st.st_size;
-    *sec = (int64_t)st.st_mtim.tv_sec;
-    *nsec = (int64_t)st.st_mtim.tv_nsec;
-    return 0;
+    if (stat(path, &st) != 0) return cm_error(ctx, CM_ERR_IO, "%s: cannot stat: %s", path, strerror(errno));
+    stamp->size = (int64_t)st.st_size;
+    stamp->sec = (int64_t)st.st_mtim.tv_sec;
+    stamp->nsec = (int64_t)st.st_mtim.tv_nsec;
+    return CM_OK;
+}
+
+/* CM_OK when path still has its stamp, else the error that says why nothing is written. */
+static cm_status check_stamp(cm_context *ctx, const char *path, const cm_file_stamp *was)
+{
+    cm_file_stamp now;
+    struct stat st;
+    if (stat(path, &st) == 0) {
+        now = (cm_file_stamp){(int64_t)st.st_size, (int64_t)st.st_mtim.tv_sec, (int64_t)st.st_mtim.tv_nsec};
+        if (now.size == was->size && now.sec == was->sec && now.nsec == was->nsec) return CM_OK;
+    }
+    return cm_error(ctx, CM_ERR_IO, "%s: the file the mesh was read from has changed or gone since; "
+                                    "read it again before writing the mesh back into it", path);
 }
 
 cm_status cm_rewrite_add_file(cm_context *ctx, cm_rewrite_source *src, const char *path,
@@ -64,8 +77,8 @@ cm_status cm_rewrite_add_file(cm_context *ctx, cm_rewrite_source *src, const cha
         free(f->name);
         return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", path);
     }
-    if (identity(path, &f->size, &f->mtime_sec, &f->mtime_nsec) != 0) {
-        cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot stat: %s", path, strerror(errno));
+    cm_status s = cm_file_stamp_take(ctx, path, &f->stamp);
+    if (s != CM_OK) {
         free(f->path);
         free(f->name);
         return s;
@@ -80,7 +93,7 @@ cm_status cm_rewrite_add_span(cm_context *ctx, cm_rewrite_source *src, size_t fi
 {
     cm_rewrite_file *f = &src->files[file];
     const cm_rewrite_span *last = f->n_spans ? &f->spans[f->n_spans - 1] : NULL;
-    if (offset < 0 || length < 0 || offset + length > f->size || (last && offset < last->offset + last->length))
+    if (offset < 0 || length < 0 || offset + length > f->stamp.size || (last && offset < last->offset + last->length))
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: coordinate span at byte %lld out of order", f->path,
                         (long long)offset);
     if (f->n_spans == f->cap_spans) {
@@ -195,16 +208,14 @@ static int copy_bytes(FILE *in, FILE *out, int64_t n, char *buf, size_t cap)
 static cm_status rewrite_one(cm_context *ctx, const cm_rewrite_source *src, const cm_rewrite_file *f,
                              const cm_mesh *mesh, FILE *out, cm_rewrite_emit_fn emit)
 {
-    int64_t size, sec, nsec;
-    if (identity(f->path, &size, &sec, &nsec) != 0 || size != f->size || sec != f->mtime_sec || nsec != f->mtime_nsec)
-        return cm_error(ctx, CM_ERR_IO, "%s: the file the mesh was read from has changed or gone since; "
-                                        "read it again before writing the mesh back into it", f->path);
+    cm_status s = check_stamp(ctx, f->path, &f->stamp);
+    if (s != CM_OK) return s;
     FILE *in = fopen(f->path, "rb");
     if (!in) return cm_error(ctx, CM_ERR_IO, "%s: cannot open: %s", f->path, strerror(errno));
     enum { CHUNK = 1 << 16 };
     char *buf = malloc(CHUNK);
     cm_rewrite_buf span_text = {0}, text = {0};
-    cm_status s = buf ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
+    if (!buf) s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
     int64_t at = 0;
     for (size_t i = 0; s == CM_OK && i < f->n_spans; ++i) {
         const cm_rewrite_span *sp = &f->spans[i];
@@ -284,5 +295,31 @@ cm_status cm_rewrite_write(cm_context *ctx, const cm_rewrite_source *src, const 
         if (outs[k].f) s = cm_outfile_commit(ctx, &outs[k]);
     for (size_t i = 0; i < src->n_files; ++i) cm_outfile_abort(&outs[i]);
     free(outs);
+    return s;
+}
+
+cm_status cm_rewrite_copy_open(cm_context *ctx, const char *source, const cm_file_stamp *stamp,
+                               const char *path, cm_outfile *out)
+{
+    cm_status s = check_stamp(ctx, source, stamp);
+    if (s != CM_OK) return s;
+    s = cm_outfile_open(ctx, path, out);
+    if (s != CM_OK) return s;
+    FILE *in = fopen(source, "rb");
+    if (!in) {
+        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot open the file the mesh was read from, %s: %s",
+                     path, source, strerror(errno));
+        cm_outfile_abort(out);
+        return s;
+    }
+    enum { CHUNK = 1 << 16 };
+    char *buf = malloc(CHUNK);
+    const int bad = !buf || copy_bytes(in, out->f, -1, buf, CHUNK) != 0 || fflush(out->f) != 0;
+    free(buf);
+    fclose(in);
+    if (bad) {
+        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: copying %s failed", path, source);
+        cm_outfile_abort(out);
+    }
     return s;
 }

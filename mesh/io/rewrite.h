@@ -14,6 +14,22 @@
 
 #include "cadmorph/mesh.h"
 
+/* The identity of a file when it was read (size, modification time): writing back into a copy
+ * of a file that changed since is refused. */
+typedef struct cm_file_stamp {
+    int64_t size, sec, nsec;
+} cm_file_stamp;
+
+/* path's stamp now; CM_ERR_IO naming the file when it cannot be examined. */
+cm_status cm_file_stamp_take(cm_context *ctx, const char *path, cm_file_stamp *stamp);
+
+/* For the formats written back through their own library (CGNS, Exodus II): opens the
+ * temporary output beside path (cm_outfile_open) and copies source into it, refusing a source
+ * that changed since stamp. The caller rewrites the coordinates in out->tmp through its
+ * library, then commits or aborts out. */
+cm_status cm_rewrite_copy_open(cm_context *ctx, const char *source, const cm_file_stamp *stamp,
+                               const char *path, cm_outfile *out);
+
 typedef struct cm_rewrite_span {
     int64_t offset, length; /* bytes [offset, offset + length) of the file */
     int64_t node;           /* the mesh node whose coordinates they hold */
@@ -24,7 +40,7 @@ typedef struct cm_rewrite_file {
     char *path;      /* the file as read */
     char *name;      /* NULL for the main file (written to the output path), else the name the
                         including file gives it, relative to the output's directory */
-    int64_t size, mtime_sec, mtime_nsec; /* its identity when read */
+    cm_file_stamp stamp;                 /* its identity when read */
     size_t n_spans, cap_spans;
     cm_rewrite_span *spans; /* in file order, not overlapping */
 } cm_rewrite_file;

@@ -11,7 +11,7 @@ library's status becomes an exception carrying its message.
 from ._capi import ffi as _ffi, lib as _lib
 from .errors import (BadInputError, CadmorphWarning, Error, InterruptedCall, MismatchError,
                      RejectedError, ResourceError)
-from .mesh import Mesh, read_mesh, write_mesh
+from .mesh import Mesh, mesh_formats, read_mesh, write_mesh
 from .quality import FoamQuality, Quality, quality
 from .geometry import Comparison, Counts, Edge, Face, Geometry, model, model_names, read_step
 from .design import DesignRow, DesignTable
@@ -29,7 +29,7 @@ __version__: str = _ffi.string(_lib.cm_version()).decode()
 __all__ = [
     "Error", "BadInputError", "MismatchError", "RejectedError", "ResourceError",
     "InterruptedCall", "CadmorphWarning",
-    "Mesh", "read_mesh", "write_mesh",
+    "Mesh", "mesh_formats", "read_mesh", "write_mesh",
     "Quality", "FoamQuality", "quality",
     "Geometry", "Face", "Edge", "Counts", "Comparison", "read_step", "model", "model_names",
     "Morpher", "MorphStep", "MorpherInfo", "SurfaceStats", "morph",

@@ -335,9 +335,9 @@ class Mesh:
 
 
 def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
-    """Reads a mesh; the format is chosen by the name (.msh, .vtu, .vtk, .mesh, .obj, .off,
-    .stl, .su2, or an OpenFOAM case directory), as in the CLI. threads: for the library's OpenMP
-    loops, 0 = all the machine has.
+    """Reads a mesh; the format is chosen by the name, as in the CLI (mesh_formats() lists
+    them: gmsh, VTK, Medit, surface formats, CGNS, SU2, Fluent, Abaqus, Nastran, Exodus II, an
+    OpenFOAM case directory). threads: for the library's OpenMP loops, 0 = all the machine has.
 
     Raises BadInputError (with the library's message naming the file, and the line or the
     byte offset) for a file that is missing, unreadable or malformed.
@@ -347,11 +347,20 @@ def read_mesh(path: PathLike, threads: int = 0) -> Mesh:
     return Mesh(ctx.create(lib.cm_mesh_read, "cm_mesh", lib.cm_mesh_destroy, p), _TOKEN)
 
 
+def mesh_formats() -> str:
+    """The mesh formats read_mesh and write_mesh know, as the CLI's messages name them:
+    ".msh .vtu ... , or an OpenFOAM case directory"."""
+    return ffi.string(lib.cm_mesh_format_list()).decode()
+
+
 def write_mesh(path: PathLike, mesh: Mesh, binary: Optional[bool] = None,
                msh_version: Optional[int] = None, compress: Optional[bool] = None,
                threads: int = 0) -> None:
     """Writes a mesh in the format its name says (as read_mesh); through a temporary file
-    renamed at the end, so a failed write leaves no partial file.
+    renamed at the end, so a failed write leaves no partial file. A mesh read from a solver's
+    file (CGNS, SU2, Fluent, Abaqus, Nastran, Exodus II, OpenFOAM) and written to a name of
+    that format, with the nodes and cells it was read with, changes only the coordinates:
+    every other byte of the file stays.
 
     binary: msh, vtk, stl binary, vtu base64 (library default when None); msh_version: 22 or
     41 (default 41); compress: vtu zlib compression (default on).

@@ -3,8 +3,7 @@
 # structured zones and hostile files refused), then the trees of the files written back
 # compared node by node with the originals (h5py, cgnsdiff, cgnscheck), and new files read by
 # meshio.
-cm_add_unit_test(test_cgns test_cgns.c LIBS cm_mesh ${CGNS_LIBRARY} LABELS "cgns;hostile")
-target_include_directories(test_cgns SYSTEM PRIVATE ${CGNS_INCLUDE_DIR})
+cm_add_unit_test(test_cgns test_cgns.c LIBS cm_mesh cm_cgns LABELS "cgns;hostile")
 set_tests_properties(test_cgns PROPERTIES FIXTURES_SETUP cgns_files)
 add_test(NAME test_cgns_tree
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_cgns_tree.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK}/cgns)

@@ -158,3 +158,14 @@ def test_no_direct_construction():
 def test_threads_checked(data, threads, exc):
     with pytest.raises(exc, match="threads"):
         cadmorph.read_mesh(data / "vtk/meshio_ascii.vtu", threads=threads)
+
+
+def test_mesh_formats_as_the_cli_names_them(cli):
+    """mesh_formats() is the list every --help shows, with the solvers' formats in it."""
+    import subprocess
+    formats = cadmorph.mesh_formats()
+    for ext in (".msh", ".vtu", ".cgns", ".su2", ".cas", ".inp", ".bdf", ".exo"):
+        assert ext in formats
+    assert formats.endswith("or an OpenFOAM case directory")
+    helptext = subprocess.run([cli, "quality", "--help"], capture_output=True, text=True).stdout
+    assert formats in " ".join(helptext.split())
