@@ -5,6 +5,7 @@
  * the numbers of *NODE lines; a new deck read back; hostile decks refused with file:line. */
 #define _POSIX_C_SOURCE 200809L
 #include "cadmorph/mesh.h"
+#include "test_files.h"
 #include "test_util.h"
 
 #include <math.h>
@@ -13,42 +14,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static char work[512];
 static cm_context *ctx;
-
-static const char *at(const char *name)
-{
-    static char buf[4][700];
-    static int k;
-    k = (k + 1) % 4;
-    snprintf(buf[k], sizeof buf[k], "%s/%s", work, name);
-    return buf[k];
-}
-
-static void put(const char *name, const char *text)
-{
-    FILE *f = fopen(at(name), "wb");
-    fputs(text, f);
-    fclose(f);
-}
-
-static char *get(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *d = malloc((size_t)n + 1);
-    d[fread(d, 1, (size_t)n, f)] = '\0';
-    fclose(f);
-    return d;
-}
 
 static cm_mesh *read_ok(const char *name)
 {
     cm_mesh *m = NULL;
-    cm_status s = cm_mesh_read(ctx, at(name), &m);
+    cm_status s = cm_mesh_read(ctx, test_at(name), &m);
     CHECK_MSG(s == CM_OK && m, "%s: %s", name, cm_context_message(ctx));
     return m;
 }
@@ -116,7 +87,7 @@ static void test_types(void)
         for (int i = 0; i < tc->nodes; ++i)
             n += (size_t)snprintf(deck + n, sizeof deck - n, "%s%lld", i == 12 ? ",\n " : ", ", 1000000000000LL - 7 * i);
         snprintf(deck + n, sizeof deck - n, "\n");
-        put("type.inp", deck);
+        test_write_text(test_at("type.inp"), deck);
         cm_mesh *m = read_ok("type.inp");
         if (!m) continue;
         CHECK_MSG(m->n_cells == 1 && m->type[0] == tc->type, "%s", tc->name);
@@ -139,11 +110,12 @@ static void test_types(void)
 
 static void test_features(void)
 {
-    mkdir(at("sub"), 0777);
-    put("sub/nodes.inp", "** nodes only: they continue the *NODE block of the includer\n"
-                         "3, 0., 1., 0.\n4, 0., 0., 1.\n*include, input=more.inp\n");
-    put("sub/more.inp", "5, 1.0, 1.0, 1.0\n");
-    put("feat.inp",
+    mkdir(test_at("sub"), 0777);
+    test_write_text(test_at("sub/nodes.inp"),
+                    "** nodes only: they continue the *NODE block of the includer\n"
+                    "3, 0., 1., 0.\n4, 0., 0., 1.\n*include, input=more.inp\n");
+    test_write_text(test_at("sub/more.inp"), "5, 1.0, 1.0, 1.0\n");
+    test_write_text(test_at("feat.inp"),
         "*HEADING\n a deck *with* words\n**\n"
         "*NODE, NSET=NALL\n"
         "1, 0.0, 0.0, 0.0\n"
@@ -161,7 +133,7 @@ static void test_features(void)
         "*SURFACE, NAME=PTS, TYPE=NODE\n CORNER\n"
         "*MATERIAL, NAME=STEEL\n*ELASTIC\n 210000, 0.3\n*STEP\n*STATIC\n*END STEP\n");
     cm_mesh *m = NULL;
-    cm_status s = cm_mesh_read(ctx, at("feat.inp"), &m);
+    cm_status s = cm_mesh_read(ctx, test_at("feat.inp"), &m);
     /* the MASS element is skipped with a warning naming it */
     CHECK_MSG(s == CM_WARNING && m && strstr(cm_context_message(ctx), "MASS"), "%d %s", s, cm_context_message(ctx));
     if (!m) return;
@@ -209,8 +181,8 @@ static const char *parts_deck =
 
 static void test_parts(void)
 {
-    mkdir(at("parts_out"), 0777);
-    put("parts.inp", parts_deck);
+    mkdir(test_at("parts_out"), 0777);
+    test_write_text(test_at("parts.inp"), parts_deck);
     cm_mesh *m = read_ok("parts.inp");
     if (!m) return;
     CHECK(m->n_nodes == 8 && cm_mesh_count_dim(m, 3) == 2);
@@ -226,15 +198,15 @@ static void test_parts(void)
     double *x1 = m->xyz + 3 * 3, *x2 = m->xyz + 3 * 7; /* node 4 of each instance: (0,0,1) */
     x1[2] += 0.5;
     x2[2] += 0.5; /* the axis is z: z is the part's z in both */
-    CHECK_MSG(cm_mesh_write(ctx, m, at("parts_out/parts.inp"), NULL) == CM_OK, "%s", cm_context_message(ctx));
-    char *out = get(at("parts_out/parts.inp"));
+    CHECK_MSG(cm_mesh_write(ctx, m, test_at("parts_out/parts.inp"), NULL) == CM_OK, "%s", cm_context_message(ctx));
+    char *out = test_read_file(test_at("parts_out/parts.inp"), NULL);
     CHECK(out && strstr(out, " 4, 0., 0., 1.5\n") && strstr(out, "*Part, name=Unused\n*Node\n 1, 9., 9., 9.\n"));
     free(out);
     /* one instance only moved: refused, naming both */
     x2[0] += 0.25;
-    CHECK(cm_mesh_write(ctx, m, at("parts_out/bad.inp"), NULL) == CM_ERR_UNSUPPORTED);
+    CHECK(cm_mesh_write(ctx, m, test_at("parts_out/bad.inp"), NULL) == CM_ERR_UNSUPPORTED);
     CHECK(strstr(cm_context_message(ctx), "B-1") && strstr(cm_context_message(ctx), "B-2"));
-    CHECK(access(at("parts_out/bad.inp"), F_OK) != 0);
+    CHECK(access(test_at("parts_out/bad.inp"), F_OK) != 0);
     cm_mesh_destroy(&m);
 }
 
@@ -242,25 +214,26 @@ static void test_parts(void)
 
 static void test_write_back(void)
 {
-    mkdir(at("wb_in"), 0777);
-    mkdir(at("wb_out"), 0777);
-    put("wb_in/inc.inp", "5,\t1.5E+00 , 2.5D0,3.5 , 7, 8\n");
-    put("wb_in/deck.inp",
+    mkdir(test_at("wb_in"), 0777);
+    mkdir(test_at("wb_out"), 0777);
+    test_write_text(test_at("wb_in/inc.inp"), "5,\t1.5E+00 , 2.5D0,3.5 , 7, 8\n");
+    test_write_text(test_at("wb_in/deck.inp"),
         "** deck\r\n*NODE\r\n1,0.1,0.2,0.3\r\n2, 1.000, 0.0, 0.0\r\n3, 0, 1\r\n4,0,0,1\r\n"
         "*INCLUDE, INPUT=inc.inp\r\n*ELEMENT, TYPE=C3D4\r\n1, 1, 2, 3, 4\r\n2, 2, 3, 4, 5\r\n");
     cm_mesh *m = read_ok("wb_in/deck.inp");
     if (!m) return;
     CHECK(m->xyz[12 + 1] == 2.5);
     /* unchanged: every byte the same */
-    CHECK(cm_mesh_write(ctx, m, at("wb_out/same.inp"), NULL) == CM_OK);
-    char *a = get(at("wb_in/deck.inp")), *b = get(at("wb_out/same.inp"));
+    CHECK(cm_mesh_write(ctx, m, test_at("wb_out/same.inp"), NULL) == CM_OK);
+    char *a = test_read_file(test_at("wb_in/deck.inp"), NULL);
+    char *b = test_read_file(test_at("wb_out/same.inp"), NULL);
     CHECK(a && b && !strcmp(a, b));
     free(b);
-    b = get(at("wb_out/inc.inp"));
+    b = test_read_file(test_at("wb_out/inc.inp"), NULL);
     CHECK_MSG(b && !strcmp(b, "5,\t1.5E+00 , 2.5D0,3.5 , 7, 8\n"), "%s", b ? b : "(none)");
     free(b);
     /* written beside the source, the include would overwrite its own source: refused */
-    CHECK(cm_mesh_write(ctx, m, at("wb_in/other.inp"), NULL) == CM_ERR_ARGUMENT);
+    CHECK(cm_mesh_write(ctx, m, test_at("wb_in/other.inp"), NULL) == CM_ERR_ARGUMENT);
     /* an affine motion of every node: the affine image, separators and ids byte for byte */
     const double A[9] = {1.25, 0.5, 0, 0, 2, 0, 0.125, 0, 1}, t[3] = {0.1, -3, 1e-3};
     double want[15];
@@ -271,9 +244,9 @@ static void test_write_back(void)
     memcpy(m->xyz, want, sizeof want);
     m->xyz[3 * 3] = 0.0; /* node 4's x stays 0: its bytes stay */
     want[9] = 0.0;
-    CHECK_MSG(cm_mesh_write(ctx, m, at("wb_out/deck.inp"), NULL) == CM_OK, "%s", cm_context_message(ctx));
-    b = get(at("wb_out/deck.inp"));
-    char *inc = get(at("wb_out/inc.inp"));
+    CHECK_MSG(cm_mesh_write(ctx, m, test_at("wb_out/deck.inp"), NULL) == CM_OK, "%s", cm_context_message(ctx));
+    b = test_read_file(test_at("wb_out/deck.inp"), NULL);
+    char *inc = test_read_file(test_at("wb_out/inc.inp"), NULL);
     CHECK(b && inc);
     if (b && inc) {
         CHECK_MSG(strstr(b, "\r\n4,0,") != NULL, "%s", b);
@@ -289,20 +262,21 @@ static void test_write_back(void)
     for (size_t i = 0; back && i < 15; ++i) CHECK_MSG(back->xyz[i] == want[i], "%zu: %.17g vs %.17g", i, back->xyz[i], want[i]);
     cm_mesh_destroy(&back);
     /* a file with nodes included into two parts: refused (each copy could move differently) */
-    put("wb_in/twice.inp", "*PART, NAME=A\n*INCLUDE, INPUT=inc.inp\n*END PART\n*PART, NAME=B\n*INCLUDE, INPUT=inc.inp\n"
-                           "*END PART\n*ASSEMBLY\n*INSTANCE, NAME=A1, PART=A\n*END INSTANCE\n"
-                           "*INSTANCE, NAME=B1, PART=B\n*END INSTANCE\n*END ASSEMBLY\n");
-    put("wb_in/inc.inp", "*NODE\n5,\t1.5E+00 , 2.5D0,3.5 , 7, 8\n");
+    test_write_text(test_at("wb_in/twice.inp"),
+                    "*PART, NAME=A\n*INCLUDE, INPUT=inc.inp\n*END PART\n*PART, NAME=B\n*INCLUDE, INPUT=inc.inp\n"
+                    "*END PART\n*ASSEMBLY\n*INSTANCE, NAME=A1, PART=A\n*END INSTANCE\n"
+                    "*INSTANCE, NAME=B1, PART=B\n*END INSTANCE\n*END ASSEMBLY\n");
+    test_write_text(test_at("wb_in/inc.inp"), "*NODE\n5,\t1.5E+00 , 2.5D0,3.5 , 7, 8\n");
     cm_mesh *twice = read_ok("wb_in/twice.inp");
     if (twice) {
         CHECK(twice->n_nodes == 2);
-        CHECK(cm_mesh_write(ctx, twice, at("wb_out/twice.inp"), NULL) == CM_ERR_UNSUPPORTED);
+        CHECK(cm_mesh_write(ctx, twice, test_at("wb_out/twice.inp"), NULL) == CM_ERR_UNSUPPORTED);
         CHECK_MSG(strstr(cm_context_message(ctx), "included more than once"), "%s", cm_context_message(ctx));
     }
     cm_mesh_destroy(&twice);
     /* the source changed since it was read: refused */
-    put("wb_in/deck.inp", "*NODE\n1, 0, 0, 0\n");
-    CHECK(cm_mesh_write(ctx, m, at("wb_out/late.inp"), NULL) == CM_ERR_IO);
+    test_write_text(test_at("wb_in/deck.inp"), "*NODE\n1, 0, 0, 0\n");
+    CHECK(cm_mesh_write(ctx, m, test_at("wb_out/late.inp"), NULL) == CM_ERR_IO);
     free(a);
     cm_mesh_destroy(&m);
 }
@@ -326,8 +300,8 @@ static void test_new_deck(void)
     CHECK(cm_mesh_add_group(ctx, m, 0, 3, "tip") == CM_OK);
     double sj[4];
     CHECK(cm_mesh_quality(ctx, m, sj) == CM_OK && sj[0] > 0 && sj[1] > 0);
-    CHECK_MSG(cm_mesh_write(ctx, m, at("new.inp"), NULL) == CM_OK, "%s", cm_context_message(ctx));
-    char *text = get(at("new.inp"));
+    CHECK_MSG(cm_mesh_write(ctx, m, test_at("new.inp"), NULL) == CM_OK, "%s", cm_context_message(ctx));
+    char *text = test_read_file(test_at("new.inp"), NULL);
     /* Abaqus's wedge order: corners 2<->3 and 5<->6 of VTK's */
     CHECK(text && strstr(text, "*ELEMENT, TYPE=C3D6, ELSET=solid_part\n2, 1, 2, 3, 4, 5, 6\n"));
     free(text);
@@ -346,7 +320,7 @@ static void test_new_deck(void)
     /* a type a deck has no element for */
     const int64_t poly[4] = {0, 1, 2, 3};
     CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_POLYGON, poly, 4, 0, 0, 0) == CM_OK);
-    CHECK(cm_mesh_write(ctx, m, at("poly.inp"), NULL) == CM_ERR_UNSUPPORTED);
+    CHECK(cm_mesh_write(ctx, m, test_at("poly.inp"), NULL) == CM_ERR_UNSUPPORTED);
     CHECK(strstr(cm_context_message(ctx), "polygon") != NULL);
     cm_mesh_destroy(&m);
 }
@@ -359,9 +333,9 @@ typedef struct bad_case {
 
 static void test_hostile(void)
 {
-    put("self.inp", "*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=self.inp\n");
-    put("loop_a.inp", "*INCLUDE, INPUT=loop_b.inp\n");
-    put("loop_b.inp", "** b\n*INCLUDE, INPUT=loop_a.inp\n");
+    test_write_text(test_at("self.inp"), "*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=self.inp\n");
+    test_write_text(test_at("loop_a.inp"), "*INCLUDE, INPUT=loop_b.inp\n");
+    test_write_text(test_at("loop_b.inp"), "** b\n*INCLUDE, INPUT=loop_a.inp\n");
     const bad_case bad[] = {
         {"*NODE\n1, 0, 0, 0\n*INCLUDE, INPUT=self.inp\n", "self.inp:3: the included file"},
         {"*INCLUDE, INPUT=loop_a.inp\n", "loop_b.inp:2: the included file"},
@@ -388,9 +362,9 @@ static void test_hostile(void)
          "*SURFACE S: element 1 (tet4) has no face S5"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof *bad; ++i) {
-        put("bad.inp", bad[i].text);
+        test_write_text(test_at("bad.inp"), bad[i].text);
         cm_mesh *m = NULL;
-        cm_status s = cm_mesh_read(ctx, at("bad.inp"), &m);
+        cm_status s = cm_mesh_read(ctx, test_at("bad.inp"), &m);
         CHECK_MSG(s < 0 && !m && strstr(cm_context_message(ctx), bad[i].message) &&
                       !strncmp(cm_context_message(ctx), "cm_mesh_read: ", 14),
                   "case %zu: %d '%s' (expected '%s')", i, s, cm_context_message(ctx), bad[i].message);
@@ -401,18 +375,17 @@ static void test_hostile(void)
         char name[32], text[64];
         snprintf(name, sizeof name, "deep%d.inp", d);
         snprintf(text, sizeof text, "*INCLUDE, INPUT=deep%d.inp\n", d + 1);
-        put(name, text);
+        test_write_text(test_at(name), text);
     }
-    put("deep20.inp", "*NODE\n1, 0, 0, 0\n");
+    test_write_text(test_at("deep20.inp"), "*NODE\n1, 0, 0, 0\n");
     cm_mesh *m = NULL;
-    CHECK(cm_mesh_read(ctx, at("deep0.inp"), &m) == CM_ERR_FORMAT && !m);
+    CHECK(cm_mesh_read(ctx, test_at("deep0.inp"), &m) == CM_ERR_FORMAT && !m);
     CHECK_MSG(strstr(cm_context_message(ctx), "nested at most 16 deep"), "%s", cm_context_message(ctx));
 }
 
 int main(int argc, char **argv)
 {
-    snprintf(work, sizeof work, "%s/abaqus", argc > 2 ? argv[2] : "/tmp");
-    mkdir(work, 0777);
+    if (test_work_in(argc > 2 ? argv[2] : "/tmp", "abaqus") != 0) return 1;
     cm_context_create(&ctx);
     test_types();
     test_features();

@@ -8,23 +8,12 @@
  * <work>/cgns for the tree comparison (test_cgns_tree.py). */
 #define _POSIX_C_SOURCE 200809L
 #include "cadmorph/mesh.h"
+#include "test_files.h"
 #include "test_util.h"
 
 #include <cgnslib.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-
-static char dir[512];
-
-static const char *at(const char *name)
-{
-    static char buf[4][600];
-    static int k;
-    k = (k + 1) % 4;
-    snprintf(buf[k], sizeof buf[k], "%s/%s", dir, name);
-    return buf[k];
-}
 
 /* ---- element types: corners and the SIDS lists of corners each further node is the mean of */
 
@@ -130,7 +119,7 @@ static void write_all_types(const char *path)
 
 static void test_all_types(cm_context *ctx)
 {
-    const char *path = at("types.cgns");
+    const char *path = test_at("types.cgns");
     write_all_types(path);
     cm_mesh *m = NULL;
     cm_status s = cm_mesh_read(ctx, path, &m);
@@ -163,7 +152,7 @@ static void test_all_types(cm_context *ctx)
     CHECK(zone && tri);
     CHECK(m->physical[4] == zone && m->physical[1] == tri);
     /* a new file of every type reads back the same */
-    const char *copy = at("types_new.cgns");
+    const char *copy = test_at("types_new.cgns");
     cm_mesh *n = NULL;
     cm_mesh *plain = NULL;
     CHECK(cm_mesh_copy(ctx, m, &plain) == CM_OK);
@@ -292,9 +281,9 @@ static void test_two_zones(cm_context *ctx, const char *name, int file_type)
     char in[64], out[64];
     snprintf(in, sizeof in, "%s.cgns", name);
     snprintf(out, sizeof out, "%s_moved.cgns", name);
-    write_two_zones(at(in), file_type);
+    write_two_zones(test_at(in), file_type);
     cm_mesh *m = NULL;
-    cm_status s = cm_mesh_read(ctx, at(in), &m);
+    cm_status s = cm_mesh_read(ctx, test_at(in), &m);
     CHECK_MSG(s == CM_OK, "%s", cm_context_message(ctx));
     if (s != CM_OK) return;
     CHECK(m->n_nodes == 27 + 27 - 9); /* the interface merged */
@@ -313,12 +302,12 @@ static void test_two_zones(cm_context *ctx, const char *name, int file_type)
     double orig[45 * 3];
     memcpy(orig, m->xyz, sizeof orig);
     for (size_t i = 0; i < m->n_nodes; ++i) affine(orig + 3 * i, m->xyz + 3 * i);
-    s = cm_mesh_write(ctx, m, at(out), NULL);
+    s = cm_mesh_write(ctx, m, test_at(out), NULL);
     CHECK_MSG(s == CM_OK, "%s", cm_context_message(ctx));
     double a[27 * 3], b[27 * 3], want[3];
     for (int Z = 1; Z <= 2; ++Z) {
-        zone_coords(at(in), Z, a, 27);
-        zone_coords(at(out), Z, b, 27);
+        zone_coords(test_at(in), Z, a, 27);
+        zone_coords(test_at(out), Z, b, 27);
         for (int i = 0; i < 27; ++i) {
             affine(a + 3 * i, want);
             for (int d = 0; d < 3; ++d) {
@@ -330,7 +319,7 @@ static void test_two_zones(cm_context *ctx, const char *name, int file_type)
     }
     /* read again: same mesh, moved */
     cm_mesh *r = NULL;
-    CHECK(cm_mesh_read(ctx, at(out), &r) == CM_OK);
+    CHECK(cm_mesh_read(ctx, test_at(out), &r) == CM_OK);
     if (r) CHECK(r->n_nodes == m->n_nodes && r->n_cells == m->n_cells);
     cm_mesh_destroy(&r);
     cm_mesh_destroy(&m);
@@ -340,7 +329,7 @@ static void test_two_zones(cm_context *ctx, const char *name, int file_type)
 
 static void test_polyhedra(cm_context *ctx)
 {
-    const char *path = at("poly.cgns");
+    const char *path = test_at("poly.cgns");
     int fn, B, Z, S, C, BC;
     double x[12], y[12], z[12];
     for (int i = 0; i < 12; ++i) {
@@ -425,18 +414,11 @@ static void expect_error(cm_context *ctx, const char *path, const char *what1, c
     cm_mesh_destroy(&m);
 }
 
-static void put(const char *path, const void *data, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    fwrite(data, 1, n, f);
-    fclose(f);
-}
-
 static void test_hostile(cm_context *ctx)
 {
     int fn, B, Z, S, C;
     /* a structured zone */
-    const char *st = at("structured.cgns");
+    const char *st = test_at("structured.cgns");
     CHECK(cg_open(st, CG_MODE_WRITE, &fn) == CG_OK);
     CHECK(cg_base_write(fn, "Base", 3, 3, &B) == CG_OK);
     cgsize_t size[9] = {2, 2, 2, 1, 1, 1, 0, 0, 0};
@@ -446,7 +428,7 @@ static void test_hostile(cm_context *ctx)
     CHECK(cg_close(fn) == CG_OK);
     expect_error(ctx, st, "/Base/Block", "structured zones are not read");
     /* an element's vertex out of range, a BC naming no element */
-    const char *bad = at("bad_index.cgns");
+    const char *bad = test_at("bad_index.cgns");
     CHECK(cg_open(bad, CG_MODE_WRITE, &fn) == CG_OK);
     CHECK(cg_base_write(fn, "Base", 3, 3, &B) == CG_OK);
     cgsize_t usize[3] = {4, 1, 0};
@@ -459,7 +441,7 @@ static void test_hostile(cm_context *ctx)
     CHECK(cg_section_write(fn, B, Z, "Tets", CGNS_ENUMV(TETRA_4), 1, 1, 0, tet, &S) == CG_OK);
     CHECK(cg_close(fn) == CG_OK);
     expect_error(ctx, bad, "/Base/Tet/Tets", "vertex 99 out of range");
-    const char *bc = at("bad_bc.cgns");
+    const char *bc = test_at("bad_bc.cgns");
     CHECK(cg_open(bc, CG_MODE_WRITE, &fn) == CG_OK);
     CHECK(cg_base_write(fn, "Base", 3, 3, &B) == CG_OK);
     CHECK(cg_zone_write(fn, B, "Tet", usize, CGNS_ENUMV(Unstructured), &Z) == CG_OK);
@@ -477,27 +459,24 @@ static void test_hostile(cm_context *ctx)
     CHECK(cg_close(fn) == CG_OK);
     expect_error(ctx, bc, "/Base/Tet/ZoneBC/ghost", "element 5 is in no section");
     /* not HDF5 or ADF; truncated HDF5 */
-    put(at("text.cgns"), "CGNS? no\n", 9);
-    expect_error(ctx, at("text.cgns"), "not a CGNS file", NULL);
-    FILE *f = fopen(at("types.cgns"), "rb");
-    static char buf[1 << 16];
-    const size_t n = f ? fread(buf, 1, sizeof buf, f) : 0;
-    if (f) fclose(f);
+    test_write_file(test_at("text.cgns"), "CGNS? no\n", 9);
+    expect_error(ctx, test_at("text.cgns"), "not a CGNS file", NULL);
+    size_t n = 0;
+    char *buf = test_read_file(test_at("types.cgns"), &n);
     for (size_t cut = 8; cut < n; cut = cut * 3 / 2 + 7) {
-        put(at("cut.cgns"), buf, cut);
+        test_write_file(test_at("cut.cgns"), buf, cut);
         cm_mesh *m = NULL;
-        CHECK(cm_mesh_read(ctx, at("cut.cgns"), &m) < 0 && m == NULL);
+        CHECK(cm_mesh_read(ctx, test_at("cut.cgns"), &m) < 0 && m == NULL);
         cm_mesh_destroy(&m);
     }
-    expect_error(ctx, at("missing.cgns"), "missing.cgns", NULL);
+    free(buf);
+    expect_error(ctx, test_at("missing.cgns"), "missing.cgns", NULL);
 }
 
 int main(int argc, char **argv)
 {
     if (argc < 3) return 2;
-    snprintf(dir, sizeof dir, "%s/cgns", argv[2]);
-    mkdir(argv[2], 0777);
-    mkdir(dir, 0777);
+    if (test_work_in(argv[2], "cgns") != 0) return 1;
     cm_context *ctx = NULL;
     if (cm_context_create(&ctx) != CM_OK) return 1;
     test_all_types(ctx);

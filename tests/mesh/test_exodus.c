@@ -7,6 +7,7 @@
  * `test_exodus --fixture PATH [4|8]` only writes the 3-D fixture (for the Python cross-check). */
 #define _POSIX_C_SOURCE 200809L
 #include "cadmorph/mesh.h"
+#include "test_files.h"
 #include "test_util.h"
 
 #include <exodusII.h>
@@ -16,8 +17,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-static char work[64];
 
 /* ---- the fixture: elements given in Exodus numbering (Exodus II manual, element figures) ---- */
 
@@ -272,8 +271,8 @@ static void affine(const double *p, double *q)
 
 static void test_write_back(cm_context *ctx, const char *in, int ws)
 {
-    char out[160];
-    snprintf(out, sizeof out, "%s/moved_%d.exo", work, ws);
+    char out[1024];
+    snprintf(out, sizeof out, "%s/moved_%d.exo", test_work_dir(), ws);
     cm_mesh *m = NULL;
     CHECK(cm_mesh_read(ctx, in, &m) == CM_OK);
     if (!m) return;
@@ -308,8 +307,8 @@ static void test_write_back(cm_context *ctx, const char *in, int ws)
     }
     /* in place: the source itself rewritten, then its unchanged copy refused after the change */
     if (ws == 8) {
-        char copy[160], cmd[400];
-        snprintf(copy, sizeof copy, "%s/in_place.exo", work);
+        const char *copy = test_at("in_place.exo");
+        char cmd[2200];
         snprintf(cmd, sizeof cmd, "cp %s %s", in, copy);
         CHECK(system(cmd) == 0);
         cm_mesh *p = NULL;
@@ -327,8 +326,7 @@ static void test_write_back(cm_context *ctx, const char *in, int ws)
     /* a mesh that is no longer the one read (one more cell) is not written back: refused */
     const int64_t one = 0;
     CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_POINT, &one, 1, 0, 0, 0) == CM_OK);
-    char other[160];
-    snprintf(other, sizeof other, "%s/other.e", work);
+    const char *other = test_at("other.e");
     CHECK(cm_mesh_write(ctx, m, other, NULL) == CM_ERR_UNSUPPORTED);
     CHECK(strstr(cm_context_message(ctx), "Exodus II is written only back") != NULL);
     CHECK(access(other, F_OK) != 0);
@@ -337,9 +335,7 @@ static void test_write_back(cm_context *ctx, const char *in, int ws)
 
 static void test_2d(cm_context *ctx)
 {
-    char path[160], out[160];
-    snprintf(path, sizeof path, "%s/flat.exo", work);
-    snprintf(out, sizeof out, "%s/flat_out.exo", work);
+    const char *path = test_at("flat.exo"), *out = test_at("flat_out.exo");
     int comp_ws = 8, io_ws = 8;
     int exoid = ex_create(path, EX_CLOBBER, &comp_ws, &io_ws);
     const double x[6] = {0, 1, 2, 0, 1, 2}, y[6] = {0, 0, 0, 1, 1, 1};
@@ -382,50 +378,44 @@ static void expect_error(cm_context *ctx, const char *path, const char *needle)
 
 static void test_hostile(cm_context *ctx, const char *good)
 {
-    char path[160];
+    char path[1024];
     const char *cases[3][2] = {{"bad_node", "block \"tets\": element 1: node 0 out of range"},
                                {"bad_side", "side set \"wall\": entry 4: element 5 (tet4) has no side 7"},
                                {"bad_nodeset", "node set \"inlet\": entry 4: node 73 out of range"}};
     for (int k = 0; k < 3; ++k) {
-        snprintf(path, sizeof path, "%s/%s.exo", work, cases[k][0]);
+        snprintf(path, sizeof path, "%s/%s.exo", test_work_dir(), cases[k][0]);
         CHECK(write_fixture(path, 8, k + 1) == 0);
         expect_error(ctx, path, cases[k][1]);
     }
-    snprintf(path, sizeof path, "%s/text.exo", work);
-    FILE *f = fopen(path, "wb");
-    fputs("not a netCDF file\n", f);
-    fclose(f);
+    snprintf(path, sizeof path, "%s", test_at("text.exo"));
+    test_write_text(path, "not a netCDF file\n");
     expect_error(ctx, path, "not an Exodus II file");
     /* every truncation of the classic file: an error, never a crash */
-    FILE *in = fopen(good, "rb");
-    static char data[1 << 16];
-    const size_t n = in ? fread(data, 1, sizeof data, in) : 0;
-    if (in) fclose(in);
-    CHECK(n > 100 && n < sizeof data);
-    snprintf(path, sizeof path, "%s/cut.exo", work);
+    size_t n = 0;
+    char *data = test_read_file(good, &n);
+    CHECK(data && n > 100);
+    snprintf(path, sizeof path, "%s", test_at("cut.exo"));
     int failed = 0;
     for (size_t len = 0; len < n; len += 1 + len / 16) {
-        f = fopen(path, "wb");
-        fwrite(data, 1, len, f);
-        fclose(f);
+        test_write_file(path, data, len);
         cm_mesh *m = NULL;
         const cm_status s = cm_mesh_read(ctx, path, &m);
         if (s >= 0 && m) cm_mesh_destroy(&m);
         else if (!strstr(cm_context_message(ctx), path)) ++failed;
     }
+    free(data);
     CHECK_MSG(failed == 0, "%d truncations with a message that does not name the file", failed);
 }
 
 int main(int argc, char **argv)
 {
     if (argc == 4 && !strcmp(argv[1], "--fixture")) return write_fixture(argv[2], atoi(argv[3]), 0) != 0;
-    snprintf(work, sizeof work, "/tmp/cm-test-exodus-XXXXXX");
-    if (!mkdtemp(work)) return 1;
+    if (test_work_temp("exodus") != 0) return 1;
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
-    char path8[160], path4[160];
-    snprintf(path8, sizeof path8, "%s/mixed.exo", work);
-    snprintf(path4, sizeof path4, "%s/mixed_float.e", work);
+    char path8[1024], path4[1024];
+    snprintf(path8, sizeof path8, "%s/mixed.exo", test_work_dir());
+    snprintf(path4, sizeof path4, "%s/mixed_float.e", test_work_dir());
     CHECK(write_fixture(path8, 8, 0) == 0);
     CHECK(write_fixture(path4, 4, 0) == 0);
     test_read(ctx, path8);
@@ -435,8 +425,6 @@ int main(int argc, char **argv)
     test_2d(ctx);
     test_hostile(ctx, path8);
     cm_context_destroy(&ctx);
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", work);
-    if (system(cmd) != 0) return 1;
+    if (test_work_remove() != 0) return 1;
     return TEST_REPORT();
 }

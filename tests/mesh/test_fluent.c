@@ -9,6 +9,7 @@
 #include "cadmorph/mesh.h"
 #include "origin.h"
 #include "rewrite.h"
+#include "test_files.h"
 #include "test_util.h"
 
 #include <stdlib.h>
@@ -32,27 +33,6 @@ static char *work(const char *name)
     char *p = path[k++ % 4];
     snprintf(p, 512, "%s/fluent_%s", work_dir, name);
     return p;
-}
-
-static char *slurp(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *d = malloc((size_t)len + 1);
-    *n = fread(d, 1, (size_t)len, f);
-    d[*n] = '\0';
-    fclose(f);
-    return d;
-}
-
-static void spill(const char *path, const char *d, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    fwrite(d, 1, n, f);
-    fclose(f);
 }
 
 static cm_mesh *read_ok(cm_context *ctx, const char *path)
@@ -172,7 +152,7 @@ static int same_outside_spans(cm_context *ctx, const char *a, const char *b)
     if (ma && mb) {
         const cm_rewrite_source *sa = cm_mesh_origin_state(ma, CM_FORMAT_FLUENT), *sb = cm_mesh_origin_state(mb, CM_FORMAT_FLUENT);
         size_t na, nb;
-        char *da = slurp(a, &na), *db = slurp(b, &nb);
+        char *da = test_read_file(a, &na), *db = test_read_file(b, &nb);
         const cm_rewrite_file *fa = &sa->files[0], *fb = &sb->files[0];
         same = fa->n_spans == fb->n_spans && fa->n_spans > 0;
         int64_t pa = 0, pb = 0;
@@ -201,7 +181,7 @@ static void test_write_back(cm_context *ctx, const char *name, double tol)
     /* unchanged: the file comes back byte for byte (to .msh: the origin wins over gmsh) */
     CHECK(cm_mesh_write(ctx, m, work(name), NULL) == CM_OK);
     size_t n0, n1;
-    char *d0 = slurp(fixture(name), &n0), *d1 = slurp(work(name), &n1);
+    char *d0 = test_read_file(fixture(name), &n0), *d1 = test_read_file(work(name), &n1);
     CHECK_MSG(d1 && n0 == n1 && !memcmp(d0, d1, n0), "%s: unchanged mesh not written back byte for byte", name);
     free(d1);
     /* an affine motion of every node */
@@ -232,7 +212,7 @@ static void test_write_back(cm_context *ctx, const char *name, double tol)
     /* moved nodes come back; unmoved ones keep their text */
     memcpy(m->xyz, x0, 3 * m->n_nodes * sizeof *x0);
     CHECK(cm_mesh_write(ctx, m, work("back.msh"), NULL) == CM_OK);
-    d1 = slurp(work("back.msh"), &n1);
+    d1 = test_read_file(work("back.msh"), &n1);
     CHECK_MSG(d1 && n0 == n1 && !memcmp(d0, d1, n0), "%s: moved back, not the original bytes", name);
     free(d1);
     free(d0);
@@ -250,7 +230,7 @@ static void test_write_back(cm_context *ctx, const char *name, double tol)
 static void hostile(cm_context *ctx, const char *name, const char *text, size_t n, const char *want)
 {
     const char *path = work(name);
-    spill(path, text, n);
+    test_write_file(path, text, n);
     cm_mesh *m = NULL;
     cm_status s = cm_mesh_read(ctx, path, &m);
     const char *msg = cm_context_message(ctx);
@@ -276,19 +256,20 @@ static char *edit(const char *text, const char *from, const char *to, size_t *n)
 static void test_hostile(cm_context *ctx)
 {
     size_t n = 0, nb = 0, ne = 0;
-    char *box = slurp(fixture("box.msh"), &n), *bin = slurp(fixture("box_double.msh"), &nb);
+    char *box = test_read_file(fixture("box.msh"), &n);
+    char *bin = test_read_file(fixture("box_double.msh"), &nb);
     /* truncations (every 29th / 11th byte: the files are written to disk) fail cleanly, or
      * read: a cut in trailing blanks */
     int crashes = 0;
     for (size_t k = 0; k < n; k += 29) {
-        spill(work("cut.msh"), box, k);
+        test_write_file(work("cut.msh"), box, k);
         cm_mesh *m = NULL;
         cm_status s = cm_mesh_read(ctx, work("cut.msh"), &m);
         crashes += s < 0 ? m != NULL || strchr(cm_context_message(ctx), '\n') != NULL : m == NULL;
         cm_mesh_destroy(&m);
     }
     for (size_t k = 0; k < nb; k += 11) {
-        spill(work("cutb.msh"), bin, k);
+        test_write_file(work("cutb.msh"), bin, k);
         cm_mesh *m = NULL;
         cm_status s = cm_mesh_read(ctx, work("cutb.msh"), &m);
         crashes += s < 0 ? m != NULL || strchr(cm_context_message(ctx), '\n') != NULL : m == NULL;
@@ -338,7 +319,7 @@ static void test_hostile(cm_context *ctx)
 static void test_case_sections(cm_context *ctx)
 {
     size_t n = 0;
-    char *box = slurp(fixture("box.msh"), &n);
+    char *box = test_read_file(fixture("box.msh"), &n);
     static const char extra[] = "(1 \"header (with a parenthesis\")\n"
                                 "(37 ((\"rp\" \"a string ) with \\\" quote\" (nested (list)))))\n"
                                 "(18 (1 2 3 4)(\n1 2\n))\n"
@@ -347,7 +328,7 @@ static void test_case_sections(cm_context *ctx)
     char *cas = malloc(n + ne);
     memcpy(cas, extra, ne);
     memcpy(cas + ne, box, n);
-    spill(work("case.cas"), cas, n + ne);
+    test_write_file(work("case.cas"), cas, n + ne);
     cm_mesh *a = read_ok(ctx, fixture("box.msh")), *b = read_ok(ctx, work("case.cas"));
     if (a && b) {
         CHECK(a->n_cells == b->n_cells && !memcmp(a->xyz, b->xyz, 3 * a->n_nodes * sizeof *a->xyz));

@@ -7,6 +7,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cadmorph/mesh.h"
 #include "origin.h"
+#include "test_files.h"
 #include "test_mesh.h"
 #include "test_util.h"
 
@@ -20,36 +21,10 @@
 static cm_context *ctx;
 static char work[2048];
 
-static char *slurp(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long l = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *d = malloc((size_t)l + 1);
-    if (d && fread(d, 1, (size_t)l, f) != (size_t)l) {
-        free(d);
-        d = NULL;
-    }
-    if (d) d[l] = '\0';
-    fclose(f);
-    if (n) *n = (size_t)l;
-    return d;
-}
-
-static void spit(const char *path, const char *d, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    if (!f) return;
-    fwrite(d, 1, n, f);
-    fclose(f);
-}
-
 static int same_file(const char *a, const char *b)
 {
     size_t na, nb;
-    char *x = slurp(a, &na), *y = slurp(b, &nb);
+    char *x = test_read_file(a, &na), *y = test_read_file(b, &nb);
     int same = x && y && na == nb && !memcmp(x, y, na);
     free(x);
     free(y);
@@ -198,11 +173,11 @@ static void zones(void)
     const char *cz = "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class regIOobject;\n    object cellZones;\n}\n"
                      "2\n(\nporous\n{\n    type cellZone;\n    cellLabels List<label> 3(0 1 2);\n}\n"
                      "rest\n{\n    type cellZone;\n    cellLabels List<label> 2{5};\n    meta { a 1; }\n}\n)\n";
-    spit(f, cz, strlen(cz));
+    test_write_file(f, cz, strlen(cz));
     snprintf(f, sizeof f, "%s/constant/polyMesh/faceZones", dir);
     const char *fz = "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class regIOobject;\n    object faceZones;\n}\n"
                      "1\n(\nbaffle\n{\n    type faceZone;\n    faceLabels List<label> 2(0 1);\n    flipMap List<bool> 2(0 1);\n}\n)\n";
-    spit(f, fz, strlen(fz));
+    test_write_file(f, fz, strlen(fz));
     cm_mesh *r = NULL;
     cm_status s = cm_mesh_read(ctx, dir, &r);
     CHECK_MSG(s == CM_OK, "zones: %s", cm_context_message(ctx));
@@ -227,7 +202,7 @@ static void zones(void)
     const char *czbad = "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class regIOobject;\n    object cellZones;\n}\n"
                         "1\n(\nz\n{\n    type cellZone;\n    cellLabels List<label> 1(999);\n}\n)\n";
     snprintf(f, sizeof f, "%s/constant/polyMesh/cellZones", dir);
-    spit(f, czbad, strlen(czbad));
+    test_write_file(f, czbad, strlen(czbad));
     s = cm_mesh_read(ctx, dir, &r);
     CHECK_MSG(s == CM_ERR_FORMAT && strstr(cm_context_message(ctx), "cellZones") &&
                   strstr(cm_context_message(ctx), "out of range"),
@@ -298,7 +273,7 @@ static void gzip_copy(const char *src_name, const char *dst_name)
         snprintf(a, sizeof a, "%s/%s/constant/polyMesh/%s", work, src_name, all[i]);
         snprintf(b, sizeof b, "%s/%s.gz", dir, all[i]);
         size_t n;
-        char *d = slurp(a, &n);
+        char *d = test_read_file(a, &n);
         gzFile g = gzopen(b, "wb");
         if (d && g) gzwrite(g, d, (unsigned)n);
         if (g) gzclose(g);
@@ -370,7 +345,7 @@ static void binary_read(void)
     for (int k = 0; k < 2; ++k) {
         char a[2400];
         snprintf(a, sizeof a, "%s/constant/polyMesh/%s", src, lists[k]);
-        char *d = slurp(a, NULL);
+        char *d = test_read_file(a, NULL);
         char *at = d ? strstr(d, "}") : NULL;
         long long n = at ? strtoll(strchr(at, '\n') ? strpbrk(at, "0123456789") : at, &at, 10) : 0;
         int64_t *v = malloc((size_t)(n ? n : 1) * 8);
@@ -387,7 +362,7 @@ static void binary_read(void)
     {
         char a[2400];
         snprintf(a, sizeof a, "%s/constant/polyMesh/faces", src);
-        char *d = slurp(a, NULL);
+        char *d = test_read_file(a, NULL);
         char *at = strpbrk(strstr(d, "}"), "0123456789");
         long long n = strtoll(at, &at, 10);
         at = strchr(at, '(') + 1;
@@ -412,8 +387,8 @@ static void binary_read(void)
         char b[2700];
         snprintf(a, sizeof a, "%s/constant/polyMesh/boundary", src);
         snprintf(b, sizeof b, "%s/boundary", pm);
-        d = slurp(a, NULL);
-        spit(b, d, strlen(d));
+        d = test_read_file(a, NULL);
+        test_write_file(b, d, strlen(d));
         free(d);
     }
     cm_mesh *bm = NULL;
@@ -434,7 +409,7 @@ static void binary_read(void)
         char pts[2500];
         snprintf(pts, sizeof pts, "%s/points", out);
         size_t n;
-        char *d = slurp(pts, &n);
+        char *d = test_read_file(pts, &n);
         CHECK(d && strstr(d, "format binary;") && n > 3 * 8 * w->n_nodes);
         free(d);
         cm_mesh *rr = NULL;
@@ -496,12 +471,12 @@ static void hostile(void)
             char g[2500];
             snprintf(g, sizeof g, "%s/%s/constant/polyMesh/%s", work, c->to, c->file);
             size_t n;
-            char *d = slurp(g, &n);
-            if (d) spit(f, d, n);
+            char *d = test_read_file(g, &n);
+            if (d) test_write_file(f, d, n);
             free(d);
         } else {
             size_t n;
-            char *d = slurp(f, &n);
+            char *d = test_read_file(f, &n);
             char *body = d ? (strcmp(c->from, "FoamFile") ? strstr(d, "// * *") : d) : NULL;
             char *at = body ? strstr(body, c->from) : NULL;
             CHECK_MSG(at != NULL, "case %zu: '%s' not in %s", i, c->from, f);
@@ -514,7 +489,7 @@ static void hostile(void)
             memcpy(e, d, pre);
             memcpy(e + pre, c->to, lt);
             memcpy(e + pre + lt, at + lf, n - pre - lf);
-            spit(f, e, n - lf + lt);
+            test_write_file(f, e, n - lf + lt);
             free(e);
             free(d);
         }
@@ -552,7 +527,7 @@ static void corruptions(void)
         snprintf(a, sizeof a, "%s/constant/polyMesh/%s", good, all[f]);
         snprintf(b, sizeof b, "%s/constant/polyMesh/%s", bad, all[f]);
         size_t n;
-        char *d = slurp(a, &n);
+        char *d = test_read_file(a, &n);
         if (!d) continue;
         int edits = 1 + (int)test_rng_range(&seed, 0, 4);
         for (int e = 0; e < edits; ++e) {
@@ -560,7 +535,7 @@ static void corruptions(void)
             if (test_rng_range(&seed, 0, 1) < 0.2) n = at; /* truncate */
             else if (at < n) d[at] = junk[(int)test_rng_range(&seed, 0, sizeof junk - 1)];
         }
-        spit(b, d, n);
+        test_write_file(b, d, n);
         cm_mesh *r = NULL;
         cm_status s = cm_mesh_read(ctx, bad, &r);
         if (s < 0) {
@@ -573,8 +548,8 @@ static void corruptions(void)
         cm_mesh_destroy(&r);
         /* restore the good file */
         free(d);
-        d = slurp(a, &n);
-        if (d) spit(b, d, n);
+        d = test_read_file(a, &n);
+        if (d) test_write_file(b, d, n);
         free(d);
     }
     CHECK_MSG(bad_mesh == 0, "%d corrupted reads returned a broken mesh or an unnamed error", bad_mesh);

@@ -3,6 +3,7 @@
  * VTK's node order says, write -> read is bit-exact in every variant, broken files fail
  * with file and line/byte. Also dumps what it read for test_msh_crosscheck.py (meshio, gmsh). */
 #include "cadmorph/mesh.h"
+#include "test_files.h"
 #include "test_util.h"
 
 #include <dirent.h>
@@ -447,10 +448,7 @@ static void test_write_errors(cm_context *ctx)
 static cm_status read_text(cm_context *ctx, const char *name, const char *text, size_t len, char *path, size_t n)
 {
     join(path, n, work_dir, name);
-    FILE *f = fopen(path, "wb");
-    if (!f) return CM_ERR_IO;
-    fwrite(text, 1, len, f);
-    fclose(f);
+    if (test_write_file(path, text, len) != 0) return CM_ERR_IO;
     cm_mesh *m = NULL;
     cm_status s = cm_mesh_read(ctx, path, &m);
     cm_mesh_destroy(&m);
@@ -504,23 +502,6 @@ static void test_bad_input(cm_context *ctx)
     }
 }
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *d = malloc((size_t)n + 1);
-    if (d && fread(d, 1, (size_t)n, f) != (size_t)n) {
-        free(d);
-        d = NULL;
-    }
-    fclose(f);
-    *len = (size_t)n;
-    return d;
-}
-
 /* Every cut of a file before its $EndElements fails with the file's name (never crashes);
  * random byte changes never crash and never give an invalid mesh. */
 static void test_truncate_and_fuzz(cm_context *ctx, const char *fixture)
@@ -528,7 +509,7 @@ static void test_truncate_and_fuzz(cm_context *ctx, const char *fixture)
     char src[1024], path[1024];
     snprintf(src, sizeof src, "%s/msh/%s", data_dir, fixture);
     size_t len = 0;
-    char *d = slurp(src, &len);
+    char *d = test_read_file(src, &len);
     CHECK_MSG(d != NULL, "cannot read %s", src);
     if (!d) return;
     size_t end = 0;

@@ -8,6 +8,7 @@
 #include "cadmorph/mesh.h"
 #include "formats.h"
 #include "nastran_internal.h"
+#include "test_files.h"
 #include "test_util.h"
 
 #include <stdlib.h>
@@ -15,43 +16,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static char work[64];
 static cm_context *ctx;
-
-static void put_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    fputs(text, f);
-    fclose(f);
-}
-
-static char *get_file(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *d = malloc((size_t)n + 1);
-    d[fread(d, 1, (size_t)n, f)] = '\0';
-    fclose(f);
-    return d;
-}
-
-static const char *at(const char *name)
-{
-    static char buf[4][256];
-    static int k;
-    k = (k + 1) % 4;
-    snprintf(buf[k], sizeof buf[k], "%s/%s", work, name);
-    return buf[k];
-}
 
 static cm_mesh *read_text(const char *name, const char *text)
 {
-    put_file(at(name), text);
+    test_write_text(test_at(name), text);
     cm_mesh *m = NULL;
-    cm_status s = cm_mesh_read(ctx, at(name), &m);
+    cm_status s = cm_mesh_read(ctx, test_at(name), &m);
     CHECK_MSG(s == CM_OK, "%s: %s", name, cm_context_message(ctx));
     return m;
 }
@@ -59,11 +30,11 @@ static cm_mesh *read_text(const char *name, const char *text)
 /* The read fails with a message naming the file and (when line > 0) the line. */
 static void refuse(const char *name, const char *text, int line, const char *what)
 {
-    put_file(at(name), text);
+    test_write_text(test_at(name), text);
     cm_mesh *m = NULL;
-    cm_status s = cm_mesh_read(ctx, at(name), &m);
+    cm_status s = cm_mesh_read(ctx, test_at(name), &m);
     char want[300];
-    snprintf(want, sizeof want, line > 0 ? "%s:%d:" : "%s", at(name), line);
+    snprintf(want, sizeof want, line > 0 ? "%s:%d:" : "%s", test_at(name), line);
     CHECK_MSG(s < 0 && !m, "%s: read succeeded", name);
     CHECK_MSG(strstr(cm_context_message(ctx), want) && strstr(cm_context_message(ctx), what), "%s: %s (want %s ... %s)",
               name, cm_context_message(ctx), want, what);
@@ -268,12 +239,12 @@ static void test_coords(void)
     const double d[3] = {0.25, -0.5, 0.125};
     for (int i = 0; i < 4; ++i)
         for (int k = 0; k < 3; ++k) m->xyz[3 * i + k] += d[k];
-    CHECK_MSG(cm_mesh_write(ctx, m, at("cord_out.bdf"), NULL) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_write(ctx, m, test_at("cord_out.bdf"), NULL) == CM_OK, "%s", cm_context_message(ctx));
     cm_mesh *b = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("cord_out.bdf"), &b) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_read(ctx, test_at("cord_out.bdf"), &b) == CM_OK, "%s", cm_context_message(ctx));
     for (int i = 0; b && i < 4; ++i)
         for (int k = 0; k < 3; ++k) CHECK_NEAR(b->xyz[3 * i + k], want[i][k] + d[k], 1e-6);
-    char *out = get_file(at("cord_out.bdf"));
+    char *out = test_read_file(test_at("cord_out.bdf"), NULL);
     /* node 2 in system 1 (x along basic y, y along -x): moved by (0.25, -0.5) basic = (-0.5, -0.25) local */
     CHECK_MSG(strstr(out, "GRID    2       1       -.5     .75     .125\n") != NULL, "%s", out);
     /* the systems' cards are untouched */
@@ -285,32 +256,34 @@ static void test_coords(void)
 
 static void test_include(void)
 {
-    mkdir(at("inc"), 0777);
-    mkdir(at("inc/sub"), 0777);
-    mkdir(at("inc_out"), 0777);
-    mkdir(at("inc_out/sub"), 0777);
-    put_file(at("inc/sub/nodes.bdf"), "$ nodes\nGRID    2               1.      0.      0.\nINCLUDE 'more.bdf'\n");
-    put_file(at("inc/sub/more.bdf"), "GRID    3               0.      1.      0.\n");
-    put_file(at("inc/main.bdf"), "SOL 101\nCEND\nBEGIN BULK\nGRID    1               0.      0.      0.\n"
-                                 "INCLUDE 'su\n  b/nodes.bdf'\nGRID    4               0.      0.      1.\n"
-                                 "CTETRA  1       1       1       2       3       4\nENDDATA\n");
+    mkdir(test_at("inc"), 0777);
+    mkdir(test_at("inc/sub"), 0777);
+    mkdir(test_at("inc_out"), 0777);
+    mkdir(test_at("inc_out/sub"), 0777);
+    test_write_text(test_at("inc/sub/nodes.bdf"),
+                    "$ nodes\nGRID    2               1.      0.      0.\nINCLUDE 'more.bdf'\n");
+    test_write_text(test_at("inc/sub/more.bdf"), "GRID    3               0.      1.      0.\n");
+    test_write_text(test_at("inc/main.bdf"),
+                    "SOL 101\nCEND\nBEGIN BULK\nGRID    1               0.      0.      0.\n"
+                    "INCLUDE 'su\n  b/nodes.bdf'\nGRID    4               0.      0.      1.\n"
+                    "CTETRA  1       1       1       2       3       4\nENDDATA\n");
     cm_mesh *m = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("inc/main.bdf"), &m) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_read(ctx, test_at("inc/main.bdf"), &m) == CM_OK, "%s", cm_context_message(ctx));
     if (!m) return;
     CHECK(m->n_nodes == 4 && m->node_tag[1] == 2 && m->node_tag[2] == 3 && m->xyz[3 * 2 + 1] == 1.0);
     m->xyz[3 * 1 + 0] = 1.5;  /* in sub/nodes.bdf */
     m->xyz[3 * 2 + 2] = -0.25; /* in sub/more.bdf, included by sub/nodes.bdf */
     /* beside the source: the included copies would overwrite their sources */
-    CHECK(cm_mesh_write(ctx, m, at("inc/main2.bdf"), NULL) == CM_ERR_ARGUMENT);
-    CHECK_MSG(cm_mesh_write(ctx, m, at("inc_out/main.bdf"), NULL) == CM_OK, "%s", cm_context_message(ctx));
-    char *a = get_file(at("inc/main.bdf")), *b = get_file(at("inc_out/main.bdf"));
+    CHECK(cm_mesh_write(ctx, m, test_at("inc/main2.bdf"), NULL) == CM_ERR_ARGUMENT);
+    CHECK_MSG(cm_mesh_write(ctx, m, test_at("inc_out/main.bdf"), NULL) == CM_OK, "%s", cm_context_message(ctx));
+    char *a = test_read_file(test_at("inc/main.bdf"), NULL), *b = test_read_file(test_at("inc_out/main.bdf"), NULL);
     CHECK(a && b && !strcmp(a, b));
     free(a);
     free(b);
-    a = get_file(at("inc_out/sub/nodes.bdf"));
+    a = test_read_file(test_at("inc_out/sub/nodes.bdf"), NULL);
     CHECK_MSG(a && !strcmp(a, "$ nodes\nGRID    2               1.5     0.      0.\nINCLUDE 'more.bdf'\n"), "%s", a);
     free(a);
-    a = get_file(at("inc_out/sub/more.bdf"));
+    a = test_read_file(test_at("inc_out/sub/more.bdf"), NULL);
     CHECK_MSG(a && !strcmp(a, "GRID    3               0.      1.      -.25\n"), "%s", a);
     free(a);
     cm_mesh_destroy(&m);
@@ -332,10 +305,10 @@ static void test_hostile(void)
     snprintf(deck, sizeof deck, "%sCTETRA,1,1,1,2,3,99999999999999999999\n", g4);
     refuse("h_bigid.bdf", deck, 5, "GRID id");
     /* a huge id is only a number: no allocation by its value */
-    put_file(at("h_hugeok.bdf"), "GRID*   9999999999999999                0.              0.\n*       0.\n"
+    test_write_text(test_at("h_hugeok.bdf"), "GRID*   9999999999999999                0.              0.\n*       0.\n"
                                  "GRID    1               1.      0.      0.\n");
     cm_mesh *m = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("h_hugeok.bdf"), &m) == CM_OK && m->node_tag[0] == 9999999999999999LL, "%s",
+    CHECK_MSG(cm_mesh_read(ctx, test_at("h_hugeok.bdf"), &m) == CM_OK && m->node_tag[0] == 9999999999999999LL, "%s",
               cm_context_message(ctx));
     cm_mesh_destroy(&m);
     snprintf(deck, sizeof deck, "%sGRID    2               0.      0.      0.\n", g4);
@@ -369,10 +342,10 @@ static void test_hostile(void)
                        "GRID,2,,1.,0.,0.\nGRID    3               0.      1.      0.\nGRID    4               0.      0.      1.\n"
                        "CTETRA  1       1       1       2       3       4\nENDDATA\n";
     for (size_t n = 0; n < strlen(full); ++n) {
-        FILE *f = fopen(at("h_cut.bdf"), "wb");
+        FILE *f = fopen(test_at("h_cut.bdf"), "wb");
         fwrite(full, 1, n, f);
         fclose(f);
-        cm_status s = cm_mesh_read(ctx, at("h_cut.bdf"), &m);
+        cm_status s = cm_mesh_read(ctx, test_at("h_cut.bdf"), &m);
         CHECK((s < 0) == (m == NULL));
         cm_mesh_destroy(&m);
     }
@@ -412,8 +385,8 @@ static void test_write_back(void)
     cm_mesh *m = read_text("wb.bdf", deck);
     if (!m) return;
     /* unmoved: byte for byte */
-    CHECK(cm_mesh_write(ctx, m, at("wb_same.bdf"), NULL) == CM_OK);
-    char *same = get_file(at("wb_same.bdf"));
+    CHECK(cm_mesh_write(ctx, m, test_at("wb_same.bdf"), NULL) == CM_OK);
+    char *same = test_read_file(test_at("wb_same.bdf"), NULL);
     CHECK(same && !strcmp(same, deck));
     free(same);
     /* an affine motion of every node */
@@ -423,8 +396,8 @@ static void test_write_back(void)
     for (int i = 0; i < 5; ++i)
         for (int k = 0; k < 3; ++k)
             now[3 * i + k] = m->xyz[3 * i + k] = t[k] + A[k][0] * was[3 * i] + A[k][1] * was[3 * i + 1] + A[k][2] * was[3 * i + 2];
-    CHECK_MSG(cm_mesh_write(ctx, m, at("wb_moved.bdf"), NULL) == CM_OK, "%s", cm_context_message(ctx));
-    char *moved = get_file(at("wb_moved.bdf"));
+    CHECK_MSG(cm_mesh_write(ctx, m, test_at("wb_moved.bdf"), NULL) == CM_OK, "%s", cm_context_message(ctx));
+    char *moved = test_read_file(test_at("wb_moved.bdf"), NULL);
     /* node 1 (-2.5 + 0.3 = -2.2 fits, 10 + 1.2 = 11.2 fits) in place; node 2's y = -2.6 fits */
     CHECK_MSG(strstr(moved, "GRID    1       0       .123    -2.2    11.2    \n") != NULL, "%s", moved);
     CHECK_MSG(strstr(moved, "GRID    2               1.223   -2.6    10.05   0       3\n") != NULL, "%s", moved);
@@ -434,7 +407,7 @@ static void test_write_back(void)
     /* the rest: byte for byte, lines of the GRID cards aside */
     compare_non_grid(deck, moved);
     cm_mesh *b = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("wb_moved.bdf"), &b) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_read(ctx, test_at("wb_moved.bdf"), &b) == CM_OK, "%s", cm_context_message(ctx));
     /* the affine image to each field's precision (node 3: 12 digits in 16 columns) */
     for (int i = 0; b && i < 15; ++i) CHECK_NEAR(b->xyz[i], now[i], 1e-11 * fabs(now[i]) + 1e-300);
     cm_mesh_destroy(&b);
@@ -446,19 +419,19 @@ static void test_write_back(void)
     m->xyz[2] = 1.23456789;   /* X3: input "1.000000", 7 digits: "1.234568" fits */
     m->xyz[3] = -1.234567e-7; /* node 2 X1, input "1." (1 digit): the most digits that fit */
     m->xyz[4] = 1234567.891;  /* node 2 X2, input "0." -> "1234568." fits in 8 */
-    CHECK(cm_mesh_write(ctx, m, at("wb_fit.bdf"), NULL) == CM_OK);
-    moved = get_file(at("wb_fit.bdf"));
+    CHECK(cm_mesh_write(ctx, m, test_at("wb_fit.bdf"), NULL) == CM_OK);
+    moved = test_read_file(test_at("wb_fit.bdf"), NULL);
     CHECK_MSG(strstr(moved, "GRID    1       0       -123.4570.00E+001.234568\n") != NULL, "%s", moved);
     CHECK_MSG(strstr(moved, "GRID    2               -1.235-71234568.0.      0       3\n") != NULL, "%s", moved);
     free(moved);
     memcpy(m->xyz, was, sizeof was);
     m->xyz[2] = -1.23456789; /* "1.000000" (7 digits): -1.234568 needs 9 columns */
-    CHECK(cm_mesh_write(ctx, m, at("wb_large.bdf"), NULL) == CM_OK);
-    moved = get_file(at("wb_large.bdf"));
+    CHECK(cm_mesh_write(ctx, m, test_at("wb_large.bdf"), NULL) == CM_OK);
+    moved = test_read_file(test_at("wb_large.bdf"), NULL);
     CHECK_MSG(strstr(moved, "\nGRID*   1               0               0.00E+00        0.00E+00\n"
                             "*       -1.23456789\nGRID    2 ") != NULL, "%s", moved);
     free(moved);
-    CHECK(cm_mesh_read(ctx, at("wb_large.bdf"), &b) == CM_OK && b->xyz[2] == -1.23456789);
+    CHECK(cm_mesh_read(ctx, test_at("wb_large.bdf"), &b) == CM_OK && b->xyz[2] == -1.23456789);
     cm_mesh_destroy(&b);
     /* written into a path of another format: a new file; into .bdf after the mesh changed: a new deck */
     cm_mesh_destroy(&m);
@@ -476,37 +449,36 @@ static void test_new_deck(void)
     cm_mesh_add_cell(ctx, m, CM_CELL_TRI3, tri, 3, 2, 0, 0);
     cm_mesh_add_cell(ctx, m, CM_CELL_POINT, &pt, 1, 0, 0, 0);
     cm_mesh_add_group(ctx, m, 3, 4, "solid");
-    CHECK(cm_mesh_write(ctx, m, at("new.bdf"), NULL) == CM_WARNING); /* the point cell is left out */
+    CHECK(cm_mesh_write(ctx, m, test_at("new.bdf"), NULL) == CM_WARNING); /* the point cell is left out */
     cm_mesh *b = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("new.bdf"), &b) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_read(ctx, test_at("new.bdf"), &b) == CM_OK, "%s", cm_context_message(ctx));
     if (b) {
         CHECK(b->n_nodes == 8 && b->n_cells == 2 && b->type[0] == CM_CELL_HEX8 && b->physical[0] == 4 && b->physical[1] == 2);
         for (int i = 0; i < 24; ++i) CHECK_NEAR(b->xyz[i], m->xyz[i], 1e-10 * fabs(m->xyz[i]));
         for (int i = 0; i < 8; ++i) CHECK(b->conn[i] == i);
     }
-    char *d = get_file(at("new.bdf"));
+    char *d = test_read_file(test_at("new.bdf"), NULL);
     CHECK(d && strstr(d, "$ PID 4 (dimension 3): solid\n") && strstr(d, "BEGIN BULK\n") && strstr(d, "ENDDATA\n"));
     free(d);
     cm_mesh_destroy(&b);
     /* no card for a polygon: refused, nothing written */
     const int64_t poly[5] = {0, 1, 2, 3, 4};
     cm_mesh_add_cell(ctx, m, CM_CELL_POLYGON, poly, 5, 0, 0, 0);
-    CHECK(cm_mesh_write(ctx, m, at("poly.bdf"), NULL) == CM_ERR_UNSUPPORTED && access(at("poly.bdf"), F_OK) != 0);
+    CHECK(cm_mesh_write(ctx, m, test_at("poly.bdf"), NULL) == CM_ERR_UNSUPPORTED && access(test_at("poly.bdf"), F_OK) != 0);
     cm_mesh_destroy(&m);
 }
 
 static void test_sniff(void)
 {
     CHECK(cm_mesh_format_from_path("x.bdf") == CM_FORMAT_NASTRAN && cm_mesh_format_from_path("x.NAS") == CM_FORMAT_NASTRAN);
-    put_file(at("deck.dat"), "$ a deck\nGRID    1               0.      0.      0.\n");
-    CHECK(cm_mesh_format_from_path(at("deck.dat")) == CM_FORMAT_NASTRAN);
+    test_write_text(test_at("deck.dat"), "$ a deck\nGRID    1               0.      0.      0.\n");
+    CHECK(cm_mesh_format_from_path(test_at("deck.dat")) == CM_FORMAT_NASTRAN);
     CHECK(cm_nastran_sniff("$ c\nBEGIN BULK\n", 15) && !cm_nastran_sniff("1 2 3\n4 5 6\n", 12));
 }
 
 int main(void)
 {
-    snprintf(work, sizeof work, "/tmp/cm-test-nastran-XXXXXX");
-    if (!mkdtemp(work)) return 1;
+    if (test_work_temp("nastran") != 0) return 1;
     cm_context_create(&ctx);
     test_numbers();
     test_layouts();
@@ -518,8 +490,6 @@ int main(void)
     test_new_deck();
     test_sniff();
     cm_context_destroy(&ctx);
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", work);
-    if (system(cmd) != 0) return 1;
+    if (test_work_remove() != 0) return 1;
     return TEST_REPORT();
 }

@@ -5,6 +5,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cadmorph/mesh.h"
 #include "rewrite.h"
+#include "test_files.h"
 #include "test_util.h"
 
 #include <stdlib.h>
@@ -12,25 +13,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-static char work[64];
-
-static void put_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    fputs(text, f);
-    fclose(f);
-}
-
-static char *get_file(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    static char buf[4096];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = '\0';
-    return buf;
-}
 
 /* The spans of "v x y z" lines: the bytes after "v " to the end of the line. */
 static void add_spans(cm_context *ctx, cm_rewrite_source *src, size_t file, const char *text, int64_t *node)
@@ -74,8 +56,8 @@ static void test_number(void)
 static void test_main_and_include(cm_context *ctx)
 {
     char in_dir[128], out_dir[128], main_in[160], inc_in[160], main_out[160], inc_out[160];
-    snprintf(in_dir, sizeof in_dir, "%s/in", work);
-    snprintf(out_dir, sizeof out_dir, "%s/out", work);
+    snprintf(in_dir, sizeof in_dir, "%s", test_at("in"));
+    snprintf(out_dir, sizeof out_dir, "%s", test_at("out"));
     mkdir(in_dir, 0777);
     mkdir(out_dir, 0777);
     snprintf(main_in, sizeof main_in, "%s/deck.txt", in_dir);
@@ -87,9 +69,9 @@ static void test_main_and_include(cm_context *ctx)
     char cells_in[160], cells_out[160];
     snprintf(cells_in, sizeof cells_in, "%s/cells.txt", in_dir);
     snprintf(cells_out, sizeof cells_out, "%s/cells.txt", out_dir);
-    put_file(main_in, main_text);
-    put_file(inc_in, inc_text);
-    put_file(cells_in, "c 0 1 2\n");
+    test_write_text(main_in, main_text);
+    test_write_text(inc_in, inc_text);
+    test_write_text(cells_in, "c 0 1 2\n");
 
     cm_rewrite_source *src = cm_rewrite_source_new();
     size_t f0 = 9, f1 = 9;
@@ -115,16 +97,25 @@ static void test_main_and_include(cm_context *ctx)
     CHECK(cm_rewrite_write(ctx, src, m, beside, emit_xyz) == CM_ERR_ARGUMENT);
     CHECK(strstr(cm_context_message(ctx), "nodes.txt") != NULL);
     CHECK(access(beside, F_OK) != 0);
-    CHECK(!strcmp(get_file(inc_in), inc_text));
+    char *d = test_read_file(inc_in, NULL);
+    CHECK(d && !strcmp(d, inc_text));
+    free(d);
 
     CHECK(cm_rewrite_write(ctx, src, m, main_out, emit_xyz) == CM_OK);
-    CHECK_MSG(!strcmp(get_file(main_out), "# deck\nv 0 0 0\ninclude nodes.txt\ninclude cells.txt\nv 1.000 2 3.25\nend\n"), "%s", get_file(main_out));
-    CHECK_MSG(!strcmp(get_file(inc_out), "v 4 5.5 6\n  trailing text\n"), "%s", get_file(inc_out));
+    d = test_read_file(main_out, NULL);
+    CHECK_MSG(d && !strcmp(d, "# deck\nv 0 0 0\ninclude nodes.txt\ninclude cells.txt\nv 1.000 2 3.25\nend\n"), "%s",
+              d ? d : "(none)");
+    free(d);
+    d = test_read_file(inc_out, NULL);
+    CHECK_MSG(d && !strcmp(d, "v 4 5.5 6\n  trailing text\n"), "%s", d ? d : "(none)");
+    free(d);
     /* an included file without coordinates is copied too: the written deck is complete */
-    CHECK_MSG(get_file(cells_out) && !strcmp(get_file(cells_out), "c 0 1 2\n"), "%s", cells_out);
+    d = test_read_file(cells_out, NULL);
+    CHECK_MSG(d && !strcmp(d, "c 0 1 2\n"), "%s", cells_out);
+    free(d);
 
     /* the source changed since it was read: refused */
-    put_file(main_in, "# deck\nv 0 0 0\ninclude nodes.txt\ninclude cells.txt\nv 1.000 2 3\nend\n\n");
+    test_write_text(main_in, "# deck\nv 0 0 0\ninclude nodes.txt\ninclude cells.txt\nv 1.000 2 3\nend\n\n");
     CHECK(cm_rewrite_write(ctx, src, m, main_out, emit_xyz) == CM_ERR_IO);
     CHECK(strstr(cm_context_message(ctx), "changed") != NULL);
     cm_mesh_destroy(&m);
@@ -133,15 +124,12 @@ static void test_main_and_include(cm_context *ctx)
 
 int main(void)
 {
-    snprintf(work, sizeof work, "/tmp/cm-test-rewrite-XXXXXX");
-    if (!mkdtemp(work)) return 1;
+    if (test_work_temp("rewrite") != 0) return 1;
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
     test_number();
     test_main_and_include(ctx);
     cm_context_destroy(&ctx);
-    char cmd[128];
-    snprintf(cmd, sizeof cmd, "rm -rf %s", work);
-    if (system(cmd) != 0) return 1;
+    if (test_work_remove() != 0) return 1;
     return TEST_REPORT();
 }

@@ -5,40 +5,12 @@
  * no mesh, no crash). Files written by gmsh and meshio: su2_crosscheck.py. */
 #define _POSIX_C_SOURCE 200809L
 #include "cadmorph/mesh.h"
+#include "test_files.h"
 #include "test_util.h"
 
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-static char work[512];
-
-static void put_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    fputs(text, f);
-    fclose(f);
-}
-
-static char *get_file(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    static char buf[1 << 16];
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = '\0';
-    return buf;
-}
-
-static const char *at(const char *name)
-{
-    static char p[4][640];
-    static int k;
-    k = (k + 1) % 4;
-    snprintf(p[k], sizeof p[k], "%s/%s", work, name);
-    return p[k];
-}
 
 static int group_tag(const cm_mesh *m, int dim, const char *name)
 {
@@ -79,9 +51,9 @@ static const char *mixed =
 
 static void test_read(cm_context *ctx)
 {
-    put_file(at("mixed.su2"), mixed);
+    test_write_text(test_at("mixed.su2"), mixed);
     cm_mesh *m = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("mixed.su2"), &m) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_read(ctx, test_at("mixed.su2"), &m) == CM_OK, "%s", cm_context_message(ctx));
     if (!m) return;
     CHECK(m->n_nodes == 13 && m->n_cells == 7);
     CHECK(m->type[0] == CM_CELL_HEX8 && m->type[1] == CM_CELL_WEDGE6 && m->type[2] == CM_CELL_PYR5 &&
@@ -104,11 +76,11 @@ static void test_read(cm_context *ctx)
 static void test_write_back(cm_context *ctx)
 {
     cm_mesh *m = NULL;
-    CHECK(cm_mesh_read(ctx, at("mixed.su2"), &m) == CM_OK);
+    CHECK(cm_mesh_read(ctx, test_at("mixed.su2"), &m) == CM_OK);
     if (!m) return;
-    CHECK(cm_mesh_write(ctx, m, at("same.su2"), NULL) == CM_OK);
-    char *same = strdup(get_file(at("same.su2")));
-    CHECK(!strcmp(same, mixed));
+    CHECK(cm_mesh_write(ctx, m, test_at("same.su2"), NULL) == CM_OK);
+    char *same = test_read_file(test_at("same.su2"), NULL);
+    CHECK(same && !strcmp(same, mixed));
     free(same);
 
     const double A[3][4] = {{0.9, 0.1, -0.2, 0.3}, {0.05, 1.1, 0.0, -1.0 / 3}, {0.0, -0.3, 1.2, 2.5}};
@@ -120,10 +92,11 @@ static void test_write_back(cm_context *ctx)
     /* node 3 stays where it is: its numbers keep their bytes */
     want[9] = m->xyz[9], want[10] = m->xyz[10], want[11] = m->xyz[11];
     memcpy(m->xyz, want, 3 * m->n_nodes * sizeof *want);
-    CHECK_MSG(cm_mesh_write(ctx, m, at("moved.su2"), NULL) == CM_OK, "%s", cm_context_message(ctx));
-    const char *moved = get_file(at("moved.su2"));
-    /* line by line: a point line keeps its blanks and index, every other line its bytes */
-    const char *a = mixed, *b = moved;
+    CHECK_MSG(cm_mesh_write(ctx, m, test_at("moved.su2"), NULL) == CM_OK, "%s", cm_context_message(ctx));
+    char *moved = test_read_file(test_at("moved.su2"), NULL);
+    /* line by line: a point line keeps its blanks and index, every other line its bytes (no
+     * file: no lines, the count check below fails) */
+    const char *a = mixed, *b = moved ? moved : "";
     int in_points = 0, points = 0, diff_other = 0;
     while (*a && *b) {
         const char *ae = strchr(a, '\n'), *be = strchr(b, '\n');
@@ -149,8 +122,9 @@ static void test_write_back(cm_context *ctx)
         b = be + 1;
     }
     CHECK(points == 13 && diff_other == 0 && !*a && !*b);
+    free(moved);
     cm_mesh *r = NULL;
-    CHECK(cm_mesh_read(ctx, at("moved.su2"), &r) == CM_OK);
+    CHECK(cm_mesh_read(ctx, test_at("moved.su2"), &r) == CM_OK);
     if (r) {
         CHECK(!memcmp(r->xyz, want, 3 * r->n_nodes * sizeof *want));
         cm_mesh_destroy(&r);
@@ -158,8 +132,8 @@ static void test_write_back(cm_context *ctx)
     /* a mesh with a node more is no longer the file's: a new file, which reads back */
     CHECK(cm_mesh_resize_nodes(ctx, m, m->n_nodes + 1, 0) == CM_OK);
     m->xyz[3 * 13] = 7, m->xyz[3 * 13 + 1] = 8, m->xyz[3 * 13 + 2] = 9;
-    CHECK(cm_mesh_write(ctx, m, at("grown.su2"), NULL) == CM_OK);
-    CHECK(cm_mesh_read(ctx, at("grown.su2"), &r) == CM_OK);
+    CHECK(cm_mesh_write(ctx, m, test_at("grown.su2"), NULL) == CM_OK);
+    CHECK(cm_mesh_read(ctx, test_at("grown.su2"), &r) == CM_OK);
     if (r) {
         CHECK(r->n_nodes == 14 && r->n_cells == 7 && !memcmp(r->xyz, m->xyz, 3 * 14 * sizeof(double)));
         CHECK(group_tag(r, 2, "lower_wall") > 0 && group_tag(r, 2, "top") > 0);
@@ -177,18 +151,20 @@ static void test_2d(cm_context *ctx)
 {
     const char *text = "NDIME= 2\nNELEM= 2\n5 0 1 2 0\n9 1 3 4 2 1\nNPOIN= 5\n0 0 0\n1 0 1\n0 1 2\n2 0 3\n2 1 4\n"
                        "NMARK= 1\nMARKER_TAG= farfield\nMARKER_ELEMS= 2\n3 0 1\n3 2 0\n";
-    put_file(at("flat.su2"), text);
+    test_write_text(test_at("flat.su2"), text);
     cm_mesh *m = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("flat.su2"), &m) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_read(ctx, test_at("flat.su2"), &m) == CM_OK, "%s", cm_context_message(ctx));
     if (!m) return;
     CHECK(m->n_nodes == 5 && m->n_cells == 4 && m->type[1] == CM_CELL_QUAD4 && m->type[2] == CM_CELL_LINE2);
     CHECK(group_tag(m, 1, "farfield") > 0 && m->xyz[3 * 3] == 2 && m->xyz[3 * 3 + 2] == 0);
     m->xyz[3 * 4 + 1] = 1.25;
-    CHECK(cm_mesh_write(ctx, m, at("flat_moved.su2"), NULL) == CM_OK);
-    CHECK(strstr(get_file(at("flat_moved.su2")), "\n2 1.25 4\nNMARK") != NULL);
+    CHECK(cm_mesh_write(ctx, m, test_at("flat_moved.su2"), NULL) == CM_OK);
+    char *flat = test_read_file(test_at("flat_moved.su2"), NULL);
+    CHECK(flat && strstr(flat, "\n2 1.25 4\nNMARK") != NULL);
+    free(flat);
     m->xyz[3 * 4 + 2] = 0.5;
-    CHECK(cm_mesh_write(ctx, m, at("flat_z.su2"), NULL) == CM_ERR_UNSUPPORTED);
-    CHECK(strstr(cm_context_message(ctx), "NDIME= 2") != NULL && access(at("flat_z.su2"), F_OK) != 0);
+    CHECK(cm_mesh_write(ctx, m, test_at("flat_z.su2"), NULL) == CM_ERR_UNSUPPORTED);
+    CHECK(strstr(cm_context_message(ctx), "NDIME= 2") != NULL && access(test_at("flat_z.su2"), F_OK) != 0);
     cm_mesh_destroy(&m);
 }
 
@@ -202,19 +178,21 @@ static void test_zones(cm_context *ctx)
     snprintf(z1, sizeof z1, zone, 1);
     snprintf(z2, sizeof z2, zone, 2);
     snprintf(text, sizeof text, "NZONE= 2\n\nIZONE= 1\n%s\nIZONE= 2\n%s", z1, z2);
-    put_file(at("zones.su2"), text);
+    test_write_text(test_at("zones.su2"), text);
     cm_mesh *m = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("zones.su2"), &m) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_read(ctx, test_at("zones.su2"), &m) == CM_OK, "%s", cm_context_message(ctx));
     if (!m) return;
     CHECK(m->n_nodes == 8 && m->n_cells == 4 && m->conn[m->offset[2] + 3] == 7 && m->xyz[3 * 7 + 2] == 2);
     const int a = group_tag(m, 3, "zone_1"), b = group_tag(m, 3, "zone_2"), i = group_tag(m, 2, "interface");
     CHECK(a > 0 && b > 0 && i > 0 && m->physical[0] == a && m->physical[2] == b && m->physical[1] == i &&
           m->physical[3] == i);
     m->xyz[3 * 7 + 2] = 3;
-    CHECK(cm_mesh_write(ctx, m, at("zones_moved.su2"), NULL) == CM_OK);
+    CHECK(cm_mesh_write(ctx, m, test_at("zones_moved.su2"), NULL) == CM_OK);
     snprintf(z2, sizeof z2, zone, 3);
     snprintf(text, sizeof text, "NZONE= 2\n\nIZONE= 1\n%s\nIZONE= 2\n%s", z1, z2);
-    CHECK(!strcmp(get_file(at("zones_moved.su2")), text));
+    char *moved = test_read_file(test_at("zones_moved.su2"), NULL);
+    CHECK(moved && !strcmp(moved, text));
+    free(moved);
     cm_mesh_destroy(&m);
 }
 
@@ -231,10 +209,10 @@ static void test_new(cm_context *ctx)
     CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_TET4, t0, 4, 0, 0, 0) == CM_OK);
     CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_TET4, t1, 4, 0, 0, 0) == CM_OK);
     CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_POINT, p, 1, 0, 0, 0) == CM_OK);
-    CHECK(cm_mesh_write(ctx, m, at("new.su2"), NULL) == CM_WARNING);
+    CHECK(cm_mesh_write(ctx, m, test_at("new.su2"), NULL) == CM_WARNING);
     CHECK(strstr(cm_context_message(ctx), "6 boundary faces are the marker 'boundary'; 1 cells") != NULL);
     cm_mesh *r = NULL;
-    CHECK_MSG(cm_mesh_read(ctx, at("new.su2"), &r) == CM_OK, "%s", cm_context_message(ctx));
+    CHECK_MSG(cm_mesh_read(ctx, test_at("new.su2"), &r) == CM_OK, "%s", cm_context_message(ctx));
     if (r) {
         CHECK(r->n_nodes == 5 && r->n_cells == 8 && cm_mesh_count_dim(r, 2) == 6 && group_tag(r, 2, "boundary") > 0);
         CHECK(!memcmp(r->xyz, xyz, sizeof xyz));
@@ -242,8 +220,8 @@ static void test_new(cm_context *ctx)
     }
     const int64_t q[10] = {0, 1, 2, 3, 0, 1, 2, 3, 0, 1};
     CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_TET10, q, 10, 0, 0, 0) == CM_OK);
-    CHECK(cm_mesh_write(ctx, m, at("quadratic.su2"), NULL) == CM_ERR_UNSUPPORTED);
-    CHECK(strstr(cm_context_message(ctx), "tet10") != NULL && access(at("quadratic.su2"), F_OK) != 0);
+    CHECK(cm_mesh_write(ctx, m, test_at("quadratic.su2"), NULL) == CM_ERR_UNSUPPORTED);
+    CHECK(strstr(cm_context_message(ctx), "tet10") != NULL && access(test_at("quadratic.su2"), F_OK) != 0);
     cm_mesh_destroy(&m);
 }
 
@@ -284,11 +262,11 @@ static void test_hostile(cm_context *ctx)
     for (size_t i = 0; i < sizeof cases / sizeof *cases; ++i) {
         char name[64], want[256];
         snprintf(name, sizeof name, "bad_%s.su2", cases[i].name);
-        put_file(at(name), cases[i].text);
+        test_write_text(test_at(name), cases[i].text);
         cm_mesh *m = (cm_mesh *)1;
-        const cm_status s = cm_mesh_read(ctx, at(name), &m);
+        const cm_status s = cm_mesh_read(ctx, test_at(name), &m);
         const char *msg = cm_context_message(ctx);
-        snprintf(want, sizeof want, "cm_mesh_read: %s:%d: expected ", at(name), cases[i].line);
+        snprintf(want, sizeof want, "cm_mesh_read: %s:%d: expected ", test_at(name), cases[i].line);
         CHECK_MSG(s == CM_ERR_FORMAT && m == NULL, "%s: status %d", cases[i].name, (int)s);
         CHECK_MSG(!strncmp(msg, want, strlen(want)) && strstr(msg, cases[i].what) && !strchr(msg, '\n'), "%s: %s",
                   cases[i].name, msg);
@@ -297,10 +275,7 @@ static void test_hostile(cm_context *ctx)
 
 int main(int argc, char **argv)
 {
-    snprintf(work, sizeof work, "%s/su2", argc > 2 ? argv[2] : "/tmp");
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", work);
-    if (system(cmd) != 0) return 1;
+    if (test_work_in(argc > 2 ? argv[2] : "/tmp", "su2") != 0) return 1;
     cm_context *ctx = NULL;
     cm_context_create(&ctx);
     test_read(ctx);
