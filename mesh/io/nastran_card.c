@@ -343,20 +343,28 @@ int nas_format_fit(char *out, size_t cap, double v, int width, int min_digits)
 {
     char t[64];
     double back;
-    /* the shortest exact text, when it fits */
-    for (int d = 1; d <= 17; ++d) {
-        const int n = nas_format_digits(t, sizeof t, v, d);
-        if (nas_parse_real(t, (size_t)n, &back) == 0 && back == v) {
-            if (n <= width && d >= 1) return snprintf(out, cap, "%s", t);
-            break;
-        }
+    /* The shortest exact text, when it fits. Bisections, not walks over the 17 digit counts
+     * (a write back formats every moved coordinate): a text exact with d digits is exact
+     * with more, and more digits never make a shorter text. */
+    int lo = 1, hi = 17;
+    while (lo < hi) {
+        const int mid = (lo + hi) / 2;
+        const int n = nas_format_digits(t, sizeof t, v, mid);
+        if (nas_parse_real(t, (size_t)n, &back) == 0 && back == v) hi = mid;
+        else lo = mid + 1;
     }
+    if (nas_format_digits(t, sizeof t, v, lo) <= width) return snprintf(out, cap, "%s", t);
     /* else the most digits that fit, if at least min_digits */
-    for (int d = 17; d >= min_digits && d >= 1; --d) {
-        const int n = nas_format_digits(t, sizeof t, v, d);
-        if (n <= width) return snprintf(out, cap, "%s", t);
+    lo = min_digits < 1 ? 1 : min_digits;
+    hi = 17;
+    if (lo > hi || nas_format_digits(t, sizeof t, v, lo) > width) return 0;
+    while (lo < hi) {
+        const int mid = (lo + hi + 1) / 2;
+        if (nas_format_digits(t, sizeof t, v, mid) <= width) lo = mid;
+        else hi = mid - 1;
     }
-    return 0;
+    nas_format_digits(t, sizeof t, v, lo);
+    return snprintf(out, cap, "%s", t);
 }
 
 /* ---- coordinate systems ---- */

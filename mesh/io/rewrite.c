@@ -10,6 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 cm_rewrite_source *cm_rewrite_source_new(void)
 {
@@ -205,56 +208,137 @@ static int copy_bytes(FILE *in, FILE *out, int64_t n, char *buf, size_t cap)
     return 0;
 }
 
+/* The spans are written in batches: the bytes from the end of the last batch to the end of
+ * this one's last span are read at once (a bounded region), the spans' new texts are made in
+ * parallel (each thread a contiguous run of spans, into its own buffer: formatting numbers is
+ * most of a write back's time), then region and texts go out in file order. */
+enum { REGION_BYTES = 8 << 20, COPY_CHUNK = 1 << 16 };
+
+typedef struct span_out {
+    size_t at, n; /* its new text in its thread's buffer */
+} span_out;
+
+/* Makes the texts of spans [i0, i1) of f whose bytes are in region (which starts at byte
+ * base of the file). Returns the first span that failed, or i1; nomem is set when a buffer
+ * could not grow. */
+static size_t emit_batch(const cm_rewrite_source *src, const cm_rewrite_file *f, const cm_mesh *mesh,
+                         cm_rewrite_emit_fn emit, const char *region, int64_t base, size_t i0, size_t i1,
+                         span_out *outs, cm_rewrite_buf *bufs, int threads, int *nomem)
+{
+    size_t failed = i1;
+#pragma omp parallel num_threads(threads) reduction(min : failed)
+    {
+        int t = 0, nt = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        nt = omp_get_num_threads();
+#endif
+        const size_t per = (i1 - i0 + (size_t)nt - 1) / (size_t)nt;
+        const size_t a = i0 + (size_t)t * per, b = a + per < i1 ? a + per : i1;
+        cm_rewrite_buf *out = &bufs[t], text = {0};
+        out->n = 0;
+        size_t mine = i1; /* this thread's first failure */
+        cm_context *quiet = NULL; /* the message is made again on one thread, below */
+        cm_context_create(&quiet);
+        for (size_t i = a; i < b && mine == i1; ++i) {
+            const cm_rewrite_span *sp = &f->spans[i];
+            text.n = 0;
+            cm_rewrite_put(&text, region + (sp->offset - base), (size_t)sp->length); /* NUL-terminated */
+            outs[i - i0].at = out->n;
+            if (!quiet || text.fail || emit(quiet, src, f, sp, text.d, mesh->xyz + 3 * sp->node, out) != CM_OK || out->fail)
+                mine = i;
+            outs[i - i0].n = out->n - outs[i - i0].at;
+        }
+        failed = mine;
+        if (text.fail || out->fail || !quiet)
+#pragma omp atomic write
+            *nomem = 1;
+        cm_context_destroy(&quiet);
+        free(text.d);
+    }
+    return failed;
+}
+
 static cm_status rewrite_one(cm_context *ctx, const cm_rewrite_source *src, const cm_rewrite_file *f,
                              const cm_mesh *mesh, FILE *out, cm_rewrite_emit_fn emit)
 {
     cm_status s = check_stamp(ctx, f->path, &f->stamp);
     if (s != CM_OK) return s;
+    for (size_t i = 0; i < f->n_spans; ++i)
+        if (f->spans[i].node < 0 || (size_t)f->spans[i].node >= mesh->n_nodes)
+            return cm_error(ctx, CM_ERR_INTERNAL, "%s: coordinate span of node %lld outside the mesh", f->path,
+                            (long long)f->spans[i].node);
     FILE *in = fopen(f->path, "rb");
     if (!in) return cm_error(ctx, CM_ERR_IO, "%s: cannot open: %s", f->path, strerror(errno));
-    enum { CHUNK = 1 << 16 };
-    char *buf = malloc(CHUNK);
-    cm_rewrite_buf span_text = {0}, text = {0};
-    if (!buf) s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
-    int64_t at = 0;
-    for (size_t i = 0; s == CM_OK && i < f->n_spans; ++i) {
-        const cm_rewrite_span *sp = &f->spans[i];
-        if (copy_bytes(in, out, sp->offset - at, buf, CHUNK) != 0) {
-            s = cm_error(ctx, CM_ERR_IO, "%s: read or write failed near byte %lld", f->path, (long long)at);
-            break;
+    const int threads = cm_context_threads_for(ctx, f->n_spans, 4096);
+    cm_rewrite_buf *bufs = calloc((size_t)threads, sizeof *bufs);
+    span_out *outs = NULL;
+    char *region = NULL, *chunk = malloc(COPY_CHUNK);
+    size_t cap_spans = 0, cap_region = 0;
+    if (!bufs || !chunk) s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
+    int64_t at = 0; /* the file's bytes before `at` are written */
+    for (size_t i0 = 0; s == CM_OK && i0 < f->n_spans;) {
+        /* the batch: spans whose bytes end within REGION_BYTES of `at` (at least one) */
+        size_t i1 = i0 + 1;
+        while (i1 < f->n_spans && f->spans[i1].offset + f->spans[i1].length - at <= REGION_BYTES) ++i1;
+        const int64_t end = f->spans[i1 - 1].offset + f->spans[i1 - 1].length;
+        if ((size_t)(end - at) > cap_region) {
+            free(region);
+            cap_region = (size_t)(end - at);
+            region = malloc(cap_region);
         }
-        span_text.n = text.n = 0;
-        cm_rewrite_put(&span_text, "", 0);
-        for (int64_t left = sp->length; left > 0 && !span_text.fail;) {
-            const size_t want = left > CHUNK ? CHUNK : (size_t)left;
-            const size_t got = fread(buf, 1, want, in);
-            cm_rewrite_put(&span_text, buf, got);
-            if (got < want) {
-                s = cm_error(ctx, CM_ERR_IO, "%s: ends inside the coordinates of node %lld", f->path, (long long)sp->node + 1);
-                break;
-            }
-            left -= (int64_t)got;
+        if (i1 - i0 > cap_spans) {
+            free(outs);
+            cap_spans = i1 - i0;
+            outs = malloc(cap_spans * sizeof *outs);
         }
-        if (s != CM_OK) break;
-        if (span_text.fail) {
+        if (!region || !outs) {
             s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
             break;
         }
-        if (sp->node < 0 || (size_t)sp->node >= mesh->n_nodes) {
-            s = cm_error(ctx, CM_ERR_INTERNAL, "%s: coordinate span of node %lld outside the mesh", f->path, (long long)sp->node);
+        if (fread(region, 1, (size_t)(end - at), in) != (size_t)(end - at)) {
+            s = cm_error(ctx, CM_ERR_IO, "%s: ends inside the coordinates of node %lld", f->path,
+                         (long long)f->spans[i1 - 1].node + 1);
             break;
         }
-        s = emit(ctx, src, f, sp, span_text.d, mesh->xyz + 3 * sp->node, &text);
-        if (s == CM_OK && text.fail) s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
-        if (s == CM_OK && text.n && fwrite(text.d, 1, text.n, out) != text.n)
-            s = cm_error(ctx, CM_ERR_IO, "%s: write failed", f->path);
-        at = sp->offset + sp->length;
+        int nomem = 0;
+        const size_t failed = emit_batch(src, f, mesh, emit, region, at, i0, i1, outs, bufs, threads, &nomem);
+        if (failed < i1) {
+            /* again on this thread, for the message in ctx */
+            const cm_rewrite_span *sp = &f->spans[failed];
+            cm_rewrite_buf text = {0}, once = {0};
+            cm_rewrite_put(&text, region + (sp->offset - at), (size_t)sp->length);
+            s = text.fail ? CM_ERR_NOMEM : emit(ctx, src, f, sp, text.d, mesh->xyz + 3 * sp->node, &once);
+            free(text.d);
+            free(once.d);
+            if (s == CM_OK || s == CM_ERR_NOMEM) s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
+            break;
+        }
+        if (nomem) {
+            s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", f->path);
+            break;
+        }
+        /* out in file order: each thread's spans are a contiguous run, in order in its buffer */
+        const size_t per = (i1 - i0 + (size_t)threads - 1) / (size_t)threads;
+        int64_t from = at;
+        for (size_t i = i0; s == CM_OK && i < i1; ++i) {
+            const cm_rewrite_span *sp = &f->spans[i];
+            const cm_rewrite_buf *b = &bufs[(i - i0) / per];
+            if (fwrite(region + (from - at), 1, (size_t)(sp->offset - from), out) != (size_t)(sp->offset - from) ||
+                (outs[i - i0].n && fwrite(b->d + outs[i - i0].at, 1, outs[i - i0].n, out) != outs[i - i0].n))
+                s = cm_error(ctx, CM_ERR_IO, "%s: write failed", f->path);
+            from = sp->offset + sp->length;
+        }
+        at = end;
+        i0 = i1;
     }
-    if (s == CM_OK && copy_bytes(in, out, -1, buf, CHUNK) != 0)
+    if (s == CM_OK && copy_bytes(in, out, -1, chunk, COPY_CHUNK) != 0)
         s = cm_error(ctx, CM_ERR_IO, "%s: read or write failed near byte %lld", f->path, (long long)at);
-    free(buf);
-    free(span_text.d);
-    free(text.d);
+    for (int t = 0; bufs && t < threads; ++t) free(bufs[t].d);
+    free(bufs);
+    free(outs);
+    free(region);
+    free(chunk);
     fclose(in);
     return s;
 }
