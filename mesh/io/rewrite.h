@@ -75,9 +75,10 @@ typedef struct cm_rewrite_buf {
 void cm_rewrite_put(cm_rewrite_buf *b, const char *s, size_t n);
 void cm_rewrite_putf(cm_rewrite_buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
-/* Appends to out what span (whose bytes as read are original, span->length of them) becomes
- * when its node is at xyz. A refusal (a value the field cannot hold, say) is an error status
- * with a message naming the file and the place. */
+/* Appends to out what span (whose bytes as read are original, span->length of them, followed by
+ * a NUL) becomes when its node is at xyz. A refusal (a value the field cannot hold, say) is an
+ * error status with a message naming the file and the place. Called on several threads at once
+ * (each with its own ctx and out): it may only read src and file. */
 typedef cm_status (*cm_rewrite_emit_fn)(cm_context *ctx, const cm_rewrite_source *src,
                                         const cm_rewrite_file *file, const cm_rewrite_span *span,
                                         const char *original, const double xyz[3],
