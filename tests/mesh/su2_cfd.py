@@ -28,16 +28,11 @@ import gmsh
 import meshio
 
 CLI = sys.argv[1]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from su2_files import check, finish, markers, point_lines  # noqa: E402
 WORK = os.path.join(sys.argv[2], "su2_cfd")
 os.makedirs(WORK, exist_ok=True)
-FAILED = []
 FFD = b"FFD_NBOX= 0\nFFD_NLEVEL= 0\n"
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what, flush=True)
-    if not cond:
-        FAILED.append(what)
 
 
 def w(name):
@@ -78,30 +73,6 @@ def make_case():
     gmsh.finalize()
     with open(w("mesh.su2"), "ab") as f:
         f.write(FFD)
-
-
-def markers(path):
-    """{name: node set} and {name: element lines} of an .su2 file."""
-    nodes, elems, lines, i = {}, {}, open(path, "rb").read().split(b"\n"), 0
-    while i < len(lines):
-        if lines[i].startswith(b"MARKER_TAG="):
-            name = lines[i].split(b"=", 1)[1].strip().decode()
-            n = int(lines[i + 1].split(b"=")[1])
-            elems[name] = lines[i + 2:i + 2 + n]
-            nodes[name] = {int(t) for s in elems[name] for t in s.split()[1:]}
-            i += 2 + n
-        else:
-            i += 1
-    return nodes, elems
-
-
-def point_lines(path):
-    lines = open(path, "rb").read().split(b"\n")
-    for i, s in enumerate(lines):
-        if s.startswith(b"NPOIN"):
-            n = int(s.split(b"=")[1].split()[0])
-            return lines[:i + 1], lines[i + 1:i + 1 + n], lines[i + 1 + n:]
-    return [], [], []
 
 
 def deform_like_su2_def(src, dst, scale):
@@ -158,10 +129,7 @@ def main():
     n_tets = sum(len(c.data) for c in ref.cells if c.type == "tetra")
     check(sum(len(c.data) for c in new.cells if c.type == "tetra") == n_tets and len(new.points) == len(ref.points),
           "new.su2: meshio reads the %d tets of the fluid group and every point" % n_tets)
-    if FAILED:
-        print("%d checks failed" % len(FAILED))
-        return 1
-    return 0
+    return finish()
 
 
 if __name__ == "__main__":

@@ -25,17 +25,12 @@ import gmsh
 import meshio
 
 CLI, DATA = sys.argv[1], sys.argv[2]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from su2_files import check, finish, markers  # noqa: E402
 WORK = os.path.join(sys.argv[3], "su2_cli")
 os.makedirs(WORK, exist_ok=True)
 CAD = os.path.join(DATA, "cad")
-FAILED = []
 SUMMARY = re.compile(r"min_scaled_jacobian=(\S+) mean_scaled_jacobian=(\S+) inverted=(\d+) cells=(\d+)\s*$")
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what, flush=True)
-    if not cond:
-        FAILED.append(what)
 
 
 def w(name):
@@ -88,23 +83,6 @@ def meshio_points(path):
         return meshio.read(path).points
 
 
-def markers(path):
-    """{marker name: set of its nodes} of an .su2 file."""
-    out, lines, i = {}, lines_of(path), 0
-    while i < len(lines):
-        if lines[i].startswith(b"MARKER_TAG="):
-            name = lines[i].split(b"=", 1)[1].strip().decode()
-            n = int(lines[i + 1].split(b"=")[1])
-            nodes = set()
-            for s in lines[i + 2:i + 2 + n]:
-                nodes.update(int(t) for t in s.split()[1:])
-            out[name] = nodes
-            i += 2 + n
-        else:
-            i += 1
-    return out
-
-
 def planarity(x):
     c = x - x.mean(axis=0)
     s = np.linalg.svd(c, compute_uv=False)
@@ -122,7 +100,7 @@ def main():
     gmsh.finalize()
     su2 = w("bore_a.su2")
     x0 = meshio_points(su2)
-    mk = markers(su2)
+    mk = markers(su2)[0]
     check(len(mk) >= 6, "gmsh wrote %d markers: %s" % (len(mk), sorted(mk)))
 
     # quality: the same as of the .msh it came from
@@ -189,10 +167,7 @@ def main():
     boundary = set().union(*mk.values())
     check(len(moved) > 0 and not (moved & boundary), "optimize: %d interior points moved, no boundary point" % len(moved))
 
-    if FAILED:
-        print("%d checks failed" % len(FAILED))
-        return 1
-    return 0
+    return finish()
 
 
 if __name__ == "__main__":

@@ -27,17 +27,12 @@ import cadmorph
 import gmsh
 import meshio
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from su2_files import check, finish  # noqa: E402
 WORK = os.path.join(sys.argv[1], "su2_crosscheck")
 os.makedirs(WORK, exist_ok=True)
-FAILED = []
 A = np.array([[0.9, 0.1, -0.2], [0.05, 1.1, 0.0], [0.0, -0.3, 1.2]])
 B = np.array([0.3, -1.0 / 3.0, 2.5])
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        FAILED.append(what)
 
 
 def path(name):
@@ -234,10 +229,7 @@ def main():
             back = meshio.read(new)
         check(np.array_equal(back.points[:, :dim], ref.points[:, :dim]), "%s: new .su2 points exactly (meshio)" % name)
         same_cells(cadmorph.read_mesh(new), back, vol, name + " (new file, meshio)")
-    if FAILED:
-        print("%d checks failed" % len(FAILED))
-        return 1
-    return 0
+    return finish()
 
 
 if __name__ == "__main__":
