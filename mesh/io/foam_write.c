@@ -8,6 +8,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
 #include "foam_internal.h"
+#include "rewrite.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -170,9 +171,15 @@ static void points_list(buf *b, const cm_mesh *m, int binary, int scalar_bytes)
             }
         }
     } else {
+        /* the shortest text that reads back exactly: a point OpenFOAM wrote (at its
+         * writePrecision) and nothing moved is written with the same digits */
         put(b, "\n", 1);
-        for (size_t i = 0; i < m->n_nodes; ++i)
-            putf(b, "(%.17g %.17g %.17g)\n", m->xyz[3 * i], m->xyz[3 * i + 1], m->xyz[3 * i + 2]);
+        char x[3][40];
+        int n[3];
+        for (size_t i = 0; i < m->n_nodes; ++i) {
+            for (int k = 0; k < 3; ++k) n[k] = cm_rewrite_number(x[k], sizeof x[k], m->xyz[3 * i + k], NULL, 0);
+            putf(b, "(%.*s %.*s %.*s)\n", n[0], x[0], n[1], x[1], n[2], x[2]);
+        }
     }
     put(b, ")", 1);
 }
