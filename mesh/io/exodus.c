@@ -517,6 +517,19 @@ done:
     return s;
 }
 
+/* The entry count of set id (kind: node or side set, what: its name in messages). */
+static cm_status set_size(exo_reader *r, ex_entity_type kind, const char *what, int64_t id,
+                          const char *gname, int64_t *n)
+{
+    int64_t n_df = 0;
+    *n = 0;
+    const int rc = ex_get_set_param(r->exoid, kind, id, n, &n_df);
+    if (rc < 0 || *n < 0 || *n > EXO_MAX_COUNT)
+        return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %s \"%s\": %s", r->path, what, gname,
+                        rc < 0 ? exo_reason(rc) : "bad entry count");
+    return CM_OK;
+}
+
 static cm_status read_node_sets(exo_reader *r)
 {
     const int64_t ns = r->par.num_node_sets;
@@ -524,14 +537,9 @@ static cm_status read_node_sets(exo_reader *r)
     char **names;
     cm_status s = entity_list(r, EX_NODE_SET, "node set", ns, &ids, &names);
     for (int64_t k = 0; s == CM_OK && k < ns; ++k) {
-        int64_t n = 0, n_df = 0;
+        int64_t n = 0;
         const char *gname = group_name(r, names[k], "nodeset", ids[k]);
-        int rc = ex_get_set_param(r->exoid, EX_NODE_SET, ids[k], &n, &n_df);
-        if (rc < 0 || n < 0 || n > EXO_MAX_COUNT) {
-            s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: node set \"%s\": %s", r->path,
-                         gname, rc < 0 ? exo_reason(rc) : "bad node count");
-            break;
-        }
+        if ((s = set_size(r, EX_NODE_SET, "node set", ids[k], gname, &n)) != CM_OK) break;
         const int tag = r->next_tag++;
         if ((s = cm_mesh_add_group(r->ctx, r->m, 0, tag, gname)) != CM_OK || n == 0) continue;
         int64_t *list = malloc((size_t)n * sizeof *list);
@@ -543,7 +551,7 @@ static cm_status read_node_sets(exo_reader *r)
         char var[32];
         snprintf(var, sizeof var, "node_ns%lld", (long long)(k + 1));
         s = check_var(r, var, n, "node set");
-        rc = s == CM_OK ? ex_get_set(r->exoid, EX_NODE_SET, ids[k], list, NULL) : 0;
+        const int rc = s == CM_OK ? ex_get_set(r->exoid, EX_NODE_SET, ids[k], list, NULL) : 0;
         if (rc < 0)
             s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: node set \"%s\": %s", r->path,
                          gname, exo_reason(rc));
@@ -582,14 +590,9 @@ static cm_status read_side_sets(exo_reader *r)
     char **names;
     cm_status s = entity_list(r, EX_SIDE_SET, "side set", ns, &ids, &names);
     for (int64_t k = 0; s == CM_OK && k < ns; ++k) {
-        int64_t n = 0, n_df = 0;
+        int64_t n = 0;
         const char *gname = group_name(r, names[k], "sideset", ids[k]);
-        int rc = ex_get_set_param(r->exoid, EX_SIDE_SET, ids[k], &n, &n_df);
-        if (rc < 0 || n < 0 || n > EXO_MAX_COUNT) {
-            s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: side set \"%s\": %s", r->path,
-                         gname, rc < 0 ? exo_reason(rc) : "bad side count");
-            break;
-        }
+        if ((s = set_size(r, EX_SIDE_SET, "side set", ids[k], gname, &n)) != CM_OK) break;
         const int tag = r->next_tag++;
         if (n == 0) {
             s = cm_mesh_add_group(r->ctx, r->m, (int)r->par.num_dim - 1, tag, gname);
@@ -607,7 +610,7 @@ static cm_status read_side_sets(exo_reader *r)
         s = check_var(r, var, n, "side set");
         snprintf(var, sizeof var, "side_ss%lld", (long long)(k + 1));
         if (s == CM_OK) s = check_var(r, var, n, "side set");
-        rc = s == CM_OK ? ex_get_set(r->exoid, EX_SIDE_SET, ids[k], elem, side) : 0;
+        const int rc = s == CM_OK ? ex_get_set(r->exoid, EX_SIDE_SET, ids[k], elem, side) : 0;
         if (rc < 0)
             s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: side set \"%s\": %s", r->path,
                          gname, exo_reason(rc));

@@ -19,45 +19,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
-/* An in-memory output, so that .gz files can be compressed in one go. */
-typedef struct buf {
-    char *d;
-    size_t n, cap;
-    int fail;
-} buf;
-
-static void put(buf *b, const void *p, size_t n)
-{
-    if (b->fail) return;
-    if (b->n + n > b->cap) {
-        size_t nc = b->cap ? b->cap : 1 << 16;
-        while (nc < b->n + n) nc *= 2;
-        char *d = realloc(b->d, nc);
-        if (!d) {
-            b->fail = 1;
-            return;
-        }
-        b->d = d;
-        b->cap = nc;
-    }
-    memcpy(b->d + b->n, p, n);
-    b->n += n;
-}
-
-static void putf(buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void putf(buf *b, const char *fmt, ...)
-{
-    char tmp[512];
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(tmp, sizeof tmp, fmt, ap);
-    va_end(ap);
-    if (n < 0 || (size_t)n >= sizeof tmp) {
-        b->fail = 1;
-        return;
-    }
-    put(b, tmp, (size_t)n);
-}
+/* Files are made in memory (cm_rewrite_buf), so that .gz files are compressed in one go. */
 
 static int mkdirs(const char *path)
 {
@@ -158,30 +120,30 @@ static cm_status copy_file(cm_context *ctx, const char *src_dir, const char *dst
     return s;
 }
 
-static void points_list(buf *b, const cm_mesh *m, int binary, int scalar_bytes)
+static void points_list(cm_rewrite_buf *b, const cm_mesh *m, int binary, int scalar_bytes)
 {
-    putf(b, "%zu\n(", m->n_nodes);
+    cm_rewrite_putf(b, "%zu\n(", m->n_nodes);
     if (binary) {
         if (scalar_bytes == 8) {
-            put(b, m->xyz, 3 * m->n_nodes * sizeof(double));
+            cm_rewrite_put(b, m->xyz, 3 * m->n_nodes * sizeof(double));
         } else {
             for (size_t i = 0; i < 3 * m->n_nodes; ++i) {
                 float x = (float)m->xyz[i];
-                put(b, &x, 4);
+                cm_rewrite_put(b, &x, 4);
             }
         }
     } else {
         /* the shortest text that reads back exactly: a point OpenFOAM wrote (at its
          * writePrecision) and nothing moved is written with the same digits */
-        put(b, "\n", 1);
+        cm_rewrite_put(b, "\n", 1);
         char x[3][40];
         int n[3];
         for (size_t i = 0; i < m->n_nodes; ++i) {
             for (int k = 0; k < 3; ++k) n[k] = cm_rewrite_number(x[k], sizeof x[k], m->xyz[3 * i + k], NULL, 0);
-            putf(b, "(%.*s %.*s %.*s)\n", n[0], x[0], n[1], x[1], n[2], x[2]);
+            cm_rewrite_putf(b, "(%.*s %.*s %.*s)\n", n[0], x[0], n[1], x[1], n[2], x[2]);
         }
     }
-    put(b, ")", 1);
+    cm_rewrite_put(b, ")", 1);
 }
 
 static int same_dir(const char *a, const char *b)
@@ -212,10 +174,10 @@ static cm_status write_points_only(cm_context *ctx, const cm_mesh *mesh, const c
     }
     closedir(d);
     if (s != CM_OK) return s;
-    buf b = {0};
-    put(&b, p->points_head, p->points_head_len);
+    cm_rewrite_buf b = {0};
+    cm_rewrite_put(&b, p->points_head, p->points_head_len);
     points_list(&b, mesh, p->points_binary, p->scalar_bytes);
-    put(&b, p->points_tail, p->points_tail_len);
+    cm_rewrite_put(&b, p->points_tail, p->points_tail_len);
     if (b.fail) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory for points");
     else s = write_file(ctx, dir, "points", b.d, b.n, p->points_gz);
     free(b.d);
@@ -224,26 +186,26 @@ static cm_status write_points_only(cm_context *ctx, const cm_mesh *mesh, const c
 
 /* ---- a converted mesh: all five files, ASCII ---- */
 
-static void header(buf *b, const char *cls, const char *object, const char *note)
+static void header(cm_rewrite_buf *b, const char *cls, const char *object, const char *note)
 {
-    putf(b, "/*--------------------------------*- C++ -*----------------------------------*\\\n"
+    cm_rewrite_putf(b, "/*--------------------------------*- C++ -*----------------------------------*\\\n"
             "  Written by cadmorph\n"
             "\\*---------------------------------------------------------------------------*/\n"
             "FoamFile\n{\n    version     2.0;\n    format      ascii;\n    class       %s;\n",
          cls);
     if (note) {
-        put(b, "    note        \"", 17);
-        put(b, note, strlen(note));
-        put(b, "\";\n", 3);
+        cm_rewrite_put(b, "    note        \"", 17);
+        cm_rewrite_put(b, note, strlen(note));
+        cm_rewrite_put(b, "\";\n", 3);
     }
-    putf(b, "    location    \"constant/polyMesh\";\n    object      %s;\n}\n"
+    cm_rewrite_putf(b, "    location    \"constant/polyMesh\";\n    object      %s;\n}\n"
             "// * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * * //\n\n\n",
          object);
 }
 
 static const char footer[] = "\n\n\n// ************************************************************************* //\n";
 
-static cm_status flush(cm_context *ctx, buf *b, const char *dir, const char *name)
+static cm_status flush(cm_context *ctx, cm_rewrite_buf *b, const char *dir, const char *name)
 {
     cm_status s = b->fail ? cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory for %s", name)
                           : write_file(ctx, dir, name, b->d, b->n, 0);
@@ -252,12 +214,12 @@ static cm_status flush(cm_context *ctx, buf *b, const char *dir, const char *nam
     return s;
 }
 
-static void labels(buf *b, const int64_t *v, int64_t n)
+static void labels(cm_rewrite_buf *b, const int64_t *v, int64_t n)
 {
-    putf(b, "%lld\n(\n", (long long)n);
-    for (int64_t i = 0; i < n; ++i) putf(b, "%lld\n", (long long)v[i]);
-    put(b, ")", 1);
-    put(b, footer, sizeof footer - 1);
+    cm_rewrite_putf(b, "%lld\n(\n", (long long)n);
+    for (int64_t i = 0; i < n; ++i) cm_rewrite_putf(b, "%lld\n", (long long)v[i]);
+    cm_rewrite_put(b, ")", 1);
+    cm_rewrite_put(b, footer, sizeof footer - 1);
 }
 
 static cm_status write_converted(cm_context *ctx, const cm_mesh *mesh, const char *dir)
@@ -268,17 +230,17 @@ static cm_status write_converted(cm_context *ctx, const cm_mesh *mesh, const cha
     char note[200];
     snprintf(note, sizeof note, "nPoints:%lld  nCells:%lld  nFaces:%lld  nInternalFaces:%lld", (long long)p->n_points,
              (long long)p->n_cells, (long long)p->n_faces, (long long)p->n_internal);
-    buf b = {0};
+    cm_rewrite_buf b = {0};
     header(&b, "faceList", "faces", NULL);
-    putf(&b, "%lld\n(\n", (long long)p->n_faces);
+    cm_rewrite_putf(&b, "%lld\n(\n", (long long)p->n_faces);
     for (int64_t f = 0; f < p->n_faces; ++f) {
-        putf(&b, "%lld(", (long long)(p->face_off[f + 1] - p->face_off[f]));
+        cm_rewrite_putf(&b, "%lld(", (long long)(p->face_off[f + 1] - p->face_off[f]));
         for (int64_t k = p->face_off[f]; k < p->face_off[f + 1]; ++k)
-            putf(&b, k + 1 < p->face_off[f + 1] ? "%lld " : "%lld", (long long)p->face_nodes[k]);
-        put(&b, ")\n", 2);
+            cm_rewrite_putf(&b, k + 1 < p->face_off[f + 1] ? "%lld " : "%lld", (long long)p->face_nodes[k]);
+        cm_rewrite_put(&b, ")\n", 2);
     }
-    put(&b, ")", 1);
-    put(&b, footer, sizeof footer - 1);
+    cm_rewrite_put(&b, ")", 1);
+    cm_rewrite_put(&b, footer, sizeof footer - 1);
     s = flush(ctx, &b, dir, "faces");
     if (s == CM_OK) {
         header(&b, "labelList", "owner", note);
@@ -292,18 +254,18 @@ static cm_status write_converted(cm_context *ctx, const cm_mesh *mesh, const cha
     }
     if (s == CM_OK) {
         header(&b, "polyBoundaryMesh", "boundary", NULL);
-        putf(&b, "%zu\n(\n", p->n_patches);
+        cm_rewrite_putf(&b, "%zu\n(\n", p->n_patches);
         for (size_t i = 0; i < p->n_patches; ++i)
-            putf(&b, "    %s\n    {\n        type            %s;\n        nFaces          %lld;\n        startFace       %lld;\n    }\n",
+            cm_rewrite_putf(&b, "    %s\n    {\n        type            %s;\n        nFaces          %lld;\n        startFace       %lld;\n    }\n",
                  p->patches[i].name, p->patches[i].type, (long long)p->patches[i].n, (long long)p->patches[i].start);
-        put(&b, ")", 1);
-        put(&b, footer, sizeof footer - 1);
+        cm_rewrite_put(&b, ")", 1);
+        cm_rewrite_put(&b, footer, sizeof footer - 1);
         s = flush(ctx, &b, dir, "boundary");
     }
     if (s == CM_OK) {
         header(&b, "vectorField", "points", NULL);
         points_list(&b, mesh, 0, 8);
-        put(&b, footer, sizeof footer - 1);
+        cm_rewrite_put(&b, footer, sizeof footer - 1);
         s = flush(ctx, &b, dir, "points");
     }
     free(b.d);

@@ -110,7 +110,7 @@ cm_status cm_rewrite_add_span(cm_context *ctx, cm_rewrite_source *src, size_t fi
     return CM_OK;
 }
 
-void cm_rewrite_put(cm_rewrite_buf *b, const char *s, size_t n)
+void cm_rewrite_put(cm_rewrite_buf *b, const void *s, size_t n)
 {
     if (b->fail) return;
     if (b->n + n + 1 > b->cap) {

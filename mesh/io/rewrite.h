@@ -65,14 +65,15 @@ cm_status cm_rewrite_add_file(cm_context *ctx, cm_rewrite_source *src, const cha
 cm_status cm_rewrite_add_span(cm_context *ctx, cm_rewrite_source *src, size_t file, int64_t offset,
                               int64_t length, int64_t node, int64_t aux);
 
-/* A growing output buffer; fail is set (and stays set) when memory runs out. */
+/* A growing output buffer (the emit functions' and the OpenFOAM writer's), kept NUL-terminated;
+ * fail is set (and stays set) when memory runs out. */
 typedef struct cm_rewrite_buf {
     char *d;
     size_t n, cap;
     int fail;
 } cm_rewrite_buf;
 
-void cm_rewrite_put(cm_rewrite_buf *b, const char *s, size_t n);
+void cm_rewrite_put(cm_rewrite_buf *b, const void *s, size_t n);
 void cm_rewrite_putf(cm_rewrite_buf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 /* Appends to out what span (whose bytes as read are original, span->length of them, followed by
