@@ -239,6 +239,13 @@ cm_status cm_mesh_add_field(cm_context *ctx, cm_mesh *mesh, const char *name,
     return CM_OK;
 }
 
+const char *cm_patch_kind_name(cm_patch_kind kind)
+{
+    static const char *const names[CM_PATCH_N_KINDS] = {"plain", "symmetry", "empty", "wedge",
+                                                        "cyclic", "processor"};
+    return (unsigned)kind < CM_PATCH_N_KINDS ? names[kind] : NULL;
+}
+
 cm_status cm_mesh_add_group(cm_context *ctx, cm_mesh *mesh, int dim, int tag, const char *name)
 {
     if (!mesh || !name) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_add_group: bad argument");
@@ -247,7 +254,7 @@ cm_status cm_mesh_add_group(cm_context *ctx, cm_mesh *mesh, int dim, int tag, co
         free(nm);
         return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_add_group: out of memory");
     }
-    mesh->groups[mesh->n_groups++] = (cm_mesh_group){dim, tag, nm};
+    mesh->groups[mesh->n_groups++] = (cm_mesh_group){dim, tag, nm, CM_PATCH_PLAIN};
     return CM_OK;
 }
 
@@ -298,7 +305,9 @@ cm_status cm_mesh_copy(cm_context *ctx, const cm_mesh *mesh, cm_mesh **copy)
         if (s == CM_OK) memcpy(d, f->data, n * (size_t)f->components * sizeof(double));
     }
     for (size_t i = 0; s == CM_OK && i < mesh->n_groups; ++i)
-        s = cm_mesh_add_group(ctx, m, mesh->groups[i].dim, mesh->groups[i].tag, mesh->groups[i].name);
+        if ((s = cm_mesh_add_group(ctx, m, mesh->groups[i].dim, mesh->groups[i].tag,
+                                   mesh->groups[i].name)) == CM_OK)
+            m->groups[m->n_groups - 1].kind = mesh->groups[i].kind;
     for (size_t i = 0; s == CM_OK && i < mesh->n_entities; ++i)
         s = cm_mesh_add_entity(ctx, m, &mesh->entities[i]);
     if (s != CM_OK) {

@@ -271,10 +271,21 @@ cm_field_location location;
 int components;
 double *data;
 } cm_field;
+typedef enum cm_patch_kind {
+CM_PATCH_PLAIN = 0,
+CM_PATCH_SYMMETRY = 1,
+CM_PATCH_EMPTY = 2,
+CM_PATCH_WEDGE = 3,
+CM_PATCH_CYCLIC = 4,
+CM_PATCH_PROCESSOR = 5,
+CM_PATCH_N_KINDS
+} cm_patch_kind;
+const char *cm_patch_kind_name(cm_patch_kind kind);
 typedef struct cm_mesh_group {
 int dim;
 int tag;
 char *name;
+cm_patch_kind kind;
 } cm_mesh_group;
 typedef struct cm_mesh_entity {
 int dim;

@@ -64,11 +64,30 @@ typedef struct cm_field {
     double *data;
 } cm_field;
 
-/* A named physical group (gmsh $PhysicalNames, Medit references). */
+/* What the file says of a boundary group that decides how its nodes may move in a morph
+ * (docs/DESIGN.md, "Boundary motion by patch kind"). */
+typedef enum cm_patch_kind {
+    CM_PATCH_PLAIN = 0,     /* no rule from the file (OpenFOAM patch or wall, CGNS BCWall,
+                               inflow, ..., and every group of a format without types) */
+    CM_PATCH_SYMMETRY = 1,  /* OpenFOAM symmetryPlane and symmetry, CGNS BCSymmetryPlane */
+    CM_PATCH_EMPTY = 2,     /* OpenFOAM empty: the front and back planes of a 2-D mesh */
+    CM_PATCH_WEDGE = 3,     /* OpenFOAM wedge: the two sides of an axisymmetric mesh */
+    CM_PATCH_CYCLIC = 4,    /* OpenFOAM cyclic, cyclicAMI, cyclicACMI, cyclicSlip */
+    CM_PATCH_PROCESSOR = 5, /* OpenFOAM processor, processorCyclic: a cut of a decomposed case */
+    CM_PATCH_N_KINDS
+} cm_patch_kind;
+
+/* Short name of a kind ("plain", "symmetry", "empty", "wedge", "cyclic", "processor"), NULL
+ * out of range. */
+CM_API const char *cm_patch_kind_name(cm_patch_kind kind);
+
+/* A named physical group (gmsh $PhysicalNames, Medit references, an OpenFOAM patch or zone, a
+ * CGNS boundary condition, ...). */
 typedef struct cm_mesh_group {
     int dim;
     int tag;
     char *name;
+    cm_patch_kind kind; /* CM_PATCH_PLAIN unless the reader knows better (set after adding) */
 } cm_mesh_group;
 
 /* A gmsh 4 geometric entity, kept so that a .msh round trip keeps $Entities. */

@@ -473,6 +473,14 @@ static cm_status tag_cell(reader *r, int64_t c, int tag)
     return s;
 }
 
+/* The motion rule a boundary condition's type implies (docs/DESIGN.md, "Boundary motion by
+ * patch kind"): a symmetry plane slides. */
+static void set_kind(cm_mesh *m, int tag, cm_patch_kind kind)
+{
+    for (size_t g = 0; g < m->n_groups; ++g)
+        if (m->groups[g].tag == tag) m->groups[g].kind = kind;
+}
+
 static cm_status read_bcs(reader *r, int B, int Z, const cm_cgns_zone *zn, section *secs, int ns)
 {
     int nb = 0;
@@ -502,6 +510,7 @@ static cm_status read_bcs(reader *r, int B, int Z, const cm_cgns_zone *zn, secti
         const int elements = pst == CGNS_ENUMV(ElementRange) || pst == CGNS_ENUMV(ElementList) || loc != CGNS_ENUMV(Vertex);
         int tag = 0;
         if (s == CM_OK) s = group_tag(r, elements ? 2 : 0, fam[0] ? fam : name, &tag);
+        if (s == CM_OK && bct == CGNS_ENUMV(BCSymmetryPlane)) set_kind(r->m, tag, CM_PATCH_SYMMETRY);
         if (s == CM_OK && range && p[1] < p[0]) s = fail(r, CM_ERR_FORMAT, "range %ld..%ld", (long)p[0], (long)p[1]);
         const size_t count = s != CM_OK ? 0 : range ? (size_t)(p[1] - p[0]) + 1 : (size_t)np;
         for (size_t i = 0; s == CM_OK && i < count; ++i) {

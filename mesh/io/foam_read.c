@@ -419,6 +419,23 @@ static cm_status check_addressing(reader *r, int64_t n_owner, int64_t n_nei)
     return CM_OK;
 }
 
+/* The motion rule OpenFOAM's patch type implies (docs/DESIGN.md, "Boundary motion by patch
+ * kind"). */
+static cm_patch_kind patch_kind(const char *type)
+{
+    static const struct {
+        const char *type;
+        cm_patch_kind kind;
+    } kinds[] = {{"symmetryPlane", CM_PATCH_SYMMETRY}, {"symmetry", CM_PATCH_SYMMETRY},
+                 {"empty", CM_PATCH_EMPTY},            {"wedge", CM_PATCH_WEDGE},
+                 {"cyclic", CM_PATCH_CYCLIC},          {"cyclicAMI", CM_PATCH_CYCLIC},
+                 {"cyclicACMI", CM_PATCH_CYCLIC},      {"cyclicSlip", CM_PATCH_CYCLIC},
+                 {"processor", CM_PATCH_PROCESSOR},    {"processorCyclic", CM_PATCH_PROCESSOR}};
+    for (size_t i = 0; type && i < sizeof kinds / sizeof kinds[0]; ++i)
+        if (strcmp(type, kinds[i].type) == 0) return kinds[i].kind;
+    return CM_PATCH_PLAIN;
+}
+
 static cm_status build_cells(reader *r, cm_mesh *m)
 {
     cm_foam_poly *p = r->p;
@@ -505,6 +522,7 @@ static cm_status build_cells(reader *r, cm_mesh *m)
     for (size_t i = 0; s == CM_OK && i < p->n_patches; ++i) {
         const cm_foam_patch *pt = &p->patches[i];
         s = cm_mesh_add_group(r->ctx, m, 2, (int)i + 1, pt->name);
+        if (s == CM_OK) m->groups[m->n_groups - 1].kind = patch_kind(pt->type);
         for (int64_t f = pt->start; s == CM_OK && f < pt->start + pt->n; ++f) {
             int64_t n = p->face_off[f + 1] - p->face_off[f];
             cm_cell_type t = n == 3 ? CM_CELL_TRI3 : n == 4 ? CM_CELL_QUAD4 : CM_CELL_POLYGON;
