@@ -16,12 +16,12 @@
 static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
     "[--method rbf|mls|dmffd|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
-    "[--cubature N] [--cover S] [--blend B] [--graded G] [--lattice N] [--clamp E] [--exact-constraints] "
+    "[--cubature N] [--cover S] [--blend B] [--graded G] [--lattice N] [--clamp E] [--approximate-constraints] "
     "[--constraint TYPE:SET ...] [--threads N] [--verbose]";
 
 typedef struct deform_args {
     const char *mesh, *handles, *fixed, *out;
-    int method, fix_boundary, exact, threads, verbose, lattice;
+    int method, fix_boundary, exact, approximate, threads, verbose, lattice;
     double clamp;
     cm_mls_options mls;   /* stretch, bend, fix also weigh the shell */
     cli_constraints cons; /* --constraint and its options (deform_constraints.c) */
@@ -50,7 +50,8 @@ static const cli_option options[] = {
      .values = method_values, .bad = "%.0sunknown method '%s' (rbf|mls|dmffd|shell)",
      .label = "--method M",
      .help = "rbf (triharmonic, exact at H and F), mls (constrained\n"
-             "MLS, approximate; default), dmffd (DM-FFD on a cubic\n"
+             "MLS, default; exact at H and F unless\n"
+             "--approximate-constraints), dmffd (DM-FFD on a cubic\n"
              "B-spline lattice enclosing M, least squares: H and F keep\n"
              "their motion, the residual is the lattice's miss) or\n"
              "shell (surfaces: the mesh-based shell of the paper's eq. 10,\n"
@@ -60,10 +61,15 @@ static const cli_option options[] = {
      .bad = "%s: '%s' is not a number > 0", .label = "--fix GF",
      .help = "mls / shell: constraint weight gamma_f (default 1000);\n"
              "--stretch and --bend weigh the shell's energies too"},
+    {.name = "--approximate-constraints", .kind = CLI_FLAG, .dest = &args.approximate,
+     .label = "--approximate-constraints",
+     .help = "mls: H and F nodes get the field's value (the paper's\n"
+             "weighted fit: they miss their motion by the residual)\n"
+             "instead of their prescribed one (the default: exact, the\n"
+             "field's miss carried into the free nodes around them)"},
+    /* exactness is the default: kept so that scripts written before still run */
     {.name = "--exact-constraints", .kind = CLI_FLAG, .dest = &args.exact,
-     .label = "--exact-constraints",
-     .help = "mls: H and F nodes get their prescribed value instead of\n"
-             "the field's (its miss blended over --blend)"},
+     .label = "--exact-constraints", .help = "mls: the default (accepted, does nothing)"},
     {.name = "--lattice", .kind = CLI_INT, .dest = &args.lattice, .lo = 4, .hi = 200,
      .bad = "%s: '%s' is not an integer in 4..200", .label = "--lattice N",
      .help = "dmffd: control points per axis (4..200, default 10)"},
@@ -113,7 +119,10 @@ static int parse_args(int argc, char **argv, deform_args *a)
     const int parsed = cli_parse(&p, argc, argv);
     *a = args;
     if (parsed >= 0) return parsed;
-    a->mls.keep_constrained = a->exact;
+    if (a->approximate) a->mls.keep_constrained = 0; /* else the library's default: exact */
+    if (a->approximate && a->exact)
+        return cli_usage(cmd, usage_line,
+                         "--approximate-constraints and --exact-constraints exclude each other");
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->handles) return cli_usage(cmd, usage_line, "--handles is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
@@ -187,14 +196,20 @@ int cli_cmd_deform(int argc, char **argv)
     const int shaped = s >= 0 && a.method == CM_DEFORM_MLS; /* the sets to resolve and free */
     if (shaped) s = cli_constraints_resolve(ctx, mesh, &a.cons, sets);
     if (s >= 0) s = cm_deform_create(ctx, &dopt, n, mesh->xyz, con, mesh, &def);
-    if (s >= 0 && cli_constraints_any(&a.cons))
+    /* no free node: nothing was built (cm_deform_stats.prescribed_only), and shape
+     * constraints have no node to move */
+    if (s >= 0 && cli_constraints_any(&a.cons) && cm_deform_get_mls(def))
         s = cli_constraints_run(ctx, cm_deform_get_mls(def), mesh, &a.cons, sets, disp, &residual);
     else if (s >= 0)
         s = cm_deform_apply(ctx, def, disp, &residual);
     if (shaped) cli_constraints_free(&a.cons, sets);
     cm_deform_stats st;
     cm_deform_get_stats(def, &st);
-    if (s >= 0 && a.method == CM_DEFORM_MLS)
+    if (s >= 0 && st.prescribed_only)
+        printf("deform: no free node: every node is a handle or fixed, so the result is the "
+               "prescribed motion (no %s built or solved)\n",
+               a.method == CM_DEFORM_MLS ? "MLS" : a.method == CM_DEFORM_DMFFD ? "lattice" : "RBF");
+    if (s >= 0 && a.method == CM_DEFORM_MLS && !st.prescribed_only)
         cm_log(ctx, CM_LOG_DEBUG,
                "deform mls: %zu samples (%zu surface), %zu cubature points, %zu constrained; "
                "sample %.3f s, basis %.3f s, factor %.3f s (%zu entries), apply %.3f s; CPU s "
@@ -202,7 +217,7 @@ int cli_cmd_deform(int argc, char **argv)
                st.mls.samples, st.mls.surface_samples, st.mls.cubature, st.mls.constrained,
                st.mls.t_sample, st.mls.t_basis, st.mls.t_factor, st.mls.factor_nonzeros,
                st.mls.t_apply, st.mls.c_sample, st.mls.c_basis, st.mls.c_factor, st.mls.c_apply);
-    if (s >= 0 && a.method == CM_DEFORM_DMFFD)
+    if (s >= 0 && a.method == CM_DEFORM_DMFFD && !st.prescribed_only)
         cm_log(ctx, CM_LOG_DEBUG,
                "deform dmffd-%d: %zu handles, %zu of %zu control points active, rank %zu (%zu "
                "clamped)",

@@ -25,6 +25,9 @@ struct cm_deform {
     double *dc; /* dmffd: control displacements, #ctrl x 3 */
     cm_mls *mls;
     double residual, t_solve, t_evaluate;
+    /* no free point, and the method gives the constrained points their prescribed values:
+     * the result is known, nothing is built (cm_deform_stats.prescribed_only) */
+    int prescribed_only;
 };
 
 typedef struct deform_row {
@@ -388,6 +391,23 @@ cm_status cm_deform_create(cm_context *ctx, const cm_deform_options *opt, size_t
     for (size_t i = 0; i < n; ++i)
         d->n_constrained += constrained[i] != 0;
     d->n_free = n - d->n_constrained;
+    /* Every point constrained (a 2-D mesh whose nodes all lie on boundary patches, with the
+     * unlisted boundary fixed): rbf and dmffd write only free points, mls with
+     * keep_constrained gives the constrained ones their prescribed values, so apply would
+     * return disp as it came in. Building the interpolant (a dense or iterative RBF over
+     * every point, the lattice's SVD, the MLS factor) would cost time and memory for no
+     * change. The shell and the approximate mls write the field's values: they are built. */
+    d->prescribed_only = n > 0 && d->n_free == 0 &&
+                         (opt->method == CM_DEFORM_RBF || opt->method == CM_DEFORM_DMFFD ||
+                          (opt->method == CM_DEFORM_MLS && opt->mls.keep_constrained));
+    if (d->prescribed_only) {
+        cm_log(ctx, CM_LOG_INFO,
+               "cm_deform_create: %s: all %zu points are constrained: the result is the "
+               "prescribed motion, nothing to build or solve",
+               row->name, n);
+        *def = d;
+        return CM_OK;
+    }
     cm_status s = row->create(ctx, d, xyz);
     if (s < 0) {
         cm_deform_destroy(&d);
@@ -402,7 +422,7 @@ cm_status cm_deform_apply(cm_context *ctx, cm_deform *def, double *disp, double 
     if (!def || !disp)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply: def or disp is NULL");
     double r = 0;
-    cm_status s = def->row->apply(ctx, def, disp, &r);
+    cm_status s = def->prescribed_only ? CM_OK : def->row->apply(ctx, def, disp, &r);
     def->residual = r;
     if (residual) *residual = r;
     return s;
@@ -417,7 +437,9 @@ cm_status cm_deform_apply_many(cm_context *ctx, cm_deform *def, size_t k, double
     if (k == 0) return CM_OK;
     double r = 0;
     cm_status s = CM_OK, warn = CM_OK;
-    if (def->row->apply_many) {
+    if (def->prescribed_only) {
+        /* every block stays as it came in */
+    } else if (def->row->apply_many) {
         s = def->row->apply_many(ctx, def, k, disp, &r);
     } else {
         /* the largest residual of the blocks; a warning of one block lets the others run */
@@ -444,6 +466,11 @@ cm_status cm_deform_apply_transpose(cm_context *ctx, cm_deform *def, const doubl
     size_t n3 = 3 * def->n;
     if (n3 && v < out + n3 && out < v + n3)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_deform_apply_transpose: v and out overlap");
+    if (def->prescribed_only) {
+        /* apply is the identity on the constrained values */
+        memcpy(out, v, n3 * sizeof *out);
+        return CM_OK;
+    }
     memset(out, 0, n3 * sizeof *out);
     return def->row->apply_transpose(ctx, def, v, out);
 }
@@ -459,6 +486,7 @@ void cm_deform_get_stats(const cm_deform *def, cm_deform_stats *stats)
     stats->residual = def->residual;
     stats->t_solve = def->t_solve;
     stats->t_evaluate = def->t_evaluate;
+    stats->prescribed_only = def->prescribed_only;
     if (def->rbf) cm_rbf_get_stats(def->rbf, &stats->rbf);
     if (def->dm) {
         cm_dmffd_get_info(def->dm, &stats->dmffd);

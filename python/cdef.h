@@ -656,6 +656,7 @@ cm_dmffd_info dmffd;
 int lattice;
 size_t control_points;
 cm_mls_stats mls;
+int prescribed_only;
 } cm_deform_stats;
 void cm_deform_get_stats(const cm_deform *def, cm_deform_stats *stats);
 cm_mls *cm_deform_get_mls(cm_deform *def);

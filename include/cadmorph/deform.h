@@ -256,7 +256,9 @@ typedef struct cm_deform cm_deform;
  * until destroy. opt NULL: the defaults. Errors: the method's (coplanar constrained points
  * are the RBF's CM_ERR_NUMERIC), without a prefix: the caller knows what it was doing;
  * CM_ERR_ARGUMENT for a dmffd lattice outside 4..200 or without a constrained point, or mls
- * and shell without a mesh. */
+ * and shell without a mesh. No free point (every point constrained): rbf, dmffd and mls with
+ * keep_constrained build nothing (their result is the prescribed values; an info message
+ * says so, cm_deform_stats.prescribed_only is 1) and cm_deform_get_mls gives NULL. */
 CM_API cm_status cm_deform_create(cm_context *ctx, const cm_deform_options *opt, size_t n,
                                   const double *xyz, const unsigned char *constrained,
                                   const cm_mesh *mesh, cm_deform **def);
@@ -308,6 +310,10 @@ typedef struct cm_deform_stats {
     int lattice;                /* dmffd: control points per axis */
     size_t control_points;      /* dmffd: of the lattice */
     cm_mls_stats mls;           /* mls: cm_mls_get_stats */
+    int prescribed_only;        /* 1: no free point and the method gives the constrained ones
+                                   their prescribed values (rbf, dmffd, mls with
+                                   keep_constrained): create built nothing, apply returns disp
+                                   unchanged (residual 0) */
 } cm_deform_stats;
 
 CM_API void cm_deform_get_stats(const cm_deform *def, cm_deform_stats *stats);

@@ -3,7 +3,8 @@ deform.h's table (cm_deform_create / cm_deform_apply), as `cadmorph deform`.
 
 Handle points move by given displacements, fixed points stay, every other point follows the
 method's space deformation: "rbf" (triharmonic RBF, exact at the constrained points), "mls"
-(constrained MLS over a mesh's cells, approximate), "shell" (the mesh-based shell of a surface
+(constrained MLS over a mesh's cells: a weighted fit, exact at the constrained points by
+its correction), "shell" (the mesh-based shell of a surface
 mesh) or "dmffd" (DM-FFD on a cubic B-spline lattice enclosing the points, least squares).
 A Deformer does the work that depends only on the points and on which of them are
 constrained (factorisation, SVD, sampling) once; apply maps any number of handle
@@ -57,8 +58,10 @@ class Deformer:
         "petsc") and tolerance (0: the RBF's default) for rbf; lattice (4..200 control points
         per axis, default 10) and clamp (singular values <= clamp x the largest are dropped,
         default 1e-10) for dmffd; samples, cubature, cover, stretch, bend, fix, blend, graded,
-        seed and exact_constraints (the handle and fixed points get their prescribed values
-        instead of the field's, default False as the CLI) for mls; stretch, bend and fix also
+        seed and exact_constraints (True, the library's default: the handle and fixed points
+        get their prescribed values, the field's miss carried into the free points near them;
+        False: the field's value, the paper's weighted fit, as `--approximate-constraints`)
+        for mls; stretch, bend and fix also
         weigh the shell. None leaves the library's default.
     threads: 0 = all; progress: see cadmorph's Context (a callable (stage, done, total),
         None for the terminal line, False for none).
@@ -76,7 +79,7 @@ class Deformer:
                  stretch: Optional[float] = None, bend: Optional[float] = None,
                  fix: Optional[float] = None, blend: Optional[float] = None,
                  graded: Optional[float] = None, seed: Optional[int] = None,
-                 exact_constraints: bool = False, threads: int = 0,
+                 exact_constraints: Optional[bool] = None, threads: int = 0,
                  progress: Progress = None) -> None:
         what = "cadmorph.Deformer"
         method = choice(what, "method", method, METHODS)
@@ -136,7 +139,8 @@ class Deformer:
             mls.graded = number(what, "graded", graded, 0, 1)
         if seed is not None:
             mls.seed = integer(what, "seed", seed, 0, 2 ** 64 - 1)
-        mls.keep_constrained = bool(exact_constraints)
+        if exact_constraints is not None:
+            mls.keep_constrained = bool(exact_constraints)
         if method in ("mls", "shell") and mls.stretch + mls.bend <= 0:
             raise ValueError("%s: stretch + bend must be > 0" % what)
         self._mesh_owner = mesh._ptr if mesh is not None else None  # the shell borrows it
