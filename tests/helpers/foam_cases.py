@@ -70,7 +70,7 @@ def run_foam(tool: str, case: str, *args, check: bool = True) -> subprocess.Comp
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _COUNTS = {"points": "points", "faces": "faces", "internal_faces": "internal faces",
            "cells": "cells", "boundary_patches": "boundary patches",
-           "faces_per_cell": "faces per cell",
+           "point_zones": "point zones", "face_zones": "face zones", "cell_zones": "cell zones",
            "hexahedra": "hexahedra", "prisms": "prisms", "wedges": "wedges",
            "pyramids": "pyramids", "tetWedges": "tet wedges", "tetrahedra": "tetrahedra",
            "polyhedra": "polyhedra"}
@@ -78,17 +78,23 @@ _COUNTS = {"points": "points", "faces": "faces", "internal_faces": "internal fac
 
 def parse_checkmesh(text: str) -> dict:
     """checkMesh (v1912) output parsed: ok, failed, text; the mesh stats and cell-type counts
-    (points faces internal_faces cells boundary_patches hexahedra prisms wedges pyramids
-    tetWedges tetrahedra polyhedra: ints, absent when not printed); directions (geometric)
+    (points faces internal_faces cells boundary_patches point_zones face_zones cell_zones
+    hexahedra prisms wedges pyramids tetWedges tetrahedra polyhedra: ints, absent when not
+    printed; faces_per_cell: float); directions (geometric)
     and solution_directions; max_aspect, max_non_orth, avg_non_orth, max_skewness,
     min_volume, max_volume, total_volume, max_cell_openness (floats); negative_volume
-    (bool: checkMesh found cells with a zero or negative volume); wrong_pyramids (int, 0
-    when the face pyramids are OK); patches {name: {"faces", "points"}}."""
+    (bool: checkMesh found cells with a zero or negative volume) and negative_cells (their
+    count, 0 otherwise); wrong_pyramids (int, 0
+    when the face pyramids are OK); errors (the lines of the failed checks, "***..."); patches
+    {name: {"faces", "points"}} from the patch topology table."""
     out = {"text": text}
     for key, label in _COUNTS.items():
         m = re.search(r"^\s+%s:\s+(%s)" % (re.escape(label), _NUM), text, re.M)
         if m:
             out[key] = int(float(m.group(1)))
+    m = re.search(r"^\s+faces per cell:\s+(%s)" % _NUM, text, re.M)
+    if m:
+        out["faces_per_cell"] = float(m.group(1))
     m = re.search(r"Mesh has (\d+) geometric \(non-empty/wedge\) directions", text)
     if m:
         out["directions"] = int(m.group(1))
@@ -109,7 +115,12 @@ def parse_checkmesh(text: str) -> dict:
             out[key] = float(m.group(1))
     m = re.search(r"Error in face pyramids: (\d+) faces", text)
     out["wrong_pyramids"] = int(m.group(1)) if m else 0
+    # every failed check's line ("***Zero or negative cell volume detected...", "***Number of
+    # edges not aligned with or perpendicular to non-empty directions: 12", ...)
+    out["errors"] = [line.strip() for line in text.splitlines() if line.lstrip().startswith("***")]
     out["negative_volume"] = bool(re.search(r"Zero or negative cell volume detected", text))
+    m = re.search(r"Number of negative volume cells: (\d+)", text)
+    out["negative_cells"] = int(m.group(1)) if m else 0
     m = re.search(r"Failed (\d+) mesh checks", text)
     out["failed"] = int(m.group(1)) if m else 0
     out["ok"] = m is None and bool(re.search(r"^Mesh OK\.", text, re.M))

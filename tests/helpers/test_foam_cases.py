@@ -103,7 +103,8 @@ text = open(pts).read()
 text = re.sub(r"^\(([-+\d.eE]+) ", lambda m: "(%r " % -float(m.group(1)), text, flags=re.M)
 open(pts, "w").write(text)
 r = fc.checkmesh(bad)
-check(not r["ok"] and r["failed"] >= 1 and r["negative_volume"], "mirrored mesh: ok %s failed %s negative %s"
+check(not r["ok"] and r["failed"] >= 1 and r["negative_volume"] and r["negative_cells"] == n1
+      and any("negative" in e for e in r["errors"]), "mirrored mesh: ok %s failed %s negative %s"
       % (r["ok"], r["failed"], r["negative_volume"]))
 # a solver that cannot run (no 0/p): solver_steps returns the failure or raises FoamError
 nop = os.path.join(WORK, "no_p")
