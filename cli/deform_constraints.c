@@ -129,9 +129,154 @@ static cm_status mesh_set(cm_context *ctx, const cm_mesh *m, const char *set, un
                     set, used ? have : "none");
 }
 
+/* The largest distance of n points (x: n x 3) from their least-squares plane, or -1. */
+static double off_plane(size_t n, const double *x, double *scratch)
+{
+    double fit[6];
+    if (n < 3 || cm_shape_project_plane(NULL, n, x, scratch, fit) < 0) return -1;
+    double m = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double e = 0;
+        for (int a = 0; a < 3; ++a)
+            e += (x[3 * i + a] - fit[a]) * fit[3 + a];
+        m = fmax(m, fabs(e));
+    }
+    return m;
+}
+
+static int64_t find_root(int64_t *parent, int64_t i)
+{
+    while (parent[i] != i)
+        i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+/* A plane set named by a group whose faces form separate pieces that do not lie in one
+ * plane (the front and back planes of a 2-D mesh are one `empty` patch; the two walls of a
+ * channel one `wall` patch): one plane set per piece, each of which must be planar itself,
+ * else an error (one least-squares plane through two parallel planes would squash the mesh
+ * between them). nodes (k, ascending) is the set; *pieces gets the piece index of each
+ * node and the return value their count (1: nothing to split), or -1 after an error. */
+static int plane_pieces(cm_context *ctx, const cm_mesh *m, const char *set, const int64_t *nodes,
+                        size_t k, int *piece)
+{
+    const cm_mesh_group *gr = NULL;
+    for (size_t g = 0; g < m->n_groups && !gr; ++g)
+        if (m->groups[g].name && !strcmp(m->groups[g].name, set)) gr = m->groups + g;
+    if (!gr || !m->physical || k < 3) return 1;
+    size_t n = m->n_nodes;
+    int64_t *parent = malloc((n ? n : 1) * sizeof *parent);
+    double *x = malloc(k * 6 * sizeof *x);
+    if (!parent || !x) {
+        free(parent), free(x);
+        cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+        return -1;
+    }
+    for (size_t i = 0; i < n; ++i)
+        parent[i] = (int64_t)i;
+    for (size_t c = 0; c < m->n_cells; ++c) {
+        const cm_cell_info *inf = cm_cell_type_info((cm_cell_type)m->type[c]);
+        if (m->physical[c] != gr->tag || !inf || inf->dim != gr->dim) continue;
+        if (m->type[c] == CM_CELL_POLYHEDRON) continue; /* a group of faces has no polyhedra */
+        for (int64_t p = m->offset[c] + 1; p < m->offset[c + 1]; ++p) {
+            int64_t a = find_root(parent, m->conn[m->offset[c]]), b = find_root(parent, m->conn[p]);
+            if (a != b) parent[b] = a;
+        }
+    }
+    /* a piece's index at its root: parent[] of a root is free for it once every node of the
+     * set knows its root (kept in x as scratch: k <= n) */
+    int64_t *root = (int64_t *)x;
+    for (size_t i = 0; i < k; ++i)
+        root[i] = find_root(parent, nodes[i]);
+    for (size_t i = 0; i < k; ++i)
+        parent[root[i]] = -1;
+    int count = 0;
+    for (size_t i = 0; i < k; ++i) {
+        if (parent[root[i]] == -1) parent[root[i]] = -2 - count++;
+        piece[i] = (int)(-2 - parent[root[i]]);
+    }
+    for (size_t i = 0; i < k; ++i)
+        memcpy(x + 3 * i, m->xyz + 3 * nodes[i], 3 * sizeof *x);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < k; ++i)
+        for (int a = 0; a < 3; ++a)
+            lo[a] = fmin(lo[a], x[3 * i + a]), hi[a] = fmax(hi[a], x[3 * i + a]);
+    double tol = 1e-6 * sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                             (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    int rc = 1;
+    if (count > 1 && off_plane(k, x, x + 3 * k) > tol) {
+        rc = count;
+        for (int q = 0; q < count && rc > 0; ++q) {
+            size_t kq = 0;
+            for (size_t i = 0; i < k; ++i)
+                if (piece[i] == q) memcpy(x + 3 * kq++, m->xyz + 3 * nodes[i], 3 * sizeof *x);
+            double off = off_plane(kq, x, x + 3 * k);
+            if (count > 64 || off < 0 || off > tol) {
+                cm_error(ctx, CM_ERR_MISMATCH,
+                         "constraint plane:%s: its nodes are not one plane but %s%d separate "
+                         "pieces, and piece %d (%zu nodes) is not planar itself (%.3g off its "
+                         "plane): give each plane its own set (a node-list file)",
+                         set, count > 64 ? "over " : "", count > 64 ? 64 : count, q + 1, kq,
+                         off);
+                rc = -1;
+            }
+        }
+    }
+    free(parent), free(x);
+    return rc;
+}
+
 int cli_constraints_any(const cli_constraints *c)
 {
     return c->n > 0 || c->cad != NULL;
+}
+
+/* Set t (a plane, named by a group) split into its planar pieces when they are not one
+ * plane (plane_pieces): the first piece stays set t, the others are appended, each labelled
+ * SET[piece] and reported on stdout. */
+static cm_status split_plane(cm_context *ctx, const cm_mesh *mesh, cli_constraints *c,
+                             cm_shape_set *sets, int t)
+{
+    size_t k = sets[t].n;
+    int *piece = malloc((k ? k : 1) * sizeof *piece);
+    if (!piece) return cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+    int count = plane_pieces(ctx, mesh, c->set[t], sets[t].nodes, k, piece);
+    cm_status s = count < 0 ? CM_ERR_MISMATCH : CM_OK;
+    if (count > 1 && c->n + count - 1 > CLI_MAX_CONSTRAINTS)
+        s = cm_error(ctx, CM_ERR_ARGUMENT, "constraint plane:%s: %d pieces make more than %d sets",
+                     c->set[t], count, CLI_MAX_CONSTRAINTS);
+    int64_t *all = (int64_t *)sets[t].nodes;
+    const char *name = c->set[t];
+    for (int q = count - 1; s >= 0 && count > 1 && q >= 0; --q) {
+        size_t kq = 0;
+        for (size_t i = 0; i < k; ++i)
+            kq += piece[i] == q;
+        int64_t *nodes = malloc((kq ? kq : 1) * sizeof *nodes);
+        char *label = malloc(strlen(name) + 16);
+        if (!nodes || !label) {
+            free(nodes), free(label);
+            s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+            break;
+        }
+        kq = 0;
+        for (size_t i = 0; i < k; ++i)
+            if (piece[i] == q) nodes[kq++] = all[i];
+        sprintf(label, "%s[%d]", name, q + 1);
+        int to = q == 0 ? t : c->n++;
+        free(c->owned[to]);
+        c->owned[to] = label;
+        c->type[to] = CM_SHAPE_PLANE;
+        c->set[to] = label;
+        sets[to].type = CM_SHAPE_PLANE;
+        sets[to].n = kq;
+        sets[to].nodes = nodes;
+        if (q == 0) free(all);
+    }
+    if (s >= 0 && count > 1)
+        printf("constraint plane:%s: %d separate planes, one constraint each (%s[1] .. %s[%d])\n",
+               name, count, name, name, count);
+    free(piece);
+    return s;
 }
 
 cm_status cli_constraints_resolve(cm_context *ctx, const cm_mesh *mesh, cli_constraints *c,
@@ -142,10 +287,12 @@ cm_status cli_constraints_resolve(cm_context *ctx, const cm_mesh *mesh, cli_cons
     unsigned char *mark = malloc(n ? n : 1);
     if (!mark) return cm_error(ctx, CM_ERR_NOMEM, "out of memory");
     cm_status s = CM_OK;
-    for (int t = 0; t < c->n && s >= 0; ++t) {
+    const int given = c->n; /* the pieces of split plane sets are appended after them */
+    for (int t = 0; t < given && s >= 0; ++t) {
         memset(mark, 0, n ? n : 1);
         struct stat st;
-        if (stat(c->set[t], &st) == 0 && S_ISREG(st.st_mode))
+        int file = stat(c->set[t], &st) == 0 && S_ISREG(st.st_mode);
+        if (file)
             s = cm_mesh_read_node_list(ctx, c->set[t], n, mark);
         else
             s = mesh_set(ctx, mesh, c->set[t], mark);
@@ -165,6 +312,7 @@ cm_status cli_constraints_resolve(cm_context *ctx, const cm_mesh *mesh, cli_cons
         sets[t].n = k;
         sets[t].nodes = nodes;
         if (k == 0) s = cm_error(ctx, CM_ERR_MISMATCH, "constraint set '%s': no node", c->set[t]);
+        if (s >= 0 && !file && c->type[t] == CM_SHAPE_PLANE) s = split_plane(ctx, mesh, c, sets, t);
     }
     free(mark);
     if (s >= 0 && c->cad) s = cli_cad_constraints(ctx, mesh, c, sets);

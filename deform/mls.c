@@ -95,6 +95,7 @@ void mls_view_get(cm_mls *m, mls_view *v)
     v->n_con = m->n_con, v->con = m->con, v->wf = m->wf, v->is_con = m->is_con;
     v->keep_constrained = m->keep_constrained;
     v->factor = m->factor;
+    v->blend = m->keep_constrained && m->blend.n ? &m->blend : NULL;
 }
 
 /* Sample and cubature positions (section 5): farthest points of the dense surface and

@@ -4,6 +4,7 @@
 #define CADMORPH_DEFORM_MLS_INTERNAL_H
 
 #include "cadmorph/mls.h"
+#include "cadmorph/shapeup.h"
 
 #include <stdint.h>
 
@@ -84,6 +85,7 @@ typedef struct mls_view {
     const unsigned char *is_con;
     int keep_constrained;
     void *factor;
+    const struct mls_blend *blend; /* keep_constrained: the miss's way into the free nodes */
 } mls_view;
 
 void mls_view_get(cm_mls *m, mls_view *v);
@@ -91,18 +93,37 @@ void mls_view_get(cm_mls *m, mls_view *v);
 /* The residual blend (mls_blend.c): for the n free nodes within `radius` of a constrained
  * node, width weights each (CSR with fixed-width rows) onto the constrained nodes (col: the
  * index in the constrained list). */
-typedef struct mls_blend {
+typedef struct mls_blend mls_blend;
+struct mls_blend {
     size_t n;
     int width;
     int64_t *node, *row;
     int32_t *col;
     double *val;
-} mls_blend;
+};
 
 cm_status mls_blend_create(cm_context *ctx, size_t n, const double *xyz, const unsigned char *is_con,
                            size_t n_con, const int64_t *con, double radius, mls_blend *b);
 void mls_blend_free(mls_blend *b);
 /* disp[node] += sum val r[col] (r: n_con x 3). */
 void mls_blend_apply(const mls_blend *b, const double *r, double *disp, int threads);
+
+/* The snap of the Shape-Up alternation (shapeup_snap.c): the sets (n_sets, type, off, nodes,
+ * ref: as cm_shapeup keeps them) and p, the projections of the positions ref + disp, every
+ * set's own fit (used for the sets that are not planes). */
+typedef struct shapeup_snap_in {
+    const mls_view *v;
+    size_t n_sets;
+    const cm_shape_type *type;
+    const size_t *off;
+    const int64_t *nodes;
+    const double *ref, *p;
+    double diag;
+} shapeup_snap_in;
+/* Moves the set nodes of disp (#nodes x 3) onto their shapes: a plane through the set's
+ * constrained nodes where they span one (keep_constrained), else its least-squares plane; a
+ * node of several planes onto their intersection; other shapes onto p. Constrained nodes
+ * stay when keep_constrained. *move: the largest move. */
+cm_status shapeup_snap(cm_context *ctx, const shapeup_snap_in *in, double *disp, double *move);
 
 #endif

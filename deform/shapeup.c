@@ -554,6 +554,14 @@ static void set_positions(const cm_shapeup *s, const double *w, double *y)
     }
 }
 
+/* The positions of the set nodes in a result disp (#nodes x 3). */
+static void set_final(const cm_shapeup *s, const double *disp, double *y)
+{
+    for (size_t i = 0; i < s->n_tot; ++i)
+        for (int a = 0; a < 3; ++a)
+            y[3 * i + a] = s->ref[3 * i + a] + disp[3 * (size_t)s->nodes[i] + a];
+}
+
 static cm_status project_all(cm_context *ctx, cm_shapeup *s, const double *y, double *p)
 {
     for (size_t t = 0; t < s->n_sets; ++t) {
@@ -626,6 +634,7 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
     double *y2 = malloc(nt * 3 * sizeof *y2), *p = malloc(nt * 3 * sizeof *p);
     double *res = malloc((s->n_sets ? s->n_sets : 1) * sizeof *res);
     anderson *aa = s->opt.anderson > 0 ? anderson_create(3 * k, s->opt.anderson) : NULL;
+    double *rc = NULL;
     if (!bfix || !b || !w || !y || !y2 || !p || !res || (s->opt.anderson > 0 && !aa)) {
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_shapeup_apply: out of memory");
         goto done;
@@ -709,9 +718,16 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
         if (move <= s->opt.tolerance * s->diag) converged = 1;
     }
     if (residual && s->n_sets) set_residuals(s, y, p, residual);
-    /* the field at every node */
+    /* the field at every node; with keep_constrained the constrained nodes keep their
+     * prescribed values and the field's miss there is carried into the free nodes around
+     * them, as cm_mls_apply does */
     double fres = 0;
-    for (size_t i = 0; i < v->n_nodes; ++i) {
+    rc = v->blend ? malloc((v->n_con ? v->n_con : 1) * 3 * sizeof *rc) : NULL;
+    if (v->blend && !rc) {
+        st = cm_error(ctx, CM_ERR_NOMEM, "cm_shapeup_apply: out of memory");
+        goto done;
+    }
+    for (size_t i = 0, c = 0; i < v->n_nodes; ++i) {
         double d[3] = {0, 0, 0};
         for (int64_t q = v->row[i]; q < v->row[i + 1]; ++q)
             for (int a = 0; a < 3; ++a)
@@ -721,23 +737,31 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
                             (d[1] - disp[3 * i + 1]) * (d[1] - disp[3 * i + 1]) +
                             (d[2] - disp[3 * i + 2]) * (d[2] - disp[3 * i + 2]));
             if (e > fres) fres = e;
+            if (rc)
+                for (int a = 0; a < 3; ++a)
+                    rc[3 * c + a] = disp[3 * i + a] - d[a];
+            ++c;
             if (v->keep_constrained) continue;
         }
         memcpy(disp + 3 * i, d, sizeof d);
     }
+    if (rc) mls_blend_apply(v->blend, rc, disp, 1);
     double smove = 0;
-    if (s->opt.snap)
-        for (size_t i = 0; i < s->n_tot; ++i) {
-            int64_t node = s->nodes[i];
-            if (v->is_con[node] && v->keep_constrained) continue; /* prescribed stays */
-            double e = 0;
-            for (int a = 0; a < 3; ++a) {
-                double target = p[3 * i + a] - s->ref[3 * i + a];
-                e += (target - disp[3 * node + a]) * (target - disp[3 * node + a]);
-                disp[3 * node + a] = target;
-            }
-            smove = fmax(smove, sqrt(e));
+    if (s->opt.snap && s->n_sets) {
+        /* onto the shapes after everything else (shapeup_snap.c), and the residuals of the
+         * result itself */
+        set_final(s, disp, y);
+        st = project_all(ctx, s, y, p);
+        shapeup_snap_in in = {v, s->n_sets, s->type, s->off, s->nodes, s->ref, p, s->diag};
+        if (st >= 0) st = shapeup_snap(ctx, &in, disp, &smove);
+        if (st < 0) goto done;
+        if (residual) {
+            set_final(s, disp, y);
+            st = project_all(ctx, s, y, p);
+            if (st < 0) goto done;
+            set_residuals(s, y, p, residual);
         }
+    }
     if (rep) {
         rep->snap_move = smove;
         rep->iterations = it;
@@ -759,7 +783,7 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
 done:
     if (bfix) cholmod_free_dense(&bfix, &s->cc);
     if (b) cholmod_free_dense(&b, &s->cc);
-    free(w), free(y), free(y2), free(p), free(res);
+    free(w), free(y), free(y2), free(p), free(res), free(rc);
     anderson_destroy(aa);
     return st;
 }
