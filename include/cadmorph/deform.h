@@ -213,7 +213,8 @@ typedef enum cm_deform_method {
     CM_DEFORM_RBF = 0,   /* "rbf": one polyharmonic RBF (rbf.h) through the constrained points,
                             exact (residual 0); needs no cells */
     CM_DEFORM_MLS = 1,   /* "mls": the constrained MLS space deformation (mls.h) over the cells
-                            of a mesh, approximate [CMLS §4-5] */
+                            of a mesh [CMLS §4-5]: a weighted fit, exact at the constrained
+                            points by default (mls.keep_constrained) */
     CM_DEFORM_SHELL = 2, /* "shell": the mesh-based shell of a surface mesh (cm_mls_shell), the
                             MLS subspace's ground truth [CMLS §3]; solved anew by every apply */
     CM_DEFORM_DMFFD = 3, /* "dmffd": DM-FFD on a cubic B-spline lattice enclosing the points,

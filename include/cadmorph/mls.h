@@ -7,7 +7,11 @@
  * cubature points q_i, and E_fix the squared miss at the constrained nodes (handle H and
  * fixed region F). The k x k normal equations (eq. 14) are sparse: CHOLMOD factors them once
  * per sample set, and every new displacement of the constrained nodes is one solve.
- * It is an approximation: the constrained nodes are met up to a residual.
+ * The field is an approximation: it meets the constrained nodes up to a residual. By default
+ * (keep_constrained) apply gives them their prescribed values all the same and carries the
+ * field's miss into the free nodes near them (blend); keep_constrained = 0 is the paper's
+ * weighted form, the field's values everywhere (docs/DESIGN.md, "Handles, fixed nodes and
+ * the MLS's miss").
  * Conventions: see core.h. */
 #ifndef CADMORPH_MLS_H
 #define CADMORPH_MLS_H
@@ -53,8 +57,9 @@ typedef struct cm_mls_options {
     double stretch;        /* gamma_s (1) */
     double bend;           /* gamma_b (1) */
     double fix;            /* gamma_f (1000) */
-    int keep_constrained;  /* apply: constrained nodes keep their prescribed value (1) or get
-                              the field's value (0) */
+    int keep_constrained;  /* apply: constrained nodes keep their prescribed value (1, the
+                              default: exact) or get the field's value (0: approximate, the
+                              paper's weighted fit) */
     double blend;          /* keep_constrained: the field's miss at the constrained nodes is
                               carried into the free nodes near them and decays over blend x
                               the mean support radius (1.5; 0: off, the miss stays in the

@@ -85,9 +85,13 @@ typedef struct cm_shapeup_options {
                            large ones) */
     int anderson;       /* > 0: Anderson acceleration with this many past iterates (at most 64;
                            0: the plain alternation, default) */
-    int snap;           /* 1: after the alternation, the set nodes take their projections
-                           (the constraints then hold to rounding; a node of several sets
-                           takes the last one's); 0: the field everywhere (default) */
+    int snap;           /* 1: after the alternation and the blend of the constrained nodes'
+                           miss, the set nodes go onto their shapes, so that the result holds
+                           them to rounding: a plane through the set's constrained nodes
+                           where they span one (with keep_constrained they stay where they
+                           are prescribed), else its least-squares plane; a node of several
+                           plane sets onto their intersection, of other sets the last one's
+                           projection; 0: the field everywhere (default) */
 } cm_shapeup_options;
 
 CM_API void cm_shapeup_options_init(cm_shapeup_options *opt);
@@ -116,9 +120,12 @@ typedef struct cm_shapeup_report {
 } cm_shapeup_report;
 
 /* disp as cm_mls_apply: #nodes x 3, read at the MLS constrained nodes, written at every node.
+ * With keep_constrained the constrained nodes keep their prescribed values and the field's
+ * miss there is blended into the free nodes, as cm_mls_apply does.
  * residual: n_sets output (may be NULL): the largest distance of a set's node from the
  * projection of its set, before (residual0, the unconstrained deformation; may be NULL) and
- * after. CM_WARNING if the cap was reached before the tolerance. */
+ * after (snap: of the result written into disp). CM_WARNING if the cap was reached before
+ * the tolerance. */
 CM_API cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *su, double *disp,
                                   double *residual0, double *residual, cm_shapeup_report *rep);
 
