@@ -6,6 +6,7 @@
 #include "cadmorph/shapeup.h"
 #include "test_util.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -252,12 +253,75 @@ static void test_shear(cm_context *ctx)
     free(con), free(side), free(block), free(d), free(d0);
 }
 
+/* The snap with exact constraints (the defaults): the faces x = 0 and y = 0 of a box whose
+ * bottom is fixed and whose top stretches within both faces (d = (0.1 x, 0.1 y, 0.2)) stay on
+ * their planes to rounding, their common edge on both; the field alone leaves them. */
+static void test_snap_exact(cm_context *ctx)
+{
+    cm_mesh *m = box(ctx, 6);
+    size_t n = m->n_nodes;
+    unsigned char *con = calloc(n, 1);
+    int64_t *fx = malloc(n * sizeof *fx), *fy = malloc(n * sizeof *fy);
+    double *d = calloc(n * 3, sizeof *d), *d0 = malloc(n * 3 * sizeof *d0);
+    for (size_t i = 0; i < n; ++i) {
+        const double *x = m->xyz + 3 * i;
+        if (x[2] < 1e-12) con[i] = 1;
+        if (x[2] > 1 - 1e-12) con[i] = 2, d[3 * i] = 0.1 * x[0], d[3 * i + 1] = 0.1 * x[1], d[3 * i + 2] = 0.2;
+    }
+    size_t nx = select_nodes(m, 0, 0, -1, 0, fx), ny = select_nodes(m, 1, 0, -1, 0, fy);
+    cm_mls_options o;
+    cm_mls_options_init(&o); /* keep_constrained: exact */
+    o.samples = 150;
+    cm_mls *mls = NULL;
+    CHECK(cm_mls_create(ctx, m, con, &o, &mls) == CM_OK);
+    memcpy(d0, d, n * 3 * sizeof *d);
+    double res = 0, off = 0;
+    CHECK(cm_mls_apply(ctx, mls, d0, &res) == CM_OK);
+    for (size_t i = 0; i < nx; ++i)
+        off = fmax(off, fabs(d0[3 * fx[i]]));
+    CHECK_MSG(off > 1e-6, "the field leaves the face x = 0: %g", off);
+    cm_shape_set sets[2] = {{CM_SHAPE_PLANE, nx, fx}, {CM_SHAPE_PLANE, ny, fy}};
+    for (int snap = 0; snap < 2; ++snap) {
+        cm_shapeup_options so;
+        cm_shapeup_options_init(&so);
+        so.snap = snap;
+        cm_shapeup *su = NULL;
+        CHECK(cm_shapeup_create(ctx, mls, m, 2, sets, &so, &su) == CM_OK);
+        memcpy(d0, d, n * 3 * sizeof *d);
+        double r1[2] = {-1, -1};
+        cm_shapeup_report rep;
+        CHECK(cm_shapeup_apply(ctx, su, d0, NULL, r1, &rep) >= 0);
+        cm_shapeup_destroy(&su);
+        double ex = 0, ey = 0, miss = 0;
+        for (size_t i = 0; i < nx; ++i)
+            ex = fmax(ex, fabs(d0[3 * fx[i]]));
+        for (size_t i = 0; i < ny; ++i)
+            ey = fmax(ey, fabs(d0[3 * fy[i] + 1]));
+        for (size_t i = 0; i < n; ++i)
+            if (con[i])
+                for (int a = 0; a < 3; ++a)
+                    miss = fmax(miss, fabs(d0[3 * i + a] - d[3 * i + a]));
+        CHECK_MSG(miss == 0, "snap %d: handles and fixed nodes exact: %g", snap, miss);
+        if (snap) {
+            CHECK_MSG(ex <= 1e-15 && ey <= 1e-15, "snapped: off x = 0 by %g, y = 0 by %g", ex, ey);
+            CHECK_MSG(r1[0] <= 1e-14 && r1[1] <= 1e-14, "snapped: residuals of the result %g %g",
+                      r1[0], r1[1]);
+        } else {
+            CHECK_MSG(ex > 1e-9 || ey > 1e-9, "not snapped: the faces hold only approximately");
+        }
+    }
+    cm_mls_destroy(&mls);
+    free(con), free(fx), free(fy), free(d), free(d0);
+    cm_mesh_destroy(&m);
+}
+
 int main(void)
 {
     cm_context *ctx = NULL;
     if (cm_context_create(&ctx) != CM_OK) return 1;
     test_satisfied(ctx);
     test_shear(ctx);
+    test_snap_exact(ctx);
     cm_shape_type t;
     CHECK(cm_shape_type_parse(ctx, "cylinder", &t) == CM_OK && t == CM_SHAPE_CYLINDER);
     CHECK(cm_shape_type_parse(ctx, "cone", &t) == CM_OK && t == CM_SHAPE_CONE);
