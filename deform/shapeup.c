@@ -634,7 +634,7 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
     double *y2 = malloc(nt * 3 * sizeof *y2), *p = malloc(nt * 3 * sizeof *p);
     double *res = malloc((s->n_sets ? s->n_sets : 1) * sizeof *res);
     anderson *aa = s->opt.anderson > 0 ? anderson_create(3 * k, s->opt.anderson) : NULL;
-    double *rc = NULL;
+    double *rc = NULL, *cb = NULL;
     if (!bfix || !b || !w || !y || !y2 || !p || !res || (s->opt.anderson > 0 && !aa)) {
         st = cm_error(ctx, CM_ERR_NOMEM, "cm_shapeup_apply: out of memory");
         goto done;
@@ -745,7 +745,33 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
         }
         memcpy(disp + 3 * i, d, sizeof d);
     }
-    if (rc) mls_blend_apply(v->blend, rc, disp, 1);
+    if (rc) {
+        /* the blend of the miss reaches set nodes near the constrained ones: at a node of a
+         * plane set only its part along the plane of the alternation's positions, so that it
+         * does not undo the flatness the constraint reached (a normal part would tilt the
+         * plane's nodes beside a handle by the miss) */
+        cb = calloc(v->n_nodes ? 3 * v->n_nodes : 1, sizeof *cb);
+        if (!cb) {
+            st = cm_error(ctx, CM_ERR_NOMEM, "cm_shapeup_apply: out of memory");
+            goto done;
+        }
+        mls_blend_apply(v->blend, rc, cb, 1);
+        for (size_t t = 0; t < s->n_sets; ++t) {
+            size_t o = s->off[t], nn = s->off[t + 1] - o;
+            double fit[6];
+            if (s->type[t] != CM_SHAPE_PLANE) continue;
+            st = cm_shape_project_plane(ctx, nn, y + 3 * o, y2 + 3 * o, fit);
+            if (st < 0) goto done;
+            for (size_t i = o; i < o + nn; ++i) {
+                double *c = cb + 3 * (size_t)s->nodes[i];
+                double dn = c[0] * fit[3] + c[1] * fit[4] + c[2] * fit[5];
+                for (int a = 0; a < 3; ++a)
+                    c[a] -= dn * fit[3 + a];
+            }
+        }
+        for (size_t i = 0; i < 3 * v->n_nodes; ++i)
+            disp[i] += cb[i];
+    }
     double smove = 0;
     if (s->opt.snap && s->n_sets) {
         /* onto the shapes after everything else (shapeup_snap.c), and the residuals of the
@@ -783,7 +809,7 @@ cm_status cm_shapeup_apply(cm_context *ctx, cm_shapeup *s, double *disp, double 
 done:
     if (bfix) cholmod_free_dense(&bfix, &s->cc);
     if (b) cholmod_free_dense(&b, &s->cc);
-    free(w), free(y), free(y2), free(p), free(res), free(rc);
+    free(w), free(y), free(y2), free(p), free(res), free(rc), free(cb);
     anderson_destroy(aa);
     return st;
 }
