@@ -121,7 +121,9 @@ typedef struct cm_shapeup_report {
 
 /* disp as cm_mls_apply: #nodes x 3, read at the MLS constrained nodes, written at every node.
  * With keep_constrained the constrained nodes keep their prescribed values and the field's
- * miss there is blended into the free nodes, as cm_mls_apply does.
+ * miss there is blended into the free nodes, as cm_mls_apply does; at the nodes of a plane
+ * set only the blend's part along the set's plane (of the alternation's positions), so that
+ * the blend does not undo the constraint beside a handle.
  * residual: n_sets output (may be NULL): the largest distance of a set's node from the
  * projection of its set, before (residual0, the unconstrained deformation; may be NULL) and
  * after (snap: of the result written into disp). CM_WARNING if the cap was reached before
