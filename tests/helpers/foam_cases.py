@@ -1,7 +1,7 @@
 """Shared OpenFOAM test cases: complete, runnable simpleFoam (laminar) cases made by blockMesh,
 for the tests and benchmarks of CFD morphs (2-D, axisymmetric, symmetry plane, cyclic), and
 thin wrappers around the real OpenFOAM v1912 tools (checkMesh's verdict parsed, a few solver
-steps, the points of a patch read from polyMesh).
+steps, the points and the points of a patch read from polyMesh).
 
 Kinds (every case has a wall patch `body`; the patch types are what the morph must respect):
   channel2d   2-D channel (one cell thick in z) around a square body in its middle;
@@ -218,6 +218,23 @@ def read_boundary(case: str) -> dict:
             d[k] = int(v) if re.fullmatch(r"-?\d+", v) else v
         out[name] = d
     return out
+
+
+def read_points(case: str, polymesh: str = "constant/polyMesh") -> list:
+    """The points of case's polyMesh (ASCII, binary or .gz) as a list of (x, y, z) floats,
+    in file order (the node order cadmorph uses)."""
+    data = _read_foam_file(os.path.join(case, polymesh, "points"))
+    h = _header(data)
+    if h.get("format") == "binary":
+        m = re.search(r"scalar=(\d+)", h.get("arch", ""))
+        size = int(m.group(1)) // 8 if m else 8
+        m = re.compile(rb"^(\d+)\s*\(", re.M).search(data, h["_end"])
+        n = int(m.group(1))
+        flat = struct.unpack_from("<%d%s" % (3 * n, "d" if size == 8 else "f"), data, m.end())
+        return [tuple(flat[3 * i:3 * i + 3]) for i in range(n)]
+    body = data[h["_end"]:].decode()
+    return [(float(a), float(b), float(c)) for a, b, c in
+            re.findall(r"\(\s*([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s*\)", body)]
 
 
 def patch_points(case: str, patch: str) -> list:

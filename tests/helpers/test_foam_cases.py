@@ -3,7 +3,8 @@
   * every kind meshes, checkMesh says "Mesh OK" with the expected geometric directions, cell
     types and patches (the wedge's axis patch has no faces, its cells at the axis are prisms),
     and 5 simpleFoam steps run;
-  * patch_points reads the same number of points per patch as checkMesh reports, from ASCII,
+  * read_points reads every point, the body's points span the body's box; patch_points
+    reads the same number of points per patch as checkMesh reports, from ASCII,
     binary and compressed polyMesh files;
   * zones=True writes the cellZones wake and none (empty) and the faceZone plane;
   * scale multiplies the cell count; write_precision reaches controlDict;
@@ -11,6 +12,7 @@
     solver_steps reports a solver that fails.
 Exit 77 (ctest SKIP) only when OpenFOAM's tools are not installed.
 usage: test_foam_cases.py WORKDIR"""
+import math
 import os
 import re
 import shutil
@@ -46,6 +48,11 @@ EXPECT = {  # kind: (geometric directions, {patch: type})
     "cyclic": (3, {"inlet": "patch", "outlet": "patch", "walls": "wall", "body": "wall",
                    "back": "cyclic", "front": "cyclic"}),
 }
+SIN = 0.25 * math.sin(math.radians(2.5))
+BODY_BOX = {"channel2d": ((2, 0.75, 0), (2.5, 1.25, 0.1)),
+            "wedge": ((2, 0, -SIN), (2.5, 0.25 * math.cos(math.radians(2.5)), SIN)),
+            "symmetry3d": ((2, 0, -0.25), (2.5, 0.25, 0.25)),
+            "cyclic": ((2, 0.75, 0.4), (2.5, 1.25, 0.8))}
 VARIANTS = {"channel2d": {}, "wedge": {"binary": True, "zones": True},
             "symmetry3d": {"compress": True}, "cyclic": {"zones": True}}
 
@@ -72,6 +79,15 @@ for kind, (ndir, types) in EXPECT.items():
         want = r["patches"].get(name, {}).get("points")
         check(len(pts) == want and pts == sorted(set(pts)) and (not pts or pts[-1] < r["points"]),
               "%s: patch_points(%s) gives %d points, checkMesh %s" % (kind, name, len(pts), want))
+    # read_points: every point, and the body's points span the body's box
+    xyz = fc.read_points(case)
+    body = [xyz[i] for i in fc.patch_points(case, "body")]
+    lo = [min(p[a] for p in body) for a in range(3)]
+    hi = [max(p[a] for p in body) for a in range(3)]
+    check(len(xyz) == r["points"], "%s: read_points gives %d points" % (kind, len(xyz)))
+    box = BODY_BOX[kind]
+    check(all(abs(lo[a] - box[0][a]) < 1e-9 and abs(hi[a] - box[1][a]) < 1e-9 for a in range(3)),
+          "%s: body points span %s %s, not %s" % (kind, lo, hi, box))
     pm = os.path.join(case, "constant", "polyMesh")
     if opts.get("compress"):
         check(os.path.exists(os.path.join(pm, "faces.gz")), "%s: no faces.gz" % kind)
