@@ -1,7 +1,7 @@
 """Shared OpenFOAM test cases: complete, runnable simpleFoam (laminar) cases made by blockMesh,
 for the tests and benchmarks of CFD morphs (2-D, axisymmetric, symmetry plane, cyclic), and
 thin wrappers around the real OpenFOAM v1912 tools (checkMesh's verdict parsed, a few solver
-steps, the points and the points of a patch read from polyMesh).
+steps, the points and a patch's faces and points read from polyMesh).
 
 Kinds (every case has a wall patch `body`; the patch types are what the morph must respect):
   channel2d   2-D channel (one cell thick in z) around a square body in its middle;
@@ -85,7 +85,8 @@ def parse_checkmesh(text: str) -> dict:
     min_volume, max_volume, total_volume, max_cell_openness (floats); negative_volume
     (bool: checkMesh found cells with a zero or negative volume) and negative_cells (their
     count, 0 otherwise); wrong_pyramids (int, 0
-    when the face pyramids are OK); errors (the lines of the failed checks, "***..."); patches
+    when the face pyramids are OK); fatal (the first line of a FOAM FATAL ERROR, e.g.
+    cyclic faces that no longer match, else None); errors (the lines of the failed checks, "***..."); patches
     {name: {"faces", "points"}} from the patch topology table."""
     out = {"text": text}
     for key, label in _COUNTS.items():
@@ -119,6 +120,8 @@ def parse_checkmesh(text: str) -> dict:
     # edges not aligned with or perpendicular to non-empty directions: 12", ...)
     out["errors"] = [line.strip() for line in text.splitlines() if line.lstrip().startswith("***")]
     out["negative_volume"] = bool(re.search(r"Zero or negative cell volume detected", text))
+    m = re.search(r"FOAM FATAL (?:IO )?ERROR:?\s*\n?\s*(.+)", text)
+    out["fatal"] = m.group(1).strip() if m else None
     m = re.search(r"Number of negative volume cells: (\d+)", text)
     out["negative_cells"] = int(m.group(1)) if m else 0
     m = re.search(r"Failed (\d+) mesh checks", text)
@@ -139,8 +142,14 @@ def parse_checkmesh(text: str) -> dict:
 def checkmesh(case: str, *args) -> dict:
     """Runs checkMesh on case (extra args e.g. "-allGeometry", "-allTopology") and returns
     parse_checkmesh() of its output; "returncode" is checkMesh's exit status (a failed mesh
-    check does not make it non-zero; an unreadable mesh does, and then "ok" is False)."""
+    check does not make it non-zero; an unreadable mesh does, and then "ok" is False). The
+    face and cell sets checkMesh writes for failed checks are removed again (polyMesh/sets,
+    when the case had none): the case is left as it was."""
+    sets = os.path.join(str(case), "constant", "polyMesh", "sets")
+    had_sets = os.path.exists(sets)
     p = run_foam("checkMesh", case, *args, check=False)
+    if not had_sets:
+        shutil.rmtree(sets, ignore_errors=True)
     out = parse_checkmesh(p.stdout + p.stderr)
     out["returncode"] = p.returncode
     if p.returncode != 0:
@@ -237,16 +246,23 @@ def read_points(case: str, polymesh: str = "constant/polyMesh") -> list:
             re.findall(r"\(\s*([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s*\)", body)]
 
 
-def patch_points(case: str, patch: str) -> list:
-    """Sorted list of the point labels on patch (read from case's constant/polyMesh; ASCII,
-    binary or .gz); [] for a patch with no faces; KeyError for an unknown patch."""
+def patch_faces(case: str, patch: str) -> list:
+    """The faces of patch (tuples of point labels, in file order) read from case's
+    constant/polyMesh (ASCII, binary or .gz); [] for a patch with no faces; KeyError for an
+    unknown patch."""
     b = read_boundary(case)[patch]
     n, start = int(b["nFaces"]), int(b["startFace"])
     if n == 0:
         return []
     faces = _read_faces(os.path.join(case, "constant", "polyMesh", "faces"))
+    return [tuple(f) for f in faces[start:start + n]]
+
+
+def patch_points(case: str, patch: str) -> list:
+    """Sorted list of the point labels on patch (read from case's constant/polyMesh; ASCII,
+    binary or .gz); [] for a patch with no faces; KeyError for an unknown patch."""
     pts = set()
-    for f in faces[start:start + n]:
+    for f in patch_faces(case, patch):
         pts.update(f)
     return sorted(pts)
 

@@ -120,8 +120,26 @@ text = re.sub(r"^\(([-+\d.eE]+) ", lambda m: "(%r " % -float(m.group(1)), text, 
 open(pts, "w").write(text)
 r = fc.checkmesh(bad)
 check(not r["ok"] and r["failed"] >= 1 and r["negative_volume"] and r["negative_cells"] == n1
-      and any("negative" in e for e in r["errors"]), "mirrored mesh: ok %s failed %s negative %s"
+      and any("negative" in e for e in r["errors"]) and r["fatal"] is None
+      and not os.path.exists(os.path.join(bad, "constant", "polyMesh", "sets")), "mirrored mesh: ok %s failed %s negative %s"
       % (r["ok"], r["failed"], r["negative_volume"]))
+# a cyclic pair that no longer matches (one side's points moved): checkMesh stops with a
+# FOAM FATAL ERROR, checkmesh() reports it
+cyc = os.path.join(WORK, "cyclic_broken")
+shutil.copytree(os.path.join(WORK, "cyclic"), cyc)
+xyz = fc.read_points(cyc)
+front = set(fc.patch_points(cyc, "front"))
+with open(os.path.join(cyc, "constant", "polyMesh", "points"), "w") as f:
+    f.write(fc.HEADER % ("vectorField", "points") + "%d\n(\n" % len(xyz))
+    for i, p in enumerate(xyz):
+        f.write("(%r %r %r)\n" % ((p[0] * 1.01 if i in front else p[0]), p[1], p[2]))
+    f.write(")\n")
+r = fc.checkmesh(cyc)
+check(not r["ok"] and r["fatal"] and "match" in r["fatal"], "broken cyclic: ok %s fatal %s" % (r["ok"], r["fatal"]))
+faces = fc.patch_faces(cyc, "front")
+check(len(faces) == fc.read_boundary(cyc)["front"]["nFaces"] and all(len(f) == 4 for f in faces)
+      and sorted(set(i for f in faces for i in f)) == sorted(front), "patch_faces(front)")
+
 # a solver that cannot run (no 0/p): solver_steps returns the failure or raises FoamError
 nop = os.path.join(WORK, "no_p")
 shutil.copytree(os.path.join(WORK, "channel2d"), nop)
