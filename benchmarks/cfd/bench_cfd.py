@@ -219,9 +219,13 @@ def main():
                     print("  %s %s: exit %d: %s" % (motion, morph, p.returncode, p.stderr.strip()[-300:]))
                 else:
                     copied += copy_missing(case, out)
+                    t = time.time()
                     cm = fc.checkmesh(out)
+                    row["t_check"] = time.time() - t
                     row["check"] = verdict(cm)
+                    t = time.time()
                     s = fc.solver_steps(out, 5, check=False)
+                    row["t_solver"] = time.time() - t
                     sig = re.search(r"(Floating point exception|sigFpe|FOAM FATAL \w+)", s.stdout + s.stderr)
                     row["solver"] = "ok" if s.returncode == 0 else "FAILED (%s)" % (sig.group(1) if sig else "exit %d" % s.returncode)
                     d = read_points(out) - xyz
@@ -230,8 +234,9 @@ def main():
                     row["plane"] = "%.3g" % (100 * np.abs((d[plane_ids] * plane_n).sum(axis=1)).max() / scale) \
                         if len(plane_ids) else "-"
                 rows.append(row)
-                print("  %-16s %-6s exit %d, %.1f s, %.0f MB, %s, simpleFoam %s" % (
-                    motion, morph, row["exit"], wall, mb, row["check"], row["solver"]), flush=True)
+                print("  %-16s %-6s exit %d, %.1f s, %.0f MB, %s (checkMesh %.0f s), simpleFoam %s (%.0f s)" % (
+                    motion, morph, row["exit"], wall, mb, row["check"], row.get("t_check", 0), row["solver"],
+                    row.get("t_solver", 0)), flush=True)
     print()
     print(hdr)
     print("|" + "---|" * hdr.count(" | ") + "---|")
