@@ -1,7 +1,7 @@
 """Shared OpenFOAM test cases: complete, runnable simpleFoam (laminar) cases made by blockMesh,
 for the tests and benchmarks of CFD morphs (2-D, axisymmetric, symmetry plane, cyclic), and
 thin wrappers around the real OpenFOAM v1912 tools (checkMesh's verdict parsed, a few solver
-steps, the points of a patch read from polyMesh).
+steps, the points and a patch's faces and points read from polyMesh).
 
 Kinds (every case has a wall patch `body`; the patch types are what the morph must respect):
   channel2d   2-D channel (one cell thick in z) around a square body in its middle;
@@ -14,6 +14,14 @@ Kinds (every case has a wall patch `body`; the patch types are what the morph mu
               patches inlet outlet walls body symmetry [symmetryPlane]
   cyclic      3-D channel around a box body, the side walls z=0 and z=W a cyclic pair;
               patches inlet outlet walls body back front [cyclic, neighbourPatch each other]
+
+Geometry (BODY_BOX holds the body's bounding box of each kind):
+  channel2d   x [0, 6], y [0, 2], z [0, 0.1]; body x [2, 2.5], y [0.75, 1.25] (centre 2.25 1)
+  wedge       x [0, 6], radius 1; body x [2, 2.5], r <= 0.25 (on the axis)
+  symmetry3d  x [0, 6], y [0, 1.5], z [-1, 1]; body x [2, 2.5], y [0, 0.25], z [-0.25, 0.25]
+  cyclic      x [0, 6], y [0, 2], z [0, 1.2]; body x [2, 2.5], y [0.75, 1.25], z [0.4, 0.8]
+Zones (zones=True): cellZone `wake` (the cells behind the body, x > 2.5), faceZone `plane`
+(the internal faces of the plane x = 2 above the body), cellZone `none` (no cells).
 
 All geometry is a lattice of blocks with the body's blocks left out; `scale` multiplies the
 cell count (every block's divisions by scale**(1/d), d = 2 for the 2-D and wedge cases, 3
@@ -29,6 +37,11 @@ import gzip
 
 TOOLS = ("blockMesh", "checkMesh")
 KINDS = ("channel2d", "wedge", "symmetry3d", "cyclic")
+_S, _C = math.sin(math.radians(2.5)), math.cos(math.radians(2.5))
+BODY_BOX = {"channel2d": ((2.0, 0.75, 0.0), (2.5, 1.25, 0.1)),
+            "wedge": ((2.0, 0.0, -0.25 * _S), (2.5, 0.25 * _C, 0.25 * _S)),
+            "symmetry3d": ((2.0, 0.0, -0.25), (2.5, 0.25, 0.25)),
+            "cyclic": ((2.0, 0.75, 0.4), (2.5, 1.25, 0.8))}
 HEADER = ("FoamFile\n{\n    version 2.0;\n    format ascii;\n    class %s;\n"
           "    object %s;\n}\n")
 
@@ -85,7 +98,8 @@ def parse_checkmesh(text: str) -> dict:
     min_volume, max_volume, total_volume, max_cell_openness (floats); negative_volume
     (bool: checkMesh found cells with a zero or negative volume) and negative_cells (their
     count, 0 otherwise); wrong_pyramids (int, 0
-    when the face pyramids are OK); errors (the lines of the failed checks, "***..."); patches
+    when the face pyramids are OK); fatal (the first line of a FOAM FATAL ERROR, e.g.
+    cyclic faces that no longer match, else None); errors (the lines of the failed checks, "***..."); patches
     {name: {"faces", "points"}} from the patch topology table."""
     out = {"text": text}
     for key, label in _COUNTS.items():
@@ -119,6 +133,8 @@ def parse_checkmesh(text: str) -> dict:
     # edges not aligned with or perpendicular to non-empty directions: 12", ...)
     out["errors"] = [line.strip() for line in text.splitlines() if line.lstrip().startswith("***")]
     out["negative_volume"] = bool(re.search(r"Zero or negative cell volume detected", text))
+    m = re.search(r"FOAM FATAL (?:IO )?ERROR:?\s*\n?\s*(.+)", text)
+    out["fatal"] = m.group(1).strip() if m else None
     m = re.search(r"Number of negative volume cells: (\d+)", text)
     out["negative_cells"] = int(m.group(1)) if m else 0
     m = re.search(r"Failed (\d+) mesh checks", text)
@@ -139,8 +155,14 @@ def parse_checkmesh(text: str) -> dict:
 def checkmesh(case: str, *args) -> dict:
     """Runs checkMesh on case (extra args e.g. "-allGeometry", "-allTopology") and returns
     parse_checkmesh() of its output; "returncode" is checkMesh's exit status (a failed mesh
-    check does not make it non-zero; an unreadable mesh does, and then "ok" is False)."""
+    check does not make it non-zero; an unreadable mesh does, and then "ok" is False). The
+    face and cell sets checkMesh writes for failed checks are removed again (polyMesh/sets,
+    when the case had none): the case is left as it was."""
+    sets = os.path.join(str(case), "constant", "polyMesh", "sets")
+    had_sets = os.path.exists(sets)
     p = run_foam("checkMesh", case, *args, check=False)
+    if not had_sets:
+        shutil.rmtree(sets, ignore_errors=True)
     out = parse_checkmesh(p.stdout + p.stderr)
     out["returncode"] = p.returncode
     if p.returncode != 0:
@@ -220,16 +242,40 @@ def read_boundary(case: str) -> dict:
     return out
 
 
-def patch_points(case: str, patch: str) -> list:
-    """Sorted list of the point labels on patch (read from case's constant/polyMesh; ASCII,
-    binary or .gz); [] for a patch with no faces; KeyError for an unknown patch."""
+def read_points(case: str, polymesh: str = "constant/polyMesh") -> list:
+    """The points of case's polyMesh (ASCII, binary or .gz) as a list of (x, y, z) floats,
+    in file order (the node order cadmorph uses)."""
+    data = _read_foam_file(os.path.join(case, polymesh, "points"))
+    h = _header(data)
+    if h.get("format") == "binary":
+        m = re.search(r"scalar=(\d+)", h.get("arch", ""))
+        size = int(m.group(1)) // 8 if m else 8
+        m = re.compile(rb"^(\d+)\s*\(", re.M).search(data, h["_end"])
+        n = int(m.group(1))
+        flat = struct.unpack_from("<%d%s" % (3 * n, "d" if size == 8 else "f"), data, m.end())
+        return [tuple(flat[3 * i:3 * i + 3]) for i in range(n)]
+    body = data[h["_end"]:].decode()
+    return [(float(a), float(b), float(c)) for a, b, c in
+            re.findall(r"\(\s*([-+0-9.eE]+)\s+([-+0-9.eE]+)\s+([-+0-9.eE]+)\s*\)", body)]
+
+
+def patch_faces(case: str, patch: str) -> list:
+    """The faces of patch (tuples of point labels, in file order) read from case's
+    constant/polyMesh (ASCII, binary or .gz); [] for a patch with no faces; KeyError for an
+    unknown patch."""
     b = read_boundary(case)[patch]
     n, start = int(b["nFaces"]), int(b["startFace"])
     if n == 0:
         return []
     faces = _read_faces(os.path.join(case, "constant", "polyMesh", "faces"))
+    return [tuple(f) for f in faces[start:start + n]]
+
+
+def patch_points(case: str, patch: str) -> list:
+    """Sorted list of the point labels on patch (read from case's constant/polyMesh; ASCII,
+    binary or .gz); [] for a patch with no faces; KeyError for an unknown patch."""
     pts = set()
-    for f in faces[start:start + n]:
+    for f in patch_faces(case, patch):
         pts.update(f)
     return sorted(pts)
 

@@ -3,7 +3,8 @@
   * every kind meshes, checkMesh says "Mesh OK" with the expected geometric directions, cell
     types and patches (the wedge's axis patch has no faces, its cells at the axis are prisms),
     and 5 simpleFoam steps run;
-  * patch_points reads the same number of points per patch as checkMesh reports, from ASCII,
+  * read_points reads every point, the body's points span the body's box; patch_points
+    reads the same number of points per patch as checkMesh reports, from ASCII,
     binary and compressed polyMesh files;
   * zones=True writes the cellZones wake and none (empty) and the faceZone plane;
   * scale multiplies the cell count; write_precision reaches controlDict;
@@ -11,6 +12,7 @@
     solver_steps reports a solver that fails.
 Exit 77 (ctest SKIP) only when OpenFOAM's tools are not installed.
 usage: test_foam_cases.py WORKDIR"""
+import math
 import os
 import re
 import shutil
@@ -46,6 +48,11 @@ EXPECT = {  # kind: (geometric directions, {patch: type})
     "cyclic": (3, {"inlet": "patch", "outlet": "patch", "walls": "wall", "body": "wall",
                    "back": "cyclic", "front": "cyclic"}),
 }
+SIN = 0.25 * math.sin(math.radians(2.5))
+BODY_BOX = {"channel2d": ((2, 0.75, 0), (2.5, 1.25, 0.1)),
+            "wedge": ((2, 0, -SIN), (2.5, 0.25 * math.cos(math.radians(2.5)), SIN)),
+            "symmetry3d": ((2, 0, -0.25), (2.5, 0.25, 0.25)),
+            "cyclic": ((2, 0.75, 0.4), (2.5, 1.25, 0.8))}
 VARIANTS = {"channel2d": {}, "wedge": {"binary": True, "zones": True},
             "symmetry3d": {"compress": True}, "cyclic": {"zones": True}}
 
@@ -72,6 +79,17 @@ for kind, (ndir, types) in EXPECT.items():
         want = r["patches"].get(name, {}).get("points")
         check(len(pts) == want and pts == sorted(set(pts)) and (not pts or pts[-1] < r["points"]),
               "%s: patch_points(%s) gives %d points, checkMesh %s" % (kind, name, len(pts), want))
+    # read_points: every point, and the body's points span the body's box
+    xyz = fc.read_points(case)
+    body = [xyz[i] for i in fc.patch_points(case, "body")]
+    lo = [min(p[a] for p in body) for a in range(3)]
+    hi = [max(p[a] for p in body) for a in range(3)]
+    check(len(xyz) == r["points"], "%s: read_points gives %d points" % (kind, len(xyz)))
+    box = BODY_BOX[kind]
+    check(all(abs(a - b) < 1e-12 for u, v in zip(box, fc.BODY_BOX[kind]) for a, b in zip(u, v)),
+          "%s: foam_cases.BODY_BOX %s" % (kind, fc.BODY_BOX[kind]))
+    check(all(abs(lo[a] - box[0][a]) < 1e-9 and abs(hi[a] - box[1][a]) < 1e-9 for a in range(3)),
+          "%s: body points span %s %s, not %s" % (kind, lo, hi, box))
     pm = os.path.join(case, "constant", "polyMesh")
     if opts.get("compress"):
         check(os.path.exists(os.path.join(pm, "faces.gz")), "%s: no faces.gz" % kind)
@@ -104,8 +122,26 @@ text = re.sub(r"^\(([-+\d.eE]+) ", lambda m: "(%r " % -float(m.group(1)), text, 
 open(pts, "w").write(text)
 r = fc.checkmesh(bad)
 check(not r["ok"] and r["failed"] >= 1 and r["negative_volume"] and r["negative_cells"] == n1
-      and any("negative" in e for e in r["errors"]), "mirrored mesh: ok %s failed %s negative %s"
+      and any("negative" in e for e in r["errors"]) and r["fatal"] is None
+      and not os.path.exists(os.path.join(bad, "constant", "polyMesh", "sets")), "mirrored mesh: ok %s failed %s negative %s"
       % (r["ok"], r["failed"], r["negative_volume"]))
+# a cyclic pair that no longer matches (one side's points moved): checkMesh stops with a
+# FOAM FATAL ERROR, checkmesh() reports it
+cyc = os.path.join(WORK, "cyclic_broken")
+shutil.copytree(os.path.join(WORK, "cyclic"), cyc)
+xyz = fc.read_points(cyc)
+front = set(fc.patch_points(cyc, "front"))
+with open(os.path.join(cyc, "constant", "polyMesh", "points"), "w") as f:
+    f.write(fc.HEADER % ("vectorField", "points") + "%d\n(\n" % len(xyz))
+    for i, p in enumerate(xyz):
+        f.write("(%r %r %r)\n" % ((p[0] * 1.01 if i in front else p[0]), p[1], p[2]))
+    f.write(")\n")
+r = fc.checkmesh(cyc)
+check(not r["ok"] and r["fatal"] and "match" in r["fatal"], "broken cyclic: ok %s fatal %s" % (r["ok"], r["fatal"]))
+faces = fc.patch_faces(cyc, "front")
+check(len(faces) == fc.read_boundary(cyc)["front"]["nFaces"] and all(len(f) == 4 for f in faces)
+      and sorted(set(i for f in faces for i in f)) == sorted(front), "patch_faces(front)")
+
 # a solver that cannot run (no 0/p): solver_steps returns the failure or raises FoamError
 nop = os.path.join(WORK, "no_p")
 shutil.copytree(os.path.join(WORK, "channel2d"), nop)
