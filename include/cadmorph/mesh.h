@@ -315,8 +315,9 @@ CM_API cm_status cm_mesh_quality(cm_context *ctx, const cm_mesh *mesh, double *s
 typedef struct cm_quality_stats {
     size_t count;
     double min, mean, p01; /* p01: 1st percentile */
-    size_t inverted;       /* scaled Jacobian <= 0; collapsed cells (Verdict's +-1e30) count as
-                              0, NaN (a polyhedron without faces) as inverted */
+    size_t inverted;       /* cells a solver rejects (cm_mesh_invalid_cells): on a polyMesh and
+                              for polyhedra checkMesh's negative volume or wrongly oriented
+                              face, else scaled Jacobian <= 0 (collapsed, NaN included) */
 } cm_quality_stats;
 
 /* Stats over volume cells: per_type[CM_CELL_TYPE_COUNT] (by linear type) and all. Either
