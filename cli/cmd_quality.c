@@ -94,7 +94,7 @@ int cli_cmd_quality(int argc, char **argv)
             rc = cli_fail(ctx, cmd, s);
             goto done;
         }
-        cli_print_foam_quality(&fq, stdout);
+        cli_print_foam_quality(&fq, mesh, stdout);
     }
     sj = malloc((mesh->n_cells ? mesh->n_cells : 1) * sizeof *sj);
     if (!sj) {

@@ -8,8 +8,19 @@ static void vec(FILE *out, const double *v)
     fprintf(out, "(%g %g %g)", v[0], v[1], v[2]);
 }
 
-void cli_print_foam_quality(const cm_foam_quality *q, FILE *out)
+/* The name of patch k (0-based): the mesh's 2-D group of tag k + 1. */
+static const char *patch_name(const cm_mesh *mesh, int64_t k, char *buf, size_t cap)
 {
+    for (size_t i = 0; mesh && i < mesh->n_groups; ++i)
+        if (mesh->groups[i].dim == 2 && mesh->groups[i].tag == k + 1 && mesh->groups[i].name)
+            return mesh->groups[i].name;
+    snprintf(buf, cap, "patch%lld", (long long)k);
+    return buf;
+}
+
+void cli_print_foam_quality(const cm_foam_quality *q, const cm_mesh *mesh, FILE *out)
+{
+    char nbuf[32];
     fprintf(out,
             "Mesh stats\n"
             "    points:           %zu\n"
@@ -74,9 +85,10 @@ void cli_print_foam_quality(const cm_foam_quality *q, FILE *out)
     if (q->alignment_checked == 2 && q->wedge_error == 0)
         fprintf(out, "    Wedge angle %g degrees\n", q->wedge_angle);
     if (q->wedge_error == 1)
-        fprintf(out, " ***Cannot find opposite wedge for a wedge patch\n");
+        fprintf(out, " ***Cannot find opposite wedge for wedge %s\n", patch_name(mesh, q->wedge_patch, nbuf, sizeof nbuf));
     else if (q->wedge_error == 3)
-        fprintf(out, " ***Wedge patch not planar. A point is not in patch plane by %g metre.\n", q->wedge_off_plane);
+        fprintf(out, " ***Wedge patch %s not planar. A point is not in patch plane by %g metre.\n",
+                patch_name(mesh, q->wedge_patch, nbuf, sizeof nbuf), q->wedge_off_plane);
     else if (q->alignment_checked && q->non_aligned_edges)
         fprintf(out, " ***Number of edges not aligned with or perpendicular to non-empty directions: %zu\n",
                 q->non_aligned_edges);

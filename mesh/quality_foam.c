@@ -179,6 +179,7 @@ cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_qua
     q->internal_faces = (size_t)ni;
     q->cells = (size_t)nc;
     q->patches = p->n_patches;
+    q->wedge_patch = -1;
     if ((s = cm_foam_check_topology(ctx, p, q)) < 0) goto fail;
     for (int k = 0; k < 3; ++k) {
         q->bbox[k] = mesh->n_nodes ? xyz[k] : 0;

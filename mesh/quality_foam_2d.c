@@ -189,6 +189,7 @@ cm_status cm_foam_check_alignment(cm_context *ctx, const cm_foam_poly *p, const 
         }
         if (!found) {
             q->wedge_error = 1;
+            q->wedge_patch = (int64_t)i;
             *failed = 1;
             return CM_OK;
         }
@@ -201,6 +202,7 @@ cm_status cm_foam_check_alignment(cm_context *ctx, const cm_foam_poly *p, const 
             const double dist = fabs(dot(d, w.n));
             if (dist > FOAM_ROOTSMALL) {
                 q->wedge_error = 3;
+                q->wedge_patch = (int64_t)i;
                 q->wedge_off_plane = dist;
                 *failed = 1;
                 return CM_OK;

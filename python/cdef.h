@@ -418,6 +418,7 @@ size_t non_aligned_edges;
 int wedge_error;
 double wedge_angle;
 double wedge_off_plane;
+int64_t wedge_patch;
 double boundary_openness[3];
 double max_cell_openness;
 size_t open_cells;

@@ -366,6 +366,7 @@ typedef struct cm_foam_quality {
                                        wedge patch not planar */
     double wedge_angle;             /* degrees, of the first wedge patch */
     double wedge_off_plane;         /* wedge_error 3: the distance of the point off its plane */
+    int64_t wedge_patch;            /* the patch (0-based) wedge_error is about, -1 if none */
     double boundary_openness[3];
     double max_cell_openness;
     size_t open_cells;

@@ -52,7 +52,8 @@ class FoamQuality:
             patches); solution_directions: the same, taken by empty patches only.
         alignment_checked (0 none, 1 2-D edge alignment, 2 wedge checks), non_aligned_edges,
             wedge_error (0 none, 1 no opposite wedge, 3 a wedge patch not planar),
-            wedge_angle (degrees), wedge_off_plane: the checks of 2-D and wedge meshes.
+            wedge_angle (degrees), wedge_off_plane, wedge_patch (0-based, -1 if none): the
+            checks of 2-D and wedge meshes.
         boundary_openness: the sum of the boundary's face area vectors over its total, per
             axis; boundary_open: it exceeds 1e-6 (a hole in the boundary).
         max_cell_openness, open_cells: the same per cell, and cells past 1e-6.
@@ -97,6 +98,7 @@ class FoamQuality:
     wedge_error: int
     wedge_angle: float
     wedge_off_plane: float
+    wedge_patch: int
     boundary_openness: Tuple[float, float, float]
     max_cell_openness: float
     open_cells: int
