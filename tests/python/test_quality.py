@@ -68,7 +68,8 @@ def foam_text(q):
            "    pyramids:      %d" % q.pyramids,
            "    tet wedges:    %d" % q.tet_wedges,
            "    tetrahedra:    %d" % q.tetrahedra,
-           "    polyhedra:     %d" % q.polyhedra, "", "Checking topology..."]
+           "    polyhedra:     %d" % q.polyhedra, "", "Checking topology...",
+           "    Boundary definition OK."]
     # the meshes below are 3-D meshes with valid addressing
     assert not q.empty_not_2d and not q.illegal_cells and not q.upper_triangular_error
     assert not q.multiple_face_cells and not q.bad_vertex_faces
