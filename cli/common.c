@@ -221,8 +221,10 @@ size_t cli_warn_inverted(const char *cmd, const cm_mesh *mesh, const double *sj)
     }
     cm_context_destroy(&ctx);
     double wv = INFINITY;
+    size_t by_faces = 0;
     for (size_t c = 0; c < mesh->n_cells; ++c) {
         if (!flag[c]) continue;
+        by_faces += flag[c] == 2;
         /* the worst: the lowest scaled Jacobian among them (NaN, undefined, first) */
         const double v = isnan(sj[c]) ? -INFINITY : fabs(sj[c]) >= 1e30 ? 0.0 : sj[c];
         if (worst == (size_t)-1 || v < wv) wv = v, worst = c;
@@ -248,12 +250,21 @@ size_t cli_warn_inverted(const char *cmd, const cm_mesh *mesh, const double *sj)
         for (int64_t i = 0; i < k; ++i)
             for (int d = 0; d < 3; ++d) centre[d] += mesh->xyz[3 * nodes[i] + d] / (double)k;
     }
+    /* the rule that made them inverted: docs/DESIGN.md, "What counts as an inverted cell" */
+    char why[200];
+    if (by_faces == 0)
+        snprintf(why, sizeof why, "scaled Jacobian <= 0");
+    else if (by_faces == n)
+        snprintf(why, sizeof why, "a negative volume or a wrongly oriented face, as checkMesh finds them");
+    else
+        snprintf(why, sizeof why,
+                 "%zu with a negative volume or a wrongly oriented face as checkMesh finds them, %zu with "
+                 "scaled Jacobian <= 0",
+                 by_faces, n - by_faces);
     fprintf(stderr,
-            "cadmorph %s: warning: %zu inverted cell%s (cells a solver rejects: a negative volume or a "
-            "wrongly oriented face as checkMesh finds them on a polyMesh and for polyhedra, scaled "
-            "Jacobian <= 0 for other cells); the worst is cell %zu (0-based, %s, scaled Jacobian %.6g) "
-            "at (%.6g, %.6g, %.6g)\n",
-            cmd, n, n == 1 ? "" : "s", worst, cm_cell_type_info(type)->name, isnan(sj[worst]) ? NAN : wv,
+            "cadmorph %s: warning: %zu inverted cell%s (%s); the worst is cell %zu (0-based, %s, scaled "
+            "Jacobian %.6g) at (%.6g, %.6g, %.6g); inverted: cells a solver rejects\n",
+            cmd, n, n == 1 ? "" : "s", why, worst, cm_cell_type_info(type)->name, isnan(sj[worst]) ? NAN : wv,
             centre[0], centre[1], centre[2]);
     return n;
 }

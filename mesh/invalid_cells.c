@@ -47,12 +47,12 @@ cm_status cm_mesh_invalid_cells(cm_context *ctx, const cm_mesh *mesh, const doub
         const cm_cell_info *info = cm_cell_type_info((cm_cell_type)mesh->type[c]);
         int v = 0;
         if (info && info->dim == 3) {
-            if (bad && (from_foam || mesh->type[c] == CM_CELL_POLYHEDRON)) v = bad[k];
+            if (bad && (from_foam || mesh->type[c] == CM_CELL_POLYHEDRON)) v = bad[k] ? 2 : 0;
             else v = isnan(sj[c]) || fabs(sj[c]) >= COLLAPSED || sj[c] <= 0;
             ++k;
         }
         if (invalid) invalid[c] = (uint8_t)v;
-        *count += (size_t)v;
+        *count += v != 0;
     }
     free(bad);
     return CM_OK;

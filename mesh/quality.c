@@ -326,7 +326,7 @@ cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const doubl
         if (!info || info->dim < 3) continue;
         if (isnan(sj[c])) ++nan_count[info->linear];
         else ++valid[info->linear];
-        bad[info->linear] += flag[c];
+        bad[info->linear] += flag[c] != 0;
         ++total;
     }
     free(flag);

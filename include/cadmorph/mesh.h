@@ -400,7 +400,8 @@ CM_API cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_f
  * incorrectly oriented face (a face pyramid of volume < -1e-15 to its centre); any other
  * volume cell (tet, hex, wedge, pyramid of a mesh from another format) when its scaled
  * Jacobian is <= 0 (or undefined). sj: as from cm_mesh_quality. invalid (may be NULL):
- * #cells, set to 1 for an inverted volume cell, 0 otherwise. *count: how many. */
+ * #cells, set to 0 for a cell that is not inverted, 1 for one inverted by its scaled
+ * Jacobian, 2 for one inverted by checkMesh's tests. *count: how many are inverted. */
 CM_API cm_status cm_mesh_invalid_cells(cm_context *ctx, const cm_mesh *mesh, const double *sj,
                                        uint8_t *invalid, size_t *count);
 

@@ -366,6 +366,21 @@ if "snappy" in PARTS:
     check(sj_folded > 0, "snappy: no cell with a scaled Jacobian <= 0: the case tests nothing")
     check(n == 0, "snappy: checkMesh finds no negative volume or wrong pyramid, cadmorph counts %d inverted" % n)
     print("snappy: %d cells with a scaled Jacobian <= 0 (a quality measure), %d inverted" % (sj_folded, n))
+    # a harmless warp (one interior point nudged) warns about no inverted cell; one that pushes
+    # it through its neighbours warns with checkMesh's rule named
+    i, p = interior_point(snappy)
+    h = spacing(snappy, p)
+    for name, d, want in (("nudged", 0.01 * h, 0), ("through", 10 * h, 1)):
+        csv = os.path.join(WORK, "snappy_%s.csv" % name)
+        with open(csv, "w") as f:
+            f.write("node,dx,dy,dz\n%d,%r,0,0\n" % (i, d))
+        w = subprocess.run([CADMORPH, "warp", "--mesh", snappy, "--displacements", csv, "-o",
+                            os.path.join(WORK, "snappy_%s.vtu" % name)], capture_output=True, text=True)
+        check(w.returncode == 0, "snappy warp %s: exit %d: %s" % (name, w.returncode, w.stderr))
+        warned = re.search(r"warning: (\d+) inverted cells? \(a negative volume or a wrongly oriented face, "
+                           r"as checkMesh finds them\).*cells a solver rejects", w.stderr)
+        check(bool(warned) == bool(want) and ("inverted" in w.stderr) == bool(want),
+              "snappy warp %s: %s" % (name, w.stderr.strip() or "no warning"))
 
 
 if failures:
