@@ -60,7 +60,8 @@ void cli_print_quality_line(FILE *out, const cm_quality_stats *all);
 /* checkMesh's layout of the OpenFOAM metrics, then one line
  * max_aspect_ratio=.. max_non_orthogonality=.. avg_non_orthogonality=.. max_skewness=..
  * wrong_pyramids=.. negative_volumes=.. failed_checks=.. cells=.. (quality_foam_print.c) */
-void cli_print_foam_quality(const cm_foam_quality *q, FILE *out);
+/* mesh: names the patches (its 2-D groups, tag = patch index + 1); may be NULL */
+void cli_print_foam_quality(const cm_foam_quality *q, const cm_mesh *mesh, FILE *out);
 /* One row per present (linear) cell type - type, cells, min, mean, 1st percentile, inverted -
  * then the line above. sj: #cells as from cm_mesh_quality; all (may be NULL) receives the
  * overall stats. */

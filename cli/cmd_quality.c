@@ -16,8 +16,10 @@ static const cli_option options[] = {
      .help = "write cell,type,scaled_jacobian for every volume cell (cell: 0-based\n"
              "index among all elements of the file)"},
     {.name = "--foam", .kind = CLI_FLAG, .dest = &foam, .label = "--foam",
-     .help = "first OpenFOAM checkMesh's geometry checks (v1912 definitions: aspect ratio,\n"
-             "non-orthogonality, skewness, face pyramids, volumes) in checkMesh's layout and\n"
+     .help = "first what OpenFOAM checkMesh runs by default (v1912 definitions: cell types,\n"
+             "topology, directions, 2-D edge alignment and wedge checks, openness, aspect\n"
+             "ratio, non-orthogonality, skewness, face pyramids, volumes, cyclic point\n"
+             "match) with its verdict (\"Mesh OK.\" or \"Failed N mesh checks.\") in its layout and\n"
              "the line max_aspect_ratio=.. max_non_orthogonality=.. avg_non_orthogonality=..\n"
              "max_skewness=.. wrong_pyramids=.. negative_volumes=.. failed_checks=.. cells=..;\n"
              "on a polyMesh its own faces, on other meshes the faces of the volume cells"},
@@ -31,9 +33,12 @@ static int help(void)
     printf("usage: %s\n\n"
            "Scaled Jacobian (as Verdict / VTK's vtkMeshQuality define it) of every volume cell of\n"
            "MESH (%s). Prints one row\n"
-           "per cell type - cells, minimum, mean, 1st percentile, inverted (scaled Jacobian <= 0) -\n"
-           "and ends with the line\n"
-           "  min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k> cells=<n>\n\n"
+           "per cell type - cells, minimum, mean, 1st percentile, inverted - and ends with the line\n"
+           "  min_scaled_jacobian=<v> mean_scaled_jacobian=<v> inverted=<k> cells=<n>\n"
+           "Inverted counts the cells a solver rejects: on an OpenFOAM polyMesh and for every\n"
+           "polyhedron, what checkMesh calls a negative volume or an incorrectly oriented face\n"
+           "(its face-pyramid test); for other cells a scaled Jacobian <= 0. The scaled Jacobian\n"
+           "of a polyhedron (the minimum over its tet decomposition) is a quality measure only.\n\n"
            "options:\n",
            usage, cm_mesh_format_list());
     cli_print_options(stdout, options, 16);
@@ -89,7 +94,7 @@ int cli_cmd_quality(int argc, char **argv)
             rc = cli_fail(ctx, cmd, s);
             goto done;
         }
-        cli_print_foam_quality(&fq, stdout);
+        cli_print_foam_quality(&fq, mesh, stdout);
     }
     sj = malloc((mesh->n_cells ? mesh->n_cells : 1) * sizeof *sj);
     if (!sj) {

@@ -207,28 +207,64 @@ void cli_print_quality_line(FILE *out, const cm_quality_stats *all)
 
 size_t cli_warn_inverted(const char *cmd, const cm_mesh *mesh, const double *sj)
 {
+    /* the cells a solver rejects (cm_mesh_invalid_cells, docs/DESIGN.md): on a polyMesh and
+     * for polyhedra checkMesh's negative volume or wrongly oriented face, not the scaled
+     * Jacobian of our tet decomposition */
+    uint8_t *flag = malloc(mesh->n_cells ? mesh->n_cells : 1);
+    cm_context *ctx = NULL;
     size_t n = 0, worst = (size_t)-1;
+    if (!flag || cm_context_create(&ctx) != CM_OK || cm_mesh_invalid_cells(ctx, mesh, sj, flag, &n) < 0) {
+        fprintf(stderr, "cadmorph %s: warning: could not count the inverted cells (out of memory)\n", cmd);
+        free(flag);
+        cm_context_destroy(&ctx);
+        return 0;
+    }
+    cm_context_destroy(&ctx);
     double wv = INFINITY;
+    size_t by_faces = 0;
     for (size_t c = 0; c < mesh->n_cells; ++c) {
-        const cm_cell_info *info = cm_cell_type_info((cm_cell_type)mesh->type[c]);
-        if (!info || info->dim < 3) continue;
-        /* as cm_quality_summarize counts: NaN (undefined) and Verdict's +-1e30 (collapsed) too */
+        if (!flag[c]) continue;
+        by_faces += flag[c] == 2;
+        /* the worst: the lowest scaled Jacobian among them (NaN, undefined, first) */
         const double v = isnan(sj[c]) ? -INFINITY : fabs(sj[c]) >= 1e30 ? 0.0 : sj[c];
-        if (v > 0) continue;
-        ++n;
         if (worst == (size_t)-1 || v < wv) wv = v, worst = c;
     }
+    free(flag);
     if (n == 0) return 0;
     double centre[3] = {0, 0, 0};
-    const int64_t *nodes = mesh->conn + mesh->offset[worst];
-    const int64_t k = mesh->offset[worst + 1] - mesh->offset[worst];
-    for (int64_t i = 0; i < k; ++i)
-        for (int d = 0; d < 3; ++d) centre[d] += mesh->xyz[3 * nodes[i] + d] / (double)k;
+    const cm_cell_type type = (cm_cell_type)mesh->type[worst];
+    if (type == CM_CELL_POLYHEDRON) {
+        /* the average of its face streams' nodes */
+        const int64_t *st = mesh->conn + mesh->offset[worst];
+        int64_t nf = st[0], k = 1, cnt = 0;
+        for (int64_t f = 0; f < nf; ++f) {
+            const int64_t m = st[k++];
+            for (int64_t i = 0; i < m; ++i, ++cnt)
+                for (int d = 0; d < 3; ++d) centre[d] += mesh->xyz[3 * st[k + i] + d];
+            k += m;
+        }
+        for (int d = 0; d < 3; ++d) centre[d] /= (double)(cnt ? cnt : 1);
+    } else {
+        const int64_t *nodes = mesh->conn + mesh->offset[worst];
+        const int64_t k = mesh->offset[worst + 1] - mesh->offset[worst];
+        for (int64_t i = 0; i < k; ++i)
+            for (int d = 0; d < 3; ++d) centre[d] += mesh->xyz[3 * nodes[i] + d] / (double)k;
+    }
+    /* the rule that made them inverted: docs/DESIGN.md, "What counts as an inverted cell" */
+    char why[200];
+    if (by_faces == 0)
+        snprintf(why, sizeof why, "scaled Jacobian <= 0");
+    else if (by_faces == n)
+        snprintf(why, sizeof why, "a negative volume or a wrongly oriented face, as checkMesh finds them");
+    else
+        snprintf(why, sizeof why,
+                 "%zu with a negative volume or a wrongly oriented face as checkMesh finds them, %zu with "
+                 "scaled Jacobian <= 0",
+                 by_faces, n - by_faces);
     fprintf(stderr,
-            "cadmorph %s: warning: %zu inverted cell%s (scaled Jacobian <= 0); the worst is cell %zu "
-            "(0-based, %s, scaled Jacobian %.6g) at (%.6g, %.6g, %.6g)\n",
-            cmd, n, n == 1 ? "" : "s", worst,
-            cm_cell_type_info((cm_cell_type)mesh->type[worst])->name, isnan(sj[worst]) ? NAN : wv,
+            "cadmorph %s: warning: %zu inverted cell%s (%s); the worst is cell %zu (0-based, %s, scaled "
+            "Jacobian %.6g) at (%.6g, %.6g, %.6g); inverted: cells a solver rejects\n",
+            cmd, n, n == 1 ? "" : "s", why, worst, cm_cell_type_info(type)->name, isnan(sj[worst]) ? NAN : wv,
             centre[0], centre[1], centre[2]);
     return n;
 }

@@ -1,5 +1,5 @@
-/* checkMesh's layout for cm_foam_quality (the "Mesh stats" and "Checking geometry..."
- * blocks of OpenFOAM v1912's checkMesh, numbers with its 6 significant digits) and
+/* checkMesh's layout for cm_foam_quality (the "Mesh stats", "Checking topology..." and
+ * "Checking geometry..." blocks of OpenFOAM v1912's checkMesh, numbers with its 6 significant digits) and
  * cadmorph's one-line summary. */
 #include "cli.h"
 
@@ -8,8 +8,19 @@ static void vec(FILE *out, const double *v)
     fprintf(out, "(%g %g %g)", v[0], v[1], v[2]);
 }
 
-void cli_print_foam_quality(const cm_foam_quality *q, FILE *out)
+/* The name of patch k (0-based): the mesh's 2-D group of tag k + 1. */
+static const char *patch_name(const cm_mesh *mesh, int64_t k, char *buf, size_t cap)
 {
+    for (size_t i = 0; mesh && i < mesh->n_groups; ++i)
+        if (mesh->groups[i].dim == 2 && mesh->groups[i].tag == k + 1 && mesh->groups[i].name)
+            return mesh->groups[i].name;
+    snprintf(buf, cap, "patch%lld", (long long)k);
+    return buf;
+}
+
+void cli_print_foam_quality(const cm_foam_quality *q, const cm_mesh *mesh, FILE *out)
+{
+    char nbuf[32];
     fprintf(out,
             "Mesh stats\n"
             "    points:           %zu\n"
@@ -25,20 +36,65 @@ void cli_print_foam_quality(const cm_foam_quality *q, FILE *out)
             "Overall number of cells of each type:\n"
             "    hexahedra:     %zu\n"
             "    prisms:        %zu\n"
+            "    wedges:        %zu\n"
             "    pyramids:      %zu\n"
+            "    tet wedges:    %zu\n"
             "    tetrahedra:    %zu\n"
             "    polyhedra:     %zu\n\n",
-            q->hexahedra, q->prisms, q->pyramids, q->tetrahedra, q->polyhedra);
-    int nd = 0;
-    for (int k = 0; k < 3; ++k) nd += q->directions[k] == 1;
-    fprintf(out, "Checking geometry...\n    Overall domain bounding box ");
+            q->hexahedra, q->prisms, q->wedges, q->pyramids, q->tet_wedges, q->tetrahedra, q->polyhedra);
+    /* the patches of a mesh cadmorph reads are contiguous and cover the boundary faces */
+    fprintf(out, "Checking topology...\n    Boundary definition OK.\n");
+    if (q->empty_not_2d)
+        fprintf(out, " ***Total number of faces on empty patches is not divisible by the number of cells in "
+                     "the mesh. Hence this mesh is not 1D or 2D.\n");
+    if (q->illegal_cells)
+        fprintf(out, "    Illegal cells (less than 4 faces or out of range faces) found,  number of cells: %zu\n",
+                q->illegal_cells);
+    else
+        fprintf(out, "    Cell to face addressing OK.\n");
+    if (q->unused_points_faces || q->unused_points_cells)
+        fprintf(out, " ***Unused points found in the mesh, number unused by faces: %zu number unused by cells: %zu\n",
+                q->unused_points_faces, q->unused_points_cells);
+    else
+        fprintf(out, "    Point usage OK.\n");
+    if (q->multiple_face_cells)
+        fprintf(out, "  <<Found %zu neighbouring cells with multiple inbetween faces.\n", q->multiple_face_cells);
+    fprintf(out, q->upper_triangular_error ? " ***Faces not in upper triangular order.\n"
+                                           : "    Upper triangular ordering OK.\n");
+    if (q->bad_vertex_faces)
+        fprintf(out, "    Faces with invalid vertex labels found,  number of faces: %zu\n", q->bad_vertex_faces);
+    else
+        fprintf(out, "    Face vertices OK.\n");
+    if (q->regions <= 1)
+        fprintf(out, "    Number of regions: %zu (OK).\n", q->regions);
+    else
+        fprintf(out, "   *Number of regions: %zu\n    The mesh has multiple regions which are not connected by "
+                     "any face.\n", q->regions);
+    int nd = 0, ns = 0;
+    for (int k = 0; k < 3; ++k) {
+        nd += q->directions[k] == 1;
+        ns += q->solution_directions[k] == 1;
+    }
+    fprintf(out, "\nChecking geometry...\n    Overall domain bounding box ");
     vec(out, q->bbox);
     fputc(' ', out);
     vec(out, q->bbox + 3);
-    fprintf(out, "\n    Mesh has %d geometric (non-empty/wedge) directions (%d %d %d)\n", nd, q->directions[0],
-            q->directions[1], q->directions[2]);
-    fprintf(out, "    Mesh has %d solution (non-empty) directions (%d %d %d)\n", nd, q->directions[0],
-            q->directions[1], q->directions[2]);
+    fprintf(out, "\n    Mesh has %d geometric (non-empty/wedge) directions (%d %d %d)\n", nd,
+            q->directions[0] == 1, q->directions[1] == 1, q->directions[2] == 1);
+    fprintf(out, "    Mesh has %d solution (non-empty) directions (%d %d %d)\n", ns,
+            q->solution_directions[0] == 1, q->solution_directions[1] == 1, q->solution_directions[2] == 1);
+    if (q->alignment_checked == 2 && q->wedge_error == 0)
+        fprintf(out, "    Wedge angle %g degrees\n", q->wedge_angle);
+    if (q->wedge_error == 1)
+        fprintf(out, " ***Cannot find opposite wedge for wedge %s\n", patch_name(mesh, q->wedge_patch, nbuf, sizeof nbuf));
+    else if (q->wedge_error == 3)
+        fprintf(out, " ***Wedge patch %s not planar. A point is not in patch plane by %g metre.\n",
+                patch_name(mesh, q->wedge_patch, nbuf, sizeof nbuf), q->wedge_off_plane);
+    else if (q->alignment_checked && q->non_aligned_edges)
+        fprintf(out, " ***Number of edges not aligned with or perpendicular to non-empty directions: %zu\n",
+                q->non_aligned_edges);
+    else if (q->alignment_checked)
+        fprintf(out, "    All edges aligned with or perpendicular to non-empty directions.\n");
     if (q->boundary_open) {
         fprintf(out, " ***Boundary openness ");
         vec(out, q->boundary_openness);
@@ -86,6 +142,12 @@ void cli_print_foam_quality(const cm_foam_quality *q, FILE *out)
                 q->max_skewness, q->high_skew_faces);
     else
         fprintf(out, "    Max skewness = %g OK.\n", q->max_skewness);
+    if (q->coupled_point_errors)
+        fprintf(out, "  **Error in coupled point location: %zu faces have their 0th or consecutive vertex not "
+                     "opposite their coupled equivalent. Average mismatch %g.\n",
+                q->coupled_point_errors, q->coupled_avg_mismatch);
+    else
+        fprintf(out, "    Coupled point location match (average %g) OK.\n", q->coupled_avg_mismatch);
     if (q->failed_checks) fprintf(out, "\nFailed %zu mesh checks.\n\n", q->failed_checks);
     else fprintf(out, "\nMesh OK.\n\n");
     fprintf(out,

@@ -286,10 +286,10 @@ static double select_kth(double *v, size_t n, size_t k)
 /* Fills st from the finite-or-infinite (non-NaN) values v[0..n_valid) plus n_nan NaN cells;
  * permutes v. 1st percentile: the value of rank floor(0.01 (n - 1)) in ascending order
  * (numpy's percentile(..., method="lower")). */
-static void stats_of(double *v, size_t n_valid, size_t n_nan, cm_quality_stats *st)
+static void stats_of(double *v, size_t n_valid, size_t n_nan, size_t inverted, cm_quality_stats *st)
 {
     st->count = n_valid + n_nan;
-    st->inverted = n_nan;
+    st->inverted = inverted;
     if (n_valid == 0) {
         st->min = st->mean = st->p01 = NAN;
         return;
@@ -298,29 +298,38 @@ static void stats_of(double *v, size_t n_valid, size_t n_nan, cm_quality_stats *
     for (size_t i = 0; i < n_valid; ++i) {
         if (v[i] < mn) mn = v[i];
         sum += v[i];
-        if (v[i] <= 0) ++st->inverted;
     }
     st->min = mn;
     st->mean = sum / (double)n_valid;
     st->p01 = select_kth(v, n_valid, (size_t)floor(0.01 * (double)(n_valid - 1)));
 }
 
-/* NaN values of volume cells (a polyhedron without faces) count as cells and as inverted
- * (their quality is undefined) but stay out of min/mean/p01. */
+/* NaN values of volume cells (a polyhedron without faces) count as cells but stay out of
+ * min/mean/p01. Inverted: the cells cm_mesh_invalid_cells rejects (docs/DESIGN.md, "What
+ * counts as an inverted cell"). */
 cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const double *sj,
                                cm_quality_stats *per_type, cm_quality_stats *all)
 {
     if (!mesh || !sj)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_quality_summarize: mesh or sj is NULL");
-    size_t valid[CM_CELL_TYPE_COUNT] = {0}, nan_count[CM_CELL_TYPE_COUNT] = {0};
-    size_t total = 0;
+    size_t valid[CM_CELL_TYPE_COUNT] = {0}, nan_count[CM_CELL_TYPE_COUNT] = {0}, bad[CM_CELL_TYPE_COUNT] = {0};
+    size_t total = 0, n_bad = 0;
+    uint8_t *flag = malloc(mesh->n_cells ? mesh->n_cells : 1);
+    if (!flag) return cm_error(ctx, CM_ERR_NOMEM, "cm_quality_summarize: out of memory (%zu cells)", mesh->n_cells);
+    cm_status s = cm_mesh_invalid_cells(ctx, mesh, sj, flag, &n_bad);
+    if (s < 0) {
+        free(flag);
+        return cm_error_prefix(ctx, s, "cm_quality_summarize");
+    }
     for (size_t c = 0; c < mesh->n_cells; ++c) {
         const cm_cell_info *info = cm_cell_type_info((cm_cell_type)mesh->type[c]);
         if (!info || info->dim < 3) continue;
         if (isnan(sj[c])) ++nan_count[info->linear];
         else ++valid[info->linear];
+        bad[info->linear] += flag[c] != 0;
         ++total;
     }
+    free(flag);
     /* group the values by linear type (counting sort) so each type is one contiguous run */
     size_t start[CM_CELL_TYPE_COUNT + 1];
     start[0] = 0;
@@ -338,11 +347,11 @@ cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const doubl
     }
     if (per_type)
         for (int t = 0; t < CM_CELL_TYPE_COUNT; ++t)
-            stats_of(v + start[t], valid[t], nan_count[t], &per_type[t]);
+            stats_of(v + start[t], valid[t], nan_count[t], bad[t], &per_type[t]);
     if (all) {
         size_t n_nan = 0;
         for (int t = 0; t < CM_CELL_TYPE_COUNT; ++t) n_nan += nan_count[t];
-        stats_of(v, start[CM_CELL_TYPE_COUNT], n_nan, all);
+        stats_of(v, start[CM_CELL_TYPE_COUNT], n_nan, n_bad, all);
     }
     free(v);
     return CM_OK;

@@ -4,9 +4,7 @@
  * polyMesh::checkFaceOrthogonality statistics over internal faces). The summation orders
  * follow OpenFOAM's so that the printed values agree to checkMesh's 6 digits. */
 #define _POSIX_C_SOURCE 200809L
-#include "cadmorph/mesh.h"
-
-#include "io/foam_internal.h"
+#include "quality_foam_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -15,10 +13,6 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-#define FOAM_SMALL 1e-15
-#define FOAM_VSMALL 1e-300
-#define FOAM_ROOTVSMALL 1e-150
-#define FOAM_GREAT 1e15
 
 static double dot(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static double mag(const double *a) { return sqrt(dot(a, a)); }
@@ -77,51 +71,32 @@ static void face_geometry(const cm_foam_poly *p, const double *xyz, int64_t f, d
 static double clamp1(double x) { return x < -1 ? -1 : x > 1 ? 1 : x; }
 static double deg(double r) { return r * 180.0 / M_PI; }
 
-cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_quality *q)
+void cm_foam_geometry_free(cm_foam_geom *g)
 {
-    if (!mesh || !q) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_quality_foam: NULL argument");
-    memset(q, 0, sizeof *q);
-    cm_foam_poly *p = NULL;
-    cm_status s = cm_foam_of_mesh(ctx, mesh, &p);
-    if (s != CM_OK) return cm_error_prefix(ctx, s, "cm_mesh_quality_foam");
-    const double *xyz = mesh->xyz;
-    const int64_t nf = p->n_faces, ni = p->n_internal, nc = p->n_cells;
-    double *fc = malloc((size_t)(nf ? nf : 1) * 3 * sizeof *fc);
-    double *fa = malloc((size_t)(nf ? nf : 1) * 3 * sizeof *fa);
-    double *cc = calloc((size_t)nc * 3, sizeof *cc);
-    double *cest = calloc((size_t)nc * 3, sizeof *cest);
-    double *vol = calloc((size_t)nc, sizeof *vol);
-    double *smag = calloc((size_t)nc * 3, sizeof *smag);
-    double *sclosed = calloc((size_t)nc * 3, sizeof *sclosed);
-    int64_t *ncf = calloc((size_t)nc, sizeof *ncf);
-    if (!fc || !fa || !cc || !cest || !vol || !smag || !sclosed || !ncf) {
-        s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_quality_foam: out of memory for %lld cells", (long long)nc);
-        goto done;
-    }
-    q->points = (size_t)p->n_points;
-    q->faces = (size_t)nf;
-    q->internal_faces = (size_t)ni;
-    q->cells = (size_t)nc;
-    q->patches = p->n_patches;
-    for (size_t c = 0; c < mesh->n_cells; ++c) switch ((cm_cell_type)mesh->type[c]) {
-        case CM_CELL_HEX8: ++q->hexahedra; break;
-        case CM_CELL_WEDGE6: ++q->prisms; break;
-        case CM_CELL_PYR5: ++q->pyramids; break;
-        case CM_CELL_TET4: ++q->tetrahedra; break;
-        case CM_CELL_POLYHEDRON: ++q->polyhedra; break;
-        default: break;
-        }
-    for (int k = 0; k < 3; ++k) {
-        q->bbox[k] = mesh->n_nodes ? xyz[k] : 0;
-        q->bbox[3 + k] = mesh->n_nodes ? xyz[k] : 0;
-    }
-    for (size_t i = 0; i < mesh->n_nodes; ++i)
-        for (int k = 0; k < 3; ++k) {
-            double x = xyz[3 * i + k];
-            if (x < q->bbox[k]) q->bbox[k] = x;
-            if (x > q->bbox[3 + k]) q->bbox[3 + k] = x;
-        }
+    free(g->fc);
+    free(g->fa);
+    free(g->cc);
+    free(g->vol);
+    memset(g, 0, sizeof *g);
+}
 
+cm_status cm_foam_geometry(cm_context *ctx, const cm_foam_poly *p, const double *xyz, cm_foam_geom *g)
+{
+    const int64_t nf = p->n_faces, ni = p->n_internal, nc = p->n_cells;
+    memset(g, 0, sizeof *g);
+    g->fc = malloc((size_t)(nf ? nf : 1) * 3 * sizeof *g->fc);
+    g->fa = malloc((size_t)(nf ? nf : 1) * 3 * sizeof *g->fa);
+    g->cc = calloc((size_t)(nc ? nc : 1) * 3, sizeof *g->cc);
+    g->vol = calloc((size_t)(nc ? nc : 1), sizeof *g->vol);
+    double *cest = calloc((size_t)(nc ? nc : 1) * 3, sizeof *cest);
+    int64_t *ncf = calloc((size_t)(nc ? nc : 1), sizeof *ncf);
+    if (!g->fc || !g->fa || !g->cc || !g->vol || !cest || !ncf) {
+        free(cest);
+        free(ncf);
+        cm_foam_geometry_free(g);
+        return cm_error(ctx, CM_ERR_NOMEM, "out of memory for %lld cells", (long long)nc);
+    }
+    double *fc = g->fc, *fa = g->fa, *cc = g->cc, *vol = g->vol;
 #pragma omp parallel for schedule(static) if (nf > 20000)
     for (int64_t f = 0; f < nf; ++f) face_geometry(p, xyz, f, fc + 3 * f, fa + 3 * f);
 
@@ -157,22 +132,74 @@ cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_qua
             memcpy(cc + 3 * c, cest + 3 * c, 3 * sizeof *cc);
         vol[c] *= 1.0 / 3.0;
     }
+    free(cest);
+    free(ncf);
+    return CM_OK;
+}
 
-    /* directions: empty patches take theirs away */
-    {
-        double e[3] = {0, 0, 0};
-        int n_empty = 0;
-        for (size_t i = 0; i < p->n_patches; ++i) {
-            const cm_foam_patch *pt = &p->patches[i];
-            if (!pt->type || strcmp(pt->type, "empty") || pt->n == 0) continue;
-            ++n_empty;
-            for (int64_t f = pt->start; f < pt->start + pt->n; ++f)
-                for (int k = 0; k < 3; ++k) e[k] += fabs(fa[3 * f + k]);
-        }
-        double m = mag(e);
-        for (int k = 0; k < 3; ++k) q->directions[k] = n_empty && m > 0 && e[k] / m > 1e-6 ? -1 : 1;
+/* checkMesh's face-pyramid test of a face for its owner (side 0) or neighbour (side 1). */
+static int wrong_pyramid(const cm_foam_geom *g, int64_t f, int64_t cell, int side)
+{
+    const double *c = g->cc + 3 * cell, *fc = g->fc + 3 * f;
+    double h[3] = {c[0] - fc[0], c[1] - fc[1], c[2] - fc[2]};
+    const double v = (1.0 / 3.0) * dot(g->fa + 3 * f, h);
+    return (side ? v : -v) < -FOAM_SMALL;
+}
+
+void cm_foam_bad_cells(const cm_foam_poly *p, const cm_foam_geom *g, uint8_t *bad)
+{
+    for (int64_t c = 0; c < p->n_cells; ++c)
+        if (g->vol[c] < FOAM_VSMALL) bad[c] = 1;
+    for (int64_t f = 0; f < p->n_faces; ++f) {
+        if (wrong_pyramid(g, f, p->owner[f], 0)) bad[p->owner[f]] = 1;
+        if (f < p->n_internal && wrong_pyramid(g, f, p->neighbour[f], 1)) bad[p->neighbour[f]] = 1;
     }
+}
+
+cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_quality *q)
+{
+    if (!mesh || !q) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_quality_foam: NULL argument");
+    memset(q, 0, sizeof *q);
+    cm_foam_poly *p = NULL;
+    cm_status s = cm_foam_of_mesh(ctx, mesh, &p);
+    if (s != CM_OK) return cm_error_prefix(ctx, s, "cm_mesh_quality_foam");
+    const double *xyz = mesh->xyz;
+    const int64_t nf = p->n_faces, ni = p->n_internal, nc = p->n_cells, nb = nf - ni;
+    cm_foam_geom g = {0};
+    double *smag = calloc((size_t)(nc ? nc : 1) * 3, sizeof *smag);
+    double *sclosed = calloc((size_t)(nc ? nc : 1) * 3, sizeof *sclosed);
+    double *nbr_cc = calloc((size_t)(nb ? nb : 1) * 3, sizeof *nbr_cc);
+    uint8_t *coupled = calloc((size_t)(nb ? nb : 1), 1);
+    if (!smag || !sclosed || !nbr_cc || !coupled) {
+        s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_quality_foam: out of memory for %lld cells", (long long)nc);
+        goto done;
+    }
+    q->points = (size_t)p->n_points;
+    q->faces = (size_t)nf;
+    q->internal_faces = (size_t)ni;
+    q->cells = (size_t)nc;
+    q->patches = p->n_patches;
+    q->wedge_patch = -1;
+    if ((s = cm_foam_check_topology(ctx, p, q)) < 0) goto fail;
+    for (int k = 0; k < 3; ++k) {
+        q->bbox[k] = mesh->n_nodes ? xyz[k] : 0;
+        q->bbox[3 + k] = mesh->n_nodes ? xyz[k] : 0;
+    }
+    for (size_t i = 0; i < mesh->n_nodes; ++i)
+        for (int k = 0; k < 3; ++k) {
+            double x = xyz[3 * i + k];
+            if (x < q->bbox[k]) q->bbox[k] = x;
+            if (x > q->bbox[3 + k]) q->bbox[3 + k] = x;
+        }
+    if ((s = cm_foam_geometry(ctx, p, xyz, &g)) < 0) goto fail;
+    const double *fc = g.fc, *fa = g.fa, *cc = g.cc, *vol = g.vol;
+
+    /* directions: empty patches take theirs away, wedge patches the geometric one */
+    cm_foam_directions(p, xyz, fa, q);
     int ndims = (q->directions[0] == 1) + (q->directions[1] == 1) + (q->directions[2] == 1);
+    int align_failed = 0;
+    if (ndims < 3 && (s = cm_foam_check_alignment(ctx, p, xyz, fa, q, &align_failed)) < 0) goto fail;
+    if ((s = cm_foam_couplings(ctx, p, xyz, &g, nbr_cc, coupled, q)) < 0) goto fail;
 
     /* boundary openness */
     {
@@ -189,7 +216,7 @@ cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_qua
         q->boundary_open = worst > 1e-6;
     }
 
-    /* cell openness and aspect ratio */
+    /* cell openness and aspect ratio (over the geometric directions) */
     for (int pass = 0; pass < 2; ++pass) {
         const int64_t n = pass ? ni : nf;
         const int64_t *cell = pass ? p->neighbour : p->owner;
@@ -245,53 +272,56 @@ cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_qua
         q->total_volume += vol[c];
     }
 
-    /* non-orthogonality (internal faces) */
+    /* non-orthogonality: internal faces and both sides of cyclic pairs count towards the
+     * thresholds, internal and the owner side of cyclic pairs towards max and average (as
+     * polyMesh::checkFaceOrthogonality) */
     {
         const double severe = cos(70.0 * M_PI / 180.0);
         double mind = FOAM_GREAT, sum = 0;
+        int64_t nsum = 0;
         q->worst_non_orthogonal_face = -1;
-        for (int64_t f = 0; f < ni; ++f) {
-            const double *a = cc + 3 * p->owner[f], *b = cc + 3 * p->neighbour[f];
+        for (int64_t f = 0; f < nf; ++f) {
+            const int is_coupled = f >= ni && coupled[f - ni];
+            if (f >= ni && !is_coupled) continue;
+            const double *a = cc + 3 * p->owner[f], *b = f < ni ? cc + 3 * p->neighbour[f] : nbr_cc + 3 * (f - ni);
             double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
             double o = dot(d, fa + 3 * f) / (mag(d) * mag(fa + 3 * f) + FOAM_ROOTVSMALL);
             if (o < severe) {
                 if (o > FOAM_SMALL) ++q->severe_non_orthogonal_faces;
                 else ++q->non_orthogonality_errors;
             }
+            if (f >= ni && coupled[f - ni] != 1) continue;
             if (o < mind) {
                 mind = o;
                 q->worst_non_orthogonal_face = f;
             }
             sum += o;
+            ++nsum;
         }
-        if (ni > 0) {
+        if (nsum > 0) {
             q->max_non_orthogonality = deg(acos(clamp1(mind)));
-            q->avg_non_orthogonality = deg(acos(clamp1(sum / (double)ni)));
+            q->avg_non_orthogonality = deg(acos(clamp1(sum / (double)nsum)));
         }
     }
 
     /* face pyramids */
     for (int64_t f = 0; f < nf; ++f) {
-        const double *c = cc + 3 * p->owner[f];
-        double h[3] = {c[0] - fc[3 * f], c[1] - fc[3 * f + 1], c[2] - fc[3 * f + 2]};
-        if (-(1.0 / 3.0) * dot(fa + 3 * f, h) < -FOAM_SMALL) ++q->wrong_pyramids;
-        if (f < ni) {
-            const double *e = cc + 3 * p->neighbour[f];
-            double g[3] = {e[0] - fc[3 * f], e[1] - fc[3 * f + 1], e[2] - fc[3 * f + 2]};
-            if ((1.0 / 3.0) * dot(fa + 3 * f, g) < -FOAM_SMALL) ++q->wrong_pyramids;
-        }
+        q->wrong_pyramids += (size_t)wrong_pyramid(&g, f, p->owner[f], 0);
+        if (f < ni) q->wrong_pyramids += (size_t)wrong_pyramid(&g, f, p->neighbour[f], 1);
     }
 
-    /* skewness: internal faces against the owner-neighbour line, boundary faces against their
-     * mirror cell */
+    /* skewness: internal and cyclic faces against the line between the cell centres,
+     * other boundary faces against their mirror cell; the far side of a cyclic pair counts
+     * towards the maximum only */
     q->max_skewness = -FOAM_GREAT;
     q->worst_skew_face = -1;
     for (int64_t f = 0; f < nf; ++f) {
         const double *own = cc + 3 * p->owner[f], *A = fa + 3 * f, *F = fc + 3 * f;
         double cpf[3] = {F[0] - own[0], F[1] - own[1], F[2] - own[2]}, d[3];
         double scale;
-        if (f < ni) {
-            const double *nb = cc + 3 * p->neighbour[f];
+        const int cpl = f >= ni ? coupled[f - ni] : 0;
+        if (f < ni || cpl) {
+            const double *nb = f < ni ? cc + 3 * p->neighbour[f] : nbr_cc + 3 * (f - ni);
             for (int k = 0; k < 3; ++k) d[k] = nb[k] - own[k];
             scale = 0.2;
         } else {
@@ -317,21 +347,24 @@ cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_qua
             q->max_skewness = sk;
             q->worst_skew_face = f;
         }
-        if (sk > 4) ++q->high_skew_faces;
+        if (sk > 4 && cpl != 2) ++q->high_skew_faces;
     }
 
-    q->failed_checks = (size_t)q->boundary_open + (q->open_cells || q->high_aspect_cells) +
+    q->failed_checks = (size_t)(q->illegal_cells > 0) + (q->unused_points_faces || q->unused_points_cells) +
+                       (size_t)q->upper_triangular_error + (q->bad_vertex_faces > 0) + (size_t)align_failed +
+                       (size_t)q->boundary_open + (q->open_cells || q->high_aspect_cells) +
                        (q->min_face_area < FOAM_VSMALL) + (q->min_volume < FOAM_VSMALL) +
-                       (q->non_orthogonality_errors > 0) + (q->wrong_pyramids > 0) + (q->high_skew_faces > 0);
+                       (q->non_orthogonality_errors > 0) + (q->wrong_pyramids > 0) + (q->high_skew_faces > 0) +
+                       (q->coupled_point_errors > 0);
+    goto done;
+fail:
+    s = cm_error_prefix(ctx, s, "cm_mesh_quality_foam");
 done:
-    free(fc);
-    free(fa);
-    free(cc);
-    free(cest);
-    free(vol);
+    cm_foam_geometry_free(&g);
     free(smag);
     free(sclosed);
-    free(ncf);
+    free(nbr_cc);
+    free(coupled);
     cm_foam_poly_release(&p);
     return s;
 }

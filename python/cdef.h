@@ -402,9 +402,23 @@ cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const doubl
 cm_quality_stats *per_type, cm_quality_stats *all);
 typedef struct cm_foam_quality {
 size_t points, faces, internal_faces, cells, patches;
-size_t hexahedra, prisms, pyramids, tetrahedra, polyhedra;
+size_t hexahedra, prisms, wedges, pyramids, tet_wedges, tetrahedra, polyhedra;
 double bbox[6];
 int directions[3];
+int solution_directions[3];
+size_t illegal_cells;
+size_t unused_points_faces, unused_points_cells;
+int upper_triangular_error;
+size_t multiple_face_cells;
+size_t bad_vertex_faces;
+size_t regions;
+int empty_not_2d;
+int alignment_checked;
+size_t non_aligned_edges;
+int wedge_error;
+double wedge_angle;
+double wedge_off_plane;
+int64_t wedge_patch;
 double boundary_openness[3];
 double max_cell_openness;
 size_t open_cells;
@@ -423,9 +437,15 @@ double max_skewness;
 size_t high_skew_faces;
 int64_t worst_skew_face;
 int boundary_open;
+size_t coupled_faces;
+size_t coupled_point_errors;
+double coupled_avg_mismatch;
+size_t uncoupled_patches;
 size_t failed_checks;
 } cm_foam_quality;
 cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_quality *q);
+cm_status cm_mesh_invalid_cells(cm_context *ctx, const cm_mesh *mesh, const double *sj,
+uint8_t *invalid, size_t *count);
 typedef enum cm_displacement_flags {
 CM_DISPLACEMENT_MOVE = 1,
 CM_DISPLACEMENT_QUALITY = 2

@@ -315,8 +315,9 @@ CM_API cm_status cm_mesh_quality(cm_context *ctx, const cm_mesh *mesh, double *s
 typedef struct cm_quality_stats {
     size_t count;
     double min, mean, p01; /* p01: 1st percentile */
-    size_t inverted;       /* scaled Jacobian <= 0; collapsed cells (Verdict's +-1e30) count as
-                              0, NaN (a polyhedron without faces) as inverted */
+    size_t inverted;       /* cells a solver rejects (cm_mesh_invalid_cells): on a polyMesh and
+                              for polyhedra checkMesh's negative volume or wrongly oriented
+                              face, else scaled Jacobian <= 0 (collapsed, NaN included) */
 } cm_quality_stats;
 
 /* Stats over volume cells: per_type[CM_CELL_TYPE_COUNT] (by linear type) and all. Either
@@ -324,19 +325,48 @@ typedef struct cm_quality_stats {
 CM_API cm_status cm_quality_summarize(cm_context *ctx, const cm_mesh *mesh, const double *sj,
                                       cm_quality_stats *per_type, cm_quality_stats *all);
 
-/* ---- OpenFOAM checkMesh's geometry checks (as OpenFOAM v1912 defines them) ----
+/* ---- OpenFOAM checkMesh's default checks (as OpenFOAM v1912 defines them) ----
+ * What checkMesh runs without options, on one (serial) mesh:
+ *  - topology: cell-to-face addressing (cells of fewer than 4 faces), point usage, upper-
+ *    triangular face order, face vertices (out of range or repeated), the number of
+ *    regions (a warning), empty-patch faces a multiple of the cells (a warning);
+ *  - geometry: geometric directions (empty and wedge patches take theirs away) and solution
+ *    directions (empty only); on a mesh with fewer than 3 geometric directions the 2-D edge
+ *    alignment (no wedge) or the wedge checks (opposite wedge, common axis, planar wedges,
+ *    edge alignment); boundary openness; cell openness and aspect ratio (over the geometric
+ *    directions); face areas; cell volumes; non-orthogonality; face pyramids; skewness;
+ *    coupled point match of translational cyclic patches.
  * Face centres and areas by the triangle fan about the face's point average, cell centres
  * and volumes by face pyramids about the face-centre average; non-orthogonality over internal
- * faces (degrees), skewness over all faces (boundary faces against their mirror), aspect
- * ratio from the cell's summed |area| components, face pyramids of owner and neighbour.
+ * and cyclic faces (degrees), skewness over all faces (boundary faces against their mirror),
+ * aspect ratio from the cell's summed |area| components, face pyramids of owner and neighbour.
  * Thresholds are checkMesh's: aspect ratio 1000, non-orthogonality 70 degrees (error past
  * 90), skewness 4, cell openness 1e-6. Uses the polyMesh's own faces when the mesh was read
- * from one, else the faces of its volume cells (matched between cells). */
+ * from one, else the faces of its volume cells (matched between cells). Cell types by
+ * OpenFOAM's cell models (hex, prism, wedge, pyramid, tetWedge, tet; anything else is a
+ * polyhedron). */
 typedef struct cm_foam_quality {
     size_t points, faces, internal_faces, cells, patches;
-    size_t hexahedra, prisms, pyramids, tetrahedra, polyhedra; /* by cadmorph's recognition */
+    size_t hexahedra, prisms, wedges, pyramids, tet_wedges, tetrahedra, polyhedra;
     double bbox[6];
-    int directions[3];              /* 1: geometric direction, -1: empty (2D) */
+    int directions[3];              /* geometric: 1 a direction, -1 taken by empty or wedge */
+    int solution_directions[3];     /* solution: 1 a direction, -1 taken by empty */
+    /* topology */
+    size_t illegal_cells;           /* fewer than 4 faces */
+    size_t unused_points_faces, unused_points_cells; /* points of no face / of no cell */
+    int upper_triangular_error;     /* internal faces not in upper-triangular order */
+    size_t multiple_face_cells;     /* cells with two faces to one neighbour (a note) */
+    size_t bad_vertex_faces;        /* faces with out-of-range or repeated vertices */
+    size_t regions;                 /* face-connected regions (more than 1: a warning) */
+    int empty_not_2d;               /* empty faces not a multiple of the cells (a warning) */
+    /* 2-D and wedge (checked when a geometric direction is taken) */
+    int alignment_checked;          /* 1 edge alignment, 2 wedge checks */
+    size_t non_aligned_edges;
+    int wedge_error;                /* 0 none, 1 no opposite wedge, 2 different axes, 3 a
+                                       wedge patch not planar */
+    double wedge_angle;             /* degrees, of the first wedge patch */
+    double wedge_off_plane;         /* wedge_error 3: the distance of the point off its plane */
+    int64_t wedge_patch;            /* the patch (0-based) wedge_error is about, -1 if none */
     double boundary_openness[3];
     double max_cell_openness;
     size_t open_cells;
@@ -355,10 +385,25 @@ typedef struct cm_foam_quality {
     size_t high_skew_faces;         /* skewness > 4 */
     int64_t worst_skew_face;
     int boundary_open;              /* boundary openness > 1e-6 */
+    size_t coupled_faces;           /* faces of cyclic patches checked for their match */
+    size_t coupled_point_errors;    /* of them, faces whose points miss their partner's */
+    double coupled_avg_mismatch;
+    size_t uncoupled_patches;       /* cyclic patches not checked (rotational, unmatched) */
     size_t failed_checks;           /* as checkMesh counts them ("Failed N mesh checks.") */
 } cm_foam_quality;
 
 CM_API cm_status cm_mesh_quality_foam(cm_context *ctx, const cm_mesh *mesh, cm_foam_quality *q);
+
+/* ---- what counts as an inverted cell (docs/DESIGN.md) ----
+ * The cells a solver rejects: on a mesh read from an OpenFOAM polyMesh and for every
+ * polyhedron, a cell checkMesh calls a negative volume (volume < 1e-300) or one with an
+ * incorrectly oriented face (a face pyramid of volume < -1e-15 to its centre); any other
+ * volume cell (tet, hex, wedge, pyramid of a mesh from another format) when its scaled
+ * Jacobian is <= 0 (or undefined). sj: as from cm_mesh_quality. invalid (may be NULL):
+ * #cells, set to 0 for a cell that is not inverted, 1 for one inverted by its scaled
+ * Jacobian, 2 for one inverted by checkMesh's tests. *count: how many are inverted. */
+CM_API cm_status cm_mesh_invalid_cells(cm_context *ctx, const cm_mesh *mesh, const double *sj,
+                                       uint8_t *invalid, size_t *count);
 
 /* ---- a moved mesh and its record ---- */
 

@@ -35,15 +35,25 @@ class Quality:
 
 @dataclass(frozen=True)
 class FoamQuality:
-    """OpenFOAM checkMesh's mesh statistics and geometry checks (as OpenFOAM v1912 defines
-    them, cm_mesh_quality_foam), the numbers `cadmorph quality --foam` prints. On a mesh read
+    """OpenFOAM checkMesh's mesh statistics, topology and geometry checks (what checkMesh of
+    OpenFOAM v1912 runs by default, cm_mesh_quality_foam), the numbers
+    `cadmorph quality --foam` prints. On a mesh read
     from a polyMesh its own faces; on other meshes the faces of the volume cells.
 
     Attributes:
         points, faces, internal_faces, cells, patches: the mesh's counts.
-        hexahedra, prisms, pyramids, tetrahedra, polyhedra: cells by shape.
+        hexahedra, prisms, wedges, pyramids, tet_wedges, tetrahedra, polyhedra: cells by
+            OpenFOAM's cell models (checkMesh's table).
+        illegal_cells (fewer than 4 faces), unused_points_faces, unused_points_cells,
+            upper_triangular_error, multiple_face_cells, bad_vertex_faces (out-of-range or
+            repeated vertices), regions, empty_not_2d: the topology checks.
         bbox: (xmin, ymin, zmin, xmax, ymax, zmax).
-        directions: per axis 1 (a geometric direction) or -1 (empty: a 2-D mesh).
+        directions: per axis 1 (a geometric direction) or -1 (taken by empty or wedge
+            patches); solution_directions: the same, taken by empty patches only.
+        alignment_checked (0 none, 1 2-D edge alignment, 2 wedge checks), non_aligned_edges,
+            wedge_error (0 none, 1 no opposite wedge, 3 a wedge patch not planar),
+            wedge_angle (degrees), wedge_off_plane, wedge_patch (0-based, -1 if none): the
+            checks of 2-D and wedge meshes.
         boundary_openness: the sum of the boundary's face area vectors over its total, per
             axis; boundary_open: it exceeds 1e-6 (a hole in the boundary).
         max_cell_openness, open_cells: the same per cell, and cells past 1e-6.
@@ -55,6 +65,8 @@ class FoamQuality:
             worst_non_orthogonal_face.
         wrong_pyramids: faces whose pyramid (owner or neighbour) has a negative volume.
         max_skewness, high_skew_faces (> 4), worst_skew_face.
+        coupled_faces, coupled_point_errors, coupled_avg_mismatch, uncoupled_patches: the
+            match of translational cyclic pairs (rotational ones are not checked).
         failed_checks: as checkMesh counts them ("Failed N mesh checks."), 0 for "Mesh OK."
     """
 
@@ -65,11 +77,28 @@ class FoamQuality:
     patches: int
     hexahedra: int
     prisms: int
+    wedges: int
     pyramids: int
+    tet_wedges: int
     tetrahedra: int
     polyhedra: int
     bbox: Tuple[float, float, float, float, float, float]
     directions: Tuple[int, int, int]
+    solution_directions: Tuple[int, int, int]
+    illegal_cells: int
+    unused_points_faces: int
+    unused_points_cells: int
+    upper_triangular_error: bool
+    multiple_face_cells: int
+    bad_vertex_faces: int
+    regions: int
+    empty_not_2d: bool
+    alignment_checked: int
+    non_aligned_edges: int
+    wedge_error: int
+    wedge_angle: float
+    wedge_off_plane: float
+    wedge_patch: int
     boundary_openness: Tuple[float, float, float]
     max_cell_openness: float
     open_cells: int
@@ -93,6 +122,10 @@ class FoamQuality:
     high_skew_faces: int
     worst_skew_face: int
     boundary_open: bool
+    coupled_faces: int
+    coupled_point_errors: int
+    coupled_avg_mismatch: float
+    uncoupled_patches: int
     failed_checks: int
 
     @property

@@ -306,6 +306,78 @@ static void test_mesh_and_summary(void)
     cm_context_destroy(&ctx);
 }
 
+/* What counts as an inverted cell (docs/DESIGN.md): polyhedra by checkMesh's negative volume
+ * and face-pyramid test, other cells of a mesh not read from a polyMesh by their scaled
+ * Jacobian; checkMesh's cell models and point usage on a mesh built in memory. */
+static void test_invalid_cells(void)
+{
+    cm_context *ctx = NULL;
+    cm_mesh *m = NULL;
+    CHECK(cm_context_create(&ctx) == CM_OK);
+    CHECK(cm_mesh_create(ctx, &m) == CM_OK);
+    /* a unit cube (nodes 0-7) as a polyhedron, a second cube beside it (nodes 8-15, the
+     * first's top corner 6 pushed below its bottom: the tets of the decomposition fold, the
+     * face pyramids about the cell centre stay positive), a tet and its mirror, one unused
+     * node */
+    CHECK(cm_mesh_resize_nodes(ctx, m, 17, 0) == CM_OK);
+    box((double(*)[3])m->xyz, 1, 1, 1);
+    box((double(*)[3])(m->xyz + 24), 1, 1, 1);
+    for (int i = 8; i < 16; ++i) m->xyz[3 * i] += 3;
+    m->xyz[3 * 14 + 2] = -0.1;
+    m->xyz[3 * 16] = m->xyz[3 * 16 + 1] = m->xyz[3 * 16 + 2] = 9;
+    const int64_t cube[] = {6, 4, 0, 4, 7, 3, 4, 1, 2, 6, 5, 4, 0, 1, 5, 4,
+                            4, 3, 7, 6, 2, 4, 0, 3, 2, 1, 4, 4, 5, 6, 7};
+    int64_t cube2[sizeof cube / sizeof *cube];
+    memcpy(cube2, cube, sizeof cube);
+    for (size_t f = 0, k = 1; f < 6; ++f, k += 5)
+        for (int j = 1; j <= 4; ++j) cube2[k + (size_t)j] += 8;
+    const int64_t tet[4] = {0, 1, 3, 4}, tet_inv[4] = {0, 3, 1, 4};
+    CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_POLYHEDRON, cube, sizeof cube / sizeof *cube, 0, 0, 0) == CM_OK);
+    CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_POLYHEDRON, cube2, sizeof cube2 / sizeof *cube2, 0, 0, 0) == CM_OK);
+    CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_TET4, tet, 4, 0, 0, 0) == CM_OK);
+    CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_TET4, tet_inv, 4, 0, 0, 0) == CM_OK);
+    double q[4];
+    CHECK(cm_mesh_quality(ctx, m, q) == CM_OK);
+    CHECK(q[0] > 0 && q[1] < 0 && q[2] > 0 && q[3] < 0);
+    uint8_t bad[4];
+    size_t n = 0;
+    CHECK(cm_mesh_invalid_cells(ctx, m, q, bad, &n) == CM_OK);
+    CHECK_MSG(n == 1 && !bad[0] && !bad[1] && !bad[2] && bad[3] == 1, "%zu invalid: %d %d %d %d", n, bad[0], bad[1],
+              bad[2], bad[3]);
+    cm_quality_stats per[CM_CELL_TYPE_COUNT], all;
+    CHECK(cm_quality_summarize(ctx, m, q, per, &all) == CM_OK);
+    CHECK(all.inverted == 1 && per[CM_CELL_POLYHEDRON].inverted == 0 && per[CM_CELL_TET4].inverted == 1);
+    CHECK(per[CM_CELL_POLYHEDRON].min < 0); /* the scaled Jacobian stays a quality measure */
+    cm_mesh_destroy(&m);
+
+    /* the cube with its faces turned inward: checkMesh's negative volume */
+    CHECK(cm_mesh_create(ctx, &m) == CM_OK);
+    CHECK(cm_mesh_resize_nodes(ctx, m, 9, 0) == CM_OK);
+    box((double(*)[3])m->xyz, 1, 1, 1);
+    m->xyz[24] = m->xyz[25] = m->xyz[26] = 5; /* node 8: used by no cell */
+    int64_t inward[sizeof cube / sizeof *cube];
+    memcpy(inward, cube, sizeof cube);
+    for (size_t f = 0, k = 1; f < 6; ++f, k += 5) {
+        int64_t t = inward[k + 2];
+        inward[k + 2] = inward[k + 4];
+        inward[k + 4] = t;
+    }
+    CHECK(cm_mesh_add_cell(ctx, m, CM_CELL_POLYHEDRON, inward, sizeof inward / sizeof *inward, 0, 0, 0) == CM_OK);
+    CHECK(cm_mesh_quality(ctx, m, q) == CM_OK);
+    CHECK(cm_mesh_invalid_cells(ctx, m, q, bad, &n) == CM_OK);
+    CHECK(n == 1 && bad[0] == 2);
+    /* checkMesh on it: a hexahedron by OpenFOAM's cell models, the unused point fails */
+    memcpy(m->conn, cube, sizeof cube);
+    cm_foam_quality fq;
+    CHECK(cm_mesh_quality_foam(ctx, m, &fq) == CM_OK);
+    CHECK(fq.hexahedra == 1 && fq.polyhedra == 0 && fq.cells == 1);
+    CHECK(fq.unused_points_faces == 1 && fq.unused_points_cells == 1 && fq.failed_checks == 1);
+    CHECK(fq.directions[0] == 1 && fq.directions[1] == 1 && fq.directions[2] == 1 && fq.regions == 1);
+    CHECK(!fq.upper_triangular_error && fq.bad_vertex_faces == 0 && fq.illegal_cells == 0);
+    cm_mesh_destroy(&m);
+    cm_context_destroy(&ctx);
+}
+
 /* Same values with 1 and 2 threads (above the parallel threshold). */
 static void test_threads(void)
 {
@@ -340,6 +412,7 @@ static void test_threads(void)
 int main(void)
 {
     test_tet();
+    test_invalid_cells();
     test_hex();
     test_wedge();
     test_pyramid();

@@ -64,15 +64,34 @@ def foam_text(q):
            "Overall number of cells of each type:",
            "    hexahedra:     %d" % q.hexahedra,
            "    prisms:        %d" % q.prisms,
+           "    wedges:        %d" % q.wedges,
            "    pyramids:      %d" % q.pyramids,
+           "    tet wedges:    %d" % q.tet_wedges,
            "    tetrahedra:    %d" % q.tetrahedra,
-           "    polyhedra:     %d" % q.polyhedra, ""]
-    nd = sum(d == 1 for d in q.directions)
+           "    polyhedra:     %d" % q.polyhedra, "", "Checking topology...",
+           "    Boundary definition OK."]
+    # the meshes below are 3-D meshes with valid addressing
+    assert not q.empty_not_2d and not q.illegal_cells and not q.upper_triangular_error
+    assert not q.multiple_face_cells and not q.bad_vertex_faces
+    out.append("    Cell to face addressing OK.")
+    if q.unused_points_faces:
+        out.append(" ***Unused points found in the mesh, number unused by faces: %d number unused "
+                   "by cells: %d" % (q.unused_points_faces, q.unused_points_cells))
+    else:
+        out.append("    Point usage OK.")
+    out += ["    Upper triangular ordering OK.", "    Face vertices OK."]
+    if q.regions <= 1:
+        out += ["    Number of regions: %d (OK)." % q.regions, ""]
+    else:
+        out += ["   *Number of regions: %d" % q.regions,
+                "    The mesh has multiple regions which are not connected by any face.", ""]
+    geo = tuple(int(d == 1) for d in q.directions)
+    sol = tuple(int(d == 1) for d in q.solution_directions)
     out += ["Checking geometry...",
             "    Overall domain bounding box %s %s" % (vec(q.bbox[:3]), vec(q.bbox[3:])),
             "    Mesh has %d geometric (non-empty/wedge) directions (%d %d %d)"
-            % ((nd,) + q.directions),
-            "    Mesh has %d solution (non-empty) directions (%d %d %d)" % ((nd,) + q.directions)]
+            % ((sum(geo),) + geo),
+            "    Mesh has %d solution (non-empty) directions (%d %d %d)" % ((sum(sol),) + sol)]
     if q.boundary_open:
         out.append(" ***Boundary openness %s possible hole in boundary description."
                    % vec(q.boundary_openness))
@@ -118,6 +137,8 @@ def foam_text(q):
                    "quality of the results" % (q.max_skewness, q.high_skew_faces))
     else:
         out.append("    Max skewness = %g OK." % q.max_skewness)
+    assert not q.coupled_point_errors
+    out.append("    Coupled point location match (average %g) OK." % q.coupled_avg_mismatch)
     out += ["", "Failed %d mesh checks." % q.failed_checks if q.failed_checks else "Mesh OK.", "",
             "max_aspect_ratio=%.9g max_non_orthogonality=%.9g avg_non_orthogonality=%.9g "
             "max_skewness=%.9g wrong_pyramids=%d negative_volumes=%d failed_checks=%d cells=%d"
