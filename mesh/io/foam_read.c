@@ -536,36 +536,54 @@ done:
     return s;
 }
 
+cm_status cm_foam_read_poly(cm_context *ctx, const char *dir, cm_foam_poly *p)
+{
+    reader r = {ctx, dir, (char *)dir, p, NULL};
+    if (!is_dir(dir)) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: no polyMesh directory %s", dir);
+    int64_t n_owner = 0, n_nei = 0;
+    cm_status s = CM_OK;
+    if (!p->dir && !(p->dir = strdup(dir))) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    if (s == CM_OK) s = read_points(&r);
+    p->xyz0 = r.xyz;
+    if (s == CM_OK) s = read_faces(&r);
+    if (s == CM_OK) s = read_labels(&r, "owner", &p->owner, &n_owner);
+    if (s == CM_OK) s = read_labels(&r, "neighbour", &p->neighbour, &n_nei);
+    if (s == CM_OK) s = read_boundary(ctx, dir, p);
+    if (s == CM_OK) s = check_addressing(&r, n_owner, n_nei);
+    if (s == CM_OK) s = read_zones(ctx, dir, "cellZones", CM_FOAM_CELL_ZONE, p);
+    if (s == CM_OK) s = read_zones(ctx, dir, "faceZones", CM_FOAM_FACE_ZONE, p);
+    if (s == CM_OK) s = read_zones(ctx, dir, "pointZones", CM_FOAM_POINT_ZONE, p);
+    return s;
+}
+
 cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh)
 {
     *mesh = NULL;
-    reader r = {ctx, path, cm_foam_polymesh_dir(path), cm_foam_poly_new(), NULL};
+    char *case_dir = NULL;
+    int decomposed = cm_foam_decomposed_path(path, &case_dir);
+    reader r = {ctx, path, decomposed ? case_dir : cm_foam_polymesh_dir(path), cm_foam_poly_new(), NULL};
     cm_mesh *m = NULL;
     cm_status s = CM_OK;
     if (!r.dir || !r.p) {
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
         goto fail;
     }
-    if (!is_dir(r.dir)) {
-        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: no polyMesh directory %s", path, r.dir);
-        goto fail;
+    if (decomposed) {
+        s = cm_foam_read_decomposed(ctx, case_dir, r.p);
+        r.p->case_dir = strdup(case_dir);
+    } else {
+        if (!is_dir(r.dir)) {
+            s = cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: no polyMesh directory %s", path, r.dir);
+            goto fail;
+        }
+        s = cm_foam_read_poly(ctx, r.dir, r.p);
+        r.p->case_dir = cm_foam_case_of(r.dir);
     }
-    r.p->dir = strdup(r.dir);
-    int64_t n_owner = 0, n_nei = 0;
-    if (!r.p->dir) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
-    if (s == CM_OK) s = read_points(&r);
-    if (s == CM_OK) s = read_faces(&r);
-    if (s == CM_OK) s = read_labels(&r, "owner", &r.p->owner, &n_owner);
-    if (s == CM_OK) s = read_labels(&r, "neighbour", &r.p->neighbour, &n_nei);
-    if (s == CM_OK) s = read_boundary(ctx, r.dir, r.p);
-    if (s == CM_OK) s = check_addressing(&r, n_owner, n_nei);
-    if (s == CM_OK) s = read_zones(ctx, r.dir, "cellZones", CM_FOAM_CELL_ZONE, r.p);
-    if (s == CM_OK) s = read_zones(ctx, r.dir, "faceZones", CM_FOAM_FACE_ZONE, r.p);
-    if (s == CM_OK) s = read_zones(ctx, r.dir, "pointZones", CM_FOAM_POINT_ZONE, r.p);
+    if (s == CM_OK && r.p->case_dir) r.p->write_precision = cm_foam_write_precision(r.p->case_dir);
     if (s == CM_OK) s = cm_mesh_create(ctx, &m);
     if (s == CM_OK) s = cm_mesh_resize_nodes(ctx, m, (size_t)r.p->n_points, 0);
     if (s == CM_OK) {
-        if (r.p->n_points) memcpy(m->xyz, r.xyz, (size_t)r.p->n_points * 3 * sizeof(double));
+        if (r.p->n_points) memcpy(m->xyz, r.p->xyz0, (size_t)r.p->n_points * 3 * sizeof(double));
         s = build_cells(&r, m);
     }
     /* cell zones become the volume cells' physical groups (zone k: tag k + 1; a cell in
@@ -582,14 +600,12 @@ cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh)
     s = cm_mesh_set_origin(ctx, m, CM_FORMAT_FOAM, r.p, cm_foam_poly_free);
     r.p = NULL; /* the origin owns it, or has freed it */
     if (s != CM_OK) goto fail;
-    free(r.xyz);
     free(r.dir);
     *mesh = m;
     return CM_OK;
 fail:
     cm_mesh_destroy(&m);
     cm_foam_poly_release(&r.p);
-    free(r.xyz);
     free(r.dir);
     return s < 0 ? s : CM_ERR_FORMAT;
 }
