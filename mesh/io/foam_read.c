@@ -1,5 +1,6 @@
 /* OpenFOAM polyMesh reader: a case directory or its constant/polyMesh (points, faces,
- * owner, neighbour, boundary; optional cell/face/point zones), ASCII or binary, plain or .gz.
+ * owner, neighbour, boundary; optional cell/face/point zones), ASCII or binary, plain or .gz;
+ * a decomposed case's pieces merged into one record first (foam_decomposed.c).
  * Cells become polyhedra, or tet/hex/wedge/pyramid when their faces have exactly that shape
  * (so that the scaled Jacobian is Verdict's); boundary faces are added as 2D cells with the
  * patch as physical group (tag = patch index + 1), cells in a cellZone get the zone's group

@@ -405,13 +405,18 @@ cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *p
     if (!dir) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
     cm_status s = CM_OK;
     cm_foam_poly *own = cm_mesh_origin_state(mesh, CM_FORMAT_FOAM);
+    char *pieces = NULL;
     if (own && (own->dir || own->n_pieces)) {
         s = write_back(ctx, mesh, own, path, dir);
+    } else if (cm_foam_decomposed_path(path, &pieces) && pieces) {
+        s = cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: %s: only a mesh read from a decomposed case is written as "
+                     "processor pieces; write the case and run decomposePar on it", path);
     } else if (mkdirs(dir) != 0) {
         s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno));
     } else {
         s = write_converted(ctx, mesh, dir, NULL);
     }
+    free(pieces);
     free(dir);
     return s;
 }

@@ -629,6 +629,68 @@ static void corruptions(void)
     cm_mesh_destroy(&m);
 }
 
+/* How a path names a case: reconstructed, decomposed, writePrecision, nesting. */
+static void case_paths(void)
+{
+    char *c = NULL;
+    CHECK(cm_foam_decomposed_path("a/b/processor*", &c) == 1 && c && !strcmp(c, "a/b"));
+    free(c);
+    CHECK(cm_foam_decomposed_path("processor*/", &c) == 1 && c && !strcmp(c, "."));
+    free(c);
+    CHECK(cm_foam_decomposed_path("/processor*", &c) == 1 && c && !strcmp(c, "/"));
+    free(c);
+    CHECK(cm_foam_decomposed_path("a/processor*x", &c) == 0 && !c);
+    c = cm_foam_case_of("x/y/constant/polyMesh/");
+    CHECK(c && !strcmp(c, "x/y"));
+    free(c);
+    c = cm_foam_case_of("constant/polyMesh");
+    CHECK(c && !strcmp(c, "."));
+    free(c);
+    CHECK(cm_foam_case_of("x/polyMesh") == NULL && cm_foam_case_of("x/myconstant/polyMesh") == NULL);
+
+    char dir[2300], f[2600];
+    path(dir, sizeof dir, work, "foam_case_paths");
+    snprintf(f, sizeof f, "%s/system", dir);
+    mkdir(dir, 0777);
+    mkdir(f, 0777);
+    CHECK(cm_foam_write_precision(dir) == 0);
+    snprintf(f, sizeof f, "%s/system/controlDict", dir);
+    const char *cd = "FoamFile { version 2.0; format ascii; class dictionary; object controlDict; }\n"
+                     "functions { probe { writePrecision 3; } }\n// writePrecision 4;\nwritePrecision   9 ;\n";
+    test_write_file(f, cd, strlen(cd));
+    CHECK(cm_foam_write_precision(dir) == 9);
+    /* processor0 alone: case/ reads the pieces; with constant/polyMesh too, the reconstructed one */
+    snprintf(f, sizeof f, "%s/processor0", dir);
+    mkdir(f, 0777);
+    snprintf(f, sizeof f, "%s/processor0/constant", dir);
+    mkdir(f, 0777);
+    snprintf(f, sizeof f, "%s/processor0/constant/polyMesh", dir);
+    mkdir(f, 0777);
+    CHECK(cm_foam_decomposed_path(dir, &c) == 1 && c && !strcmp(c, dir));
+    free(c);
+    snprintf(f, sizeof f, "%s/constant", dir);
+    mkdir(f, 0777);
+    snprintf(f, sizeof f, "%s/constant/polyMesh", dir);
+    mkdir(f, 0777);
+    CHECK(cm_foam_decomposed_path(dir, &c) == 0 && !c);
+    /* the pieces' addressing files missing: named in the message */
+    cm_mesh *m = NULL;
+    snprintf(f, sizeof f, "%s/processor*", dir);
+    cm_status s = cm_mesh_read(ctx, f, &m);
+    CHECK_MSG(s != CM_OK && strstr(cm_context_message(ctx), "processor0/constant/polyMesh"), "%s",
+              cm_context_message(ctx));
+    /* a converted mesh is not written as pieces */
+    m = hex_mesh(0, 0.25);
+    CHECK(cm_mesh_write(ctx, m, f, NULL) == CM_ERR_UNSUPPORTED);
+    struct stat st;
+    CHECK(stat(f, &st) != 0);
+    cm_mesh_destroy(&m);
+    snprintf(f, sizeof f, "%s/new/deeper", dir);
+    CHECK(cm_foam_nested(dir, f) && cm_foam_nested(f, dir) && cm_foam_nested(dir, dir));
+    snprintf(f, sizeof f, "%s_other", dir);
+    CHECK(!cm_foam_nested(dir, f));
+}
+
 int main(int argc, char **argv)
 {
     snprintf(work, sizeof work, "%s", argc > 2 ? argv[2] : ".");
@@ -653,6 +715,7 @@ int main(int argc, char **argv)
     volume_check();
     hostile_patch_names();
     zones();
+    case_paths();
 
     points_only("foam_hex", "foam_hex_morphed", 0);
     gzip_copy("foam_tet", "foam_tet_gz");
