@@ -243,6 +243,24 @@ static void labels(cm_rewrite_buf *b, const int64_t *v, int64_t n)
     cm_rewrite_put(b, footer, sizeof footer - 1);
 }
 
+/* The lines of a patch dictionary but its nFaces and startFace entries (OpenFOAM writes one
+ * entry a line). */
+static void patch_entries(cm_rewrite_buf *b, const char *dict)
+{
+    const char *at = dict;
+    while (*at) {
+        const char *end = strchr(at, '\n');
+        size_t n = end ? (size_t)(end - at) + 1 : strlen(at);
+        const char *w = at;
+        while (w < at + n && (*w == ' ' || *w == '\t')) ++w;
+        int range = (!strncmp(w, "nFaces", 6) && (w[6] == ' ' || w[6] == '\t')) ||
+                    (!strncmp(w, "startFace", 9) && (w[9] == ' ' || w[9] == '\t'));
+        if (!range && w < at + n && *w != '\n' && *w != '\r') cm_rewrite_put(b, at, n);
+        else if (!range && at == dict) cm_rewrite_put(b, "\n", 1);
+        at += n;
+    }
+}
+
 /* own: the addressing to write (a decomposed case's merged one), else built from the cells. */
 static cm_status write_converted(cm_context *ctx, const cm_mesh *mesh, const char *dir, cm_foam_poly *own)
 {
@@ -277,9 +295,19 @@ static cm_status write_converted(cm_context *ctx, const cm_mesh *mesh, const cha
     if (s == CM_OK) {
         header(&b, "polyBoundaryMesh", "boundary", NULL);
         cm_rewrite_putf(&b, "%zu\n(\n", p->n_patches);
-        for (size_t i = 0; i < p->n_patches; ++i)
+        for (size_t i = 0; i < p->n_patches; ++i) {
+            if (own && p->patches[i].dict) {
+                /* a decomposed case's merged patch: its entries as read (a cyclic's
+                 * neighbourPatch, inGroups, ...), the face range its own */
+                cm_rewrite_putf(&b, "    %s\n    {", p->patches[i].name);
+                patch_entries(&b, p->patches[i].dict);
+                cm_rewrite_putf(&b, "        nFaces          %lld;\n        startFace       %lld;\n    }\n",
+                                (long long)p->patches[i].n, (long long)p->patches[i].start);
+                continue;
+            }
             cm_rewrite_putf(&b, "    %s\n    {\n        type            %s;\n        nFaces          %lld;\n        startFace       %lld;\n    }\n",
                  p->patches[i].name, p->patches[i].type, (long long)p->patches[i].n, (long long)p->patches[i].start);
+        }
         cm_rewrite_put(&b, ")", 1);
         cm_rewrite_put(&b, footer, sizeof footer - 1);
         s = flush(ctx, &b, dir, "boundary");
