@@ -3,6 +3,7 @@
  * whole case that makes `-o newcase/` runnable (docs/DESIGN.md, the OpenFOAM row of the
  * format table). */
 #define _XOPEN_SOURCE 700 /* realpath */
+#include "formats.h"
 #include "foam_internal.h"
 
 #include <dirent.h>
@@ -17,6 +18,44 @@ static int is_dir(const char *p)
 {
     struct stat st;
     return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+static int exists(const char *dir, const char *name)
+{
+    char buf[4096];
+    struct stat st;
+    return cm_foam_join(buf, sizeof buf, dir, name, NULL) == 0 && stat(buf, &st) == 0;
+}
+
+char *cm_foam_polymesh_dir(const char *path)
+{
+    size_t l = strlen(path);
+    while (l > 1 && path[l - 1] == '/') --l;
+    const char *base = path + l;
+    while (base > path && base[-1] != '/') --base;
+    char *d;
+    int as_is = (size_t)(path + l - base) == 8 && !memcmp(base, "polyMesh", 8);
+    if (!as_is && l < 4000) {
+        char tmp[4096];
+        memcpy(tmp, path, l);
+        tmp[l] = '\0';
+        /* a directory that holds the polyMesh files itself, whatever its name */
+        as_is = is_dir(tmp) && (exists(tmp, "faces") || exists(tmp, "faces.gz")) && !exists(tmp, "constant");
+    }
+    if (as_is) {
+        d = malloc(l + 1);
+        if (d) {
+            memcpy(d, path, l);
+            d[l] = '\0';
+        }
+        return d;
+    }
+    d = malloc(l + sizeof "/constant/polyMesh");
+    if (d) {
+        memcpy(d, path, l);
+        memcpy(d + l, "/constant/polyMesh", sizeof "/constant/polyMesh");
+    }
+    return d;
 }
 
 static int ends_with(const char *s, size_t l, const char *tail)
@@ -85,7 +124,18 @@ int cm_foam_write_precision(const char *case_dir)
     char path[4200];
     if (cm_foam_join(path, sizeof path, case_dir, "system/controlDict", NULL)) return 0;
     FILE *in = fopen(path, "rb");
-    if (!in) return 0;
+    if (!in) {
+        /* one piece of a decomposed case read alone: the case's controlDict */
+        size_t l = strlen(case_dir);
+        while (l > 1 && case_dir[l - 1] == '/') --l;
+        size_t b = l;
+        while (b > 0 && case_dir[b - 1] >= '0' && case_dir[b - 1] <= '9') --b;
+        if (b == l || b < 9 || strncmp(case_dir + b - 9, "processor", 9) || (b > 9 && case_dir[b - 10] != '/'))
+            return 0;
+        size_t k = b - 9;
+        int n = snprintf(path, sizeof path, "%.*ssystem/controlDict", (int)k, k ? case_dir : "");
+        if (n < 0 || (size_t)n >= sizeof path || !(in = fopen(path, "rb"))) return 0;
+    }
     cm_foam_file f;
     memset(&f, 0, sizeof f);
     f.path = path;
@@ -235,4 +285,37 @@ cm_status cm_foam_copy_tree(cm_context *ctx, const char *src, const char *dst,
 {
     char rel[2048] = "";
     return copy_rec(ctx, src, dst, rel, 0, skip, arg);
+}
+
+static int is_dir_path(const char *p)
+{
+    struct stat st;
+    return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh)
+{
+    *mesh = NULL;
+    char *case_dir = NULL;
+    int decomposed = cm_foam_decomposed_path(path, &case_dir);
+    char *dir = decomposed ? NULL : cm_foam_polymesh_dir(path);
+    cm_foam_poly *p = cm_foam_poly_new();
+    cm_status s = CM_OK;
+    if (!p || (!decomposed && !dir)) {
+        s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    } else if (decomposed) {
+        s = cm_foam_read_decomposed(ctx, case_dir, p);
+        if (!(p->case_dir = strdup(case_dir))) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    } else if (!is_dir_path(dir)) {
+        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: no polyMesh directory %s", path, dir);
+    } else {
+        s = cm_foam_read_poly(ctx, dir, p);
+        p->case_dir = cm_foam_case_of(dir);
+    }
+    if (s == CM_OK && p->case_dir) p->write_precision = cm_foam_write_precision(p->case_dir);
+    if (s == CM_OK) s = cm_foam_mesh_of_poly(ctx, p, decomposed ? case_dir : dir, mesh);
+    else cm_foam_poly_release(&p);
+    free(case_dir);
+    free(dir);
+    return s == CM_OK || s < 0 ? s : CM_ERR_FORMAT;
 }

@@ -61,6 +61,10 @@ typedef struct cm_foam_poly {
 
 /* Reads one polyMesh directory into p (points kept as p->xyz0). */
 cm_status cm_foam_read_poly(cm_context *ctx, const char *dir, cm_foam_poly *p);
+/* The mesh of a read record: cells (typed where their faces allow), patches as 2D cells,
+ * cell zones as groups; p becomes its origin (consumed, also on failure). where: for
+ * messages. */
+cm_status cm_foam_mesh_of_poly(cm_context *ctx, cm_foam_poly *p, const char *where, cm_mesh **mesh);
 /* The pieces of a decomposed case (case_dir/processorN/constant/polyMesh, N = 0, 1, ...)
  * merged into p through their *ProcAddressing files, as reconstructPar numbers the mesh. */
 cm_status cm_foam_read_decomposed(cm_context *ctx, const char *case_dir, cm_foam_poly *p);
@@ -70,7 +74,8 @@ cm_status cm_foam_read_decomposed(cm_context *ctx, const char *case_dir, cm_foam
 int cm_foam_decomposed_path(const char *path, char **case_dir);
 /* The case of a polyMesh directory "X/constant/polyMesh": X (malloc'ed), else NULL. */
 char *cm_foam_case_of(const char *polymesh_dir);
-/* system/controlDict's writePrecision of a case, 0 if none is found. */
+/* system/controlDict's writePrecision of a case (of a piece "X/processorN" read alone: X's),
+ * 0 if none is found. */
 int cm_foam_write_precision(const char *case_dir);
 /* Copies every regular file under src to dst (same layout, each through a temporary and a
  * rename), skipping the relative paths for which skip() returns 1. */

@@ -650,6 +650,13 @@ static void case_paths(void)
 
     char dir[2300], f[2600];
     path(dir, sizeof dir, work, "foam_case_paths");
+    /* left by an earlier run: start empty */
+    const char *old[] = {"system/controlDict", "system", "constant/polyMesh", "constant", "processor0/constant/polyMesh",
+                         "processor0/constant", "processor0"};
+    for (int k = 0; k < 7; ++k) {
+        snprintf(f, sizeof f, "%s/%s", dir, old[k]);
+        remove(f);
+    }
     snprintf(f, sizeof f, "%s/system", dir);
     mkdir(dir, 0777);
     mkdir(f, 0777);
@@ -659,6 +666,10 @@ static void case_paths(void)
                      "functions { probe { writePrecision 3; } }\n// writePrecision 4;\nwritePrecision   9 ;\n";
     test_write_file(f, cd, strlen(cd));
     CHECK(cm_foam_write_precision(dir) == 9);
+    snprintf(f, sizeof f, "%s/processor12", dir);
+    CHECK(cm_foam_write_precision(f) == 9); /* a piece read alone: the case's */
+    snprintf(f, sizeof f, "%s/xprocessor12", dir);
+    CHECK(cm_foam_write_precision(f) == 0);
     /* processor0 alone: case/ reads the pieces; with constant/polyMesh too, the reconstructed one */
     snprintf(f, sizeof f, "%s/processor0", dir);
     mkdir(f, 0777);
