@@ -184,25 +184,26 @@ static cm_status write_points(cm_context *ctx, const cm_foam_poly *q, const doub
     return s;
 }
 
-/* Every regular file of the source polyMesh but points copied into dir (copy: 1), then points. */
-static cm_status write_points_only(cm_context *ctx, const cm_mesh *mesh, const cm_foam_poly *p, const char *dir,
-                                   int copy)
+/* Every regular file of q's polyMesh but points copied into dir (copy: 1), then points with
+ * the coordinates xyz. */
+static cm_status polymesh_out(cm_context *ctx, const cm_foam_poly *q, const double *xyz, int precision,
+                              const char *dir, int copy)
 {
-    DIR *d = copy ? opendir(p->dir) : NULL;
+    DIR *d = copy ? opendir(q->dir) : NULL;
     if (copy && !d)
-        return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot list the source polyMesh: %s", p->dir, strerror(errno));
+        return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot list the source polyMesh: %s", q->dir, strerror(errno));
     cm_status s = CM_OK;
     struct dirent *e;
     while (d && s == CM_OK && (e = readdir(d))) {
         if (e->d_name[0] == '.' || is_points(e->d_name)) continue;
         char src[4200];
         struct stat st;
-        if (cm_foam_join(src, sizeof src, p->dir, e->d_name, NULL) || stat(src, &st) != 0 || !S_ISREG(st.st_mode)) continue; /* sets/ and the like stay behind */
-        s = copy_file(ctx, p->dir, dir, e->d_name);
+        if (cm_foam_join(src, sizeof src, q->dir, e->d_name, NULL) || stat(src, &st) != 0 || !S_ISREG(st.st_mode)) continue; /* sets/ and the like: see the case copy */
+        s = copy_file(ctx, q->dir, dir, e->d_name);
     }
     if (d) closedir(d);
     if (s != CM_OK) return s;
-    return write_points(ctx, p, mesh->xyz, p->write_precision, dir);
+    return write_points(ctx, q, xyz, precision, dir);
 }
 
 /* ---- a converted mesh: all five files, ASCII ---- */
@@ -326,13 +327,15 @@ static cm_status write_converted(cm_context *ctx, const cm_mesh *mesh, const cha
 /* ---- whole cases ---- */
 
 typedef struct skip_rule {
+    const char *src;  /* the source case */
     int undecomposed; /* the source was read from constant/polyMesh */
     size_t n_pieces;
 } skip_rule;
 
-/* What the case copy leaves out: the points written after it, and for a case read
- * undecomposed its processor* directories (pieces of the mesh before the morph, which a
- * parallel run would take instead of the morphed mesh: decompose the new case again). */
+/* What the case copy leaves out: the files directly in the polyMesh directories read (written
+ * after it, `points` replaced, a stale .gz twin removed), and for a case read undecomposed its
+ * processor* directories (pieces of the mesh before the morph, which a parallel run would take
+ * instead of the morphed mesh: decompose the new case again). */
 static int skip_in_copy(const char *rel, void *arg)
 {
     const skip_rule *r = arg;
@@ -344,12 +347,16 @@ static int skip_in_copy(const char *rel, void *arg)
     }
     const char *pm = strstr(rel, "constant/polyMesh/");
     if (!pm || strchr(pm + 18, '/')) return 0;
-    if (r->undecomposed ? pm != rel : strncmp(rel, "processor", 9) != 0) return 0;
-    return is_points(pm + 18);
+    if (r->undecomposed ? pm != rel : strncmp(rel, "processor", 9) != 0 || strchr(rel, '/') + 1 != pm) return 0;
+    char src[4200];
+    struct stat st;
+    return snprintf(src, sizeof src, "%s/%s", r->src, rel) < (int)sizeof src && stat(src, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-/* The pieces' points (each from the merged coordinates) into case_dir/processorN. */
-static cm_status write_pieces(cm_context *ctx, const cm_mesh *mesh, const cm_foam_poly *p, const char *case_dir)
+/* The pieces (each's points from the merged coordinates) into case_dir/processorN; copy: the
+ * other files of each piece's polyMesh too. */
+static cm_status write_pieces(cm_context *ctx, const cm_mesh *mesh, const cm_foam_poly *p, const char *case_dir,
+                              int copy)
 {
     cm_status s = CM_OK;
     for (size_t i = 0; s == CM_OK && i < p->n_pieces; ++i) {
@@ -362,7 +369,7 @@ static cm_status write_pieces(cm_context *ctx, const cm_mesh *mesh, const cm_foa
         if (mkdirs(dir) != 0)
             s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno));
         else
-            s = write_points(ctx, q, xyz, p->write_precision, dir);
+            s = polymesh_out(ctx, q, xyz, p->write_precision, dir, copy);
         free(xyz);
     }
     return s;
@@ -403,23 +410,23 @@ static cm_status write_back(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly *
         s = cm_error(ctx, CM_ERR_UNSUPPORTED,
                      "cm_mesh_write: %s: the mesh was read undecomposed; write the case and run decomposePar on it", path);
     } else if (own->n_pieces && same_dir(scase, tcase)) {
-        s = write_pieces(ctx, mesh, own, scase); /* in place: points only */
+        s = write_pieces(ctx, mesh, own, scase, 0); /* in place: points only */
     } else if (!own->n_pieces && same_dir(own->dir, dir)) {
-        s = write_points_only(ctx, mesh, own, dir, 0); /* in place: points only */
+        s = polymesh_out(ctx, own, mesh->xyz, own->write_precision, dir, 0); /* in place: points only */
     } else if (tcase && scase && cm_foam_nested(scase, tcase)) {
         s = cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: %s: the new case and the source case %s lie one inside the other; "
                      "write it beside the source", tcase, scase);
     } else if (tcase && scase) {
-        skip_rule rule = {!own->n_pieces, own->n_pieces};
+        skip_rule rule = {scase, !own->n_pieces, own->n_pieces};
         s = mkdirs(tcase) ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", tcase, strerror(errno))
                           : cm_foam_copy_tree(ctx, scase, tcase, skip_in_copy, &rule);
-        if (s == CM_OK && own->n_pieces) s = write_pieces(ctx, mesh, own, tcase);
+        if (s == CM_OK && own->n_pieces) s = write_pieces(ctx, mesh, own, tcase, 1);
         else if (s == CM_OK && mkdirs(dir) != 0)
             s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno));
-        else if (s == CM_OK) s = write_points_only(ctx, mesh, own, dir, 0);
+        else if (s == CM_OK) s = polymesh_out(ctx, own, mesh->xyz, own->write_precision, dir, 1);
     } else {
         s = mkdirs(dir) ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno))
-                        : write_points_only(ctx, mesh, own, dir, 1);
+                        : polymesh_out(ctx, own, mesh->xyz, own->write_precision, dir, 1);
     }
     free(tcase);
     return s;
