@@ -15,6 +15,14 @@ Kinds (every case has a wall patch `body`; the patch types are what the morph mu
   cyclic      3-D channel around a box body, the side walls z=0 and z=W a cyclic pair;
               patches inlet outlet walls body back front [cyclic, neighbourPatch each other]
 
+Geometry (BODY_BOX holds the body's bounding box of each kind):
+  channel2d   x [0, 6], y [0, 2], z [0, 0.1]; body x [2, 2.5], y [0.75, 1.25] (centre 2.25 1)
+  wedge       x [0, 6], radius 1; body x [2, 2.5], r <= 0.25 (on the axis)
+  symmetry3d  x [0, 6], y [0, 1.5], z [-1, 1]; body x [2, 2.5], y [0, 0.25], z [-0.25, 0.25]
+  cyclic      x [0, 6], y [0, 2], z [0, 1.2]; body x [2, 2.5], y [0.75, 1.25], z [0.4, 0.8]
+Zones (zones=True): cellZone `wake` (the cells behind the body, x > 2.5), faceZone `plane`
+(the internal faces of the plane x = 2 above the body), cellZone `none` (no cells).
+
 All geometry is a lattice of blocks with the body's blocks left out; `scale` multiplies the
 cell count (every block's divisions by scale**(1/d), d = 2 for the 2-D and wedge cases, 3
 otherwise). Importable by file path from tests/ and benchmarks/ (standard library only).
@@ -29,6 +37,11 @@ import gzip
 
 TOOLS = ("blockMesh", "checkMesh")
 KINDS = ("channel2d", "wedge", "symmetry3d", "cyclic")
+_S, _C = math.sin(math.radians(2.5)), math.cos(math.radians(2.5))
+BODY_BOX = {"channel2d": ((2.0, 0.75, 0.0), (2.5, 1.25, 0.1)),
+            "wedge": ((2.0, 0.0, -0.25 * _S), (2.5, 0.25 * _C, 0.25 * _S)),
+            "symmetry3d": ((2.0, 0.0, -0.25), (2.5, 0.25, 0.25)),
+            "cyclic": ((2.0, 0.75, 0.4), (2.5, 1.25, 0.8))}
 HEADER = ("FoamFile\n{\n    version 2.0;\n    format ascii;\n    class %s;\n"
           "    object %s;\n}\n")
 

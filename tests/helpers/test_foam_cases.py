@@ -86,6 +86,8 @@ for kind, (ndir, types) in EXPECT.items():
     hi = [max(p[a] for p in body) for a in range(3)]
     check(len(xyz) == r["points"], "%s: read_points gives %d points" % (kind, len(xyz)))
     box = BODY_BOX[kind]
+    check(all(abs(a - b) < 1e-12 for u, v in zip(box, fc.BODY_BOX[kind]) for a, b in zip(u, v)),
+          "%s: foam_cases.BODY_BOX %s" % (kind, fc.BODY_BOX[kind]))
     check(all(abs(lo[a] - box[0][a]) < 1e-9 and abs(hi[a] - box[1][a]) < 1e-9 for a in range(3)),
           "%s: body points span %s %s, not %s" % (kind, lo, hi, box))
     pm = os.path.join(case, "constant", "polyMesh")
