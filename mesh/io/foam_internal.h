@@ -45,7 +45,45 @@ typedef struct cm_foam_poly {
     char *points_tail;         /* bytes after the closing ')' */
     size_t points_tail_len;
     int points_binary, points_gz, scalar_bytes, label_bytes;
+    double *xyz0;              /* the points as read: a point equal to them keeps its text */
+    /* the case directory (the one holding constant/, or processorN/ pieces) when the mesh
+     * was read from a case, else NULL; the case's system/controlDict writePrecision, 0 when
+     * absent (ASCII points moved are then written in the shortest exact text) */
+    char *case_dir;
+    int write_precision;
+    /* a decomposed case: the pieces as read (processor0..n_pieces-1, each with its own dir,
+     * points format and xyz0) and their local-to-global point labels (pointProcAddressing);
+     * this record is then the merged mesh, processor faces internal (dir NULL) */
+    size_t n_pieces;
+    struct cm_foam_poly **pieces;
+    int64_t **piece_points;
 } cm_foam_poly;
+
+/* Reads one polyMesh directory into p (points kept as p->xyz0). */
+cm_status cm_foam_read_poly(cm_context *ctx, const char *dir, cm_foam_poly *p);
+/* The mesh of a read record: cells (typed where their faces allow), patches as 2D cells,
+ * cell zones as groups; p becomes its origin (consumed, also on failure). where: for
+ * messages. */
+cm_status cm_foam_mesh_of_poly(cm_context *ctx, cm_foam_poly *p, const char *where, cm_mesh **mesh);
+/* The pieces of a decomposed case (case_dir/processorN/constant/polyMesh, N = 0, 1, ...)
+ * merged into p through their *ProcAddressing files, as reconstructPar numbers the mesh. */
+cm_status cm_foam_read_decomposed(cm_context *ctx, const char *case_dir, cm_foam_poly *p);
+/* How a mesh path reads: 1 for a decomposed case (the case directory into *case_dir), 0 for
+ * a polyMesh (see cm_foam_polymesh_dir). "case/processor*" (the literal name) asks for the
+ * pieces; "case/" reads case/constant/polyMesh, or the pieces when only they exist. */
+int cm_foam_decomposed_path(const char *path, char **case_dir);
+/* The case of a polyMesh directory "X/constant/polyMesh": X (malloc'ed), else NULL. */
+char *cm_foam_case_of(const char *polymesh_dir);
+/* system/controlDict's writePrecision of a case (of a piece "X/processorN" read alone: X's),
+ * 0 if none is found. */
+int cm_foam_write_precision(const char *case_dir);
+/* Copies every regular file under src to dst (same layout, each through a temporary and a
+ * rename), skipping the relative paths for which skip() returns 1. */
+cm_status cm_foam_copy_tree(cm_context *ctx, const char *src, const char *dst,
+                            int (*skip)(const char *rel, void *arg), void *arg);
+/* 1 when a and b are the same directory or one lies inside the other (links resolved; a
+ * path that does not exist yet is taken as written below its existing parent). */
+int cm_foam_nested(const char *a, const char *b);
 
 cm_foam_poly *cm_foam_poly_retain(cm_foam_poly *p);
 void cm_foam_poly_release(cm_foam_poly **p);

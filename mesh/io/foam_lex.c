@@ -357,7 +357,14 @@ static cm_status list_open(cm_context *ctx, cm_foam_lex *lx, const char *what, i
     char buf[200];
     snprintf(buf, sizeof buf, "the size of %s", what);
     if (t.kind != CM_FOAM_WORD || !parse_i64(t.s, t.len, n) || *n < 0) return tok_error(ctx, lx, buf, t);
-    cm_foam_tok b = cm_foam_next(lx);
+    cm_foam_tok b = cm_foam_peek(lx);
+    /* OpenFOAM writes an empty list in binary as its size alone ("cellLabels 0;"), in ASCII
+     * as "0()"; "0{v}" is read below like any uniform list */
+    if (*n == 0 && !(b.kind == CM_FOAM_PUNCT && (b.s[0] == '(' || b.s[0] == '{'))) {
+        *open = 0;
+        return CM_OK;
+    }
+    b = cm_foam_next(lx);
     if (b.kind != CM_FOAM_PUNCT || (b.s[0] != '(' && b.s[0] != '{')) {
         snprintf(buf, sizeof buf, "'(' or '{' opening %s", what);
         return tok_error(ctx, lx, buf, b);
@@ -407,6 +414,7 @@ cm_status cm_foam_label_list(cm_context *ctx, cm_foam_lex *lx, const char *what,
     int64_t cnt;
     cm_status s = list_open(ctx, lx, what, &cnt, &open);
     if (s != CM_OK) return s;
+    if (!open) return CM_OK; /* an empty list written as its size alone */
     int64_t *v = alloc_n(cnt, sizeof *v);
     if (cnt > 0 && !v) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory for %lld labels", lx->f->path, (long long)cnt);
     if (open == '{') {
@@ -451,6 +459,7 @@ cm_status cm_foam_scalar_list(cm_context *ctx, cm_foam_lex *lx, const char *what
     int64_t cnt;
     cm_status s = list_open(ctx, lx, what, &cnt, &open);
     if (s != CM_OK) return s;
+    if (!open) return CM_OK; /* an empty list written as its size alone */
     double *v = alloc_n(cnt * width, sizeof *v);
     if (cnt > 0 && !v) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory for %lld values", lx->f->path, (long long)cnt);
     if (open == '{' || !lx->f->binary || cnt == 0) {
@@ -520,7 +529,7 @@ cm_status cm_foam_face_list(cm_context *ctx, cm_foam_lex *lx, int compact, const
     int64_t cnt;
     cm_status s = list_open(ctx, lx, what, &cnt, &open);
     if (s != CM_OK) return s;
-    if (open != '(') return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: expected '(' opening the face list", cm_foam_where(lx, w, sizeof w));
+    if (open != '(' && !(open == 0 && cnt == 0)) return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: expected '(' opening the face list", cm_foam_where(lx, w, sizeof w));
     int64_t *o = alloc_n(cnt + 1, sizeof *o);
     size_t cap = (size_t)(cnt > 0 ? cnt : 1) * 4, used = 0;
     int64_t *nd = malloc(cap * sizeof *nd);
@@ -550,7 +559,7 @@ cm_status cm_foam_face_list(cm_context *ctx, cm_foam_lex *lx, int compact, const
         used += (size_t)fn;
         o[i + 1] = (int64_t)used;
     }
-    if (s == CM_OK) s = cm_foam_expect(ctx, lx, ')', "')' closing the face list (more faces than its size?)");
+    if (s == CM_OK && open) s = cm_foam_expect(ctx, lx, ')', "')' closing the face list (more faces than its size?)");
     if (s != CM_OK) {
         free(o);
         free(nd);
@@ -591,6 +600,7 @@ cm_status cm_foam_bool_list(cm_context *ctx, cm_foam_lex *lx, const char *what, 
     int64_t cnt;
     cm_status s = list_open(ctx, lx, what, &cnt, &open);
     if (s != CM_OK) return s;
+    if (!open) return CM_OK; /* an empty list written as its size alone */
     uint8_t *v = alloc_n(cnt, 1);
     if (cnt > 0 && !v) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", lx->f->path);
     int64_t x = 0;

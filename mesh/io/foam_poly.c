@@ -53,5 +53,13 @@ void cm_foam_poly_release(cm_foam_poly **pp)
     free(p->zones);
     free(p->points_head);
     free(p->points_tail);
+    free(p->xyz0);
+    free(p->case_dir);
+    for (size_t i = 0; i < p->n_pieces; ++i) {
+        cm_foam_poly_release(&p->pieces[i]);
+        free(p->piece_points[i]);
+    }
+    free(p->pieces);
+    free(p->piece_points);
     free(p);
 }

@@ -1,5 +1,7 @@
-/* OpenFOAM polyMesh reader: a case directory or its constant/polyMesh (points, faces,
- * owner, neighbour, boundary; optional cell/face/point zones), ASCII or binary, plain or .gz.
+/* OpenFOAM polyMesh reader: one polyMesh directory (points, faces, owner, neighbour,
+ * boundary; optional cell/face/point zones), ASCII or binary, plain or .gz, and the mesh of
+ * such a record (or of a decomposed case's merged one: foam_decomposed.c; which a path names:
+ * foam_case.c).
  * Cells become polyhedra, or tet/hex/wedge/pyramid when their faces have exactly that shape
  * (so that the scaled Jacobian is Verdict's); boundary faces are added as 2D cells with the
  * patch as physical group (tag = patch index + 1), cells in a cellZone get the zone's group
@@ -17,44 +19,6 @@ static int is_dir(const char *p)
 {
     struct stat st;
     return stat(p, &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-static int exists(const char *dir, const char *name)
-{
-    char buf[4096];
-    struct stat st;
-    return cm_foam_join(buf, sizeof buf, dir, name, NULL) == 0 && stat(buf, &st) == 0;
-}
-
-char *cm_foam_polymesh_dir(const char *path)
-{
-    size_t l = strlen(path);
-    while (l > 1 && path[l - 1] == '/') --l;
-    const char *base = path + l;
-    while (base > path && base[-1] != '/') --base;
-    char *d;
-    int as_is = (size_t)(path + l - base) == 8 && !memcmp(base, "polyMesh", 8);
-    if (!as_is && l < 4000) {
-        char tmp[4096];
-        memcpy(tmp, path, l);
-        tmp[l] = '\0';
-        /* a directory that holds the polyMesh files itself, whatever its name */
-        as_is = is_dir(tmp) && (exists(tmp, "faces") || exists(tmp, "faces.gz")) && !exists(tmp, "constant");
-    }
-    if (as_is) {
-        d = malloc(l + 1);
-        if (d) {
-            memcpy(d, path, l);
-            d[l] = '\0';
-        }
-        return d;
-    }
-    d = malloc(l + sizeof "/constant/polyMesh");
-    if (d) {
-        memcpy(d, path, l);
-        memcpy(d + l, "/constant/polyMesh", sizeof "/constant/polyMesh");
-    }
-    return d;
 }
 
 /* ---- boundary and zones ---- */
@@ -536,60 +500,56 @@ done:
     return s;
 }
 
-cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh)
+cm_status cm_foam_read_poly(cm_context *ctx, const char *dir, cm_foam_poly *p)
+{
+    reader r = {ctx, dir, (char *)dir, p, NULL};
+    if (!is_dir(dir)) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: no polyMesh directory %s", dir);
+    int64_t n_owner = 0, n_nei = 0;
+    cm_status s = CM_OK;
+    if (!p->dir && !(p->dir = strdup(dir))) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    if (s == CM_OK) s = read_points(&r);
+    p->xyz0 = r.xyz;
+    if (s == CM_OK) s = read_faces(&r);
+    if (s == CM_OK) s = read_labels(&r, "owner", &p->owner, &n_owner);
+    if (s == CM_OK) s = read_labels(&r, "neighbour", &p->neighbour, &n_nei);
+    if (s == CM_OK) s = read_boundary(ctx, dir, p);
+    if (s == CM_OK) s = check_addressing(&r, n_owner, n_nei);
+    if (s == CM_OK) s = read_zones(ctx, dir, "cellZones", CM_FOAM_CELL_ZONE, p);
+    if (s == CM_OK) s = read_zones(ctx, dir, "faceZones", CM_FOAM_FACE_ZONE, p);
+    if (s == CM_OK) s = read_zones(ctx, dir, "pointZones", CM_FOAM_POINT_ZONE, p);
+    return s;
+}
+
+cm_status cm_foam_mesh_of_poly(cm_context *ctx, cm_foam_poly *p, const char *where, cm_mesh **mesh)
 {
     *mesh = NULL;
-    reader r = {ctx, path, cm_foam_polymesh_dir(path), cm_foam_poly_new(), NULL};
+    reader r = {ctx, where, (char *)where, p, NULL};
     cm_mesh *m = NULL;
-    cm_status s = CM_OK;
-    if (!r.dir || !r.p) {
-        s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
-        goto fail;
-    }
-    if (!is_dir(r.dir)) {
-        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: no polyMesh directory %s", path, r.dir);
-        goto fail;
-    }
-    r.p->dir = strdup(r.dir);
-    int64_t n_owner = 0, n_nei = 0;
-    if (!r.p->dir) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
-    if (s == CM_OK) s = read_points(&r);
-    if (s == CM_OK) s = read_faces(&r);
-    if (s == CM_OK) s = read_labels(&r, "owner", &r.p->owner, &n_owner);
-    if (s == CM_OK) s = read_labels(&r, "neighbour", &r.p->neighbour, &n_nei);
-    if (s == CM_OK) s = read_boundary(ctx, r.dir, r.p);
-    if (s == CM_OK) s = check_addressing(&r, n_owner, n_nei);
-    if (s == CM_OK) s = read_zones(ctx, r.dir, "cellZones", CM_FOAM_CELL_ZONE, r.p);
-    if (s == CM_OK) s = read_zones(ctx, r.dir, "faceZones", CM_FOAM_FACE_ZONE, r.p);
-    if (s == CM_OK) s = read_zones(ctx, r.dir, "pointZones", CM_FOAM_POINT_ZONE, r.p);
-    if (s == CM_OK) s = cm_mesh_create(ctx, &m);
-    if (s == CM_OK) s = cm_mesh_resize_nodes(ctx, m, (size_t)r.p->n_points, 0);
+    cm_status s = cm_mesh_create(ctx, &m);
+    if (s == CM_OK) s = cm_mesh_resize_nodes(ctx, m, (size_t)p->n_points, 0);
     if (s == CM_OK) {
-        if (r.p->n_points) memcpy(m->xyz, r.xyz, (size_t)r.p->n_points * 3 * sizeof(double));
+        if (p->n_points) memcpy(m->xyz, p->xyz0, (size_t)p->n_points * 3 * sizeof(double));
         s = build_cells(&r, m);
     }
     /* cell zones become the volume cells' physical groups (zone k: tag k + 1; a cell in
      * several zones keeps the last) */
-    for (size_t z = 0, k = 0; s == CM_OK && z < r.p->n_zones; ++z) {
-        const cm_foam_zone *zn = &r.p->zones[z];
+    for (size_t z = 0, k = 0; s == CM_OK && z < p->n_zones; ++z) {
+        const cm_foam_zone *zn = &p->zones[z];
         if (zn->kind != CM_FOAM_CELL_ZONE) continue;
         ++k;
-        s = cm_mesh_add_group(ctx, m, 3, (int)(r.p->n_patches + k), zn->name);
+        s = cm_mesh_add_group(ctx, m, 3, (int)(p->n_patches + k), zn->name);
         for (int64_t i = 0; s == CM_OK && i < zn->n; ++i)
-            m->physical[zn->ids[i]] = m->entity[zn->ids[i]] = (int)(r.p->n_patches + k);
+            m->physical[zn->ids[i]] = m->entity[zn->ids[i]] = (int)(p->n_patches + k);
     }
-    if (s != CM_OK) goto fail;
-    s = cm_mesh_set_origin(ctx, m, CM_FORMAT_FOAM, r.p, cm_foam_poly_free);
-    r.p = NULL; /* the origin owns it, or has freed it */
-    if (s != CM_OK) goto fail;
-    free(r.xyz);
-    free(r.dir);
+    if (s == CM_OK) {
+        s = cm_mesh_set_origin(ctx, m, CM_FORMAT_FOAM, p, cm_foam_poly_free);
+        p = NULL; /* the origin owns it, or has freed it */
+    }
+    cm_foam_poly_release(&p);
+    if (s != CM_OK) {
+        cm_mesh_destroy(&m);
+        return s < 0 ? s : CM_ERR_FORMAT;
+    }
     *mesh = m;
     return CM_OK;
-fail:
-    cm_mesh_destroy(&m);
-    cm_foam_poly_release(&r.p);
-    free(r.xyz);
-    free(r.dir);
-    return s < 0 ? s : CM_ERR_FORMAT;
 }

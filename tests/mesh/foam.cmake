@@ -11,3 +11,9 @@ set_tests_properties(test_foam_crosscheck PROPERTIES LABELS "foam;cli" SKIP_RETU
 add_test(NAME test_foam_car
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_foam_car.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
 set_tests_properties(test_foam_car PROPERTIES LABELS "foam;cli;slow" SKIP_RETURN_CODE 77 TIMEOUT 600)
+# Decomposed cases (decomposePar pieces read as one mesh, written back piece by piece,
+# against reconstructPar and checkMesh) and whole-case output (-o newcase/ runs simpleFoam;
+# ASCII points at the case's writePrecision).
+add_test(NAME test_foam_decomposed
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_foam_decomposed.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
+set_tests_properties(test_foam_decomposed PROPERTIES LABELS "foam;cli;cfd" SKIP_RETURN_CODE 77 TIMEOUT 300)

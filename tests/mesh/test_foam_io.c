@@ -6,6 +6,7 @@
  * (The cross-check against the real OpenFOAM is test_foam_crosscheck.py.) */
 #define _POSIX_C_SOURCE 200809L
 #include "cadmorph/mesh.h"
+#include "foam_internal.h"
 #include "origin.h"
 #include "test_files.h"
 #include "test_mesh.h"
@@ -258,9 +259,25 @@ static void points_only(const char *src_name, const char *dst_name, int gz)
         for (size_t i = 0; exact && i < 3 * w->n_nodes; ++i) exact &= r->xyz[i] == w->xyz[i];
         CHECK_MSG(exact, "%s: morphed points do not round-trip", dst_name);
     }
-    /* writing onto the polyMesh it came from is refused */
-    s = cm_mesh_write(ctx, m, src, NULL);
-    CHECK(s == CM_ERR_ARGUMENT);
+    /* a new case inside the source case, or holding it, is refused (the case copy would
+     * copy itself) */
+    char inner[2500];
+    snprintf(inner, sizeof inner, "%s/inner", src);
+    s = cm_mesh_write(ctx, w, inner, NULL);
+    CHECK_MSG(s == CM_ERR_ARGUMENT && strstr(cm_context_message(ctx), "one inside the other"), "%s",
+              cm_context_message(ctx));
+    CHECK(stat(inner, &st) != 0);
+    CHECK(cm_mesh_write(ctx, w, work, NULL) == CM_ERR_ARGUMENT);
+    /* written onto the case it came from: points replaced in place, the rest untouched */
+    s = cm_mesh_write(ctx, w, src, NULL);
+    CHECK_MSG(s == CM_OK, "in place: %s", cm_context_message(ctx));
+    for (int i = 0; i < 5; ++i) {
+        char name[64];
+        snprintf(name, sizeof name, "constant/polyMesh/%s%s", i < 4 ? files[i] : "points", gz ? ".gz" : "");
+        path(a, sizeof a, src, name);
+        path(b, sizeof b, dst, name);
+        CHECK_MSG(same_file(a, b), "in place: %s differs from %s", a, b);
+    }
     cm_mesh_destroy(&r);
     cm_mesh_destroy(&w);
     cm_mesh_destroy(&m);
@@ -330,6 +347,49 @@ static char *binary_case(const cm_mesh *m, const char *name, int truncate)
     if (!truncate) fprintf(o, ")\n");
     fclose(o);
     return dir;
+}
+
+/* Zones in binary files as decomposePar writes them for a piece a zone does not reach: an
+ * empty list is its size alone ("cellLabels 0;"); beside them "0()", "0{0}" and a non-empty
+ * binary block. */
+static void empty_binary_zones(const char *dir, size_t n_cells)
+{
+    char f[2600];
+    const char *names[] = {"cellZones", "faceZones", "pointZones"};
+    const char *bodies[] = {"2\n(\nnone\n{\n    type cellZone;\ncellLabels      0;\n}\nsome\n{\n    type cellZone;\n"
+                            "cellLabels      2(",
+                            "2\n(\nnoFaces\n{\n    type faceZone;\nfaceLabels      0;\nflipMap         0;\n}\n"
+                            "uniform\n{\n    type faceZone;\nfaceLabels      0();\nflipMap         0{0};\n}\n)\n",
+                            "1\n(\nnoPoints\n{\n    type pointZone;\npointLabels     0;\n}\n)\n"};
+    for (int k = 0; k < 3; ++k) {
+        snprintf(f, sizeof f, "%s/constant/polyMesh/%s", dir, names[k]);
+        FILE *o = fopen(f, "wb");
+        bin_header(o, "regIOobject", names[k]);
+        fputs(bodies[k], o);
+        if (k == 0) {
+            int64_t two[2] = {0, (int64_t)n_cells - 1};
+            fwrite(two, 8, 2, o);
+            fputs(");\n}\n)\n", o);
+        }
+        fclose(o);
+    }
+    cm_mesh *z = NULL;
+    cm_status s = cm_mesh_read(ctx, dir, &z);
+    CHECK_MSG(s == CM_OK, "empty binary zones: %s", cm_context_message(ctx));
+    const struct cm_foam_poly *p = z ? cm_mesh_origin_state(z, CM_FORMAT_FOAM) : NULL;
+    CHECK(p && p->n_zones == 5);
+    for (size_t i = 0; p && i < p->n_zones; ++i)
+        CHECK_MSG(p->zones[i].n == (strcmp(p->zones[i].name, "some") ? 0 : 2), "zone %s: %lld labels",
+                  p->zones[i].name, (long long)p->zones[i].n);
+    int some = -1;
+    for (size_t g = 0; z && g < z->n_groups; ++g)
+        if (z->groups[g].dim == 3 && !strcmp(z->groups[g].name, "some")) some = z->groups[g].tag;
+    CHECK(z && some > 0 && z->physical[0] == some && z->physical[n_cells - 1] == some && z->physical[1] != some);
+    cm_mesh_destroy(&z);
+    for (int k = 0; k < 3; ++k) {
+        snprintf(f, sizeof f, "%s/constant/polyMesh/%s", dir, names[k]);
+        remove(f);
+    }
 }
 
 static void binary_read(void)
@@ -429,6 +489,8 @@ static void binary_read(void)
         cm_mesh_destroy(&w);
     }
     cm_mesh_destroy(&bm);
+    const cm_foam_poly *rp = cm_mesh_origin_state(r, CM_FORMAT_FOAM);
+    if (rp) empty_binary_zones(dir, (size_t)rp->n_cells);
     /* truncated binary block */
     binary_case(r, "foam_hex_bin", 1);
     s = cm_mesh_read(ctx, dir, &bm);
@@ -568,6 +630,79 @@ static void corruptions(void)
     cm_mesh_destroy(&m);
 }
 
+/* How a path names a case: reconstructed, decomposed, writePrecision, nesting. */
+static void case_paths(void)
+{
+    char *c = NULL;
+    CHECK(cm_foam_decomposed_path("a/b/processor*", &c) == 1 && c && !strcmp(c, "a/b"));
+    free(c);
+    CHECK(cm_foam_decomposed_path("processor*/", &c) == 1 && c && !strcmp(c, "."));
+    free(c);
+    CHECK(cm_foam_decomposed_path("/processor*", &c) == 1 && c && !strcmp(c, "/"));
+    free(c);
+    CHECK(cm_foam_decomposed_path("a/processor*x", &c) == 0 && !c);
+    c = cm_foam_case_of("x/y/constant/polyMesh/");
+    CHECK(c && !strcmp(c, "x/y"));
+    free(c);
+    c = cm_foam_case_of("constant/polyMesh");
+    CHECK(c && !strcmp(c, "."));
+    free(c);
+    CHECK(cm_foam_case_of("x/polyMesh") == NULL && cm_foam_case_of("x/myconstant/polyMesh") == NULL);
+
+    char dir[2300], f[2600];
+    path(dir, sizeof dir, work, "foam_case_paths");
+    /* left by an earlier run: start empty */
+    const char *old[] = {"system/controlDict", "system", "constant/polyMesh", "constant", "processor0/constant/polyMesh",
+                         "processor0/constant", "processor0"};
+    for (int k = 0; k < 7; ++k) {
+        snprintf(f, sizeof f, "%s/%s", dir, old[k]);
+        remove(f);
+    }
+    snprintf(f, sizeof f, "%s/system", dir);
+    mkdir(dir, 0777);
+    mkdir(f, 0777);
+    CHECK(cm_foam_write_precision(dir) == 0);
+    snprintf(f, sizeof f, "%s/system/controlDict", dir);
+    const char *cd = "FoamFile { version 2.0; format ascii; class dictionary; object controlDict; }\n"
+                     "functions { probe { writePrecision 3; } }\n// writePrecision 4;\nwritePrecision   9 ;\n";
+    test_write_file(f, cd, strlen(cd));
+    CHECK(cm_foam_write_precision(dir) == 9);
+    snprintf(f, sizeof f, "%s/processor12", dir);
+    CHECK(cm_foam_write_precision(f) == 9); /* a piece read alone: the case's */
+    snprintf(f, sizeof f, "%s/xprocessor12", dir);
+    CHECK(cm_foam_write_precision(f) == 0);
+    /* processor0 alone: case/ reads the pieces; with constant/polyMesh too, the reconstructed one */
+    snprintf(f, sizeof f, "%s/processor0", dir);
+    mkdir(f, 0777);
+    snprintf(f, sizeof f, "%s/processor0/constant", dir);
+    mkdir(f, 0777);
+    snprintf(f, sizeof f, "%s/processor0/constant/polyMesh", dir);
+    mkdir(f, 0777);
+    CHECK(cm_foam_decomposed_path(dir, &c) == 1 && c && !strcmp(c, dir));
+    free(c);
+    snprintf(f, sizeof f, "%s/constant", dir);
+    mkdir(f, 0777);
+    snprintf(f, sizeof f, "%s/constant/polyMesh", dir);
+    mkdir(f, 0777);
+    CHECK(cm_foam_decomposed_path(dir, &c) == 0 && !c);
+    /* the pieces' addressing files missing: named in the message */
+    cm_mesh *m = NULL;
+    snprintf(f, sizeof f, "%s/processor*", dir);
+    cm_status s = cm_mesh_read(ctx, f, &m);
+    CHECK_MSG(s != CM_OK && strstr(cm_context_message(ctx), "processor0/constant/polyMesh"), "%s",
+              cm_context_message(ctx));
+    /* a converted mesh is not written as pieces */
+    m = hex_mesh(0, 0.25);
+    CHECK(cm_mesh_write(ctx, m, f, NULL) == CM_ERR_UNSUPPORTED);
+    struct stat st;
+    CHECK(stat(f, &st) != 0);
+    cm_mesh_destroy(&m);
+    snprintf(f, sizeof f, "%s/new/deeper", dir);
+    CHECK(cm_foam_nested(dir, f) && cm_foam_nested(f, dir) && cm_foam_nested(dir, dir));
+    snprintf(f, sizeof f, "%s_other", dir);
+    CHECK(!cm_foam_nested(dir, f));
+}
+
 int main(int argc, char **argv)
 {
     snprintf(work, sizeof work, "%s", argc > 2 ? argv[2] : ".");
@@ -592,6 +727,7 @@ int main(int argc, char **argv)
     volume_check();
     hostile_patch_names();
     zones();
+    case_paths();
 
     points_only("foam_hex", "foam_hex_morphed", 0);
     gzip_copy("foam_tet", "foam_tet_gz");
