@@ -312,7 +312,13 @@ cm_status cm_mesh_read_foam(cm_context *ctx, const char *path, cm_mesh **mesh)
         s = cm_foam_read_poly(ctx, dir, p);
         p->case_dir = cm_foam_case_of(dir);
     }
-    if (s == CM_OK && p->case_dir) p->write_precision = cm_foam_write_precision(p->case_dir);
+    /* OpenFOAM's mesh utilities (blockMesh, snappyHexMesh) write points at writePrecision but
+     * at least 10 digits: at 6, a wedge's points leave their plane by more than checkMesh's
+     * wedge check allows (docs/DESIGN.md, the OpenFOAM row of the format table) */
+    if (s == CM_OK && p->case_dir) {
+        const int wp = cm_foam_write_precision(p->case_dir);
+        p->write_precision = wp > 0 && wp < 10 ? 10 : wp;
+    }
     if (s == CM_OK) s = cm_foam_mesh_of_poly(ctx, p, decomposed ? case_dir : dir, mesh);
     else cm_foam_poly_release(&p);
     free(case_dir);

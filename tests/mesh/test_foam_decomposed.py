@@ -4,7 +4,7 @@
 (tests/helpers/foam_cases.py):
 
   * decomposePar (simple: 2 pieces, binary; 2 pieces cutting a cyclic pair, ASCII;
-    hierarchical: 4 pieces, ASCII at writePrecision 8)
+    hierarchical: 4 pieces, ASCII at writePrecision 12)
     writes pieces with empty zones ("cellLabels 0;" in binary, "0()" in ASCII); cadmorph
     reads `CASE/processor*` and, with no constant/polyMesh, `CASE/` as one mesh that is the
     undecomposed mesh: the same .msh byte for byte (points, cells, patches, zones) and
@@ -19,7 +19,7 @@
     processor* left out, points replaced; 5 simpleFoam steps run) and a new case inside the
     source is refused;
   * ASCII points at the case's writePrecision: an unmoved point's line unchanged, a moved
-    one at 8 significant digits.
+    one at 12 significant digits (the case says 12; below 10 it gets 10, as blockMesh writes points).
 Exit 77 (ctest SKIP) only when OpenFOAM's tools are not installed.
 usage: test_foam_decomposed.py CADMORPH WORKDIR"""
 import filecmp
@@ -206,12 +206,12 @@ def decomposed_round_trip(kind, n, method, binary, precision, split=None):
 
 
 # 1. binary, 2 pieces (simple); 2. the cyclic pair cut by the decomposition (processorCyclic
-# patches); 3. ASCII at writePrecision 8, 4 pieces (hierarchical)
+# patches); 3. ASCII at writePrecision 12, 4 pieces (hierarchical)
 decomposed_round_trip("channel2d", 2, "simple", True, None)
 decomposed_round_trip("cyclic", 2, "simple", False, None, "1 1 2")
 with open(os.path.join(WORK, "cyclic_src", "processor0", "constant", "polyMesh", "boundary")) as f:
     check("processorCyclic" in f.read(), "cyclic: the decomposition has no processorCyclic patch")
-src, und = decomposed_round_trip("symmetry3d", 4, "hierarchical", False, 8)
+src, und = decomposed_round_trip("symmetry3d", 4, "hierarchical", False, 12)
 
 # 3. -o newcase/ of an undecomposed case: the whole case (processor* left out)
 changed = ["constant/polyMesh/points"]
@@ -230,7 +230,7 @@ r = cadmorph("warp", "--mesh", src + "/", "--displacements", os.path.join(WORK, 
 check(r.returncode != 0 and "one inside the other" in r.stderr and not os.path.exists(src + "/inner"),
       "new case inside the source: exit %d, %s" % (r.returncode, r.stderr))
 
-# 4. ASCII points at writePrecision 8: unmoved lines unchanged, moved ones at 8 digits
+# 4. ASCII points at writePrecision 12: unmoved lines unchanged, moved ones at 12 digits
 a = open(os.path.join(src, "constant", "polyMesh", "points")).read().splitlines()
 b = open(os.path.join(und, "constant", "polyMesh", "points")).read().splitlines()
 pa, pb = fc.read_points(src), fc.read_points(und)
@@ -244,12 +244,12 @@ for la, lb in zip(a, b) if ok else []:
         continue
     moved += 1
     digits = max(len(re.sub(r"e.*|^-|\.", "", v).lstrip("0")) for v in m.groups()) if m else 99
-    ok &= m is not None and digits <= 8
+    ok &= m is not None and digits <= 12
 unmoved_pts = sum(1 for p, q in zip(pa, pb) if p == q)
 check(ok and moved > 0 and unmoved == unmoved_pts > 0,
-      "writePrecision 8: %d moved lines, %d unchanged lines for %d unmoved points; all moved at <= 8 "
+      "writePrecision 12: %d moved lines, %d unchanged lines for %d unmoved points; all moved at <= 12 "
       "digits: %s" % (moved, unmoved, unmoved_pts, ok))
-print("new case: every file copied, checkMesh OK, 5 simpleFoam steps; points: %d moved lines at 8 "
+print("new case: every file copied, checkMesh OK, 5 simpleFoam steps; points: %d moved lines at 12 "
       "digits, %d unchanged" % (moved, unmoved))
 
 if failures:
