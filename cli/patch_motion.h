@@ -36,12 +36,12 @@ void cli_patch_motion_options(const cli_patch_motion *pm, cm_motion_options *opt
 
 #define CLI_PATCH_MOTION_OPTIONS(pm)                                                           \
     {.name = "--slide", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_patch_list,  \
-     .dest = &(pm), .label = "--slide P,...",                                             \
-     .help = "these patches slide too (on their plane when flat,\n"                           \
-             "else on their initial surface by closest point)"},                               \
+     .dest = &(pm), .label = "--slide P,..",                                             \
+     .help = "comma list: these patches slide too (on their plane when\n"                           \
+             "flat, else on their initial surface by closest point)"},                               \
     {.name = "--fixed-patches", .kind = CLI_CUSTOM, .takes_value = 1,                          \
-     .parse = cli_parse_patch_list, .dest = &(pm), .label = "--fixed-patches P,...",      \
-     .help = "these patches are fixed even if their type slides"},                             \
+     .parse = cli_parse_patch_list, .dest = &(pm), .label = "--fixed-patches P",      \
+     .help = "comma list: these patches are fixed even if their type slides"},                             \
     {.name = "--no-slide", .kind = CLI_FLAG, .dest = &(pm).all_fixed, .label = "--no-slide",   \
      .help = "every unlisted boundary node fixed, no 2-D/wedge reduction\n"                   \
              "(the motion before patch kinds)"}

@@ -213,6 +213,11 @@ static cm_status slide_geometry(cm_context *ctx, cm_boundary_motion *m, const cm
         gsurf[g] = -1;
         if (role[g] != ROLE_SLIDE) continue;
         const cm_mesh_group *gr = &mesh->groups[g];
+        if (m->reduction == CM_MOTION_AXISYMMETRIC && gr->kind == CM_PATCH_WEDGE) {
+            /* the planes w = +-c of the slab (their faces at the axis touch w = 0) */
+            gn[3 * g] = gn[3 * g + 1] = 0, gn[3 * g + 2] = 1;
+            continue;
+        }
         double tol = (gr->kind == CM_PATCH_PLAIN ? FLAT_PLAIN : FLAT_TYPED) * m->diag;
         if (cm_motion_group_plane(mesh, X, gr->tag, tol, gn + 3 * g)) continue;
         cm_motion_surface *sf = NULL;

@@ -301,3 +301,49 @@ cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsig
     if (stats) *stats = st;
     return CM_OK;
 }
+
+cm_status cm_warp_correct(cm_context *ctx, const cm_mesh *mesh, const cm_boundary_motion *motion,
+                          double *disp, const cm_warp_options *opt)
+{
+    if (!mesh || !motion || !disp)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_correct: NULL input");
+    if (motion->n != mesh->n_nodes)
+        return cm_error(ctx, CM_ERR_MISMATCH, "cm_warp_correct: the motion has %zu nodes, the mesh %zu",
+                        motion->n, mesh->n_nodes);
+    size_t nn = mesh->n_nodes;
+    double *target = malloc(3 * (nn ? nn : 1) * sizeof *target);
+    double *corr = calloc(3 * (nn ? nn : 1), sizeof *corr);
+    unsigned char *held = calloc(nn ? nn : 1, 1);
+    cm_status s = target && corr && held ? CM_OK
+                                         : cm_error(ctx, CM_ERR_NOMEM, "cm_warp_correct: out of memory");
+    cm_status warn = CM_OK;
+    if (s >= 0) {
+        memcpy(target, disp, 3 * nn * sizeof *target);
+        s = cm_boundary_motion_project(ctx, motion, target);
+        if (s == CM_WARNING) warn = s;
+    }
+    size_t n_free = 0, changed = 0;
+    for (size_t i = 0; s >= 0 && i < nn; ++i) {
+        held[i] = motion->kind[i] != CM_MOTION_FREE;
+        n_free += !held[i];
+        for (int k = 0; held[i] && k < 3; ++k) {
+            corr[3 * i + k] = target[3 * i + k] - disp[3 * i + k];
+            changed += corr[3 * i + k] != 0;
+        }
+    }
+    if (s >= 0 && n_free && changed) {
+        cm_mesh_boundary *b = NULL;
+        cm_warp *w = NULL;
+        s = cm_mesh_boundary_create(ctx, mesh, &b);
+        if (s >= 0) s = cm_warp_create(ctx, mesh, b, held, opt, &w);
+        if (s >= 0) s = cm_warp_apply(ctx, w, corr);
+        cm_warp_destroy(&w);
+        cm_mesh_boundary_destroy(&b);
+    }
+    /* the held nodes exactly at their target, the free ones moved by the correction */
+    for (size_t i = 0; s >= 0 && i < nn; ++i)
+        for (int k = 0; k < 3; ++k)
+            disp[3 * i + k] = held[i] ? target[3 * i + k] : disp[3 * i + k] + corr[3 * i + k];
+    free(target), free(corr), free(held);
+    return s < 0 ? s : warn;
+}

@@ -172,6 +172,17 @@ CM_API cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp,
                               const cm_warp_options *opt, const cm_optimize_options *optimize,
                               double **sj, cm_warp_mesh_stats *stats);
 
+/* Makes a displacement field of every node (#nodes x 3, e.g. a space deformation's) hold a
+ * boundary motion (motion.h, created on this mesh): the fixed nodes get 0, the prescribed ones
+ * keep their value in disp (the caller puts the prescribed values there), the slide nodes are
+ * projected onto their constraints and 2-D/wedge pairs get one motion
+ * (cm_boundary_motion_project); what that changed at those nodes is carried into the free
+ * nodes by a warp (opt: NULL = rbf) held at them, so that the interior follows. No warp where
+ * no free node is in a volume cell or nothing changed. */
+CM_API cm_status cm_warp_correct(cm_context *ctx, const cm_mesh *mesh,
+                                 const cm_boundary_motion *motion, double *disp,
+                                 const cm_warp_options *opt);
+
 /* Reads a displacement table (the D.csv of `cadmorph warp`): header `node,dx,dy,dz`, then one
  * row per listed node; node is the 0-based index in the mesh file's node order. Blank lines
  * and a CRLF ending are accepted.
