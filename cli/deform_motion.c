@@ -15,6 +15,14 @@ cm_status cli_deform_motion_begin(cm_context *ctx, const cm_mesh *mesh, const cm
     cli_patch_motion_options(pm, &mo);
     cm_status s = cm_boundary_motion_create(ctx, mesh, b, con, &mo, &dm->motion);
     if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
+    /* nothing slides and no 2-D pair: the deformation as it always was (no correction) */
+    if (s >= 0 && cm_boundary_motion_reduction(dm->motion, NULL, NULL) == CM_MOTION_3D &&
+        !cm_boundary_motion_count(dm->motion, CM_MOTION_SLIDE_PLANE) &&
+        !cm_boundary_motion_count(dm->motion, CM_MOTION_SLIDE_LINE) &&
+        !cm_boundary_motion_count(dm->motion, CM_MOTION_SLIDE_SURFACE)) {
+        cli_deform_motion_free(dm);
+        return CM_OK;
+    }
     if (s >= 0) {
         s = cm_boundary_motion_project(ctx, dm->motion, disp);
         if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));

@@ -2,7 +2,8 @@
  * docs/DESIGN.md, "Boundary motion by patch kind"): sliding patches are not fixed, they follow
  * the deformation and are then projected onto their constraints, the interior corrected by a
  * warp of the correction (cm_warp_correct), so that fixed, handle and slide nodes hold
- * exactly; 2-D and wedge meshes get one in-plane motion per pair. */
+ * exactly; 2-D and wedge meshes get one in-plane motion per pair. A mesh where nothing slides
+ * deforms as it always did (no motion, no correction). */
 #ifndef CADMORPH_CLI_DEFORM_MOTION_H
 #define CADMORPH_CLI_DEFORM_MOTION_H
 

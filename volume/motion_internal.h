@@ -39,7 +39,13 @@ cm_status cm_motion_reduce(cm_context *ctx, cm_boundary_motion *m, const cm_mesh
                            const cm_mesh_boundary *b, const int *empty, int n_empty,
                            const int *wedge, int n_wedge, double flat_tol);
 
-/* Shared geometry (motion.c): a polygon's area normal (Newell); a unit vector with round-off
+/* Translational cyclic pairs (motion_reduce.c): two flat parallel cyclic patches whose nodes
+ * match across their normal; each node is paired with its image (partner), so that both
+ * sides of the pair get one motion. A mesh already reduced keeps its pairs. */
+cm_status cm_motion_pair_cyclic(cm_context *ctx, cm_boundary_motion *m, const cm_mesh *mesh,
+                                const int *cyclic, int n_cyclic, double flat_tol);
+
+/* Shared geometry (motion_geom.c): a polygon's area normal (Newell); a unit vector with round-off
  * components made 0; a group's aligned area-weighted normal, 1 if its faces lie in planes of
  * that normal to tol. */
 void cm_motion_face_normal(const double *xyz, const int64_t *nodes, int64_t k, double *n);

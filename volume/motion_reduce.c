@@ -283,6 +283,53 @@ cm_status cm_motion_reduce(cm_context *ctx, cm_boundary_motion *m, const cm_mesh
     return s;
 }
 
+cm_status cm_motion_pair_cyclic(cm_context *ctx, cm_boundary_motion *m, const cm_mesh *mesh,
+                                const int *cyclic, int n_cyclic, double flat_tol)
+{
+    size_t n = mesh->n_nodes;
+    if (n_cyclic < 2 || m->partner) return CM_OK;
+    signed char *side = calloc(n ? n : 1, 1);
+    unsigned char *on = calloc(n ? n : 1, 1);
+    double *q = malloc(3 * (n ? n : 1) * sizeof *q);
+    int64_t *partner = malloc((n ? n : 1) * sizeof *partner), *pair = malloc((n ? n : 1) * sizeof *pair);
+    cm_status s = side && on && q && partner && pair
+                      ? CM_OK
+                      : cm_error(ctx, CM_ERR_NOMEM, "cm_boundary_motion_create: out of memory");
+    for (size_t i = 0; s >= 0 && i < n; ++i)
+        partner[i] = -1;
+    size_t pairs = 0;
+    /* each two parallel flat cyclic patches whose nodes match along their normal: a
+     * translational pair, whose sides get one motion */
+    for (int a = 0; s >= 0 && a < n_cyclic; ++a)
+        for (int c = a + 1; s >= 0 && c < n_cyclic; ++c) {
+            double na[3], nc[3];
+            if (!cm_motion_group_plane(mesh, mesh->xyz, mesh->groups[cyclic[a]].tag, flat_tol, na) ||
+                !cm_motion_group_plane(mesh, mesh->xyz, mesh->groups[cyclic[c]].tag, flat_tol, nc) ||
+                fabs(dot(na, nc)) < 1 - 1e-9)
+                continue;
+            memset(on, 0, n);
+            mark_groups(mesh, cyclic + a, 1, on, 1);
+            mark_groups(mesh, cyclic + c, 1, on, 2);
+            int ok = 1;
+            for (size_t i = 0; i < n && ok; ++i) {
+                ok = on[i] != 3 && (on[i] == 0 || partner[i] < 0);
+                side[i] = on[i] == 1 ? 1 : on[i] == 2 ? -1 : 0;
+                double h = dot(mesh->xyz + 3 * i, na);
+                for (int k = 0; k < 3; ++k)
+                    q[3 * i + k] = mesh->xyz[3 * i + k] - h * na[k];
+            }
+            if (ok) s = pair_sides(ctx, n, q, side, flat_tol, pair, &ok);
+            for (size_t i = 0; s >= 0 && ok && i < n; ++i)
+                if (pair[i] >= 0) partner[i] = pair[i], ++pairs;
+        }
+    if (s >= 0 && pairs) {
+        m->partner = partner, partner = NULL;
+        cm_log(ctx, CM_LOG_DEBUG, "motion: %zu nodes of cyclic patches paired", pairs);
+    }
+    free(side), free(on), free(q), free(partner), free(pair);
+    return s;
+}
+
 double cm_motion_to_work(const cm_boundary_motion *m, const double *disp, double *work,
                          size_t *worst)
 {

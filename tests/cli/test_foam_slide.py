@@ -139,10 +139,15 @@ def verify(kind, src, out, motion, label, solve):
         check(all(p1[i][1] == p0[i][1] for i in sym), "%s: symmetry nodes keep y" % label)
         check(any(p1[i] != p0[i] for i in sym), "%s: symmetry nodes slide" % label)
     if kind == "cyclic":
-        zs = [p0[i][2] for i in fc.patch_points(src, "front")]
         for side in ("front", "back"):
             pts = fc.patch_points(src, side)
             check(all(p1[i][2] == p0[i][2] for i in pts), "%s: cyclic %s keeps z" % (label, side))
+        back = {p0[i][:2]: i for i in fc.patch_points(src, "back")}
+        pairs = [(i, back.get(p0[i][:2])) for i in fc.patch_points(src, "front")]
+        check(all(j is not None for _, j in pairs) and
+              all(p1[i][:2] == p1[j][:2] for i, j in pairs) and
+              any(p1[i] != p0[i] for i, _ in pairs),
+              "%s: the cyclic sides slide with one motion per pair" % label)
     cm = fc.checkmesh(out)
     check(cm["ok"], "%s: checkMesh Mesh OK%s" % (label, "" if cm["ok"] else
                                                  ":\n" + cm["text"][-1500:]))
