@@ -164,9 +164,10 @@ static cm_status slide_geometry(cm_context *ctx, cm_boundary_motion *m, const cm
         m->surfaces = grown;
         s = cm_motion_surface_create(ctx, mesh, X, gr->tag, &sf);
         if (s == CM_ERR_NOMEM) return s;
-        if (s < 0 || !sf) {
+        if (!sf && s >= 0) continue; /* no faces (a wedge's axis patch): nothing to move */
+        if (s < 0) {
             cm_log(ctx, CM_LOG_WARNING, "patch '%s' slides on no surface (%s): fixed",
-                   gr->name ? gr->name : "?", s < 0 ? cm_context_message(ctx) : "no faces");
+                   gr->name ? gr->name : "?", cm_context_message(ctx));
             role[g] = ROLE_FIXED, s = CM_OK, *warned = 1;
             continue;
         }
@@ -325,7 +326,8 @@ cm_status cm_boundary_motion_create(cm_context *ctx, const cm_mesh *mesh,
         return s;
     }
     *motion = m;
-    return warned ? CM_WARNING : CM_OK;
+    (void)warned; /* logged where it happened */
+    return CM_OK;
 }
 
 cm_motion_kind cm_boundary_motion_kind(const cm_boundary_motion *m, size_t node)

@@ -59,8 +59,8 @@ typedef struct cm_boundary_motion cm_boundary_motion;
 /* mesh, b (cm_mesh_boundary_create of mesh): borrowed for the call. prescribed: #nodes flags
  * (may be NULL: none), non-zero where the caller gives the displacement (boundary or
  * interior nodes). The kinds of the boundary nodes come from the 2-D cells carrying a
- * patch's physical tag; a boundary node on no patch face is fixed. Warnings (CM_WARNING, the
- * message says what): a slide patch that could not be used (it is fixed instead). */
+ * patch's physical tag; a boundary node on no patch face is fixed. A slide patch that could
+ * not be used (its surface could not be built) is fixed, with a CM_LOG_WARNING. */
 CM_API cm_status cm_boundary_motion_create(cm_context *ctx, const cm_mesh *mesh,
                                            const cm_mesh_boundary *b,
                                            const unsigned char *prescribed,
