@@ -3,6 +3,7 @@
  * space deformation of deform.h's table (triharmonic RBF, constrained MLS, shell, DM-FFD). */
 #include "cli.h"
 #include "deform_constraints.h"
+#include "deform_motion.h"
 
 #include "cadmorph/deform.h"
 
@@ -17,7 +18,8 @@ static const char *const usage_line =
     "cadmorph deform --mesh M --handles H.csv [--fixed F.csv | --fix-unlisted-boundary] "
     "[--method rbf|mls|dmffd|shell] -o M' [--stretch GS] [--bend GB] [--fix GF] [--samples K] "
     "[--cubature N] [--cover S] [--blend B] [--graded G] [--lattice N] [--clamp E] [--approximate-constraints] "
-    "[--constraint TYPE:SET ...] [--threads N] [--verbose]";
+    "[--constraint TYPE:SET ...] [--slide P,...] [--fixed-patches P,...] [--no-slide] "
+    "[--threads N] [--verbose]";
 
 typedef struct deform_args {
     const char *mesh, *handles, *fixed, *out;
@@ -25,6 +27,7 @@ typedef struct deform_args {
     double clamp;
     cm_mls_options mls;   /* stretch, bend, fix also weigh the shell */
     cli_constraints cons; /* --constraint and its options (deform_constraints.c) */
+    cli_patch_motion patches; /* --slide, --fixed-patches, --no-slide (deform_motion.c) */
 } deform_args;
 
 static deform_args args;
@@ -77,6 +80,7 @@ static const cli_option options[] = {
      .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--clamp E",
      .help = "dmffd: singular values <= E x the largest dropped\n(default 1e-10)"},
     CLI_CONSTRAINT_OPTIONS(args.cons),
+    CLI_PATCH_MOTION_OPTIONS(args.patches),
     {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
      .label = "-o, --output M'", .help = "output mesh (must not be an input)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
@@ -97,8 +101,9 @@ static int print_help(void)
         "Laplacian) and a mean-curvature summary, volume meshes the quality summary line.\n\n"
         "H.csv: header node,dx,dy,dz (0-based node index in M's file order).\n"
         "F.csv: header node, then one node index per line.\n\n"
+        "--fix-unlisted-boundary of a volume mesh: %s\n"
         "options:\n",
-        cm_mesh_format_list());
+        cm_mesh_format_list(), CLI_PATCH_MOTION_DEFAULTS);
     cli_print_options(stdout, options, 26);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input.\n");
     return CLI_EXIT_OK;
@@ -171,6 +176,9 @@ int cli_cmd_deform(int argc, char **argv)
                 border[b->nodes[i]] = 1;
         }
     }
+    cli_deform_motion dm = {0}; /* sliding patches are not fixed (deform_motion.c) */
+    if (s >= 0 && volume && a.fix_boundary)
+        s = cli_deform_motion_begin(ctx, mesh, b, &a.patches, disp, con, border, &dm);
     size_t nh = 0, nf = 0;
     for (size_t i = 0; s >= 0 && i < n; ++i) {
         if (con[i] && fixed[i]) {
@@ -224,6 +232,8 @@ int cli_cmd_deform(int argc, char **argv)
                st.lattice, st.dmffd.handles, st.dmffd.active, st.control_points, st.dmffd.rank,
                st.dmffd.clamped);
     cm_deform_destroy(&def);
+    if (s >= 0) s = cli_deform_motion_end(ctx, mesh, &dm, disp);
+    cli_deform_motion_free(&dm);
     double t1 = cm_wtime();
     /* volume meshes get the quality; surfaces their mean curvature, below */
     if (s >= 0)

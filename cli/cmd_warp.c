@@ -2,6 +2,7 @@
  * displacements given in a CSV table, writes the moved mesh and reports its quality. */
 #include "cli.h"
 #include "options.h"
+#include "patch_motion.h"
 
 #include "cadmorph/warp.h"
 
@@ -13,7 +14,7 @@
 static const char *const usage_line =
     "cadmorph warp --mesh M0 --displacements D.csv -o M1 [--method M] "
     "[--solver S] [--rbf-tol T] [--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS "
-    "--bend GB --blend B] [--optimize] "
+    "--bend GB --blend B] [--optimize] [--slide P,...] [--fixed-patches P,...] [--no-slide] "
     "[--threads N] [--verbose]";
 
 typedef struct warp_args {
@@ -23,6 +24,7 @@ typedef struct warp_args {
     double tolerance;
     double clamp;
     cm_mls_options mls;
+    cli_patch_motion patches;
 } warp_args;
 
 static warp_args args;
@@ -61,6 +63,7 @@ static const cli_option options[] = {
      .help = "dmffd: singular values <= E x the largest are dropped\n"
              "(default 1e-10; 1e-2 keeps coarse lattices usable)"},
     CLI_MLS_OPTIONS(args.mls),
+    CLI_PATCH_MOTION_OPTIONS(args.patches),
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
      .help = "threads for evaluation and quality (default: all)"},
     {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
@@ -78,10 +81,11 @@ static int print_help(void)
         "with per-node 'displacement' and per-cell\n"
         "'scaled_jacobian', then prints the quality summary line.\n\n"
         "D.csv: header node,dx,dy,dz; node is the 0-based index of the node in M0's file order.\n"
-        "  Boundary nodes that are not listed stay where they are;\n"
+        "  Boundary nodes that are not listed stay where they are, or slide (below);\n"
         "  listed interior nodes are pinned to their displacement.\n\n"
+        "%s\n"
         "options:\n",
-        cm_mesh_format_list());
+        cm_mesh_format_list(), CLI_PATCH_MOTION_DEFAULTS);
     cli_print_options(stdout, options, 21);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed file, degenerate boundary).\n");
     return CLI_EXIT_OK;
@@ -105,6 +109,35 @@ static int parse_args(int argc, char **argv, warp_args *a)
     if (cli_check_solver(cmd, usage_line, a->solver) >= 0) return CLI_EXIT_USAGE;
     const char *inputs[] = {a->mesh, a->csv};
     return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 2) ? CLI_EXIT_USAGE : -1;
+}
+
+/* The boundary motion of the mesh with the listed nodes prescribed (a warning is shown and
+ * the warp goes on). */
+static cm_status warp_motion_create(cm_context *ctx, const cm_mesh *mesh,
+                                    const unsigned char *listed, const cli_patch_motion *pm,
+                                    cm_boundary_motion **motion)
+{
+    cm_mesh_boundary *b = NULL;
+    cm_motion_options mo;
+    cli_patch_motion_options(pm, &mo);
+    cm_status s = cm_mesh_boundary_create(ctx, mesh, &b);
+    if (s >= 0) s = cm_boundary_motion_create(ctx, mesh, b, listed, &mo, motion);
+    if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
+    cm_mesh_boundary_destroy(&b);
+    if (s >= 0 && *motion) {
+        double axis[6], angle;
+        cm_motion_reduction r = cm_boundary_motion_reduction(*motion, axis, &angle);
+        cm_log(ctx, CM_LOG_DEBUG,
+               "warp: boundary motion: %zu fixed, %zu prescribed, %zu sliding on planes, %zu on "
+               "lines, %zu on surfaces%s",
+               cm_boundary_motion_count(*motion, CM_MOTION_FIXED),
+               cm_boundary_motion_count(*motion, CM_MOTION_PRESCRIBED),
+               cm_boundary_motion_count(*motion, CM_MOTION_SLIDE_PLANE),
+               cm_boundary_motion_count(*motion, CM_MOTION_SLIDE_LINE),
+               cm_boundary_motion_count(*motion, CM_MOTION_SLIDE_SURFACE),
+               r == CM_MOTION_2D ? "; a 2-D mesh" : r == CM_MOTION_AXISYMMETRIC ? "; a wedge" : "");
+    }
+    return s < 0 ? s : CM_OK;
 }
 
 int cli_cmd_warp(int argc, char **argv)
@@ -134,12 +167,15 @@ int cli_cmd_warp(int argc, char **argv)
     opt.clamp = a.clamp;
     opt.mls = a.mls;
     cm_warp_mesh_stats st;
+    cm_boundary_motion *motion = NULL;
+    if (s >= 0) s = warp_motion_create(ctx, mesh, listed, &a.patches, &motion);
     if (s >= 0) {
         cm_optimize_options oo;
         cm_optimize_options_init(&oo);
-        s = cm_warp_mesh(ctx, mesh, disp, listed, &opt, a.optimize ? &oo : NULL, &sj, &st);
+        s = cm_warp_mesh(ctx, mesh, disp, listed, motion, &opt, a.optimize ? &oo : NULL, &sj, &st);
         if (s < 0) s = cm_error_prefix(ctx, s, "%s", a.mesh);
     }
+    cm_boundary_motion_destroy(&motion);
     if (s >= 0)
         cm_log(ctx, CM_LOG_DEBUG,
                "warp: %s, %zu nodes, %zu boundary nodes, %zu components: create %.3f s, "

@@ -816,6 +816,44 @@ cm_surface_set *set;
 cm_status cm_surface_cad_sets(cm_context *ctx, const cm_cad_model *g, const cm_mesh *mesh,
 const cm_surface_set_filter *filter, cm_surface_sets **sets);
 void cm_surface_sets_destroy(cm_surface_sets **sets);
+typedef enum cm_motion_kind {
+CM_MOTION_FREE = 0,
+CM_MOTION_FIXED = 1,
+CM_MOTION_PRESCRIBED = 2,
+CM_MOTION_SLIDE_PLANE = 3,
+CM_MOTION_SLIDE_LINE = 4,
+CM_MOTION_SLIDE_SURFACE = 5,
+CM_MOTION_N_KINDS
+} cm_motion_kind;
+const char *cm_motion_kind_name(cm_motion_kind kind);
+typedef enum cm_motion_reduction {
+CM_MOTION_3D = 0,
+CM_MOTION_2D = 1,
+CM_MOTION_AXISYMMETRIC = 2,
+} cm_motion_reduction;
+typedef struct cm_motion_options {
+const char *const *slide;
+size_t n_slide;
+const char *const *fixed;
+size_t n_fixed;
+int all_fixed;
+int no_reduction;
+} cm_motion_options;
+void cm_motion_options_init(cm_motion_options *opt);
+typedef struct cm_boundary_motion cm_boundary_motion;
+cm_status cm_boundary_motion_create(cm_context *ctx, const cm_mesh *mesh,
+const cm_mesh_boundary *b,
+const unsigned char *prescribed,
+const cm_motion_options *opt,
+cm_boundary_motion **motion);
+void cm_boundary_motion_destroy(cm_boundary_motion **motion);
+cm_motion_kind cm_boundary_motion_kind(const cm_boundary_motion *motion, size_t node);
+size_t cm_boundary_motion_count(const cm_boundary_motion *motion, cm_motion_kind kind);
+cm_motion_reduction cm_boundary_motion_reduction(const cm_boundary_motion *motion,
+double *axis, double *angle);
+int64_t cm_boundary_motion_partner(const cm_boundary_motion *motion, size_t node);
+cm_status cm_boundary_motion_project(cm_context *ctx, const cm_boundary_motion *motion,
+double *disp);
 typedef enum cm_warp_method {
 CM_WARP_RBF = 0,
 CM_WARP_RBF_BIHARMONIC = 1,
@@ -857,10 +895,15 @@ double t_create, t_apply, t_optimize;
 double residual;
 size_t optimized_moves;
 size_t fallback_nodes;
+size_t slide_nodes;
 } cm_warp_mesh_stats;
-cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
+cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp,
+const unsigned char *listed, const cm_boundary_motion *motion,
 const cm_warp_options *opt, const cm_optimize_options *optimize,
 double **sj, cm_warp_mesh_stats *stats);
+cm_status cm_warp_correct(cm_context *ctx, const cm_mesh *mesh,
+const cm_boundary_motion *motion, double *disp,
+const cm_warp_options *opt);
 cm_status cm_warp_read_displacements(cm_context *ctx, const char *path, size_t n_nodes,
 double *disp, unsigned char *listed);
 typedef struct cm_morph_method {

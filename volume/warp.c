@@ -1,7 +1,9 @@
 /* The warp interface (warp.h): the method table, argument checks every method shares, and
  * the whole-mesh warp behind `cadmorph warp`. */
+#include "motion_internal.h"
 #include "warp_method.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -171,16 +173,84 @@ size_t cm_warp_fallback_nodes(const cm_warp *warp)
     return warp && warp->ops->fallback_nodes ? warp->ops->fallback_nodes(warp->state) : 0;
 }
 
+/* One create + apply with the given constrained nodes; times and residual into st. */
+static cm_status warp_once(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
+                           const unsigned char *constrained, const cm_warp_options *opt,
+                           double *disp, cm_warp_mesh_stats *st)
+{
+    cm_warp *w = NULL;
+    double t0 = cm_wtime();
+    cm_status s = cm_warp_create(ctx, mesh, b, constrained, opt, &w);
+    double t1 = cm_wtime();
+    if (s >= 0) s = cm_warp_apply(ctx, w, disp);
+    st->t_create += t1 - t0;
+    st->t_apply += cm_wtime() - t1;
+    st->residual = fmax(st->residual, cm_warp_residual(w));
+    st->fallback_nodes += cm_warp_fallback_nodes(w);
+    cm_warp_destroy(&w);
+    return s;
+}
+
+/* The warp under a boundary motion (docs/DESIGN.md, "Boundary motion by patch kind"), in its
+ * work space (a wedge: the slab): pass 1 with the slide nodes free, their motion projected
+ * onto their constraints (and a 2-D pair given one motion), pass 2 with them held there so
+ * that the interior follows (skipped where no node is free). constrained: out, the nodes held
+ * by the last pass. */
+static cm_status warp_motion(cm_context *ctx, cm_mesh *mesh, const cm_mesh_boundary *b,
+                             const cm_boundary_motion *motion, const cm_warp_options *opt,
+                             double *disp, unsigned char *constrained, cm_warp_mesh_stats *st)
+{
+    size_t nn = mesh->n_nodes, worst0 = 0, worst1 = 0;
+    double *work = malloc(3 * (nn ? nn : 1) * sizeof *work), dropped1 = 0;
+    if (!work) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_mesh: out of memory");
+    double dropped0 = cm_motion_to_work(motion, disp, work, &worst0);
+    cm_motion_project_work(motion, work, &dropped1, &worst1);
+    if (fmax(dropped0, dropped1) > 1e-12 * motion->diag)
+        cm_log(ctx, CM_LOG_WARNING,
+               "%s mesh: the prescribed motion out of its plane is dropped (largest %.3g, at "
+               "node %zu)",
+               motion->reduction == CM_MOTION_2D ? "2-D" : "axisymmetric",
+               fmax(dropped0, dropped1), dropped0 >= dropped1 ? worst0 : worst1);
+    size_t slides = 0, free_nodes = 0;
+    for (size_t i = 0; i < nn; ++i) {
+        cm_motion_kind k = (cm_motion_kind)motion->kind[i];
+        constrained[i] = k == CM_MOTION_FIXED || k == CM_MOTION_PRESCRIBED;
+        slides += k >= CM_MOTION_SLIDE_PLANE;
+        free_nodes += k == CM_MOTION_FREE;
+    }
+    double *xyz = mesh->xyz;
+    if (motion->slab) mesh->xyz = motion->slab; /* the warp sees the slab */
+    cm_status s = warp_once(ctx, mesh, b, constrained, opt, work, st);
+    if (s >= 0 && slides) {
+        cm_motion_project_work(motion, work, &dropped1, &worst1);
+        if (free_nodes) {
+            for (size_t i = 0; i < nn; ++i)
+                constrained[i] = motion->kind[i] != CM_MOTION_FREE;
+            s = warp_once(ctx, mesh, b, constrained, opt, work, st);
+        } else
+            for (size_t i = 0; i < nn; ++i)
+                constrained[i] = motion->kind[i] != CM_MOTION_FREE;
+    }
+    mesh->xyz = xyz;
+    if (s >= 0) cm_motion_from_work(motion, work, disp);
+    st->slide_nodes = slides;
+    free(work);
+    return s;
+}
+
 cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
-                       const cm_warp_options *opt, const cm_optimize_options *optimize,
-                       double **sj, cm_warp_mesh_stats *stats)
+                       const cm_boundary_motion *motion, const cm_warp_options *opt,
+                       const cm_optimize_options *optimize, double **sj,
+                       cm_warp_mesh_stats *stats)
 {
     if (sj) *sj = NULL;
     if (!mesh || !disp) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_mesh: NULL input");
+    if (motion && motion->n != mesh->n_nodes)
+        return cm_error(ctx, CM_ERR_MISMATCH, "cm_warp_mesh: the motion has %zu nodes, the mesh %zu",
+                        motion->n, mesh->n_nodes);
     cm_warp_mesh_stats st;
     memset(&st, 0, sizeof st);
     cm_mesh_boundary *b = NULL;
-    cm_warp *w = NULL;
     size_t nn = mesh->n_nodes;
     unsigned char *constrained = calloc(nn ? nn : 1, 1);
     if (!constrained) return cm_error(ctx, CM_ERR_NOMEM, "cm_warp_mesh: out of memory");
@@ -188,23 +258,19 @@ cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsig
     /* a boundary warning (non-manifold faces) is worth showing, and the warp goes on */
     if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
     if (s >= 0) {
-        if (listed) memcpy(constrained, listed, nn);
-        for (size_t i = 0; i < b->n_nodes; ++i)
-            constrained[b->nodes[i]] = 1;
         st.boundary_nodes = b->n_nodes;
         st.components = b->n_components;
+        if (motion) {
+            s = warp_motion(ctx, mesh, b, motion, opt, disp, constrained, &st);
+        } else {
+            if (listed) memcpy(constrained, listed, nn);
+            for (size_t i = 0; i < b->n_nodes; ++i)
+                constrained[b->nodes[i]] = 1;
+            s = warp_once(ctx, mesh, b, constrained, opt, disp, &st);
+        }
         for (size_t i = 0; i < nn; ++i)
             st.constrained_nodes += constrained[i] != 0;
-        double t0 = cm_wtime();
-        s = cm_warp_create(ctx, mesh, b, constrained, opt, &w);
-        double t1 = cm_wtime();
-        if (s >= 0) s = cm_warp_apply(ctx, w, disp);
-        st.t_create = t1 - t0;
-        st.t_apply = cm_wtime() - t1;
-        st.residual = cm_warp_residual(w);
-        st.fallback_nodes = cm_warp_fallback_nodes(w);
     }
-    cm_warp_destroy(&w);
     cm_mesh_boundary_destroy(&b);
     double *q = NULL;
     if (s >= 0) {
@@ -234,4 +300,50 @@ cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsig
     if (sj) *sj = q;
     if (stats) *stats = st;
     return CM_OK;
+}
+
+cm_status cm_warp_correct(cm_context *ctx, const cm_mesh *mesh, const cm_boundary_motion *motion,
+                          double *disp, const cm_warp_options *opt)
+{
+    if (!mesh || !motion || !disp)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_warp_correct: NULL input");
+    if (motion->n != mesh->n_nodes)
+        return cm_error(ctx, CM_ERR_MISMATCH, "cm_warp_correct: the motion has %zu nodes, the mesh %zu",
+                        motion->n, mesh->n_nodes);
+    size_t nn = mesh->n_nodes;
+    double *target = malloc(3 * (nn ? nn : 1) * sizeof *target);
+    double *corr = calloc(3 * (nn ? nn : 1), sizeof *corr);
+    unsigned char *held = calloc(nn ? nn : 1, 1);
+    cm_status s = target && corr && held ? CM_OK
+                                         : cm_error(ctx, CM_ERR_NOMEM, "cm_warp_correct: out of memory");
+    cm_status warn = CM_OK;
+    if (s >= 0) {
+        memcpy(target, disp, 3 * nn * sizeof *target);
+        s = cm_boundary_motion_project(ctx, motion, target);
+        if (s == CM_WARNING) warn = s;
+    }
+    size_t n_free = 0, changed = 0;
+    for (size_t i = 0; s >= 0 && i < nn; ++i) {
+        held[i] = motion->kind[i] != CM_MOTION_FREE;
+        n_free += !held[i];
+        for (int k = 0; held[i] && k < 3; ++k) {
+            corr[3 * i + k] = target[3 * i + k] - disp[3 * i + k];
+            changed += corr[3 * i + k] != 0;
+        }
+    }
+    if (s >= 0 && n_free && changed) {
+        cm_mesh_boundary *b = NULL;
+        cm_warp *w = NULL;
+        s = cm_mesh_boundary_create(ctx, mesh, &b);
+        if (s >= 0) s = cm_warp_create(ctx, mesh, b, held, opt, &w);
+        if (s >= 0) s = cm_warp_apply(ctx, w, corr);
+        cm_warp_destroy(&w);
+        cm_mesh_boundary_destroy(&b);
+    }
+    /* the held nodes exactly at their target, the free ones moved by the correction */
+    for (size_t i = 0; s >= 0 && i < nn; ++i)
+        for (int k = 0; k < 3; ++k)
+            disp[3 * i + k] = held[i] ? target[3 * i + k] : disp[3 * i + k] + corr[3 * i + k];
+    free(target), free(corr), free(held);
+    return s < 0 ? s : warn;
 }

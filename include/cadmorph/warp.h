@@ -17,6 +17,7 @@
 
 #include "cadmorph/mesh.h"
 #include "cadmorph/mls.h"
+#include "cadmorph/motion.h"
 #include "cadmorph/optimize.h"
 #include "cadmorph/rbf.h"
 
@@ -147,19 +148,40 @@ typedef struct cm_warp_mesh_stats {
     double t_create, t_apply, t_optimize; /* seconds */
     double residual;                      /* cm_warp_residual */
     size_t optimized_moves;               /* node moves kept by the optimisation */
-    size_t fallback_nodes;                /* cm_warp_fallback_nodes */
+    size_t fallback_nodes;                /* cm_warp_fallback_nodes (summed over passes) */
+    size_t slide_nodes;                   /* nodes that slid (motion.h) */
 } cm_warp_mesh_stats;
 
 /* Moves mesh by disp (#nodes x 3; read at the boundary nodes and at listed nodes, the rest
- * computed by the warp): the boundary nodes and the listed ones (listed: #nodes flags, may be
- * NULL) are constrained. On return mesh->xyz is moved, and the mesh carries a per-node
- * "displacement" and a per-cell "scaled_jacobian" field (sj, may be NULL: that field's data).
- * disp is overwritten with the displacement of every node. optimize: NULL, or the options
- * of an interior optimisation of the warped mesh (constrained nodes never move). stats may
- * be NULL. */
-CM_API cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp, const unsigned char *listed,
-                       const cm_warp_options *opt, const cm_optimize_options *optimize,
-                       double **sj, cm_warp_mesh_stats *stats);
+ * computed by the warp).
+ * motion NULL: the boundary nodes and the listed ones (listed: #nodes flags, may be NULL) are
+ * constrained to disp.
+ * motion (motion.h, created on this mesh with its prescribed flags; listed is then ignored):
+ * fixed nodes stay, prescribed ones move by disp, slide nodes slide (a first warp with them
+ * free, its motion projected onto their constraints, a second warp with them held there:
+ * skipped where no node is free), 2-D pairs get one motion; a wedge is warped in its slab
+ * (r, z, w) and mapped back (docs/DESIGN.md, "Boundary motion by patch kind"). Without
+ * slides, the same warp as motion NULL with the fixed nodes' disp 0.
+ * On return mesh->xyz is moved, and the mesh carries a per-node "displacement" and a
+ * per-cell "scaled_jacobian" field (sj, may be NULL: that field's data). disp is overwritten
+ * with the displacement of every node. optimize: NULL, or the options of an interior
+ * optimisation of the warped mesh (constrained and slide nodes never move). stats may be
+ * NULL. */
+CM_API cm_status cm_warp_mesh(cm_context *ctx, cm_mesh *mesh, double *disp,
+                              const unsigned char *listed, const cm_boundary_motion *motion,
+                              const cm_warp_options *opt, const cm_optimize_options *optimize,
+                              double **sj, cm_warp_mesh_stats *stats);
+
+/* Makes a displacement field of every node (#nodes x 3, e.g. a space deformation's) hold a
+ * boundary motion (motion.h, created on this mesh): the fixed nodes get 0, the prescribed ones
+ * keep their value in disp (the caller puts the prescribed values there), the slide nodes are
+ * projected onto their constraints and 2-D/wedge pairs get one motion
+ * (cm_boundary_motion_project); what that changed at those nodes is carried into the free
+ * nodes by a warp (opt: NULL = rbf) held at them, so that the interior follows. No warp where
+ * no free node is in a volume cell or nothing changed. */
+CM_API cm_status cm_warp_correct(cm_context *ctx, const cm_mesh *mesh,
+                                 const cm_boundary_motion *motion, double *disp,
+                                 const cm_warp_options *opt);
 
 /* Reads a displacement table (the D.csv of `cadmorph warp`): header `node,dx,dy,dz`, then one
  * row per listed node; node is the 0-based index in the mesh file's node order. Blank lines

@@ -97,7 +97,7 @@ static void check_zero(const cm_mesh *m0, cm_warp_method method, const char *wha
     cm_warp_options wo;
     cm_warp_options_init(&wo);
     wo.method = method;
-    cm_status s = cm_warp_mesh(ctx, m, d, NULL, &wo, NULL, NULL, NULL);
+    cm_status s = cm_warp_mesh(ctx, m, d, NULL, NULL, &wo, NULL, NULL, NULL);
     CHECK_MSG(s == CM_OK, "%s %s: %s", what, cm_warp_method_name(method), cm_context_message(ctx));
     CHECK_MSG(s == CM_OK && !memcmp(m->xyz, m0->xyz, 3 * m->n_nodes * sizeof *m->xyz),
               "%s %s: zero motion moved a node", what, cm_warp_method_name(method));

@@ -41,3 +41,6 @@ cm_add_unit_test(test_warp_interrupt test_warp_interrupt.c LIBS cm_volume cm_stu
 # the bore's O-grid (cm_hexmesh_bore: study/) and the mixed mesh of warp_staten.py setup
 cm_add_unit_test(test_warp_transpose test_warp_transpose.c LIBS cm_volume cm_study LABELS volume)
 set_tests_properties(test_warp_transpose PROPERTIES FIXTURES_REQUIRED warp_staten)
+# Boundary motion by patch kind (motion.h): kinds, lines, 2-D and wedge recognition, the
+# projection, cm_warp_mesh under a motion, and the same bits as before without slides.
+cm_add_unit_test(test_motion test_motion.c LIBS cm_volume)
