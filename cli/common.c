@@ -152,6 +152,32 @@ int cli_same_file(const char *a, const char *b)
     return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
+/* The case directory an OpenFOAM path names: "X/", "X/constant/polyMesh" and the pieces
+ * "X/processor*" all name X. 0, or -1 if it does not fit. */
+static int foam_case_root(const char *path, char *out, size_t cap)
+{
+    size_t len = strlen(path);
+    if (len >= cap) return -1;
+    memcpy(out, path, len + 1);
+    static const char *const tails[] = {"/", "/processor*", "/polyMesh", "/constant"};
+    for (int t = 0; t < 4; ++t) {
+        const size_t k = strlen(tails[t]);
+        while (len > k && memcmp(out + len - k, tails[t], k) == 0)
+            out[len -= k] = '\0';
+    }
+    return 0;
+}
+
+/* 1 when out and in name the same OpenFOAM case: writing there replaces its points in place,
+ * the way OpenFOAM's own moveMesh does (docs/DESIGN.md, "Command line contract"). */
+static int same_foam_case(const char *out, const char *in)
+{
+    char a[4096], b[4096];
+    return cm_mesh_format_from_path(out) == CM_FORMAT_FOAM &&
+           cm_mesh_format_from_path(in) == CM_FORMAT_FOAM && foam_case_root(out, a, sizeof a) == 0 &&
+           foam_case_root(in, b, sizeof b) == 0 && cli_same_file(a, b);
+}
+
 int cli_check_mesh_output(const char *cmd, const char *usage, const char *out,
                           const char *const *inputs, size_t n)
 {
@@ -159,7 +185,7 @@ int cli_check_mesh_output(const char *cmd, const char *usage, const char *out,
         return cli_usage(cmd, usage, "%s: unknown mesh extension (%s)", out,
                          cm_mesh_format_list());
     for (size_t k = 0; k < n; ++k)
-        if (inputs[k] && cli_same_file(out, inputs[k]))
+        if (inputs[k] && !same_foam_case(out, inputs[k]) && cli_same_file(out, inputs[k]))
             return cli_usage(cmd, usage, "output %s is an input: refusing to overwrite it", out);
     return 0;
 }

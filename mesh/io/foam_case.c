@@ -221,7 +221,7 @@ int cm_foam_nested(const char *a, const char *b)
     return m == 1 || longer[m] == '/'; /* "/" holds everything */
 }
 
-static cm_status copy_one(cm_context *ctx, const char *src, const char *dst)
+cm_status cm_foam_copy_file(cm_context *ctx, const char *src, const char *dst)
 {
     FILE *in = fopen(src, "rb");
     if (!in) return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot open: %s", src, strerror(errno));
@@ -272,7 +272,7 @@ static cm_status copy_rec(cm_context *ctx, const char *src, const char *dst, cha
         snprintf(dp, sizeof dp, "%s/%s", dst, rel);
         if (!(skip && skip(rel, arg)) && stat(sp, &st) == 0) {
             if (S_ISDIR(st.st_mode)) s = copy_rec(ctx, src, dst, rel, nrl, skip, arg);
-            else if (S_ISREG(st.st_mode)) s = copy_one(ctx, sp, dp);
+            else if (S_ISREG(st.st_mode)) s = cm_foam_copy_file(ctx, sp, dp);
         }
         rel[rl] = '\0';
     }

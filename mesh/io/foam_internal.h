@@ -77,6 +77,8 @@ char *cm_foam_case_of(const char *polymesh_dir);
 /* system/controlDict's writePrecision of a case (of a piece "X/processorN" read alone: X's),
  * 0 if none is found. */
 int cm_foam_write_precision(const char *case_dir);
+/* Copies the file src to dst through a temporary and a rename. */
+cm_status cm_foam_copy_file(cm_context *ctx, const char *src, const char *dst);
 /* Copies every regular file under src to dst (same layout, each through a temporary and a
  * rename), skipping the relative paths for which skip() returns 1. */
 cm_status cm_foam_copy_tree(cm_context *ctx, const char *src, const char *dst,

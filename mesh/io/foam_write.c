@@ -95,24 +95,7 @@ static cm_status copy_file(cm_context *ctx, const char *src_dir, const char *dst
     char src[4200], dst[4200];
     if (cm_foam_join(src, sizeof src, src_dir, name, NULL) || cm_foam_join(dst, sizeof dst, dst_dir, name, NULL))
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: %s: path too long", dst_dir);
-    FILE *in = fopen(src, "rb");
-    if (!in) return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot open: %s", src, strerror(errno));
-    cm_outfile out;
-    cm_status s = cm_outfile_open(ctx, dst, &out);
-    if (s != CM_OK) {
-        fclose(in);
-        return s;
-    }
-    char chunk[1 << 16];
-    size_t got;
-    while ((got = fread(chunk, 1, sizeof chunk, in)) > 0) fwrite(chunk, 1, got, out.f);
-    int err = ferror(in);
-    fclose(in);
-    if (err) {
-        cm_outfile_abort(&out);
-        return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: read error", src);
-    }
-    s = cm_outfile_commit(ctx, &out);
+    cm_status s = cm_foam_copy_file(ctx, src, dst);
     if (s == CM_OK) {
         /* a copied "faces" must not sit beside an old "faces.gz" (and the reverse) */
         size_t l = strlen(dst);

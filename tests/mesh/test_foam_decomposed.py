@@ -252,6 +252,19 @@ check(ok and moved > 0 and unmoved == unmoved_pts > 0,
 print("new case: every file copied, checkMesh OK, 5 simpleFoam steps; points: %d moved lines at 12 "
       "digits, %d unchanged" % (moved, unmoved))
 
+# the case named as input and output (`--mesh case/ -o case/`): its points replaced in place, as
+# moveMesh does, every other file unchanged (another format's same-file output stays refused:
+# tests/cli/warp.cmake)
+whole = os.path.join(WORK, "whole_in_place")
+shutil.rmtree(whole, ignore_errors=True)
+shutil.copytree(src, whole)
+with open(os.path.join(WORK, "one_node.csv"), "w") as f:
+    f.write("node,dx,dy,dz\n0,0,0,0.001\n")
+r = cadmorph("warp", "--mesh", whole + "/", "--displacements", os.path.join(WORK, "one_node.csv"),
+             "-o", whole + "/")
+check(r.returncode == 0, "case/ onto itself: exit %d, %s" % (r.returncode, r.stderr))
+same_tree(src, whole, ["constant/polyMesh/points"], "case/ onto itself")
+
 if failures:
     print("%d failures" % len(failures))
     sys.exit(1)
