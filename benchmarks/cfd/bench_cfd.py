@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """CFD morphs as a CFD user runs them, judged by OpenFOAM itself: the four blockMesh cases
 of tests/helpers/foam_cases.py (2-D channel, axisymmetric wedge, half tunnel with a symmetry
-plane, cyclic channel) at a realistic resolution and a snappyHexMesh case (snappy_case.py),
+plane, cyclic channel) at a realistic resolution and foam_cases.py's snappyHexMesh case (a sphere),
 the body moved (2-D: a translation and a rotation; wedge: a radial scale; the 3-D cases: a
 translation), each by
     cadmorph warp   --mesh CASE --displacements D.csv -o OUT/
@@ -33,7 +33,6 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "tests", "helpers"))
 sys.path.insert(0, HERE)
 import foam_cases as fc  # noqa: E402
 import numpy as np  # noqa: E402  (Debian python3-numpy)
-from snappy_case import make_snappy_case  # noqa: E402
 
 # case: (kind, foam_cases scale or snappy base, [(motion name, function of a point -> target)])
 SIN, COS = math.sin(math.radians(5)), math.cos(math.radians(5))
@@ -183,7 +182,7 @@ def main():
         case = os.path.join(a.work, name)
         t = time.time()
         if kind == "snappy":
-            make_snappy_case(case, max(4, int(round(size * a.size ** (1 / 3)))))
+            fc.make_snappy_case(case, body="sphere", base=max(4, int(round(size * a.size ** (1 / 3)))))
         else:
             fc.make_case(kind, case, scale=size * a.size)
         src = fc.checkmesh(case)

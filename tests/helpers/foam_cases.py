@@ -23,6 +23,10 @@ Geometry (BODY_BOX holds the body's bounding box of each kind):
 Zones (zones=True): cellZone `wake` (the cells behind the body, x > 2.5), faceZone `plane`
 (the internal faces of the plane x = 2 above the body), cellZone `none` (no cells).
 
+make_snappy_case() writes the snappyHexMesh case (a tunnel around a rounded box from an STL,
+or a sphere; hexahedra, polyhedra, boundary layers; patches inlet outlet walls body), and
+write_dict() any further dictionary file of a case.
+
 All geometry is a lattice of blocks with the body's blocks left out; `scale` multiplies the
 cell count (every block's divisions by scale**(1/d), d = 2 for the 2-D and wedge cases, 3
 otherwise). Importable by file path from tests/ and benchmarks/ (standard library only).
@@ -33,6 +37,7 @@ import re
 import shutil
 import struct
 import subprocess
+import sys
 import gzip
 
 TOOLS = ("blockMesh", "checkMesh")
@@ -60,7 +65,8 @@ def foam_available() -> bool:
 
 
 class FoamError(subprocess.CalledProcessError):
-    """An OpenFOAM tool exited non-zero; str() carries the tail of its output."""
+    """An OpenFOAM tool (or the gmsh run writing make_snappy_case's STL) exited non-zero;
+    str() carries the tail of its output."""
 
     def __str__(self):
         tail = ((self.stdout or "")[-3000:] + "\n" + (self.stderr or "")[-2000:]).strip()
@@ -310,8 +316,13 @@ def _write(path: str, text: str):
         f.write(text)
 
 
-def _dict(case: str, rel: str, body: str, cls: str = "dictionary"):
-    _write(os.path.join(case, rel), HEADER % (cls, os.path.basename(rel)) + body)
+def write_dict(case: str, rel: str, body: str, cls: str = "dictionary") -> str:
+    """Writes the OpenFOAM file rel (e.g. "system/blockMeshDict", "0/U") into case: the
+    FoamFile header (format ascii, class cls, object the file's name) followed by body, the
+    folders made as needed; an existing file is replaced. Returns the file's path."""
+    path = os.path.join(str(case), rel)
+    _write(path, HEADER % (cls, os.path.basename(rel)) + body)
+    return path
 
 
 def _divisions(base, s):
@@ -525,11 +536,11 @@ def _write_fields(case, types):
                 bc = _FIELD_BC[field][name]
             lines.append("    %s { %s }" % (name, bc))
         lines.append("}")
-        _dict(case, "0/" + field, "\n".join(lines) + "\n", cls)
+        write_dict(case, "0/" + field, "\n".join(lines) + "\n", cls)
 
 
 def _write_system(case, binary, compress, write_precision):
-    _dict(case, "system/controlDict", """application simpleFoam;
+    write_dict(case, "system/controlDict", """application simpleFoam;
 startFrom startTime;
 startTime 0;
 stopAt endTime;
@@ -546,7 +557,7 @@ timePrecision 6;
 runTimeModifiable false;
 """ % ("binary" if binary else "ascii", 6 if write_precision is None else int(write_precision),
        "on" if compress else "off"))
-    _dict(case, "system/fvSchemes", """ddtSchemes { default steadyState; }
+    write_dict(case, "system/fvSchemes", """ddtSchemes { default steadyState; }
 gradSchemes { default Gauss linear; }
 divSchemes
 {
@@ -559,7 +570,7 @@ interpolationSchemes { default linear; }
 snGradSchemes { default limited corrected 0.5; }
 wallDist { method meshWave; }
 """)
-    _dict(case, "system/fvSolution", """solvers
+    write_dict(case, "system/fvSolution", """solvers
 {
     p { solver GAMG; smoother GaussSeidel; tolerance 1e-7; relTol 0.1; }
     U { solver smoothSolver; smoother symGaussSeidel; tolerance 1e-7; relTol 0.1; }
@@ -576,9 +587,9 @@ relaxationFactors
     equations { U 0.9; ".*" 0.9; }
 }
 """)
-    _dict(case, "constant/transportProperties", "transportModel Newtonian;\nnu 0.01;\n")
+    write_dict(case, "constant/transportProperties", "transportModel Newtonian;\nnu 0.01;\n")
     # v1912 (ESI) reads turbulenceProperties; momentumTransport is the Foundation's later name
-    _dict(case, "constant/turbulenceProperties", "simulationType laminar;\n")
+    write_dict(case, "constant/turbulenceProperties", "simulationType laminar;\n")
 
 
 def _write_topo_set(case, zones):
@@ -587,7 +598,7 @@ def _write_topo_set(case, zones):
     have)."""
     (c0, c1), (f0, f1) = zones["cells"], zones["faces"]
     box = "box (%s %s %s) (%s %s %s);"
-    _dict(case, "system/topoSetDict", """actions
+    write_dict(case, "system/topoSetDict", """actions
 (
     { name wakeSet; type cellSet; action new; source boxToCell; %s }
     { name wake; type cellZoneSet; action new; source setToCellZone; set wakeSet; }
@@ -618,7 +629,7 @@ def make_case(kind: str, case_dir: str, *, scale: float = 1.0, binary: bool = Fa
     else:
         text, types, zone_boxes = _lattice_case(kind, scale)
     _write_system(case_dir, binary, compress, write_precision)
-    _dict(case_dir, "system/blockMeshDict", text)
+    write_dict(case_dir, "system/blockMeshDict", text)
     _write_fields(case_dir, types)
     run_foam("blockMesh", case_dir)
     if zones:
@@ -626,4 +637,106 @@ def make_case(kind: str, case_dir: str, *, scale: float = 1.0, binary: bool = Fa
         run_foam("topoSet", case_dir)
         # topoSet leaves its sets in polyMesh/sets: the zones are what the case carries
         shutil.rmtree(os.path.join(case_dir, "constant", "polyMesh", "sets"), ignore_errors=True)
+    return case_dir
+
+
+# ---------------------------------------------------------------------------------------
+# snappyHexMesh
+
+SNAPPY_BODIES = ("rounded_box", "sphere")
+# body: tunnel start x0, snappy's geometry entry, surface refinement levels, refinement
+# regions, nCellsBetweenLevels, implicitFeatureSnap. Changing any of them changes the meshes
+# the tests' expectations (folded tet decompositions on valid cells, byte-identical copies)
+# and the benchmark's recorded sizes were established on.
+_SNAPPY = {
+    "rounded_box": (-1.0, "body.stl { type triSurfaceMesh; name body; }", "1 2", "", 2, "true"),
+    "sphere": (-1.5, "body { type searchableSphere; centre (0 0 0); radius 0.35; }", "2 2",
+               "body { mode distance; levels ((0.25 1)); }", 3, "false"),
+}
+_SNAPPY_DICT = """castellatedMesh true; snap true; addLayers true;
+geometry { %s }
+castellatedMeshControls { maxLocalCells 10000000; maxGlobalCells 20000000; minRefinementCells 0;
+  maxLoadUnbalance 0.1; nCellsBetweenLevels %d; features ( );
+  refinementSurfaces { body { level (%s); patchInfo { type wall; } } }
+  resolveFeatureAngle 30;
+  refinementRegions { %s }
+  locationInMesh (2.71 0.831 0.771); allowFreeStandingZoneFaces true; }
+snapControls { nSmoothPatch 3; tolerance 2.0; nSolveIter 30; nRelaxIter 5; nFeatureSnapIter 10;
+  implicitFeatureSnap %s; explicitFeatureSnap false; multiRegionFeatureSnap false; }
+addLayersControls { relativeSizes true; layers { body { nSurfaceLayers 2; } }
+  expansionRatio 1.2; finalLayerThickness 0.4; minThickness 0.05; nGrow 0; featureAngle 120;
+  slipFeatureAngle 30; nRelaxIter 3; nSmoothSurfaceNormals 1; nSmoothNormals 3; nSmoothThickness 10;
+  maxFaceThicknessRatio 0.5; maxThicknessToMedialRatio 0.3; minMedialAxisAngle 90;
+  nBufferCellsNoExtrude 0; nLayerIter 50; }
+meshQualityControls { maxNonOrtho 65; maxBoundarySkewness 20; maxInternalSkewness 4; maxConcave 80;
+  minVol 1e-13; minTetQuality 1e-15; minArea -1; minTwist 0.02; minDeterminant 0.001;
+  minFaceWeight 0.05; minVolRatio 0.01; minTriangleTwist -1; nSmoothScale 4; errorReduction 0.75; }
+mergeTolerance 1e-6;
+"""
+# the rounded box's surface, triangulated by gmsh (run by the same Python as a separate
+# process: this module stays importable without gmsh)
+_ROUNDED_BOX_STL = """
+import gmsh, sys
+gmsh.initialize(); gmsh.option.setNumber("General.Terminal", 0)
+b = gmsh.model.occ.addBox(-0.4, -0.3, -0.25, 1.0, 0.6, 0.5)
+gmsh.model.occ.synchronize()
+edges = [e[1] for e in gmsh.model.getEntities(1)]
+gmsh.model.occ.fillet([b], edges, [0.1])
+gmsh.model.occ.synchronize()
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.06)
+gmsh.model.mesh.generate(2)
+gmsh.write(sys.argv[1])
+gmsh.finalize()
+"""
+
+
+def make_snappy_case(case_dir: str, *, body: str = "rounded_box", base: int = 8) -> str:
+    """Writes a complete simpleFoam (laminar) case meshed by snappyHexMesh into case_dir
+    (emptied first): a tunnel, y and z in [-1, 1], around a body at the origin,
+    castellated, snapped, with 2 boundary layers on the body; patches inlet (x low), outlet
+    (x high), walls, body (all but the body from blockMesh's background box). Runs blockMesh
+    and snappyHexMesh -overwrite, then writes 0/U and 0/p. The mesh is mostly hexahedra,
+    with polyhedra where refinement levels meet and at the snapped body. body:
+      rounded_box  tunnel x [-1, 3]; the box [-0.4, 0.6] x [-0.3, 0.3] x [-0.25, 0.25] with
+                   every edge filleted (radius 0.1), an STL that gmsh writes
+                   (constant/triSurface/body.stl; needs gmsh's Python module for this
+                   Python); surface refinement levels 1 to 2 (base 8: 5,076 cells)
+      sphere       tunnel x [-1.5, 3]; a sphere of radius 0.35 (snappyHexMesh's
+                   searchableSphere: no STL); surface level 2 and level 1 within 0.25 of it
+                   (base 6: 3,132 cells; base 32: 126,912)
+    base is the number of background cells across the tunnel's height (cells of about 2/base
+    on a side); the cell count grows as base**3. Raises ValueError for an unknown body or a
+    base below 2, FoamError when gmsh or an OpenFOAM tool fails. Returns case_dir."""
+    if body not in _SNAPPY:
+        raise ValueError("body must be one of %s, not %r" % (", ".join(SNAPPY_BODIES), body))
+    if int(base) != base or base < 2:
+        raise ValueError("base must be an integer of at least 2, not %r" % (base,))
+    x0, geometry, level, regions, between, implicit = _SNAPPY[body]
+    case_dir = str(case_dir)
+    shutil.rmtree(case_dir, ignore_errors=True)
+    os.makedirs(case_dir)
+    _write_system(case_dir, False, False, None)
+    n = int(base)
+    write_dict(case_dir, "system/blockMeshDict", """convertToMeters 1;
+vertices ( (X0 -1 -1) (3 -1 -1) (3 1 -1) (X0 1 -1) (X0 -1 1) (3 -1 1) (3 1 1) (X0 1 1) );
+blocks ( hex (0 1 2 3 4 5 6 7) (%d %d %d) simpleGrading (1 1 1) );
+edges ();
+boundary ( inlet { type patch; faces ((0 4 7 3)); } outlet { type patch; faces ((1 2 6 5)); }
+  walls { type wall; faces ((0 1 5 4) (3 7 6 2) (0 3 2 1) (4 5 6 7)); } );
+mergePatchPairs ();
+""".replace("X0", _fmt(x0)) % (int(round(n * (3.0 - x0) / 2)), n, n))
+    write_dict(case_dir, "system/snappyHexMeshDict",
+               _SNAPPY_DICT % (geometry, between, level, regions, implicit))
+    if body == "rounded_box":
+        stl = os.path.join(case_dir, "constant", "triSurface", "body.stl")
+        os.makedirs(os.path.dirname(stl))
+        cmd = [sys.executable, "-c", _ROUNDED_BOX_STL, stl]
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        if p.returncode != 0:
+            raise FoamError(p.returncode, [sys.executable, "-c", "<gmsh: the body's STL>", stl],
+                            p.stdout, p.stderr)
+    run_foam("blockMesh", case_dir)
+    run_foam("snappyHexMesh", case_dir, "-overwrite")
+    # the fields after meshing: snappyHexMesh would map (and then need) fields it found in 0/
+    _write_fields(case_dir, {"inlet": "patch", "outlet": "patch", "walls": "wall", "body": "wall"})
     return case_dir

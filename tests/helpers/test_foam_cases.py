@@ -9,7 +9,10 @@
   * zones=True writes the cellZones wake and none (empty) and the faceZone plane;
   * scale multiplies the cell count; write_precision reaches controlDict;
   * checkmesh() reports a failed verdict and negative volumes on a mirrored (inside-out) mesh;
-    solver_steps reports a solver that fails.
+    solver_steps reports a solver that fails;
+  * write_dict writes the FoamFile header and the body; make_snappy_case's sphere meshes
+    (checkMesh OK, polyhedra, the patches, the body's points on the sphere) and simpleFoam
+    runs on it; an unknown body or base is a ValueError.
 Exit 77 (ctest SKIP) only when OpenFOAM's tools are not installed.
 usage: test_foam_cases.py WORKDIR"""
 import math
@@ -153,6 +156,44 @@ try:
     check(False, "solver_steps did not raise on a failing run")
 except fc.FoamError as e:
     check("simpleFoam" in str(e) and "0/p" in str(e), "FoamError text: %s" % e)
+
+# write_dict: the FoamFile header (class, object) and the body, the folders made
+path = fc.write_dict(os.path.join(WORK, "dicts"), "constant/sub/fieldX", "value 1;\n", "volScalarField")
+text = open(path).read()
+check(path == os.path.join(WORK, "dicts", "constant", "sub", "fieldX") and text.endswith("}\nvalue 1;\n")
+      and re.search(r"class\s+volScalarField;", text) and re.search(r"object\s+fieldX;", text)
+      and text.startswith("FoamFile\n{"), "write_dict wrote %r" % text)
+
+# make_snappy_case: the benchmark's sphere, small (the tests' rounded box is meshed by
+# test_foam_crosscheck and test_checkmesh_verdict): checkMesh OK, hexahedra and polyhedra,
+# the patches and their types, the body's points snapped onto the sphere, base the
+# background's divisions, and simpleFoam runs on it
+sph = fc.make_snappy_case(os.path.join(WORK, "snappy_sphere"), body="sphere", base=4)
+r = fc.checkmesh(sph)
+check(r["ok"] and r.get("polyhedra", 0) > 0 and r.get("hexahedra", 0) > r["cells"] // 2,
+      "snappy sphere: verdict %s, %s hexahedra, %s polyhedra of %s cells"
+      % (r["ok"], r.get("hexahedra"), r.get("polyhedra"), r.get("cells")))
+b = fc.read_boundary(sph)
+check({n: p["type"] for n, p in b.items()} == {"inlet": "patch", "outlet": "patch", "walls": "wall",
+                                                "body": "wall"} and b["body"]["nFaces"] > 0,
+      "snappy sphere: patches %s" % b)
+xyz = fc.read_points(sph)
+radii = [math.sqrt(sum(c * c for c in xyz[i])) for i in fc.patch_points(sph, "body")]
+check(radii and max(abs(x - 0.35) for x in radii) < 1e-3, "snappy sphere: body points at radii %s to %s"
+      % (min(radii or [0]), max(radii or [0])))
+check(re.search(r"\(9 4 4\)", open(os.path.join(sph, "system", "blockMeshDict")).read()),
+      "snappy sphere: base 4 is not a (9 4 4) background")
+p = fc.solver_steps(sph, 2)
+check(p.returncode == 0 and "Time = 2" in p.stdout, "snappy sphere: simpleFoam did not run 2 steps")
+for kw in ({"body": "cube"}, {"base": 1}, {"base": 4.5}):
+    try:
+        fc.make_snappy_case(os.path.join(WORK, "snappy_bad"), **kw)
+        check(False, "make_snappy_case(%s) did not raise" % kw)
+    except ValueError:
+        pass
+check(not os.path.exists(os.path.join(WORK, "snappy_bad")), "a rejected make_snappy_case wrote its folder")
+print("snappy sphere: %d cells (%d polyhedra), Mesh OK, body on the sphere to %.1e, 2 simpleFoam steps"
+      % (r["cells"], r.get("polyhedra", 0), max(abs(x - 0.35) for x in radii or [0])))
 
 print("%.1f s" % (time.time() - t0))
 if failures:

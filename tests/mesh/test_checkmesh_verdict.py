@@ -15,7 +15,6 @@ import re
 import shutil
 import subprocess
 import sys
-import textwrap
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "helpers"))
@@ -223,7 +222,7 @@ if "blockmesh" in PARTS:
     # blocks with collapsed edges: checkMesh's wedge (a hex with one edge collapsed) and tet
     # wedge cells, besides prisms and hexahedra (two blocks that share no face: 2 regions)
     c = fresh("symmetry3d", "collapsed_blocks")
-    foam_cases._dict(c, "system/blockMeshDict", """
+    foam_cases.write_dict(c, "system/blockMeshDict", """
     vertices ( (0 0 0) (1 0 0) (1 1 0) (0 1 0) (0 0 1) (1 0 1) (1 1 1) (0 1 1)
                (2 0 0) (3 0 0) (3 1 0) (2 1 0) (2 0 1) (3 0 1) (3 1 1) (2 1 1) );
     blocks ( hex (0 1 2 3 4 5 6 6) (2 3 2) simpleGrading (1 1 1)
@@ -308,51 +307,7 @@ if "blockmesh" in PARTS:
 if "snappy" in PARTS:
     # 4. snappyHexMesh around a rounded box: polyhedra whose tet decomposition folds (a scaled
     # Jacobian <= 0) while checkMesh finds every volume and face pyramid fine: not inverted
-    snappy = os.path.join(WORK, "snappy")
-    shutil.rmtree(snappy, ignore_errors=True)
-    foam_cases.make_case("symmetry3d", snappy)  # system/, constant/ and 0/ of a runnable case
-    os.makedirs(os.path.join(snappy, "constant", "triSurface"))
-    foam_cases._dict(snappy, "system/blockMeshDict", """
-    vertices ( (-1 -1 -1) (3 -1 -1) (3 1 -1) (-1 1 -1) (-1 -1 1) (3 -1 1) (3 1 1) (-1 1 1) );
-    blocks ( hex (0 1 2 3 4 5 6 7) (16 8 8) simpleGrading (1 1 1) );
-    boundary ( inlet { type patch; faces ((0 4 7 3)); } outlet { type patch; faces ((1 2 6 5)); }
-      walls { type wall; faces ((0 1 5 4) (3 7 6 2) (0 3 2 1) (4 5 6 7)); } );
-    """)
-    foam_cases._dict(snappy, "system/snappyHexMeshDict", """
-    castellatedMesh true; snap true; addLayers true;
-    geometry { body.stl { type triSurfaceMesh; name body; } }
-    castellatedMeshControls { maxLocalCells 1000000; maxGlobalCells 2000000; minRefinementCells 0;
-      maxLoadUnbalance 0.1; nCellsBetweenLevels 2; features ( );
-      refinementSurfaces { body { level (1 2); } } resolveFeatureAngle 30; refinementRegions { }
-      locationInMesh (2.7 0.83 0.77); allowFreeStandingZoneFaces true; }
-    snapControls { nSmoothPatch 3; tolerance 2.0; nSolveIter 30; nRelaxIter 5; nFeatureSnapIter 10;
-      implicitFeatureSnap true; explicitFeatureSnap false; multiRegionFeatureSnap false; }
-    addLayersControls { relativeSizes true; layers { body { nSurfaceLayers 2; } }
-      expansionRatio 1.2; finalLayerThickness 0.4; minThickness 0.05; nGrow 0; featureAngle 120;
-      slipFeatureAngle 30; nRelaxIter 3; nSmoothSurfaceNormals 1; nSmoothNormals 3; nSmoothThickness 10;
-      maxFaceThicknessRatio 0.5; maxThicknessToMedialRatio 0.3; minMedialAxisAngle 90;
-      nBufferCellsNoExtrude 0; nLayerIter 50; }
-    meshQualityControls { maxNonOrtho 65; maxBoundarySkewness 20; maxInternalSkewness 4; maxConcave 80;
-      minVol 1e-13; minTetQuality 1e-15; minArea -1; minTwist 0.02; minDeterminant 0.001;
-      minFaceWeight 0.05; minVolRatio 0.01; minTriangleTwist -1; nSmoothScale 4; errorReduction 0.75; }
-    mergeTolerance 1e-6;
-    """)
-    gm = subprocess.run([sys.executable, "-c", textwrap.dedent("""
-    import gmsh, sys
-    gmsh.initialize(); gmsh.option.setNumber("General.Terminal", 0)
-    b = gmsh.model.occ.addBox(-0.4, -0.3, -0.25, 1.0, 0.6, 0.5)
-    gmsh.model.occ.synchronize()
-    edges = [e[1] for e in gmsh.model.getEntities(1)]
-    gmsh.model.occ.fillet([b], edges, [0.1])
-    gmsh.model.occ.synchronize()
-    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.06)
-    gmsh.model.mesh.generate(2)
-    gmsh.write(sys.argv[1])
-    gmsh.finalize()
-    """), os.path.join(snappy, "constant", "triSurface", "body.stl")], capture_output=True, text=True)
-    check(gm.returncode == 0, "gmsh STL: " + gm.stderr[-500:])
-    foam_cases.run_foam("blockMesh", snappy)
-    foam_cases.run_foam("snappyHexMesh", snappy, "-overwrite")
+    snappy = foam_cases.make_snappy_case(os.path.join(WORK, "snappy"), body="rounded_box")
     ref, ours, text = compare("snappy", snappy, expect_ok=True)
     check(ref.get("polyhedra", 0) > 0 and ref.get("prisms", 0) + ref.get("wedges", 0) + ref.get("pyramids", 0) > 0,
           "snappy: expected polyhedra and other shapes: %s" % {k: ref.get(k) for k in COUNTS})

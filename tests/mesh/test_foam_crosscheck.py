@@ -3,7 +3,7 @@
 openfoam package) and VTK's vtkOpenFOAMReader:
 
   * meshes made by blockMesh (a hex box, ASCII; graded and skewed blocks, binary and .gz)
-    and by snappyHexMesh around a body whose STL gmsh writes here;
+    and by snappyHexMesh around a body whose STL gmsh writes (tests/helpers/foam_cases.py);
   * every number of checkMesh's "Checking geometry..." block (and the mesh stats) equals
     `cadmorph quality CASE --foam` to checkMesh's printed precision; values that are
     round-off noise (|x| < 1e-10, e.g. the openness of a closed box) only to 1e-12;
@@ -19,6 +19,7 @@ import re
 import shutil
 import subprocess
 import sys
+import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
@@ -34,6 +35,8 @@ ENV = dict(os.environ)
 if "WM_PROJECT_DIR" not in ENV:
     ENV["WM_PROJECT_DIR"] = "/usr/share/openfoam"
 from foam_compare import FoamCompare, metrics  # noqa: E402  (this folder: shared with test_foam_car.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "helpers"))
+import foam_cases  # noqa: E402
 
 FC = FoamCompare(CADMORPH, ENV)
 check, run, compare, failures = FC.check, FC.run, FC.compare, FC.failures
@@ -102,57 +105,15 @@ skewgz = make_case("skew_gz", SKEW, binary=False, compress=True)
 check(os.path.exists(os.path.join(skewgz, "constant/polyMesh/faces.gz")), "blockMesh wrote no faces.gz")
 compare("skew_gz", skewgz)
 
-# 3. snappyHexMesh around a rounded box (STL from gmsh)
-snappy = os.path.join(WORK, "snappy")
-shutil.rmtree(snappy, ignore_errors=True)
-os.makedirs(os.path.join(snappy, "constant", "triSurface"))
-write_system(snappy)
-with open(os.path.join(snappy, "system", "blockMeshDict"), "w") as f:
-    f.write(HEADER % "blockMeshDict" + """
-vertices ( (-1 -1 -1) (3 -1 -1) (3 1 -1) (-1 1 -1) (-1 -1 1) (3 -1 1) (3 1 1) (-1 1 1) );
-blocks ( hex (0 1 2 3 4 5 6 7) (16 8 8) simpleGrading (1 1 1) );
-boundary ( inlet { type patch; faces ((0 4 7 3)); } outlet { type patch; faces ((1 2 6 5)); }
-  walls { type wall; faces ((0 1 5 4) (3 7 6 2) (0 3 2 1) (4 5 6 7)); } );
-""")
-with open(os.path.join(snappy, "system", "snappyHexMeshDict"), "w") as f:
-    f.write(HEADER % "snappyHexMeshDict" + """
-castellatedMesh true; snap true; addLayers true;
-geometry { body.stl { type triSurfaceMesh; name body; } }
-castellatedMeshControls { maxLocalCells 1000000; maxGlobalCells 2000000; minRefinementCells 0;
-  maxLoadUnbalance 0.1; nCellsBetweenLevels 2; features ( );
-  refinementSurfaces { body { level (1 2); } } resolveFeatureAngle 30; refinementRegions { }
-  locationInMesh (2.7 0.83 0.77); allowFreeStandingZoneFaces true; }
-snapControls { nSmoothPatch 3; tolerance 2.0; nSolveIter 30; nRelaxIter 5; nFeatureSnapIter 10;
-  implicitFeatureSnap true; explicitFeatureSnap false; multiRegionFeatureSnap false; }
-addLayersControls { relativeSizes true; layers { body { nSurfaceLayers 2; } }
-  expansionRatio 1.2; finalLayerThickness 0.4; minThickness 0.05; nGrow 0; featureAngle 120;
-  slipFeatureAngle 30; nRelaxIter 3; nSmoothSurfaceNormals 1; nSmoothNormals 3; nSmoothThickness 10;
-  maxFaceThicknessRatio 0.5; maxThicknessToMedialRatio 0.3; minMedialAxisAngle 90;
-  nBufferCellsNoExtrude 0; nLayerIter 50; }
-meshQualityControls { maxNonOrtho 65; maxBoundarySkewness 20; maxInternalSkewness 4; maxConcave 80;
-  minVol 1e-13; minTetQuality 1e-15; minArea -1; minTwist 0.02; minDeterminant 0.001;
-  minFaceWeight 0.05; minVolRatio 0.01; minTriangleTwist -1; nSmoothScale 4; errorReduction 0.75; }
-mergeTolerance 1e-6;
-""")
-gm = subprocess.run([sys.executable, "-c", """
-import gmsh, sys
-gmsh.initialize(); gmsh.option.setNumber("General.Terminal", 0)
-b = gmsh.model.occ.addBox(-0.4, -0.3, -0.25, 1.0, 0.6, 0.5)
-gmsh.model.occ.synchronize()
-edges = [e[1] for e in gmsh.model.getEntities(1)]
-gmsh.model.occ.fillet([b], edges, [0.1])
-gmsh.model.occ.synchronize()
-gmsh.option.setNumber("Mesh.MeshSizeMax", 0.06)
-gmsh.model.mesh.generate(2)
-gmsh.write(sys.argv[1])
-gmsh.finalize()
-""", os.path.join(snappy, "constant", "triSurface", "body.stl")], capture_output=True, text=True)
-check(gm.returncode == 0, "gmsh STL: " + gm.stderr[-500:])
-for tool in (["blockMesh"], ["snappyHexMesh", "-overwrite"]):
-    p = run(tool + ["-case", snappy], foam=True)
-    if p.returncode != 0:
-        print(p.stdout[-3000:], p.stderr[-2000:])
-        sys.exit("%s failed" % tool[0])
+# 3. snappyHexMesh around a rounded box (STL from gmsh; tests/helpers/foam_cases.py)
+t = time.time()
+try:
+    snappy = foam_cases.make_snappy_case(os.path.join(WORK, "snappy"), body="rounded_box")
+except foam_cases.FoamError as e:
+    print(e)
+    sys.exit("snappy case failed")
+# blockMesh and snappyHexMesh (and gmsh's STL) count against the OpenFOAM budget below
+FC.foam_seconds += time.time() - t
 ref, _ = compare("snappy", snappy)
 cm = run(["checkMesh", "-case", snappy], foam=True).stdout
 poly = re.search(r"polyhedra:\s+(\d+)", cm)
