@@ -224,6 +224,12 @@ if rc == 0:
     rows = [l.split() for l in out.splitlines() if l.startswith(("g1 ", "g2 "))]
     check(len(rows) == 2 and all(r[5] == "0" and r[-1] == "ok" for r in rows),
           "study: two rows, no inverted cell: %s" % out)
+    import csv
+    with open(path(os.path.join("study", "study.csv"))) as f:
+        solve = [float(r["t_volume_solve"]) for r in csv.DictReader(f)]
+    check(len(solve) == 2 and solve[0] > 0 and solve[1] == 0,
+          "study: the second variant reuses the first's factorisations (t_volume_solve %r)"
+          % solve)
     order = sorted(m0)  # the .msh's node tags 1..n in file order
     for v in ("g1", "g2"):
         vp = path(os.path.join("study", "rbf-s_absolute_%s.vtu" % v))
