@@ -16,7 +16,8 @@ static const char *const usage_line =
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] [--rbf-tol T] "
     "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB --blend B] "
     "[--steps auto [--min-sj F] [--keep-partial] [--no-escalate]] [--optimize] [--report R.csv] "
-    "[--fail-on-inverted] [--cad-unit U] [--cad-tol F [--keep-offset]] [--off-cad refuse|fixed [--slide P,..] [--fixed-patches P,..] [--no-slide]] "
+    "[--fail-on-inverted] [--cad-unit U] [--cad-tol F [--keep-offset]] "
+    "[--off-cad refuse|fixed [--slide P,..] [--fixed-patches P,..] [--no-slide]] "
     "[--threads N] [--verbose]";
 
 #define MORPH_MAX_VIA 256

@@ -134,7 +134,8 @@ static int print_help(void)
         "variant i runs on rank i mod K; rank 0 writes study.csv and study.svg.\n\n"
         "options:\n");
     cli_print_options(stdout, options, 22);
-    printf("\n" MORPH_SLIDE_HELP "%s\n", "Every variant shares the factorisations of the two warp passes.");
+    printf("\n" MORPH_SLIDE_HELP
+           "Every variant shares the factorisations of the two warp passes.\n");
     printf("\nProgress (on a terminal): the variant count and an estimate of the time left.\n"
            "exit codes: 0 done (failed variants are warnings on stderr and rows in study.csv),\n"
            "1 usage, 2 bad input (G0, M0 or the list: one line naming the file), 4 internal "
