@@ -2,6 +2,7 @@
  * RBF warp of the interior), writes it, reports its quality and, on request, a CSV of stages. */
 #include "cli.h"
 #include "options.h"
+#include "patch_motion.h"
 
 #include "cadmorph/morph.h"
 
@@ -15,7 +16,8 @@ static const char *const usage_line =
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] [--rbf-tol T] "
     "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB --blend B] "
     "[--steps auto [--min-sj F] [--keep-partial] [--no-escalate]] [--optimize] [--report R.csv] "
-    "[--fail-on-inverted] [--cad-unit U] [--cad-tol F [--keep-offset]] [--off-cad refuse|fixed] "
+    "[--fail-on-inverted] [--cad-unit U] [--cad-tol F [--keep-offset]] "
+    "[--off-cad refuse|fixed [--slide P,..] [--fixed-patches P,..] [--no-slide]] "
     "[--threads N] [--verbose]";
 
 #define MORPH_MAX_VIA 256
@@ -27,6 +29,7 @@ typedef struct morph_args {
     char via_list[8192]; /* --via, split in place at the commas */
     const char *via[MORPH_MAX_VIA];
     size_t n_via;
+    cli_patch_motion patches; /* the motion of the nodes off G0 */
 } morph_args;
 
 static morph_args args;
@@ -74,6 +77,15 @@ static const int surface_methods[] = {CM_SURFACE_RBF, CM_SURFACE_PROJECT};
 
 static const char *const off_cad_names[] = {"refuse", "fixed", NULL};
 static const int off_cad_values[] = {CM_OFF_CAD_REFUSE, CM_OFF_CAD_FIXED};
+
+#define MORPH_SLIDE_HELP                                                                      \
+    "With --off-cad fixed, the boundary nodes off G0 move by the kinds of their patches\n"      \
+    "(OpenFOAM patch types; CGNS symmetry planes): symmetryPlane/symmetry, empty, wedge and\n"  \
+    "cyclic patches slide on their plane (a curved one on its own surface), other patches\n"   \
+    "are fixed; a node on two sliding planes slides along their common line, on three or on\n" \
+    "a fixed patch it is fixed. The nodes on G0 follow the CAD whatever their patch. A .msh,\n" \
+    "VTK or other mesh without patch types has nothing that slides unless --slide names its\n" \
+    "groups. No 2-D or wedge reduction here (the morphed body is 3-D).\n"
 
 static int print_help(void);
 
@@ -162,8 +174,11 @@ static const cli_option options[] = {
      .values = off_cad_values, .bad = "%.0sexpected refuse or fixed, got '%s'",
      .label = "--off-cad P",
      .help = "boundary nodes not on G0: refuse (default: not a mesh of G0) or\n"
-             "fixed (kept where they are, e.g. a wind tunnel around the body;\n"
-             "only whole boundary components off G0, some node must be on it)"},
+             "fixed (kept where they are, e.g. a wind tunnel around the body,\n"
+             "or sliding on their patch: see below; only whole boundary\n"
+             "components off G0, or ones touching the body where the surface\n"
+             "off G0 is flat; some node must be on G0)"},
+    CLI_PATCH_MOTION_OPTIONS(args.patches),
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads,
      .bad = "%s: expected a positive integer, got '%s'", .label = "--threads N",
      .help = "threads (default: all)"},
@@ -185,6 +200,7 @@ static int print_help(void)
         "options:\n",
         cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
+    printf("\n" MORPH_SLIDE_HELP);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
            "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted or no\n"
            "valid adaptive step (the message names the worst cells).\n");
@@ -201,6 +217,8 @@ static int parse_args(int argc, char **argv, morph_args *a)
     const int parsed = cli_parse(&p, argc, argv);
     if (args.unit) args.opt.cad_unit = args.unit;
     if (args.no_escalate) args.opt.escalate = 0;
+    /* the names stay in the static args, so a's copy may point at them */
+    cli_patch_motion_options(&args.patches, &args.opt.motion);
     *a = args;
     for (size_t k = 0; k < a->n_via; ++k) /* into a's own copy of the list */
         a->via[k] = a->via_list + (args.via[k] - args.via_list);
@@ -212,6 +230,11 @@ static int parse_args(int argc, char **argv, morph_args *a)
     if (cli_check_solver(cmd, usage_line, a->opt.method.warp.solver) >= 0) return CLI_EXIT_USAGE;
     if (a->keep_partial && a->opt.steps != CM_MORPH_STEPS_AUTO)
         return cli_usage(cmd, usage_line, "--keep-partial goes with --steps auto");
+    if ((a->patches.n[0] || a->patches.n[1] || a->patches.all_fixed) &&
+        a->opt.off_cad != CM_OFF_CAD_FIXED)
+        return cli_usage(cmd, usage_line,
+                         "--slide, --fixed-patches and --no-slide go with --off-cad fixed (the "
+                         "nodes on G0 follow the CAD)");
     if (a->n_via && !a->relative)
         return cli_usage(cmd, usage_line, "--via needs --relative (a morph through them)");
     const char *inputs[3 + MORPH_MAX_VIA] = {a->from, a->to, a->mesh};
@@ -308,8 +331,10 @@ int cli_cmd_morph(int argc, char **argv)
         printf("boundary nodes: %zu on vertices, %zu on edges, %zu on faces; ", r->counts[0],
                r->counts[1], r->counts[2]);
         if (r->off_cad_nodes)
-            printf("%zu off G0 kept fixed (%zu boundary components); ", r->off_cad_nodes,
-                   r->off_cad_components);
+            printf(r->off_cad_slide ? "%zu off G0 (%zu boundary components; %zu of them slide, "
+                                      "the rest kept fixed); "
+                                    : "%zu off G0 kept fixed (%zu boundary components); ",
+                   r->off_cad_nodes, r->off_cad_components, r->off_cad_slide);
         printf("largest distance to G1: %.3g (%.3g x diagonal)\n", r->max_dist,
                r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
         s = cli_print_quality(ctx, r->mesh, r->sj, stdout, NULL);

@@ -3,6 +3,7 @@
  * study.csv, study.svg and the meshes in the output directory, a summary on stdout. */
 #include "cli.h"
 #include "options.h"
+#include "patch_motion.h"
 
 #include "cadmorph/study.h"
 
@@ -13,19 +14,30 @@
 static const char *const usage_line =
     "cadmorph study --from G0.step --mesh M0 --variants LIST -o DIR "
     "[--mode absolute|relative|both] [--methods LIST] [--write-meshes none|all|failed] "
-    "[--steps K|auto] [--optimize] [--cad-unit U] [--threads N] [--verbose]";
+    "[--steps K|auto] [--optimize] [--cad-unit U] [--off-cad refuse|fixed [--slide P,..] "
+    "[--fixed-patches P,..] [--no-slide]] [--threads N] [--verbose]";
 
 enum { MAX_METHODS = 16 };
 
 typedef struct study_args {
     const char *from, *mesh, *variants, *out, *unit, *methods;
-    int modes, write_meshes, threads, verbose, steps, optimize;
+    int modes, write_meshes, threads, verbose, steps, optimize, off_cad;
+    cli_patch_motion patches; /* the motion of the nodes off G0 */
     int rank, ranks; /* under mpirun (cli_mpi_ranks) */
     cm_study_method list[MAX_METHODS];
     size_t n_methods;
 } study_args;
 
 static study_args args;
+
+#define MORPH_SLIDE_HELP                                                                      \
+    "With --off-cad fixed, the boundary nodes off G0 move by the kinds of their patches\n"      \
+    "(OpenFOAM patch types; CGNS symmetry planes): symmetryPlane/symmetry, empty, wedge and\n"  \
+    "cyclic patches slide on their plane (a curved one on its own surface), other patches\n"   \
+    "are fixed; a node on two sliding planes slides along their common line, on three or on\n" \
+    "a fixed patch it is fixed. The nodes on G0 follow the CAD whatever their patch. A .msh,\n" \
+    "VTK or other mesh without patch types has nothing that slides unless --slide names its\n" \
+    "groups. No 2-D or wedge reduction here (the morphed body is 3-D).\n"
 
 static int print_help(void);
 
@@ -54,6 +66,9 @@ static const char *method_help(void)
 static const char *const write_names[] = {"none", "all", "failed", NULL};
 static const int write_values[] = {CM_STUDY_WRITE_NONE, CM_STUDY_WRITE_ALL,
                                    CM_STUDY_WRITE_FAILED};
+
+static const char *const off_cad_names[] = {"refuse", "fixed", NULL};
+static const int off_cad_values[] = {CM_OFF_CAD_REFUSE, CM_OFF_CAD_FIXED};
 
 static const cli_option options[] = {
     {.name = "--help", .alias = "-h", .kind = CLI_HELP},
@@ -89,6 +104,12 @@ static const cli_option options[] = {
      .help = "interior optimisation after each morph step"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &args.unit, .label = "--cad-unit U",
      .help = "unit of the mesh coordinates (mm default; cm m in ft um ...)"},
+    {.name = "--off-cad", .kind = CLI_ENUM, .dest = &args.off_cad, .names = off_cad_names,
+     .values = off_cad_values, .bad = "%.0sexpected refuse or fixed, got '%s'",
+     .label = "--off-cad P",
+     .help = "boundary nodes not on G0: refuse (default) or fixed (kept, or\n"
+             "sliding on their patch: see below), as in morph --off-cad"},
+    CLI_PATCH_MOTION_OPTIONS(args.patches),
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
      .help = "threads (default: all)"},
     {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
@@ -113,6 +134,8 @@ static int print_help(void)
         "variant i runs on rank i mod K; rank 0 writes study.csv and study.svg.\n\n"
         "options:\n");
     cli_print_options(stdout, options, 22);
+    printf("\n" MORPH_SLIDE_HELP
+           "Every variant shares the factorisations of the two warp passes.\n");
     printf("\nProgress (on a terminal): the variant count and an estimate of the time left.\n"
            "exit codes: 0 done (failed variants are warnings on stderr and rows in study.csv),\n"
            "1 usage, 2 bad input (G0, M0 or the list: one line naming the file), 4 internal "
@@ -132,8 +155,14 @@ static int parse_args(int argc, char **argv, study_args *a)
     cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
                     .unknown = "unknown argument '%s'"};
     const int parsed = cli_parse(&p, argc, argv);
+    /* the names stay in the static args, so a's copy may point at them */
     *a = args;
     if (parsed >= 0) return parsed;
+    if ((a->patches.n[0] || a->patches.n[1] || a->patches.all_fixed) &&
+        a->off_cad != CM_OFF_CAD_FIXED)
+        return cli_usage(cmd, usage_line,
+                         "--slide, --fixed-patches and --no-slide go with --off-cad fixed (the "
+                         "nodes on G0 follow the CAD)");
     if (!a->from || !a->mesh || !a->variants || !a->out)
         return cli_usage(cmd, usage_line, "--from, --mesh, --variants and -o are required");
     cm_context *ctx = NULL;
@@ -207,6 +236,8 @@ static int run(cm_context *ctx, const study_args *a)
             if (a->unit) so.morph.cad_unit = a->unit;
             so.morph.steps = a->steps;
             so.morph.optimize = a->optimize;
+            so.morph.off_cad = (cm_off_cad)a->off_cad;
+            cli_patch_motion_options(&args.patches, &so.morph.motion);
             so.rank = a->rank;
             so.ranks = a->ranks;
             s = cm_study_run(ctx, g0, mesh, &fam, &so, &r);

@@ -104,6 +104,7 @@ cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path
         r->h = in->h;
         r->off_cad_nodes = in->off_cad_nodes;
         r->off_cad_components = in->off_cad_components;
+        r->off_cad_slide = in->off_cad_slide;
         xyz = malloc(3 * (mesh->n_nodes ? mesh->n_nodes : 1) * sizeof *xyz);
         if (!xyz) s = cm_error(ctx, CM_ERR_NOMEM, "cm_morph_run: out of memory");
     }

@@ -30,6 +30,7 @@ void cm_morph_options_init(cm_morph_options *opt)
     cm_classify_options_init(&opt->classify);
     cm_surface_morph_options_init(&opt->morph);
     opt->off_cad = CM_OFF_CAD_REFUSE;
+    cm_motion_options_init(&opt->motion);
 }
 
 /* Warnings found before the mesh is known to lie on G are held back: a mesh in the wrong unit
@@ -86,6 +87,37 @@ static cm_status node_offsets(cm_context *ctx, cm_morpher *mp)
     return CM_OK;
 }
 
+/* The boundary motion of the nodes off G (cm_morph_options.motion): the nodes on G
+ * prescribed, the others by their patches' kinds. Kept only when some node off G slides. */
+static cm_status make_motion(cm_context *ctx, cm_morpher *mp, held_warnings *held)
+{
+    cm_boundary_motion_destroy(&mp->motion);
+    mp->info.off_cad_slide = 0;
+    const cm_surface_nodes *nd = mp->nodes;
+    if (!nd->n_off || mp->opt.motion.all_fixed) return CM_OK;
+    size_t nn = mp->mesh->n_nodes;
+    unsigned char *pre = calloc(nn ? nn : 1, 1);
+    if (!pre) return cm_error(ctx, CM_ERR_NOMEM, "morph: out of memory for the boundary motion");
+    for (size_t i = 0; i < nd->n; ++i)
+        pre[nd->node[i]] = 1;
+    cm_motion_options mo = mp->opt.motion;
+    mo.no_reduction = 1;
+    cm_status s = cm_boundary_motion_create(ctx, mp->mesh, mp->b, pre, &mo, &mp->motion);
+    free(pre);
+    if (s < 0) return cm_error_prefix(ctx, s, "the motion of the boundary off the CAD model");
+    hold(ctx, held, s);
+    for (size_t i = 0; i < nd->n_off; ++i)
+        mp->info.off_cad_slide +=
+            cm_boundary_motion_kind(mp->motion, (size_t)nd->off[i]) >= CM_MOTION_SLIDE_PLANE;
+    if (!mp->info.off_cad_slide) cm_boundary_motion_destroy(&mp->motion);
+    else
+        cm_log(ctx, CM_LOG_DEBUG,
+               "classify: %zu of the %zu boundary nodes off the CAD model slide on their "
+               "patches, the rest stay",
+               mp->info.off_cad_slide, nd->n_off);
+    return CM_OK;
+}
+
 /* Samples g (once h is known) and classifies the boundary of mp->mesh on it. */
 static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
 {
@@ -121,10 +153,12 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
                "the fixed surface (they may slide along it where it is flat)",
                partial, mp->contact.n);
     mp->info.off_cad_nodes = mp->nodes->n_off;
+    s = make_motion(ctx, mp, held);
+    if (s < 0) return s;
     if (mp->nodes->n_off)
         cm_log(ctx, CM_LOG_DEBUG,
                "classify: %zu of %zu boundary nodes are off the CAD model, in %zu boundary "
-               "components of their own: kept fixed (--off-cad fixed)",
+               "components of their own (--off-cad fixed)",
                mp->nodes->n_off, mp->b->n_nodes, mp->info.off_cad_components);
     for (int k = 0; k < 3; ++k)
         mp->info.counts[k] = mp->nodes->count[k];
@@ -148,8 +182,10 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
 
 static void drop_warps(cm_morpher *mp)
 {
-    for (int i = 0; i < mp->n_warps; ++i)
+    for (int i = 0; i < mp->n_warps; ++i) {
         cm_warp_destroy(&mp->warps[i].warp);
+        cm_warp_destroy(&mp->warps[i].warp1);
+    }
     mp->n_warps = 0;
 }
 
@@ -171,6 +207,7 @@ void cm_morpher_destroy(cm_morpher **morpher)
     free(mp->offset);
     free(mp->fixed);
     cm_off_cad_contact_free(&mp->contact);
+    cm_boundary_motion_destroy(&mp->motion);
     free(mp->rows);
     free(mp);
     *morpher = NULL;
@@ -265,27 +302,67 @@ static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
 
 /* The warp with options wo on the start mesh, made on first use (options compared bytewise:
  * cm_warp_options_init zeroes them first); *t: its factorisation time. */
-cm_status cm_morpher_shared_warp(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
-                                 cm_warp **warp, double *t)
+/* The two masks of the two-pass warp: pass 1 holds the fixed and prescribed nodes, pass 2
+ * every node that is not free (docs/DESIGN.md, "Boundary motion by patch kind"). */
+static cm_status slide_masks(cm_context *ctx, const cm_morpher *mp, unsigned char **m1,
+                             unsigned char **m2)
+{
+    size_t nn = mp->mesh->n_nodes;
+    *m1 = malloc(nn ? nn : 1), *m2 = malloc(nn ? nn : 1);
+    if (!*m1 || !*m2) {
+        free(*m1), free(*m2);
+        *m1 = *m2 = NULL;
+        return cm_error(ctx, CM_ERR_NOMEM, "morph: out of memory for the slide masks");
+    }
+    for (size_t i = 0; i < nn; ++i) {
+        cm_motion_kind k = cm_boundary_motion_kind(mp->motion, i);
+        (*m1)[i] = k == CM_MOTION_FIXED || k == CM_MOTION_PRESCRIBED;
+        (*m2)[i] = k != CM_MOTION_FREE;
+    }
+    return CM_OK;
+}
+
+/* The warp (and with slides the pass-1 warp too) on mesh, created with the morpher's
+ * boundary; *w1 NULL without slides. */
+static cm_status make_warps(cm_context *ctx, const cm_morpher *mp, const cm_mesh *mesh,
+                            const cm_warp_options *wo, cm_warp **w, cm_warp **w1)
+{
+    *w = *w1 = NULL;
+    if (!mp->motion) return cm_warp_create(ctx, mesh, mp->b, NULL, wo, w);
+    unsigned char *m1 = NULL, *m2 = NULL;
+    cm_status s = slide_masks(ctx, mp, &m1, &m2);
+    if (s >= 0) s = cm_warp_create(ctx, mesh, mp->b, m2, wo, w);
+    if (s >= 0) s = cm_warp_create(ctx, mesh, mp->b, m1, wo, w1);
+    free(m1), free(m2);
+    if (s < 0) cm_warp_destroy(w), cm_warp_destroy(w1);
+    return s;
+}
+
+cm_status cm_morpher_shared_warps(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
+                                  cm_warp **warp, cm_warp **warp1, double *t)
 {
     for (int i = 0; i < mp->n_warps; ++i)
         if (!memcmp(&mp->warps[i].opt, wo, sizeof *wo)) {
             *warp = mp->warps[i].warp;
+            if (warp1) *warp1 = mp->warps[i].warp1;
             return CM_OK;
         }
     if (mp->n_warps == CM_MORPHER_MAX_WARPS) { /* keep the newest: drop the oldest */
         cm_warp_destroy(&mp->warps[0].warp);
+        cm_warp_destroy(&mp->warps[0].warp1);
         memmove(mp->warps, mp->warps + 1, (CM_MORPHER_MAX_WARPS - 1) * sizeof mp->warps[0]);
         --mp->n_warps;
     }
     double t0 = cm_wtime();
-    cm_warp *w = NULL;
-    cm_status s = cm_warp_create(ctx, mp->mesh, mp->b, NULL, wo, &w);
+    cm_warp *w = NULL, *w1 = NULL;
+    cm_status s = make_warps(ctx, mp, mp->mesh, wo, &w, &w1);
     if (s < 0) return s;
     *t = cm_wtime() - t0;
     mp->warps[mp->n_warps].opt = *wo;
+    mp->warps[mp->n_warps].warp1 = w1;
     mp->warps[mp->n_warps++].warp = w;
     *warp = w;
+    if (warp1) *warp1 = w1;
     return CM_OK;
 }
 
@@ -328,6 +405,26 @@ static cm_morph_step *new_row(cm_context *ctx, cm_morpher *mp)
     return r;
 }
 
+/* Pass 1 of the two-pass warp (docs/DESIGN.md, "Boundary motion by patch kind"): mp->disp
+ * (the move from `from`, set at the nodes on G, 0 elsewhere) warped with the slide nodes
+ * free, then made admissible: the fixed nodes 0, the slide nodes projected onto their
+ * constraints. The projection sees the motion from the start mesh (on which the motion was
+ * made), so that a curved slide projects positions, not increments. */
+static cm_status slide_pass(cm_context *ctx, cm_morpher *mp, cm_warp *w1, const double *from)
+{
+    size_t n3 = 3 * mp->mesh->n_nodes;
+    const double *x0 = mp->mesh->xyz;
+    cm_status s = cm_warp_apply(ctx, w1, mp->disp);
+    if (s < 0) return s;
+    for (size_t i = 0; i < n3; ++i) /* from is x0 in the shared first step: adds 0 */
+        mp->disp[i] += from[i] - x0[i];
+    s = cm_boundary_motion_project(ctx, mp->motion, mp->disp);
+    if (s < 0) return s;
+    for (size_t i = 0; i < n3; ++i)
+        mp->disp[i] -= from[i] - x0[i];
+    return CM_OK;
+}
+
 /* The mesh at fraction f of the boundary motion: the boundary blended linearly from M's
  * boundary to the surface morph's positions (exactly those at f = 1), the interior by the
  * warp of the move from `from` (the shared factorisation when from is the start mesh, else
@@ -346,31 +443,39 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
             mp->bxyz[3 * i + c] = want;
             mp->disp[3 * nd->node[i] + c] = want - from[3 * nd->node[i] + c];
         }
-    cm_warp *w = NULL, *own = NULL;
+    cm_warp *w = NULL, *w1 = NULL, *own = NULL, *own1 = NULL;
     double t0 = cm_wtime();
     cm_status s;
     if (shared) {
-        s = cm_morpher_shared_warp(ctx, mp, wo, &w, &row->t_volume_solve);
+        s = cm_morpher_shared_warps(ctx, mp, wo, &w, &w1, &row->t_volume_solve);
     } else {
         memcpy(mp->work->xyz, from, 3 * nn * sizeof *from);
-        s = cm_warp_create(ctx, mp->work, mp->b, NULL, wo, &own);
-        w = own;
+        s = make_warps(ctx, mp, mp->work, wo, &own, &own1);
+        w = own, w1 = own1;
         row->t_volume_solve = cm_wtime() - t0;
     }
-    double t1 = cm_wtime();
+    double t1 = cm_wtime(), residual1 = 0;
+    if (s >= 0 && w1) {
+        s = slide_pass(ctx, mp, w1, from);
+        residual1 = cm_warp_residual(w1);
+    }
     if (s >= 0) s = cm_warp_apply(ctx, w, mp->disp);
     double t_apply = cm_wtime() - t1;
-    row->residual = cm_warp_residual(w);
+    row->residual = fmax(cm_warp_residual(w), residual1);
     cm_warp_destroy(&own);
+    cm_warp_destroy(&own1);
     if (s < 0) return s;
     for (size_t i = 0; i < 3 * nn; ++i)
         xyz[i] = from[i] + mp->disp[i];
     /* boundary nodes exactly where they were sent (no round-off from the increments), those
-     * off G exactly where they were (the warp's residual there is not zero) */
+     * off G exactly where they were (the warp's residual there is not zero) unless they slide
+     * (their normal motion is exactly 0 already) */
     for (size_t i = 0; i < nd->n; ++i)
         memcpy(xyz + 3 * nd->node[i], mp->bxyz + 3 * i, 3 * sizeof(double));
     for (size_t i = 0; i < nd->n_off; ++i)
-        memcpy(xyz + 3 * nd->off[i], mp->mesh->xyz + 3 * nd->off[i], 3 * sizeof(double));
+        if (!mp->motion || cm_boundary_motion_kind(mp->motion, (size_t)nd->off[i]) <
+                               CM_MOTION_SLIDE_PLANE)
+            memcpy(xyz + 3 * nd->off[i], mp->mesh->xyz + 3 * nd->off[i], 3 * sizeof(double));
     memcpy(mp->work->xyz, xyz, 3 * nn * sizeof *xyz);
     if (optimize) {
         cm_optimize_stats st;

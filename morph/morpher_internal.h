@@ -21,7 +21,8 @@ struct cm_morpher {
      * one method with several settings, e.g. lattice sizes) */
     struct {
         cm_warp_options opt;
-        cm_warp *warp;
+        cm_warp *warp;  /* every boundary node held (the only warp when nothing slides) */
+        cm_warp *warp1; /* with motion: pass 1, the slide nodes free; else NULL */
     } warps[CM_MORPHER_MAX_WARPS];
     int n_warps;
     const cm_cad_model *target; /* the last target (borrowed), its bounding box (so that another
@@ -38,6 +39,10 @@ struct cm_morpher {
     double *offset; /* keep_offset: #boundary x 3, each node minus its point on g */
     unsigned char *fixed; /* #nodes: the boundary nodes, which optimisation never moves */
     cm_off_cad_contact contact; /* off_cad fixed: nodes on G touching the fixed surface */
+    /* off_cad fixed with nodes off G that slide (motion.h): the nodes on G prescribed, those
+     * off it fixed or sliding by their patches; NULL when none slides (the warp is then the
+     * one-pass warp with every boundary node held, as without patch kinds) */
+    cm_boundary_motion *motion;
     double min_sj0;       /* M's minimum scaled Jacobian (keep_fraction) */
     cm_morph_step *rows;  /* the last apply's steps */
     size_t n_rows, cap_rows;
@@ -47,9 +52,13 @@ struct cm_morpher {
 
 /* The warp with options wo on the start mesh, made on first use and kept (up to
  * CM_MORPHER_MAX_WARPS, the oldest dropped beyond); *t: its factorisation time (untouched
- * when the warp was already made). */
-cm_status cm_morpher_shared_warp(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
-                                 cm_warp **warp, double *t);
+ * when the warp was already made). With slides (mp->motion) the pair of the two-pass warp
+ * is made at once: *warp holds every node that is not free (pass 2), *warp1 (may be NULL
+ * when not wanted) only the fixed and prescribed ones (pass 1); without slides *warp1 is
+ * NULL. */
+cm_status cm_morpher_shared_warps(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
+                                  cm_warp **warp, cm_warp **warp1, double *t);
+#define cm_morpher_shared_warp(ctx, mp, wo, warp, t) cm_morpher_shared_warps(ctx, mp, wo, warp, NULL, t)
 
 /* The surface morph onto target as apply makes it (its classification, keep_offset, the
  * contact check of boundaries partly off G): bnew (nodes->n x 3) the positions of the

@@ -931,6 +931,7 @@ cm_classify_options classify;
 cm_surface_morph_options morph;
 cm_off_cad off_cad;
 int keep_offset;
+cm_motion_options motion;
 } cm_morph_options;
 void cm_morph_options_init(cm_morph_options *opt);
 typedef struct cm_morph_step {
@@ -957,6 +958,7 @@ double diagonal;
 double t_sample, t_classify;
 size_t off_cad_nodes;
 size_t off_cad_components;
+size_t off_cad_slide;
 } cm_morpher_info;
 cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mesh *mesh,
 const cm_morph_options *opt, cm_morpher **morpher);
@@ -995,6 +997,7 @@ double max_dist;
 double diagonal;
 double h;
 size_t off_cad_nodes, off_cad_components;
+size_t off_cad_slide;
 } cm_morph_result;
 cm_status cm_morph_run(cm_context *ctx, const char *g0_path, const char *g1_path,
 const char *mesh_path, const char *const *via, size_t n_via,

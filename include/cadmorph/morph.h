@@ -90,6 +90,15 @@ typedef struct cm_morph_options {
      * snappyHexMesh onto an STL of G, classified with a loose classify.rel_tol) keeps its
      * cells, and G' = G changes nothing. 0 (default): the boundary lands on G'. */
     int keep_offset;
+    /* CM_OFF_CAD_FIXED: how the boundary nodes off G move, from the kinds of their patches
+     * (motion.h; docs/DESIGN.md, "Boundary motion by patch kind"): those on a sliding patch (a
+     * symmetry plane, empty or wedge planes, a patch named in motion.slide) slide on it, the
+     * others stay; motion.all_fixed = 1 keeps every one of them where it is. The nodes on G are
+     * prescribed (they beat a patch's kind). No 2-D or wedge reduction (no_reduction is
+     * implied). The patch names are borrowed for the morpher's life (a rebase reads them
+     * again). Default (cm_motion_options_init): the patch kinds. Where no node off G slides,
+     * the morph is the one without slides, bit for bit. */
+    cm_motion_options motion;
 } cm_morph_options;
 
 CM_API void cm_morph_options_init(cm_morph_options *opt);
@@ -125,8 +134,9 @@ typedef struct cm_morpher_info {
     double class_dist; /* largest distance of a boundary node to its entity of G */
     double diagonal;   /* bbox diagonal of G */
     double t_sample, t_classify;
-    size_t off_cad_nodes;      /* boundary nodes off G kept fixed (CM_OFF_CAD_FIXED) */
+    size_t off_cad_nodes;      /* boundary nodes off G (CM_OFF_CAD_FIXED): fixed or sliding */
     size_t off_cad_components; /* the boundary components they form */
+    size_t off_cad_slide;      /* of off_cad_nodes, those that slide (cm_morph_options.motion) */
 } cm_morpher_info;
 
 /* g: the geometry M lies on; mesh: M (copied). Errors: CM_ERR_UNSUPPORTED for a mesh without
@@ -242,7 +252,8 @@ typedef struct cm_morph_result {
     double max_dist; /* largest distance of the final boundary nodes to G' */
     double diagonal; /* bbox diagonal of G' (for relative tolerances) */
     double h;        /* sampling h actually used on G */
-    size_t off_cad_nodes, off_cad_components; /* kept fixed off G (CM_OFF_CAD_FIXED) */
+    size_t off_cad_nodes, off_cad_components; /* off G (CM_OFF_CAD_FIXED) */
+    size_t off_cad_slide; /* of off_cad_nodes, those that slide (the rest kept fixed) */
 } cm_morph_result;
 
 /* Reads G (g0_path), G' (g1_path) and M, checks that they correspond, and morphs M onto G'.

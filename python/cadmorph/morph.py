@@ -81,8 +81,9 @@ class MorpherInfo:
         h: sampling step used on G; class_dist: largest distance of a boundary node to its
             entity of G; diagonal: G's bounding-box diagonal.
         t_sample, t_classify: seconds.
-        off_cad_nodes, off_cad_components: boundary nodes off G kept fixed
-            (off_cad="fixed") and the boundary components they form.
+        off_cad_nodes, off_cad_components: boundary nodes off G (off_cad="fixed") and
+            the boundary components they form; off_cad_slide: those of them that slide on
+            their patches (docs/DESIGN.md, "Boundary motion by patch kind"), the rest stay.
     """
 
     nodes: int
@@ -97,6 +98,7 @@ class MorpherInfo:
     t_classify: float
     off_cad_nodes: int
     off_cad_components: int
+    off_cad_slide: int
 
 
 @dataclass(frozen=True)
