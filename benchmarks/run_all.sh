@@ -27,3 +27,4 @@ echo "== gradients: the warps' reverse product against one apply"; sh "$here/gra
 echo "== warp methods in the sweeps"; sh "$here/warp/bench_warp_sweep.sh" "$build" "$work/wsweep" 2
 echo "== Python binding";      /usr/bin/python3 "$here/python/bench_binding.py" "$build" "$work/python"
 echo "== mesh formats against .vtu (1M tets)"; sh "$here/formats/bench_formats.sh" "$build/cli/cadmorph" "$work/formats"
+echo "== CFD meshes: body motions judged by checkMesh and simpleFoam"; sh "$here/cfd/run.sh" "$build" "$work/cfd"

@@ -78,14 +78,6 @@ static const int surface_methods[] = {CM_SURFACE_RBF, CM_SURFACE_PROJECT};
 static const char *const off_cad_names[] = {"refuse", "fixed", NULL};
 static const int off_cad_values[] = {CM_OFF_CAD_REFUSE, CM_OFF_CAD_FIXED};
 
-#define MORPH_SLIDE_HELP                                                                      \
-    "With --off-cad fixed, the boundary nodes off G0 move by the kinds of their patches\n"      \
-    "(OpenFOAM patch types; CGNS symmetry planes): symmetryPlane/symmetry, empty, wedge and\n"  \
-    "cyclic patches slide on their plane (a curved one on its own surface), other patches\n"   \
-    "are fixed; a node on two sliding planes slides along their common line, on three or on\n" \
-    "a fixed patch it is fixed. The nodes on G0 follow the CAD whatever their patch. A .msh,\n" \
-    "VTK or other mesh without patch types has nothing that slides unless --slide names its\n" \
-    "groups. No 2-D or wedge reduction here (the morphed body is 3-D).\n"
 
 static int print_help(void);
 
@@ -200,7 +192,7 @@ static int print_help(void)
         "options:\n",
         cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
-    printf("\n" MORPH_SLIDE_HELP);
+    printf("\n" CLI_PATCH_MOTION_OFF_CAD);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
            "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted or no\n"
            "valid adaptive step (the message names the worst cells).\n");

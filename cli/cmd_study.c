@@ -30,14 +30,6 @@ typedef struct study_args {
 
 static study_args args;
 
-#define MORPH_SLIDE_HELP                                                                      \
-    "With --off-cad fixed, the boundary nodes off G0 move by the kinds of their patches\n"      \
-    "(OpenFOAM patch types; CGNS symmetry planes): symmetryPlane/symmetry, empty, wedge and\n"  \
-    "cyclic patches slide on their plane (a curved one on its own surface), other patches\n"   \
-    "are fixed; a node on two sliding planes slides along their common line, on three or on\n" \
-    "a fixed patch it is fixed. The nodes on G0 follow the CAD whatever their patch. A .msh,\n" \
-    "VTK or other mesh without patch types has nothing that slides unless --slide names its\n" \
-    "groups. No 2-D or wedge reduction here (the morphed body is 3-D).\n"
 
 static int print_help(void);
 
@@ -134,7 +126,7 @@ static int print_help(void)
         "variant i runs on rank i mod K; rank 0 writes study.csv and study.svg.\n\n"
         "options:\n");
     cli_print_options(stdout, options, 22);
-    printf("\n" MORPH_SLIDE_HELP
+    printf("\n" CLI_PATCH_MOTION_OFF_CAD
            "Every variant shares the factorisations of the two warp passes.\n");
     printf("\nProgress (on a terminal): the variant count and an estimate of the time left.\n"
            "exit codes: 0 done (failed variants are warnings on stderr and rows in study.csv),\n"

@@ -1,4 +1,4 @@
-/* --slide PATCH,... and --fixed-patches PATCH,... of warp and deform: the user's choice of how
+/* --slide PATCH,... and --fixed-patches PATCH,... of warp, deform, morph and study: the user's choice of how
  * boundary patches move (motion.h; docs/DESIGN.md, "Boundary motion by patch kind"). The
  * names are only parsed here; the library checks them against the mesh. */
 #ifndef CADMORPH_CLI_PATCH_MOTION_H
@@ -33,6 +33,16 @@ void cli_patch_motion_options(const cli_patch_motion *pm, cm_motion_options *opt
     "  their common line, on three it is fixed; listed beats fixed beats slide.\n"            \
     "  A one-cell-thick mesh between two empty planes is morphed exactly 2-D, a\n"             \
     "  wedge in its (r, z) half-plane; motion out of the plane is dropped with a warning.\n"
+
+/* The help text on the defaults for morph and study (the nodes off the CAD model). */
+#define CLI_PATCH_MOTION_OFF_CAD                                                                      \
+    "With --off-cad fixed, the boundary nodes off G0 move by the kinds of their patches\n"      \
+    "(OpenFOAM patch types; CGNS symmetry planes): symmetryPlane/symmetry, empty, wedge and\n"  \
+    "cyclic patches slide on their plane (a curved one on its own surface), other patches\n"   \
+    "are fixed; a node on two sliding planes slides along their common line, on three or on\n" \
+    "a fixed patch it is fixed. The nodes on G0 follow the CAD whatever their patch. A .msh,\n" \
+    "VTK or other mesh without patch types has nothing that slides unless --slide names its\n" \
+    "groups. No 2-D or wedge reduction here (the morphed body is 3-D).\n"
 
 #define CLI_PATCH_MOTION_OPTIONS(pm)                                                           \
     {.name = "--slide", .kind = CLI_CUSTOM, .takes_value = 1, .parse = cli_parse_patch_list,  \
