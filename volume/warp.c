@@ -223,13 +223,9 @@ static cm_status warp_motion(cm_context *ctx, cm_mesh *mesh, const cm_mesh_bound
     cm_status s = warp_once(ctx, mesh, b, constrained, opt, work, st);
     if (s >= 0 && slides) {
         cm_motion_project_work(motion, work, &dropped1, &worst1);
-        if (free_nodes) {
-            for (size_t i = 0; i < nn; ++i)
-                constrained[i] = motion->kind[i] != CM_MOTION_FREE;
-            s = warp_once(ctx, mesh, b, constrained, opt, work, st);
-        } else
-            for (size_t i = 0; i < nn; ++i)
-                constrained[i] = motion->kind[i] != CM_MOTION_FREE;
+        for (size_t i = 0; i < nn; ++i)
+            constrained[i] = motion->kind[i] != CM_MOTION_FREE;
+        if (free_nodes) s = warp_once(ctx, mesh, b, constrained, opt, work, st);
     }
     mesh->xyz = xyz;
     if (s >= 0) cm_motion_from_work(motion, work, disp);
