@@ -12,6 +12,7 @@ packages=(
   python3-cffi python3-pytest  # the Python package (python/cadmorph) and its tests
   python3-pip python3-venv python3-setuptools  # `pip install ./python` into a venv (install test)
   openfoam  # blockMesh, snappyHexMesh, checkMesh: polyMesh test meshes and the checkMesh cross-check
+  openfoam-examples  # OpenFOAM's own tutorial cases, morphed by benchmarks/cfd/tutorials.py
   python3-matplotlib  # examples/python (plots); imported by PyGeM (make_pygem_fixture.py)
   clang libclang-rt-14-dev  # make fuzz (libFuzzer); make check-asan uses gcc's sanitizers
   libcgns-dev  # CGNS meshes (mesh/io/cgns_read.c, cgns_write.c), ADF and HDF5

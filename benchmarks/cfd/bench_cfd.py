@@ -15,8 +15,7 @@ motion and command:
   on the body, %), off-plane (largest motion normal to its plane of a point of an empty,
   wedge, symmetryPlane or cyclic patch, %).
 Nothing is hidden: a morph that checkMesh fails or the solver dies on is printed as such.
-The written case gets the source case's system/, 0/ and constant/ files that cadmorph did not
-write (counted in the last line), so that checkMesh and the solver can run on it.
+`-o OUT/` writes the whole case; the last line counts the source's files missing from it (0).
 usage: bench_cfd.py CADMORPH WORK_DIR [--size F] [--cases LIST] [--morphs warp,deform]
   --size F   multiplies every case's cell count (default 1: the sizes of the README)"""
 import argparse
