@@ -7,6 +7,7 @@
 
 #include "formats.h"
 #include "rewrite.h"
+#include "text.h"
 
 #include <sys/types.h>
 
@@ -127,7 +128,6 @@ int abq_next_field(const char **p, const char *e, const char **fb, const char **
 int abq_ends_with_comma(const char *b, const char *e);
 /* "cm_mesh_read: FILE:LINE: message", CM_ERR_FORMAT. */
 cm_status abq_err(abq_reader *r, const abq_file *f, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-int abq_parse_int(const char *b, const char *e, int64_t *v);
 int abq_parse_coord(const char *b, const char *e, double *v);
 const char *abq_show(const char *b, const char *e, char *buf, size_t cap);
 void abq_upper(char *dst, size_t cap, const char *b, const char *e);

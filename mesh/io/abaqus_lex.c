@@ -131,22 +131,6 @@ cm_status abq_err(abq_reader *r, const abq_file *f, const char *fmt, ...)
     return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: %s", f->path, f->line, msg);
 }
 
-/* An integer: an optional sign and digits, no overflow. */
-int abq_parse_int(const char *b, const char *e, int64_t *v)
-{
-    int neg = 0;
-    if (b < e && (*b == '+' || *b == '-')) neg = *b++ == '-';
-    if (b == e) return 0;
-    uint64_t x = 0;
-    for (; b < e; ++b) {
-        const unsigned d = (unsigned)(*b - '0');
-        if (d > 9 || x > (UINT64_C(9223372036854775807) - d) / 10) return 0;
-        x = 10 * x + d;
-    }
-    *v = neg ? -(int64_t)x : (int64_t)x;
-    return 1;
-}
-
 /* A coordinate: empty is 0 (Abaqus's rule for blank fields); finite only. */
 int abq_parse_coord(const char *b, const char *e, double *v)
 {

@@ -69,7 +69,7 @@ static cm_status node_line(abq_reader *r, abq_file *f, abq_block *blk, const cha
     const char *p = b, *fb, *fe;
     char show_buf[48];
     int64_t id;
-    if (!abq_next_field(&p, e, &fb, &fe) || !abq_parse_int(fb, fe, &id))
+    if (!abq_next_field(&p, e, &fb, &fe) || !cm_text_parse_int(fb, fe, &id))
         return abq_err(r, f, "expected a node id, got '%s'", abq_show(b, e, show_buf, sizeof show_buf));
     if (id < 1) return abq_err(r, f, "expected a node id >= 1, got %lld", (long long)id);
     const char *span = p;
@@ -120,7 +120,7 @@ static cm_status element_line(abq_reader *r, abq_file *f, abq_block *blk, const 
         if (blk->have == want)
             return abq_err(r, f, "expected %d nodes for element %lld of type %s, got more", want - 1,
                        (long long)blk->vals[0], blk->type_name);
-        if (!abq_parse_int(fb, fe, &v))
+        if (!cm_text_parse_int(fb, fe, &v))
             return abq_err(r, f, "expected an %s, got '%s'", blk->have ? "element's node id" : "element id",
                        abq_show(fb, fe, show_buf, sizeof show_buf));
         if (v < 1) return abq_err(r, f, "expected an id >= 1, got %lld", (long long)v);
@@ -140,7 +140,7 @@ static cm_status set_line(abq_reader *r, abq_file *f, abq_block *blk, const char
         int64_t v[3] = {0, 0, 1};
         int k = 0;
         while (abq_next_field(&p, e, &fb, &fe)) {
-            if (k == 3 || !abq_parse_int(fb, fe, &v[k]))
+            if (k == 3 || !cm_text_parse_int(fb, fe, &v[k]))
                 return abq_err(r, f, "expected 'first, last[, increment]' of GENERATE, got '%s'", abq_show(b, e, show_buf, sizeof show_buf));
             ++k;
         }
@@ -162,7 +162,7 @@ static cm_status set_line(abq_reader *r, abq_file *f, abq_block *blk, const char
     while (abq_next_field(&p, e, &fb, &fe)) {
         int64_t v;
         if (fb == fe) continue;
-        if (abq_parse_int(fb, fe, &v)) {
+        if (cm_text_parse_int(fb, fe, &v)) {
             if (v < 1) return abq_err(r, f, "expected an id >= 1, got %lld", (long long)v);
             cm_status st = abq_set_add(r, &r->sets[blk->set], blk->inst, v, 0);
             if (st != CM_OK) return st;
@@ -203,7 +203,7 @@ static cm_status surface_line(abq_reader *r, abq_file *f, abq_block *blk, const 
         }
     }
     int64_t v;
-    if (abq_parse_int(fb, fe, &v)) {
+    if (cm_text_parse_int(fb, fe, &v)) {
         if (v < 1) return abq_err(r, f, "expected an id >= 1, got %lld", (long long)v);
         ++r->members;
         return abq_set_add(r, &r->sets[blk->set], -1, v, face);

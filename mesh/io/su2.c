@@ -30,6 +30,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
 #include "rewrite.h"
+#include "text.h"
 #include "su2_internal.h"
 
 #include <ctype.h>
@@ -159,23 +160,6 @@ static int token(const char **p, const char *e, const char **tb, const char **te
     return 1;
 }
 
-/* A decimal integer filling [b, e) exactly, without overflow. */
-static int parse_int(const char *b, const char *e, int64_t *v)
-{
-    int neg = 0;
-    if (b < e && (*b == '+' || *b == '-')) neg = *b++ == '-';
-    if (b == e) return 0;
-    uint64_t x = 0;
-    for (; b < e; ++b) {
-        if (*b < '0' || *b > '9') return 0;
-        const unsigned d = (unsigned)(*b - '0');
-        if (x > (UINT64_C(9223372036854775807) - d) / 10) return 0;
-        x = 10 * x + d;
-    }
-    *v = neg ? -(int64_t)x : (int64_t)x;
-    return 1;
-}
-
 /* A finite number filling [b, e) exactly (the data is NUL-terminated: cm_file_read). */
 static int parse_real(const char *b, const char *e, double *v)
 {
@@ -204,7 +188,7 @@ static cm_status read_count(su2_reader *r, const char *value, const char *key, s
     const char *p = value, *tb = NULL, *te = NULL;
     char what[64];
     snprintf(what, sizeof what, "a count after %s=", key);
-    if (!token(&p, r->e, &tb, &te) || !parse_int(tb, te, n) || *n < 0) return expected_token(r, what, tb, te);
+    if (!token(&p, r->e, &tb, &te) || !cm_text_parse_int(tb, te, n) || *n < 0) return expected_token(r, what, tb, te);
     if (min_bytes && (uint64_t)*n > (r->size - r->pos) / min_bytes + 1)
         return fail(r, "expected at most %llu %s after %s= in the rest of the file, got %lld (truncated?)",
                     (unsigned long long)((r->size - r->pos) / min_bytes + 1),
@@ -221,7 +205,7 @@ static cm_status trailing(su2_reader *r, const char *p, int max_extra, const cha
     const char *tb, *te;
     int64_t v;
     for (int k = 0; token(&p, r->e, &tb, &te); ++k)
-        if (k >= max_extra || !parse_int(tb, te, &v)) return expected_token(r, what, tb, te);
+        if (k >= max_extra || !cm_text_parse_int(tb, te, &v)) return expected_token(r, what, tb, te);
     return CM_OK;
 }
 
@@ -269,7 +253,7 @@ static cm_status read_cells(su2_reader *r, int64_t n, int marker, long key_line)
         const char *p = r->b, *tb = NULL, *te = NULL;
         int64_t id = 0, nodes[8];
         cm_cell_type type = CM_CELL_TYPE_COUNT;
-        const int nn = token(&p, r->e, &tb, &te) && parse_int(tb, te, &id) ? cm_su2_cell(id, &type) : 0;
+        const int nn = token(&p, r->e, &tb, &te) && cm_text_parse_int(tb, te, &id) ? cm_su2_cell(id, &type) : 0;
         if (!nn) {
             char buf[48];
             return fail(r, "expected an element type (3, 5, 9, 10, 12, 13 or 14), got '%s'", shown(r, buf));
@@ -280,7 +264,7 @@ static cm_status read_cells(su2_reader *r, int64_t n, int marker, long key_line)
                         cm_cell_type_info(type)->name);
         for (int k = 0; k < nn; ++k) {
             const int got = token(&p, r->e, &tb, &te);
-            if (!got || !parse_int(tb, te, &nodes[k]) || nodes[k] < 0 || nodes[k] > INT64_MAX / 2) {
+            if (!got || !cm_text_parse_int(tb, te, &nodes[k]) || nodes[k] < 0 || nodes[k] > INT64_MAX / 2) {
                 char what[64];
                 snprintf(what, sizeof what, "node %d of a %s (a point index >= 0)", k, cm_cell_type_info(type)->name);
                 return expected_token(r, what, got ? tb : NULL, te);
@@ -433,7 +417,7 @@ static cm_status parse_su2(cm_context *ctx, const char *path, const char *data, 
                 const char *rest = NULL, *tb, *te;
                 int64_t domain = 0;
                 s = read_count(&r, value, key, 2 * (size_t)r.dim, &n, &rest);
-                if (s == CM_OK && token(&rest, r.e, &tb, &te) && (!parse_int(tb, te, &domain) || domain < 0 || domain > n))
+                if (s == CM_OK && token(&rest, r.e, &tb, &te) && (!cm_text_parse_int(tb, te, &domain) || domain < 0 || domain > n))
                     s = expected_token(&r, "the domain point count (at most the points)", tb, te);
                 if (s == CM_OK) s = trailing(&r, rest, 0, "the end of the line");
                 if (s == CM_OK && (uint64_t)n > (SIZE_MAX / 24) - r.base)

@@ -45,19 +45,27 @@ static cm_status token_error(cm_context *ctx, cm_text *t, const char *what, cons
                     (int)(len > 40 ? 40 : len), tok);
 }
 
+int cm_text_parse_int(const char *b, const char *e, int64_t *v)
+{
+    int neg = 0;
+    if (b < e && (*b == '+' || *b == '-')) neg = *b++ == '-';
+    if (b == e) return 0;
+    uint64_t x = 0;
+    for (; b < e; ++b) {
+        const unsigned d = (unsigned)(*b - '0');
+        if (d > 9 || x > (UINT64_C(9223372036854775807) - d) / 10) return 0;
+        x = 10 * x + d;
+    }
+    *v = neg ? -(int64_t)x : (int64_t)x;
+    return 1;
+}
+
 cm_status cm_text_int(cm_context *ctx, cm_text *t, const char *what, int64_t *v)
 {
     const char *tok = NULL;
     size_t len = 0;
     if (!cm_text_token(t, &tok, &len)) return token_error(ctx, t, what, NULL, 0);
-    char buf[32], *end;
-    if (len >= sizeof buf) return token_error(ctx, t, what, tok, len);
-    memcpy(buf, tok, len);
-    buf[len] = '\0';
-    errno = 0;
-    long long x = strtoll(buf, &end, 10);
-    if (*end || errno) return token_error(ctx, t, what, tok, len);
-    *v = (int64_t)x;
+    if (!cm_text_parse_int(tok, tok + len, v)) return token_error(ctx, t, what, tok, len);
     return CM_OK;
 }
 

@@ -21,6 +21,9 @@ void cm_text_init(cm_text *t, const char *path, const char *data, size_t size);
 int cm_text_skip_space(cm_text *t);
 /* Next whitespace-separated token: *tok points into data, *len its length; 0 at end. */
 int cm_text_token(cm_text *t, const char **tok, size_t *len);
+/* A decimal integer filling [b, e) exactly: an optional sign and digits, refused (0) on
+ * anything else or on overflow; 1 with *v set. */
+int cm_text_parse_int(const char *b, const char *e, int64_t *v);
 /* Next token parsed as integer / double; on failure sets a message naming path:line and
  * `what` (e.g. "node count") and returns CM_ERR_FORMAT. */
 cm_status cm_text_int(cm_context *ctx, cm_text *t, const char *what, int64_t *v);
