@@ -4,6 +4,9 @@ the cadmorph CLI in bounded time, and checks the exit code from the README's lis
 stderr line that matches the case's pattern and names the file, and peak memory.
 
 usage: hostile.py CADMORPH DATA_DIR WORK_DIR CASE       (CASE 'list' prints the cases)
+
+The other tests/cli/hostile_*.py scripts share this frame: they import it, register their
+cases with @case and end with `hostile.main()`; each lists only its own cases.
 """
 import os
 import re
@@ -472,10 +475,18 @@ def inp_many_sets():
     run(["quality", p], 0, None, lines=0)
 
 
-if __name__ == "__main__":
+def main():
+    """Lists the cases of the script being run, or runs the one named on the command line."""
+    own = [n for n, fn in cases.items() if fn.__module__ == "__main__"]
     if CASE == "list":
-        print("\n".join(cases))
+        print("\n".join(own))
         sys.exit(0)
+    if CASE not in own:
+        fail(f"no case {CASE!r}")
     os.makedirs(WORK, exist_ok=True)
     cases[CASE]()
     print("ok")
+
+
+if __name__ == "__main__":
+    main()
