@@ -45,6 +45,12 @@ double cm_bbox_diagonal(const double bb[6]);
 double cm_wtime(void);
 double cm_memory_budget(void);
 cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *size);
+cm_status cm_file_read_text(cm_context *ctx, const char *path, size_t max_line,
+const char *what, char **data, size_t *size);
+cm_status cm_file_open_read(cm_context *ctx, const char *path, FILE **f);
+FILE *cm_file_open_quiet(const char *path, const char **why);
+int cm_file_read_line(cm_context *ctx, FILE *f, const char *path, const char *what,
+long *line, char *buf, size_t cap, size_t *len);
 typedef struct cm_outfile {
 FILE *f;
 char *path;

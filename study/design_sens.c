@@ -9,6 +9,10 @@
 #include <string.h>
 #include <strings.h>
 
+/* node,gx,gy,gz: four numbers; a longer line (a binary file, no newlines) is refused while
+ * the file is read */
+#define SENS_LINE_MAX 4096
+
 static int ends_with_csv(const char *p)
 {
     size_t n = strlen(p);
@@ -39,7 +43,8 @@ static cm_status read_csv(cm_context *ctx, const char *path, size_t nn, double *
 {
     char *text = NULL;
     size_t size = 0;
-    cm_status s = cm_file_read(ctx, path, &text, &size);
+    cm_status s = cm_file_read_text(ctx, path, SENS_LINE_MAX, "a sensitivity CSV (node,gx,gy,gz)",
+                                    &text, &size);
     if (s < 0) return s;
     unsigned char *seen = calloc(nn ? nn : 1, 1);
     if (!seen) {

@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <glob.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,18 +49,35 @@ static cm_status push(cm_context *ctx, path_list *l, const char *dir, size_t dir
 }
 
 
+/* A list line holds one path and perhaps a comment: a line longer than this is not a list
+ * (a binary file, /dev/zero's endless line). */
+#define LIST_LINE_MAX (PATH_MAX + 256)
+
+static const char list_what[] = "a list of STEP paths";
+
 static cm_status read_file(cm_context *ctx, const char *list, path_list *l)
 {
-    FILE *f = fopen(list, "r");
-    if (!f) return cm_error(ctx, CM_ERR_IO, "%s: cannot read: %s", list, strerror(errno));
+    FILE *f = NULL;
+    cm_status s = cm_file_open_read(ctx, list, &f);
+    if (s < 0) return s;
     const char *slash = strrchr(list, '/');
     size_t dir_len = slash ? (size_t)(slash - list) + 1 : 0;
-    char *line = NULL;
-    size_t size = 0;
+    char *line = malloc(LIST_LINE_MAX + 1);
+    if (!line) {
+        fclose(f);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_study_read_list: out of memory");
+    }
     long lineno = 0;
-    cm_status s = CM_OK;
-    while (s >= 0 && getline(&line, &size, f) >= 0) {
-        ++lineno;
+    size_t len = 0;
+    int rc;
+    while ((rc = cm_file_read_line(ctx, f, list, list_what, &lineno, line, LIST_LINE_MAX + 1, &len)) > 0) {
+        /* a STEP file given where its list was meant: say so instead of "no such file" for
+         * its first line */
+        if (lineno == 1 && !strncmp(line, "ISO-10303-21;", 13)) {
+            rc = cm_error(ctx, CM_ERR_FORMAT, "%s: a STEP file, not a list of variants (expected a "
+                          "list of STEP paths, a quoted glob pattern or a design table)", list);
+            break;
+        }
         char *hash = strchr(line, '#');
         if (hash) *hash = 0;
         char *b = line, *e = line + strlen(line);
@@ -67,15 +85,17 @@ static cm_status read_file(cm_context *ctx, const char *list, path_list *l)
         while (e > b && (e[-1] == ' ' || e[-1] == '\t' || e[-1] == '\n' || e[-1] == '\r')) --e;
         if (e == b) continue;
         *e = 0;
-        s = push(ctx, l, list, dir_len, b, (size_t)(e - b));
-        if (s < 0) break;
+        rc = push(ctx, l, list, dir_len, b, (size_t)(e - b));
+        if (rc < 0) break;
         const char *why = cm_study_unreadable(l->v[l->n - 1]);
-        if (why)
-            s = cm_error(ctx, CM_ERR_IO, "%s:%ld: %s: %s", list, lineno, l->v[l->n - 1], why);
+        if (why) {
+            rc = cm_error(ctx, CM_ERR_IO, "%s:%ld: %s: %s", list, lineno, l->v[l->n - 1], why);
+            break;
+        }
     }
-    if (s >= 0 && ferror(f)) s = cm_error(ctx, CM_ERR_IO, "%s: read error", list);
     free(line);
     fclose(f);
+    s = rc < 0 ? (cm_status)rc : CM_OK;
     if (s >= 0 && l->n == 0) s = cm_error(ctx, CM_ERR_FORMAT, "%s: no STEP paths", list);
     return s;
 }

@@ -8,8 +8,8 @@
  * csv.c. */
 void cm_csv_field(FILE *f, const char *s);
 
-/* NULL for a readable regular file, else the reason ("is a directory", strerror):
- * readable.c. */
+/* NULL for a readable regular file, else the reason ("not a regular file (a directory)",
+ * "cannot open: <strerror>"), found without blocking on a FIFO: readable.c. */
 const char *cm_study_unreadable(const char *path);
 
 #endif

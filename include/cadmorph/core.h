@@ -138,9 +138,37 @@ CM_API double cm_memory_budget(void);
 
 /* ---- files ---- */
 
+/* Every input is opened by the functions below (docs/DESIGN.md, "Reading input"): regular
+ * files only, refused without blocking otherwise ("<path>: not a regular file (a FIFO)", a
+ * directory, a device, ...). */
+
 /* Reads a whole regular file into *data (NUL-terminated; *size excludes the NUL). The caller
  * frees *data. CM_ERR_IO with the path and the reason on failure. */
 CM_API cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *size);
+
+/* As cm_file_read for a text file whose lines are at most max_line bytes (the newline not
+ * counted): a longer line or a NUL byte is CM_ERR_FORMAT "<path>:<line>: longer than K
+ * bytes: not <what>" (what: e.g. "a design table"; NULL: "a text file"), found while reading,
+ * so that a huge file without a newline costs about max_line bytes of memory. */
+CM_API cm_status cm_file_read_text(cm_context *ctx, const char *path, size_t max_line,
+                                   const char *what, char **data, size_t *size);
+
+/* Opens a regular file for streaming reads ("rb"); the caller fcloses *f. CM_ERR_IO with the
+ * path and the reason on failure. */
+CM_API cm_status cm_file_open_read(cm_context *ctx, const char *path, FILE **f);
+
+/* The same rule without a context, for looking at a file's first bytes: the stream, or NULL
+ * with *why (if why is not NULL) the reason, e.g. "not a regular file (a FIFO)" (valid until
+ * the thread's next call). */
+CM_API FILE *cm_file_open_quiet(const char *path, const char **why);
+
+/* Reads the next line of f into buf (cap >= 2 bytes; the newline is dropped, a '\r' kept) and
+ * counts it in *line: 1 and its length in *len, 0 at the end of the file, or CM_ERR_FORMAT
+ * for a line of cap bytes or more or a NUL byte ("<path>:<line>: longer than K bytes: not
+ * <what>"), CM_ERR_IO for a read error. At most cap bytes are kept whatever the line's
+ * length. */
+CM_API int cm_file_read_line(cm_context *ctx, FILE *f, const char *path, const char *what,
+                             long *line, char *buf, size_t cap, size_t *len);
 
 /* Output through a temporary "<dir of path>/.cm-XXXXXX", renamed onto path by
  * cm_outfile_commit, so that a failed write never leaves a partial file. Write with

@@ -100,10 +100,12 @@ CM_API void cm_study_family_release(cm_study_family *family);
 /* The variants of `cadmorph study --variants LIST`: LIST is a text file of STEP paths (one per
  * line; blank lines and '#' comments skipped, surrounding blanks trimmed, a relative path is
  * relative to the list file's directory) or, when it is not an existing file and contains
- * '*', '?' or '[', a glob(3) pattern (matches sorted). Every path must name a readable file.
- * Errors: CM_ERR_IO "LIST: cannot read: ..." or "LIST:<line>: <path>: No such file ...",
- * CM_ERR_FORMAT "LIST: no STEP paths" for an empty list, CM_ERR_IO for a glob matching no
- * file. *paths: *n strings, free with cm_study_paths_free. */
+ * '*', '?' or '[', a glob(3) pattern (matches sorted). Every path must name a readable
+ * regular file. Errors: CM_ERR_IO "LIST: cannot open: ...", "LIST: not a regular file (a
+ * FIFO)" or "LIST:<line>: <path>: cannot open: No such file ..." (or "not a regular file
+ * (...)"), CM_ERR_FORMAT "LIST: no STEP paths" for an empty list, "LIST:<line>: longer than K
+ * bytes: not a list of STEP paths" (K = PATH_MAX + 256), a NUL byte, or a STEP file given as
+ * the list; CM_ERR_IO for a glob matching no file. *paths: *n strings, free with cm_study_paths_free. */
 CM_API cm_status cm_study_read_list(cm_context *ctx, const char *list, char ***paths, size_t *n);
 
 /* The variants of a design table (a `--variants T.csv` whose header is `step,<p1>,...`,

@@ -24,8 +24,8 @@ void cm_cgns_unlock(void) { pthread_mutex_unlock(&cgns_mutex); }
 int cm_cgns_magic_ok(const char *path)
 {
     unsigned char b[32] = {0};
-    FILE *f = fopen(path, "rb");
-    if (!f) return 1; /* let the library say why it cannot open it */
+    FILE *f = cm_file_open_quiet(path, NULL);
+    if (!f) return 1; /* the reader says why it cannot open it */
     size_t n = fread(b, 1, sizeof b, f);
     fclose(f);
     static const unsigned char hdf5[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
@@ -666,8 +666,11 @@ cm_status cm_mesh_read_cgns(cm_context *ctx, const char *path, cm_mesh **mesh)
 {
     if (!mesh || !path) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_read_cgns: NULL argument");
     *mesh = NULL;
-    FILE *f = fopen(path, "rb");
-    if (!f) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: cannot open", path);
+    /* the input rule (core.h): a FIFO or a directory is refused here, before the CGNS
+     * library opens (and blocks on) it */
+    FILE *f = NULL;
+    cm_status s0 = cm_file_open_read(ctx, path, &f);
+    if (s0 != CM_OK) return cm_error_prefix(ctx, s0, "cm_mesh_read");
     fclose(f);
     if (!cm_cgns_magic_ok(path))
         return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: /: not a CGNS file (neither HDF5 nor ADF)", path);

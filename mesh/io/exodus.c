@@ -652,15 +652,15 @@ static cm_status read_side_sets(exo_reader *r)
 /* Whether the file starts as netCDF classic/64-bit/CDF-5 or HDF5 (netCDF-4) does. */
 static cm_status check_signature(cm_context *ctx, const char *path, struct stat *st)
 {
-    if (stat(path, st) != 0)
-        return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: %s", path, strerror(errno));
-    if (!S_ISREG(st->st_mode))
-        return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: not a regular file", path);
+    /* the input rule (core.h): regular files only, never a blocking open */
+    FILE *f = NULL;
+    cm_status s = cm_file_open_read(ctx, path, &f);
+    if (s != CM_OK) return cm_error_prefix(ctx, s, "cm_mesh_read");
     unsigned char head[8] = {0};
-    FILE *f = fopen(path, "rb");
-    if (!f) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: %s", path, strerror(errno));
+    const int sr = fstat(fileno(f), st);
     const size_t n = fread(head, 1, sizeof head, f);
     fclose(f);
+    if (sr != 0) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: %s", path, strerror(errno));
     const int cdf = n >= 4 && !memcmp(head, "CDF", 3) && (head[3] == 1 || head[3] == 2 || head[3] == 5);
     const int hdf = n == 8 && !memcmp(head, "\x89HDF\r\n\x1a\n", 8);
     if (!cdf && !hdf)

@@ -96,15 +96,14 @@ static cm_mesh_format format_of_content(const char *path)
 {
     char head[4097];
     size_t n = 0;
-    struct stat st;
     int have = 0;
     for (size_t i = 0; i < cm_mesh_format_row_count; ++i) {
         const cm_mesh_format_row *r = &cm_mesh_format_rows[i];
         if (!r->sniff || !has_extension(i, path)) continue;
         if (!have) {
             have = 1;
-            /* regular files only: opening a FIFO would block (cm_file_read has the same rule) */
-            FILE *f = stat(path, &st) == 0 && S_ISREG(st.st_mode) ? fopen(path, "rb") : NULL;
+            /* the input rule (core.h): opening a FIFO would block */
+            FILE *f = cm_file_open_quiet(path, NULL);
             if (f) {
                 n = fread(head, 1, sizeof head - 1, f);
                 fclose(f);

@@ -268,8 +268,9 @@ static cm_status rewrite_one(cm_context *ctx, const cm_rewrite_source *src, cons
         if (f->spans[i].node < 0 || (size_t)f->spans[i].node >= mesh->n_nodes)
             return cm_error(ctx, CM_ERR_INTERNAL, "%s: coordinate span of node %lld outside the mesh", f->path,
                             (long long)f->spans[i].node);
-    FILE *in = fopen(f->path, "rb");
-    if (!in) return cm_error(ctx, CM_ERR_IO, "%s: cannot open: %s", f->path, strerror(errno));
+    FILE *in = NULL;
+    s = cm_file_open_read(ctx, f->path, &in); /* the input rule (core.h): no FIFO, no device */
+    if (s != CM_OK) return s;
     const int threads = cm_context_threads_for(ctx, f->n_spans, 4096);
     cm_rewrite_buf *bufs = calloc((size_t)threads, sizeof *bufs);
     span_out *outs = NULL;
@@ -389,10 +390,11 @@ cm_status cm_rewrite_copy_open(cm_context *ctx, const char *source, const cm_fil
     if (s != CM_OK) return s;
     s = cm_outfile_open(ctx, path, out);
     if (s != CM_OK) return s;
-    FILE *in = fopen(source, "rb");
+    const char *why = NULL;
+    FILE *in = cm_file_open_quiet(source, &why); /* the input rule (core.h): no FIFO, no device */
     if (!in) {
-        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot open the file the mesh was read from, %s: %s",
-                     path, source, strerror(errno));
+        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: the file the mesh was read from, %s: %s",
+                     path, source, why);
         cm_outfile_abort(out);
         return s;
     }
