@@ -80,8 +80,9 @@ static int print_help(void)
         "options:\n",
         cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
-    printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed .prm or CSV, a lattice that is not\n"
-           "invertible).\n");
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed .prm or CSV, a number that is not\n"
+           "finite, a box length of 0, a displacement - weight times box length - or a box beyond\n"
+           "1e150, a lattice that is not invertible), 3 a result that is not finite (not written).\n");
     return CLI_EXIT_OK;
 }
 
