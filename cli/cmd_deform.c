@@ -141,6 +141,16 @@ static int parse_args(int argc, char **argv, deform_args *a)
     return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 4) ? CLI_EXIT_USAGE : -1;
 }
 
+/* The mesh moved by the method; a non-finite result (refused by cm_mesh_write) names the
+ * method that made it. */
+static cm_status write_result(cm_context *ctx, const cm_mesh *mesh, const deform_args *a)
+{
+    cm_status s = cm_mesh_write(ctx, mesh, a->out, NULL);
+    if (s == CM_ERR_REJECTED)
+        s = cm_error_prefix(ctx, s, "the %s deformation of %s", cm_deform_method_name(a->method), a->handles);
+    return s;
+}
+
 int cli_cmd_deform(int argc, char **argv)
 {
     deform_args a;
@@ -260,7 +270,7 @@ int cli_cmd_deform(int argc, char **argv)
             }
             if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "mean_curvature", CM_FIELD_NODE, 1, &field);
             if (s >= 0) memcpy(field, H, n * sizeof *field);
-            if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
+            if (s >= 0) s = write_result(ctx, mesh, &a);
             if (s >= 0) {
                 printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
                        cm_deform_method_name(a.method), nh, nf, n - nh - nf, t1 - t0, residual);
@@ -272,7 +282,7 @@ int cli_cmd_deform(int argc, char **argv)
         }
     }
     if (s >= 0 && volume) {
-        s = cm_mesh_write(ctx, mesh, a.out, NULL);
+        s = write_result(ctx, mesh, &a);
         if (s >= 0) {
             printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
                    cm_deform_method_name(a.method), nh, nf, n - nh - nf, t1 - t0, residual);

@@ -153,7 +153,11 @@ int cli_cmd_ffd(int argc, char **argv)
     if (s >= 0)
         s = cm_mesh_apply_displacement(ctx, mesh, disp, CM_DISPLACEMENT_MOVE | CM_DISPLACEMENT_QUALITY,
                                        &sj);
-    if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
+    if (s >= 0) {
+        s = cm_mesh_write(ctx, mesh, a.out, NULL);
+        /* a non-finite result: what made it */
+        if (s == CM_ERR_REJECTED) s = cm_error_prefix(ctx, s, "the motion of %s", a.csv ? a.csv : a.lattice);
+    }
     if (s >= 0) {
         printf("ffd: %zu nodes: %zu inside the lattice, %zu outside (not moved), %zu not "
                "inverted by Newton\n",

@@ -112,7 +112,10 @@ int cli_cmd_optimize(int argc, char **argv)
             start[i] = mesh->xyz[i] - start[i];
         s = cm_mesh_apply_displacement(ctx, mesh, start, CM_DISPLACEMENT_QUALITY, &sj);
     }
-    if (s >= 0) s = cm_mesh_write(ctx, mesh, out, NULL);
+    if (s >= 0) {
+        s = cm_mesh_write(ctx, mesh, out, NULL);
+        if (s == CM_ERR_REJECTED) s = cm_error_prefix(ctx, s, "the optimisation of %s", in); /* non-finite */
+    }
     int rc = CLI_EXIT_OK;
     if (s >= 0) {
         printf("optimize: %zu interior nodes worked on, %zu moves in %d passes; min scaled "
