@@ -141,6 +141,16 @@ static int parse_args(int argc, char **argv, deform_args *a)
     return cli_check_mesh_output(cmd, usage_line, a->out, inputs, 4) ? CLI_EXIT_USAGE : -1;
 }
 
+/* The mesh moved by the method; a non-finite result (refused by cm_mesh_write) names the
+ * method that made it. */
+static cm_status write_result(cm_context *ctx, const cm_mesh *mesh, const deform_args *a)
+{
+    cm_status s = cm_mesh_write(ctx, mesh, a->out, NULL);
+    if (s == CM_ERR_REJECTED)
+        s = cm_error_prefix(ctx, s, "the %s deformation of %s", cm_deform_method_name(a->method), a->handles);
+    return s;
+}
+
 int cli_cmd_deform(int argc, char **argv)
 {
     deform_args a;
@@ -191,7 +201,9 @@ int cli_cmd_deform(int argc, char **argv)
         if (fixed[i]) con[i] = 1, disp[3 * i] = disp[3 * i + 1] = disp[3 * i + 2] = 0;
         else if (con[i]) con[i] = 2; /* the MLS weighs handle and fixed groups apart */
     }
-    if (s >= 0 && nh == 0) s = cm_error(ctx, CM_ERR_ARGUMENT, "%s: no handle node", a.handles);
+    /* every listed node is a handle (one listed as fixed too is refused above): none is a
+     * table without rows, bad input like any other malformed file */
+    if (s >= 0 && nh == 0) s = cm_error(ctx, CM_ERR_FORMAT, "%s: no rows after the header", a.handles);
     double residual = 0, t0 = cm_wtime();
     if (s >= 0 && a.method == CM_DEFORM_SHELL && volume)
         s = cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: --method shell deforms surface meshes only", a.mesh);
@@ -208,8 +220,11 @@ int cli_cmd_deform(int argc, char **argv)
      * constraints have no node to move */
     if (s >= 0 && cli_constraints_any(&a.cons) && cm_deform_get_mls(def))
         s = cli_constraints_run(ctx, cm_deform_get_mls(def), mesh, &a.cons, sets, disp, &residual);
-    else if (s >= 0)
+    else if (s >= 0) {
         s = cm_deform_apply(ctx, def, disp, &residual);
+        /* the shell refuses a degenerate face of the surface it was given: say which file */
+        if (s == CM_ERR_FORMAT && a.method == CM_DEFORM_SHELL) s = cm_error_prefix(ctx, s, "%s", a.mesh);
+    }
     if (shaped) cli_constraints_free(&a.cons, sets);
     cm_deform_stats st;
     cm_deform_get_stats(def, &st);
@@ -255,7 +270,7 @@ int cli_cmd_deform(int argc, char **argv)
             }
             if (s >= 0) s = cm_mesh_add_field(ctx, mesh, "mean_curvature", CM_FIELD_NODE, 1, &field);
             if (s >= 0) memcpy(field, H, n * sizeof *field);
-            if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
+            if (s >= 0) s = write_result(ctx, mesh, &a);
             if (s >= 0) {
                 printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
                        cm_deform_method_name(a.method), nh, nf, n - nh - nf, t1 - t0, residual);
@@ -267,7 +282,7 @@ int cli_cmd_deform(int argc, char **argv)
         }
     }
     if (s >= 0 && volume) {
-        s = cm_mesh_write(ctx, mesh, a.out, NULL);
+        s = write_result(ctx, mesh, &a);
         if (s >= 0) {
             printf("deform: %s, %zu handle nodes, %zu fixed, %zu free, %.3f s, residual %.6g\n",
                    cm_deform_method_name(a.method), nh, nf, n - nh - nf, t1 - t0, residual);

@@ -80,8 +80,9 @@ static int print_help(void)
         "options:\n",
         cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
-    printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed .prm or CSV, a lattice that is not\n"
-           "invertible).\n");
+    printf("\nexit codes: 0 done, 1 usage, 2 bad input (malformed .prm or CSV, a number that is not\n"
+           "finite, a box length of 0, a displacement - weight times box length - or a box beyond\n"
+           "1e150, a lattice that is not invertible), 3 a result that is not finite (not written).\n");
     return CLI_EXIT_OK;
 }
 
@@ -152,7 +153,11 @@ int cli_cmd_ffd(int argc, char **argv)
     if (s >= 0)
         s = cm_mesh_apply_displacement(ctx, mesh, disp, CM_DISPLACEMENT_MOVE | CM_DISPLACEMENT_QUALITY,
                                        &sj);
-    if (s >= 0) s = cm_mesh_write(ctx, mesh, a.out, NULL);
+    if (s >= 0) {
+        s = cm_mesh_write(ctx, mesh, a.out, NULL);
+        /* a non-finite result: what made it */
+        if (s == CM_ERR_REJECTED) s = cm_error_prefix(ctx, s, "the motion of %s", a.csv ? a.csv : a.lattice);
+    }
     if (s >= 0) {
         printf("ffd: %zu nodes: %zu inside the lattice, %zu outside (not moved), %zu not "
                "inverted by Newton\n",

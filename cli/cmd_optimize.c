@@ -5,6 +5,7 @@
 
 #include "cadmorph/optimize.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,6 +54,30 @@ static int print_help(void)
     return CLI_EXIT_OK;
 }
 
+/* Exit 3 says why on one line (README, "Exit codes"): how many cells stay inverted and the
+ * worst of them (the lowest scaled Jacobian of a volume cell, NaN first). */
+static int rejected(const cm_mesh *mesh, const double *sj, const cm_optimize_stats *st, const char *path)
+{
+    size_t worst = (size_t)-1;
+    double wv = INFINITY;
+    for (size_t c = 0; sj && c < mesh->n_cells; ++c) {
+        const cm_cell_info *info = cm_cell_type_info((cm_cell_type)mesh->type[c]);
+        if (!info || info->dim != 3) continue;
+        const double v = isnan(sj[c]) ? -INFINITY : sj[c];
+        if (worst == (size_t)-1 || v < wv) wv = v, worst = c;
+    }
+    if (worst == (size_t)-1)
+        fprintf(stderr, "cadmorph optimize: %zu inverted cells remain; %s is written all the same\n",
+                st->inverted_after, path);
+    else
+        fprintf(stderr,
+                "cadmorph optimize: %zu inverted cell%s remain%s (the worst: cell %zu, 0-based, %s, scaled "
+                "Jacobian %.6g); written all the same, no worse than the input: %s\n",
+                st->inverted_after, st->inverted_after == 1 ? "" : "s", st->inverted_after == 1 ? "s" : "",
+                worst, cm_cell_type_info((cm_cell_type)mesh->type[worst])->name, isnan(sj[worst]) ? NAN : sj[worst], path);
+    return CLI_EXIT_REJECTED;
+}
+
 int cli_cmd_optimize(int argc, char **argv)
 {
     static const char *cmd = "optimize";
@@ -87,7 +112,10 @@ int cli_cmd_optimize(int argc, char **argv)
             start[i] = mesh->xyz[i] - start[i];
         s = cm_mesh_apply_displacement(ctx, mesh, start, CM_DISPLACEMENT_QUALITY, &sj);
     }
-    if (s >= 0) s = cm_mesh_write(ctx, mesh, out, NULL);
+    if (s >= 0) {
+        s = cm_mesh_write(ctx, mesh, out, NULL);
+        if (s == CM_ERR_REJECTED) s = cm_error_prefix(ctx, s, "the optimisation of %s", in); /* non-finite */
+    }
     int rc = CLI_EXIT_OK;
     if (s >= 0) {
         printf("optimize: %zu interior nodes worked on, %zu moves in %d passes; min scaled "
@@ -99,7 +127,7 @@ int cli_cmd_optimize(int argc, char **argv)
     if (s < 0)
         rc = cli_fail(ctx, cmd, s);
     else if (st.inverted_after > 0)
-        rc = CLI_EXIT_REJECTED; /* written all the same: it is better than the input */
+        rc = rejected(mesh, sj, &st, out); /* written all the same: it is better than the input */
     free(start);
     cm_mesh_destroy(&mesh);
     cm_context_destroy(&ctx);

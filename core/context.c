@@ -126,12 +126,12 @@ void cm_context_set_progress(cm_context *ctx, cm_progress_fn fn, void *user)
 
 /* A message is one line (the CLI prints it as "cadmorph <cmd>: <message>"), and parts of it
  * come from files: control characters (newlines, escape sequences) become \n, \r, \t or
- * \xHH, so that nothing a file holds can break the line or drive the terminal. */
-static void escape_controls(char *msg, size_t size)
+ * \xHH, so that nothing a file holds can break the line or drive the terminal. Writes at most
+ * cap - 1 characters and a NUL. */
+static void escape_controls(char *out, size_t cap, const char *msg)
 {
-    char out[CM_MESSAGE_MAX];
     size_t k = 0;
-    for (const unsigned char *p = (const unsigned char *)msg; *p && k + 5 < sizeof out && k + 5 < size; ++p) {
+    for (const unsigned char *p = (const unsigned char *)msg; *p && k + 5 < cap; ++p) {
         if (*p >= 0x20 && *p != 0x7f) {
             out[k++] = (char)*p;
         } else if (*p == '\n' || *p == '\r' || *p == '\t') {
@@ -142,41 +142,140 @@ static void escape_controls(char *msg, size_t size)
         }
     }
     out[k] = '\0';
-    memcpy(msg, out, k + 1);
+}
+
+/* Long words of a message are paths (the readers quote file contents at most 60 characters
+ * long): a word longer than CM_WORD_MAX is shortened in the middle, "/head/.../name.vtu",
+ * keeping its last component whole up to CM_NAME_MAX characters, so that a message about a
+ * path of any length still fits the message buffer and its reason, after the path, is never
+ * cut off. Words end at blanks and quotes; "name.vtu:12:" stays one word, its line kept. */
+#define CM_WORD_MAX 200
+#define CM_NAME_MAX 100
+
+static int word_end(char c)
+{
+    return c == '\0' || c == ' ' || c == '\t' || c == '\'' || c == '"' || c == '`' || c == '(' ||
+           c == ')' || c == ',' || c == ';';
+}
+
+/* Appends w[0..n) to out at *k (out holds cap bytes, the last for the NUL). */
+static void put(char *out, size_t cap, size_t *k, const char *w, size_t n)
+{
+    for (size_t i = 0; i < n && *k + 1 < cap; ++i)
+        out[(*k)++] = w[i];
+}
+
+/* One word of n characters, at most CM_WORD_MAX once shortened. */
+static void put_word(char *out, size_t cap, size_t *k, const char *w, size_t n)
+{
+    if (n <= CM_WORD_MAX) {
+        put(out, cap, k, w, n);
+        return;
+    }
+    /* the last component: after the last '/' that is not the word's last character */
+    size_t slash = n - 1;
+    while (slash > 0 && w[slash - 1] != '/')
+        --slash;
+    const size_t name = n - slash; /* slash == 0: no directory part */
+    if (slash > 0 && name <= CM_NAME_MAX) {
+        /* "<head>/.../<name>", the head cut at a '/' where it has one */
+        size_t head = CM_WORD_MAX - 5 - name, cut = head;
+        while (cut > 1 && w[cut] != '/')
+            --cut;
+        if (w[cut] == '/') {
+            put(out, cap, k, w, cut);
+            put(out, cap, k, "/.../", 5);
+        } else {
+            put(out, cap, k, w, head);
+            put(out, cap, k, ".../", 4);
+        }
+        put(out, cap, k, w + slash, name);
+        return;
+    }
+    /* no directory part, or a name too long itself: its start and its end (the extension) */
+    const size_t tail = (CM_WORD_MAX - 3) / 3, head = CM_WORD_MAX - 3 - tail;
+    put(out, cap, k, w, head);
+    put(out, cap, k, "...", 3);
+    put(out, cap, k, w + n - tail, tail);
+}
+
+/* msg, escaped and with its long words shortened, into out (cap bytes). */
+static void compose(char *out, size_t cap, const char *msg)
+{
+    char small[4 * CM_MESSAGE_MAX + 1];
+    const size_t n = strlen(msg);
+    /* escaping makes a character at most four */
+    char *esc = 4 * n + 1 <= sizeof small ? small : malloc(4 * n + 1);
+    size_t esc_cap = esc == small ? sizeof small : 4 * n + 1;
+    if (!esc) esc = small, esc_cap = sizeof small; /* out of memory: the message's start */
+    escape_controls(esc, esc_cap, msg);
+    size_t k = 0;
+    for (const char *p = esc; *p && k + 1 < cap;) {
+        const char *e = p;
+        while (!word_end(*e))
+            ++e;
+        put_word(out, cap, &k, p, (size_t)(e - p));
+        if (*e) put(out, cap, &k, e++, 1);
+        p = e;
+    }
+    out[k] = '\0';
+    if (esc != small) free(esc);
+}
+
+/* The whole text of a printf-style message: on the stack when it fits, else on the heap (the
+ * caller frees *heap); NULL when it cannot be formatted at all. */
+static const char *format_all(char *buf, size_t size, char **heap, const char *fmt, va_list ap)
+{
+    va_list aq;
+    va_copy(aq, ap);
+    const int len = vsnprintf(buf, size, fmt, aq);
+    va_end(aq);
+    *heap = NULL;
+    if (len < 0) return NULL;
+    if ((size_t)len < size) return buf;
+    *heap = malloc((size_t)len + 1);
+    if (!*heap) return buf; /* out of memory: the message's start */
+    vsnprintf(*heap, (size_t)len + 1, fmt, ap);
+    return *heap;
 }
 
 cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
 {
-    if (ctx) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(ctx->message, sizeof ctx->message, fmt, ap);
-        va_end(ap);
-        escape_controls(ctx->message, sizeof ctx->message);
-    }
+    if (!ctx) return code;
+    char buf[CM_MESSAGE_MAX], *heap;
+    va_list ap;
+    va_start(ap, fmt);
+    const char *msg = format_all(buf, sizeof buf, &heap, fmt, ap);
+    va_end(ap);
+    compose(ctx->message, sizeof ctx->message, msg ? msg : "");
+    free(heap);
     return code;
 }
 
 cm_status cm_error_prefix(cm_context *ctx, cm_status code, const char *fmt, ...)
 {
     if (!ctx) return code;
-    char prefix[CM_MESSAGE_MAX], old[CM_MESSAGE_MAX];
+    char buf[CM_MESSAGE_MAX], *heap;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(prefix, sizeof prefix, fmt, ap);
+    const char *prefix = format_all(buf, sizeof buf, &heap, fmt, ap);
     va_end(ap);
-    /* copy first: the message is rewritten from itself */
-    snprintf(old, sizeof old, "%s", ctx->message);
-    size_t n = strlen(prefix), size = sizeof ctx->message;
-    if (n > size - 3) n = size - 3;
-    memcpy(ctx->message, prefix, n);
-    memcpy(ctx->message + n, ": ", 2);
-    n += 2;
-    size_t k = strlen(old);
-    if (k > size - 1 - n) k = size - 1 - n; /* a long message loses its end, not its start */
-    memcpy(ctx->message + n, old, k);
-    ctx->message[n + k] = 0;
-    escape_controls(ctx->message, sizeof ctx->message);
+    if (!prefix) prefix = "";
+    /* the old message is composed already (escaped, its words short): composing it again
+     * leaves it as it is */
+    const size_t np = strlen(prefix), no = strlen(ctx->message);
+    char both[2 * CM_MESSAGE_MAX];
+    char *all = np + 2 + no + 1 <= sizeof both ? both : malloc(np + 2 + no + 1);
+    if (all) {
+        memcpy(all, prefix, np);
+        memcpy(all + np, ": ", 2);
+        memcpy(all + np + 2, ctx->message, no + 1);
+        compose(ctx->message, sizeof ctx->message, all);
+    } else {
+        compose(ctx->message, sizeof ctx->message, prefix); /* out of memory: where, at least */
+    }
+    if (all != both) free(all);
+    free(heap);
     return code;
 }
 
@@ -198,13 +297,14 @@ double cm_bbox_diagonal(const double bb[6])
 void cm_log(cm_context *ctx, cm_log_level level, const char *fmt, ...)
 {
     if (!ctx || !ctx->log) return;
-    char buf[CM_MESSAGE_MAX];
+    char buf[CM_MESSAGE_MAX], line[CM_MESSAGE_MAX], *heap;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
+    const char *msg = format_all(buf, sizeof buf, &heap, fmt, ap);
     va_end(ap);
-    escape_controls(buf, sizeof buf);
-    ctx->log(ctx->log_user, level, buf);
+    compose(line, sizeof line, msg ? msg : "");
+    free(heap);
+    ctx->log(ctx->log_user, level, line);
 }
 
 void cm_context_interrupt(cm_context *ctx)

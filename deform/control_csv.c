@@ -95,6 +95,11 @@ cm_status cm_ffd_read_displacements(cm_context *ctx, const char *path, const int
             if (end == f[c + 3] || *end || errno == ERANGE || !isfinite(v[c]))
                 s = cm_error(ctx, CM_ERR_FORMAT, "%s:%d: %s '%s' is not a finite number", path,
                              line, names[c + 3], f[c + 3]);
+            /* the bound of the .prm's displacements (prm.c): beyond it the moved nodes' cubes
+             * overflow */
+            else if (fabs(v[c]) > 1e150)
+                s = cm_error(ctx, CM_ERR_FORMAT, "%s:%d: %s %s is beyond any mesh (|d| <= 1e150)",
+                             path, line, names[c + 3], f[c + 3]);
         }
         if (s < 0) break;
         size_t idx = ((size_t)ijk[0] * n[1] + ijk[1]) * n[2] + ijk[2];

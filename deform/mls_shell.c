@@ -15,6 +15,43 @@ typedef struct tri_list {
     int64_t *v; /* n x 3 */
 } tri_list;
 
+/* A face with a repeated corner or no area is bad input, not a system to factor: its rows
+ * would repeat an index in one CHOLMOD column (CHOLMOD refuses the matrix) or leave its nodes
+ * without area (a singular system). The caller knows the file and adds it. */
+static cm_status check_face(cm_context *ctx, const cm_mesh *mesh, size_t c, const cm_cell_info *info,
+                            const int64_t *p, int64_t len)
+{
+    for (int64_t i = 0; i < len; ++i)
+        for (int64_t j = i + 1; j < len; ++j)
+            if (p[i] == p[j])
+                return cm_error(ctx, CM_ERR_FORMAT,
+                                "cell %zu (0-based, %s): corners %lld and %lld are the same node %lld: "
+                                "a degenerate face",
+                                c, info->name, (long long)i + 1, (long long)j + 1, (long long)p[i]);
+    /* the area vector of the fan, against the square of the longest edge: a face whose corners
+     * are (to round-off) on one line has none */
+    const double *X = mesh->xyz, *o = X + 3 * p[0];
+    double n[3] = {0, 0, 0}, e2 = 0;
+    for (int64_t i = 0; i < len; ++i) {
+        const double *a = X + 3 * p[i], *b = X + 3 * p[(i + 1) % len];
+        const double d[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        e2 = fmax(e2, d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (i == 0 || i + 1 == len) continue;
+        const double u[3] = {a[0] - o[0], a[1] - o[1], a[2] - o[2]};
+        const double v[3] = {b[0] - o[0], b[1] - o[1], b[2] - o[2]};
+        n[0] += u[1] * v[2] - u[2] * v[1];
+        n[1] += u[2] * v[0] - u[0] * v[2];
+        n[2] += u[0] * v[1] - u[1] * v[0];
+    }
+    const double a2 = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(a2 > 1e-14 * e2))
+        return cm_error(ctx, CM_ERR_FORMAT,
+                        "cell %zu (0-based, %s, nodes %lld %lld %lld%s): the face has no area: a "
+                        "degenerate face",
+                        c, info->name, (long long)p[0], (long long)p[1], (long long)p[2], len > 3 ? " ..." : "");
+    return CM_OK;
+}
+
 static cm_status collect(cm_context *ctx, const cm_mesh *mesh, tri_list *t)
 {
     size_t cap = 0;
@@ -32,6 +69,12 @@ static cm_status collect(cm_context *ctx, const cm_mesh *mesh, tri_list *t)
         if (!info || info->dim != 2) continue;
         const int64_t *p = mesh->conn + mesh->offset[c];
         int64_t len = info->corners > 0 ? info->corners : mesh->offset[c + 1] - mesh->offset[c];
+        cm_status s = check_face(ctx, mesh, c, info, p, len);
+        if (s < 0) {
+            free(t->v);
+            t->v = NULL;
+            return s;
+        }
         for (int64_t f = 1; f + 1 < len; ++f) {
             t->v[3 * t->n] = p[0], t->v[3 * t->n + 1] = p[f], t->v[3 * t->n + 2] = p[f + 1];
             ++t->n;

@@ -9,6 +9,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Larger lengths, positions or displacements are no mesh: the lattice's map and the quality
+ * of the moved cells multiply them (volumes are cubes, squared norms in the solvers), so
+ * 1e308 overflows to inf there and writes inf/nan coordinates. The warp's displacement table
+ * has the same bound. */
+#define CM_PRM_MAX 1e150
+
 typedef struct weight_entry {
     int axis, i, j, k, line;
     double v;
@@ -17,7 +23,7 @@ typedef struct weight_entry {
 typedef struct prm_parse {
     cm_context *ctx;
     const char *path;
-    int have[12]; /* n x y z, length x y z, origin x y z, angle x y z */
+    int have[12]; /* the line of n x y z, length x y z, origin x y z, angle x y z; 0: none */
     cm_ffd_prm *prm;
     weight_entry *w;
     size_t nw, capw;
@@ -111,7 +117,7 @@ static cm_status box_key(prm_parse *p, const char *key, char *value, int line)
         } else {
             p->prm->angle[a] = v;
         }
-        p->have[3 * q + a] = 1;
+        p->have[3 * q + a] = line;
         return CM_OK;
     }
     return CM_OK; /* configparser keeps unknown keys; PyGeM ignores them */
@@ -194,6 +200,17 @@ cm_status cm_ffd_prm_read(cm_context *ctx, const char *path, cm_ffd_prm *prm)
             s = cm_error(ctx, CM_ERR_FORMAT,
                          "cm_ffd_prm_read: %s: [Parameters weights] has no 'parameter %c'", path,
                          'x' + a);
+    for (int q = 3; s >= 0 && q < 9; ++q) {
+        const double v = q < 6 ? prm->length[q - 3] : prm->origin[q - 6];
+        if (q < 6 && v == 0)
+            s = cm_error(ctx, CM_ERR_FORMAT,
+                         "cm_ffd_prm_read: %s:%d: '%s' is 0: the box is flat (no lattice)", path,
+                         p.have[q], names[q]);
+        else if (fabs(v) > CM_PRM_MAX)
+            s = cm_error(ctx, CM_ERR_FORMAT,
+                         "cm_ffd_prm_read: %s:%d: '%s' is %g, beyond any mesh (|v| <= %g)", path,
+                         p.have[q], names[q], v, CM_PRM_MAX);
+    }
     size_t nc = 0;
     if (s >= 0) {
         double count = (double)prm->n[0] * prm->n[1] * prm->n[2];
@@ -211,6 +228,16 @@ cm_status cm_ffd_prm_read(cm_context *ctx, const char *path, cm_ffd_prm *prm)
                          "cm_ffd_prm_read: %s:%d: control point (%d, %d, %d) outside the %d x %d "
                          "x %d lattice",
                          path, w->line, w->i, w->j, w->k, prm->n[0], prm->n[1], prm->n[2]);
+            break;
+        }
+        /* the physical displacement is R diag(length) mu: |mu| length along the box axis */
+        const double d = fabs(w->v) * fabs(prm->length[w->axis]);
+        if (d > CM_PRM_MAX) {
+            s = cm_error(ctx, CM_ERR_FORMAT,
+                         "cm_ffd_prm_read: %s:%d: weight %g of control point (%d, %d, %d) along %c "
+                         "times the box length %g is a displacement of %g, beyond any mesh (|d| <= %g)",
+                         path, w->line, w->v, w->i, w->j, w->k, 'x' + w->axis,
+                         prm->length[w->axis], d, CM_PRM_MAX);
             break;
         }
         size_t idx = ((size_t)w->i * prm->n[1] + w->j) * prm->n[2] + w->k;

@@ -104,7 +104,10 @@ CM_API void cm_context_interrupt(cm_context *ctx);
 /* ---- for module code ---- */
 
 /* Sets the context message (printf-style) and returns code, so that errors read
- * `return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: expected ...", ...);` */
+ * `return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: expected ...", ...);`
+ * The message is one line (control characters escaped as \n, \xHH) and a word longer than
+ * 200 characters - a path - is shortened in its middle ("/head/.../name.vtu", the last
+ * component kept whole up to 100 characters), so that what follows a long path stays. */
 CM_API cm_status cm_error(cm_context *ctx, cm_status code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

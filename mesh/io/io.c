@@ -6,6 +6,7 @@
 #include "foam_internal.h"
 
 #include <ctype.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
@@ -226,5 +227,17 @@ cm_status cm_mesh_write(cm_context *ctx, const cm_mesh *mesh, const char *path,
     if (!mesh) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: mesh is NULL");
     const cm_mesh_format_row *row = cm_mesh_format_row_of(format_to_write(mesh, path));
     if (!row || !row->write) return unknown_extension(ctx, "cm_mesh_write", path);
+    /* A result with a non-finite coordinate is never written, in any format: no reader
+     * (cm_mesh_read above) would take the file back. Every input is checked where it is read,
+     * so such a mesh comes from a computation that overflowed: the result is rejected
+     * (README, "Exit codes"), before anything is created on disk. */
+    for (size_t i = 0; i < 3 * mesh->n_nodes; ++i)
+        if (!isfinite(mesh->xyz[i]))
+            return cm_error(ctx, CM_ERR_REJECTED,
+                            "cm_mesh_write: node %zu (0-based, tag %lld) has a non-finite coordinate "
+                            "(%c = %g), the result is not written: %s",
+                            i / 3,
+                            (long long)(mesh->node_tag ? mesh->node_tag[i / 3] : (int64_t)(i / 3) + 1),
+                            "xyz"[i % 3], mesh->xyz[i], path ? path : "(null)");
     return row->write(ctx, mesh, path, opt);
 }

@@ -255,6 +255,26 @@ static void test_shell(void)
     CHECK(cm_mls_shell(ctx, m, con, 1, 0.5, 100, ref) == CM_OK);
     CHECK(same_bits(out, ref, 3 * n));
     CHECK(res == 0);
+    /* a face with a repeated corner, then one whose corners are on a line: bad input naming
+     * the cell, not a factorisation failure, and disp untouched */
+    const int64_t good[3] = {m->conn[m->offset[5]], m->conn[m->offset[5] + 1], m->conn[m->offset[5] + 2]};
+    m->conn[m->offset[5] + 1] = good[0];
+    memcpy(ref, disp, n * 3 * sizeof *ref);
+    CHECK(cm_mls_shell(ctx, m, con, 1, 0.5, 100, ref) == CM_ERR_FORMAT);
+    CHECK_MSG(strstr(cm_context_message(ctx), "cell 5 (0-based, tri3): corners 1 and 2 are the same node"),
+              "%s", cm_context_message(ctx));
+    CHECK(same_bits(ref, disp, 3 * n));
+    m->conn[m->offset[5] + 1] = good[1];
+    double keep[3];
+    memcpy(keep, m->xyz + 3 * good[1], sizeof keep);
+    for (int a = 0; a < 3; ++a) /* the middle corner halfway between the other two */
+        m->xyz[3 * good[1] + a] = 0.5 * (m->xyz[3 * good[0] + a] + m->xyz[3 * good[2] + a]);
+    CHECK(cm_mls_shell(ctx, m, con, 1, 0.5, 100, ref) == CM_ERR_FORMAT);
+    CHECK_MSG(strstr(cm_context_message(ctx), "cell 5 (0-based, tri3, nodes") &&
+                  strstr(cm_context_message(ctx), "the face has no area"),
+              "%s", cm_context_message(ctx));
+    memcpy(m->xyz + 3 * good[1], keep, sizeof keep);
+    CHECK(cm_mls_shell(ctx, m, con, 1, 0.5, 100, ref) == CM_OK);
     free(con), free(disp), free(out), free(ref);
     cm_mesh_destroy(&m);
 }

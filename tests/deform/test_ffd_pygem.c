@@ -141,6 +141,53 @@ static void test_reader_errors(void)
     write_file(path, "[Box info]\nn control points x: 2\n");
     CHECK(cm_ffd_prm_read(ctx, path, &prm) == CM_ERR_FORMAT);
     CHECK(strstr(cm_context_message(ctx), "n control points y") != NULL);
+    /* finite weights the lattice cannot apply: times the box length they overflow (1e308 x 2)
+     * or leave coordinates whose cubes do (1e200): refused at their line */
+    const char *huge[] = {"1e308", "-1e200", "1.7976931348623157e308"};
+    for (int h = 0; h < 3; ++h) {
+        char big_box[1024];
+        snprintf(big_box, sizeof big_box, "%s", box);
+        char *lx = strstr(big_box, "box length x: 1");
+        if (lx) lx[14] = '2';
+        snprintf(text, sizeof text,
+                 "%s[Parameters weights]\nparameter x: 0 0 0 0\n  1 0 1 %s\nparameter y: 0 0 0 0\n"
+                 "parameter z: 0 0 0 0\n",
+                 big_box, huge[h]);
+        write_file(path, text);
+        CHECK(cm_ffd_prm_read(ctx, path, &prm) == CM_ERR_FORMAT);
+        CHECK_MSG(strstr(cm_context_message(ctx), "ffd_bad.prm:16: weight") &&
+                      strstr(cm_context_message(ctx), "control point (1, 0, 1) along x") &&
+                      strstr(cm_context_message(ctx), "beyond any mesh"),
+                  "%s", cm_context_message(ctx));
+        CHECK(prm.mu == NULL);
+    }
+    /* a flat box (no lattice), a box no mesh fits in, a non-finite origin */
+    const char *boxes[][2] = {{"box length y: 1", "box length y: 0"},
+                              {"box length z: 1", "box length z: 1e151"},
+                              {"box origin x: 0", "box origin x: nan"}};
+    const char *why[] = {":6: 'box length y' is 0", ":7: 'box length z' is 1e+151, beyond any mesh",
+                         ":8: 'box origin x' is not a number"};
+    for (int b = 0; b < 3; ++b) {
+        char bad_box[1024];
+        const char *at = strstr(box, boxes[b][0]);
+        snprintf(bad_box, sizeof bad_box, "%.*s%s%s", (int)(at - box), box, boxes[b][1],
+                 at + strlen(boxes[b][0]));
+        snprintf(text, sizeof text,
+                 "%s[Parameters weights]\nparameter x: 0 0 0 0.5\nparameter y: 0 0 0 0\n"
+                 "parameter z: 0 0 0 0\n",
+                 bad_box);
+        write_file(path, text);
+        CHECK(cm_ffd_prm_read(ctx, path, &prm) == CM_ERR_FORMAT);
+        CHECK_MSG(strstr(cm_context_message(ctx), why[b]) != NULL, "%s", cm_context_message(ctx));
+    }
+    /* the bound itself and a negative (mirrored) box are fine */
+    snprintf(text, sizeof text,
+             "%s[Parameters weights]\nparameter x: 0 0 0 1e150\nparameter y: 0 0 0 -1e150\n"
+             "parameter z: 0 0 0 0\n",
+             box);
+    write_file(path, text);
+    CHECK(cm_ffd_prm_read(ctx, path, &prm) == CM_OK);
+    cm_ffd_prm_free(&prm);
     /* good, with '=' and upper case keys and a continuation line */
     snprintf(text, sizeof text,
              "%s[Parameters weights]\nParameter X = 0 0 0 0.5\n   1 1 1 -0.25\n"

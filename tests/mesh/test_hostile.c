@@ -4,6 +4,7 @@
 #include "cadmorph/mesh.h"
 #include "test_util.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -123,6 +124,38 @@ static void test_one_line_messages(void)
     CHECK(strstr(msg, "Float64\\nX\\x1b[31m") != NULL);
 }
 
+/* A mesh with a non-finite coordinate is written in no format: rejected before anything is
+ * created (a previous file stays as it was), naming the node and the coordinate. */
+static void test_no_nonfinite_write(void)
+{
+    static const char *const names[] = {"nf.vtu", "nf.vtk", "nf.msh", "nf.mesh", "nf.obj", "nf.stl", "nf.off",
+                                        "nf.su2", "nf.inp", "nf.bdf"};
+    const double bad[3] = {NAN, INFINITY, -INFINITY};
+    for (int b = 0; b < 3; ++b)
+        for (size_t k = 0; k < sizeof names / sizeof *names; ++k) {
+            cm_mesh *m = hostile_mesh();
+            m->xyz[3 * 2 + 1] = bad[b];
+            char path[1200];
+            snprintf(path, sizeof path, "%s/%s", work_dir, names[k]);
+            FILE *f = fopen(path, "w");
+            if (f) fputs("previous", f), fclose(f);
+            CHECK_MSG(cm_mesh_write(ctx, m, path, NULL) == CM_ERR_REJECTED, "%s", names[k]);
+            const char *msg = cm_context_message(ctx);
+            CHECK_MSG(strstr(msg, "node 2 (0-based, tag 3) has a non-finite coordinate (y = ") &&
+                          strstr(msg, names[k]),
+                      "%s", msg);
+            char buf[16] = {0};
+            f = fopen(path, "r");
+            CHECK(f && fread(buf, 1, sizeof buf - 1, f) == 8 && !strcmp(buf, "previous"));
+            if (f) fclose(f);
+            remove(path);
+            CHECK_MSG(cm_mesh_write(ctx, m, path, NULL) == CM_ERR_REJECTED, "%s", names[k]);
+            struct stat st;
+            CHECK_MSG(stat(path, &st) != 0, "%s was created", names[k]);
+            cm_mesh_destroy(&m);
+        }
+}
+
 static void test_temporary_registry(void)
 {
     char path[2048];
@@ -170,6 +203,7 @@ int main(int argc, char **argv)
     test_growth();
     test_one_line_messages();
     test_temporary_registry();
+    test_no_nonfinite_write();
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }
