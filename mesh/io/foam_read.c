@@ -433,29 +433,42 @@ static cm_status check_addressing(reader *r, int64_t n_owner, int64_t n_nei)
     p->n_cells = maxc + 1;
     if (p->n_cells == 0)
         return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: no cells (owner is empty)", own);
-    /* cells are numbered without gaps: a cell with no face means a label beyond the cells
-     * before it; the file and entry named are those of the smallest label past the gap */
+    /* Cells are numbered without gaps and have at least 4 faces each. The first cell c with
+     * fewer is blamed on the file and entry of the smallest label >= c: a label beyond the
+     * c cells before it when no cell from c on is complete (a label out of range), else cell
+     * c itself. */
     {
-        uint8_t *seen = calloc((size_t)p->n_cells, 1);
-        if (!seen) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory for %lld cells", (long long)p->n_cells);
-        for (int64_t i = 0; i < p->n_faces; ++i) seen[p->owner[i]] = 1;
-        for (int64_t i = 0; i < n_nei; ++i) seen[p->neighbour[i]] = 1;
-        int64_t gap = 0;
-        while (gap < p->n_cells && seen[gap]) ++gap;
-        int64_t past = gap;
-        while (past < p->n_cells && !seen[past]) ++past;
-        free(seen);
-        if (gap < p->n_cells) {
+        int64_t *count = calloc((size_t)p->n_cells, sizeof *count);
+        if (!count) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory for %lld cells", (long long)p->n_cells);
+        for (int64_t i = 0; i < p->n_faces; ++i) ++count[p->owner[i]];
+        for (int64_t i = 0; i < n_nei; ++i) ++count[p->neighbour[i]];
+        int64_t c = 0;
+        while (c < p->n_cells && count[c] >= 4) ++c;
+        int trailing = 1;
+        for (int64_t d = c; d < p->n_cells && trailing; ++d) trailing = count[d] < 4;
+        const int64_t faces_c = c < p->n_cells ? count[c] : 0;
+        free(count);
+        if (c < p->n_cells) {
+            const char *file = own;
+            int64_t at = -1, label = INT64_MAX;
             for (int k = 0; k < 2; ++k) {
                 const int64_t *v = k ? p->neighbour : p->owner, n = k ? n_nei : p->n_faces;
                 for (int64_t i = 0; i < n; ++i)
-                    if (v[i] == past)
-                        return cm_error(r->ctx, CM_ERR_FORMAT,
-                                        "cm_mesh_read: %s: entry %lld: cell label %lld beyond the %lld cells "
-                                        "numbered 0 to %lld (no face has cell %lld)",
-                                        k ? nei : own, (long long)i, (long long)past, (long long)gap,
-                                        (long long)(gap - 1), (long long)gap);
+                    if (v[i] >= c && v[i] < label) {
+                        label = v[i];
+                        at = i;
+                        file = k ? nei : own;
+                    }
             }
+            if (trailing || faces_c == 0)
+                return cm_error(r->ctx, CM_ERR_FORMAT,
+                                "cm_mesh_read: %s: entry %lld: cell label %lld beyond the %lld cells numbered 0 to %lld "
+                                "(cell %lld has %lld faces, at least 4 expected)",
+                                file, (long long)at, (long long)label, (long long)c, (long long)(c - 1),
+                                (long long)c, (long long)faces_c);
+            return cm_error(r->ctx, CM_ERR_FORMAT,
+                            "cm_mesh_read: %s: entry %lld: cell %lld has %lld faces (at least 4 expected)", file,
+                            (long long)at, (long long)c, (long long)faces_c);
         }
     }
     /* patches: contiguous, from the first boundary face to the last face */
