@@ -156,14 +156,14 @@ static cm_status read_zones(cm_context *ctx, const char *dir, const char *name, 
         else p->zones = z;
     }
     const char *labels = kind == CM_FOAM_CELL_ZONE ? "cellLabels" : kind == CM_FOAM_FACE_ZONE ? "faceLabels" : "pointLabels";
-    /* a zone holds each of its cells, faces or points once: no more labels than there are,
-     * and no uniform list of more than one */
+    /* a zone holds each of its cells, faces or points once: no more labels than there are */
     char expect[160];
     snprintf(expect, sizeof expect, "at most the %lld %s of the mesh, each once", (long long)limit, things);
     const cm_foam_limit zone_lim = {0, limit, limit, expect};
-    /* a uniform list "N{c}" repeats one label: all such lists of the file together hold at
-     * most as many labels as the mesh has cells (faces, points), so that a few bytes cannot
-     * become a zone of the mesh's size, many times over */
+    /* a uniform list "N{c}" repeats one label: all such lists of the file together (and any
+     * list whose first, middle and last labels are equal, a cheap test that a valid zone never
+     * meets) hold at most as many labels as the mesh has cells (faces, points), so that a few
+     * bytes cannot become zones of the mesh's size, many times over */
     int64_t repeated = 0;
     for (int64_t i = 0; s == CM_OK && i < n; ++i) {
         cm_foam_zone *zn = &p->zones[p->n_zones];
