@@ -506,9 +506,9 @@ static cm_status list_open(cm_context *ctx, cm_foam_lex *lx, const char *what, c
     } else {
         const int64_t most = lim ? lim->uniform_hi : UNIFORM_DEFAULT;
         if (*n > most)
-            return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: %s: uniform list of %lld entries, expected at most %lld%s%s",
-                            lx->f->path, lx->line, what, (long long)*n, (long long)most, lim ? ", " : "",
-                            lim ? lim->expect : "");
+            return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: %s: uniform list of %lld entries, expected at most %lld%s%s%s",
+                            lx->f->path, lx->line, what, (long long)*n, (long long)most, lim ? " (" : "",
+                            lim ? lim->expect : "", lim ? ")" : "");
     }
     return CM_OK;
 }
@@ -645,8 +645,8 @@ cm_status cm_foam_face_list(cm_context *ctx, cm_foam_lex *lx, int compact, const
     if (compact) {
         int64_t no = 0, nn = 0;
         /* offsets rise from 0 and a face's vertices are distinct: neither is uniform */
-        static const cm_foam_limit offsets = {0, INT64_MAX, 1, "one: the offsets of faces rise"};
-        static const cm_foam_limit vertices = {0, INT64_MAX, 1, "one: a face's vertices are distinct points"};
+        static const cm_foam_limit offsets = {0, INT64_MAX, 1, "the offsets of faces rise"};
+        static const cm_foam_limit vertices = {0, INT64_MAX, 1, "a face's vertices are distinct points"};
         cm_status s = cm_foam_label_list_in(ctx, lx, "face offsets", &offsets, off, &no);
         if (s == CM_OK) s = cm_foam_label_list_in(ctx, lx, "face nodes", &vertices, nodes, &nn);
         if (s == CM_OK && no < 1) {
@@ -684,7 +684,7 @@ cm_status cm_foam_face_list(cm_context *ctx, cm_foam_lex *lx, int compact, const
     }
     o[0] = 0;
     /* a face's vertices are distinct: "n{v}" is no face */
-    static const cm_foam_limit one_face = {0, INT64_MAX, 0, "none: a face's vertices are distinct points"};
+    static const cm_foam_limit one_face = {0, INT64_MAX, 0, "a face's vertices are distinct points"};
     for (int64_t i = 0; s == CM_OK && i < cnt; ++i) {
         int64_t *f = NULL, fn = 0;
         s = cm_foam_label_list_in(ctx, lx, "a face", &one_face, &f, &fn);
