@@ -128,9 +128,14 @@ typedef struct cm_foam_file {
 } cm_foam_file;
 
 /* Reads dir/name or dir/name.gz (zlib), parses the FoamFile header. optional: a missing file
- * returns CM_OK with f->data NULL instead of an error. */
+ * returns CM_OK with f->data NULL instead of an error. A compressed file is inflated within a
+ * budget (foam_lex.c, read_gz): entry_bytes per entry of its first count (the list size, the
+ * number of patches or zones), that count taken as at most max_count (< 0: as written);
+ * cm_foam_file_load uses 1 KiB per entry and no max_count. */
 cm_status cm_foam_file_load(cm_context *ctx, const char *dir, const char *name, int optional,
                             cm_foam_file *f);
+cm_status cm_foam_file_load_bounded(cm_context *ctx, const char *dir, const char *name, int optional,
+                                    uint64_t entry_bytes, int64_t max_count, cm_foam_file *f);
 void cm_foam_file_free(cm_foam_file *f);
 
 /* A cursor over a file's bytes: tokens skip white space and C/C++ comments. */
@@ -163,19 +168,31 @@ const char *cm_foam_where(const cm_foam_lex *lx, char *buf, size_t cap);
 cm_status cm_foam_expect(cm_context *ctx, cm_foam_lex *lx, char c, const char *what);
 cm_status cm_foam_label(cm_context *ctx, cm_foam_lex *lx, const char *what, int64_t *v);
 
+/* What a list's count may be, known from the other files before anything is allocated: in
+ * [lo, hi], and for a uniform list "N{v}" at most uniform_hi. expect says it in messages
+ * ("as many as the 12 faces"). Independently of it, a count must fit the bytes left in the
+ * file (2 per ASCII label, the exact size of a binary block). */
+typedef struct cm_foam_limit {
+    int64_t lo, hi, uniform_hi;
+    const char *expect;
+} cm_foam_limit;
+
 /* A list at the cursor, "N(...)" or "N{v}", ASCII or binary as the header says:
  * labels (int64), scalars, or fixed-size tuples of scalars (width 3 for points).
- * *out is malloc'ed (NULL for an empty list). */
+ * *out is malloc'ed (NULL for an empty list). lim may be NULL: any count that fits the file,
+ * a uniform list of at most 2^20 entries. */
 cm_status cm_foam_label_list(cm_context *ctx, cm_foam_lex *lx, const char *what, int64_t **out,
                              int64_t *n);
+cm_status cm_foam_label_list_in(cm_context *ctx, cm_foam_lex *lx, const char *what,
+                                const cm_foam_limit *lim, int64_t **out, int64_t *n);
 cm_status cm_foam_scalar_list(cm_context *ctx, cm_foam_lex *lx, const char *what, int width,
-                              double **out, int64_t *n);
+                              const cm_foam_limit *lim, double **out, int64_t *n);
 /* faceList (n(a b c) ...) or faceCompactList (offsets list + nodes list). */
 cm_status cm_foam_face_list(cm_context *ctx, cm_foam_lex *lx, int compact, const char *what,
                             int64_t **off, int64_t **nodes, int64_t *n);
 
-cm_status cm_foam_bool_list(cm_context *ctx, cm_foam_lex *lx, const char *what, uint8_t **out,
-                            int64_t *n);
+cm_status cm_foam_bool_list(cm_context *ctx, cm_foam_lex *lx, const char *what,
+                            const cm_foam_limit *lim, uint8_t **out, int64_t *n);
 /* Skips an entry's value up to (not including) the ';' that ends it (ASCII content only). */
 cm_status cm_foam_skip_value(cm_context *ctx, cm_foam_lex *lx, const char *what);
 

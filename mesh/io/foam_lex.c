@@ -3,11 +3,15 @@
 #define _POSIX_C_SOURCE 200809L
 #include "foam_internal.h"
 
+#include "text.h"
+
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 static char *join(const char *dir, const char *name)
@@ -36,39 +40,145 @@ int cm_foam_join(char *out, size_t cap, const char *dir, const char *name, const
     return 0;
 }
 
-/* gzread inflates gzip and passes plain files through, so one path reads both. */
-static cm_status read_gz(cm_context *ctx, const char *path, char **data, size_t *size)
+/* An inflated stream is bounded by what its content can hold, so that a small .gz cannot
+ * become gigabytes in memory (1 MB of gzip'ed blanks inflates to 1 GB):
+ * - the FoamFile header, banner and comments before the file's first count (the list size,
+ *   or the number of patches or zones) may take GZ_PREFIX = 1 MiB (OpenFOAM writes ~1 KB);
+ *   a stream of at most that much is read whatever it holds;
+ * - after the count N, entry_bytes per entry (the caller's: 64 for a label, 256 for a point,
+ *   1 KiB for a face, 16 KiB for a patch: an entry written by OpenFOAM in ASCII at full
+ *   precision takes a quarter of that or less, in binary less still), N taken as at most the
+ *   count the other files allow (max_count), plus GZ_PREFIX for what follows the list;
+ * - nowhere more than GZ_PREFIX blank bytes in a row (OpenFOAM indents by a few bytes):
+ *   blanks, in one gzip member or many concatenated, are the cheapest way to a huge stream.
+ * Beyond the budget the file is refused with the inflated offset, and the buffer never grows
+ * past the budget (+1 byte to see that there is more). What is left: a file whose N entries
+ * are really there (repeated, so they compress 1000:1) is read, as any file of N entries. */
+enum { GZ_PREFIX = 1 << 20, GZ_CHUNK = 1 << 16 };
+
+static int is_blank(char c)
 {
-    gzFile g = gzopen(path, "rb");
-    if (!g) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: cannot open: %s", path, strerror(errno));
-    size_t cap = 1 << 16, n = 0;
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
+}
+
+/* The first count after the FoamFile header in d[0, n): 1 with *count and *end set; 0 when it
+ * is not there (the parser then reports what is). */
+static int first_count(const char *d, size_t n, int64_t *count, size_t *end)
+{
+    cm_foam_file tmp;
+    memset(&tmp, 0, sizeof tmp);
+    tmp.data = (char *)d;
+    tmp.size = n;
+    cm_foam_lex lx;
+    cm_foam_lex_init(&lx, &tmp, 0);
+    cm_foam_tok t = cm_foam_next(&lx);
+    if (t.kind != CM_FOAM_WORD || t.len != 8 || memcmp(t.s, "FoamFile", 8)) return 0;
+    t = cm_foam_next(&lx);
+    if (t.kind != CM_FOAM_PUNCT || t.s[0] != '{') return 0;
+    for (int depth = 1; depth > 0;) {
+        t = cm_foam_next(&lx);
+        if (t.kind == CM_FOAM_EOF) return 0;
+        if (t.kind == CM_FOAM_PUNCT && t.s[0] == '{') ++depth;
+        if (t.kind == CM_FOAM_PUNCT && t.s[0] == '}') --depth;
+    }
+    t = cm_foam_next(&lx);
+    if (t.kind == CM_FOAM_WORD && t.len > 5 && !memcmp(t.s, "List<", 5)) t = cm_foam_next(&lx);
+    /* a count cut by the end of what was inflated is not a count yet */
+    if (t.kind != CM_FOAM_WORD || lx.pos >= n || !cm_text_parse_int(t.s, t.s + t.len, count) || *count < 0)
+        return 0;
+    *end = lx.pos;
+    return 1;
+}
+
+static size_t budget_of(size_t end, int64_t count, int64_t max_count, uint64_t entry_bytes)
+{
+    uint64_t c = (uint64_t)count;
+    if (max_count >= 0 && c > (uint64_t)max_count) c = (uint64_t)max_count;
+    uint64_t b = entry_bytes && c > (UINT64_MAX - end - GZ_PREFIX) / entry_bytes
+                     ? UINT64_MAX
+                     : end + GZ_PREFIX + c * entry_bytes;
+    return b > SIZE_MAX - 2 ? SIZE_MAX - 2 : (size_t)b;
+}
+
+/* gzread inflates gzip (members concatenated too) and passes plain files through, so one path
+ * reads both; opened as cm_file_read opens (a FIFO would block in open()). */
+static cm_status read_gz(cm_context *ctx, const char *path, uint64_t entry_bytes, int64_t max_count,
+                         char **data, size_t *size)
+{
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: not a regular file", path);
+    }
+    fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    gzFile g = gzdopen(fd, "rb");
+    if (!g) {
+        close(fd);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", path);
+    }
+    size_t cap = GZ_CHUNK, n = 0, limit = GZ_PREFIX, blank = 0;
+    int64_t count = -1;
     char *buf = malloc(cap + 1);
-    for (;;) {
+    cm_status s = CM_OK;
+    while (s == CM_OK) {
         if (!buf) {
-            gzclose(g);
-            return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", path);
+            s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", path);
+            break;
         }
-        if (n == cap) {
-            char *nb = cap < (SIZE_MAX - 1) / 2 ? realloc(buf, 2 * cap + 1) : NULL;
+        /* read up to one byte past the budget, to see that there is more */
+        size_t want = limit + 1 - n < GZ_CHUNK ? limit + 1 - n : GZ_CHUNK;
+        if (n + want > cap) {
+            size_t nc = cap < SIZE_MAX / 4 ? 2 * cap : SIZE_MAX / 2;
+            if (nc < n + want) nc = n + want;
+            if (nc > limit + 1) nc = limit + 1;
+            char *nb = realloc(buf, nc + 1);
             if (!nb) free(buf);
             buf = nb;
-            cap *= 2;
+            cap = nc;
             continue;
         }
-        unsigned want = cap - n > UINT_MAX / 2 ? UINT_MAX / 2 : (unsigned)(cap - n);
-        int got = gzread(g, buf + n, want);
+        int got = gzread(g, buf + n, (unsigned)want);
         if (got < 0) {
             int e;
             const char *msg = gzerror(g, &e);
-            cm_status s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: corrupt gzip data: %s", path, msg);
-            free(buf);
-            gzclose(g);
-            return s;
+            s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: inflated offset %zu: corrupt gzip data: %s", path, n, msg);
+            break;
         }
         if (got == 0) break;
+        for (size_t i = n; i < n + (size_t)got; ++i) {
+            blank = is_blank(buf[i]) ? blank + 1 : 0;
+            if (blank > GZ_PREFIX) {
+                s = cm_error(ctx, CM_ERR_FORMAT,
+                             "cm_mesh_read: %s: inflated offset %zu: more than %d blank bytes in a row", path,
+                             i, GZ_PREFIX);
+                break;
+            }
+        }
         n += (size_t)got;
+        if (s != CM_OK || n <= limit) continue;
+        size_t end = 0;
+        if (count < 0 && first_count(buf, n, &count, &end)) {
+            limit = budget_of(end, count, max_count, entry_bytes);
+            if (n <= limit) continue;
+        }
+        if (count < 0)
+            s = cm_error(ctx, CM_ERR_FORMAT,
+                         "cm_mesh_read: %s: inflated offset %zu: no FoamFile header and list size in the first %d bytes",
+                         path, n - 1, GZ_PREFIX);
+        else
+            s = cm_error(ctx, CM_ERR_FORMAT,
+                         "cm_mesh_read: %s: inflated offset %zu: more than the %zu bytes %lld entries can take "
+                         "(%llu per entry)",
+                         path, limit, limit, (long long)(max_count >= 0 && count > max_count ? max_count : count),
+                         (unsigned long long)entry_bytes);
     }
     gzclose(g);
+    if (s != CM_OK) {
+        free(buf);
+        return s;
+    }
     buf[n] = '\0';
     *data = buf;
     *size = n;
@@ -85,6 +195,12 @@ static cm_status parse_header(cm_context *ctx, cm_foam_file *f);
 
 cm_status cm_foam_file_load(cm_context *ctx, const char *dir, const char *name, int optional,
                             cm_foam_file *f)
+{
+    return cm_foam_file_load_bounded(ctx, dir, name, optional, 1024, -1, f);
+}
+
+cm_status cm_foam_file_load_bounded(cm_context *ctx, const char *dir, const char *name, int optional,
+                                    uint64_t entry_bytes, int64_t max_count, cm_foam_file *f)
 {
     memset(f, 0, sizeof *f);
     f->label_bytes = 4;
@@ -117,7 +233,7 @@ cm_status cm_foam_file_load(cm_context *ctx, const char *dir, const char *name, 
     }
     cm_status s;
     if (f->gz) {
-        s = read_gz(ctx, f->path, &f->data, &f->size);
+        s = read_gz(ctx, f->path, entry_bytes, max_count, &f->data, &f->size);
     } else {
         s = cm_file_read(ctx, f->path, &f->data, &f->size);
         /* A gzip file under the plain name: read it through zlib too. */
@@ -126,7 +242,7 @@ cm_status cm_foam_file_load(cm_context *ctx, const char *dir, const char *name, 
             free(f->data);
             f->data = NULL;
             f->gz = 1;
-            s = read_gz(ctx, f->path, &f->data, &f->size);
+            s = read_gz(ctx, f->path, entry_bytes, max_count, &f->data, &f->size);
         }
     }
     if (s == CM_OK) s = parse_header(ctx, f);
@@ -256,15 +372,7 @@ cm_status cm_foam_expect(cm_context *ctx, cm_foam_lex *lx, char c, const char *w
 
 static int parse_i64(const char *s, size_t len, int64_t *v)
 {
-    char buf[32], *end;
-    if (len == 0 || len >= sizeof buf) return 0;
-    memcpy(buf, s, len);
-    buf[len] = '\0';
-    errno = 0;
-    long long x = strtoll(buf, &end, 10);
-    if (*end || errno) return 0;
-    *v = (int64_t)x;
-    return 1;
+    return cm_text_parse_int(s, s + len, v);
 }
 
 static int parse_f64(const char *s, size_t len, double *v)
@@ -349,14 +457,25 @@ static cm_status parse_header(cm_context *ctx, cm_foam_file *f)
 
 /* ---- lists ---- */
 
-/* Reads the count (skipping a "List<...>" word before it) and the opening bracket. */
-static cm_status list_open(cm_context *ctx, cm_foam_lex *lx, const char *what, int64_t *n, char *open)
+/* A uniform list "N{v}" with no limit given: more is refused (OpenFOAM writes one only when
+ * all N values are equal, which no polyMesh list of that size has). */
+enum { UNIFORM_DEFAULT = 1 << 20 };
+
+/* Reads the count (skipping a "List<...>" word before it) and the opening bracket, and checks
+ * the count before anything is allocated: against lim, and against the bytes left in the file
+ * (an ASCII entry takes at least ascii_min bytes with its separator, a binary one exactly
+ * bin_bytes). */
+static cm_status list_open(cm_context *ctx, cm_foam_lex *lx, const char *what, const cm_foam_limit *lim,
+                           size_t ascii_min, size_t bin_bytes, int64_t *n, char *open)
 {
     cm_foam_tok t = cm_foam_next(lx);
     if (t.kind == CM_FOAM_WORD && t.len > 5 && !memcmp(t.s, "List<", 5)) t = cm_foam_next(lx);
     char buf[200];
     snprintf(buf, sizeof buf, "the size of %s", what);
     if (t.kind != CM_FOAM_WORD || !parse_i64(t.s, t.len, n) || *n < 0) return tok_error(ctx, lx, buf, t);
+    if (lim && (*n < lim->lo || *n > lim->hi))
+        return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: %s has %lld entries, expected %s", lx->f->path,
+                        lx->line, what, (long long)*n, lim->expect);
     cm_foam_tok b = cm_foam_peek(lx);
     /* OpenFOAM writes an empty list in binary as its size alone ("cellLabels 0;"), in ASCII
      * as "0()"; "0{v}" is read below like any uniform list */
@@ -370,14 +489,27 @@ static cm_status list_open(cm_context *ctx, cm_foam_lex *lx, const char *what, i
         return tok_error(ctx, lx, buf, b);
     }
     *open = b.s[0];
-    /* every entry of a bracketed list takes at least one byte: a larger count is a corrupt
-     * size, reported before anything is allocated */
-    if (*open == '(' && (uint64_t)*n > lx->f->size - lx->pos)
-        return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: %s has size %lld, more than the %zu bytes left in the file",
-                        lx->f->path, lx->line, what, (long long)*n, lx->f->size - lx->pos);
-    if (*open == '{' && *n > ((int64_t)1 << 40))
-        return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: uniform list %s of size %lld", lx->f->path, lx->line,
-                        what, (long long)*n);
+    const size_t left = lx->f->size - lx->pos;
+    if (*open == '(') {
+        const int bin = lx->f->binary && bin_bytes;
+        const size_t per = bin ? bin_bytes : ascii_min;
+        if (bin && (uint64_t)*n > (left ? left - 1 : 0) / per)
+            return cm_error(ctx, CM_ERR_FORMAT,
+                            "cm_mesh_read: %s: byte %zu: truncated binary block of %s: %lld entries of %zu bytes and "
+                            "')' expected, the file has %zu bytes left",
+                            lx->f->path, lx->pos, what, (long long)*n, per, left);
+        if (!bin && (uint64_t)*n > left / per)
+            return cm_error(ctx, CM_ERR_FORMAT,
+                            "cm_mesh_read: %s:%ld: %s has size %lld, more than the %zu bytes left in the file can "
+                            "hold (%zu per entry at least)",
+                            lx->f->path, lx->line, what, (long long)*n, left, per);
+    } else {
+        const int64_t most = lim ? lim->uniform_hi : UNIFORM_DEFAULT;
+        if (*n > most)
+            return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s:%ld: %s: uniform list of %lld entries, expected at most %lld%s%s%s",
+                            lx->f->path, lx->line, what, (long long)*n, (long long)most, lim ? " (" : "",
+                            lim ? lim->expect : "", lim ? ")" : "");
+    }
     return CM_OK;
 }
 
@@ -408,11 +540,17 @@ static void *alloc_n(int64_t n, size_t size)
 cm_status cm_foam_label_list(cm_context *ctx, cm_foam_lex *lx, const char *what, int64_t **out,
                              int64_t *n)
 {
+    return cm_foam_label_list_in(ctx, lx, what, NULL, out, n);
+}
+
+cm_status cm_foam_label_list_in(cm_context *ctx, cm_foam_lex *lx, const char *what,
+                                const cm_foam_limit *lim, int64_t **out, int64_t *n)
+{
     *out = NULL;
     *n = 0;
     char open;
     int64_t cnt;
-    cm_status s = list_open(ctx, lx, what, &cnt, &open);
+    cm_status s = list_open(ctx, lx, what, lim, 2, (size_t)lx->f->label_bytes, &cnt, &open);
     if (s != CM_OK) return s;
     if (!open) return CM_OK; /* an empty list written as its size alone */
     int64_t *v = alloc_n(cnt, sizeof *v);
@@ -451,13 +589,15 @@ cm_status cm_foam_label_list(cm_context *ctx, cm_foam_lex *lx, const char *what,
 }
 
 cm_status cm_foam_scalar_list(cm_context *ctx, cm_foam_lex *lx, const char *what, int width,
-                              double **out, int64_t *n)
+                              const cm_foam_limit *lim, double **out, int64_t *n)
 {
     *out = NULL;
     *n = 0;
     char open;
     int64_t cnt;
-    cm_status s = list_open(ctx, lx, what, &cnt, &open);
+    /* ASCII: "(a b c)" takes 7 bytes, a scalar and its separator 2 */
+    cm_status s = list_open(ctx, lx, what, lim, width > 1 ? 2 * (size_t)width + 1 : 2,
+                            (size_t)width * (size_t)lx->f->scalar_bytes, &cnt, &open);
     if (s != CM_OK) return s;
     if (!open) return CM_OK; /* an empty list written as its size alone */
     double *v = alloc_n(cnt * width, sizeof *v);
@@ -504,8 +644,11 @@ cm_status cm_foam_face_list(cm_context *ctx, cm_foam_lex *lx, int compact, const
     char w[600];
     if (compact) {
         int64_t no = 0, nn = 0;
-        cm_status s = cm_foam_label_list(ctx, lx, "face offsets", off, &no);
-        if (s == CM_OK) s = cm_foam_label_list(ctx, lx, "face nodes", nodes, &nn);
+        /* offsets rise from 0 and a face's vertices are distinct: neither is uniform */
+        static const cm_foam_limit offsets = {0, INT64_MAX, 1, "the offsets of faces rise"};
+        static const cm_foam_limit vertices = {0, INT64_MAX, 1, "a face's vertices are distinct points"};
+        cm_status s = cm_foam_label_list_in(ctx, lx, "face offsets", &offsets, off, &no);
+        if (s == CM_OK) s = cm_foam_label_list_in(ctx, lx, "face nodes", &vertices, nodes, &nn);
         if (s == CM_OK && no < 1) {
             s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: faceCompactList: empty offsets list", cm_foam_where(lx, w, sizeof w));
         }
@@ -527,7 +670,8 @@ cm_status cm_foam_face_list(cm_context *ctx, cm_foam_lex *lx, int compact, const
     }
     char open;
     int64_t cnt;
-    cm_status s = list_open(ctx, lx, what, &cnt, &open);
+    /* "3(a b c)" takes 8 bytes */
+    cm_status s = list_open(ctx, lx, what, NULL, 8, 0, &cnt, &open);
     if (s != CM_OK) return s;
     if (open != '(' && !(open == 0 && cnt == 0)) return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: expected '(' opening the face list", cm_foam_where(lx, w, sizeof w));
     int64_t *o = alloc_n(cnt + 1, sizeof *o);
@@ -539,9 +683,11 @@ cm_status cm_foam_face_list(cm_context *ctx, cm_foam_lex *lx, int compact, const
         return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory for %lld faces", lx->f->path, (long long)cnt);
     }
     o[0] = 0;
+    /* a face's vertices are distinct: "n{v}" is no face */
+    static const cm_foam_limit one_face = {0, INT64_MAX, 0, "a face's vertices are distinct points"};
     for (int64_t i = 0; s == CM_OK && i < cnt; ++i) {
         int64_t *f = NULL, fn = 0;
-        s = cm_foam_label_list(ctx, lx, "a face", &f, &fn);
+        s = cm_foam_label_list_in(ctx, lx, "a face", &one_face, &f, &fn);
         if (s != CM_OK) break;
         if (used + (size_t)fn > cap) {
             size_t nc = 2 * cap + (size_t)fn;
@@ -591,14 +737,14 @@ cm_status cm_foam_skip_value(cm_context *ctx, cm_foam_lex *lx, const char *what)
     }
 }
 
-cm_status cm_foam_bool_list(cm_context *ctx, cm_foam_lex *lx, const char *what, uint8_t **out,
-                            int64_t *n)
+cm_status cm_foam_bool_list(cm_context *ctx, cm_foam_lex *lx, const char *what,
+                            const cm_foam_limit *lim, uint8_t **out, int64_t *n)
 {
     *out = NULL;
     *n = 0;
     char open;
     int64_t cnt;
-    cm_status s = list_open(ctx, lx, what, &cnt, &open);
+    cm_status s = list_open(ctx, lx, what, lim, 2, 1, &cnt, &open);
     if (s != CM_OK) return s;
     if (!open) return CM_OK; /* an empty list written as its size alone */
     uint8_t *v = alloc_n(cnt, 1);

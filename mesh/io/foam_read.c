@@ -57,18 +57,32 @@ static cm_status skip_entry(cm_context *ctx, cm_foam_lex *lx)
     return s;
 }
 
+/* Inflated-byte budgets of a .gz file per entry of its first count (foam_lex.c, read_gz):
+ * generous, an entry written by OpenFOAM in ASCII at full precision takes a quarter or less:
+ * a label ("-9223372036854775808" and a newline: 21 bytes), a point (three 24-character
+ * scalars in brackets: 77), a face (1 KiB: some 45 vertices of 20 digits, where real meshes
+ * average 4 to 6 vertices), a patch dictionary (type, inGroups, nFaces, startFace, the
+ * processor and cyclic entries: under 1 KiB) or a zone (its labels, and a flipMap for a face
+ * zone, at most one per cell, face or point). */
+enum { LABEL_BYTES = 64, POINT_BYTES = 256, FACE_BYTES = 1024, PATCH_BYTES = 16384, ZONE_BYTES = 16384 };
+/* more patches or zones than any case has (a decomposed piece has one per neighbour piece) */
+enum { MAX_PATCHES = 1000000, MAX_ZONES = 1000000 };
+
 static cm_status read_boundary(cm_context *ctx, const char *dir, cm_foam_poly *p)
 {
     cm_foam_file f;
-    cm_status s = cm_foam_file_load(ctx, dir, "boundary", 0, &f);
+    cm_status s = cm_foam_file_load_bounded(ctx, dir, "boundary", 0, PATCH_BYTES, MAX_PATCHES, &f);
     if (s != CM_OK) return s;
     cm_foam_lex lx;
     cm_foam_lex_init(&lx, &f, f.body);
     int64_t n = 0;
     char w[600];
     s = cm_foam_label(ctx, &lx, "the number of patches", &n);
-    if (s == CM_OK && (n < 0 || n > 1000000))
-        s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %lld patches", cm_foam_where(&lx, w, sizeof w), (long long)n);
+    /* a patch takes at least "p{nFaces 0;startFace 0;}" (24 bytes): a larger count is refused
+     * before the patches are allocated */
+    if (s == CM_OK && (n < 0 || n > MAX_PATCHES || (uint64_t)n > (f.size - lx.pos) / 24))
+        s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %lld patches, more than the %zu bytes left can hold",
+                     cm_foam_where(&lx, w, sizeof w), (long long)n, f.size - lx.pos);
     if (s == CM_OK) s = cm_foam_expect(ctx, &lx, '(', "'(' opening the patch list");
     if (s == CM_OK && n > 0 && !(p->patches = calloc((size_t)n, sizeof *p->patches)))
         s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
@@ -118,14 +132,22 @@ static cm_status read_boundary(cm_context *ctx, const char *dir, cm_foam_poly *p
 static cm_status read_zones(cm_context *ctx, const char *dir, const char *name, cm_foam_zone_kind kind,
                             cm_foam_poly *p)
 {
+    const int64_t limit = kind == CM_FOAM_CELL_ZONE ? p->n_cells : kind == CM_FOAM_FACE_ZONE ? p->n_faces : p->n_points;
+    const char *things = kind == CM_FOAM_CELL_ZONE ? "cells" : kind == CM_FOAM_FACE_ZONE ? "faces" : "points";
     cm_foam_file f;
-    cm_status s = cm_foam_file_load(ctx, dir, name, 1, &f);
+    /* a zone: its dictionary, at most one label (and flipMap entry) per cell, face or point */
+    cm_status s = cm_foam_file_load_bounded(ctx, dir, name, 1, ZONE_BYTES + (uint64_t)limit * (LABEL_BYTES + 4),
+                                            MAX_ZONES, &f);
     if (s != CM_OK || !f.data) return s;
     cm_foam_lex lx;
     cm_foam_lex_init(&lx, &f, f.body);
     int64_t n = 0;
+    char w[600];
     s = cm_foam_label(ctx, &lx, "the number of zones", &n);
-    if (s == CM_OK && (n < 0 || n > 1000000)) s = cm_foam_expect(ctx, &lx, '?', "a zone count");
+    /* a zone takes at least "z{}" (3 bytes) */
+    if (s == CM_OK && (n < 0 || n > MAX_ZONES || (uint64_t)n > (f.size - lx.pos) / 3))
+        s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %lld zones, more than the %zu bytes left can hold",
+                     cm_foam_where(&lx, w, sizeof w), (long long)n, f.size - lx.pos);
     if (s == CM_OK) s = cm_foam_expect(ctx, &lx, '(', "'(' opening the zone list");
     cm_foam_zone *z = NULL;
     if (s == CM_OK && n > 0) {
@@ -134,7 +156,15 @@ static cm_status read_zones(cm_context *ctx, const char *dir, const char *name, 
         else p->zones = z;
     }
     const char *labels = kind == CM_FOAM_CELL_ZONE ? "cellLabels" : kind == CM_FOAM_FACE_ZONE ? "faceLabels" : "pointLabels";
-    const int64_t limit = kind == CM_FOAM_CELL_ZONE ? p->n_cells : kind == CM_FOAM_FACE_ZONE ? p->n_faces : p->n_points;
+    /* a zone holds each of its cells, faces or points once: no more labels than there are */
+    char expect[160];
+    snprintf(expect, sizeof expect, "at most the %lld %s of the mesh, each once", (long long)limit, things);
+    const cm_foam_limit zone_lim = {0, limit, limit, expect};
+    /* a uniform list "N{c}" repeats one label: all such lists of the file together (and any
+     * list whose first, middle and last labels are equal, a cheap test that a valid zone never
+     * meets) hold at most as many labels as the mesh has cells (faces, points), so that a few
+     * bytes cannot become zones of the mesh's size, many times over */
+    int64_t repeated = 0;
     for (int64_t i = 0; s == CM_OK && i < n; ++i) {
         cm_foam_zone *zn = &p->zones[p->n_zones];
         memset(zn, 0, sizeof *zn);
@@ -147,6 +177,7 @@ static cm_status read_zones(cm_context *ctx, const char *dir, const char *name, 
         }
         if (!(zn->name = dup_n(nm.s, nm.len))) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
         if (s == CM_OK) s = cm_foam_expect(ctx, &lx, '{', "'{' opening the zone");
+        int64_t n_flip = -1;
         while (s == CM_OK) {
             cm_foam_tok key = cm_foam_next(&lx);
             if (key.kind == CM_FOAM_PUNCT && key.s[0] == '}') break;
@@ -154,21 +185,31 @@ static cm_status read_zones(cm_context *ctx, const char *dir, const char *name, 
                 s = cm_foam_expect(ctx, &lx, '}', "an entry or '}' in the zone");
                 break;
             }
-            if (tok_is(key, labels)) {
-                s = cm_foam_label_list(ctx, &lx, labels, &zn->ids, &zn->n);
+            if (tok_is(key, labels) && !zn->ids) {
+                s = cm_foam_label_list_in(ctx, &lx, labels, &zone_lim, &zn->ids, &zn->n);
+                if (s == CM_OK && zn->n > 1 && zn->ids[0] == zn->ids[zn->n - 1] && zn->ids[0] == zn->ids[zn->n / 2] &&
+                    (repeated += zn->n) > limit)
+                    s = cm_error(ctx, CM_ERR_FORMAT,
+                                 "cm_mesh_read: %s: zone '%s': %lld labels repeated in the zones so far, more than the "
+                                 "%lld %s of the mesh",
+                                 f.path, zn->name, (long long)repeated, (long long)limit, things);
                 for (int64_t k = 0; s == CM_OK && k < zn->n; ++k)
                     if (zn->ids[k] < 0 || zn->ids[k] >= limit)
                         s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: zone '%s': label %lld out of range [0, %lld)",
                                      f.path, zn->name, (long long)zn->ids[k], (long long)limit);
                 if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ';', "';' after the labels");
-            } else if (tok_is(key, "flipMap")) {
-                int64_t nf = 0;
-                s = cm_foam_bool_list(ctx, &lx, "flipMap", &zn->flip, &nf);
+            } else if (tok_is(key, "flipMap") && !zn->flip) {
+                /* all false is written "N{0}" */
+                const cm_foam_limit flip_lim = {0, limit, limit, expect};
+                s = cm_foam_bool_list(ctx, &lx, "flipMap", &flip_lim, &zn->flip, &n_flip);
                 if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ';', "';' after flipMap");
             } else {
                 s = skip_entry(ctx, &lx);
             }
         }
+        if (s == CM_OK && n_flip >= 0 && n_flip != zn->n)
+            s = cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: zone '%s': flipMap has %lld entries, %s has %lld",
+                         f.path, zn->name, (long long)n_flip, labels, (long long)zn->n);
     }
     if (s == CM_OK) s = cm_foam_expect(ctx, &lx, ')', "')' closing the zone list");
     cm_foam_file_free(&f);
@@ -264,17 +305,25 @@ typedef struct reader {
     char *dir;
     cm_foam_poly *p;
     double *xyz;
+    char *faces_path, *owner_path, *nei_path; /* the files read (X or X.gz), for messages */
 } reader;
 
 static cm_status read_points(reader *r)
 {
     cm_foam_file f;
-    cm_status s = cm_foam_file_load(r->ctx, r->dir, "points", 0, &f);
+    cm_status s = cm_foam_file_load_bounded(r->ctx, r->dir, "points", 0, POINT_BYTES, -1, &f);
     if (s != CM_OK) return s;
     cm_foam_lex lx;
     cm_foam_lex_init(&lx, &f, f.body);
     size_t head = cm_foam_peek(&lx).at;
-    s = cm_foam_scalar_list(r->ctx, &lx, "points", 3, &r->xyz, &r->p->n_points);
+    /* the faces were read first: a uniform list (all points equal) is at most as long as the
+     * faces' vertex lists together (a mesh may keep unused points, so a list of points
+     * written one by one is bounded by the file only) */
+    char expect[160];
+    const int64_t used = r->p->face_off[r->p->n_faces];
+    snprintf(expect, sizeof expect, "the %lld vertices of the faces", (long long)used);
+    const cm_foam_limit lim = {0, INT64_MAX, used, expect};
+    s = cm_foam_scalar_list(r->ctx, &lx, "points", 3, &lim, &r->xyz, &r->p->n_points);
     if (s == CM_OK) {
         cm_foam_poly *p = r->p;
         p->points_head = dup_n(f.data, head);
@@ -291,14 +340,25 @@ static cm_status read_points(reader *r)
     return s;
 }
 
-static cm_status read_labels(reader *r, const char *name, int64_t **v, int64_t *n)
+/* owner (exact: one per face) or neighbour (at most one per face), counted against the faces
+ * before anything is allocated or inflated further */
+static cm_status read_labels(reader *r, const char *name, int exact, int64_t **v, int64_t *n)
 {
+    const int64_t nf = r->p->n_faces;
     cm_foam_file f;
-    cm_status s = cm_foam_file_load(r->ctx, r->dir, name, 0, &f);
+    cm_status s = cm_foam_file_load_bounded(r->ctx, r->dir, name, 0, LABEL_BYTES, nf, &f);
     if (s != CM_OK) return s;
     cm_foam_lex lx;
     cm_foam_lex_init(&lx, &f, f.body);
-    s = cm_foam_label_list(r->ctx, &lx, name, v, n);
+    char expect[160];
+    snprintf(expect, sizeof expect, "%s the %lld faces in faces", exact ? "as many as" : "at most", (long long)nf);
+    const cm_foam_limit lim = {exact ? nf : 0, nf, nf, expect};
+    s = cm_foam_label_list_in(r->ctx, &lx, name, &lim, v, n);
+    char **keep = exact ? &r->owner_path : &r->nei_path;
+    if (s == CM_OK) {
+        *keep = f.path;
+        f.path = NULL;
+    }
     cm_foam_file_free(&f);
     return s;
 }
@@ -306,37 +366,41 @@ static cm_status read_labels(reader *r, const char *name, int64_t **v, int64_t *
 static cm_status read_faces(reader *r)
 {
     cm_foam_file f;
-    cm_status s = cm_foam_file_load(r->ctx, r->dir, "faces", 0, &f);
+    cm_status s = cm_foam_file_load_bounded(r->ctx, r->dir, "faces", 0, FACE_BYTES, -1, &f);
     if (s != CM_OK) return s;
     cm_foam_lex lx;
     cm_foam_lex_init(&lx, &f, f.body);
     int compact = strcmp(f.cls, "faceCompactList") == 0;
     s = cm_foam_face_list(r->ctx, &lx, compact, "faces", &r->p->face_off, &r->p->face_nodes, &r->p->n_faces);
-    char *fp = f.path;
-    f.path = NULL;
     for (int64_t i = 0; s == CM_OK && i < r->p->n_faces; ++i) {
         int64_t b = r->p->face_off[i], e = r->p->face_off[i + 1];
         if (e - b < 3)
-            s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld has %lld nodes (at least 3 expected)", fp,
-                         (long long)i, (long long)(e - b));
-        for (int64_t k = b; s == CM_OK && k < e; ++k)
-            if (r->p->face_nodes[k] < 0 || r->p->face_nodes[k] >= r->p->n_points)
-                s = cm_error(r->ctx, CM_ERR_FORMAT,
-                             "cm_mesh_read: %s: face %lld: point index %lld out of range [0, %lld) (points has %lld)",
-                             fp, (long long)i, (long long)r->p->face_nodes[k], (long long)r->p->n_points,
-                             (long long)r->p->n_points);
+            s = cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld has %lld nodes (at least 3 expected)",
+                         f.path, (long long)i, (long long)(e - b));
     }
-    free(fp);
+    if (s == CM_OK && !(r->faces_path = strdup(f.path))) s = cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
     cm_foam_file_free(&f);
     return s;
+}
+
+/* After the points: every vertex of a face is one of them. */
+static cm_status check_face_points(reader *r)
+{
+    const cm_foam_poly *p = r->p;
+    for (int64_t i = 0; i < p->n_faces; ++i)
+        for (int64_t k = p->face_off[i]; k < p->face_off[i + 1]; ++k)
+            if (p->face_nodes[k] < 0 || p->face_nodes[k] >= p->n_points)
+                return cm_error(r->ctx, CM_ERR_FORMAT,
+                                "cm_mesh_read: %s: face %lld: point index %lld out of range [0, %lld) (points has %lld)",
+                                r->faces_path, (long long)i, (long long)p->face_nodes[k], (long long)p->n_points,
+                                (long long)p->n_points);
+    return CM_OK;
 }
 
 static cm_status check_addressing(reader *r, int64_t n_owner, int64_t n_nei)
 {
     cm_foam_poly *p = r->p;
-    char own[4200], nei[4200];
-    cm_foam_join(own, sizeof own, r->dir, "owner", NULL);
-    cm_foam_join(nei, sizeof nei, r->dir, "neighbour", NULL);
+    const char *own = r->owner_path, *nei = r->nei_path;
     if (n_owner != p->n_faces)
         return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %lld entries, but faces has %lld faces", own,
                         (long long)n_owner, (long long)p->n_faces);
@@ -344,25 +408,69 @@ static cm_status check_addressing(reader *r, int64_t n_owner, int64_t n_nei)
         return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: %lld entries, more than the %lld faces", nei,
                         (long long)n_nei, (long long)p->n_faces);
     p->n_internal = n_nei;
+    /* Every cell has at least 4 faces, and a face is seen by its owner and, if internal, its
+     * neighbour: the faces can bound (faces + internal faces) / 4 cells at most. A label
+     * beyond is refused here, naming its file and entry, before anything is allocated per
+     * cell (a label near 2^63 would otherwise be an allocation, or an overflow). */
+    const int64_t most = (p->n_faces + n_nei) / 4;
     int64_t maxc = -1;
-    for (int64_t i = 0; i < p->n_faces; ++i) {
-        if (p->owner[i] < 0)
-            return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld: negative owner %lld", own, (long long)i,
-                            (long long)p->owner[i]);
-        if (p->owner[i] > maxc) maxc = p->owner[i];
-    }
-    for (int64_t i = 0; i < n_nei; ++i) {
-        if (p->neighbour[i] < 0)
-            return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld: negative neighbour %lld", nei,
-                            (long long)i, (long long)p->neighbour[i]);
-        if (p->neighbour[i] == p->owner[i])
-            return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: face %lld: owner and neighbour are both cell %lld",
-                            nei, (long long)i, (long long)p->owner[i]);
-        if (p->neighbour[i] > maxc) maxc = p->neighbour[i];
+    for (int k = 0; k < 2; ++k) {
+        const int64_t *v = k ? p->neighbour : p->owner, n = k ? n_nei : p->n_faces;
+        const char *file = k ? nei : own;
+        for (int64_t i = 0; i < n; ++i) {
+            if (v[i] < 0 || v[i] >= most)
+                return cm_error(r->ctx, CM_ERR_FORMAT,
+                                v[i] < 0 ? "cm_mesh_read: %s: entry %lld: cell label %lld is negative"
+                                         : "cm_mesh_read: %s: entry %lld: cell label %lld beyond the %lld cells "
+                                           "that %lld faces can bound (each cell has at least 4 faces)",
+                                file, (long long)i, (long long)v[i], (long long)most, (long long)p->n_faces);
+            if (k && v[i] == p->owner[i])
+                return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: entry %lld: owner and neighbour are both cell %lld",
+                                file, (long long)i, (long long)v[i]);
+            if (v[i] > maxc) maxc = v[i];
+        }
     }
     p->n_cells = maxc + 1;
     if (p->n_cells == 0)
         return cm_error(r->ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: no cells (owner is empty)", own);
+    /* Cells are numbered without gaps and have at least 4 faces each. The first cell c with
+     * fewer is blamed on the file and entry of the smallest label >= c: a label beyond the
+     * c cells before it when no cell from c on is complete (a label out of range), else cell
+     * c itself. */
+    {
+        int64_t *count = calloc((size_t)p->n_cells, sizeof *count);
+        if (!count) return cm_error(r->ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory for %lld cells", (long long)p->n_cells);
+        for (int64_t i = 0; i < p->n_faces; ++i) ++count[p->owner[i]];
+        for (int64_t i = 0; i < n_nei; ++i) ++count[p->neighbour[i]];
+        int64_t c = 0;
+        while (c < p->n_cells && count[c] >= 4) ++c;
+        int trailing = 1;
+        for (int64_t d = c; d < p->n_cells && trailing; ++d) trailing = count[d] < 4;
+        const int64_t faces_c = c < p->n_cells ? count[c] : 0;
+        free(count);
+        if (c < p->n_cells) {
+            const char *file = own;
+            int64_t at = -1, label = INT64_MAX;
+            for (int k = 0; k < 2; ++k) {
+                const int64_t *v = k ? p->neighbour : p->owner, n = k ? n_nei : p->n_faces;
+                for (int64_t i = 0; i < n; ++i)
+                    if (v[i] >= c && v[i] < label) {
+                        label = v[i];
+                        at = i;
+                        file = k ? nei : own;
+                    }
+            }
+            if (trailing || faces_c == 0)
+                return cm_error(r->ctx, CM_ERR_FORMAT,
+                                "cm_mesh_read: %s: entry %lld: cell label %lld beyond the %lld cells numbered 0 to %lld "
+                                "(cell %lld has %lld faces, at least 4 expected)",
+                                file, (long long)at, (long long)label, (long long)c, (long long)(c - 1),
+                                (long long)c, (long long)faces_c);
+            return cm_error(r->ctx, CM_ERR_FORMAT,
+                            "cm_mesh_read: %s: entry %lld: cell %lld has %lld faces (at least 4 expected)", file,
+                            (long long)at, (long long)c, (long long)faces_c);
+        }
+    }
     /* patches: contiguous, from the first boundary face to the last face */
     int64_t at = p->n_internal;
     for (size_t i = 0; i < p->n_patches; ++i) {
@@ -502,18 +610,23 @@ done:
 
 cm_status cm_foam_read_poly(cm_context *ctx, const char *dir, cm_foam_poly *p)
 {
-    reader r = {ctx, dir, (char *)dir, p, NULL};
+    reader r = {ctx, dir, (char *)dir, p, NULL, NULL, NULL, NULL};
     if (!is_dir(dir)) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: no polyMesh directory %s", dir);
     int64_t n_owner = 0, n_nei = 0;
     cm_status s = CM_OK;
     if (!p->dir && !(p->dir = strdup(dir))) s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: out of memory");
+    /* faces first: every other count is checked against theirs before it is allocated */
+    if (s == CM_OK) s = read_faces(&r);
     if (s == CM_OK) s = read_points(&r);
     p->xyz0 = r.xyz;
-    if (s == CM_OK) s = read_faces(&r);
-    if (s == CM_OK) s = read_labels(&r, "owner", &p->owner, &n_owner);
-    if (s == CM_OK) s = read_labels(&r, "neighbour", &p->neighbour, &n_nei);
+    if (s == CM_OK) s = check_face_points(&r);
+    free(r.faces_path);
+    if (s == CM_OK) s = read_labels(&r, "owner", 1, &p->owner, &n_owner);
+    if (s == CM_OK) s = read_labels(&r, "neighbour", 0, &p->neighbour, &n_nei);
     if (s == CM_OK) s = read_boundary(ctx, dir, p);
     if (s == CM_OK) s = check_addressing(&r, n_owner, n_nei);
+    free(r.owner_path);
+    free(r.nei_path);
     if (s == CM_OK) s = read_zones(ctx, dir, "cellZones", CM_FOAM_CELL_ZONE, p);
     if (s == CM_OK) s = read_zones(ctx, dir, "faceZones", CM_FOAM_FACE_ZONE, p);
     if (s == CM_OK) s = read_zones(ctx, dir, "pointZones", CM_FOAM_POINT_ZONE, p);
@@ -523,7 +636,7 @@ cm_status cm_foam_read_poly(cm_context *ctx, const char *dir, cm_foam_poly *p)
 cm_status cm_foam_mesh_of_poly(cm_context *ctx, cm_foam_poly *p, const char *where, cm_mesh **mesh)
 {
     *mesh = NULL;
-    reader r = {ctx, where, (char *)where, p, NULL};
+    reader r = {ctx, where, (char *)where, p, NULL, NULL, NULL, NULL};
     cm_mesh *m = NULL;
     cm_status s = cm_mesh_create(ctx, &m);
     if (s == CM_OK) s = cm_mesh_resize_nodes(ctx, m, (size_t)p->n_points, 0);

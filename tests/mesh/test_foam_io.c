@@ -515,7 +515,7 @@ static void hostile(void)
 {
     const bad cases[] = {
         {"owner", NULL, NULL, CM_ERR_IO, "owner: no such file"},
-        {"owner", NULL, "foam_tet", CM_ERR_FORMAT, "entries, but faces has"},
+        {"owner", NULL, "foam_tet", CM_ERR_FORMAT, "entries, expected as many as the"},
         {"owner", "\n(\n", "\n(\n0\n", CM_ERR_FORMAT, "more entries than its size"},
         {"owner", "\n0\n", "\n", CM_ERR_FORMAT, "entries of owner"},
         {"faces", "4(0 ", "4(100000 ", CM_ERR_FORMAT, "out of range"},
