@@ -296,11 +296,18 @@ void cm_outdir_abort(cm_outdir *out)
     memset(out, 0, sizeof *out);
 }
 
-cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *const *inputs, size_t n)
+cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *dir, const char *const *inputs,
+                          size_t n)
 {
+    /* a new (or empty) dir beside the temporary: one rename */
+    if (rename(out->tmp, dir) == 0) {
+        live_remove(out->tmp);
+        cm_outdir_abort(out);
+        return CM_OK;
+    }
     DIR *d = opendir(out->tmp);
     if (!d) {
-        cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot list the temporary directory: %s", out->path,
+        cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot list the temporary directory: %s", dir,
                                strerror(errno));
         cm_outdir_abort(out);
         return s;
@@ -316,17 +323,17 @@ cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *const *in
             cap = cap ? 2 * cap : 16;
             char **grown = realloc(names, cap * sizeof *names);
             if (!grown) {
-                s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", out->path);
+                s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", dir);
                 break;
             }
             names = grown;
         }
-        size_t l = strlen(out->path) + strlen(e->d_name) + 2;
+        size_t l = strlen(dir) + strlen(e->d_name) + 2;
         if (!(names[k] = malloc(l))) {
-            s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", out->path);
+            s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", dir);
             break;
         }
-        snprintf(names[k++], l, "%s/%s", out->path, e->d_name);
+        snprintf(names[k++], l, "%s/%s", dir, e->d_name);
     }
     closedir(d);
     for (size_t i = 0; s == CM_OK && i < k; ++i)
@@ -343,7 +350,7 @@ cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *const *in
             const char *base = strrchr(names[i], '/') + 1;
             char *from = malloc(t + strlen(base) + 2);
             if (!from) {
-                s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", out->path);
+                s = cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", dir);
                 break;
             }
             sprintf(from, "%s/%s", out->tmp, base);
@@ -361,23 +368,24 @@ cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *const *in
     return s;
 }
 
-cm_status cm_outfile_commit_all(cm_context *ctx, cm_outfile *outs, size_t n)
+cm_status cm_outfile_commit_all(cm_context *ctx, cm_outfile *outs, size_t n, const char *from,
+                                const char *to)
 {
     /* everything written out before the first rename: a full disk shows here */
     cm_status s = CM_OK;
     for (size_t i = 0; s == CM_OK && i < n; ++i)
         if (outs[i].f && (fflush(outs[i].f) != 0 || ferror(outs[i].f)))
             s = cm_error(ctx, CM_ERR_IO, "%s: write failed: %s", outs[i].path, strerror(errno));
-    if (s != CM_OK) {
-        for (size_t i = 0; i < n; ++i)
-            cm_outfile_abort(&outs[i]);
-        return s;
-    }
     commit_begin();
+    if (s == CM_OK && from && rename(from, to) != 0)
+        s = cm_error(ctx, CM_ERR_IO, "%s: cannot rename the temporary file onto it: %s", to, strerror(errno));
     for (size_t i = 0; i < n; ++i) {
         if (!outs[i].f) continue;
-        cm_status e = cm_outfile_commit(ctx, &outs[i]);
-        if (s == CM_OK) s = e;
+        if (s != CM_OK) {
+            cm_outfile_abort(&outs[i]);
+            continue;
+        }
+        s = cm_outfile_commit(ctx, &outs[i]);
     }
     commit_end();
     return s;

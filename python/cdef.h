@@ -61,10 +61,11 @@ char *tmp;
 } cm_outdir;
 cm_status cm_outdir_open(cm_context *ctx, const char *path, cm_outdir *out);
 cm_status cm_outdir_commit(cm_context *ctx, cm_outdir *out);
-cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *const *inputs,
-size_t n);
+cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *dir,
+const char *const *inputs, size_t n);
 void cm_outdir_abort(cm_outdir *out);
-cm_status cm_outfile_commit_all(cm_context *ctx, cm_outfile *outs, size_t n);
+cm_status cm_outfile_commit_all(cm_context *ctx, cm_outfile *outs, size_t n,
+const char *from, const char *to);
 cm_status cm_output_lock(cm_context *ctx, const char *dir, int *fd);
 void cm_output_unlock(int *fd);
 int cm_same_file(const char *a, const char *b);

@@ -180,17 +180,22 @@ typedef struct cm_outdir {
 
 CM_API cm_status cm_outdir_open(cm_context *ctx, const char *path, cm_outdir *out);
 CM_API cm_status cm_outdir_commit(cm_context *ctx, cm_outdir *out);
-/* Moves every file of the temporary into the existing target directory: first each name is
- * checked against the n inputs by device and inode (CM_ERR_ARGUMENT, nothing moved, when one
- * is an input), then all are renamed as one group. The temporary is removed in any case. */
-CM_API cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *const *inputs,
-                                 size_t n);
+/* The temporary's files into the directory dir: when dir is new or empty (and the temporary
+ * beside it), one rename of the temporary; else each name is first checked against the n
+ * inputs by device and inode (CM_ERR_ARGUMENT, nothing moved, when one is an input), then
+ * all are renamed as one group that signals do not interrupt. The temporary is removed in
+ * any case. (For a temporary inside dir: cm_outdir_open of "dir/.cm".) */
+CM_API cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *dir,
+                                 const char *const *inputs, size_t n);
 /* Removes the temporary directory and its content. Safe to call twice. */
 CM_API void cm_outdir_abort(cm_outdir *out);
 
 /* Commits n open outputs together: all flushed first (a write error aborts every one, none
- * renamed), then renamed as one group that signals do not interrupt. */
-CM_API cm_status cm_outfile_commit_all(cm_context *ctx, cm_outfile *outs, size_t n);
+ * renamed), then renamed as one group that signals do not interrupt; with from (else NULL),
+ * the file from (written by another writer into a temporary directory) is renamed onto to
+ * first, in the same group. */
+CM_API cm_status cm_outfile_commit_all(cm_context *ctx, cm_outfile *outs, size_t n,
+                                       const char *from, const char *to);
 
 /* An exclusive lock (flock) on an output directory for the time of a write: CM_ERR_BUSY
  * "<dir>: another process is writing it" at once when another process holds it. *fd is the

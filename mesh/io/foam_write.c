@@ -469,7 +469,7 @@ static cm_status write_pieces(cm_context *ctx, const cm_mesh *mesh, const cm_foa
             s = e;
         }
     } else {
-        s = cm_outfile_commit_all(ctx, outs, n);
+        s = cm_outfile_commit_all(ctx, outs, n, NULL, NULL);
         for (size_t i = 0; s == CM_OK && i < n; ++i) unlink(twins[i]);
     }
     free(outs);
