@@ -400,7 +400,21 @@ static cm_status fill_polymesh(cm_context *ctx, const cm_mesh *mesh, const char 
     cm_status s = cm_outdir_open(ctx, dir, od);
     if (s != CM_OK) return cm_error_prefix(ctx, s, "cm_mesh_write");
     s = src ? polymesh_out(ctx, src, xyz, precision, od->tmp, 1) : write_converted(ctx, mesh, od->tmp, conv);
-    if (s != CM_OK) cm_outdir_abort(od);
+    if (s != CM_OK) {
+        /* the message names the file as it would have been, not its temporary */
+        const char *msg = cm_context_message(ctx);
+        size_t t = strlen(od->tmp);
+        char *at = msg ? strstr(msg, od->tmp) : NULL;
+        if (at && at[t] == '/') {
+            char *copy = malloc(strlen(msg) + 1);
+            if (copy) {
+                strcpy(copy, msg);
+                s = cm_error(ctx, s, "%.*s%s%s", (int)(at - msg), copy, dir, copy + (at - msg) + t);
+                free(copy);
+            }
+        }
+        cm_outdir_abort(od);
+    }
     return s;
 }
 
