@@ -371,6 +371,7 @@ def out_converted_over_zones():
         f.write("// the user's\n")
     convert(CUBE, c)
     reads(c)
+    print(f"polyMesh after the write: {sorted(os.listdir(pm))}")
     if os.path.exists(os.path.join(pm, "cellZones")) or os.path.exists(os.path.join(pm, "sets")):
         fail("the old mesh's zones or sets are still there")
     if file_bytes(os.path.join(c, "system", "controlDict")) != b"// the user's\n":
