@@ -296,17 +296,33 @@ def out_study_list_named_study_csv():
 
 @case
 def out_study_new_dir_whole():
-    """A study into a new DIR: DIR appears with all its results, and no temporary beside it."""
+    """A study into a new DIR: DIR appears with all its results and nothing beside it; one
+    interrupted (SIGINT) leaves no DIR and no temporary (it used to leave DIR begun)."""
     fresh()
     g0, g1, m0, lst = study_setup()
     d = path("sub/new")
-    p = run(["study", "--from", g0, "--mesh", m0, "--variants", lst, "-o", d, "--methods", "rbf",
-             "--write-meshes", "all"], 0, None, lines=0)
+    args = ["study", "--from", g0, "--mesh", m0, "--variants", lst, "--methods", "rbf",
+            "--write-meshes", "all", "-o"]
+    run(args + [d], 0, None, lines=0)
     got = sorted(os.listdir(d))
     if got != ["rbf_absolute_G1.vtu", "study.csv", "study.svg"]:
         fail(f"DIR holds {got}")
     if [e for e in os.listdir(path("sub")) if e != "new"]:
         fail(f"left beside DIR: {os.listdir(path('sub'))}")
+    d2 = path("sub/cut")
+    p = subprocess.Popen([CLI] + args + [d2], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    t0 = time.time()
+    while p.poll() is None and time.time() - t0 < 60:
+        if os.path.exists(d2) or glob.glob(path("sub/.cm-*")):
+            p.send_signal(signal.SIGINT)
+            break
+        time.sleep(0.001)
+    p.communicate(timeout=60)
+    print(f"interrupted study: exit {p.returncode}; beside DIR: {sorted(os.listdir(path('sub')))}")
+    if p.returncode != -signal.SIGINT:
+        fail(f"the study was not interrupted (exit {p.returncode})")
+    if os.path.exists(d2) or glob.glob(path("sub/.cm-*")):
+        fail("an interrupted study left DIR or its temporary")
 
 
 @case
