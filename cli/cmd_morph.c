@@ -272,8 +272,8 @@ static void fill_report(FILE *f, const cm_morph_result *r)
 /* The mesh and the report as one output (docs/DESIGN.md, "Command line contract"): the
  * report's temporary is created first (a report that cannot be written leaves no mesh); a
  * mesh file is written into a temporary directory beside -o and renamed together with the
- * report; an OpenFOAM case (a directory with its own atomic scheme) is written before the
- * report is committed. Returns the exit code (rc when all went well). */
+ * report; an OpenFOAM case (a directory with its own atomic scheme) and an Abaqus or Nastran
+ * deck (with its included files) are written before the report is committed. Returns the exit code (rc when all went well). */
 static int write_outputs(cm_context *ctx, const morph_args *a, cm_morph_result *r, int want_mesh,
                          int want_report, int rc)
 {
@@ -284,7 +284,9 @@ static int write_outputs(cm_context *ctx, const morph_args *a, cm_morph_result *
     if (want_report) s = cm_outfile_open(ctx, a->report, &rep);
     if (s >= 0 && want_mesh) {
         double t = cm_wtime();
-        if (want_report && cm_mesh_format_from_path(a->out) != CM_FORMAT_FOAM) {
+        /* an Abaqus or Nastran deck writes its included files beside it: not staged */
+        const cm_mesh_format fmt = cm_mesh_format_from_path(a->out);
+        if (want_report && fmt != CM_FORMAT_FOAM && fmt != CM_FORMAT_ABAQUS && fmt != CM_FORMAT_NASTRAN) {
             s = cm_outdir_open(ctx, a->out, &od);
             const char *base = strrchr(a->out, '/');
             base = base ? base + 1 : a->out;

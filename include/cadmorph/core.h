@@ -164,7 +164,7 @@ CM_API void cm_outfile_abort(cm_outfile *out);
  * library installs no handlers). */
 CM_API void cm_outfile_unlink_all(void);
 
-/* ---- outputs of several files (core/output_dir.c; docs/DESIGN.md, "Command line
+/* ---- outputs of several files (docs/DESIGN.md, "Command line
  * contract") ---- */
 
 /* A directory built as a temporary sibling "<parent>/.cm-XXXXXX" (the parent is created)
