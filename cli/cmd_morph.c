@@ -287,9 +287,12 @@ static int write_outputs(cm_context *ctx, const morph_args *a, cm_morph_result *
         /* an Abaqus or Nastran deck writes its included files beside it: not staged */
         const cm_mesh_format fmt = cm_mesh_format_from_path(a->out);
         if (want_report && fmt != CM_FORMAT_FOAM && fmt != CM_FORMAT_ABAQUS && fmt != CM_FORMAT_NASTRAN) {
-            s = cm_outdir_open(ctx, a->out, &od);
+            /* the temporary directory beside -o: "<dir of -o>/.cm-XXXXXX" */
             const char *base = strrchr(a->out, '/');
             base = base ? base + 1 : a->out;
+            char beside[4200];
+            snprintf(beside, sizeof beside, "%.*s.cm", (int)(base - a->out), a->out);
+            s = cm_outdir_open(ctx, beside, &od);
             size_t len = s >= 0 ? strlen(od.tmp) + strlen(base) + 2 : 0;
             if (s >= 0 && !(staged = malloc(len))) s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
             if (s >= 0) {
