@@ -38,6 +38,14 @@ int cli_usage(const char *cmd, const char *usage, const char *fmt, ...)
  * line on stderr naming cmd. */
 int cli_make_dir(const char *cmd, const char *dir);
 
+/* The output directory DIR of a command that writes several files (study, sweep; see
+ * docs/DESIGN.md, "Command line contract"): the fixed output names (NULL-terminated list)
+ * checked against the n inputs by device and inode, then a temporary directory to write into
+ * (beside a new DIR, inside an existing one), od->tmp, made visible by cm_outdir_merge(ctx,
+ * od, DIR, inputs, n) or removed by cm_outdir_abort. 0, or the exit code after one line on
+ * stderr (1 when an output is an input). */
+int cli_outdir_begin(cm_context *ctx, const char *cmd, const char *dir, const char *const *names,
+                     const char *const *inputs, size_t n, cm_outdir *od);
 /* Non-zero if the two paths name the same file (an existing output that is an input). */
 int cli_same_file(const char *a, const char *b);
 /* The checks of a mesh output before any work: a known mesh format, and none of the n inputs

@@ -244,15 +244,12 @@ static int parse_args(int argc, char **argv, morph_args *a)
     return -1;
 }
 
-/* The CSV report, written through a temporary file like the meshes. */
-static cm_status write_report(cm_context *ctx, const char *path, const cm_morph_result *r)
+/* The CSV report into its open temporary file (committed with the mesh). */
+static void fill_report(FILE *f, const cm_morph_result *r)
 {
-    cm_outfile out;
-    cm_status s = cm_outfile_open(ctx, path, &out);
-    if (s < 0) return s;
-    fprintf(out.f, "step,min_scaled_jacobian,mean_scaled_jacobian,inverted,max_distance_to_g1,"
-                   "t_read,t_sample,t_classify,t_surface_morph,t_volume_solve,t_evaluation,"
-                   "t_write,fraction,accepted,optimized_moves,note\n");
+    fprintf(f, "step,min_scaled_jacobian,mean_scaled_jacobian,inverted,max_distance_to_g1,"
+               "t_read,t_sample,t_classify,t_surface_morph,t_volume_solve,t_evaluation,"
+               "t_write,fraction,accepted,optimized_moves,note\n");
     for (int k = 0; k < r->n_steps; ++k) {
         const cm_morph_step *st = &r->steps[k];
         /* the note names cells and positions: quoted, with its own quotes doubled */
@@ -265,12 +262,56 @@ static cm_status write_report(cm_context *ctx, const char *path, const cm_morph_
         }
         note[n++] = '"';
         note[n] = 0;
-        fprintf(out.f, "%d,%.9g,%.9g,%zu,%.6g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.9g,%d,%zu,%s\n",
+        fprintf(f, "%d,%.9g,%.9g,%zu,%.6g,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.9g,%d,%zu,%s\n",
                 st->step, st->min_sj, st->mean_sj, st->inverted, st->max_dist, st->t_read,
                 st->t_sample, st->t_classify, st->t_surface, st->t_volume_solve, st->t_evaluation,
                 st->t_write, st->fraction, st->accepted, st->optimized_moves, note);
     }
-    return cm_outfile_commit(ctx, &out);
+}
+
+/* The mesh and the report as one output (docs/DESIGN.md, "Command line contract"): the
+ * report's temporary is created first (a report that cannot be written leaves no mesh); a
+ * mesh file is written into a temporary directory beside -o and renamed together with the
+ * report; an OpenFOAM case (a directory with its own atomic scheme) and an Abaqus or Nastran
+ * deck (with its included files) are written before the report is committed. Returns the exit code (rc when all went well). */
+static int write_outputs(cm_context *ctx, const morph_args *a, cm_morph_result *r, int want_mesh,
+                         int want_report, int rc)
+{
+    cm_outfile rep = {0};
+    cm_outdir od = {0};
+    char *staged = NULL;
+    cm_status s = CM_OK;
+    if (want_report) s = cm_outfile_open(ctx, a->report, &rep);
+    if (s >= 0 && want_mesh) {
+        double t = cm_wtime();
+        /* an Abaqus or Nastran deck writes its included files beside it: not staged */
+        const cm_mesh_format fmt = cm_mesh_format_from_path(a->out);
+        if (want_report && fmt != CM_FORMAT_FOAM && fmt != CM_FORMAT_ABAQUS && fmt != CM_FORMAT_NASTRAN) {
+            /* the temporary directory beside -o: "<dir of -o>/.cm-XXXXXX" */
+            const char *base = strrchr(a->out, '/');
+            base = base ? base + 1 : a->out;
+            char beside[4200];
+            snprintf(beside, sizeof beside, "%.*s.cm", (int)(base - a->out), a->out);
+            s = cm_outdir_open(ctx, beside, &od);
+            size_t len = s >= 0 ? strlen(od.tmp) + strlen(base) + 2 : 0;
+            if (s >= 0 && !(staged = malloc(len))) s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+            if (s >= 0) {
+                snprintf(staged, len, "%s/%s", od.tmp, base);
+                s = cm_mesh_write(ctx, r->mesh, staged, NULL);
+            }
+        } else {
+            s = cm_mesh_write(ctx, r->mesh, a->out, NULL);
+        }
+        r->steps[r->n_steps - 1].t_write = cm_wtime() - t;
+    }
+    if (s >= 0 && want_report) {
+        fill_report(rep.f, r);
+        s = cm_outfile_commit_all(ctx, &rep, 1, staged, a->out);
+    }
+    cm_outfile_abort(&rep);
+    cm_outdir_abort(&od);
+    free(staged);
+    return s < 0 ? cli_fail(ctx, "morph", s) : rc;
 }
 
 int cli_cmd_morph(int argc, char **argv)
@@ -309,16 +350,9 @@ int cli_cmd_morph(int argc, char **argv)
     }
     /* under mpirun (--solver petsc) every rank has the result; rank 0 writes it */
     const int writer = cli_output_rank();
-    if (writer && (rc == CLI_EXIT_OK || (partial && a.keep_partial))) {
-        double t = cm_wtime();
-        s = cm_mesh_write(ctx, r->mesh, a.out, NULL);
-        r->steps[r->n_steps - 1].t_write = cm_wtime() - t;
-        if (s < 0) rc = cli_fail(ctx, "morph", s);
-    }
-    if (writer && a.report && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED)) {
-        s = write_report(ctx, a.report, r);
-        if (s < 0) rc = cli_fail(ctx, "morph", s);
-    }
+    const int want_mesh = writer && (rc == CLI_EXIT_OK || (partial && a.keep_partial));
+    const int want_report = writer && a.report && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED);
+    if (want_mesh || want_report) rc = write_outputs(ctx, &a, r, want_mesh, want_report, rc);
     if (writer && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED)) {
         printf("boundary nodes: %zu on vertices, %zu on edges, %zu on faces; ", r->counts[0],
                r->counts[1], r->counts[2]);

@@ -207,7 +207,25 @@ static int run(cm_context *ctx, const study_args *a)
     cm_status s = design ? cm_design_table_read(ctx, a->variants, &table)
                          : cm_study_read_list(ctx, a->variants, &paths, &n);
     if (s >= 0 && design) s = cm_design_table_find(ctx, table, a->from, &base);
-    int rc = s < 0 ? cli_fail(ctx, "study", s) : cli_make_dir("study", a->out);
+    /* every input, against which every output is checked (device and inode) */
+    const char **inputs = s >= 0 ? malloc((n + 3) * sizeof *inputs) : NULL;
+    if (s >= 0 && !inputs) s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
+    size_t n_in = 0;
+    if (inputs) {
+        inputs[n_in++] = a->from;
+        inputs[n_in++] = a->mesh;
+        inputs[n_in++] = a->variants;
+        for (size_t k = 0; k < n; ++k)
+            inputs[n_in++] = paths[k];
+    }
+    /* the results go to a temporary directory made visible at the end (docs/DESIGN.md,
+     * "Command line contract"); under mpirun the ranks write into DIR itself */
+    static const char *const names[] = {"study.csv", "study.svg", NULL};
+    cm_outdir od = {0};
+    int rc = s < 0 ? cli_fail(ctx, "study", s)
+             : a->ranks > 1 ? cli_make_dir("study", a->out)
+                            : cli_outdir_begin(ctx, "study", a->out, names, inputs, n_in, &od);
+    const char *out_dir = od.tmp ? od.tmp : a->out;
     if (rc == 0) {
         s = cm_cad_read(ctx, a->from, &ro, &g0);
         if (s >= 0) s = cm_mesh_read(ctx, a->mesh, &mesh);
@@ -221,7 +239,7 @@ static int run(cm_context *ctx, const study_args *a)
             so.methods = a->list;
             so.n_methods = a->n_methods;
             so.write_meshes = a->write_meshes;
-            so.out_dir = a->out;
+            so.out_dir = out_dir;
             const char *base = strrchr(a->from, '/'), *mbase = strrchr(a->mesh, '/');
             so.model = base ? base + 1 : a->from;
             so.mesh = mbase ? mbase + 1 : a->mesh;
@@ -236,22 +254,25 @@ static int run(cm_context *ctx, const study_args *a)
             if (s < 0) s = cm_error_prefix(ctx, s, "%s, %s", a->from, a->mesh);
         }
         if (s >= 0 && a->rank == 0) { /* under mpirun: every rank has all rows, rank 0 writes */
-            size_t len = strlen(a->out) + 16;
+            size_t len = strlen(out_dir) + 16;
             char *path = malloc(len);
             if (!path) s = cm_error(ctx, CM_ERR_NOMEM, "out of memory");
             if (s >= 0) {
-                snprintf(path, len, "%s/study.csv", a->out);
+                snprintf(path, len, "%s/study.csv", out_dir);
                 s = cm_study_write_csv(ctx, r, path, CM_STUDY_CSV_FULL);
             }
             if (s >= 0) {
-                snprintf(path, len, "%s/study.svg", a->out);
+                snprintf(path, len, "%s/study.svg", out_dir);
                 s = cm_study_write_svg(ctx, r, path);
             }
             free(path);
         }
+        if (s >= 0 && od.tmp) s = cm_outdir_merge(ctx, &od, a->out, inputs, n_in);
         rc = s < 0 ? cli_fail(ctx, "study", s) : CLI_EXIT_OK;
         if (rc == CLI_EXIT_OK && a->rank == 0) print_summary(r);
     }
+    cm_outdir_abort(&od);
+    free(inputs);
     cm_study_result_destroy(&r);
     cm_study_family_release(&fam);
     cm_mesh_destroy(&mesh);

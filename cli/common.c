@@ -149,7 +149,37 @@ int cli_same_file(const char *a, const char *b)
 {
     struct stat sa, sb;
     if (stat(a, &sa) != 0 || stat(b, &sb) != 0) return strcmp(a, b) == 0;
-    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    return cm_same_file(a, b);
+}
+
+int cli_outdir_begin(cm_context *ctx, const char *cmd, const char *dir, const char *const *names,
+                     const char *const *inputs, size_t n, cm_outdir *od)
+{
+    memset(od, 0, sizeof *od);
+    for (size_t k = 0; names && names[k]; ++k) {
+        char path[4200];
+        if (snprintf(path, sizeof path, "%s/%s", dir, names[k]) >= (int)sizeof path) {
+            fprintf(stderr, "cadmorph %s: output directory name too long\n", cmd);
+            return CLI_EXIT_BAD_INPUT;
+        }
+        for (size_t j = 0; j < n; ++j)
+            if (inputs[j] && cm_same_file(path, inputs[j])) {
+                fprintf(stderr, "cadmorph %s: output %s is the input %s: refusing to overwrite it\n",
+                        cmd, path, inputs[j]);
+                return CLI_EXIT_USAGE;
+            }
+    }
+    struct stat st;
+    cm_status s;
+    if (stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) {
+        /* an existing DIR: the temporary inside it (one file system for the renames) */
+        char inside[4200];
+        snprintf(inside, sizeof inside, "%s/.cm", dir);
+        s = cm_outdir_open(ctx, inside, od);
+    } else {
+        s = cm_outdir_open(ctx, dir, od);
+    }
+    return s < 0 ? cli_fail(ctx, cmd, s) : 0;
 }
 
 /* The case directory an OpenFOAM path names: "X/", "X/constant/polyMesh" and the pieces

@@ -44,6 +44,7 @@ static int usage(FILE *out)
  * then die of the same signal (default action) so that the caller sees how we ended. */
 static void on_signal(int sig)
 {
+    if (cm_output_signal(sig)) return; /* raised again when the renames under way are done */
     cm_outfile_unlink_all();
     signal(sig, SIG_DFL);
     raise(sig);

@@ -43,6 +43,7 @@ const char *cm_status_name(cm_status s)
     case CM_ERR_INTERNAL: return "internal error";
     case CM_ERR_REJECTED: return "result rejected";
     case CM_ERR_INTERRUPTED: return "interrupted";
+    case CM_ERR_BUSY: return "busy";
     }
     return "unknown status";
 }

@@ -16,7 +16,8 @@ CM_ERR_NUMERIC = -7,
 CM_ERR_CAD = -8,
 CM_ERR_INTERNAL = -9,
 CM_ERR_REJECTED = -10,
-CM_ERR_INTERRUPTED = -11
+CM_ERR_INTERRUPTED = -11,
+CM_ERR_BUSY = -12
 } cm_status;
 const char *cm_status_name(cm_status s);
 int cm_status_is_input_error(cm_status s);
@@ -60,6 +61,21 @@ cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out);
 cm_status cm_outfile_commit(cm_context *ctx, cm_outfile *out);
 void cm_outfile_abort(cm_outfile *out);
 void cm_outfile_unlink_all(void);
+typedef struct cm_outdir {
+char *path;
+char *tmp;
+} cm_outdir;
+cm_status cm_outdir_open(cm_context *ctx, const char *path, cm_outdir *out);
+cm_status cm_outdir_commit(cm_context *ctx, cm_outdir *out);
+cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *dir,
+const char *const *inputs, size_t n);
+void cm_outdir_abort(cm_outdir *out);
+cm_status cm_outfile_commit_all(cm_context *ctx, cm_outfile *outs, size_t n,
+const char *from, const char *to);
+cm_status cm_output_lock(cm_context *ctx, const char *dir, int *fd);
+void cm_output_unlock(int *fd);
+int cm_same_file(const char *a, const char *b);
+int cm_output_signal(int sig);
 int cm_host_little_endian(void);
 typedef struct cm_blas_cpu {
 int avx2, fma;

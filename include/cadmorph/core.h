@@ -59,8 +59,10 @@ typedef enum cm_status {
     CM_ERR_INTERNAL = -9,      /* a bug or an exception from a dependency */
     CM_ERR_REJECTED = -10,     /* a result refused by a quality guard (inverted cells that no
                                   adaptive step avoids): exit code 3 in the CLI */
-    CM_ERR_INTERRUPTED = -11   /* the caller asked the call to stop (cm_context_interrupt);
+    CM_ERR_INTERRUPTED = -11,  /* the caller asked the call to stop (cm_context_interrupt);
                                   nothing was written and outputs are as on any error */
+    CM_ERR_BUSY = -12          /* another process is writing the output (cm_output_lock):
+                                  exit code 4 in the CLI */
 } cm_status;
 
 /* Short fixed name of a status, e.g. "format error". */
@@ -192,6 +194,54 @@ CM_API void cm_outfile_abort(cm_outfile *out);
  * async-signal-safe calls: meant for a program's own SIGINT/SIGTERM/SIGHUP handler (the
  * library installs no handlers). */
 CM_API void cm_outfile_unlink_all(void);
+
+/* ---- outputs of several files (docs/DESIGN.md, "Command line
+ * contract") ---- */
+
+/* A directory built as a temporary sibling "<parent>/.cm-XXXXXX" (the parent is created)
+ * and made visible by cm_outdir_commit in one step: a rename when the target is new or
+ * empty, else an exchange of the two directories (Linux renameat2 RENAME_EXCHANGE) after
+ * which the old one is removed. A file system that refuses the exchange gets two renames
+ * (the old directory aside as ".cm-old-XXXXXX", then the new one into place; signals wait
+ * for both). */
+typedef struct cm_outdir {
+    char *path; /* the target */
+    char *tmp;  /* the temporary directory to write into */
+} cm_outdir;
+
+CM_API cm_status cm_outdir_open(cm_context *ctx, const char *path, cm_outdir *out);
+CM_API cm_status cm_outdir_commit(cm_context *ctx, cm_outdir *out);
+/* The temporary's files into the directory dir: when dir is new or empty (and the temporary
+ * beside it), one rename of the temporary; else each name is first checked against the n
+ * inputs by device and inode (CM_ERR_ARGUMENT, nothing moved, when one is an input), then
+ * all are renamed as one group that signals do not interrupt. The temporary is removed in
+ * any case. (For a temporary inside dir: cm_outdir_open of "dir/.cm".) */
+CM_API cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *dir,
+                                 const char *const *inputs, size_t n);
+/* Removes the temporary directory and its content. Safe to call twice. */
+CM_API void cm_outdir_abort(cm_outdir *out);
+
+/* Commits n open outputs together: all flushed first (a write error aborts every one, none
+ * renamed), then renamed as one group that signals do not interrupt; with from (else NULL),
+ * the file from (written by another writer into a temporary directory) is renamed onto to
+ * first, in the same group. */
+CM_API cm_status cm_outfile_commit_all(cm_context *ctx, cm_outfile *outs, size_t n,
+                                       const char *from, const char *to);
+
+/* An exclusive lock (flock) on an output directory for the time of a write: CM_ERR_BUSY
+ * "<dir>: another process is writing it" at once when another process holds it. *fd is the
+ * lock, released by cm_output_unlock (or the process's end). */
+CM_API cm_status cm_output_lock(cm_context *ctx, const char *dir, int *fd);
+CM_API void cm_output_unlock(int *fd);
+
+/* 1 when a and b both exist and are the same file (device and inode: hard links, symbolic
+ * links and ".." paths included). */
+CM_API int cm_same_file(const char *a, const char *b);
+
+/* For a program's SIGINT/SIGTERM/SIGHUP handler, async-signal-safe: returns 1 when a group
+ * of renames is under way (the signal is raised again when it is done: return from the
+ * handler), else removes the live temporary directories and returns 0. */
+CM_API int cm_output_signal(int sig);
 
 /* True on a little-endian host (binary formats are written little-endian). */
 CM_API int cm_host_little_endian(void);

@@ -41,23 +41,23 @@ static int mkdirs(const char *path)
     return stat(path, &st) == 0 && S_ISDIR(st.st_mode) ? 0 : -1;
 }
 
-/* Writes data to dir/name atomically, gzip-compressed when gz (name then ends in .gz), and
- * removes a stale twin (name.gz beside name, or name beside name.gz). */
-static cm_status write_file(cm_context *ctx, const char *dir, const char *name, const char *data,
-                            size_t n, int gz)
+/* dir/name (name.gz when gz) into the temporary *out, gzip-compressed when gz, not committed;
+ * twin: the stale other form (name.gz beside name, or name beside name.gz), to remove once
+ * committed. */
+static cm_status fill_file(cm_context *ctx, const char *dir, const char *name, const char *data, size_t n, int gz,
+                           cm_outfile *out, char *twin, size_t cap)
 {
-    char path[4200], twin[4200];
+    char path[4200];
     if (cm_foam_join(path, sizeof path, dir, name, gz ? ".gz" : NULL) ||
-        cm_foam_join(twin, sizeof twin, dir, name, gz ? NULL : ".gz"))
+        cm_foam_join(twin, cap, dir, name, gz ? NULL : ".gz"))
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: %s: path too long", dir);
-    cm_outfile out;
-    cm_status s = cm_outfile_open(ctx, path, &out);
+    cm_status s = cm_outfile_open(ctx, path, out);
     if (s != CM_OK) return s;
     if (gz) {
         z_stream z;
         memset(&z, 0, sizeof z);
         if (deflateInit2(&z, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
-            cm_outfile_abort(&out);
+            cm_outfile_abort(out);
             return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: %s: zlib initialisation failed", path);
         }
         unsigned char chunk[1 << 16];
@@ -74,18 +74,28 @@ static cm_status write_file(cm_context *ctx, const char *dir, const char *name, 
                 z.next_out = chunk;
                 z.avail_out = sizeof chunk;
                 rc = deflate(&z, flush);
-                fwrite(chunk, 1, sizeof chunk - z.avail_out, out.f);
+                fwrite(chunk, 1, sizeof chunk - z.avail_out, out->f);
             } while (z.avail_out == 0);
         } while (left);
         deflateEnd(&z);
         if (rc != Z_STREAM_END) {
-            cm_outfile_abort(&out);
+            cm_outfile_abort(out);
             return cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: compression failed", path);
         }
     } else if (n) {
-        fwrite(data, 1, n, out.f);
+        fwrite(data, 1, n, out->f);
     }
-    s = cm_outfile_commit(ctx, &out);
+    return CM_OK;
+}
+
+/* Writes data to dir/name atomically (see fill_file). */
+static cm_status write_file(cm_context *ctx, const char *dir, const char *name, const char *data,
+                            size_t n, int gz)
+{
+    char twin[4200];
+    cm_outfile out;
+    cm_status s = fill_file(ctx, dir, name, data, n, gz, &out, twin, sizeof twin);
+    if (s == CM_OK) s = cm_outfile_commit(ctx, &out);
     if (s == CM_OK) unlink(twin);
     return s;
 }
@@ -154,21 +164,35 @@ static int is_points(const char *name)
     return !strcmp(name, "points") || !strcmp(name, "points.gz");
 }
 
-/* q's points file into dir, the coordinates xyz (q->n_points of them). */
-static cm_status write_points(cm_context *ctx, const cm_foam_poly *q, const double *xyz, int precision, const char *dir)
+/* q's points file (the coordinates xyz, q->n_points of them) into dir, left in the temporary
+ * *out (see fill_file). */
+static cm_status fill_points(cm_context *ctx, const cm_foam_poly *q, const double *xyz, int precision,
+                             const char *dir, cm_outfile *out, char *twin, size_t cap)
 {
     cm_rewrite_buf b = {0};
     cm_rewrite_put(&b, q->points_head, q->points_head_len);
     points_list(&b, xyz, q->n_points, q->xyz0, precision, q->points_binary, q->scalar_bytes);
     cm_rewrite_put(&b, q->points_tail, q->points_tail_len);
     cm_status s = b.fail ? cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory for points")
-                         : write_file(ctx, dir, "points", b.d, b.n, q->points_gz);
+                         : fill_file(ctx, dir, "points", b.d, b.n, q->points_gz, out, twin, cap);
     free(b.d);
     return s;
 }
 
-/* Every regular file of q's polyMesh but points copied into dir (copy: 1), then points with
- * the coordinates xyz. */
+/* q's points file into dir, committed: one rename, so that the old or the new points are
+ * there whatever happens. */
+static cm_status write_points(cm_context *ctx, const cm_foam_poly *q, const double *xyz, int precision, const char *dir)
+{
+    char twin[4200];
+    cm_outfile out;
+    cm_status s = fill_points(ctx, q, xyz, precision, dir, &out, twin, sizeof twin);
+    if (s == CM_OK) s = cm_outfile_commit(ctx, &out);
+    if (s == CM_OK) unlink(twin);
+    return s;
+}
+
+/* Everything in q's polyMesh but points copied into dir (copy: 1; subdirectories such as
+ * sets/ whole), then points with the coordinates xyz. */
 static cm_status polymesh_out(cm_context *ctx, const cm_foam_poly *q, const double *xyz, int precision,
                               const char *dir, int copy)
 {
@@ -181,8 +205,16 @@ static cm_status polymesh_out(cm_context *ctx, const cm_foam_poly *q, const doub
         if (e->d_name[0] == '.' || is_points(e->d_name)) continue;
         char src[4200];
         struct stat st;
-        if (cm_foam_join(src, sizeof src, q->dir, e->d_name, NULL) || stat(src, &st) != 0 || !S_ISREG(st.st_mode)) continue; /* sets/ and the like: see the case copy */
-        s = copy_file(ctx, q->dir, dir, e->d_name);
+        if (cm_foam_join(src, sizeof src, q->dir, e->d_name, NULL) || stat(src, &st) != 0) continue;
+        if (S_ISREG(st.st_mode)) {
+            s = copy_file(ctx, q->dir, dir, e->d_name);
+        } else if (S_ISDIR(st.st_mode)) {
+            char dst[4200];
+            if (cm_foam_join(dst, sizeof dst, dir, e->d_name, NULL))
+                s = cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: %s: path too long", dir);
+            else
+                s = cm_foam_copy_tree(ctx, src, dst, NULL, NULL);
+        }
     }
     if (d) closedir(d);
     if (s != CM_OK) return s;
@@ -315,10 +347,10 @@ typedef struct skip_rule {
     size_t n_pieces;
 } skip_rule;
 
-/* What the case copy leaves out: the files directly in the polyMesh directories read (written
- * after it, `points` replaced, a stale .gz twin removed), and for a case read undecomposed its
- * processor* directories (pieces of the mesh before the morph, which a parallel run would take
- * instead of the morphed mesh: decompose the new case again). */
+/* What the case copy leaves out: the polyMesh directories read (each written whole after it,
+ * see swap_polymesh), and for a case read undecomposed its processor* directories (pieces of
+ * the mesh before the morph, which a parallel run would take instead of the morphed mesh:
+ * decompose the new case again). */
 static int skip_in_copy(const char *rel, void *arg)
 {
     const skip_rule *r = arg;
@@ -328,33 +360,135 @@ static int skip_in_copy(const char *rel, void *arg)
         unsigned long k = strtoul(rel + 9, &end, 10);
         return end == rel + 9 || *end || k >= r->n_pieces; /* not one of the pieces read */
     }
-    const char *pm = strstr(rel, "constant/polyMesh/");
-    if (!pm || strchr(pm + 18, '/')) return 0;
-    if (r->undecomposed ? pm != rel : strncmp(rel, "processor", 9) != 0 || strchr(rel, '/') + 1 != pm) return 0;
-    char src[4200];
-    struct stat st;
-    return snprintf(src, sizeof src, "%s/%s", r->src, rel) < (int)sizeof src && stat(src, &st) == 0 && S_ISREG(st.st_mode);
+    if (r->undecomposed) return !strcmp(rel, "constant/polyMesh");
+    const char *slash = strchr(rel, '/');
+    return !strncmp(rel, "processor", 9) && slash && !strcmp(slash, "/constant/polyMesh");
 }
 
-/* The pieces (each's points from the merged coordinates) into case_dir/processorN; copy: the
- * other files of each piece's polyMesh too. */
+/* The directory a write into the polyMesh directory dir locks: the case X of
+ * "X/constant/polyMesh", else the directory holding dir. Created when missing. */
+static cm_status lock_for(cm_context *ctx, const char *dir, int *fd)
+{
+    *fd = -1;
+    char *c = cm_foam_case_of(dir);
+    if (!c) {
+        size_t l = strlen(dir);
+        while (l > 1 && dir[l - 1] == '/') --l;
+        while (l > 0 && dir[l - 1] != '/') --l;
+        while (l > 1 && dir[l - 1] == '/') --l;
+        c = malloc(l + 2);
+        if (c && l) {
+            memcpy(c, dir, l);
+            c[l] = '\0';
+        } else if (c) {
+            strcpy(c, ".");
+        }
+    }
+    if (!c) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
+    cm_status s = mkdirs(c) ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", c, strerror(errno))
+                            : cm_output_lock(ctx, c, fd);
+    free(c);
+    return s;
+}
+
+/* The polyMesh directory dir written whole into a temporary sibling (od), not yet committed:
+ * the mesh converted (src NULL; conv: a decomposed case's merged addressing or NULL), or src's
+ * files with the coordinates xyz. */
+static cm_status fill_polymesh(cm_context *ctx, const cm_mesh *mesh, const char *dir, const cm_foam_poly *src,
+                               const double *xyz, int precision, cm_foam_poly *conv, cm_outdir *od)
+{
+    cm_status s = cm_outdir_open(ctx, dir, od);
+    if (s != CM_OK) return cm_error_prefix(ctx, s, "cm_mesh_write");
+    s = src ? polymesh_out(ctx, src, xyz, precision, od->tmp, 1) : write_converted(ctx, mesh, od->tmp, conv);
+    if (s != CM_OK) {
+        /* the message names the file as it would have been, not its temporary */
+        const char *msg = cm_context_message(ctx);
+        size_t t = strlen(od->tmp);
+        char *at = msg ? strstr(msg, od->tmp) : NULL;
+        if (at && at[t] == '/') {
+            char *copy = malloc(strlen(msg) + 1);
+            if (copy) {
+                strcpy(copy, msg);
+                s = cm_error(ctx, s, "%.*s%s%s", (int)(at - msg), copy, dir, copy + (at - msg) + t);
+                free(copy);
+            }
+        }
+        cm_outdir_abort(od);
+    }
+    return s;
+}
+
+/* fill_polymesh, then swapped in: the old polyMesh (its zones and sets included) is replaced
+ * in one step by a complete new one (docs/DESIGN.md, "Command line contract"). */
+static cm_status swap_polymesh(cm_context *ctx, const cm_mesh *mesh, const char *dir, const cm_foam_poly *src,
+                               const double *xyz, int precision, cm_foam_poly *conv)
+{
+    cm_outdir od;
+    cm_status s = fill_polymesh(ctx, mesh, dir, src, xyz, precision, conv, &od);
+    return s == CM_OK ? cm_outdir_commit(ctx, &od) : s;
+}
+
+/* Piece i's points, from the merged coordinates (malloc'ed; NULL: out of memory). */
+static double *piece_xyz(const cm_mesh *mesh, const cm_foam_poly *p, size_t i)
+{
+    const cm_foam_poly *q = p->pieces[i];
+    double *xyz = malloc(((size_t)q->n_points * 3 + 1) * sizeof *xyz);
+    if (xyz)
+        for (int64_t k = 0; k < q->n_points; ++k) memcpy(xyz + 3 * k, mesh->xyz + 3 * p->piece_points[i][k], 3 * sizeof *xyz);
+    return xyz;
+}
+
+/* The pieces into case_dir/processorN. In place (copy 0): each piece's points only, every
+ * temporary complete before the first rename, the renames one group (cm_outfile_commit_all).
+ * Into another case (copy 1): each piece's polyMesh whole in a temporary directory, all
+ * written before the first is swapped in. */
 static cm_status write_pieces(cm_context *ctx, const cm_mesh *mesh, const cm_foam_poly *p, const char *case_dir,
                               int copy)
 {
-    cm_status s = CM_OK;
-    for (size_t i = 0; s == CM_OK && i < p->n_pieces; ++i) {
-        const cm_foam_poly *q = p->pieces[i];
-        double *xyz = malloc(((size_t)q->n_points * 3 + 1) * sizeof *xyz);
-        if (!xyz) return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
-        for (int64_t k = 0; k < q->n_points; ++k) memcpy(xyz + 3 * k, mesh->xyz + 3 * p->piece_points[i][k], 3 * sizeof *xyz);
-        char dir[4200];
-        snprintf(dir, sizeof dir, "%s/processor%zu/constant/polyMesh", case_dir, i);
-        if (mkdirs(dir) != 0)
-            s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno));
-        else
-            s = polymesh_out(ctx, q, xyz, p->write_precision, dir, copy);
-        free(xyz);
+    size_t n = p->n_pieces;
+    cm_outfile *outs = calloc(n + 1, sizeof *outs);
+    cm_outdir *ods = calloc(n + 1, sizeof *ods);
+    char(*twins)[4200] = calloc(n + 1, sizeof *twins);
+    if (!outs || !ods || !twins) {
+        free(outs);
+        free(ods);
+        free(twins);
+        return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
     }
+    cm_status s = CM_OK;
+    size_t done = 0;
+    for (; s == CM_OK && done < n; ++done) {
+        const cm_foam_poly *q = p->pieces[done];
+        double *xyz = piece_xyz(mesh, p, done);
+        char dir[4200];
+        snprintf(dir, sizeof dir, "%s/processor%zu/constant/polyMesh", case_dir, done);
+        if (!xyz)
+            s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_write: out of memory");
+        else if (copy)
+            s = fill_polymesh(ctx, mesh, dir, q, xyz, p->write_precision, NULL, &ods[done]);
+        else
+            s = fill_points(ctx, q, xyz, p->write_precision, dir, &outs[done], twins[done], sizeof twins[done]);
+        free(xyz);
+        if (s != CM_OK) break;
+    }
+    if (s != CM_OK) {
+        for (size_t i = 0; i < done; ++i) {
+            cm_outfile_abort(&outs[i]);
+            cm_outdir_abort(&ods[i]);
+        }
+    } else if (copy) {
+        for (size_t i = 0; i < n; ++i) {
+            cm_status e = s == CM_OK ? cm_outdir_commit(ctx, &ods[i]) : CM_OK;
+            if (s != CM_OK) cm_outdir_abort(&ods[i]);
+            s = e;
+        }
+    } else {
+        s = cm_outfile_commit_all(ctx, outs, n, NULL, NULL);
+        for (size_t i = 0; s == CM_OK && i < n; ++i) unlink(twins[i]);
+    }
+    free(outs);
+    free(ods);
+    free(twins);
     return s;
 }
 
@@ -377,40 +511,44 @@ static char *target_case(const char *path, const char *polymesh_dir, int *pieces
     return c;
 }
 
-/* A mesh read from a case or polyMesh, written to path. */
+/* A mesh read from a case or polyMesh, written to path, under the lock of the case written. */
 static cm_status write_back(cm_context *ctx, const cm_mesh *mesh, cm_foam_poly *own, const char *path,
                             const char *dir)
 {
-    int pieces = 0;
+    int pieces = 0, lock = -1;
     char *tcase = target_case(path, dir, &pieces);
     cm_status s = CM_OK;
     const char *scase = own->case_dir;
     if (own->n_pieces && !tcase) {
         /* a polyMesh directory named: the reconstructed mesh */
-        s = mkdirs(dir) ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno))
-                        : write_converted(ctx, mesh, dir, own);
+        s = lock_for(ctx, dir, &lock);
+        if (s == CM_OK) s = swap_polymesh(ctx, mesh, dir, NULL, NULL, 0, own);
     } else if (pieces && !own->n_pieces) {
         s = cm_error(ctx, CM_ERR_UNSUPPORTED,
                      "cm_mesh_write: %s: the mesh was read undecomposed; write the case and run decomposePar on it", path);
     } else if (own->n_pieces && same_dir(scase, tcase)) {
-        s = write_pieces(ctx, mesh, own, scase, 0); /* in place: points only */
+        s = cm_output_lock(ctx, scase, &lock);
+        if (s == CM_OK) s = write_pieces(ctx, mesh, own, scase, 0); /* in place: points only */
     } else if (!own->n_pieces && same_dir(own->dir, dir)) {
-        s = polymesh_out(ctx, own, mesh->xyz, own->write_precision, dir, 0); /* in place: points only */
+        s = lock_for(ctx, dir, &lock);
+        if (s == CM_OK) s = write_points(ctx, own, mesh->xyz, own->write_precision, dir); /* in place: one file */
     } else if (tcase && scase && cm_foam_nested(scase, tcase)) {
         s = cm_error(ctx, CM_ERR_ARGUMENT, "cm_mesh_write: %s: the new case and the source case %s lie one inside the other; "
                      "write it beside the source", tcase, scase);
     } else if (tcase && scase) {
+        /* the other files of the source case copied over (each one atomically; files of the
+         * target case that the source lacks stay), then the polyMesh swapped in whole */
         skip_rule rule = {scase, !own->n_pieces, own->n_pieces};
         s = mkdirs(tcase) ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", tcase, strerror(errno))
-                          : cm_foam_copy_tree(ctx, scase, tcase, skip_in_copy, &rule);
+                          : cm_output_lock(ctx, tcase, &lock);
+        if (s == CM_OK) s = cm_foam_copy_tree(ctx, scase, tcase, skip_in_copy, &rule);
         if (s == CM_OK && own->n_pieces) s = write_pieces(ctx, mesh, own, tcase, 1);
-        else if (s == CM_OK && mkdirs(dir) != 0)
-            s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno));
-        else if (s == CM_OK) s = polymesh_out(ctx, own, mesh->xyz, own->write_precision, dir, 1);
+        else if (s == CM_OK) s = swap_polymesh(ctx, mesh, dir, own, mesh->xyz, own->write_precision, NULL);
     } else {
-        s = mkdirs(dir) ? cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno))
-                        : polymesh_out(ctx, own, mesh->xyz, own->write_precision, dir, 1);
+        s = lock_for(ctx, dir, &lock);
+        if (s == CM_OK) s = swap_polymesh(ctx, mesh, dir, own, mesh->xyz, own->write_precision, NULL);
     }
+    cm_output_unlock(&lock);
     free(tcase);
     return s;
 }
@@ -429,10 +567,12 @@ cm_status cm_mesh_write_foam(cm_context *ctx, const cm_mesh *mesh, const char *p
     } else if (cm_foam_decomposed_path(path, &pieces) && pieces) {
         s = cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_mesh_write: %s: only a mesh read from a decomposed case is written as "
                      "processor pieces; write the case and run decomposePar on it", path);
-    } else if (mkdirs(dir) != 0) {
-        s = cm_error(ctx, CM_ERR_IO, "cm_mesh_write: %s: cannot create the directory: %s", dir, strerror(errno));
     } else {
-        s = write_converted(ctx, mesh, dir, NULL);
+        /* a converted mesh: a whole new polyMesh swapped in; nothing else of the case touched */
+        int lock = -1;
+        s = lock_for(ctx, dir, &lock);
+        if (s == CM_OK) s = swap_polymesh(ctx, mesh, dir, NULL, NULL, 0, NULL);
+        cm_output_unlock(&lock);
     }
     free(pieces);
     free(dir);

@@ -40,7 +40,8 @@ class RejectedError(Error):
 
 
 class ResourceError(Error):
-    """Out of memory, or a request beyond what the machine can hold (exit code 4)."""
+    """Out of memory, a request beyond what the machine can hold, or an output another
+    process is writing (exit code 4)."""
 
 
 class InterruptedCall(Error):
@@ -58,7 +59,7 @@ def error_class(status: int) -> type:
         return MismatchError
     if status == lib.CM_ERR_REJECTED:
         return RejectedError
-    if status == lib.CM_ERR_NOMEM:
+    if status in (lib.CM_ERR_NOMEM, lib.CM_ERR_BUSY):
         return ResourceError
     if status == lib.CM_ERR_INTERRUPTED:
         return InterruptedCall
