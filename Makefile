@@ -6,7 +6,7 @@ ifeq ($(CI),true)
 CMAKE_FLAGS += -DCADMORPH_WERROR=ON
 endif
 
-.PHONY: all setup build demo test test-all bench clean check-asan fuzz
+.PHONY: all setup build demo test test-all bench clean check-asan fuzz fuzz-run
 
 all: build
 
@@ -47,11 +47,23 @@ check-asan: setup
 
 # libFuzzer drivers (clang) in $(BUILD)-fuzz, seed corpora in $(BUILD)-fuzz/corpus; run one with
 # e.g. $(BUILD)-fuzz/tests/fuzz/fuzz_vtu $(BUILD)-fuzz/corpus/vtu -max_total_time=300
+# (tests/fuzz/README.md). `make fuzz-run` runs every driver in turn for FUZZ_SECONDS each, one
+# process at a time, and stops at the first finding (the reproducer is left in the current
+# directory as crash-*, leak-*, timeout-* or oom-*).
+FUZZ_SECONDS ?= 60
+FUZZ_DRIVERS = msh vtu vtk medit fluent su2 nastran cgns inp exodus obj off stl foam foam_gz \
+  dcsv prm ctrl nodes sens design list step_scan
 fuzz: setup
 	cmake -S . -B $(BUILD)-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCADMORPH_FUZZ=ON \
 	  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++
 	cmake --build $(BUILD)-fuzz -j $(JOBS) --target fuzz_drivers
 	sh tests/fuzz/seeds.sh $(CURDIR) $(BUILD)-fuzz/corpus
+
+fuzz-run: fuzz
+	for d in $(FUZZ_DRIVERS); do \
+	  $(BUILD)-fuzz/tests/fuzz/fuzz_$$d $(BUILD)-fuzz/corpus/$$d -max_total_time=$(FUZZ_SECONDS) \
+	    -rss_limit_mb=2048 -timeout=10 -print_final_stats=1 || exit 1; \
+	done
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-asan $(BUILD)-fuzz

@@ -510,7 +510,7 @@ static cm_status groups(abq_build_state *b)
     }
     /* element sets: the smallest set's tag wins (the largest assigned first) */
     if (s == CM_OK) {
-        qsort(gs, ng, sizeof *gs, by_size);
+        if (ng > 1) qsort(gs, ng, sizeof *gs, by_size);
         for (size_t g = 0; g < ng; ++g)
             for (size_t i = 0; i < gs[g].n; ++i) m->physical[gs[g].cells[i]] = gs[g].tag;
     }

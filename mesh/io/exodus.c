@@ -15,6 +15,7 @@
  * tables ex_get_side_set_node_list uses), outward for an element of positive volume. */
 #define _POSIX_C_SOURCE 200809L
 #include "formats.h"
+#include "netcdf_header.h"
 #include "rewrite.h"
 
 #include <exodusII.h>
@@ -675,6 +676,8 @@ static cm_status read_locked(exo_reader *r, const struct stat *fst)
     const char *path = r->path;
     int comp_ws = 8, io_ws = 0;
     float version = 0.0f;
+    cm_status hs = cm_netcdf_check_header(ctx, path, (uint64_t)fst->st_size);
+    if (hs != CM_OK) return hs;
     r->exoid = ex_open(path, EX_READ, &comp_ws, &io_ws, &version);
     if (r->exoid < 0)
         return cm_error(ctx, CM_ERR_FORMAT, "cm_mesh_read: %s: cannot open as Exodus II: %s", path,

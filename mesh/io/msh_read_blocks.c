@@ -69,7 +69,7 @@ cm_status cm_msh_read_entities41(cm_msh_reader *r)
             cm_mesh_entity e;
             memset(&e, 0, sizeof e);
             e.dim = d;
-            int64_t tag, np, nb = 0;
+            int64_t tag, np = 0, nb = 0; /* counts 0 when a read before them failed */
             size_t at = r->t.pos;
             s = cm_msh_int(r, bin, "entity tag", &tag);
             if (s == CM_OK) s = check_int(r, bin, at, "entity tag", tag);
@@ -92,7 +92,7 @@ cm_status cm_msh_read_entities41(cm_msh_reader *r)
             if (s != CM_OK) return s;
         }
     }
-    qsort(r->ents, r->n_ents, sizeof *r->ents, cmp_key);
+    if (r->n_ents > 1) qsort(r->ents, r->n_ents, sizeof *r->ents, cmp_key); /* NULL when none */
     return cm_msh_expect(r, bin, "$EndEntities");
 }
 
@@ -330,7 +330,7 @@ cm_status cm_msh_read_elements22(cm_msh_reader *r)
     int64_t ftag[32];
     if (!bin) {
         for (int64_t i = 0; i < ne; ++i) {
-            int64_t tag, gtype, ntags, phys = 0, ent = 0, v;
+            int64_t tag, gtype, ntags = 0, phys = 0, ent = 0, v;
             s = cm_msh_size(r, 0, "element tag", &tag);
             if (s == CM_OK) s = check_tag(r, 0, 0, "element tag", tag);
             if (s == CM_OK) s = cm_msh_int(r, 0, "element type", &gtype);
@@ -421,7 +421,7 @@ cm_status cm_msh_read_data(cm_msh_reader *r, cm_field_location where)
     if (!r->have_nodes || (where == CM_FIELD_CELL && !r->have_elements))
         return cm_msh_err(r, CM_ERR_FORMAT, 0, 0, "expected %s after $Nodes and $Elements", sec);
     cm_status s = where == CM_FIELD_CELL ? cm_msh_map_cells(r) : CM_OK;
-    int64_t nstr, nreal, nint, v;
+    int64_t nstr = 0, nreal = 0, nint = 0, v; /* the loops test them even after a failure */
     char *name = NULL;
     double x;
     if (s == CM_OK) s = cm_msh_count(r, 0, "number of string tags", 2, &nstr);

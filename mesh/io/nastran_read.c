@@ -434,7 +434,8 @@ static nas_coord *find_coord(reader *r, int64_t id)
 {
     nas_coord key = {0};
     key.id = id;
-    return bsearch(&key, r->cs, r->ncs, sizeof *r->cs, cmp_coord);
+    /* no system at all: r->cs is NULL, which bsearch must not see */
+    return r->ncs ? bsearch(&key, r->cs, r->ncs, sizeof *r->cs, cmp_coord) : NULL;
 }
 
 static cm_status resolve(reader *r, nas_coord *c, int depth)
@@ -520,7 +521,7 @@ static cm_status build(reader *r, cm_mesh *m, nas_record *rec)
 {
     cm_context *ctx = r->ctx;
     /* systems: sorted by id, each id once, resolved */
-    qsort(r->cs, r->ncs, sizeof *r->cs, cmp_coord);
+    if (r->ncs > 1) qsort(r->cs, r->ncs, sizeof *r->cs, cmp_coord); /* r->cs NULL when none */
     for (size_t i = 1; i < r->ncs; ++i)
         if (r->cs[i].id == r->cs[i - 1].id)
             return cm_error(ctx, CM_ERR_FORMAT, "%s:%ld: coordinate system %lld is defined twice", path_of(r, r->cs[i].file),
@@ -555,7 +556,7 @@ static cm_status build(reader *r, cm_mesh *m, nas_record *rec)
                             g->line, (long long)g->id);
         r->src->files[g->file].spans[g->span].aux += 2 * (1 + (int64_t)(c - r->cs));
     }
-    memcpy(rec->xyz, m->xyz, r->ng * 3 * sizeof(double));
+    if (r->ng) memcpy(rec->xyz, m->xyz, r->ng * 3 * sizeof(double));
     /* GRID ids: sorted (id, index) pairs, each id once */
     int64_t *pairs = malloc((r->ng ? r->ng : 1) * 2 * sizeof *pairs);
     if (!pairs) return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", path_of(r, 0));

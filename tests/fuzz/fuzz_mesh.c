@@ -1,9 +1,10 @@
 /* libFuzzer driver for one mesh reader (CM_FUZZ_EXT picks it by extension: ".msh", ".vtu",
  * ".cas" for Fluent, ...). The readers take paths, so each input goes to a file of that extension first
  * (in /dev/shm when there is one). A reader may refuse anything, but must not crash, leak,
- * hang or let a message span lines. */
+ * hang or let a message span lines, and a mesh it accepts has finite coordinates. */
 #include "cadmorph/mesh.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,6 +31,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     cm_mesh *m = NULL;
     cm_status s = cm_mesh_read(ctx, path, &m);
     if (s < 0 && (m != NULL || strchr(cm_context_message(ctx), '\n'))) abort();
+    for (size_t i = 0; s >= 0 && m && i < 3 * m->n_nodes; ++i)
+        if (!isfinite(m->xyz[i])) abort();
     cm_mesh_destroy(&m);
     cm_context_destroy(&ctx);
     return 0;

@@ -7,7 +7,7 @@ cm_add_unit_test(test_abaqus test_abaqus.c LIBS cm_mesh LABELS hostile)
 # and run by CalculiX; cli: quality, warp, deform (an *NSET as the constraint set), optimize.
 foreach(case roundtrip ccx cli)
   add_test(NAME test_abaqus_${case}
-    COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_abaqus_crosscheck.py $<TARGET_FILE:cadmorph>
+    COMMAND ${CM_PYTHON_LIB} ${CMAKE_CURRENT_SOURCE_DIR}/test_abaqus_crosscheck.py $<TARGET_FILE:cadmorph>
             ${PROJECT_BINARY_DIR}/python ${CM_TEST_WORK}/abaqus_${case} ${case})
   set_tests_properties(test_abaqus_${case} PROPERTIES LABELS "unit;cli" TIMEOUT 300 SKIP_RETURN_CODE 77
     ENVIRONMENT "PYTHONDONTWRITEBYTECODE=1")

@@ -6,7 +6,7 @@
 # (the test writes its fixtures with the library itself: linked here, opened by cm_mesh)
 cm_add_unit_test(test_exodus test_exodus.c LIBS cm_mesh cm_exodus ${EXODUS_LIBRARY} LABELS hostile)
 add_test(NAME test_exodus_crosscheck
-  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_exodus_crosscheck.py
+  COMMAND ${CM_PYTHON_LIB} ${CMAKE_CURRENT_SOURCE_DIR}/test_exodus_crosscheck.py
           $<TARGET_FILE:test_exodus> $<TARGET_FILE:cadmorph> ${CM_TEST_WORK}/exodus)
 set_tests_properties(test_exodus_crosscheck PROPERTIES LABELS "unit;cli"
   ENVIRONMENT "PYTHONPATH=${PROJECT_BINARY_DIR}/python")

@@ -5,7 +5,7 @@
 cm_add_unit_test(test_su2 test_su2.c LIBS cm_mesh)
 set_tests_properties(test_su2 PROPERTIES LABELS "unit;hostile")
 add_test(NAME test_su2_crosscheck
-  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/su2_crosscheck.py ${CM_TEST_WORK})
+  COMMAND ${CM_PYTHON_LIB} ${CMAKE_CURRENT_SOURCE_DIR}/su2_crosscheck.py ${CM_TEST_WORK})
 set_tests_properties(test_su2_crosscheck PROPERTIES LABELS "unit;python" TIMEOUT 120
   ENVIRONMENT "PYTHONPATH=${PROJECT_BINARY_DIR}/python;PYTHONDONTWRITEBYTECODE=1")
 add_test(NAME test_su2_cli
