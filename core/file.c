@@ -2,6 +2,7 @@
  * reading and atomic output (a temporary file beside the target, renamed only on success),
  * shared by every module that reads or writes files, and the CLI. */
 #include "cadmorph/core.h"
+#include "live_paths.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -214,27 +215,19 @@ cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *s
     return CM_OK;
 }
 
-/* Live temporaries, so that a program's signal handler can remove them
- * (cm_outfile_unlink_all). Slots are claimed and released with atomic exchanges; the handler
- * only reads them and calls unlink(), which is async-signal-safe. A full table only means
- * that the extra temporaries are not removed on a signal. */
+/* Live temporaries, so that a program's signal handler can remove them (cm_outfile_unlink_all
+ * calls only unlink(), which is async-signal-safe; live_paths.h). */
 #define CM_LIVE_TMP 64
 static _Atomic(char *) live_tmp[CM_LIVE_TMP];
 
 static void live_add(char *tmp)
 {
-    for (int i = 0; i < CM_LIVE_TMP; ++i) {
-        char *expected = NULL;
-        if (atomic_compare_exchange_strong(&live_tmp[i], &expected, tmp)) return;
-    }
+    cm_live_add(live_tmp, CM_LIVE_TMP, tmp);
 }
 
 static void live_remove(const char *tmp)
 {
-    for (int i = 0; i < CM_LIVE_TMP; ++i) {
-        char *expected = (char *)tmp;
-        if (atomic_compare_exchange_strong(&live_tmp[i], &expected, NULL)) return;
-    }
+    cm_live_remove(live_tmp, CM_LIVE_TMP, tmp);
 }
 
 void cm_outfile_unlink_all(void)

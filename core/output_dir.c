@@ -3,6 +3,7 @@
  * committed together, a writer's lock, and the same-file test by device and inode. */
 #define _GNU_SOURCE
 #include "cadmorph/core.h"
+#include "live_paths.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -18,25 +19,18 @@
 #include <unistd.h>
 #include <dirent.h>
 
-/* Live temporary directories, removed by cm_output_signal (same scheme as the temporary
- * files of core/file.c: atomic slots, the handler only reads them). */
+/* Live temporary directories, removed by cm_output_signal (live_paths.h). */
 #define CM_LIVE_DIRS 32
 static _Atomic(char *) live_dir[CM_LIVE_DIRS];
 
 static void live_add(char *tmp)
 {
-    for (int i = 0; i < CM_LIVE_DIRS; ++i) {
-        char *expected = NULL;
-        if (atomic_compare_exchange_strong(&live_dir[i], &expected, tmp)) return;
-    }
+    cm_live_add(live_dir, CM_LIVE_DIRS, tmp);
 }
 
 static void live_remove(const char *tmp)
 {
-    for (int i = 0; i < CM_LIVE_DIRS; ++i) {
-        char *expected = (char *)tmp;
-        if (atomic_compare_exchange_strong(&live_dir[i], &expected, NULL)) return;
-    }
+    cm_live_remove(live_dir, CM_LIVE_DIRS, tmp);
 }
 
 /* While a group of renames runs, a signal is only recorded (cm_output_signal returns 1) and

@@ -101,27 +101,23 @@ static size_t budget_of(size_t end, int64_t count, int64_t max_count, uint64_t e
 }
 
 /* gzread inflates gzip (members concatenated too) and passes plain files through, so one path
- * reads both; opened as cm_file_read opens (a FIFO would block in open()). */
+ * reads both; opened by the input rule of core/file.c (a FIFO would block in open()). */
 static cm_status read_gz(cm_context *ctx, const char *path, uint64_t entry_bytes, int64_t max_count,
                          char **data, size_t *size)
 {
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0) return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-        close(fd);
-        return cm_error(ctx, CM_ERR_IO, "cm_mesh_read: %s: not a regular file", path);
-    }
-    fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
-    gzFile g = gzdopen(fd, "rb");
+    FILE *f = NULL;
+    cm_status s = cm_file_open_read(ctx, path, &f);
+    if (s != CM_OK) return cm_error_prefix(ctx, s, "cm_mesh_read");
+    int fd = dup(fileno(f));
+    fclose(f);
+    gzFile g = fd >= 0 ? gzdopen(fd, "rb") : NULL;
     if (!g) {
-        close(fd);
+        if (fd >= 0) close(fd);
         return cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", path);
     }
     size_t cap = GZ_CHUNK, n = 0, limit = GZ_PREFIX, blank = 0;
     int64_t count = -1;
     char *buf = malloc(cap + 1);
-    cm_status s = CM_OK;
     while (s == CM_OK) {
         if (!buf) {
             s = cm_error(ctx, CM_ERR_NOMEM, "cm_mesh_read: %s: out of memory", path);
