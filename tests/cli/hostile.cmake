@@ -15,7 +15,7 @@ foreach(_script IN LISTS _hostile_scripts)
     set_tests_properties(cli_hostile_${_case} PROPERTIES LABELS "cli;hostile"
       PASS_REGULAR_EXPRESSION "\nok\n" FAIL_REGULAR_EXPRESSION "FAIL:")
     if(CADMORPH_SANITIZE)
-      set_tests_properties(cli_hostile_${_case} PROPERTIES ENVIRONMENT "CM_MEM_FACTOR=4;CM_TIME_FACTOR=4")
+      set_tests_properties(cli_hostile_${_case} PROPERTIES ENVIRONMENT "CM_MEM_FACTOR=4;CM_TIME_FACTOR=${CM_TIME_FACTOR}")
     endif()
   endforeach()
 endforeach()

@@ -31,4 +31,5 @@ add_test(NAME cli_demo
     --dir ${CM_SWEEP_WORK}/demo --steps 10 --modes absolute
     --methods rbf-s,project,rbf-s-biharmonic --max-distance-rel 1e-9 --
     $<TARGET_FILE:cadmorph> demo -o ${CM_SWEEP_WORK}/demo)
-set_tests_properties(cli_demo PROPERTIES LABELS "unit;cad;cli" TIMEOUT 300)
+math(EXPR _cm_demo_timeout "300 * ${CM_TIME_FACTOR}")
+set_tests_properties(cli_demo PROPERTIES LABELS "unit;cad;cli" TIMEOUT ${_cm_demo_timeout})
