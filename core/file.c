@@ -217,23 +217,12 @@ cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *s
 
 /* Live temporaries, so that a program's signal handler can remove them (cm_outfile_unlink_all
  * calls only unlink(), which is async-signal-safe; live_paths.h). */
-#define CM_LIVE_TMP 64
-static _Atomic(char *) live_tmp[CM_LIVE_TMP];
-
-static void live_add(char *tmp)
-{
-    cm_live_add(live_tmp, CM_LIVE_TMP, tmp);
-}
-
-static void live_remove(const char *tmp)
-{
-    cm_live_remove(live_tmp, CM_LIVE_TMP, tmp);
-}
+static cm_live_table live_tmp;
 
 void cm_outfile_unlink_all(void)
 {
-    for (int i = 0; i < CM_LIVE_TMP; ++i) {
-        char *t = atomic_load(&live_tmp[i]);
+    for (int i = 0; i < CM_LIVE_SLOTS; ++i) {
+        char *t = atomic_load(&live_tmp.slot[i]);
         if (t) unlink(t);
     }
 }
@@ -260,13 +249,13 @@ cm_status cm_outfile_open(cm_context *ctx, const char *path, cm_outfile *out)
     /* Registered before it exists: a signal may reach any thread (OpenMP workers too) while
      * mkstemp runs, and a handler that unlinks the template or a name mkstemp is still
      * filling in does no harm. */
-    live_add(out->tmp);
+    cm_live_add(&live_tmp, out->tmp);
     int fd = mkstemp(out->tmp);
     int err = errno;
     if (fd < 0) {
         cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot create a temporary file beside it: %s",
                                path, strerror(err));
-        live_remove(out->tmp);
+        cm_live_remove(&live_tmp, out->tmp);
         free(out->tmp);
         out->tmp = NULL;
         cm_outfile_abort(out);
@@ -302,7 +291,7 @@ cm_status cm_outfile_commit(cm_context *ctx, cm_outfile *out)
         cm_outfile_abort(out);
         return s;
     }
-    live_remove(out->tmp);
+    cm_live_remove(&live_tmp, out->tmp);
     free(out->tmp);
     free(out->path);
     out->tmp = out->path = NULL;
@@ -314,7 +303,7 @@ void cm_outfile_abort(cm_outfile *out)
     if (out->f) fclose(out->f);
     if (out->tmp) {
         remove(out->tmp);
-        live_remove(out->tmp);
+        cm_live_remove(&live_tmp, out->tmp);
     }
     free(out->tmp);
     free(out->path);

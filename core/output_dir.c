@@ -20,18 +20,7 @@
 #include <dirent.h>
 
 /* Live temporary directories, removed by cm_output_signal (live_paths.h). */
-#define CM_LIVE_DIRS 32
-static _Atomic(char *) live_dir[CM_LIVE_DIRS];
-
-static void live_add(char *tmp)
-{
-    cm_live_add(live_dir, CM_LIVE_DIRS, tmp);
-}
-
-static void live_remove(const char *tmp)
-{
-    cm_live_remove(live_dir, CM_LIVE_DIRS, tmp);
-}
+static cm_live_table live_dir;
 
 /* While a group of renames runs, a signal is only recorded (cm_output_signal returns 1) and
  * raised again when the group is done, so that SIGINT/SIGTERM/SIGHUP never stop it half-way. */
@@ -100,8 +89,8 @@ int cm_output_signal(int sig)
         errno = saved;
         return 1;
     }
-    for (int i = 0; i < CM_LIVE_DIRS; ++i) {
-        char *t = atomic_load(&live_dir[i]);
+    for (int i = 0; i < CM_LIVE_SLOTS; ++i) {
+        char *t = atomic_load(&live_dir.slot[i]);
         if (t) remove_at(AT_FDCWD, t, 0);
     }
     errno = saved;
@@ -194,10 +183,10 @@ cm_status cm_outdir_open(cm_context *ctx, const char *path, cm_outdir *out)
             return s;
         }
     }
-    live_add(out->tmp);
+    cm_live_add(&live_dir, out->tmp);
     if (!mkdtemp(out->tmp)) {
         int err = errno;
-        live_remove(out->tmp);
+        cm_live_remove(&live_dir, out->tmp);
         free(out->tmp);
         out->tmp = NULL;
         cm_status s = cm_error(ctx, CM_ERR_IO, "%s: cannot create a temporary directory beside it: %s",
@@ -228,7 +217,7 @@ cm_status cm_outdir_commit(cm_context *ctx, cm_outdir *out)
     chmod(out->tmp, 0777 & ~mask);
     /* a new (or empty) target: one rename */
     if (rename(out->tmp, out->path) == 0) {
-        live_remove(out->tmp);
+        cm_live_remove(&live_dir, out->tmp);
         cm_outdir_abort(out);
         return CM_OK;
     }
@@ -269,7 +258,7 @@ cm_status cm_outdir_commit(cm_context *ctx, cm_outdir *out)
                          out->path, strerror(errno));
             rename(old, out->path); /* the old one back */
         } else {
-            live_remove(out->tmp);
+            cm_live_remove(&live_dir, out->tmp);
             remove_at(AT_FDCWD, old, 0);
         }
         commit_end();
@@ -283,7 +272,7 @@ void cm_outdir_abort(cm_outdir *out)
 {
     if (out->tmp) {
         remove_at(AT_FDCWD, out->tmp, 0);
-        live_remove(out->tmp);
+        cm_live_remove(&live_dir, out->tmp);
     }
     free(out->tmp);
     free(out->path);
@@ -295,7 +284,7 @@ cm_status cm_outdir_merge(cm_context *ctx, cm_outdir *out, const char *dir, cons
 {
     /* a new (or empty) dir beside the temporary: one rename */
     if (rename(out->tmp, dir) == 0) {
-        live_remove(out->tmp);
+        cm_live_remove(&live_dir, out->tmp);
         cm_outdir_abort(out);
         return CM_OK;
     }
