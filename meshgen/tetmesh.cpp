@@ -9,6 +9,7 @@
 #include "cadmorph/tetmesh.h"
 
 #include "tetgen_run.h"
+#include "tetmesh_assembly.h"
 #include "tetmesh_gmsh.h"
 
 #include <algorithm>
@@ -225,7 +226,8 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: the model has no solid (%d faces)", fn,
                         counts.faces);
     const char *path = cm_cad_path(model);
-    cm_status s = cm_cad_check_solids_apart(ctx, model);
+    int touching[2];  // solids that touch: an assembly (tetmesh_assembly.h)
+    cm_status s = cm_cad_check_solids_apart(ctx, model, touching);
     if (s < 0) return s;
     double bb[6];
     cm_cad_bbox(model, bb);
@@ -253,6 +255,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
                         path, h, estimate, volume, max_tets);
 
     const double limit = o.time_limit > 0 ? o.time_limit : CM_TETMESH_TIME_LIMIT;
+    if (touching[0] >= 0) return cmvol::assembly_mesh(ctx, model, o.mesher, h, limit, touching, out);
     if (o.mesher == CM_MESHER_GMSH) {
         if ((s = cm_progress(ctx, "gmsh", 0, 1)) < 0) return s;
         cmvol::raw_mesh r;
@@ -489,7 +492,10 @@ extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *mode
         cm_status s = build(ctx, model, o, mesh);
         /* TetGen's radius-edge bound leaves slivers: move the interior nodes to lift them */
         if (s >= 0 && o.optimize) {
-            cm_status e = cm_mesh_optimize(ctx, *mesh, nullptr, nullptr, nullptr);
+            // an assembly's interfaces are inside the mesh, on CAD faces: fixed too
+            const std::vector<unsigned char> fixed = cmvol::assembly_fixed_nodes(*mesh);
+            cm_status e = cm_mesh_optimize(ctx, *mesh, fixed.empty() ? nullptr : fixed.data(),
+                                           nullptr, nullptr);
             if (e < 0) {
                 cm_mesh_destroy(mesh);
                 return e;

@@ -233,6 +233,11 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
                                  "cm_morpher_create: steps must be >= 1 or auto");
     if (s >= 0) s = cm_mesh_boundary_create(ctx, mp->mesh, &mp->b);
     hold(ctx, &held, s);
+    size_t n_interface = 0; /* an assembly's interfaces move onto G' as the boundary does */
+    if (s >= 0) s = cm_morph_add_interfaces(ctx, mp->mesh, mp->b, &n_interface);
+    if (n_interface)
+        cm_log(ctx, CM_LOG_DEBUG, "classify: %zu interface triangles between solids join the "
+               "boundary", n_interface);
     if (s >= 0 && mp->b->n_nodes == 0)
         s = cm_error(ctx, CM_ERR_UNSUPPORTED, "no volume cells, nothing to morph");
     double hmin = 0;

@@ -68,4 +68,9 @@ cm_status cm_morpher_surface_positions(cm_context *ctx, cm_morpher *mp,
                                        const cm_cad_model *target, cm_surface_method surface,
                                        double *bnew);
 
+/* Appends to b the faces of an assembly's interfaces (a triangle of the mesh between two
+ * tets of different physical groups) and their nodes (interfaces.c); *n_added: how many. */
+cm_status cm_morph_add_interfaces(cm_context *ctx, const cm_mesh *mesh, cm_mesh_boundary *b,
+                                  size_t *n_added);
+
 #endif

@@ -161,7 +161,12 @@ cm_status cm_cad_face_wire(cm_context *ctx, const cm_cad_model *model, int face,
 const int **edges, const int **reversed, int *n);
 cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge,
 const int **faces, int *n);
-cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model);
+cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model,
+int *touching);
+cm_status cm_cad_face_solid(cm_context *ctx, const cm_cad_model *model, int face,
+int *solid);
+cm_status cm_cad_solid_at(cm_context *ctx, const cm_cad_model *model, const double *xyz,
+int *solid);
 typedef struct cm_cad_correspondence {
 cm_cad_counts counts;
 int *face;

@@ -119,11 +119,29 @@ CM_API cm_status cm_cad_face_wire(cm_context *ctx, const cm_cad_model *model, in
 CM_API cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge,
                             const int **faces, int *n);
 
-/* Two solids of the model that touch, overlap or contain one another (closer than 1e-6 of the
- * model's bounding-box diagonal): a mesher that fills every solid cannot take them (TetGen
- * crashes on the shared or crossing faces). CM_OK when no two solids meet (or there is one);
- * CM_ERR_UNSUPPORTED naming the first such pair (1-based, in TopExp order) otherwise. */
-CM_API cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model);
+/* How the model's solids meet (solids numbered 0-based in TopExp order, as in the groups
+ * "solid_<k>" of an assembly mesh). Two solids closer than 1e-6 of the model's bounding-box
+ * diagonal (or one inside the other) meet; OpenCASCADE's Boolean Common then tells whether
+ * they overlap (a common volume above 1e-6 of the smaller solid's) or only touch (share a
+ * face or part of one, as the parts of an assembly do).
+ * Overlapping solids: CM_ERR_UNSUPPORTED naming the first such pair, whether one is inside
+ * the other, and the way out (fuse them, or fragment them in the CAD). Touching solids: with
+ * touching non-NULL, CM_OK and the first touching pair in touching[0..1] ({-1, -1} when all
+ * solids are apart; a mesher meshes such a model as one conformal mesh, docs/DESIGN.md,
+ * "Assemblies"); with touching NULL, CM_ERR_UNSUPPORTED naming the pair. CM_OK for one solid
+ * or none. */
+CM_API cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model,
+                                           int *touching);
+
+/* The solid (0-based) whose shell holds the face; -1 for a face of no solid. A face shared
+ * by two solids (a fragmented assembly) belongs to the first. */
+CM_API cm_status cm_cad_face_solid(cm_context *ctx, const cm_cad_model *model, int face,
+                                   int *solid);
+
+/* The solid (0-based) the point xyz (3 doubles) is strictly inside, -1 when none (outside
+ * every solid or on a face, to 1e-7 of the diagonal). */
+CM_API cm_status cm_cad_solid_at(cm_context *ctx, const cm_cad_model *model, const double *xyz,
+                                 int *solid);
 
 /* ---- correspondence of G and G' ---- */
 
