@@ -64,7 +64,10 @@ CM_API void cm_tetmesh_options_init(cm_tetmesh_options *opt);
  * perturbed by 1e-6 x size (its nodes put back after); success after a retry logs a warning
  * naming what worked, failure names everything tried. A timeout is not retried.
  * Errors: CM_ERR_UNSUPPORTED for a model without a solid, whose faces do not close
- * (message: number of open edges), whose solids touch or overlap (cm_cad_check_solids_apart)
+ * (message: number of open edges), whose solids overlap (cm_cad_check_solids_apart), whose
+ * solids touch with TetGen (gmsh meshes them: one conformal mesh, the tets of solid k tagged
+ * k + 1, group "solid_<k>", an interface triangle once per CAD face, docs/DESIGN.md
+ * "Assemblies")
  * or whose surface triangulation intersects itself (TetGen's -d check, run first because
  * TetGen's own error path crashes), CM_ERR_NOMEM beyond max_tets, CM_ERR_CAD for a surface triangulation failure,
  * CM_ERR_NUMERIC with TetGen's code and its meaning, or its crash, when every retry failed,

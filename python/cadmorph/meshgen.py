@@ -21,9 +21,10 @@ def mesh_step(geometry: Geometry, size: Optional[float] = None, mesher: Optional
               time_limit: Optional[float] = None, threads: int = 0,
               progress: Progress = None) -> Mesh:
     """A tet mesh of geometry (a cadmorph.Geometry) as `cadmorph mesh G.step -o M`: the
-    tets (group "solid") and the boundary triangles, each tagged with its CAD face (face
-    index + 1, groups "face_<k>"), every boundary node on the CAD model, and the per-cell
-    field "scaled_jacobian" the CLI writes with it.
+    tets (group "solid"; solids that touch, an assembly: one conformal mesh, groups
+    "solid_<k>") and the boundary triangles, each tagged with its CAD face (face index + 1,
+    groups "face_<k>"), every boundary node on the CAD model, and the per-cell field
+    "scaled_jacobian" the CLI writes with it.
 
     size: target edge length in model units (None: bbox diagonal / 20). mesher: "gmsh" or
     "tetgen"; None chooses as the CLI: "tetgen" when quality, min_dihedral or
