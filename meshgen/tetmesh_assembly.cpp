@@ -151,7 +151,10 @@ int child_work(void *arg, int fd)
     G.gmshModelGetBoundingBox(-1, -1, &hd.bbox[0], &hd.bbox[1], &hd.bbox[2], &hd.bbox[3],
                               &hd.bbox[4], &hd.bbox[5], &ierr);
     G.gmshOptionSetNumber("Mesh.MeshSizeMax", j.h, &ierr);
-    G.gmshOptionSetNumber("Mesh.MeshSizeMin", 0, &ierr);
+    // a floor far below any feature: gmsh 4.8's curvature sizing gives 0 on some degenerate
+    // curves of real assemblies and then throws past its C API ("Wrong mesh element size
+    // lc = 0"), which aborts the child
+    G.gmshOptionSetNumber("Mesh.MeshSizeMin", 1e-3 * j.h, &ierr);
     G.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 12, &ierr);
     G.gmshModelMeshGenerate(3, &ierr);
     if (ierr) return send_error(G, fd, "meshing failed");
