@@ -9,7 +9,7 @@ target_link_libraries(gen_shapes PRIVATE cm_warnings cm_occ)
 add_test(NAME cad_gen_shapes COMMAND gen_shapes ${CM_CAD_WORK})
 set_tests_properties(cad_gen_shapes PROPERTIES FIXTURES_SETUP cad_shapes LABELS "unit;cad")
 
-foreach(t model project sample boundary)
+foreach(t model project sample boundary solids)
   cm_add_unit_test(test_cad_${t} test_cad_${t}.c LIBS cm_cad LABELS cad)
   set_tests_properties(test_cad_${t} PROPERTIES FIXTURES_REQUIRED cad_shapes)
 endforeach()

@@ -22,6 +22,7 @@
 #include <GeomAPI_PointsToBSpline.hxx>
 #include <Geom_BSplineCurve.hxx>
 #include <TColgp_Array1OfPnt.hxx>
+#include <TopoDS_Compound.hxx>
 #include <TopoDS_Vertex.hxx>
 #include <gp_GTrsf.hxx>
 #include <BRepAdaptor_Surface.hxx>
@@ -255,6 +256,29 @@ static TopoDS_Shape spindle_part()
     return fix.Solid();
 }
 
+// Assemblies for cm_cad_check_solids_apart (separate solids in one compound, not fused):
+// two unit boxes sharing the face x = 1 and a cylinder standing on part of the first box's
+// top (touching), two boxes that cross (overlap), a box inside another (nested).
+static bool write_assemblies(const std::string &dir)
+{
+    auto compound = [](std::initializer_list<TopoDS_Shape> parts) {
+        TopoDS_Compound c;
+        BRep_Builder b;
+        b.MakeCompound(c);
+        for (const TopoDS_Shape &p : parts) b.Add(c, p);
+        return c;
+    };
+    const TopoDS_Shape a = BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 1, 1, 1).Shape();
+    const TopoDS_Shape b = BRepPrimAPI_MakeBox(gp_Pnt(1, 0, 0), 1, 1, 1).Shape();
+    const TopoDS_Shape c =
+        BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0.5, 0.5, 1), gp_Dir(0, 0, 1)), 0.3, 0.5).Shape();
+    const TopoDS_Shape x = BRepPrimAPI_MakeBox(gp_Pnt(0.5, 0.2, 0.2), 1, 1, 1).Shape();
+    const TopoDS_Shape big = BRepPrimAPI_MakeBox(gp_Pnt(-1, -1, -1), 3, 3, 3).Shape();
+    return write_step(compound({a, b, c}), dir + "/asm_touch.step") &&
+           write_step(compound({a, x}), dir + "/asm_overlap.step") &&
+           write_step(compound({big, a}), dir + "/asm_nested.step");
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -328,6 +352,10 @@ int main(int argc, char **argv)
                 fprintf(stderr, "gen_shapes: cannot write %s\n", p.name);
                 return 1;
             }
+        if (!write_assemblies(dir)) {
+            fprintf(stderr, "gen_shapes: cannot write the assemblies\n");
+            return 1;
+        }
         // bad inputs: a STEP with only an edge (no solid, shell or face), a text file
         TopoDS_Shape edge = BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(1, 2, 3)).Shape();
         if (!write_step(edge, dir + "/edge_only.step")) return 1;
