@@ -1,8 +1,8 @@
 // Writes the STEP pairs G0, G1 = A G0 + b of the affine tests (test_affine.c) into OUT/affine:
 // G0 = the built-in bore and bracket at t = 0 (cm_model_write_step), the gmsh-written hole_a
-// and bore_a of DATA, the FreeCAD-written shaft_0 of DATA and a turned part made here (a
-// cylinder with a cone end and a cross bore: its vertices all lie in one plane, so they alone
-// cannot determine a 3-D map); G1 = G0 transformed with OpenCASCADE, <part>_<map>.step. Also
+// and bore_a of DATA, the FreeCAD-written shaft_0 and OpenCASCADE's screw of DATA, and a
+// turned part made here (a cylinder with a cone end and a cross bore: its vertices all lie in
+// one plane, so they alone cannot determine a 3-D map); G1 = G0 transformed with OpenCASCADE, <part>_<map>.step. Also
 // turned_bore.step: the turned part with a wider bore, an edit that is not affine.
 //   gen_affine DATA OUT
 // rigid and scale go through BRepBuilderAPI_Transform (surface types kept), general through
@@ -134,13 +134,14 @@ int main(int argc, char **argv)
         fprintf(stderr, "gen_affine: OpenCASCADE: %s\n", e.GetMessageString());
         bad = 1;
     }
-    const std::string parts[6][2] = {{out + "/bore.step", "bore"},
+    const std::string parts[7][2] = {{out + "/bore.step", "bore"},
                                      {out + "/bracket.step", "bracket"},
                                      {out + "/turned.step", "turned"},
                                      {data + "/surface/hole_a.step", "hole_a"},
                                      {data + "/cad/bore_a.step", "bore_a"},
-                                     {data + "/freecad/shaft_0.step", "shaft"}};
-    for (int i = 3; i < 6; ++i) { // the files written elsewhere next to their images
+                                     {data + "/freecad/shaft_0.step", "shaft"},
+                                     {data + "/occt/screw.step", "screw"}};
+    for (int i = 3; i < 7; ++i) { // the files written elsewhere next to their images
         std::ifstream in(parts[i][0], std::ios::binary);
         std::ofstream o(out + "/" + parts[i][1] + ".step", std::ios::binary);
         o << in.rdbuf();
