@@ -252,8 +252,8 @@ static cm_status guess_moments(cm_context *ctx, const cm_cad_model *g, const cm_
     double cen[2][3], sec[2][9], l[2][3][3], li[2][3][3];
     for (int k = 0; k < 2; ++k) {
         cm_status r = cm_cad_volume_moments(ctx, k ? g2 : g, &vol[k], cen[k], sec[k]);
-        if (r == CM_ERR_UNSUPPORTED) return CM_OK;
-        if (r < 0) return r;
+        if (r == CM_ERR_NOMEM) return r;
+        if (r < 0) return CM_OK; /* no solid, or OpenCASCADE could not integrate: no guess */
         if (!chol3(sec[k], l[k]) || !inv3(l[k], li[k])) return CM_OK;
     }
     double h[3][3] = {{0}};
@@ -360,10 +360,10 @@ static cm_status project_all(cm_context *ctx, const cm_cad_model *g2, samples *s
                              const double m[3][4], int first, double *worst, double nn[12][12],
                              double rhs[12], const double *xc, const double *yc, double sc)
 {
-    double *q = malloc(s->n * 13 * sizeof *q);
+    double *q = malloc(s->n * 16 * sizeof *q);
     if (!q) return cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
     double *foot = q + 3 * s->n, *nrm = foot + 3 * s->n, *t = nrm + 3 * s->n, *d = t + s->n,
-           *uv = d + s->n;
+           *uv = d + s->n, *scratch = uv + 2 * s->n;
     for (size_t i = 0; i < s->n; ++i)
         apply(m, s->x + 3 * i, q + 3 * i);
     cm_status r = CM_OK;
@@ -412,7 +412,7 @@ static cm_status project_all(cm_context *ctx, const cm_cad_model *g2, samples *s
             r = cm_cad_project_face(ctx, g2, f, q + 3 * i, k, first ? NULL : s->uv + 2 * i,
                                     uv + 2 * i, d + i, foot + 3 * i);
             if (r >= 0) memcpy(s->uv + 2 * i, uv + 2 * i, 2 * k * sizeof(double));
-            if (r >= 0 && nn) r = cm_cad_face_eval(ctx, g2, f, uv + 2 * i, k, t, nrm + 3 * i);
+            if (r >= 0 && nn) r = cm_cad_face_eval(ctx, g2, f, uv + 2 * i, k, scratch, nrm + 3 * i);
             for (size_t p = i; p < j && r >= 0; ++p) {
                 if (!(d[p] <= *worst)) *worst = d[p];
                 const double *n = nrm + 3 * p;
@@ -438,7 +438,7 @@ cm_status cm_surface_affine_fit_samples(cm_context *ctx, const cm_cad_model *g,
     if (r == CM_OK) r = guess_moments(ctx, g, g2, &s, m, vol, &have_moments);
     if (r != CM_OK || (!have_moments && !guess_points(&s, m))) {
         samples_free(&s);
-        return r;
+        return r == CM_ERR_NOMEM ? r : CM_OK; /* no guess: not affine */
     }
     /* coordinates centred on the boxes and scaled by G's diagonal: the normal equations
      * stay well conditioned whatever the part's size and position */
@@ -485,7 +485,13 @@ cm_status cm_surface_affine_fit_samples(cm_context *ctx, const cm_cad_model *g,
         }
     }
     samples_free(&s);
-    if (r != CM_OK) return r;
+    if (r == CM_ERR_NOMEM || r == CM_ERR_INTERRUPTED) return r;
+    if (r != CM_OK || !isfinite(best)) {
+        /* a projection OpenCASCADE could not do: the edit keeps the parameter warps, as
+         * before this fit existed */
+        cm_log(ctx, CM_LOG_DEBUG, "surface morph: no affine fit from edge and face samples");
+        return CM_OK;
+    }
     memcpy(a->m, best_m, sizeof best_m);
     a->residual = best;
     a->tol = tol;

@@ -1,12 +1,12 @@
 #!/usr/bin/python3
-"""affine_parts.py CADMORPH DIR OUT [PART ...]: affine edits of STEP parts reproduced
+"""affine_parts.py CADMORPH DIR OUT [--size-fraction F] [PART ...]: affine edits of STEP parts reproduced
 (benchmarks/RESULTS.md, "Affine edits").
 
 For each DIR/PART.step (default: every .step of DIR), gmsh's OpenCASCADE kernel writes
 OUT/PART_0.step (the part as read, so that G0 and G1 share gmsh's reading of the file) and
 OUT/PART_1.step = A PART_0 + b (gmsh.model.occ.affineTransform, i.e.
 BRepBuilderAPI_GTransform: a non-uniform scale with shear, the map of the general affine test).
-Then `cadmorph mesh PART_0.step --mesher tetgen` and `cadmorph morph --steps 1` onto
+Then `cadmorph mesh PART_0.step --mesher tetgen [--size F x diagonal]` and `cadmorph morph --steps 1` onto
 PART_1.step, and the largest |x' - (A x + b)| over every node of the morphed mesh, as a
 fraction of the diagonal of the morphed mesh's bounding box. One line per part:
   PART nodes=N max_dev=D (x diagonal) morph=exit-code [message]"""
@@ -27,7 +27,7 @@ def write_pair(src, g0, g1):
     with open(os.devnull, "w") as null:
         os.dup2(null.fileno(), 1)
     try:
-        write_pair_quiet(src, g0, g1)
+        return write_pair_quiet(src, g0, g1)
     finally:
         os.dup2(saved, 1)
         os.close(saved)
@@ -40,12 +40,15 @@ def write_pair_quiet(src, g0, g1):
         gmsh.model.occ.importShapes(src)
         gmsh.model.occ.synchronize()
         gmsh.write(g0)
+        box = gmsh.model.getBoundingBox(-1, -1)
+        diag = sum((box[i + 3] - box[i]) ** 2 for i in range(3)) ** 0.5
         gmsh.model.occ.affineTransform(gmsh.model.getEntities(3) or gmsh.model.getEntities(2),
                                        [v for row in A for v in row])
         gmsh.model.occ.synchronize()
         gmsh.write(g1)
     finally:
         gmsh.finalize()
+    return diag
 
 
 def read_medit_nodes(path):
@@ -76,13 +79,18 @@ def last_line(path):
 
 def main():
     cli, src, out = sys.argv[1:4]
-    parts = sys.argv[4:] or sorted(f[:-5] for f in os.listdir(src) if f.endswith(".step"))
+    rest, fraction = sys.argv[4:], 0
+    if rest[:1] == ["--size-fraction"]:
+        fraction, rest = float(rest[1]), rest[2:]
+    parts = rest or sorted(f[:-5] for f in os.listdir(src) if f.endswith(".step"))
     os.makedirs(out, exist_ok=True)
     for p in parts:
         g0, g1 = os.path.join(out, p + "_0.step"), os.path.join(out, p + "_1.step")
         m0, m1 = os.path.join(out, p + "_0.mesh"), os.path.join(out, p + "_1.mesh")
-        write_pair(os.path.join(src, p + ".step"), g0, g1)
-        rc = run([cli, "mesh", g0, "-o", m0, "--mesher", "tetgen"], os.path.join(out, p + "_mesh.log"))
+        diag = write_pair(os.path.join(src, p + ".step"), g0, g1)
+        size = ["--size", "%.6g" % (fraction * diag)] if fraction > 0 else []
+        rc = run([cli, "mesh", g0, "-o", m0, "--mesher", "tetgen"] + size,
+                 os.path.join(out, p + "_mesh.log"))
         if rc != 0:
             print("%-12s mesh exit %d: %s" % (p, rc, last_line(os.path.join(out, p + "_mesh.log"))))
             continue

@@ -115,6 +115,47 @@ static void check_surface(cm_context *ctx, const cm_cad_model *g, const cm_cad_m
     cm_mesh_boundary_destroy(&b);
 }
 
+/* The volume moments transform covariantly: V1 = |det A| V0, c1 = A c0 + b, S1 = A S0 A^T
+ * (to the integration's accuracy; the first guess of the map depends on it). */
+static void check_moments(cm_context *ctx, const char *part, const char *map)
+{
+    char name[256];
+    snprintf(name, sizeof name, "%s_%s", part, map);
+    cm_cad_model *g = read_step(ctx, part), *g1 = read_step(ctx, name);
+    double m[3][4], v[2], c[2][3], s[2][9];
+    CHECK(cm_affine_map(map, m));
+    for (int k = 0; k < 2 && g && g1; ++k)
+        CHECK_MSG(cm_cad_volume_moments(ctx, k ? g1 : g, &v[k], c[k], s[k]) == CM_OK, "%s: %s",
+                  name, cm_context_message(ctx));
+    if (g && g1) {
+        double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        CHECK_MSG(fabs(fabs(det) * v[0] - v[1]) <= 1e-6 * v[1], "%s: volume %.12g, |det A| V0 %.12g",
+                  name, v[1], fabs(det) * v[0]);
+        double worst_c = 0, worst_s = 0, scale = s[1][0] + s[1][4] + s[1][8];
+        for (int i = 0; i < 3; ++i) {
+            double y = m[i][3];
+            for (int j = 0; j < 3; ++j) {
+                y += m[i][j] * c[0][j];
+                double ys = 0;
+                for (int a = 0; a < 3; ++a)
+                    for (int b = 0; b < 3; ++b)
+                        ys += m[i][a] * s[0][3 * a + b] * m[j][b];
+                worst_s = fmax(worst_s, fabs(ys - s[1][3 * i + j]));
+            }
+            worst_c = fmax(worst_c, fabs(y - c[1][i]));
+        }
+        CHECK_MSG(worst_c <= 1e-6 * fx_diagonal(g1) && worst_s <= 1e-6 * scale,
+                  "%s: centroid off by %g, second moments by %g", name, worst_c, worst_s);
+        printf("%-26s moments: |V1 - |det A| V0| / V1 = %.1e, |c1 - (A c0 + b)| = %.1e, "
+               "|S1 - A S0 A^T| / tr S1 = %.1e\n",
+               name, fabs(fabs(det) * v[0] - v[1]) / v[1], worst_c, worst_s / scale);
+    }
+    cm_cad_destroy(&g1);
+    cm_cad_destroy(&g);
+}
+
 /* An edit that is not affine (the turned part's bore widened): no affine map accepted, no face
  * moved as an affine image. */
 static void check_not_affine(cm_context *ctx, const char *part, const char *edit)
@@ -204,6 +245,7 @@ int main(int argc, char **argv)
             if (strcmp(mode, "surface") && !strcmp(cases[c][1], "tetd") &&
                 (!general || strcmp(cases[c][0], "turned")))
                 continue;
+            if (!strcmp(cases[c][1], "tetd") && k == 0) continue; /* rigid: as scale */
             char name[256], what[256];
             snprintf(name, sizeof name, "%s_%s", cases[c][0], maps[k]);
             snprintf(what, sizeof what, "%s (%s) %s", cases[c][0], cases[c][1], maps[k]);
@@ -217,7 +259,10 @@ int main(int argc, char **argv)
         cm_mesh_destroy(&mesh);
         cm_cad_destroy(&g);
     }
-    if (!strcmp(mode, "surface")) check_not_affine(ctx, "turned", "turned_bore");
+    if (!strcmp(mode, "surface")) {
+        check_moments(ctx, "turned", "general");
+        check_not_affine(ctx, "turned", "turned_bore");
+    }
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }
