@@ -255,6 +255,8 @@ cm_status cm_cad_triangulate(cm_context *ctx, const cm_cad_model *model,
 const cm_cad_triangulate_options *opt, cm_cad_triangulation **out);
 void cm_cad_triangulation_destroy(cm_cad_triangulation **t);
 cm_status cm_cad_volume(cm_context *ctx, const cm_cad_model *model, double *volume);
+cm_status cm_cad_volume_moments(cm_context *ctx, const cm_cad_model *model,
+double *volume, double *centroid, double *second);
 typedef enum cm_cell_type {
 CM_CELL_POINT = 0,
 CM_CELL_LINE2,

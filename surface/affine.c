@@ -5,7 +5,9 @@
  * squares), and an edge or face is called an affine image when A x + b of points spread over
  * it lands on its counterpart in G' (within a tolerance of the model size); the morph then
  * sends a node at x to the projection of A x + b, which is A x + b itself. Edits that are
- * not affine fail the vertex fit and keep the arc-length / parameter-warp morph unchanged. */
+ * not affine fail the vertex fit and keep the arc-length / parameter-warp morph unchanged.
+ * When the vertices cannot determine A (fewer than 4, or coplanar: a revolved part), the map
+ * comes from the volume moments and points over the edges and faces (affine_fit.c). */
 #include "surface_internal.h"
 
 #include <math.h>
@@ -43,8 +45,7 @@ cm_status cm_surface_affine_fit(cm_context *ctx, const cm_cad_model *g, const cm
     a->residual = INFINITY;
     cm_cad_counts c;
     cm_cad_get_counts(g, &c);
-    if (c.vertices < 4) return CM_OK;
-    double *x = malloc(6 * (size_t)c.vertices * sizeof *x);
+    double *x = malloc(6 * (size_t)(c.vertices > 0 ? c.vertices : 1) * sizeof *x);
     if (!x) return cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
     double *y = x + 3 * (size_t)c.vertices, xc[3] = {0, 0, 0}, yc[3] = {0, 0, 0};
     cm_status r = CM_OK;
@@ -61,7 +62,10 @@ cm_status cm_surface_affine_fit(cm_context *ctx, const cm_cad_model *g, const cm
                 cxx[i][j] += (x[3 * v + i] - xc[i]) * (x[3 * v + j] - xc[j]);
                 cyx[i][j] += (y[3 * v + i] - yc[i]) * (x[3 * v + j] - xc[j]);
             }
-    if (r == CM_OK && inverse3(cxx, inv)) {
+    if (r == CM_OK && (c.vertices < 4 || !inverse3(cxx, inv))) {
+        /* the vertices leave A undetermined across their plane or line (affine_fit.c) */
+        r = cm_surface_affine_fit_samples(ctx, g, g2, x, y, c.vertices, tol, a);
+    } else if (r == CM_OK) {
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j)
                 a->m[i][j] = cyx[i][0] * inv[0][j] + cyx[i][1] * inv[1][j] + cyx[i][2] * inv[2][j];

@@ -19,10 +19,18 @@ typedef struct cm_surface_affine {
 } cm_surface_affine;
 
 void cm_surface_affine_apply(const cm_surface_affine *a, const double *x, double *y);
-/* Least-squares fit of G' vertices against G vertices (at least 4, not coplanar); a->valid
- * says whether every vertex is reproduced within tol. Errors only for lack of memory. */
+/* Least-squares fit of G' vertices against G vertices; a->valid says whether every vertex is
+ * reproduced within tol. Fewer than 4 or coplanar vertices: cm_surface_affine_fit_samples. */
 cm_status cm_surface_affine_fit(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
                                 double tol, cm_surface_affine *a);
+/* The map from the volume moments and points over every edge and face of G (surface/
+ * affine_fit.c), xv, yv: the nv vertices of G and G' (n x 3). a->valid when every vertex,
+ * edge point and face point of G maps within tol of its entity of G' (a->residual: the
+ * largest miss) and the volumes agree. */
+cm_status cm_surface_affine_fit_samples(cm_context *ctx, const cm_cad_model *g,
+                                        const cm_cad_model *g2, const double *xv,
+                                        const double *yv, int nv, double tol,
+                                        cm_surface_affine *a);
 /* *is_image = 1 when n points spread over edge e of G map within a->tol of edge e of G'. */
 cm_status cm_surface_affine_edge(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
                                  const cm_surface_affine *a, int e, int n, int *is_image);

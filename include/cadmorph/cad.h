@@ -336,6 +336,12 @@ CM_API void cm_cad_triangulation_destroy(cm_cad_triangulation **t);
 
 /* Total volume of the model's solids (BRepGProp); CM_ERR_UNSUPPORTED if it has no solid. */
 CM_API cm_status cm_cad_volume(cm_context *ctx, const cm_cad_model *model, double *volume);
+/* Volume moments of the model's solids (BRepGProp, adaptive): volume (> 0), centroid (3) and
+ * the centred second moments per unit volume, second (3 x 3 row-major) = int (x - c)(x - c)^T
+ * dV / volume. An affine map x -> A x + b maps them to |det A| volume, A c + b, A second A^T.
+ * CM_ERR_UNSUPPORTED if the model has no solid. */
+CM_API cm_status cm_cad_volume_moments(cm_context *ctx, const cm_cad_model *model,
+                                       double *volume, double *centroid, double *second);
 
 #ifdef __cplusplus
 }
