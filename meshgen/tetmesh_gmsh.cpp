@@ -3,7 +3,8 @@
 // kernel (the same OpenCASCADE 7.6 as cad/), meshes in 3D on one thread (no OpenMP pool after
 // a fork) and sends nodes, tets and the boundary triangles with their gmsh surface tags. The
 // parent maps each gmsh surface to the CAD face all its nodes lie on, so that the boundary
-// triangles carry our face indices as the TetGen path's do.
+// triangles carry our face indices as the TetGen path's do, within the model's own tolerances
+// (cm_cad_face_tolerances).
 #include "tetmesh_gmsh.h"
 
 #include "child_process.h"
@@ -20,6 +21,7 @@ extern "C" {
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 #include <map>
 #include <string>
 
@@ -255,31 +257,26 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
     for (size_t t = 0; t < nt; ++t)
         for (int k = 0; k < 4; ++k) out->tets[t][k] = renum[tets[4 * t + k]];
 
-    // the same geometry and unit? gmsh's box (OpenCASCADE's, not tight on curved faces:
-    // control points, tolerances) holds ours and is of its size; the faces are checked below
+    // gmsh surface -> CAD face: the face all of the surface's nodes lie on, within the model's
+    // own tolerance there (gmsh binds faces in OpenCASCADE's order, so face tag - 1 is tried
+    // first; a renumbering costs only time). A point of an edge may be its tolerance away from
+    // the faces that meet there: a file's tolerances of 1e-4 x its size are common (CAD
+    // systems' own), and gmsh places its nodes on the edge curves.
     double bb[6];
     cm_cad_bbox(model, bb);
     const double diag = cm_bbox_diagonal(bb), gdiag = cm_bbox_diagonal(hd.bbox);
-    bool holds = gdiag >= 0.5 * diag && gdiag <= 2 * diag;
-    for (int k = 0; k < 3; ++k)
-        holds = holds && hd.bbox[k] <= bb[k] + 1e-4 * diag && hd.bbox[k + 3] >= bb[k + 3] - 1e-4 * diag;
-    if (!holds)
-        return cm_error(ctx, CM_ERR_MISMATCH,
-                        "%s: gmsh read another geometry: its bounding box [%g %g %g, %g %g %g] "
-                        "does not fit cadmorph's [%g %g %g, %g %g %g] (another unit?)",
-                        path, hd.bbox[0], hd.bbox[1], hd.bbox[2], hd.bbox[3], hd.bbox[4],
-                        hd.bbox[5], bb[0], bb[1], bb[2], bb[3], bb[4], bb[5]);
-
-    // gmsh surface -> CAD face: the face all of the surface's nodes lie on (gmsh binds faces in
-    // OpenCASCADE's order, so face tag - 1 is tried first; a renumbering costs only time)
     cm_cad_counts counts;
     cm_cad_get_counts(model, &counts);
-    const double tol = 1e-7 * diag;
+    std::vector<double> face_tol(counts.faces);
+    double largest_tol = 0;
+    if ((s = cm_cad_face_tolerances(ctx, model, face_tol.data(), &largest_tol)) < 0) return s;
+    const double floor_tol = 1e-7 * diag;
     std::map<int, std::vector<int64_t>> nodes_of;
     for (size_t t = 0; t < nb; ++t)
         for (int k = 0; k < 3; ++k) nodes_of[tri_tag[t]].push_back(out->tri[3 * t + k]);
     std::map<int, int> face_of;
     std::vector<int> taken(counts.faces, 0);
+    double worst_ok = 0;
     for (auto &sn : nodes_of) {
         std::vector<int64_t> &v = sn.second;
         std::sort(v.begin(), v.end());
@@ -291,7 +288,7 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
             p.insert(p.end(), &out->xyz[3 * v[i]], &out->xyz[3 * v[i]] + 3);
         const size_t np = p.size() / 3;
         std::vector<double> dist(np);
-        int found = -1;
+        int found = -1, best_face = -1;
         double best = INFINITY;
         for (int k = -1; k < counts.faces && found < 0; ++k) {
             const int f = k < 0 ? sn.first - 1 : k;
@@ -299,17 +296,27 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
             s = cm_cad_project_face(ctx, model, f, p.data(), np, nullptr, nullptr, dist.data(), nullptr);
             if (s < 0) return s;
             const double worst = *std::max_element(dist.begin(), dist.end());
-            best = std::min(best, worst);
-            if (worst <= tol) found = f;
+            if (worst < best) best = worst, best_face = f;
+            if (worst <= std::max(floor_tol, 4 * face_tol[f])) found = f;
         }
-        if (found < 0)
+        if (found < 0) {
+            // the boxes tell a unit apart (factors of 10 and more) from a geometry that differs
+            char unit[160] = "";
+            if (gdiag > 2 * diag || gdiag < 0.5 * diag)
+                std::snprintf(unit, sizeof unit, " (its size %g, ours %g: another unit?)", gdiag, diag);
             return cm_error(ctx, CM_ERR_MISMATCH,
-                            "%s: gmsh's surface %d lies on no CAD face (closest: %.3g away): "
-                            "gmsh's geometry is not cadmorph's",
-                            path, sn.first, best);
+                            "%s: gmsh's surface %d lies on no CAD face (closest: face %d, %.3g "
+                            "away, beyond 4 x the model's tolerance there, %.3g): gmsh's "
+                            "geometry is not cadmorph's%s",
+                            path, sn.first, best_face, best,
+                            best_face >= 0 ? std::max(floor_tol / 4, face_tol[best_face]) : 0.0, unit);
+        }
+        worst_ok = std::max(worst_ok, best);
         taken[found] = 1;
         face_of[sn.first] = found;
     }
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: gmsh's surfaces on the CAD faces within %.3g (largest "
+           "tolerance of the model %.3g)", worst_ok, largest_tol);
     out->tri_face.resize(nb);
     for (size_t t = 0; t < nb; ++t) out->tri_face[t] = face_of[tri_tag[t]];
     cm_log(ctx, CM_LOG_DEBUG, "tetmesh: gmsh: %zu nodes, %zu tets, %zu boundary triangles on %zu "

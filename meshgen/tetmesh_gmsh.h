@@ -22,8 +22,9 @@ struct raw_mesh {
 
 // gmsh's mesh of the model's file with maximum element size h (and 12 elements per 2 pi of
 // curvature, close to the TetGen path's chord deflection h / 10 on the fixtures' radii).
-// Every boundary triangle gets the CAD face its gmsh surface is (checked: all its nodes on
-// that face to 1e-7 x diagonal). Errors: CM_ERR_UNSUPPORTED without gmsh or at the time
+// Every boundary triangle gets the CAD face its gmsh surface is (checked: sampled nodes on
+// that face within 4 x the model's tolerance there, cm_cad_face_tolerances, at least 1e-7 x
+// diagonal); the nodes are gmsh's, not yet projected. Errors: CM_ERR_UNSUPPORTED without gmsh or at the time
 // limit, CM_ERR_NUMERIC when gmsh fails or crashes, CM_ERR_MISMATCH when gmsh's geometry is
 // not ours.
 cm_status gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h, double time_limit,
