@@ -23,13 +23,6 @@
 #include <string>
 #include <vector>
 
-// The estimate's constants (estimate_tets): tets per volume bound and per level of the graded
-// layer over each boundary triangle, fitted on the parts of benchmarks/RESULTS.md, Meshers
-#define CM_EST_TETGEN_VOLUME 3.0
-#define CM_EST_TETGEN_LAYER 1.0
-#define CM_EST_GMSH_VOLUME 3.0
-#define CM_EST_GMSH_LAYER 1.0
-
 namespace {
 
 struct cad_guard {
@@ -58,11 +51,13 @@ double orient(const double *a, const double *b, const double *c, const double *d
 
 // Projects the boundary nodes TetGen added (index >= first) onto the CAD model: onto the face
 // when all their boundary triangles lie on one face, else onto the nearest edge between
-// those faces.
+// those faces. flat_exact: the nodes on planes and lines are on them already (TetGen's, on
+// our triangles); gmsh's are on its own reading of the file, off ours within the tolerances.
 cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
                             const cm_cad_triangulation &surf, size_t first,
                             std::vector<double> &xyz, const std::vector<int64_t> &tri,
-                            const std::vector<int> &tri_face, size_t *n_projected)
+                            const std::vector<int> &tri_face, size_t *n_projected,
+                            bool flat_exact = true)
 {
     *n_projected = 0;
     const char *fn = "cm_tetmesh_create";
@@ -81,7 +76,7 @@ cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
         cm_cad_face_info info;
         cm_status s = cm_cad_face_get_info(ctx, model, fn_nodes.first, &info);
         if (s < 0) return s;
-        if (info.type == CM_CAD_PLANE) continue;
+        if (flat_exact && info.type == CM_CAD_PLANE) continue;
         *n_projected += nodes.size();
         std::vector<double> p(3 * nodes.size()), foot(3 * nodes.size());
         for (size_t i = 0; i < nodes.size(); ++i)
@@ -150,7 +145,7 @@ cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
             if (d < best) best = d, bt = t, be = e;
         }
         // a point TetGen put on a straight segment is on the line already
-        if (einfo[be].type == CM_CAD_LINE) continue;
+        if (flat_exact && einfo[be].type == CM_CAD_LINE) continue;
         ++*n_projected;
         cm_status s = cm_cad_edge_eval(ctx, model, be, &bt, 1, &xyz[3 * node]);
         if (s < 0) return s;
@@ -229,36 +224,28 @@ struct plan {
     const char *path;
     cm_cad_counts counts;
     double h, q, vmax;
+    double volume = 0, max_tets = 0;  // enclosed by the triangulation; the bound on the estimate
+    double estimate = 0;              // TetGen's tets expected (estimate_tets)
     cad_guard surf;
-    double deadline = INFINITY;  // cm_wtime() at which the whole budget ends
 };
 
-// The enclosed volume and the tets expected in the meshers' fill of triangulation T: the
-// volume at a third of the bound vmax per tet (TetGen's tets average about a third of it:
-// measured on the bore model, sizes 0.1-0.3: 2.4-2.9), plus the graded layer over each
-// boundary triangle smaller than h, whose tet count grows as the triangle's size falls
-// (both constants: benchmarks/RESULTS.md, Meshers).
-double estimate_tets(const cm_cad_triangulation &T, double h, double vmax, int mesher,
-                     double *volume)
+// The enclosed volume and the tets expected in TetGen's fill of triangulation T: the volume
+// at a fraction of the bound vmax per tet (TetGen's tets average about a third of it:
+// measured on the bore model, sizes 0.1-0.3: 2.4-2.9), plus the graded layer over the
+// boundary triangles (cmvol::surface_layers; constants: benchmarks/RESULTS.md, Meshers).
+double estimate_tets(const cm_cad_triangulation &T, double h, double vmax, double *volume,
+                     double *layers)
 {
-    double v6 = 0, layer = 0;
+    double v6 = 0;
     for (size_t t = 0; t < T.n_triangles; ++t) {
         const double *a = &T.xyz[3 * T.tri[3 * t]], *b = &T.xyz[3 * T.tri[3 * t + 1]],
                      *c = &T.xyz[3 * T.tri[3 * t + 2]];
         v6 += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
               a[2] * (b[0] * c[1] - b[1] * c[0]);
-        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-        const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
-                             u[0] * w[1] - u[1] * w[0]};
-        const double area = 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        const double l = std::sqrt(area * 4 / std::sqrt(3.0));  // equilateral of that area
-        layer += l < h ? std::log2(h / l) + 1 : 1;
     }
     *volume = std::fabs(v6) / 6;
-    const double per_volume = mesher == CM_MESHER_GMSH ? CM_EST_GMSH_VOLUME : CM_EST_TETGEN_VOLUME;
-    const double per_layer = mesher == CM_MESHER_GMSH ? CM_EST_GMSH_LAYER : CM_EST_TETGEN_LAYER;
-    return per_volume * *volume / vmax + per_layer * layer;
+    *layers = cmvol::surface_layers(T.xyz, T.tri, T.n_triangles, h);
+    return CM_EST_TETGEN_VOLUME * *volume / vmax + CM_EST_TETGEN_LAYER * *layers;
 }
 
 const char *mesher_name(int mesher) { return mesher == CM_MESHER_GMSH ? "gmsh" : "TetGen"; }
@@ -295,18 +282,12 @@ cm_status prepare(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_o
     topt.size = h;
     if ((s = cm_cad_triangulate(ctx, model, &topt, &pl->surf.t)) < 0) return s;
     const cm_cad_triangulation &T = *pl->surf.t;
-    double volume = 0;
-    const double estimate = estimate_tets(T, h, pl->vmax, o.mesher, &volume);
-    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: surface %zu nodes, %zu triangles (%.3f s), volume %g, "
-           "about %.3g tets expected from %s", T.n_nodes, T.n_triangles, cm_wtime() - t0, volume,
-           estimate, mesher_name(o.mesher));
-    const double max_tets = o.max_tets > 0 ? o.max_tets : CM_TETMESH_MAX_TETS;
-    if (!(estimate <= max_tets))
-        return cm_error(ctx, CM_ERR_NOMEM,
-                        "%s: size %g would make about %.2g tets (%zu surface triangles, volume "
-                        "%g), more than the limit of %.3g: use a larger size or lift the limit "
-                        "(cadmorph mesh --force)",
-                        pl->path, h, estimate, T.n_triangles, volume, max_tets);
+    double layers = 0;
+    const double estimate = pl->estimate = estimate_tets(T, h, pl->vmax, &pl->volume, &layers);
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: surface %zu nodes, %zu triangles (%.3f s), volume %g "
+           "(%.4g x the bound), layers %.4g: about %.3g tets expected from TetGen", T.n_nodes,
+           T.n_triangles, cm_wtime() - t0, pl->volume, pl->volume / pl->vmax, layers, estimate);
+    pl->max_tets = o.max_tets > 0 ? o.max_tets : CM_TETMESH_MAX_TETS;
     return CM_OK;
 }
 
@@ -314,16 +295,16 @@ cm_status prepare(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_o
 cm_status run_gmsh(cm_context *ctx, const cm_cad_model *model, const plan &pl, double limit,
                    cmvol::raw_mesh *r)
 {
-    cm_status s = cmvol::gmsh_mesh(ctx, model, pl.h, limit, r);
+    cm_status s = cmvol::gmsh_mesh(ctx, model, pl.h, limit, pl.volume, pl.max_tets, r);
     if (s < 0) return s;
     // gmsh's nodes lie on gmsh's reading of the file, which differs from ours within the
     // model's tolerances: put every boundary node on our faces (edges where faces meet)
     const double t0 = cm_wtime();
     size_t n_projected = 0;
     if ((s = project_new_nodes(ctx, model, *pl.surf.t, 0, r->xyz, r->tri, r->tri_face,
-                               &n_projected)) < 0)
+                               &n_projected, false)) < 0)
         return s;
-    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu gmsh boundary nodes projected onto curved faces and "
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu gmsh boundary nodes projected onto the faces and "
            "edges (%.3f s)", n_projected, cm_wtime() - t0);
     return CM_OK;
 }
@@ -337,6 +318,13 @@ cm_status run_tetgen(cm_context *ctx, const cm_cad_model *model, const cm_tetmes
     const cm_cad_triangulation &T = *pl.surf.t;
     const cm_cad_counts &counts = pl.counts;
     const double h = pl.h, q = pl.q, vmax = pl.vmax;
+    // refused before TetGen runs (gmsh's estimate comes from its own surface mesh)
+    if (!(pl.estimate <= pl.max_tets))
+        return cm_error(ctx, CM_ERR_NOMEM,
+                        "%s: size %g would make about %.2g tets in TetGen (%zu surface triangles, "
+                        "volume %g), more than the limit of %.3g: use a larger size or lift the "
+                        "limit (cadmorph mesh --force)",
+                        path, h, pl.estimate, T.n_triangles, pl.volume, pl.max_tets);
     if (T.n_open_edges)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
                         "%s: the faces do not close a solid (%zu open or non-manifold edges)", fn,

@@ -68,9 +68,11 @@ const uint64_t record_magic = 0x636d676d73686d73ULL;  // "cmgmshms"
 
 struct header {
     uint64_t magic;
-    int64_t failed;  // 1: gmsh reported an error, message in msg
+    int64_t failed;  // 1: gmsh reported an error, message in msg; 2: the estimate is too large
     int64_t n_nodes, n_tets, n_tris;
     double bbox[6];
+    double estimate;      // tets expected from gmsh's surface mesh (surface_layers)
+    int64_t n_surface;    // its triangles
     char msg[400];
 };
 
@@ -78,6 +80,7 @@ struct job {
     const char *path;
     const char *unit;  // OpenCASCADE's name of the target unit ("MM", "M", "INCH", ...)
     double h;
+    double volume, max_tets;  // the model's volume (ours), the bound on the estimate
 };
 
 int send_error(const gmsh_api &G, int fd, const char *what)
@@ -129,6 +132,35 @@ int child_work(void *arg, int fd)
     G.gmshOptionSetNumber("Mesh.MeshSizeMax", j.h, &ierr);
     G.gmshOptionSetNumber("Mesh.MeshSizeMin", 0, &ierr);
     G.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 12, &ierr);
+    // the surface mesh first: the tets expected from it, refused before the volume mesh
+    G.gmshModelMeshGenerate(2, &ierr);
+    if (ierr) return send_error(G, fd, "meshing the surfaces failed");
+    {
+        size_t *tags = nullptr, ntags = 0, ncoord = 0, npar = 0;
+        double *coord = nullptr, *par = nullptr;
+        G.gmshModelMeshGetNodes(&tags, &ntags, &coord, &ncoord, &par, &npar, -1, -1, 1, 0, &ierr);
+        if (ierr || ncoord != 3 * ntags) return send_error(G, fd, "cannot read the surface nodes");
+        size_t max_tag = 0;
+        for (size_t i = 0; i < ntags; ++i) max_tag = std::max(max_tag, tags[i]);
+        std::vector<int64_t> index(max_tag + 1, -1);
+        for (size_t i = 0; i < ntags; ++i) index[tags[i]] = (int64_t)i;
+        size_t *etags = nullptr, netags = 0, *enodes = nullptr, nenodes = 0;
+        G.gmshModelMeshGetElementsByType(2, &etags, &netags, &enodes, &nenodes, -1, 0, 1, &ierr);
+        if (ierr || nenodes != 3 * netags) return send_error(G, fd, "cannot read the surface triangles");
+        std::vector<int64_t> tri(nenodes);
+        for (size_t i = 0; i < nenodes; ++i)
+            tri[i] = enodes[i] <= max_tag ? index[enodes[i]] : -1;
+        if (std::find(tri.begin(), tri.end(), -1) != tri.end())
+            return send_error(G, fd, "a surface triangle has a node that is not in the mesh");
+        const double vmax = j.h * j.h * j.h * std::sqrt(2.0) / 12.0;
+        hd.n_surface = (int64_t)netags;
+        hd.estimate = CM_EST_GMSH_VOLUME * j.volume / vmax +
+                      CM_EST_GMSH_LAYER * cmvol::surface_layers(coord, tri.data(), netags, j.h);
+        if (!(hd.estimate <= j.max_tets)) {
+            hd.failed = 2;
+            return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
+        }
+    }
     G.gmshModelMeshGenerate(3, &ierr);
     if (ierr) return send_error(G, fd, "meshing failed");
 
@@ -191,11 +223,27 @@ const char *occ_unit(const char *u)
 
 }  // namespace
 
+double cmvol::surface_layers(const double *xyz, const int64_t *tri, size_t n_tri, double h)
+{
+    double layer = 0;
+    for (size_t t = 0; t < n_tri; ++t) {
+        const double *a = &xyz[3 * tri[3 * t]], *b = &xyz[3 * tri[3 * t + 1]], *c = &xyz[3 * tri[3 * t + 2]];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                             u[0] * w[1] - u[1] * w[0]};
+        const double area = 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        const double l = std::sqrt(area * 4 / std::sqrt(3.0));  // equilateral of that area
+        layer += l < h && l > 0 ? std::log2(h / l) + 1 : 1;
+    }
+    return layer;
+}
+
 cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
-                           double time_limit, raw_mesh *out)
+                           double time_limit, double volume, double max_tets, raw_mesh *out)
 {
     const char *path = cm_cad_path(model);
-    job j = {path, occ_unit(cm_cad_unit(model)), h};
+    job j = {path, occ_unit(cm_cad_unit(model)), h, volume, max_tets};
     char *data = nullptr;
     size_t size = 0;
     cm_child_outcome o;
@@ -212,6 +260,14 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
     if (size < sizeof hd || (std::memcpy(&hd, data, sizeof hd), hd.magic != record_magic)) {
         std::free(data);
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: gmsh's child sent no record (%zu bytes)", path, size);
+    }
+    if (hd.failed == 2) {
+        std::free(data);
+        return cm_error(ctx, CM_ERR_NOMEM,
+                        "%s: size %g would make about %.2g tets in gmsh (its surface mesh: %lld "
+                        "triangles), more than the limit of %.3g: use a larger size or lift the "
+                        "limit (cadmorph mesh --force)",
+                        path, h, hd.estimate, (long long)hd.n_surface, max_tets);
     }
     if (hd.failed) {
         std::free(data);
@@ -319,7 +375,8 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
            "tolerance of the model %.3g)", worst_ok, largest_tol);
     out->tri_face.resize(nb);
     for (size_t t = 0; t < nb; ++t) out->tri_face[t] = face_of[tri_tag[t]];
-    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: gmsh: %zu nodes, %zu tets, %zu boundary triangles on %zu "
-           "faces (%.3f s)", nn, nt, nb, nodes_of.size(), o.seconds);
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: gmsh: %zu nodes, %zu tets (about %.3g expected from its "
+           "%lld surface triangles), %zu boundary triangles on %zu faces (%.3f s)", nn, nt,
+           hd.estimate, (long long)hd.n_surface, nb, nodes_of.size(), o.seconds);
     return CM_OK;
 }
