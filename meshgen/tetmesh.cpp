@@ -295,6 +295,14 @@ cm_status prepare(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_o
 cm_status run_gmsh(cm_context *ctx, const cm_cad_model *model, const plan &pl, double limit,
                    cmvol::raw_mesh *r)
 {
+    // the volume's share of gmsh's estimate alone, before gmsh meshes any surface (which at a
+    // size far too small would take longer than any limit)
+    const double lower = CM_EST_GMSH_VOLUME * pl.volume / pl.vmax;
+    if (!(lower <= pl.max_tets))
+        return cm_error(ctx, CM_ERR_NOMEM,
+                        "%s: size %g would make at least %.2g tets in gmsh (volume %g), more than "
+                        "the limit of %.3g: use a larger size or lift the limit (cadmorph mesh "
+                        "--force)", pl.path, pl.h, lower, pl.volume, pl.max_tets);
     cm_status s = cmvol::gmsh_mesh(ctx, model, pl.h, limit, pl.volume, pl.max_tets, r);
     if (s < 0) return s;
     // gmsh's nodes lie on gmsh's reading of the file, which differs from ours within the
@@ -525,10 +533,10 @@ cm_status finish(cm_context *ctx, const plan &pl, const cm_tetmesh_options &o, i
             for (int k = 0; k < 4; ++k)
                 for (int d = 0; d < 3; ++d) c[d] += 0.25 * m.m->xyz[3 * nodes[k] + d];
             return cm_error(ctx, CM_ERR_REJECTED,
-                            "%s: %s's mesh has %zu tets at or below the scaled-Jacobian floor %g%s "
+                            "%s: %s's mesh has %zu tet%s at or below the scaled-Jacobian floor %g%s "
                             "after the optimisation; the worst, tet %zu at (%.6g, %.6g, %.6g), "
                             "has %.3g",
-                            pl.path, mesher_name(mesher), std::max(below, flat), o.min_sj,
+                            pl.path, mesher_name(mesher), std::max(below, flat), std::max(below, flat) == 1 ? "" : "s", o.min_sj,
                             o.min_sj >= 0 ? " or flat" : "", worst, c[0], c[1], c[2], sj[worst]);
         }
     }

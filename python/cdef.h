@@ -162,6 +162,8 @@ const int **edges, const int **reversed, int *n);
 cm_status cm_cad_edge_faces(cm_context *ctx, const cm_cad_model *model, int edge,
 const int **faces, int *n);
 cm_status cm_cad_check_solids_apart(cm_context *ctx, const cm_cad_model *model);
+cm_status cm_cad_face_tolerances(cm_context *ctx, const cm_cad_model *model, double *tol,
+double *largest);
 typedef struct cm_cad_correspondence {
 cm_cad_counts counts;
 int *face;
@@ -1320,6 +1322,8 @@ int optimize;
 double max_tets;
 double time_limit;
 int mesher;
+int fallback;
+double min_sj;
 } cm_tetmesh_options;
 enum { CM_MESHER_TETGEN = 0, CM_MESHER_GMSH = 1 };
 void cm_tetmesh_options_init(cm_tetmesh_options *opt);

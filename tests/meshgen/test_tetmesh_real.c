@@ -103,6 +103,8 @@ static cm_status mesh_it(cm_context *ctx, const cm_cad_model *model, int mesher,
     opt.size = size;
     opt.min_sj = min_sj;
     opt.max_tets = max_tets;
+    /* the optimisation only where the judgement depends on it (the real files): seconds */
+    opt.optimize = size == 0;
     n_warnings = 0;
     warning[0] = '\0';
     return cm_tetmesh_create(ctx, model, &opt, m);
