@@ -256,10 +256,12 @@ cm_status prepare(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_o
 {
     const char *fn = "cm_tetmesh_create";
     cm_cad_get_counts(model, &pl->counts);
-    if (pl->counts.solids == 0)
-        return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: the model has no solid (%d faces)", fn,
-                        pl->counts.faces);
     pl->path = cm_cad_path(model);
+    if (pl->counts.solids == 0)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "%s: the model has no solid (%d faces): a mesher fills solids (make the "
+                        "closed shells solids in the CAD system)",
+                        *pl->path ? pl->path : fn, pl->counts.faces);
     cm_status s = cm_cad_check_solids_apart(ctx, model);
     if (s < 0) return s;
     double bb[6];
