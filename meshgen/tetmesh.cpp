@@ -566,6 +566,23 @@ cm_status run_one(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_o
     s = mesher == CM_MESHER_GMSH ? run_gmsh(ctx, model, pl, limit, &r)
                                  : run_tetgen(ctx, model, o, pl, limit, &r);
     if (s >= 0) s = finish(ctx, pl, o, mesher, r, out);
+    // the nodes TetGen adds on curved faces, projected onto them, can flatten the tets under
+    // them beyond what moving interior nodes lifts; the surface kept as triangulated (-Y)
+    // has no such nodes (OpenCASCADE data/occ/bottle: 162 flat tets refined, none kept)
+    if (s == CM_ERR_REJECTED && mesher == CM_MESHER_TETGEN && !o.preserve_surface) {
+        const std::string why = reason(ctx, pl.path);
+        cm_tetmesh_options kept = o;
+        kept.preserve_surface = 1;
+        cmvol::raw_mesh ry;
+        s = run_tetgen(ctx, model, kept, pl, limit, &ry);
+        if (s >= 0) s = finish(ctx, pl, kept, mesher, ry, out);
+        if (s >= 0)
+            cm_log(ctx, CM_LOG_WARNING, "%s: %s; meshed with the surface kept (TetGen -Y)",
+                   pl.path, why.c_str());
+        else if (s != CM_ERR_INTERRUPTED)
+            s = cm_error(ctx, s, "%s: %s; with the surface kept (-Y): %s", pl.path, why.c_str(),
+                         reason(ctx, pl.path).c_str());
+    }
     if (s >= 0 && (s = cm_progress(ctx, stage, 1, 1)) < 0) cm_mesh_destroy(out);
     return s;
 }
