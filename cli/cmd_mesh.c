@@ -14,7 +14,8 @@
 
 static const char *const usage =
     "cadmorph mesh G.step -o MESH [--size H] [--quality Q] [--preserve-surface] "
-    "[--min-dihedral D] [--no-optimize] [--force] [--mesher tetgen|gmsh] [--time-limit S] "
+    "[--min-dihedral D] [--no-optimize] [--min-sj F] [--force] [--mesher tetgen|gmsh] "
+    "[--time-limit S] "
     "[--cad-unit U] [--threads N] [-v] [-h|--help]";
 
 static const char *out, *unit;
@@ -42,22 +43,32 @@ static const cli_option options[] = {
      .help = "lower bound on the tets' dihedral angles, degrees in [0, 20]\n"
              "(default 12; 0: TetGen's own): fewer slivers, more tets"},
     {.name = "--no-optimize", .kind = CLI_FLAG, .dest = &no_optimize, .label = "--no-optimize",
-     .help = "keep TetGen's interior nodes; by default they are optimised\n"
+     .help = "keep the mesher's interior nodes; by default they are optimised\n"
              "to lift slivers (boundary nodes never move)"},
+    {.name = "--min-sj", .kind = CLI_DOUBLE, .dest = &opt.min_sj, .lo = -1, .hi = 1,
+     .open = 2, .bad = "%s: expected a number in [-1, 1), got '%s'", .label = "--min-sj F",
+     .help = "floor of the tets' scaled Jacobian after the optimisation, as\n"
+             "morph's (default 0: no inverted tet, nor a flat one, below 1e-6);\n"
+             "a mesh below it is not written (exit 3; -1 accepts any mesh)"},
     {.name = "--force", .kind = CLI_FLAG, .dest = &force, .label = "--force",
      .help = "mesh even when the estimated tet count exceeds 1e7 (refused\n"
-             "otherwise, exit code 4, with the estimate)"},
+             "otherwise, exit code 4, with the estimate; estimated from the\n"
+             "surface triangulation, within 3x on the measured parts)"},
     {.name = "--mesher", .kind = CLI_ENUM, .dest = &opt.mesher, .names = mesher_names,
      .values = mesher_values, .bad = "%.0sunknown mesher '%s' (tetgen|gmsh)",
      .label = "--mesher M",
      .help = "gmsh (default; gmsh's library meshes the same STEP file, --size\n"
              "is its largest element size) or tetgen (OpenCASCADE's surface\n"
              "triangulation filled by TetGen; the default when --quality,\n"
-             "--min-dihedral or --preserve-surface is given: TetGen's options)"},
+             "--min-dihedral or --preserve-surface is given: TetGen's options).\n"
+             "Without --mesher, when the first mesher fails (or its mesh is\n"
+             "below --min-sj) the other is tried, with a warning; an explicit\n"
+             "--mesher means that mesher only"},
     {.name = "--time-limit", .kind = CLI_DOUBLE, .dest = &opt.time_limit, .lo = 0, .hi = NAN,
      .open = 1, .bad = "%s needs seconds > 0, got '%s'", .label = "--time-limit S",
-     .help = "seconds one mesher run may take (default 600); the mesher runs\n"
-             "in a child process, so its crash or hang is an error message"},
+     .help = "seconds the meshing may take (default 600); the mesher runs in\n"
+             "a child process, so its crash or hang is an error message. With\n"
+             "the fallback the first mesher gets half, the other the rest"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &unit, .label = "--cad-unit U",
      .help = "length unit of the coordinates (default mm)"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &threads, .label = "--threads N",
@@ -74,8 +85,11 @@ static int help(void)
            "or by TetGen (OpenCASCADE triangulates the faces, watertight across face borders,\n"
            "TetGen fills the solid with tets of bounded radius-edge ratio). The mesher runs in a\n"
            "child process under a time limit: its crash or hang is an error message; when\n"
-           "TetGen fails, -Y, a looser quality bound and a perturbed surface are tried. Every\n"
-           "boundary node lies on the CAD model. MESH gets the tets and the boundary\n"
+           "TetGen fails, -Y, a looser quality bound and a perturbed surface are tried; when\n"
+           "one mesher fails, the other is tried (one warning line says so) unless --mesher\n"
+           "is given. gmsh's surface must lie on the CAD faces within the model's own\n"
+           "tolerances; every boundary node is then put on the CAD model. The mesh is\n"
+           "optimised and judged as a morph's (--min-sj). MESH gets the tets and the boundary\n"
            "triangles, each tagged with its CAD face (face index + 1, as in 'cadmorph info'),\n"
            "and the cell field scaled_jacobian, in the format of its extension:\n"
            "%s.\n"
@@ -85,8 +99,9 @@ static int help(void)
            usage, cm_mesh_format_list());
     cli_print_options(stdout, options, 20);
     printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable STEP, no closed solid, touching\n"
-           "solids, the mesher failed, crashed or ran out of time: the message says what was\n"
-           "tried), 4 out of memory or beyond the tet limit, internal error.\n");
+           "solids, the meshers failed, crashed or ran out of time: the message says what was\n"
+           "tried), 3 the mesh stays below --min-sj (the worst tet named, nothing written),\n"
+           "4 out of memory or beyond the tet limit, internal error.\n");
     return CLI_EXIT_OK;
 }
 
@@ -111,6 +126,8 @@ int cli_cmd_mesh(int argc, char **argv)
                          "TetGen's: not with --mesher gmsh");
     /* gmsh by default: better tets than TetGen's at the same size or tet count
      * (benchmarks/RESULTS.md, Meshers) and no crash on its error paths */
+    /* an explicit --mesher is that mesher only: a user who chose it wants its result or why not */
+    if (opt.mesher >= 0) opt.fallback = 0;
     if (opt.mesher < 0) opt.mesher = tetgen_options ? CM_MESHER_TETGEN : CM_MESHER_GMSH;
     if (preserve_surface) opt.preserve_surface = 1;
     if (no_optimize) opt.optimize = 0;

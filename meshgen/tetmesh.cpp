@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <map>
@@ -51,11 +52,13 @@ double orient(const double *a, const double *b, const double *c, const double *d
 
 // Projects the boundary nodes TetGen added (index >= first) onto the CAD model: onto the face
 // when all their boundary triangles lie on one face, else onto the nearest edge between
-// those faces.
+// those faces. flat_exact: the nodes on planes and lines are on them already (TetGen's, on
+// our triangles); gmsh's are on its own reading of the file, off ours within the tolerances.
 cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
                             const cm_cad_triangulation &surf, size_t first,
                             std::vector<double> &xyz, const std::vector<int64_t> &tri,
-                            const std::vector<int> &tri_face, size_t *n_projected)
+                            const std::vector<int> &tri_face, size_t *n_projected,
+                            bool flat_exact = true)
 {
     *n_projected = 0;
     const char *fn = "cm_tetmesh_create";
@@ -74,7 +77,7 @@ cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
         cm_cad_face_info info;
         cm_status s = cm_cad_face_get_info(ctx, model, fn_nodes.first, &info);
         if (s < 0) return s;
-        if (info.type == CM_CAD_PLANE) continue;
+        if (flat_exact && info.type == CM_CAD_PLANE) continue;
         *n_projected += nodes.size();
         std::vector<double> p(3 * nodes.size()), foot(3 * nodes.size());
         for (size_t i = 0; i < nodes.size(); ++i)
@@ -143,7 +146,7 @@ cm_status project_new_nodes(cm_context *ctx, const cm_cad_model *model,
             if (d < best) best = d, bt = t, be = e;
         }
         // a point TetGen put on a straight segment is on the line already
-        if (einfo[be].type == CM_CAD_LINE) continue;
+        if (flat_exact && einfo[be].type == CM_CAD_LINE) continue;
         ++*n_projected;
         cm_status s = cm_cad_edge_eval(ctx, model, be, &bt, 1, &xyz[3 * node]);
         if (s < 0) return s;
@@ -216,23 +219,57 @@ cm_status assemble(cm_context *ctx, int n_faces, std::vector<double> &xyz,
     return CM_OK;
 }
 
-cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
-                cm_mesh **out)
+// What the meshers share: the size, the bounds, OpenCASCADE's surface triangulation (TetGen's
+// input, the estimate's and the projections' seeds) and the time budget.
+struct plan {
+    const char *path;
+    cm_cad_counts counts;
+    double h, q, vmax;
+    double volume = 0, max_tets = 0;  // enclosed by the triangulation; the bound on the estimate
+    double estimate = 0;              // TetGen's tets expected (estimate_tets)
+    int touching[2] = {-1, -1};       // solids that touch: an assembly (tetmesh_assembly.h)
+    cad_guard surf;
+};
+
+// The enclosed volume and the tets expected in TetGen's fill of triangulation T: the volume
+// at a fraction of the bound vmax per tet (TetGen's tets average about a third of it:
+// measured on the bore model, sizes 0.1-0.3: 2.4-2.9), plus the graded layer over the
+// boundary triangles (cmvol::surface_layers; constants: benchmarks/RESULTS.md, Meshers).
+double estimate_tets(const cm_cad_triangulation &T, double h, double vmax, double *volume,
+                     double *layers)
+{
+    double v6 = 0;
+    for (size_t t = 0; t < T.n_triangles; ++t) {
+        const double *a = &T.xyz[3 * T.tri[3 * t]], *b = &T.xyz[3 * T.tri[3 * t + 1]],
+                     *c = &T.xyz[3 * T.tri[3 * t + 2]];
+        v6 += a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) +
+              a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    *volume = std::fabs(v6) / 6;
+    *layers = cmvol::surface_layers(T.xyz, T.tri, T.n_triangles, h);
+    return CM_EST_TETGEN_VOLUME * *volume / vmax + CM_EST_TETGEN_LAYER * *layers;
+}
+
+const char *mesher_name(int mesher) { return mesher == CM_MESHER_GMSH ? "gmsh" : "TetGen"; }
+
+// The checks before any mesher runs, the triangulation and the estimate.
+cm_status prepare(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
+                  plan *pl)
 {
     const char *fn = "cm_tetmesh_create";
-    cm_cad_counts counts;
-    cm_cad_get_counts(model, &counts);
-    if (counts.solids == 0)
-        return cm_error(ctx, CM_ERR_UNSUPPORTED, "%s: the model has no solid (%d faces)", fn,
-                        counts.faces);
-    const char *path = cm_cad_path(model);
-    int touching[2];  // solids that touch: an assembly (tetmesh_assembly.h)
-    cm_status s = cm_cad_check_solids_apart(ctx, model, touching);
+    cm_cad_get_counts(model, &pl->counts);
+    pl->path = cm_cad_path(model);
+    if (pl->counts.solids == 0)
+        return cm_error(ctx, CM_ERR_UNSUPPORTED,
+                        "%s: the model has no solid (%d faces): a mesher fills solids (make the "
+                        "closed shells solids in the CAD system)",
+                        *pl->path ? pl->path : fn, pl->counts.faces);
+    cm_status s = cm_cad_check_solids_apart(ctx, model, pl->touching);
     if (s < 0) return s;
     double bb[6];
     cm_cad_bbox(model, bb);
-    const double h = o.size > 0 ? o.size : cm_bbox_diagonal(bb) / 20;
-    const double q = o.quality > 0 ? o.quality : 1.4;
+    const double h = pl->h = o.size > 0 ? o.size : cm_bbox_diagonal(bb) / 20;
+    const double q = pl->q = o.quality > 0 ? o.quality : 1.4;
     if (!std::isfinite(h) || !std::isfinite(q) || q < 1.0)
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: size %g or quality %g out of range (quality >= 1)",
                         fn, h, q);
@@ -240,55 +277,80 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     if (!(o.min_dihedral >= 0 && o.min_dihedral <= 20))
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: minimum dihedral angle %g out of [0, 20] degrees",
                         fn, o.min_dihedral);
-    const double vmax = h * h * h * std::sqrt(2.0) / 12.0;  // regular tet of edge h
-    // TetGen's tets average about a third of the volume bound (measured on the bore model,
-    // sizes 0.1-0.3: 2.4-2.9): estimate before the surface triangulation, which grows as
-    // 1/h^2 itself
-    double volume = 0;
-    if ((s = cm_cad_volume(ctx, model, &volume)) < 0) return s;
-    const double estimate = 3.0 * std::fabs(volume) / vmax;
-    const double max_tets = o.max_tets > 0 ? o.max_tets : CM_TETMESH_MAX_TETS;
-    if (!(estimate <= max_tets))
-        return cm_error(ctx, CM_ERR_NOMEM,
-                        "%s: size %g would make about %.2g tets (volume %g), more than the limit "
-                        "of %.3g: use a larger size or lift the limit (cadmorph mesh --force)",
-                        path, h, estimate, volume, max_tets);
-
-    const double limit = o.time_limit > 0 ? o.time_limit : CM_TETMESH_TIME_LIMIT;
-    if (touching[0] >= 0) return cmvol::assembly_mesh(ctx, model, o.mesher, h, limit, touching, out);
-    if (o.mesher == CM_MESHER_GMSH) {
-        if ((s = cm_progress(ctx, "gmsh", 0, 1)) < 0) return s;
-        cmvol::raw_mesh r;
-        if ((s = cmvol::gmsh_mesh(ctx, model, h, limit, &r)) < 0) return s;
-        s = assemble(ctx, counts.faces, r.xyz, r.tets, r.tri, r.tri_face, out);
-        if (s >= 0) {
-            cm_status p = cm_progress(ctx, "gmsh", 1, 1);
-            if (p < 0) {
-                cm_mesh_destroy(out);
-                return p;
-            }
-        }
-        return s;
-    }
-    if (o.mesher != CM_MESHER_TETGEN)
+    if (o.mesher != CM_MESHER_TETGEN && o.mesher != CM_MESHER_GMSH)
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: unknown mesher %d", fn, o.mesher);
-
+    pl->vmax = h * h * h * std::sqrt(2.0) / 12.0;  // regular tet of edge h
     const double t0 = cm_wtime();
-    cad_guard surf;
     cm_cad_triangulate_options topt;
     cm_cad_triangulate_options_init(&topt);
     topt.size = h;
-    s = cm_cad_triangulate(ctx, model, &topt, &surf.t);
+    if ((s = cm_cad_triangulate(ctx, model, &topt, &pl->surf.t)) < 0) return s;
+    const cm_cad_triangulation &T = *pl->surf.t;
+    double layers = 0;
+    const double estimate = pl->estimate = estimate_tets(T, h, pl->vmax, &pl->volume, &layers);
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: surface %zu nodes, %zu triangles (%.3f s), volume %g "
+           "(%.4g x the bound), layers %.4g: about %.3g tets expected from TetGen", T.n_nodes,
+           T.n_triangles, cm_wtime() - t0, pl->volume, pl->volume / pl->vmax, layers, estimate);
+    pl->max_tets = o.max_tets > 0 ? o.max_tets : CM_TETMESH_MAX_TETS;
+    return CM_OK;
+}
+
+// The volume's share of gmsh's estimate alone, checked before gmsh meshes any surface (which
+// at a size far too small would take longer than any limit).
+cm_status check_gmsh_volume(cm_context *ctx, const plan &pl)
+{
+    const double lower = CM_EST_GMSH_VOLUME * pl.volume / pl.vmax;
+    if (!(lower <= pl.max_tets))
+        return cm_error(ctx, CM_ERR_NOMEM,
+                        "%s: size %g would make at least %.2g tets in gmsh (volume %g), more than "
+                        "the limit of %.3g: use a larger size or lift the limit (cadmorph mesh "
+                        "--force)", pl.path, pl.h, lower, pl.volume, pl.max_tets);
+    return CM_OK;
+}
+
+// gmsh's mesh of the model's file, its boundary nodes then projected onto our faces and edges.
+cm_status run_gmsh(cm_context *ctx, const cm_cad_model *model, const plan &pl, double limit,
+                   cmvol::raw_mesh *r)
+{
+    cm_status s = check_gmsh_volume(ctx, pl);
     if (s < 0) return s;
-    const cm_cad_triangulation &T = *surf.t;
+    s = cmvol::gmsh_mesh(ctx, model, pl.h, limit, pl.volume, pl.max_tets, r);
+    if (s < 0) return s;
+    // gmsh's nodes lie on gmsh's reading of the file, which differs from ours within the
+    // model's tolerances: put every boundary node on our faces (edges where faces meet)
+    const double t0 = cm_wtime();
+    size_t n_projected = 0;
+    if ((s = project_new_nodes(ctx, model, *pl.surf.t, 0, r->xyz, r->tri, r->tri_face,
+                               &n_projected, false)) < 0)
+        return s;
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu gmsh boundary nodes projected onto the faces and "
+           "edges (%.3f s)", n_projected, cm_wtime() - t0);
+    return CM_OK;
+}
+
+// OpenCASCADE's triangulation filled by TetGen, with its retries; the nodes TetGen adds on
+// the surface projected onto the CAD faces and edges.
+cm_status run_tetgen(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
+                     const plan &pl, double limit, cmvol::raw_mesh *r)
+{
+    const char *fn = "cm_tetmesh_create", *path = pl.path;
+    const cm_cad_triangulation &T = *pl.surf.t;
+    const cm_cad_counts &counts = pl.counts;
+    const double h = pl.h, q = pl.q, vmax = pl.vmax;
+    // refused before TetGen runs (gmsh's estimate comes from its own surface mesh)
+    if (!(pl.estimate <= pl.max_tets))
+        return cm_error(ctx, CM_ERR_NOMEM,
+                        "%s: size %g would make about %.2g tets in TetGen (%zu surface triangles, "
+                        "volume %g), more than the limit of %.3g: use a larger size or lift the "
+                        "limit (cadmorph mesh --force)",
+                        path, h, pl.estimate, T.n_triangles, pl.volume, pl.max_tets);
     if (T.n_open_edges)
         return cm_error(ctx, CM_ERR_UNSUPPORTED,
                         "%s: the faces do not close a solid (%zu open or non-manifold edges)", fn,
                         T.n_open_edges);
     const double t1 = cm_wtime();
-    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: surface %zu nodes, %zu triangles (%.3f s)", T.n_nodes,
-           T.n_triangles, t1 - t0);
-    if ((s = cm_progress(ctx, "tetgen", 0, 1)) < 0) return s;
+    cm_status s = cm_progress(ctx, "tetgen", 0, 1);
+    if (s < 0) return s;
 
     const cm_tetgen_plc plc = {T.n_nodes, T.n_triangles, T.xyz, T.tri, nullptr};
     std::vector<int> marker(T.n_triangles);
@@ -309,8 +371,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
             cm_log(ctx, CM_LOG_DEBUG, "tetmesh: TetGen -d: %s", cm_context_message(ctx));
             if (failure == 3)
                 return cm_error(ctx, s, "%s: TetGen's intersection check did not finish in %.3g s "
-                                "(nothing more tried: raise the time limit, --time-limit, or try "
-                                "--mesher gmsh)", path, limit);
+                                "(nothing more tried: raise the time limit, --time-limit)", path, limit);
         } else if (diag.r.n_trifaces > 0) {
             std::set<int> faces;
             for (size_t t = 0; t < diag.r.n_trifaces; ++t) faces.insert(diag.r.trimarker[t] - 1);
@@ -420,9 +481,7 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
         const bool hung = tried.find("did not finish") != std::string::npos;
         return cm_error(ctx, s < 0 ? s : CM_ERR_NUMERIC, "%s: TetGen could not mesh it. Tried %s%s",
                         path, tried.c_str(),
-                        hung ? " (nothing more: raise the time limit, --time-limit, or try "
-                               "--mesher gmsh)"
-                             : " (try --mesher gmsh)");
+                        hung ? " (nothing more: raise the time limit, --time-limit)" : "");
     }
     if (chosen > 0)
         cm_log(ctx, CM_LOG_WARNING, "%s: TetGen meshed with %s (switches %s) after: %s", path,
@@ -431,9 +490,12 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     if (tv.r.trimarker == nullptr && tv.r.n_trifaces)
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: TetGen gave no face markers", fn);
     const size_t nn = tv.r.n_points, nt = tv.r.n_tets, nb = tv.r.n_trifaces;
-    std::vector<double> xyz(tv.r.xyz, tv.r.xyz + 3 * nn);
-    std::vector<int64_t> tri(nb * 3);
-    std::vector<int> tri_face(nb);
+    std::vector<double> &xyz = r->xyz;
+    std::vector<int64_t> &tri = r->tri;
+    std::vector<int> &tri_face = r->tri_face;
+    xyz.assign(tv.r.xyz, tv.r.xyz + 3 * nn);
+    tri.resize(nb * 3);
+    tri_face.resize(nb);
     for (size_t t = 0; t < nb; ++t) {
         for (int k = 0; k < 3; ++k) tri[3 * t + k] = tv.r.triface[3 * t + k];
         tri_face[t] = tv.r.trimarker[t] - 1;
@@ -450,18 +512,145 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     cm_log(ctx, CM_LOG_DEBUG, "tetmesh: %zu new boundary nodes projected onto curved faces and edges (%.3f s)",
            n_projected, cm_wtime() - t2);
 
-    std::vector<std::array<int64_t, 4>> tets(nt);
+    r->tets.resize(nt);
     for (size_t t = 0; t < nt; ++t)
-        for (int k = 0; k < 4; ++k) tets[t][k] = tv.r.tet[4 * t + k];
-    s = assemble(ctx, counts.faces, xyz, tets, tri, tri_face, out);
-    if (s >= 0) {
-        cm_status p = cm_progress(ctx, "tetgen", 1, 1);
-        if (p < 0) {
-            cm_mesh_destroy(out);
-            return p;
+        for (int k = 0; k < 4; ++k) r->tets[t][k] = tv.r.tet[4 * t + k];
+    return CM_OK;
+}
+
+// A new mesh optimised, and its quality judgement: CM_ERR_REJECTED naming the worst tet when
+// it stays below the floor. On success *out takes the mesh.
+cm_status judge(cm_context *ctx, const plan &pl, const cm_tetmesh_options &o, int mesher,
+                mesh_guard &m, cm_mesh **out)
+{
+    cm_status s = CM_OK;
+    /* the meshers' radius-edge bounds leave slivers: move the interior nodes to lift them;
+     * an assembly's interfaces are inside the mesh, on CAD faces: held too */
+    if (o.optimize) {
+        const std::vector<unsigned char> fixed = cmvol::assembly_fixed_nodes(m.m);
+        s = cm_mesh_optimize(ctx, m.m, fixed.empty() ? nullptr : fixed.data(), nullptr, nullptr);
+        if (s < 0) return s;
+    }
+    if (o.min_sj >= -1) {
+        std::vector<double> sj(m.m->n_cells);
+        if ((s = cm_mesh_quality(ctx, m.m, sj.data())) < 0) return s;
+        size_t worst = SIZE_MAX, flat = 0, below = 0;
+        for (size_t c = 0; c < m.m->n_cells; ++c) {
+            if (m.m->type[c] != CM_CELL_TET4) continue;
+            if (worst == SIZE_MAX || !(sj[c] >= sj[worst])) worst = c;
+            below += !(sj[c] > o.min_sj);
+            flat += o.min_sj >= 0 && !(sj[c] >= CM_TETMESH_FLAT_SJ);
+        }
+        if (worst != SIZE_MAX && (below || flat)) {
+            const int64_t *nodes = &m.m->conn[m.m->offset[worst]];
+            double c[3] = {0, 0, 0};
+            for (int k = 0; k < 4; ++k)
+                for (int d = 0; d < 3; ++d) c[d] += 0.25 * m.m->xyz[3 * nodes[k] + d];
+            return cm_error(ctx, CM_ERR_REJECTED,
+                            "%s: %s's mesh has %zu tet%s at or below the scaled-Jacobian floor %g%s "
+                            "after the optimisation; the worst, tet %zu at (%.6g, %.6g, %.6g), "
+                            "has %.3g",
+                            pl.path, mesher_name(mesher), std::max(below, flat), std::max(below, flat) == 1 ? "" : "s", o.min_sj,
+                            o.min_sj >= 0 ? " or flat" : "", worst, c[0], c[1], c[2], sj[worst]);
         }
     }
+    *out = m.m;
+    m.m = nullptr;
+    return CM_OK;
+}
+
+// The mesh of one mesher's result, optimised and judged.
+cm_status finish(cm_context *ctx, const plan &pl, const cm_tetmesh_options &o, int mesher,
+                 cmvol::raw_mesh &r, cm_mesh **out)
+{
+    mesh_guard m;
+    cm_status s = assemble(ctx, pl.counts.faces, r.xyz, r.tets, r.tri, r.tri_face, &m.m);
+    return s < 0 ? s : judge(ctx, pl, o, mesher, m, out);
+}
+
+// The message of the last error without the model's path in front (it opens the final one).
+std::string reason(cm_context *ctx, const char *path)
+{
+    std::string why = cm_context_message(ctx);
+    const std::string prefix = std::string(path) + ": ";
+    if (why.compare(0, prefix.size(), prefix) == 0) why.erase(0, prefix.size());
+    return why;
+}
+
+cm_status run_one(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
+                  const plan &pl, int mesher, double limit, cm_mesh **out)
+{
+    const char *stage = mesher == CM_MESHER_GMSH ? "gmsh" : "tetgen";
+    cm_status s = cm_progress(ctx, stage, 0, 1);
+    if (s < 0) return s;
+    cmvol::raw_mesh r;
+    s = mesher == CM_MESHER_GMSH ? run_gmsh(ctx, model, pl, limit, &r)
+                                 : run_tetgen(ctx, model, o, pl, limit, &r);
+    if (s >= 0) s = finish(ctx, pl, o, mesher, r, out);
+    // the nodes TetGen adds on curved faces, projected onto them, can flatten the tets under
+    // them beyond what moving interior nodes lifts; the surface kept as triangulated (-Y)
+    // has no such nodes (OpenCASCADE data/occ/bottle: 162 flat tets refined, none kept)
+    if (s == CM_ERR_REJECTED && mesher == CM_MESHER_TETGEN && !o.preserve_surface) {
+        const std::string why = reason(ctx, pl.path);
+        cm_tetmesh_options kept = o;
+        kept.preserve_surface = 1;
+        cmvol::raw_mesh ry;
+        s = run_tetgen(ctx, model, kept, pl, limit, &ry);
+        if (s >= 0) s = finish(ctx, pl, kept, mesher, ry, out);
+        if (s >= 0)
+            cm_log(ctx, CM_LOG_WARNING, "%s: %s; meshed with the surface kept (TetGen -Y)",
+                   pl.path, why.c_str());
+        else if (s != CM_ERR_INTERRUPTED)
+            s = cm_error(ctx, s, "%s: %s; with the surface kept (-Y): %s", pl.path, why.c_str(),
+                         reason(ctx, pl.path).c_str());
+    }
+    if (s >= 0 && (s = cm_progress(ctx, stage, 1, 1)) < 0) cm_mesh_destroy(out);
     return s;
+}
+
+// The driver: the mesher asked for, then (o.fallback) the other one, each judged the same way.
+cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_options &o,
+                cm_mesh **out)
+{
+    plan pl;
+    cm_status s = prepare(ctx, model, o, &pl);
+    if (s < 0) return s;
+    const double limit = o.time_limit > 0 ? o.time_limit : CM_TETMESH_TIME_LIMIT;
+    if (pl.touching[0] >= 0) {
+        // solids that touch: only gmsh meshes them (docs/DESIGN.md, Assemblies), so the
+        // fallback goes there at once; an explicit TetGen is refused by assembly_mesh
+        const int mesher = o.fallback ? CM_MESHER_GMSH : o.mesher;
+        mesh_guard m;
+        if ((s = check_gmsh_volume(ctx, pl)) < 0 ||
+            (s = cmvol::assembly_mesh(ctx, model, mesher, pl.h, limit, pl.touching, &m.m)) < 0)
+            return s;
+        return judge(ctx, pl, o, mesher, m, out);
+    }
+    const int first = o.mesher, second = first == CM_MESHER_GMSH ? CM_MESHER_TETGEN : CM_MESHER_GMSH;
+    const double t0 = cm_wtime();
+    const double first_limit = o.fallback ? CM_TETMESH_FIRST_SHARE * limit : limit;
+    s = run_one(ctx, model, o, pl, first, first_limit, out);
+    if (s >= 0 || s == CM_ERR_INTERRUPTED) return s;
+    const std::string why1 = reason(ctx, pl.path);
+    if (!o.fallback)
+        return cm_error(ctx, s, "%s: %s (the other mesher: --mesher %s)", pl.path, why1.c_str(),
+                        first == CM_MESHER_GMSH ? "tetgen" : "gmsh");
+    const cm_status s1 = s;
+    const double left = std::isfinite(limit) ? std::max(limit - (cm_wtime() - t0), 0.05 * limit)
+                                             : limit;
+    s = run_one(ctx, model, o, pl, second, left, out);
+    if (s >= 0) {
+        cm_log(ctx, CM_LOG_WARNING, "%s: %s could not mesh it (%s); meshed with %s", pl.path,
+               mesher_name(first), why1.c_str(), mesher_name(second));
+        return s;
+    }
+    if (s == CM_ERR_INTERRUPTED) return s;
+    const std::string why2 = reason(ctx, pl.path);
+    // the status of the mesher asked for, unless the other one's says more (memory, quality)
+    const cm_status worst = s1 == CM_ERR_REJECTED || s == CM_ERR_REJECTED ? CM_ERR_REJECTED : s1;
+    return cm_error(ctx, worst, "%s: no mesh: %s: %s; %s: %s (try another --size, a longer "
+                    "--time-limit, or repair the model)", pl.path, mesher_name(first),
+                    why1.c_str(), mesher_name(second), why2.c_str());
 }
 
 }  // namespace
@@ -477,6 +666,8 @@ extern "C" void cm_tetmesh_options_init(cm_tetmesh_options *opt)
     opt->max_tets = 0;
     opt->time_limit = 0;
     opt->mesher = CM_MESHER_TETGEN;
+    opt->fallback = 1;
+    opt->min_sj = 0;
 }
 
 extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
@@ -489,19 +680,7 @@ extern "C" cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *mode
     cm_tetmesh_options_init(&o);
     if (opt) o = *opt;
     try {
-        cm_status s = build(ctx, model, o, mesh);
-        /* TetGen's radius-edge bound leaves slivers: move the interior nodes to lift them */
-        if (s >= 0 && o.optimize) {
-            // an assembly's interfaces are inside the mesh, on CAD faces: fixed too
-            const std::vector<unsigned char> fixed = cmvol::assembly_fixed_nodes(*mesh);
-            cm_status e = cm_mesh_optimize(ctx, *mesh, fixed.empty() ? nullptr : fixed.data(),
-                                           nullptr, nullptr);
-            if (e < 0) {
-                cm_mesh_destroy(mesh);
-                return e;
-            }
-        }
-        return s;
+        return build(ctx, model, o, mesh);
     } catch (const std::bad_alloc &) {
         return cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", fn);
     } catch (const std::exception &e) {

@@ -3,7 +3,8 @@
 // kernel (the same OpenCASCADE 7.6 as cad/), meshes in 3D on one thread (no OpenMP pool after
 // a fork) and sends nodes, tets and the boundary triangles with their gmsh surface tags. The
 // parent maps each gmsh surface to the CAD face all its nodes lie on, so that the boundary
-// triangles carry our face indices as the TetGen path's do.
+// triangles carry our face indices as the TetGen path's do, within the model's own tolerances
+// (cm_cad_face_tolerances).
 #include "tetmesh_gmsh.h"
 
 #include "child_process.h"
@@ -20,6 +21,7 @@ extern "C" {
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <vector>
 #include <map>
 #include <string>
 
@@ -66,9 +68,11 @@ const uint64_t record_magic = 0x636d676d73686d73ULL;  // "cmgmshms"
 
 struct header {
     uint64_t magic;
-    int64_t failed;  // 1: gmsh reported an error, message in msg
+    int64_t failed;  // 1: gmsh reported an error, message in msg; 2: the estimate is too large
     int64_t n_nodes, n_tets, n_tris;
     double bbox[6];
+    double estimate;      // tets expected from gmsh's surface mesh (surface_layers)
+    int64_t n_surface;    // its triangles
     char msg[400];
 };
 
@@ -76,6 +80,7 @@ struct job {
     const char *path;
     const char *unit;  // OpenCASCADE's name of the target unit ("MM", "M", "INCH", ...)
     double h;
+    double volume, max_tets;  // the model's volume (ours), the bound on the estimate
 };
 
 int send_error(const gmsh_api &G, int fd, const char *what)
@@ -127,6 +132,35 @@ int child_work(void *arg, int fd)
     G.gmshOptionSetNumber("Mesh.MeshSizeMax", j.h, &ierr);
     G.gmshOptionSetNumber("Mesh.MeshSizeMin", 0, &ierr);
     G.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 12, &ierr);
+    // the surface mesh first: the tets expected from it, refused before the volume mesh
+    G.gmshModelMeshGenerate(2, &ierr);
+    if (ierr) return send_error(G, fd, "meshing the surfaces failed");
+    {
+        size_t *tags = nullptr, ntags = 0, ncoord = 0, npar = 0;
+        double *coord = nullptr, *par = nullptr;
+        G.gmshModelMeshGetNodes(&tags, &ntags, &coord, &ncoord, &par, &npar, -1, -1, 1, 0, &ierr);
+        if (ierr || ncoord != 3 * ntags) return send_error(G, fd, "cannot read the surface nodes");
+        size_t max_tag = 0;
+        for (size_t i = 0; i < ntags; ++i) max_tag = std::max(max_tag, tags[i]);
+        std::vector<int64_t> index(max_tag + 1, -1);
+        for (size_t i = 0; i < ntags; ++i) index[tags[i]] = (int64_t)i;
+        size_t *etags = nullptr, netags = 0, *enodes = nullptr, nenodes = 0;
+        G.gmshModelMeshGetElementsByType(2, &etags, &netags, &enodes, &nenodes, -1, 0, 1, &ierr);
+        if (ierr || nenodes != 3 * netags) return send_error(G, fd, "cannot read the surface triangles");
+        std::vector<int64_t> tri(nenodes);
+        for (size_t i = 0; i < nenodes; ++i)
+            tri[i] = enodes[i] <= max_tag ? index[enodes[i]] : -1;
+        if (std::find(tri.begin(), tri.end(), -1) != tri.end())
+            return send_error(G, fd, "a surface triangle has a node that is not in the mesh");
+        const double vmax = j.h * j.h * j.h * std::sqrt(2.0) / 12.0;
+        hd.n_surface = (int64_t)netags;
+        hd.estimate = CM_EST_GMSH_VOLUME * j.volume / vmax +
+                      CM_EST_GMSH_LAYER * cmvol::surface_layers(coord, tri.data(), netags, j.h);
+        if (!(hd.estimate <= j.max_tets)) {
+            hd.failed = 2;
+            return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
+        }
+    }
     G.gmshModelMeshGenerate(3, &ierr);
     if (ierr) return send_error(G, fd, "meshing failed");
 
@@ -189,11 +223,27 @@ const char *occ_unit(const char *u)
 
 }  // namespace
 
+double cmvol::surface_layers(const double *xyz, const int64_t *tri, size_t n_tri, double h)
+{
+    double layer = 0;
+    for (size_t t = 0; t < n_tri; ++t) {
+        const double *a = &xyz[3 * tri[3 * t]], *b = &xyz[3 * tri[3 * t + 1]], *c = &xyz[3 * tri[3 * t + 2]];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                             u[0] * w[1] - u[1] * w[0]};
+        const double area = 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        const double l = std::sqrt(area * 4 / std::sqrt(3.0));  // equilateral of that area
+        layer += l < h && l > 0 ? std::log2(h / l) + 1 : 1;
+    }
+    return layer;
+}
+
 cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
-                           double time_limit, raw_mesh *out)
+                           double time_limit, double volume, double max_tets, raw_mesh *out)
 {
     const char *path = cm_cad_path(model);
-    job j = {path, occ_unit(cm_cad_unit(model)), h};
+    job j = {path, occ_unit(cm_cad_unit(model)), h, volume, max_tets};
     char *data = nullptr;
     size_t size = 0;
     cm_child_outcome o;
@@ -210,6 +260,14 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
     if (size < sizeof hd || (std::memcpy(&hd, data, sizeof hd), hd.magic != record_magic)) {
         std::free(data);
         return cm_error(ctx, CM_ERR_INTERNAL, "%s: gmsh's child sent no record (%zu bytes)", path, size);
+    }
+    if (hd.failed == 2) {
+        std::free(data);
+        return cm_error(ctx, CM_ERR_NOMEM,
+                        "%s: size %g would make about %.2g tets in gmsh (its surface mesh: %lld "
+                        "triangles), more than the limit of %.3g: use a larger size or lift the "
+                        "limit (cadmorph mesh --force)",
+                        path, h, hd.estimate, (long long)hd.n_surface, max_tets);
     }
     if (hd.failed) {
         std::free(data);
@@ -255,31 +313,26 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
     for (size_t t = 0; t < nt; ++t)
         for (int k = 0; k < 4; ++k) out->tets[t][k] = renum[tets[4 * t + k]];
 
-    // the same geometry and unit? gmsh's box (OpenCASCADE's, not tight on curved faces:
-    // control points, tolerances) holds ours and is of its size; the faces are checked below
+    // gmsh surface -> CAD face: the face all of the surface's nodes lie on, within the model's
+    // own tolerance there (gmsh binds faces in OpenCASCADE's order, so face tag - 1 is tried
+    // first; a renumbering costs only time). A point of an edge may be its tolerance away from
+    // the faces that meet there: a file's tolerances of 1e-4 x its size are common (CAD
+    // systems' own), and gmsh places its nodes on the edge curves.
     double bb[6];
     cm_cad_bbox(model, bb);
     const double diag = cm_bbox_diagonal(bb), gdiag = cm_bbox_diagonal(hd.bbox);
-    bool holds = gdiag >= 0.5 * diag && gdiag <= 2 * diag;
-    for (int k = 0; k < 3; ++k)
-        holds = holds && hd.bbox[k] <= bb[k] + 1e-4 * diag && hd.bbox[k + 3] >= bb[k + 3] - 1e-4 * diag;
-    if (!holds)
-        return cm_error(ctx, CM_ERR_MISMATCH,
-                        "%s: gmsh read another geometry: its bounding box [%g %g %g, %g %g %g] "
-                        "does not fit cadmorph's [%g %g %g, %g %g %g] (another unit?)",
-                        path, hd.bbox[0], hd.bbox[1], hd.bbox[2], hd.bbox[3], hd.bbox[4],
-                        hd.bbox[5], bb[0], bb[1], bb[2], bb[3], bb[4], bb[5]);
-
-    // gmsh surface -> CAD face: the face all of the surface's nodes lie on (gmsh binds faces in
-    // OpenCASCADE's order, so face tag - 1 is tried first; a renumbering costs only time)
     cm_cad_counts counts;
     cm_cad_get_counts(model, &counts);
-    const double tol = 1e-7 * diag;
+    std::vector<double> face_tol(counts.faces);
+    double largest_tol = 0;
+    if ((s = cm_cad_face_tolerances(ctx, model, face_tol.data(), &largest_tol)) < 0) return s;
+    const double floor_tol = 1e-7 * diag;
     std::map<int, std::vector<int64_t>> nodes_of;
     for (size_t t = 0; t < nb; ++t)
         for (int k = 0; k < 3; ++k) nodes_of[tri_tag[t]].push_back(out->tri[3 * t + k]);
     std::map<int, int> face_of;
     std::vector<int> taken(counts.faces, 0);
+    double worst_ok = 0;
     for (auto &sn : nodes_of) {
         std::vector<int64_t> &v = sn.second;
         std::sort(v.begin(), v.end());
@@ -291,7 +344,7 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
             p.insert(p.end(), &out->xyz[3 * v[i]], &out->xyz[3 * v[i]] + 3);
         const size_t np = p.size() / 3;
         std::vector<double> dist(np);
-        int found = -1;
+        int found = -1, best_face = -1;
         double best = INFINITY;
         for (int k = -1; k < counts.faces && found < 0; ++k) {
             const int f = k < 0 ? sn.first - 1 : k;
@@ -299,20 +352,31 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
             s = cm_cad_project_face(ctx, model, f, p.data(), np, nullptr, nullptr, dist.data(), nullptr);
             if (s < 0) return s;
             const double worst = *std::max_element(dist.begin(), dist.end());
-            best = std::min(best, worst);
-            if (worst <= tol) found = f;
+            if (worst < best) best = worst, best_face = f;
+            if (worst <= std::max(floor_tol, 4 * face_tol[f])) found = f;
         }
-        if (found < 0)
+        if (found < 0) {
+            // the boxes tell a unit apart (factors of 10 and more) from a geometry that differs
+            char unit[160] = "";
+            if (gdiag > 2 * diag || gdiag < 0.5 * diag)
+                std::snprintf(unit, sizeof unit, " (its size %g, ours %g: another unit?)", gdiag, diag);
             return cm_error(ctx, CM_ERR_MISMATCH,
-                            "%s: gmsh's surface %d lies on no CAD face (closest: %.3g away): "
-                            "gmsh's geometry is not cadmorph's",
-                            path, sn.first, best);
+                            "%s: gmsh's surface %d lies on no CAD face (closest: face %d, %.3g "
+                            "away, beyond 4 x the model's tolerance there, %.3g): gmsh's "
+                            "geometry is not cadmorph's%s",
+                            path, sn.first, best_face, best,
+                            best_face >= 0 ? std::max(floor_tol / 4, face_tol[best_face]) : 0.0, unit);
+        }
+        worst_ok = std::max(worst_ok, best);
         taken[found] = 1;
         face_of[sn.first] = found;
     }
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: gmsh's surfaces on the CAD faces within %.3g (largest "
+           "tolerance of the model %.3g)", worst_ok, largest_tol);
     out->tri_face.resize(nb);
     for (size_t t = 0; t < nb; ++t) out->tri_face[t] = face_of[tri_tag[t]];
-    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: gmsh: %zu nodes, %zu tets, %zu boundary triangles on %zu "
-           "faces (%.3f s)", nn, nt, nb, nodes_of.size(), o.seconds);
+    cm_log(ctx, CM_LOG_DEBUG, "tetmesh: gmsh: %zu nodes, %zu tets (about %.3g expected from its "
+           "%lld surface triangles), %zu boundary triangles on %zu faces (%.3f s)", nn, nt,
+           hd.estimate, (long long)hd.n_surface, nb, nodes_of.size(), o.seconds);
     return CM_OK;
 }

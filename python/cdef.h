@@ -167,6 +167,8 @@ cm_status cm_cad_face_solid(cm_context *ctx, const cm_cad_model *model, int face
 int *solid);
 cm_status cm_cad_solid_at(cm_context *ctx, const cm_cad_model *model, const double *xyz,
 int *solid);
+cm_status cm_cad_face_tolerances(cm_context *ctx, const cm_cad_model *model, double *tol,
+double *largest);
 typedef struct cm_cad_correspondence {
 cm_cad_counts counts;
 int *face;
@@ -1327,6 +1329,8 @@ int optimize;
 double max_tets;
 double time_limit;
 int mesher;
+int fallback;
+double min_sj;
 } cm_tetmesh_options;
 enum { CM_MESHER_TETGEN = 0, CM_MESHER_GMSH = 1 };
 void cm_tetmesh_options_init(cm_tetmesh_options *opt);

@@ -143,6 +143,13 @@ CM_API cm_status cm_cad_face_solid(cm_context *ctx, const cm_cad_model *model, i
 CM_API cm_status cm_cad_solid_at(cm_context *ctx, const cm_cad_model *model, const double *xyz,
                                  int *solid);
 
+/* The model's own tolerance around each face (BRep_Tool::Tolerance): tol[f], #faces doubles,
+ * the largest of face f's tolerance and those of its edges and vertices, i.e. how far a point
+ * of the face's boundary as one entity places it may be from the face's surface; *largest
+ * (when not NULL) the largest over the model. In model units. */
+CM_API cm_status cm_cad_face_tolerances(cm_context *ctx, const cm_cad_model *model, double *tol,
+                                        double *largest);
+
 /* ---- correspondence of G and G' ---- */
 
 /* The correspondence of the topology of G and G' as graphs: solids, shells, faces, wires,

@@ -29,12 +29,16 @@ typedef struct cm_tetmesh_options {
     /* 1 (default): the interior nodes are then optimised (optimize.h) to lift TetGen's
      * slivers; boundary nodes stay where they are. */
     int optimize;
-    /* Refused (CM_ERR_NOMEM, with the estimate) when the tets expected from the model's volume
-     * and `size` exceed this; <= 0: CM_TETMESH_MAX_TETS. INFINITY lifts the limit. */
+    /* Refused (CM_ERR_NOMEM, with the estimate) when the tets expected exceed this; <= 0:
+     * CM_TETMESH_MAX_TETS. INFINITY lifts the limit. The estimate comes from OpenCASCADE's
+     * surface triangulation at `size` (what TetGen fills; a proxy of gmsh's surface mesh):
+     * its enclosed volume over the volume bound plus a layer of tets per boundary triangle
+     * (benchmarks/RESULTS.md, Meshers: within 3x of the real count on the measured parts). */
     double max_tets;
-    /* Seconds of wall time one mesher run may take (it runs in a child process, killed at
-     * the limit: CM_ERR_UNSUPPORTED "... did not finish in N s"); <= 0:
-     * CM_TETMESH_TIME_LIMIT, INFINITY: none. */
+    /* Seconds of wall time the meshing may take (each mesher runs in a child process, killed
+     * at its limit: CM_ERR_UNSUPPORTED "... did not finish in N s"); <= 0:
+     * CM_TETMESH_TIME_LIMIT, INFINITY: none. With a fallback, the first mesher gets
+     * CM_TETMESH_FIRST_SHARE of it and the second what is left. */
     double time_limit;
     /* CM_MESHER_TETGEN (the library's default, which keeps the study sweeps' meshes as
      * recorded) or CM_MESHER_GMSH (`cadmorph mesh`'s default: gmsh's library, opened at run
@@ -43,12 +47,32 @@ typedef struct cm_tetmesh_options {
      * surfaces are mapped to the CAD faces by projection, so the boundary triangles carry
      * the same face tags either way. */
     int mesher;
+    /* 1 (default): when `mesher` fails (refuses, crashes, runs out of its time, or its mesh
+     * stays below min_sj after the optimisation), the other mesher is tried, and its success
+     * logs one warning naming why the first one failed; the error, when both fail, names
+     * both reasons. 0: `mesher` only. */
+    int fallback;
+    /* The quality judgement of the result (after the optimisation), as a morph's (morph.h):
+     * the mesh is accepted when every tet's scaled Jacobian is above min_sj and, for
+     * min_sj >= 0, none is flat (below CM_TETMESH_FLAT_SJ); else CM_ERR_REJECTED naming the
+     * worst tet and its scaled Jacobian (after the fallback, if any). Default 0: no inverted
+     * or flat tet. < -1 (e.g. -INFINITY): no judgement. */
+    double min_sj;
 } cm_tetmesh_options;
 
 enum { CM_MESHER_TETGEN = 0, CM_MESHER_GMSH = 1 };
 
 /* Default time limit of one mesher run, seconds: a 1e7-tet mesh takes TetGen a few minutes. */
 #define CM_TETMESH_TIME_LIMIT 600.0
+
+/* Share of the time limit the first mesher gets when the other may follow: the rest is
+ * the fallback's (TetGen's -Y fallback on a 313-face plate takes seconds where gmsh took
+ * more than 600 s: benchmarks/RESULTS.md, Meshers). */
+#define CM_TETMESH_FIRST_SHARE 0.5
+
+/* Scaled Jacobian below which a tet counts as flat (a millionth as high as it is wide):
+ * what TetGen's -Y leaves on surfaces it cannot refine, which no solver takes. */
+#define CM_TETMESH_FLAT_SJ 1e-6
 
 /* Default bound on the estimated tet count: ~3 GB in TetGen and the mesh, minutes of work. */
 #define CM_TETMESH_MAX_TETS 1e7
@@ -59,7 +83,10 @@ CM_API void cm_tetmesh_options_init(cm_tetmesh_options *opt);
  * group "solid") and the boundary triangles, outward, each with physical and entity tag
  * face + 1 of the CAD face it lies on (groups "face_<k>", k 0-based as in cad.h).
  * The mesher runs in a child process: its crash, abort (TetGen 1.5.0 on some valid
- * surfaces) or hang is a status, never a signal. When TetGen fails, cadmorph tries again with
+ * surfaces) or hang is a status, never a signal. gmsh's mesh is accepted when every boundary
+ * node lies on its CAD face within the model's own tolerance (cm_cad_face_tolerances: 4 x
+ * the face's, at least 1e-7 x diagonal); its boundary nodes are then projected onto the
+ * faces and edges, as TetGen's added nodes are, so the mesh lies on this model. When TetGen fails, cadmorph tries again with
  * the surface kept (-Y), a looser quality bound (q 2, no dihedral bound) and a surface
  * perturbed by 1e-6 x size (its nodes put back after); success after a retry logs a warning
  * naming what worked, failure names everything tried. A timeout is not retried.
@@ -71,7 +98,8 @@ CM_API void cm_tetmesh_options_init(cm_tetmesh_options *opt);
  * or whose surface triangulation intersects itself (TetGen's -d check, run first because
  * TetGen's own error path crashes), CM_ERR_NOMEM beyond max_tets, CM_ERR_CAD for a surface triangulation failure,
  * CM_ERR_NUMERIC with TetGen's code and its meaning, or its crash, when every retry failed,
- * CM_ERR_UNSUPPORTED at the time limit, CM_ERR_NOMEM. What the mesher prints goes into the
+ * CM_ERR_UNSUPPORTED at the time limit, CM_ERR_NOMEM, CM_ERR_REJECTED below min_sj; with
+ * the fallback, the status of the first mesher's failure and a message naming both. What the mesher prints goes into the
  * message's tail, never to stdout. Not thread-safe on one model. */
 CM_API cm_status cm_tetmesh_create(cm_context *ctx, const cm_cad_model *model,
                             const cm_tetmesh_options *opt, cm_mesh **mesh);

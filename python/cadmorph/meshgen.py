@@ -32,18 +32,23 @@ def mesh_step(geometry: Geometry, size: Optional[float] = None, mesher: Optional
     TetGen's radius-edge bound; min_dihedral (0..20 degrees, default 12); preserve_surface:
     keep OpenCASCADE's surface triangulation (TetGen -Y). optimize: optimise the interior
     nodes after meshing (default True). force: lift the 1e7-tet limit. time_limit: seconds
-    one mesher run may take (default 600).
+    the meshing may take (default 600). With mesher None, when the first mesher fails (or its
+    mesh has an inverted or flat tet after the optimisation) the other one is tried, with a
+    warning; an explicit mesher is that mesher only.
 
     gmsh reads the geometry's STEP file; a Geometry whose file is gone is written to a
     temporary STEP file and read back for it (what the CLI's input goes through).
     Raises BadInputError when the mesher fails (the message says what was tried),
-    ResourceError beyond the tet limit.
+    RejectedError when its mesh keeps an inverted or flat tet, ResourceError beyond the tet
+    limit.
     """
     what = "cadmorph.mesh_step"
     model = model_of(what, "geometry", geometry)
     opt = ffi.new("cm_tetmesh_options *")
     lib.cm_tetmesh_options_init(opt)
     tetgen_options = quality is not None or min_dihedral is not None or bool(preserve_surface)
+    # as the CLI: an explicit mesher is that mesher only, without it the other one follows
+    opt.fallback = 1 if mesher is None else 0
     if mesher is None:
         mesher = "tetgen" if tetgen_options else "gmsh"
     mesher = choice(what, "mesher", mesher, tuple(_MESHERS))

@@ -279,6 +279,27 @@ static bool write_assemblies(const std::string &dir)
            write_step(compound({big, a}), dir + "/asm_nested.step");
 }
 
+// A box whose vertices sit 3e-4 to 5e-4 off the corners where its edge lines meet, edges and
+// vertices of tolerance 1e-3 (as a CAD system's export leaves them; the STEP reader sets the
+// tolerances back from the gaps): a mesher that reads the file by itself (gmsh) puts its corner
+// nodes on the vertex points, off our faces by up to the model's tolerance.
+static TopoDS_Shape loose_box()
+{
+    TopoDS_Shape box = BRepBuilderAPI_Copy(BRepPrimAPI_MakeBox(gp_Pnt(0, 0, 0), 3, 4, 2).Shape()).Shape();
+    BRep_Builder b;
+    TopTools_IndexedMapOfShape vs, es;
+    TopExp::MapShapes(box, TopAbs_VERTEX, vs);
+    TopExp::MapShapes(box, TopAbs_EDGE, es);
+    for (int i = 1; i <= es.Extent(); ++i) b.UpdateEdge(TopoDS::Edge(es(i)), 1e-3);
+    for (int i = 1; i <= vs.Extent(); ++i) {
+        const TopoDS_Vertex &v = TopoDS::Vertex(vs(i));
+        const gp_Pnt p = BRep_Tool::Pnt(v);
+        const double d = 3e-4;
+        b.UpdateVertex(v, gp_Pnt(p.X() + (i % 2 ? d : -d), p.Y() + (i % 3 ? d : -d), p.Z() + d * ((i % 5) - 2) / 2), 1e-3);
+    }
+    return box;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -346,7 +367,8 @@ int main(int argc, char **argv)
                      {"spindle", spindle_part()},
                      {"loose_bspline", loose_bspline_face(bs)},
                      {"row_a", hole_row(6, 1.0)},
-                     {"row_b", hole_row(6, 2.5)}};
+                     {"row_b", hole_row(6, 2.5)},
+                     {"loose_box", loose_box()}};
         for (auto &p : pairs)
             if (!write_step(p.s, dir + "/" + p.name + ".step")) {
                 fprintf(stderr, "gen_shapes: cannot write %s\n", p.name);

@@ -18,3 +18,27 @@ foreach(_case two_boxes box_cylinder stack overlap nested tetgen_touching morph_
     ${CM_TEST_WORK}/assembly_${_case} ${_case})
   set_tests_properties(meshgen_assembly_${_case} PROPERTIES LABELS "unit;cli;cad" TIMEOUT 120)
 endforeach()
+# real files and what goes wrong with them: gmsh judged by the model's own tolerances (the
+# OpenCASCADE repository's screw, gen_shapes' loose box), the fallback to the other mesher,
+# the quality judgement, the estimate within 3x (docs/DESIGN.md, "Meshers")
+cm_add_unit_test(test_tetmesh_real test_tetmesh_real.c LIBS cm_meshgen cm_cad cm_mesh LABELS cad)
+set_tests_properties(test_tetmesh_real PROPERTIES FIXTURES_REQUIRED cad_shapes)
+# `cadmorph mesh` with its defaults on the screw: gmsh meshes it, nothing on stderr
+set(CM_MESHGEN_WORK ${CM_TEST_WORK}/meshgen)
+file(MAKE_DIRECTORY ${CM_MESHGEN_WORK})
+add_test(NAME cli_mesh_screw_defaults COMMAND ${CM_RUN_CLI} --exit 0 --stderr-lines 0 --last-line
+  "min_scaled_jacobian=0\\.[0-9]+ mean_scaled_jacobian=0\\.[0-9]+ inverted=0 cells=[0-9]+" --
+  $<TARGET_FILE:cadmorph> mesh ${CM_TEST_DATA}/occt/screw.step -o ${CM_MESHGEN_WORK}/screw.vtu)
+add_test(NAME cli_mesh_loose_box_gmsh COMMAND ${CM_RUN_CLI} --exit 0 --stderr-lines 0 --last-line
+  ".* inverted=0 cells=[0-9]+" --
+  $<TARGET_FILE:cadmorph> mesh ${CM_TEST_WORK}/cad/loose_box.step -o ${CM_MESHGEN_WORK}/loose_box.vtu
+  --mesher gmsh)
+set_tests_properties(cli_mesh_loose_box_gmsh PROPERTIES FIXTURES_REQUIRED cad_shapes)
+# a mesh below --min-sj is not written: exit 3, one line naming the worst tet
+add_test(NAME cli_mesh_min_sj_rejected COMMAND ${CM_RUN_CLI} --exit 3 --stderr-lines 1
+  --stderr "cadmorph mesh: [^\n]*bore_0.step: TetGen.s mesh has [0-9]+ tets? at or below the scaled-Jacobian floor 0.99[^\n]*the worst, tet [0-9]+"
+  --absent ${CM_MESHGEN_WORK}/rejected.vtu --
+  $<TARGET_FILE:cadmorph> mesh ${CM_TEST_DATA}/models/bore_0.step -o ${CM_MESHGEN_WORK}/rejected.vtu
+  --size 0.8 --mesher tetgen --min-sj 0.99)
+set_tests_properties(cli_mesh_screw_defaults cli_mesh_loose_box_gmsh cli_mesh_min_sj_rejected
+  PROPERTIES LABELS "unit;cli;cad")
