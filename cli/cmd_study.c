@@ -94,7 +94,7 @@ static const cli_option options[] = {
      .help = "each morph's steps, as in morph: adaptive (auto, the default)\n"
              "or K equal increments (1: the plain one-step morph); a variant\n"
              "whose morph reaches no valid mesh is a row with its error (status\n"
-             "rejected), its mesh not written"},
+             "\"result rejected\"), its mesh not written"},
     {.name = "--allow-inverted", .kind = CLI_FLAG, .dest = &args.allow_inverted,
      .label = "--allow-inverted",
      .help = "keep results with inverted cells (rows with their count, meshes\n"

@@ -262,8 +262,7 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
         mp->fixed[mp->b->nodes[i]] = 1;
     cm_quality_stats q0;
     if (cm_mesh_quality(ctx, mp->work, mp->sj) >= 0 &&
-        cm_quality_summarize(ctx, mp->work, mp->sj, NULL, &q0) >= 0)
-    {
+        cm_quality_summarize(ctx, mp->work, mp->sj, NULL, &q0) >= 0) {
         mp->min_sj0 = q0.min;
         mp->inverted0 = q0.inverted;
     }

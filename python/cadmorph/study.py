@@ -193,9 +193,9 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     "rbf-s", the CLI's default. mode: "absolute" (default), "relative" or "both". steps:
     "auto" (default: adaptive steps, as Morpher) or increments of each morph (1..1000; 1:
     the plain one-step morph). A morph that reaches no valid mesh is a row with status
-    "rejected" and its message, and no mesh; allow_inverted=True keeps such results (rows
-    with their inverted cells, meshes written). optimize: interior optimisation after each
-    step. write_meshes: "none" (default here; the CLI's is "all"), "all" or "failed"; the
+    CM_ERR_REJECTED ("result rejected") and its message, and no mesh; allow_inverted=True
+    keeps such results (rows with their inverted cells, meshes written). optimize: interior
+    optimisation after each step. write_meshes: "none" (default here; the CLI's is "all"), "all" or "failed"; the
     meshes go to out_dir (created if missing) as <method>_<mode>_<label>.vtu. model_name,
     mesh_name: the CSV's model and mesh columns (default: g0's file name and "file").
 

@@ -78,6 +78,17 @@ add_test(NAME cad_cli_freecad_shoulder_no_escalate COMMAND ${CM_RUN_CLI} --exit 
          --threads 1)
 set_tests_properties(cad_cli_freecad_shoulder_no_escalate PROPERTIES LABELS "cad;cli"
                      FIXTURES_REQUIRED "cad_freecad_mesh;cad_freecad_guard")
+# --allow-inverted with adaptive steps: where no step is valid the rest goes in one step,
+# written with its inverted cells and both warnings (why, and which cells)
+add_test(NAME cad_cli_freecad_shoulder_auto_allowed COMMAND ${CM_RUN_CLI} --exit 0
+         --stderr "no step is valid; inverted cells are allowed, so the rest was morphed in one step \([1-9][0-9]* inverted"
+         --stderr "warning: [1-9][0-9]* inverted cells? \(scaled Jacobian <= 0\); the worst is cell"
+         --stdout "inverted=[1-9][0-9]* cells=" --
+         $<TARGET_FILE:cadmorph> morph --from ${FC_DATA}/bracket_0.step --to ${FC_DATA}/bracket_2.step
+         --mesh ${FC_WORK}/bracket_0.msh -o ${FC_WORK}/bracket_2_na.vtu --no-escalate
+         --allow-inverted --threads 1)
+set_tests_properties(cad_cli_freecad_shoulder_auto_allowed PROPERTIES LABELS "cad;cli"
+                     FIXTURES_REQUIRED cad_freecad_mesh)
 add_test(NAME cad_cli_freecad_shoulder_optimize COMMAND ${CM_RUN_CLI} --exit 0 --stdout "inverted=0 cells=[1-9]" --
          $<TARGET_FILE:cadmorph> morph --from ${FC_DATA}/bracket_0.step --to ${FC_DATA}/bracket_2.step
          --mesh ${FC_WORK}/bracket_0.msh -o ${FC_WORK}/bracket_2_o.vtu --steps auto --optimize
