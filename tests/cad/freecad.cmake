@@ -81,8 +81,8 @@ set_tests_properties(cad_cli_freecad_shoulder_no_escalate PROPERTIES LABELS "cad
 # --allow-inverted with adaptive steps: where no step is valid the rest goes in one step,
 # written with its inverted cells and both warnings (why, and which cells)
 add_test(NAME cad_cli_freecad_shoulder_auto_allowed COMMAND ${CM_RUN_CLI} --exit 0
-         --stderr "no step is valid; inverted cells are allowed, so the rest was morphed in one step \([1-9][0-9]* inverted"
-         --stderr "warning: [1-9][0-9]* inverted cells? \(scaled Jacobian <= 0\); the worst is cell"
+         --stderr "no step is valid; inverted cells are allowed, so the rest was morphed in one step [(][1-9][0-9]* inverted"
+         --stderr "warning: [1-9][0-9]* inverted cells? \\(scaled Jacobian <= 0\\); the worst is cell"
          --stdout "inverted=[1-9][0-9]* cells=" --
          $<TARGET_FILE:cadmorph> morph --from ${FC_DATA}/bracket_0.step --to ${FC_DATA}/bracket_2.step
          --mesh ${FC_WORK}/bracket_0.msh -o ${FC_WORK}/bracket_2_na.vtu --no-escalate
