@@ -22,6 +22,7 @@ echo "== CAD layer";           "$build/benchmarks/cad/bench_cad" "$root/tests/da
 echo "== models, tet meshes";  sh "$here/models/bench_models.sh" "$build" "$work/models"
 echo "== sweeps (20 steps, all models)"; sh "$here/sweep/run_sweeps.sh" "$build" "$work/sweeps" 2
 echo "== study: 20 bore variants vs one"; sh "$here/study/bench_study.sh" "$build" "$work/study" 2
+echo "== the guarded morph against --steps 1"; sh "$here/morph_guard/run.sh" "$build" "$work/morph_guard" 5
 echo "== warp methods side by side"; sh "$here/warp/bench_warp.sh" "$build" "$work/warp" 2
 echo "== gradients: the warps' reverse product against one apply"; sh "$here/gradients/bench_warp_vjp.sh" "$build" "$work/gradients" 2
 echo "== warp methods in the sweeps"; sh "$here/warp/bench_warp_sweep.sh" "$build" "$work/wsweep" 2

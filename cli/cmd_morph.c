@@ -12,11 +12,11 @@
 #include <string.h>
 
 static const char *const usage_line =
-    "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps K] "
+    "cadmorph morph --from G0.step --to G1.step --mesh M0 -o M1 [--steps auto|K] "
     "[--relative --via Ga.step,Gb.step,...] [--surface rbf|project] [--method M] [--solver S] [--rbf-tol T] "
     "[--lattice N [--clamp E]] [--samples K --cubature N --cover S --stretch GS --bend GB --blend B] "
-    "[--steps auto [--min-sj F] [--keep-partial] [--no-escalate]] [--optimize] [--report R.csv] "
-    "[--fail-on-inverted] [--cad-unit U] [--cad-tol F [--keep-offset]] "
+    "[--min-sj F] [--min-step F] [--no-escalate] [--keep-partial | --allow-inverted] [--optimize] "
+    "[--report R.csv] [--cad-unit U] [--cad-tol F [--keep-offset]] "
     "[--off-cad refuse|fixed [--slide P,..] [--fixed-patches P,..] [--no-slide]] "
     "[--threads N] [--verbose]";
 
@@ -25,7 +25,7 @@ static const char *const usage_line =
 typedef struct morph_args {
     const char *from, *to, *mesh, *out, *report, *unit;
     cm_morph_options opt;
-    int fail_on_inverted, threads, verbose, relative, keep_partial, no_escalate;
+    int fail_on_inverted, allow_inverted, threads, verbose, relative, keep_partial, no_escalate;
     char via_list[8192]; /* --via, split in place at the commas */
     const char *via[MORPH_MAX_VIA];
     size_t n_via;
@@ -92,23 +92,27 @@ static const cli_option options[] = {
     {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.out,
      .label = "-o, --output M1", .help = "output mesh (must not be an input)"},
     {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_steps,
-     .dest = &args.opt.steps, .label = "--steps K",
-     .help = "split the boundary motion into K equal increments (default 1);\n"
-             "each increment after the first refits the warp on the last mesh"},
-    {.name = "--steps", .kind = CLI_NOTE, .label = "--steps auto",
-     .help = "adaptive steps: the whole motion first, halved on failure and\n"
-             "refitted on the last valid mesh, doubled after easy steps,\n"
-             "until every cell keeps a scaled Jacobian above --min-sj"},
+     .dest = &args.opt.steps, .label = "--steps auto",
+     .help = "adaptive steps (the default): the whole motion first (a valid\n"
+             "one-step morph costs what --steps 1 costs), halved on failure\n"
+             "and refitted on the last valid mesh, doubled after easy steps,\n"
+             "until the mesh is valid (no inverted cell, --min-sj)"},
+    {.name = "--steps", .kind = CLI_NOTE, .label = "--steps K",
+     .help = "split the boundary motion into K equal increments (--steps 1:\n"
+             "the plain one-step morph of the papers); each increment after\n"
+             "the first refits the warp on the last mesh; an increment that\n"
+             "is not valid ends the morph (exit 3) unless --allow-inverted"},
     {.name = "--min-sj", .kind = CLI_DOUBLE, .dest = &args.opt.min_sj, .lo = -1, .hi = 1,
      .open = 2, .bad = "%s: expected a number in [-1, 1), got '%s'", .label = "--min-sj F",
-     .help = "floor of --steps auto (default 0: no inverted cell)"},
+     .help = "a valid mesh keeps every scaled Jacobian above F when F > 0\n"
+             "(default 0: no inverted cell)"},
     {.name = "--min-step", .kind = CLI_DOUBLE, .dest = &args.opt.min_fraction, .lo = 0, .hi = 1,
      .open = 3, .bad = "%s: expected a number in (0, 1), got '%s'", .label = "--min-step F",
      .help = "smallest adaptive step, a fraction of the motion (default 1/256)"},
     {.name = "--keep-partial", .kind = CLI_FLAG, .dest = &args.keep_partial,
      .label = "--keep-partial",
-     .help = "when --steps auto finds no valid step, still write the last\n"
-             "valid mesh (and the report) before exiting 3"},
+     .help = "when no valid mesh is reached, still write the last valid\n"
+             "mesh (and the report) before exiting 3"},
     {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.opt.optimize, .label = "--optimize",
      .help = "optimise the interior nodes after every step (boundary nodes\n"
              "stay on G1): untangles and raises the worst cells"},
@@ -149,8 +153,15 @@ static const cli_option options[] = {
     CLI_MLS_OPTIONS(args.opt.method.warp.mls),
     {.name = "--report", .kind = CLI_STRING, .dest = &args.report, .label = "--report R.csv",
      .help = "one row per step: quality, distance to G1, stage times"},
+    {.name = "--allow-inverted", .kind = CLI_FLAG, .dest = &args.allow_inverted,
+     .label = "--allow-inverted",
+     .help = "write M1 even with inverted cells (exit 0, a warning naming\n"
+             "them): --steps K runs to the end, --steps auto morphs the rest\n"
+             "of the motion in one step when no step is valid"},
     {.name = "--fail-on-inverted", .kind = CLI_FLAG, .dest = &args.fail_on_inverted,
-     .label = "--fail-on-inverted", .help = "exit 3 without writing M1 if a cell is inverted"},
+     .label = "--fail-on-inverted",
+     .help = "the default (exit 3, M1 not written, when a cell is inverted);\n"
+             "accepted for scripts that say so"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &args.unit, .label = "--cad-unit U",
      .help = "unit of the mesh coordinates: the STEP files are converted to\n"
              "it (mm default; cm m in ft um ...)"},
@@ -193,9 +204,10 @@ static int print_help(void)
         cm_mesh_format_list());
     cli_print_options(stdout, options, 21);
     printf("\n" CLI_PATCH_MOTION_OFF_CAD);
-    printf("\nexit codes: 0 done, 1 usage, 2 bad input (unreadable file, G0 and G1 that do not\n"
-           "correspond, a mesh that is not on G0), 3 inverted cells with --fail-on-inverted or no\n"
-           "valid adaptive step (the message names the worst cells).\n");
+    printf("\nexit codes: 0 done (a valid M1, or one with inverted cells and --allow-inverted),\n"
+           "1 usage, 2 bad input (unreadable file, G0 and G1 that do not correspond, a mesh that\n"
+           "is not on G0), 3 no valid mesh reached (the message names the worst cells; M1 not\n"
+           "written unless --keep-partial, the report written with the rejected rows).\n");
     return CLI_EXIT_OK;
 }
 
@@ -209,6 +221,7 @@ static int parse_args(int argc, char **argv, morph_args *a)
     const int parsed = cli_parse(&p, argc, argv);
     if (args.unit) args.opt.cad_unit = args.unit;
     if (args.no_escalate) args.opt.escalate = 0;
+    if (args.allow_inverted) args.opt.allow_inverted = 1;
     /* the names stay in the static args, so a's copy may point at them */
     cli_patch_motion_options(&args.patches, &args.opt.motion);
     *a = args;
@@ -220,8 +233,12 @@ static int parse_args(int argc, char **argv, morph_args *a)
     if (!a->mesh) return cli_usage(cmd, usage_line, "--mesh is required");
     if (!a->out) return cli_usage(cmd, usage_line, "-o is required");
     if (cli_check_solver(cmd, usage_line, a->opt.method.warp.solver) >= 0) return CLI_EXIT_USAGE;
-    if (a->keep_partial && a->opt.steps != CM_MORPH_STEPS_AUTO)
-        return cli_usage(cmd, usage_line, "--keep-partial goes with --steps auto");
+    if (a->keep_partial && a->allow_inverted)
+        return cli_usage(cmd, usage_line,
+                         "--keep-partial (the last valid mesh) and --allow-inverted (the final "
+                         "mesh, inverted cells and all): one or the other");
+    if (a->fail_on_inverted && a->allow_inverted)
+        return cli_usage(cmd, usage_line, "--fail-on-inverted and --allow-inverted contradict");
     if ((a->patches.n[0] || a->patches.n[1] || a->patches.all_fixed) &&
         a->opt.off_cad != CM_OFF_CAD_FIXED)
         return cli_usage(cmd, usage_line,
@@ -328,7 +345,7 @@ int cli_cmd_morph(int argc, char **argv)
         cm_context_destroy(&ctx);
         return rc;
     }
-    /* a rejected adaptive morph: the report, and with --keep-partial the last valid mesh */
+    /* no valid mesh reached: the report, and with --keep-partial the last valid mesh */
     int partial = s == CM_ERR_REJECTED;
     if (partial) rc = cli_fail(ctx, "morph", s);
     /* warnings were logged as they happened; the mesh is that of the last accepted step */
@@ -342,7 +359,8 @@ int cli_cmd_morph(int argc, char **argv)
            r->counts[0], r->counts[1], r->counts[2], r->max_dist,
            r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
     if (!partial) rc = CLI_EXIT_OK;
-    if (!partial && a.fail_on_inverted && last->inverted > 0) {
+    /* the library's guard returns valid meshes only; this is the writer's own check */
+    if (!partial && !a.allow_inverted && last->inverted > 0) {
         fprintf(stderr,
                 "cadmorph morph: %zu inverted cells (min scaled Jacobian %.6g); %s not written\n",
                 last->inverted, last->min_sj, a.out);
@@ -350,7 +368,18 @@ int cli_cmd_morph(int argc, char **argv)
     }
     /* under mpirun (--solver petsc) every rank has the result; rank 0 writes it */
     const int writer = cli_output_rank();
-    const int want_mesh = writer && (rc == CLI_EXIT_OK || (partial && a.keep_partial));
+    int keep = partial && a.keep_partial;
+    if (keep && writer) {
+        /* the last valid mesh is M0 itself when the first step failed: not valid when M0 is not */
+        cm_quality_stats q;
+        if (cm_quality_summarize(ctx, r->mesh, r->sj, NULL, &q) >= 0 && q.inverted > 0) {
+            fprintf(stderr, "cadmorph morph: --keep-partial: the last valid mesh would be %s "
+                    "itself, which has %zu inverted cells; %s not written\n", a.mesh,
+                    q.inverted, a.out);
+            keep = 0;
+        }
+    }
+    const int want_mesh = writer && (rc == CLI_EXIT_OK || keep);
     const int want_report = writer && a.report && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED);
     if (want_mesh || want_report) rc = write_outputs(ctx, &a, r, want_mesh, want_report, rc);
     if (writer && (rc == CLI_EXIT_OK || rc == CLI_EXIT_REJECTED)) {
@@ -365,7 +394,7 @@ int cli_cmd_morph(int argc, char **argv)
                r->diagonal > 0 ? r->max_dist / r->diagonal : 0.0);
         s = cli_print_quality(ctx, r->mesh, r->sj, stdout, NULL);
         if (s < 0 && rc == CLI_EXIT_OK) rc = cli_fail(ctx, "morph", s);
-        /* --fail-on-inverted said so already */
+        /* a rejected result said so already */
         if (s >= 0 && rc == CLI_EXIT_OK) cli_warn_inverted("morph", r->mesh, r->sj);
     }
     cm_morph_result_destroy(&r);

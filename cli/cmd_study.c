@@ -14,14 +14,15 @@
 static const char *const usage_line =
     "cadmorph study --from G0.step --mesh M0 --variants LIST -o DIR "
     "[--mode absolute|relative|both] [--methods LIST] [--write-meshes none|all|failed] "
-    "[--steps K|auto] [--optimize] [--cad-unit U] [--off-cad refuse|fixed [--slide P,..] "
+    "[--steps auto|K] [--allow-inverted] [--optimize] [--cad-unit U] "
+    "[--off-cad refuse|fixed [--slide P,..] "
     "[--fixed-patches P,..] [--no-slide]] [--threads N] [--verbose]";
 
 enum { MAX_METHODS = 16 };
 
 typedef struct study_args {
     const char *from, *mesh, *variants, *out, *unit, *methods;
-    int modes, write_meshes, threads, verbose, steps, optimize, off_cad;
+    int modes, write_meshes, threads, verbose, steps, optimize, off_cad, allow_inverted;
     cli_patch_motion patches; /* the motion of the nodes off G0 */
     int rank, ranks; /* under mpirun (cli_mpi_ranks) */
     cm_study_method list[MAX_METHODS];
@@ -86,12 +87,18 @@ static const cli_option options[] = {
     {.name = "--write-meshes", .kind = CLI_ENUM, .dest = &args.write_meshes,
      .names = write_names, .values = write_values, .bad = "%s: none, all or failed, got '%s'",
      .label = "--write-meshes W",
-     .help = "none, all (default) or failed (results with inverted cells)"},
+     .help = "none, all (default) or failed (results with inverted cells:\n"
+             "with --allow-inverted)"},
     {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_steps,
-     .dest = &args.steps, .label = "--steps K|auto",
-     .help = "increments of each morph (default 1), or adaptive steps as\n"
-             "in morph --steps auto (a variant without a valid step is a row\n"
-             "with its error)"},
+     .dest = &args.steps, .label = "--steps auto|K",
+     .help = "each morph's steps, as in morph: adaptive (auto, the default)\n"
+             "or K equal increments (1: the plain one-step morph); a variant\n"
+             "whose morph reaches no valid mesh is a row with its error (status\n"
+             "\"result rejected\"), its mesh not written"},
+    {.name = "--allow-inverted", .kind = CLI_FLAG, .dest = &args.allow_inverted,
+     .label = "--allow-inverted",
+     .help = "keep results with inverted cells (rows with their count, meshes\n"
+             "written), as morph --allow-inverted"},
     {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.optimize, .label = "--optimize",
      .help = "interior optimisation after each morph step"},
     {.name = "--cad-unit", .kind = CLI_STRING, .dest = &args.unit, .label = "--cad-unit U",
@@ -129,9 +136,11 @@ static int print_help(void)
     printf("\n" CLI_PATCH_MOTION_OFF_CAD
            "Every variant shares the factorisations of the two warp passes.\n");
     printf("\nProgress (on a terminal): the variant count and an estimate of the time left.\n"
-           "exit codes: 0 done (failed variants are warnings on stderr and rows in study.csv),\n"
-           "1 usage, 2 bad input (G0, M0 or the list: one line naming the file), 4 internal "
-           "error.\n");
+           "exit codes: 0 every row done, 1 usage, 2 bad input (G0, M0 or the list: one line\n"
+           "naming the file), 3 some rows failed (a variant that cannot be read or does not\n"
+           "match G0, a morph that reached no valid mesh): the study ran to the end, each\n"
+           "failure a warning on stderr and a row with its status and message in study.csv,\n"
+           "the other rows' meshes written; 4 internal error.\n");
     return CLI_EXIT_OK;
 }
 
@@ -142,7 +151,7 @@ static int parse_args(int argc, char **argv, study_args *a)
     memset(&args, 0, sizeof args);
     args.modes = CM_STUDY_ABSOLUTE;
     args.write_meshes = CM_STUDY_WRITE_ALL;
-    args.steps = 1;
+    args.steps = CM_MORPH_STEPS_AUTO;
     args.methods = "rbf-s";
     cli_parser p = {.cmd = cmd, .usage = usage_line, .options = options, .help = print_help,
                     .unknown = "unknown argument '%s'"};
@@ -246,6 +255,7 @@ static int run(cm_context *ctx, const study_args *a)
             if (a->unit) so.morph.cad_unit = a->unit;
             so.morph.steps = a->steps;
             so.morph.optimize = a->optimize;
+            so.morph.allow_inverted = a->allow_inverted;
             so.morph.off_cad = (cm_off_cad)a->off_cad;
             cli_patch_motion_options(&args.patches, &so.morph.motion);
             so.rank = a->rank;
@@ -270,6 +280,13 @@ static int run(cm_context *ctx, const study_args *a)
         if (s >= 0 && od.tmp) s = cm_outdir_merge(ctx, &od, a->out, inputs, n_in);
         rc = s < 0 ? cli_fail(ctx, "study", s) : CLI_EXIT_OK;
         if (rc == CLI_EXIT_OK && a->rank == 0) print_summary(r);
+        /* failed rows were warnings as they happened: the exit code says so at the end */
+        if (rc == CLI_EXIT_OK && r->n_failed) {
+            if (a->rank == 0)
+                fprintf(stderr, "cadmorph study: %zu of %zu rows failed (status and message in "
+                        "%s/study.csv)\n", r->n_failed, r->n_rows, a->out);
+            rc = CLI_EXIT_REJECTED;
+        }
     }
     cm_outdir_abort(&od);
     free(inputs);

@@ -73,7 +73,11 @@ static const cli_option options[] = {
      .bad = "%s: expected 1..1000, got '%s'", .label = "--steps N",
      .help = "parameter steps (default 10)"},
     {.name = "--adaptive", .kind = CLI_FLAG, .dest = &args.opt.adaptive, .label = "--adaptive",
-     .help = "each morph with adaptive steps (as morph --steps auto)"},
+     .help = "each morph with adaptive steps (as morph --steps auto; a morph\n"
+             "that reaches no valid mesh is a failed row); default: the plain\n"
+             "one-step morph of the papers, inverted cells kept (as morph\n"
+             "--steps 1 --allow-inverted): where they appear is what a sweep\n"
+             "measures"},
     {.name = "--optimize", .kind = CLI_FLAG, .dest = &args.opt.optimize, .label = "--optimize",
      .help = "each morph with interior optimisation (as morph --optimize)"},
     {.name = "-o", .alias = "--output", .kind = CLI_STRING, .dest = &args.opt.out_dir,

@@ -20,8 +20,9 @@ void cm_morph_options_init(cm_morph_options *opt)
 {
     memset(opt, 0, sizeof *opt);
     cm_morph_method_init(&opt->method);
-    opt->steps = 1;
+    opt->steps = CM_MORPH_STEPS_AUTO;
     opt->min_sj = 0;
+    opt->allow_inverted = 0;
     opt->keep_fraction = 0;
     opt->min_fraction = 1.0 / 256;
     opt->optimize = 0;
@@ -266,8 +267,10 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
         mp->fixed[mp->b->nodes[i]] = 1;
     cm_quality_stats q0;
     if (cm_mesh_quality(ctx, mp->work, mp->sj) >= 0 &&
-        cm_quality_summarize(ctx, mp->work, mp->sj, NULL, &q0) >= 0)
+        cm_quality_summarize(ctx, mp->work, mp->sj, NULL, &q0) >= 0) {
         mp->min_sj0 = q0.min;
+        mp->inverted0 = q0.inverted;
+    }
     mp->info.nodes = nn;
     mp->info.cells = cm_mesh_count_dim(mp->mesh, 3);
     mp->info.boundary_nodes = mp->b->n_nodes; /* on G (nb) and off it */
@@ -554,7 +557,37 @@ static void worst_cells(const cm_morpher *mp, char *out, size_t size)
     }
 }
 
-/* K equal increments (opt.steps >= 1). */
+/* Whether a trial's mesh is valid (cm_morph_options): no inverted cell (the one definition,
+ * cm_mesh_invalid_cells, which an OpenFOAM mesh's valid cells of scaled Jacobian <= 0 pass)
+ * and, above a positive floor, every cell's scaled Jacobian. */
+static int valid(const cm_morph_step *row, double floor)
+{
+    return row->inverted == 0 && (floor <= 0 || row->min_sj > floor);
+}
+
+/* A rejected trial: its row says why (the worst cells). */
+static void reject(cm_morpher *mp, cm_morph_step *row, double floor)
+{
+    row->accepted = 0;
+    int w = row->inverted
+                ? snprintf(row->note, sizeof row->note, "%zu inverted: ", row->inverted)
+                : snprintf(row->note, sizeof row->note, "min SJ %.3g <= %.3g: ", row->min_sj,
+                           floor);
+    if (w > 0 && (size_t)w < sizeof row->note)
+        worst_cells(mp, row->note + w, sizeof row->note - (size_t)w);
+}
+
+/* "; M itself has N inverted cells ..." when it has: no morph of it can be valid. */
+static void start_note(const cm_morpher *mp, char *out, size_t size)
+{
+    out[0] = 0;
+    if (mp->inverted0)
+        snprintf(out, size, "; the mesh to morph has %zu inverted cells itself (allowing "
+                 "inverted cells, --allow-inverted, morphs it as it is)", mp->inverted0);
+}
+
+/* K equal increments (opt.steps >= 1); unless allow_inverted, the first increment that is
+ * not valid ends the morph (xyz: the increment before it). */
 static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
                              double *xyz)
 {
@@ -567,6 +600,23 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
         cm_status s =
             trial(ctx, mp, wo, (double)k / n, k == 1, mp->opt.optimize, xyz, mp->next, row);
         if (s < 0) return cm_error_prefix(ctx, s, "step %d of %d", k, n);
+        if (!mp->opt.allow_inverted && !valid(row, mp->opt.min_sj)) {
+            reject(mp, row, mp->opt.min_sj);
+            char many[1024], start[200];
+            worst_cells(mp, many, sizeof many);
+            start_note(mp, start, sizeof start);
+            const char *what = n == 1 ? "the one-step morph" : "this increment";
+            if (row->inverted)
+                return cm_error(ctx, CM_ERR_REJECTED,
+                                "step %d of %d: %s leaves %zu inverted cells (worst: %s); "
+                                "adaptive steps (--steps auto) may avoid them, --allow-inverted "
+                                "keeps them%s",
+                                k, n, what, row->inverted, many, start);
+            return cm_error(ctx, CM_ERR_REJECTED,
+                            "step %d of %d: %s leaves cells at or below scaled Jacobian %.3g "
+                            "(worst: %s); adaptive steps (--steps auto) may avoid them%s",
+                            k, n, what, mp->opt.min_sj, many, start);
+        }
         memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
     }
     return cm_progress(ctx, "morph", n, n);
@@ -591,7 +641,7 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
         double floor = o->min_sj;
         if (o->keep_fraction > 0 && step > min_step && o->keep_fraction * mp->min_sj0 > floor)
             floor = o->keep_fraction * mp->min_sj0;
-        if (row->min_sj > floor) {
+        if (valid(row, floor)) {
             memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
             done = f;
             if (++easy >= 2) { /* two easy steps in a row: try a longer one */
@@ -600,10 +650,7 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
             }
             continue;
         }
-        row->accepted = 0;
-        int w = snprintf(row->note, sizeof row->note, "min SJ %.3g <= %.3g: ", row->min_sj, floor);
-        if (w > 0 && (size_t)w < sizeof row->note)
-            worst_cells(mp, row->note + w, sizeof row->note - (size_t)w);
+        reject(mp, row, floor);
         easy = 0;
         step /= 2;
         if (step < min_step && !optimize && o->escalate) {
@@ -617,16 +664,44 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
             step = 1;
             continue;
         }
+        if (step < min_step && o->allow_inverted) {
+            /* asked for: the rest of the motion in one step, whatever its cells */
+            double from = done;
+            row = new_row(ctx, mp);
+            if (!row) return CM_ERR_NOMEM;
+            s = trial(ctx, mp, wo, 1, done == 0, optimize, xyz, mp->next, row);
+            if (s < 0) return cm_error_prefix(ctx, s, "step to 100 %%");
+            memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
+            snprintf(row->note, sizeof row->note, "inverted cells allowed");
+            p = cm_progress(ctx, "morph", 1, 1);
+            if (p < 0) return p;
+            cm_log(ctx, CM_LOG_WARNING,
+                   "morph: from %.4g %% of the motion no step is valid; inverted cells are "
+                   "allowed, so the rest was morphed in one step (%zu inverted cells, min "
+                   "scaled Jacobian %.3g)",
+                   100 * from, row->inverted, row->min_sj);
+            return cm_error(ctx, CM_WARNING,
+                            "morph: from %.4g %% of the motion no step is valid; inverted cells "
+                            "are allowed, so the rest was morphed in one step (%zu inverted "
+                            "cells, min scaled Jacobian %.3g)",
+                            100 * from, row->inverted, row->min_sj);
+        }
         if (step < min_step) {
-            char many[1024];
+            char many[1024], start[200];
             worst_cells(mp, many, sizeof many);
+            start_note(mp, start, sizeof start);
+            char what[64];
+            if (row->inverted)
+                snprintf(what, sizeof what, "%zu inverted cells", row->inverted);
+            else
+                snprintf(what, sizeof what, "cells at or below scaled Jacobian %.3g", floor);
             return cm_error(ctx, CM_ERR_REJECTED,
                             "no valid step: from %.4g %% of the motion even a step of %.3g %% "
-                            "leaves %zu cells at or below scaled Jacobian %.3g (worst: %s)%s",
-                            100 * done, 100 * 2 * step, row->inverted > 0 ? row->inverted : 1,
-                            floor, many,
+                            "leaves %s (worst: %s)%s%s",
+                            100 * done, 100 * 2 * step, what, many,
                             optimize ? (o->optimize ? "" : ", also with interior optimisation")
-                                     : "; interior optimisation (--optimize) may lift them");
+                                     : "; interior optimisation (--optimize) may lift them",
+                            start);
         }
     }
     return cm_progress(ctx, "morph", 1, 1);
@@ -660,6 +735,9 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     memcpy(out_xyz, mp->mesh->xyz, 3 * mp->mesh->n_nodes * sizeof *out_xyz);
     s = mp->opt.steps == CM_MORPH_STEPS_AUTO ? auto_steps(ctx, mp, &method->warp, out_xyz)
                                              : fixed_steps(ctx, mp, &method->warp, out_xyz);
+    /* allow_inverted finished an adaptive morph with inverted cells (logged already) */
+    if (s == CM_WARNING && !warning[0])
+        snprintf(warning, sizeof warning, "%s", cm_context_message(ctx));
     if (mp->n_rows) {
         mp->rows[0].t_sample += t_sample;
         mp->rows[0].t_surface += t_surface;

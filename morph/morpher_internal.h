@@ -44,6 +44,7 @@ struct cm_morpher {
      * one-pass warp with every boundary node held, as without patch kinds) */
     cm_boundary_motion *motion;
     double min_sj0;       /* M's minimum scaled Jacobian (keep_fraction) */
+    size_t inverted0;     /* M's inverted cells (named when no valid mesh is reached) */
     cm_morph_step *rows;  /* the last apply's steps */
     size_t n_rows, cap_rows;
     cm_surface_morph_stats surface;

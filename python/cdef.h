@@ -952,6 +952,7 @@ int steps;
 double min_sj;
 double keep_fraction;
 double min_fraction;
+int allow_inverted;
 int optimize;
 int escalate;
 cm_optimize_options optimize_options;

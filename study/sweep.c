@@ -115,7 +115,10 @@ cm_status cm_sweep_run(cm_context *ctx, const cm_sweep_options *opt, cm_study_re
         so.modes = opt->modes;
         so.methods = opt->methods;
         so.n_methods = opt->n_methods;
-        if (opt->adaptive) so.morph.steps = CM_MORPH_STEPS_AUTO;
+        /* the sweeps reproduce [SKM11]: the plain one-step morph, whose inverted cells are
+         * what they measure (rows and meshes keep them); adaptive: the guarded morph */
+        so.morph.steps = opt->adaptive ? CM_MORPH_STEPS_AUTO : 1;
+        so.morph.allow_inverted = !opt->adaptive;
         so.morph.optimize = opt->optimize;
         so.out_dir = opt->out_dir;
         so.model = opt->model;

@@ -171,7 +171,7 @@ for name, (val, d) in params.items():
     for sign in (1, -1):
         case = os.path.join(work, "M_%s%s" % (name, "p" if sign > 0 else "m"))
         out = run([cli, "morph", "--from", g0, "--to", perturbed[(name, sign)], "--mesh", base,
-                   "-o", case, "--threads", a.threads], what="cadmorph morph")
+                   "-o", case, "--steps", "1", "--threads", a.threads], what="cadmorph morph")
         morph_sj[(name, sign)] = out.strip().splitlines()[-1]
         case_dicts(case)
         run(["checkMesh"], cwd=case, log="log.checkMesh")

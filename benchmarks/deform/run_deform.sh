@@ -27,7 +27,7 @@ for mesh in tet hex; do
     targets=""
     for t in $steps; do
         "$cadmorph" morph --from pipe_0.step --to "pipe_$t.step" --mesh "pipe_$mesh.vtu" \
-            -o "rbf_${mesh}_$t.vtu" --threads "$threads" | tail -1
+            -o "rbf_${mesh}_$t.vtu" --steps 1 --allow-inverted --threads "$threads" | tail -1
         targets="$targets $t:rbf_${mesh}_$t.vtu"
     done
     # the library default clamping 1e-10, then the paper's 1e-2 (BENCH_EPS)
@@ -40,5 +40,5 @@ done
 # the CLI path: `cadmorph morph --method dmffd` at 100 % (same numbers as the exact-boundary
 # column of bench_deform volume)
 "$cadmorph" morph --from pipe_0.step --to pipe_1.0.step --mesh pipe_tet.vtu -o dmffd5_tet_1.0.vtu \
-    --method dmffd --lattice 5 --clamp 1e-2 --threads "$threads" | tail -1
+    --method dmffd --lattice 5 --clamp 1e-2 --steps 1 --allow-inverted --threads "$threads" | tail -1
 /usr/bin/python3 "$here/plots.py" "$work"

@@ -19,7 +19,7 @@ for model in pipe bore; do
     for method in rbf mls; do
         t0=$(date +%s.%N)
         out=$($C morph --from ${model}_0.step --to ${model}_1.step --mesh hex_$model.vtu \
-              -o ${model}_$method.vtu --method $method --verbose 2>&1)
+              -o ${model}_$method.vtu --method $method --steps 1 --allow-inverted --verbose 2>&1)
         t1=$(date +%s.%N)
         q=$(echo "$out" | tail -1)
         res=$(echo "$out" | grep 'warp mls:' | sed 's/.*residual \([^;]*\);.*/\1/' || true)

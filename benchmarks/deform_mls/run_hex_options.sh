@@ -39,7 +39,8 @@ for model in $models; do
         local method=$1; shift
         local out cpu
         out=$( { /usr/bin/time -f "CPU %U %S" $C morph --from ${model}_0.step --to ${model}_1.step \
-                 --mesh hex_$model.vtu -o ${model}_out.vtu --method $method "$@" --verbose; } 2>&1)
+                 --mesh hex_$model.vtu -o ${model}_out.vtu --method $method --steps 1 --allow-inverted \
+                 "$@" --verbose; } 2>&1)
         cpu=$(echo "$out" | awk '/^CPU /{printf "%.1f", $2 + $3}')
         local q=$(echo "$out" | grep 'min_scaled_jacobian=' | tail -1)
         local res=$(echo "$out" | grep 'warp mls:' | tail -1 | sed 's/.*residual \([^;]*\);.*/\1/' || true)

@@ -23,7 +23,7 @@ for p in shaft plate bracket; do
     [ -f "$D/${p}_$m.msh" ] || continue
     for g in "$D/${p}"_[1-9].step "$D/${p}_re.step"; do
       b=$(basename "$g" .step)
-      "$C" morph --from "$D/${p}_0.step" --to "$g" --mesh "$D/${p}_$m.msh" -o "$D/out_${b}_$m.vtu" --report "$D/rep_${b}_$m.csv" --threads 1 > "$D/morph_${b}_$m.txt" 2>&1
+      "$C" morph --from "$D/${p}_0.step" --to "$g" --mesh "$D/${p}_$m.msh" -o "$D/out_${b}_$m.vtu" --steps 1 --allow-inverted --report "$D/rep_${b}_$m.csv" --threads 1 > "$D/morph_${b}_$m.txt" 2>&1
       rc=$?
       echo "morph $b $m steps 1: exit $rc | $(tail -2 "$D/morph_${b}_$m.txt" | tr '\n' '|' | cut -c1-300)"
       if grep -q 'inverted=[1-9]' "$D/morph_${b}_$m.txt"; then

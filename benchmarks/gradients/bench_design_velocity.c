@@ -48,6 +48,7 @@ int main(int argc, char **argv)
     double *xyz = malloc(3 * m0->n_nodes * sizeof *xyz);
     cm_morph_options o;
     cm_morph_options_init(&o);
+    o.steps = 1; /* the one-increment morph, whose derivative the velocities are (morph.h) */
 
     const int repeats = argc > 6 && atoi(argv[6]) > 0 ? atoi(argv[6]) : 3;
     double w_create = INFINITY, w_morph = INFINITY, c_morph = INFINITY, solve = 0;

@@ -31,8 +31,9 @@ for mode in absolute relative; do
   extra=""
   [ $mode = relative ] && extra="--relative --via $(via bracket)"
   for v in plain auto optimize both; do
-    flags=""
-    case $v in auto) flags="--steps auto";; optimize) flags="--optimize";; both) flags="--steps auto --optimize";; esac
+    # plain and optimize: one step, its inverted cells kept as measured (--allow-inverted)
+    flags="--steps 1 --allow-inverted"
+    case $v in auto) flags="--steps auto";; optimize) flags="--steps 1 --allow-inverted --optimize";; both) flags="--steps auto --optimize";; esac
     keep=""
     case $v in auto|both) keep="--keep-partial";; esac
     t=$(run "$O/b1_${mode}_$v.out" $C morph --from "$O/bracket_0.step" --to "$O/bracket_1.step" \
@@ -51,6 +52,7 @@ for m in bore pipe bracket; do
   [ -f "$O/${m}_0.vtu" ] || $C mesh "$O/${m}_0.step" -o "$O/${m}_0.vtu" --size 0.2 --min-dihedral 0 --no-optimize > /dev/null
   for meth in rbf-s project biharmonic; do
     case $meth in rbf-s) f="";; project) f="--surface project";; biharmonic) f="--method rbf-biharmonic";; esac
+    f="$f --steps 1 --allow-inverted"  # the one-step morph, its inverted cells measured
     t0=$(run "$O/q.out" $C morph --from "$O/${m}_0.step" --to "$O/${m}_1.step" --mesh "$O/${m}_0.vtu" -o "$O/q.vtu" $f)
     t1=$(run "$O/qo.out" $C morph --from "$O/${m}_0.step" --to "$O/${m}_1.step" --mesh "$O/${m}_0.vtu" -o "$O/q.vtu" $f --optimize)
     echo "$m,$meth,$(summary "$O/q.out"),$(summary "$O/qo.out"),${t0#*,},${t1#*,}"

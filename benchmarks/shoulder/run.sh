@@ -8,8 +8,10 @@ C=$1; O=$2
 for r in 1.15 1.2 1.25 1.35; do
   for st in 1 5 auto; do
     printf 'r2 %s steps %s: ' $r $st
+    # fixed steps as measured: their inverted cells kept (--allow-inverted)
+    keep=--allow-inverted; [ $st = auto ] && keep=
     "$C" morph --from "$O/shoulder_a.step" --to "$O/shoulder_r$r.step" --mesh "$O/shoulder_a.msh" \
-      -o "$O/out_${r}_$st.msh" --steps $st --report "$O/report_${r}_$st.csv" 2> "$O/err_${r}_$st.txt" | tail -1
+      -o "$O/out_${r}_$st.msh" --steps $st $keep --report "$O/report_${r}_$st.csv" 2> "$O/err_${r}_$st.txt" | tail -1
     echo "  exit $? $(cut -c1-160 "$O/err_${r}_$st.txt")"
   done
 done

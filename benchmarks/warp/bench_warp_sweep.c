@@ -83,8 +83,13 @@ int main(int argc, char **argv)
         if (!strstr(modes, rel ? "relative" : "absolute")) continue;
         cm_morpher *mp[16] = {NULL};
         int alive[16];
+        /* the sweeps of [SKM11]: the plain one-step morph, whose inverted cells are measured */
+        cm_morph_options mo;
+        cm_morph_options_init(&mo);
+        mo.steps = 1;
+        mo.allow_inverted = 1;
         for (int i = 0; i < nm; ++i) {
-            alive[i] = (rel || i == 0) ? cm_morpher_create(ctx, g[0], m0, NULL, &mp[i]) >= 0 : 1;
+            alive[i] = (rel || i == 0) ? cm_morpher_create(ctx, g[0], m0, &mo, &mp[i]) >= 0 : 1;
             if (!alive[i]) fprintf(stderr, "bench_warp_sweep: %s\n", cm_context_message(ctx));
         }
         for (int k = 1; k <= steps; ++k)

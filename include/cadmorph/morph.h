@@ -53,18 +53,32 @@ typedef enum cm_off_cad {
 
 typedef struct cm_morph_options {
     cm_morph_method method;
-    /* >= 1 (default 1): equal increments of the boundary motion; increment 1 uses the shared
-     * factorisation, later ones refit the warp on the intermediate mesh.
-     * CM_MORPH_STEPS_AUTO: the largest steps that keep every cell's scaled Jacobian above
-     * min_sj (and, while steps can still shrink, above keep_fraction x M0's minimum): first
-     * the whole motion at once (the shared factorisation), on failure half the step, refit on
-     * the last accepted mesh; after two easy steps in a row the step doubles. Fails with
-     * CM_ERR_REJECTED, naming the worst cells, when no step down to min_fraction of the
-     * motion succeeds. */
+    /* A result is valid when no volume cell is inverted (cm_mesh_invalid_cells: docs/DESIGN.md,
+     * "What counts as an inverted cell") and, for min_sj > 0, every cell's scaled Jacobian is
+     * above min_sj. Unless allow_inverted, a morph returns only valid meshes (CM_ERR_REJECTED
+     * otherwise, naming the worst cells).
+     * CM_MORPH_STEPS_AUTO (the default): adaptive steps, the largest that keep the mesh valid
+     * (and, while steps can still shrink, its minimum scaled Jacobian above keep_fraction x
+     * M's): first the whole motion at once with the shared factorisation, so that a morph
+     * whose one step is valid costs what steps = 1 costs and gives the same mesh bit for bit;
+     * on failure half the step, refit on the last accepted mesh; after two easy steps in a row
+     * the step doubles. When no step down to min_fraction of the motion is valid: escalate
+     * (below), else CM_ERR_REJECTED (out_xyz: the last accepted mesh, valid).
+     * >= 1: equal increments of the boundary motion (1: the plain one-step morph of the
+     * papers); increment 1 uses the shared factorisation, later ones refit the warp on the
+     * intermediate mesh. Unless allow_inverted, the first increment that is not valid ends the
+     * morph with CM_ERR_REJECTED (out_xyz: the increment before it, M itself for the first). */
     int steps;
-    double min_sj;        /* auto: floor (default 0: no inversion) */
+    double min_sj;        /* floor of a valid mesh (default 0: no inverted cell; <= 0 means
+                             that, which also accepts an OpenFOAM mesh's valid cells whose
+                             scaled Jacobian is <= 0) */
     double keep_fraction; /* auto: 0 (default) = floor only */
     double min_fraction;  /* auto: smallest step (default 1/256) */
+    /* 1: the result is returned whatever its cells (the morph never fails for inverted cells;
+     * rows and cm_morpher_quality say how many): fixed steps run to the end, and adaptive
+     * steps that find no valid step (after the escalation) morph the rest of the motion in one
+     * step from the last accepted mesh, with a warning. 0 (default): see steps. */
+    int allow_inverted;
     int optimize;         /* 1: optimise the interior (optimize.h) after every increment,
                              before it is judged; boundary nodes never move */
     /* auto without optimize: 1 (default) = when no step down to min_fraction is valid, the
@@ -152,8 +166,10 @@ CM_API void cm_morpher_destroy(cm_morpher **morpher);
  * NULL) the last step's row with the times of all steps added up; every row (with rejected
  * adaptive steps) is in cm_morpher_steps. Errors: CM_ERR_MISMATCH when target does not
  * correspond to G (up to 5 differences in the message); the warp's errors; CM_ERR_REJECTED
- * when adaptive steps found no valid step (out_xyz then holds the last accepted mesh, valid,
- * and out_row its row). Returns CM_WARNING when face nodes left their trimmed face (the
+ * when no valid mesh was reached (cm_morph_options.steps: out_xyz then holds the last
+ * accepted mesh, valid unless M itself is not, out_row its row; the rejected row, accepted
+ * = 0, has the worst cells in its note). Returns CM_WARNING when face nodes left their
+ * trimmed face, or when allow_inverted finished an adaptive morph with inverted cells (the
  * result is complete). */
 CM_API cm_status cm_morpher_apply(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *target,
                            double *out_xyz, cm_morph_step *out_row);
@@ -258,10 +274,10 @@ typedef struct cm_morph_result {
 
 /* Reads G (g0_path), G' (g1_path) and M, checks that they correspond, and morphs M onto G'.
  * via: n_via intermediate geometries (may be 0): a relative morph G -> via[0] -> ... -> G',
- * each step a rebase onto the previous result (opt.steps increments each). When adaptive
- * steps find no valid step, the return is CM_ERR_REJECTED and, unlike every other error,
- * *result is set: the last valid mesh and every row, rejected ones included (the caller
- * decides whether to keep it). Errors:
+ * each step a rebase onto the previous result (opt.steps increments each). When no valid mesh
+ * is reached (cm_morph_options.steps), the return is CM_ERR_REJECTED and, unlike every other
+ * error, *result is set: the last valid mesh (M itself when even the first step failed) and
+ * every row, rejected ones included (the caller decides whether to keep it). Errors:
  * CM_ERR_MISMATCH when two geometries do not correspond or M is not a mesh of G; file errors
  * from the readers. Returns CM_WARNING (the first warning's message) when a stage warned
  * (nodes left a trimmed domain, sample cap reached) but the result is complete. Warnings

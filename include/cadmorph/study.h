@@ -126,7 +126,8 @@ CM_API void cm_study_paths_free(char ***paths, size_t n);
 enum {
     CM_STUDY_WRITE_NONE = 0,
     CM_STUDY_WRITE_ALL = 1,    /* every variant's mesh, per method and mode */
-    CM_STUDY_WRITE_FAILED = 2, /* the complete results with inverted cells */
+    CM_STUDY_WRITE_FAILED = 2, /* the complete results with inverted cells (morph options
+                                  with allow_inverted: the others refuse such results) */
     CM_STUDY_WRITE_LISTED = 3  /* the variants flagged in write_listed */
 };
 
@@ -134,9 +135,11 @@ typedef struct cm_study_options {
     int modes;                     /* CM_STUDY_ABSOLUTE | CM_STUDY_RELATIVE (default both) */
     const cm_study_method *methods; /* NULL: cm_study_default_methods */
     size_t n_methods;
-    cm_morph_options morph; /* everything but the method (default cm_morph_options_init;
-                               its target_h_scale 0 means CM_STUDY_TARGET_H_SCALE for the
-                               absolute morpher, 1 for the relative ones) */
+    cm_morph_options morph; /* everything but the method (default cm_morph_options_init:
+                               adaptive steps, a morph that reaches no valid mesh a row with
+                               CM_ERR_REJECTED and no mesh; its target_h_scale 0 means
+                               CM_STUDY_TARGET_H_SCALE for the absolute morpher, 1 for the
+                               relative ones) */
     int write_meshes;       /* CM_STUDY_WRITE_* (default NONE) */
     const unsigned char *write_listed; /* #variants flags for CM_STUDY_WRITE_LISTED */
     const char *out_dir;    /* meshes go to <out_dir>/<method>_<mode>_<label>.vtu, with
@@ -154,7 +157,8 @@ CM_API void cm_study_options_init(cm_study_options *opt);
 
 /* One variant x method x mode. Times in seconds. status: CM_OK, CM_WARNING (complete, the
  * message says what was odd: face nodes left their trimmed face) or the error that stopped
- * this row (the quality fields are then 0). In absolute mode the classification of M0 and the
+ * this row (the quality fields are then 0; CM_ERR_REJECTED: the morph reached no valid mesh,
+ * the message names the worst cells). In absolute mode the classification of M0 and the
  * factorisation of each warp happen once: t_classify (sampling G0 and classifying M0) is in
  * each method's first row, t_volume_solve in the first row of each warp method; relative rows
  * have the re-base onto the previous variant in t_classify. t_sample: reading G (writing and
@@ -405,7 +409,10 @@ typedef struct cm_sweep_options {
                             the meshes at 50 and 100 % (<method>_<mode>_<pct>.vtu) */
     int write_step;      /* keep DIR/G_<t>.step */
     int write_meshes;    /* write the meshes at 50 % and 100 % */
-    int adaptive;        /* each morph with adaptive steps (CM_MORPH_STEPS_AUTO, floor 0) */
+    int adaptive;        /* 0: each morph is the plain one-step morph of the papers, inverted
+                            cells kept (steps 1, allow_inverted: what the sweep measures);
+                            1: adaptive steps (CM_MORPH_STEPS_AUTO, floor 0), a morph that
+                            reaches no valid mesh a failed row (CM_ERR_REJECTED) */
     int optimize;        /* each morph with interior optimisation (cm_morph_options.optimize) */
 } cm_sweep_options;
 

@@ -149,8 +149,9 @@ _OFF_CAD = {"refuse": lib.CM_OFF_CAD_REFUSE, "fixed": lib.CM_OFF_CAD_FIXED}
 
 
 def _morph_options(what: str, method: str = "rbf", kernel: Optional[str] = None,
-                   surface: str = "rbf", steps: Union[int, str] = 1, min_sj: float = 0.0,
-                   min_step: float = 1.0 / 256, keep_fraction: float = 0.0,
+                   surface: str = "rbf", steps: Union[int, str] = "auto",
+                   min_sj: float = 0.0, min_step: float = 1.0 / 256,
+                   keep_fraction: float = 0.0, allow_inverted: bool = False,
                    escalate: bool = True, optimize: bool = False, optimize_sweeps: int = 6,
                    optimize_target_sj: float = 0.3, optimize_newton: int = 4,
                    solver: str = "auto", tolerance: float = 0.0,
@@ -184,6 +185,7 @@ def _morph_options(what: str, method: str = "rbf", kernel: Optional[str] = None,
                             hi_open=True)
     o.keep_fraction = number(what, "keep_fraction", keep_fraction, 0.0, 1.0)
     o.escalate = flag(what, "escalate", escalate)
+    o.allow_inverted = flag(what, "allow_inverted", allow_inverted)
     o.optimize = flag(what, "optimize", optimize)
     o.optimize_options.sweeps = integer(what, "optimize_sweeps", optimize_sweeps, 0, 10000)
     o.optimize_options.target_sj = number(what, "optimize_target_sj", optimize_target_sj,
@@ -233,11 +235,14 @@ class Morpher:
         solver [--solver], tolerance [--rbf-tol], lattice [--lattice], clamp [--clamp],
             samples, cubature, cover, stretch, bend, blend, graded [the MLS options]: as
             cadmorph.Warp.
-    Steps:
-        steps [--steps]: 1..4096 equal increments (each after the first refits the warp on
-            the last mesh), or "auto": adaptive steps keeping every cell's scaled Jacobian
-            above min_sj.
-        min_sj [--min-sj]: the floor of steps="auto", in [-1, 1) (0: no inverted cell).
+    Steps (a result is valid when no cell is inverted and, for min_sj > 0, every scaled
+    Jacobian is above min_sj; apply returns valid meshes only, unless allow_inverted):
+        steps [--steps]: "auto" (the default): adaptive steps, the whole motion first (a
+            valid one-step morph costs what steps=1 costs and is the same mesh), halved
+            on failure, until the mesh is valid; or 1..4096 equal increments (each after
+            the first refits the warp on the last mesh; 1: the plain one-step morph of the
+            papers), the first increment that is not valid raising RejectedError.
+        min_sj [--min-sj]: the floor of a valid mesh, in [-1, 1) (<= 0: no inverted cell).
         min_step [--min-step]: smallest adaptive step, a fraction of the motion in (0, 1)
             (the library's min_fraction; default 1/256).
         keep_fraction: steps="auto": while steps can still shrink, also keep the minimum
@@ -245,6 +250,10 @@ class Morpher:
         escalate: steps="auto" without optimize: when no step is valid, the rest of the
             motion is retried with interior optimisation (a CadmorphWarning says so);
             False: RejectedError there [--no-escalate].
+        allow_inverted [--allow-inverted]: return the result whatever its cells (never a
+            RejectedError for inverted cells; check `steps[-1].inverted`): fixed steps run
+            to the end, steps="auto" morphs the rest of the motion in one step when no step
+            is valid (a CadmorphWarning says so). Default False.
         optimize [--optimize]: optimise the interior after every step (boundary nodes stay
             on G'); optimize_sweeps (0..10000, default 6), optimize_target_sj ([-1, 1],
             default 0.3), optimize_newton (1..100, default 4): its options (optimize.h).
@@ -268,10 +277,10 @@ class Morpher:
             none; raising in it (or Ctrl-C) stops the call and is raised from it.
 
     Not here: --from/--to/--mesh/-o/--report/--cad-unit (files: read_step's unit,
-    read_mesh, write_mesh, and `steps` for the report), --fail-on-inverted (check
-    `steps[-1].inverted`), --keep-partial (RejectedError always carries the last valid
-    mesh), --relative --via (`rebase`, or `morph(..., via=[...])`), --verbose (the
-    "cadmorph" logger).
+    read_mesh, write_mesh, and `steps` for the report), --fail-on-inverted (the default:
+    RejectedError), --keep-partial (RejectedError always carries the last valid mesh),
+    --relative --via (`rebase`, or `morph(..., via=[...])`), --verbose (the "cadmorph"
+    logger).
 
     Lifetimes: the library borrows G and the last target; the Morpher holds references to
     those Geometry objects, so deleting them while the Morpher lives is safe. The mesh is
@@ -290,8 +299,9 @@ class Morpher:
 
     def __init__(self, g0: Geometry, mesh: Mesh, *, method: str = "rbf",
                  kernel: Optional[str] = None, surface: str = "rbf",
-                 steps: Union[int, str] = 1, min_sj: float = 0.0, min_step: float = 1.0 / 256,
-                 keep_fraction: float = 0.0, escalate: bool = True, optimize: bool = False,
+                 steps: Union[int, str] = "auto", min_sj: float = 0.0,
+                 min_step: float = 1.0 / 256, keep_fraction: float = 0.0,
+                 allow_inverted: bool = False, escalate: bool = True, optimize: bool = False,
                  optimize_sweeps: int = 6, optimize_target_sj: float = 0.3,
                  optimize_newton: int = 4, solver: str = "auto", tolerance: float = 0.0,
                  lattice: Optional[int] = None, clamp: Optional[float] = None,
@@ -361,8 +371,9 @@ class Morpher:
         Jacobian, `surface_stats` the surface morph's figures.
 
         Raises MismatchError when g1 does not correspond to G (the library's message lists
-        the differences); RejectedError when adaptive steps find no valid step: the
-        exception's `points` is the last valid mesh (n_nodes, 3) and its `steps` the rows,
+        the differences); RejectedError when no valid mesh is reached (see `steps`; never
+        with allow_inverted): the exception's `points` is the last valid mesh (n_nodes, 3;
+        the Morpher's own mesh when the first step failed) and its `steps` the rows,
         rejected ones included. A CadmorphWarning when face nodes left their trimmed face.
         """
         what = "cadmorph.Morpher.apply"
@@ -587,6 +598,9 @@ def morph(g0: Geometry, g1: Geometry, mesh: Mesh, *, via: Sequence[Geometry] = (
     (`--relative --via`): each leg starts from the last result (Morpher.rebase), with
     `steps` increments each; the displacement field is that of the last leg, as in the CLI.
 
+    Returns a valid mesh (no inverted cell) or raises RejectedError, as `cadmorph morph`
+    writes M1 or exits 3; allow_inverted=True returns the mesh whatever its cells, as
+    `--allow-inverted` (its "scaled_jacobian" field and `quality` say which are inverted).
     Raises as Morpher and Morpher.apply; a RejectedError also carries `mesh`, the last
     valid mesh (with its fields), as `cadmorph morph --keep-partial` writes it.
     """

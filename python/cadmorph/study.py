@@ -9,7 +9,7 @@ from typing import Any, List, Optional, Sequence, Tuple, Union
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._inputs import choice, integer, mesh_of, model_of, number, path_bytes, text
+from ._inputs import choice, flag, integer, mesh_of, model_of, number, path_bytes, text
 from .mesh import Mesh, PathLike
 from .geometry import Geometry
 
@@ -177,9 +177,9 @@ def _stem(path: bytes) -> str:
 
 def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]],
           methods: Union[None, str, Sequence[str]] = None, mode: str = "absolute",
-          steps: Union[int, str] = 1, optimize: bool = False, write_meshes: str = "none",
+          steps: Union[int, str] = "auto", optimize: bool = False, write_meshes: str = "none",
           out_dir: Optional[PathLike] = None, model_name: Optional[str] = None,
-          mesh_name: Optional[str] = None, *, threads: int = 0,
+          mesh_name: Optional[str] = None, *, allow_inverted: bool = False, threads: int = 0,
           progress: Progress = None) -> StudyResult:
     """Morphs mesh (a cadmorph.Mesh of g0, a cadmorph.Geometry) onto every target, as
     `cadmorph study --from G0.step --mesh M0 --variants LIST -o DIR`.
@@ -191,13 +191,16 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     "G<i>" (1-based). methods: a comma-separated str or a list of names ("rbf-s",
     "project", "rbf-s-biharmonic", "<warp>", "rbf-s-<warp>", "project-<warp>"); None:
     "rbf-s", the CLI's default. mode: "absolute" (default), "relative" or "both". steps:
-    increments of each morph (1..1000) or "auto". optimize: interior optimisation after each
-    step. write_meshes: "none" (default here; the CLI's is "all"), "all" or "failed"; the
+    "auto" (default: adaptive steps, as Morpher) or increments of each morph (1..1000; 1:
+    the plain one-step morph). A morph that reaches no valid mesh is a row with status
+    CM_ERR_REJECTED ("result rejected") and its message, and no mesh; allow_inverted=True
+    keeps such results (rows with their inverted cells, meshes written). optimize: interior
+    optimisation after each step. write_meshes: "none" (default here; the CLI's is "all"), "all" or "failed"; the
     meshes go to out_dir (created if missing) as <method>_<mode>_<label>.vtu. model_name,
     mesh_name: the CSV's model and mesh columns (default: g0's file name and "file").
 
     Errors that end the study (mesh not a mesh of g0, ...) raise; failed rows are a
-    CadmorphWarning and rows with status < 0.
+    CadmorphWarning and rows with status < 0 (n_failed > 0: where the CLI exits 3).
     """
     what = "cadmorph.study"
     model = model_of(what, "g0", g0)
@@ -215,6 +218,7 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     so.methods, so.n_methods = ms, nm
     so.morph.steps = _steps(steps, what)
     so.morph.optimize = bool(optimize)
+    so.morph.allow_inverted = flag(what, "allow_inverted", allow_inverted)
     so.write_meshes = _WRITE[choice(what, "write_meshes", write_meshes, tuple(_WRITE))]
     keep = [ms]
     if so.write_meshes != lib.CM_STUDY_WRITE_NONE:
@@ -283,7 +287,9 @@ def sweep(model: str = "bore", mesh: Union[str, PathLike] = "tet", steps: int = 
     (the O-grid hex mesh, bore and pipe; cells of about size, default 0.1) or the path of a
     mesh of G(0). mode: "absolute", "relative" or "both" (default). methods: as study's
     (None: rbf-s, project, rbf-s-biharmonic), put in the sweeps' table order as the CLI
-    does. adaptive: adaptive steps in each morph; optimize: interior optimisation.
+    does. adaptive: adaptive steps in each morph (a morph that reaches no valid mesh is a
+    failed row); default the plain one-step morph of the papers, inverted cells kept (what
+    a sweep measures). optimize: interior optimisation.
     out_dir: where G_<t>.step goes (kept with write_step) and, with write_meshes, the
     meshes at 50 % and 100 %; None: a temporary directory (nothing kept).
     """

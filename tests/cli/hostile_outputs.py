@@ -261,8 +261,10 @@ def out_study_m0_named_like_a_result():
         else:
             (os.link if kind == "hard" else os.symlink)(m0, res)
             mesh = m0
+        # the one-step morph with its inverted cells kept: a result to write (and refuse)
         run(["study", "--from", g0, "--mesh", mesh, "--variants", lst, "-o", d, "--methods", "rbf",
-             "--write-meshes", "all"], 1, "refusing to overwrite", names=["rbf_absolute_G1.vtu"])
+             "--write-meshes", "all", "--steps", "1", "--allow-inverted"], 1,
+            "refusing to overwrite", names=["rbf_absolute_G1.vtu"])
         if file_bytes(mesh) != before or file_bytes(m0) != before:
             fail(f"{kind}: M0 changed")
         if kind == "soft" and not os.path.islink(res):
@@ -302,7 +304,7 @@ def out_study_new_dir_whole():
     g0, g1, m0, lst = study_setup()
     d = path("sub/new")
     args = ["study", "--from", g0, "--mesh", m0, "--variants", lst, "--methods", "rbf",
-            "--write-meshes", "all", "-o"]
+            "--write-meshes", "all", "--steps", "1", "--allow-inverted", "-o"]
     run(args + [d], 0, None, lines=0)
     got = sorted(os.listdir(d))
     if got != ["rbf_absolute_G1.vtu", "study.csv", "study.svg"]:

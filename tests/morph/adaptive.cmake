@@ -1,7 +1,8 @@
 # Adaptive steps and interior optimisation through `cadmorph morph` on gmsh meshes of blocks
-# with a bore (make_adaptive.py): a motion that inverts cells in one step reaches 100 % with
-# --steps auto in more than one step; an easy one takes one step; a cell that the boundary
-# motion itself flattens ends in exit 3 naming it, with or without the last valid mesh.
+# with a bore (make_adaptive.py): a motion that inverts cells in one step (refused by --steps 1,
+# written with --allow-inverted) reaches 100 % with --steps auto in more than one step; an easy
+# one takes one step; a cell that the boundary motion itself flattens ends in exit 3 naming
+# it, with or without the last valid mesh.
 set(AW ${CM_TEST_WORK}/adaptive)
 set(CHECK ${CM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/surface/check_morph.py)
 set(CLEAN "inverted=0 cells=[1-9][0-9]*\n?\\Z")
@@ -16,13 +17,33 @@ endfunction()
 
 set(MORPH_MOVED $<TARGET_FILE:cadmorph> morph --from ${AW}/hole_0.step --to ${AW}/hole_moved.step
   --mesh ${AW}/hole_0.msh)
-cm_adaptive_cli(cli_morph_one_step_inverts ${CM_RUN_CLI} --exit 3 --stderr "inverted cells" --
-  ${MORPH_MOVED} -o ${AW}/one_step.vtu --fail-on-inverted)
-# the same without --fail-on-inverted: written, exit 0, and one warning line naming the count
-# and the worst cell (the summary line alone is easy to miss)
+# the plain one-step morph (--steps 1) inverts cells: exit 3, nothing written (the default;
+# --fail-on-inverted, which says so, is still accepted)
+add_test(NAME adaptive_guard_clean COMMAND ${CMAKE_COMMAND} -E rm -f ${AW}/one_step.vtu
+  ${AW}/one_step_default.vtu ${AW}/one_step_partial.vtu)
+set_tests_properties(adaptive_guard_clean PROPERTIES FIXTURES_SETUP adaptive_guard LABELS cli)
+cm_adaptive_cli(cli_morph_one_step_inverts ${CM_RUN_CLI} --exit 3 --stderr-lines 1
+  --stderr "^cadmorph morph: .*step 1 of 1: the one-step morph leaves [1-9][0-9]* inverted cells"
+  --absent ${AW}/one_step.vtu -- ${MORPH_MOVED} -o ${AW}/one_step.vtu --steps 1 --fail-on-inverted)
+cm_adaptive_cli(cli_morph_one_step_refused ${CM_RUN_CLI} --exit 3 --stderr-lines 1
+  --stderr "^cadmorph morph: .*step 1 of 1: the one-step morph leaves [1-9][0-9]* inverted cells"
+  --absent ${AW}/one_step_default.vtu -- ${MORPH_MOVED} -o ${AW}/one_step_default.vtu --steps 1)
+# --keep-partial: the last valid mesh of one step is M0 itself, written as such
+cm_adaptive_cli(cli_morph_one_step_partial ${CM_RUN_CLI} --exit 3 --stderr-lines 1
+  --stderr "^cadmorph morph: .*step 1 of 1" --stdout "${CLEAN}" --
+  ${MORPH_MOVED} -o ${AW}/one_step_partial.vtu --steps 1 --keep-partial)
+set_tests_properties(cli_morph_one_step_inverts cli_morph_one_step_refused
+  cli_morph_one_step_partial PROPERTIES FIXTURES_REQUIRED "adaptive;adaptive_guard")
+cm_adaptive_cli(cli_morph_one_step_partial_is_m0 ${CM_PYTHON}
+  ${PROJECT_SOURCE_DIR}/tests/cli/compare_moved.py ${AW}/hole_0.msh ${AW}/one_step_partial.vtu
+  0 diagonal)
+set_tests_properties(cli_morph_one_step_partial_is_m0 PROPERTIES DEPENDS cli_morph_one_step_partial)
+# asked for (--allow-inverted): written, exit 0, and one warning line naming the count and the
+# worst cell (the summary line alone is easy to miss)
 cm_adaptive_cli(cli_morph_one_step_warns ${CM_RUN_CLI} --exit 0 --stderr-lines 1
   --stderr "^cadmorph morph: warning: [1-9][0-9]* inverted cells? \\(scaled Jacobian <= 0\\). the worst is cell [0-9]+ \\(0-based, tet4, scaled Jacobian -?[0-9.e+-]+\\) at \\("
-  --stdout "inverted=[1-9][0-9]* cells=" -- ${MORPH_MOVED} -o ${AW}/one_step_warned.vtu)
+  --stdout "inverted=[1-9][0-9]* cells=" -- ${MORPH_MOVED} -o ${AW}/one_step_warned.vtu
+  --steps 1 --allow-inverted)
 cm_adaptive_cli(cli_morph_auto ${CM_RUN_CLI} --exit 0 --stdout "${CLEAN}" --
   ${MORPH_MOVED} -o ${AW}/auto.vtu --steps auto --report ${AW}/auto.csv)
 cm_adaptive_cli(cli_morph_auto_report ${CHECK} report ${AW}/auto.csv auto+2)
@@ -52,6 +73,11 @@ cm_adaptive_cli(cli_morph_auto_partial ${CM_RUN_CLI} --exit 3 --stderr "no valid
 cm_adaptive_cli(cli_morph_auto_partial_valid ${CM_RUN_CLI} --exit 0 --stdout "${CLEAN}" --
   $<TARGET_FILE:cadmorph> quality ${AW}/partial.vtu)
 set_tests_properties(cli_morph_auto_partial_valid PROPERTIES DEPENDS cli_morph_auto_partial)
-cm_adaptive_cli(cli_morph_keep_partial_alone ${CM_RUN_CLI} --exit 1 --stderr "--keep-partial goes with" --
+cm_adaptive_cli(cli_morph_keep_partial_allow_inverted ${CM_RUN_CLI} --exit 1
+  --stderr "--keep-partial .* and --allow-inverted .*: one or the other" --
   $<TARGET_FILE:cadmorph> morph --from ${AW}/tilt_0.step --to ${AW}/tilt_15.step
-  --mesh ${AW}/tilt_0.msh -o ${AW}/x.vtu --keep-partial)
+  --mesh ${AW}/tilt_0.msh -o ${AW}/x.vtu --keep-partial --allow-inverted)
+cm_adaptive_cli(cli_morph_fail_on_inverted_allow_inverted ${CM_RUN_CLI} --exit 1
+  --stderr "--fail-on-inverted and --allow-inverted contradict" --
+  $<TARGET_FILE:cadmorph> morph --from ${AW}/tilt_0.step --to ${AW}/tilt_15.step
+  --mesh ${AW}/tilt_0.msh -o ${AW}/x.vtu --fail-on-inverted --allow-inverted)

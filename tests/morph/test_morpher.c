@@ -33,12 +33,16 @@ static void test_entry_points_agree(cm_context *ctx)
     double *xyz = malloc(n3 * sizeof *xyz), *again = malloc(n3 * sizeof *again);
     const cm_surface_method surf[2] = {CM_SURFACE_RBF, CM_SURFACE_PROJECT};
     const cm_warp_method warp[2] = {CM_WARP_RBF, CM_WARP_RBF_BIHARMONIC};
+    /* the one-step morph, whatever its cells: the baseline (project) inverts some */
+    cm_morph_options one;
+    cm_morph_options_init(&one);
+    one.steps = 1;
+    one.allow_inverted = 1;
     cm_morpher *mp = NULL;
-    cm_status s = cm_morpher_create(ctx, g0, m0, NULL, &mp);
+    cm_status s = cm_morpher_create(ctx, g0, m0, &one, &mp);
     CHECK_MSG(s == CM_OK && mp, "%s", cm_context_message(ctx));
     for (int k = 0; mp && k < 3; ++k) {
-        cm_morph_options o;
-        cm_morph_options_init(&o);
+        cm_morph_options o = one;
         o.method.surface = surf[k == 1];
         o.method.warp.method = warp[k == 2];
         cm_morph_result *r = NULL;
@@ -136,6 +140,9 @@ static void test_errors(cm_context *ctx)
               cm_context_message(ctx));
     cm_morph_options o;
     cm_morph_options_init(&o);
+    /* the guarded morph is the default: adaptive steps, no inverted result unless asked */
+    CHECK(o.steps == CM_MORPH_STEPS_AUTO && o.allow_inverted == 0 && o.escalate == 1 &&
+          o.min_sj == 0);
     o.steps = -1;
     CHECK(cm_morpher_create(ctx, g0, m0, &o, &mp) == CM_ERR_ARGUMENT && mp == NULL);
     free(xyz);

@@ -57,8 +57,9 @@ def test_morph_equals_cli_bit_for_bit_on_the_bore(cli, bore_files, work):
 @pytest.mark.parametrize("options,args", [
     ({"steps": 3}, ["--steps", "3"]),
     ({"method": "femwarp"}, ["--method", "femwarp"]),
-    ({"steps": 2, "method": "lbwarp", "surface": "project"},
-     ["--steps", "2", "--method", "lbwarp", "--surface", "project"]),
+    # the baseline inverts cells: kept on request, as the CLI's --allow-inverted
+    ({"steps": 2, "method": "lbwarp", "surface": "project", "allow_inverted": True},
+     ["--steps", "2", "--method", "lbwarp", "--surface", "project", "--allow-inverted"]),
     ({"steps": "auto", "optimize": True}, ["--steps", "auto", "--optimize"]),
 ], ids=["steps3", "femwarp", "lbwarp-project-steps2", "auto-optimize"])
 def test_morph_options_equal_cli_bit_for_bit(cli, bore_files, work, options, args):
@@ -231,17 +232,18 @@ def dataclass_frozen_error():
 def test_apply_with_another_method(bore_files):
     m0, g0_path, g1_path, _ = bore_files
     g0, g1, mesh = read_step(g0_path), read_step(g1_path), cadmorph.read_mesh(m0)
-    m = cadmorph.Morpher(g0, mesh, progress=False)
+    # one step, inverted cells kept: the baseline (project) inverts some
+    one = dict(steps=1, allow_inverted=True, progress=False)
+    m = cadmorph.Morpher(g0, mesh, **one)
     rbf = m.apply(g1)
     fem = m.apply(g1, method="femwarp")
-    assert np.array_equal(fem, cadmorph.Morpher(g0, mesh, method="femwarp",
-                                                progress=False).apply(g1))
+    assert np.array_equal(fem, cadmorph.Morpher(g0, mesh, method="femwarp", **one).apply(g1))
     assert not np.array_equal(fem, rbf)
     proj = m.apply(g1, surface="project")
     assert np.array_equal(proj, cadmorph.Morpher(g0, mesh, surface="project",
-                                                 progress=False).apply(g1))
+                                                 **one).apply(g1))
     assert np.array_equal(m.apply(g1), rbf)  # the Morpher's own method again, unchanged
-    fem_m = cadmorph.Morpher(g0, mesh, method="femwarp", progress=False)
+    fem_m = cadmorph.Morpher(g0, mesh, method="femwarp", **one)
     assert np.array_equal(fem_m.apply(g1, kernel="triharmonic"), rbf)  # kernel: a method
     with pytest.raises(ValueError, match="method must be one of"):
         m.apply(g1, method="spline")

@@ -5,10 +5,10 @@ study.csv: one row per variant x method x mode; the --odd variant's rows have st
 warning), min <= mean scaled Jacobian, its boundary within --max-distance-rel x diagonal of
 its G, and no inverted cell for rbf-s. Each complete row's mesh exists and its quality
 recomputed by VTK's vtkMeshQuality (code nobody here wrote) agrees with the row; the odd
-variant has no mesh. study.svg parses as XML with one polyline per mode x method of
+variant has no mesh; the exit code is --exit (3: the odd variant's rows failed). study.svg parses as XML with one polyline per mode x method of
 (complete variants + 1) points, a legend entry for each, and a mark for the odd variant.
 Usage: check_study.py --dir DIR --variants N --odd LABEL --modes a[,b] --methods m[,n]
-       [--max-distance-rel R] -- COMMAND...
+       [--max-distance-rel R] [--exit N] -- COMMAND...
 """
 import argparse
 import csv
@@ -41,6 +41,7 @@ def main():
     ap.add_argument("--modes", required=True)
     ap.add_argument("--methods", required=True)
     ap.add_argument("--max-distance-rel", type=float, default=1e-9)
+    ap.add_argument("--exit", type=int, default=0)
     ap.add_argument("command", nargs=argparse.REMAINDER)
     a = ap.parse_args()
     cmd = a.command[1:] if a.command and a.command[0] == "--" else a.command
@@ -48,8 +49,8 @@ def main():
     p = subprocess.run(cmd, capture_output=True, text=True)
     sys.stdout.write(p.stdout)
     sys.stderr.write(p.stderr)
-    if p.returncode != 0:
-        print("FAIL: exit code", p.returncode)
+    if p.returncode != a.exit:
+        print("FAIL: exit code", p.returncode, "expected", a.exit)
         return 1
     check(a.odd in p.stderr, "no warning about the odd variant on stderr")
     modes, methods = a.modes.split(","), a.methods.split(",")

@@ -147,6 +147,10 @@ static void test_study(cm_context *ctx)
     so.n_methods = nm;
     so.write_meshes = CM_STUDY_WRITE_FAILED;
     so.out_dir = out;
+    /* the one-step morphs with their inverted cells kept: rbf (closest point) inverts, and
+     * only those results are written */
+    so.morph.steps = 1;
+    so.morph.allow_inverted = 1;
     progress_log pl = {0, 1, 0, 0};
     cm_context_set_progress(ctx, on_progress, &pl);
     s = cm_study_run(ctx, g0, mesh, &fam, &so, &r);

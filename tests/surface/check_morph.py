@@ -56,8 +56,23 @@ def ongeom(m0_path, m1_path, step, rel):
     return ok
 
 
+def rejected(rows):
+    """A refused morph's report: its last row rejected, with inverted cells that its note
+    names; every accepted row before it valid."""
+    last = rows[-1]
+    if float(last[13]) != 0 or int(last[3]) < 1 or "inverted" not in last[15] or "SJ" not in last[15]:
+        print("FAIL: the last row is not a rejected step naming its inverted cells: %s" % last)
+        return False
+    for r in rows[1:-1]:
+        if float(r[13]) == 1 and int(r[3]) != 0:
+            print("FAIL: accepted row with inverted cells %s" % r)
+            return False
+    return True
+
+
 def report(path, k):
-    """k rows (an integer), or 'auto+N': any number with at least N accepted steps."""
+    """k rows (an integer), 'auto+N': any number with at least N accepted steps, or
+    'rejected': a morph that reached no valid mesh (the last row says why)."""
     rows = list(csv.reader(open(path)))
     want = ["step", "min_scaled_jacobian", "mean_scaled_jacobian", "inverted",
             "max_distance_to_g1", "t_read", "t_sample", "t_classify", "t_surface_morph",
@@ -67,6 +82,8 @@ def report(path, k):
         print("FAIL: header %s" % rows[0])
         return False
     n = len(rows) - 1
+    if k == "rejected":
+        return n >= 1 and rejected(rows)
     auto = k.startswith("auto+")
     if (not auto and n != int(k)) or n < 1 or [int(r[0]) for r in rows[1:]] != list(range(1, n + 1)):
         print("FAIL: %d rows, expected steps 1..%s" % (n, k))

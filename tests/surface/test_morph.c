@@ -17,6 +17,7 @@ static cm_morph_result *run(cm_context *ctx, const char *from, const char *to, c
     cm_morph_options_init(&o);
     o.method.surface = method;
     o.steps = steps;
+    o.allow_inverted = 1; /* the baseline's inverted cells are measured, not refused */
     cm_morph_result *r = NULL;
     cm_status s = cm_morph_run(ctx, g0, g1, m, NULL, 0, &o, &r);
     CHECK_MSG(s == CM_OK, "%s -> %s: %s", from, to, cm_context_message(ctx));
