@@ -72,3 +72,8 @@ add_test(NAME cad_cli_morph_nurbs_in_place COMMAND ${CM_PYTHON}
          ${CM_CAD_WORK}/part_nurbs_m.vtu 1e-9 diagonal)
 set_tests_properties(cad_cli_morph_nurbs_in_place PROPERTIES LABELS "cad;cli"
                      FIXTURES_REQUIRED cad_part_nurbs_m)
+
+# An independent distance of a mesh's boundary nodes to a STEP model (OpenCASCADE's reader and
+# BRepExtrema_DistShapeShape, no cadmorph CAD code): checks the distance figures cadmorph reports.
+add_executable(brep_distance brep_distance.cpp)
+target_link_libraries(brep_distance PRIVATE cm_warnings cm_occ cm_mesh cm_core)
