@@ -704,6 +704,8 @@ void cm_deform_get_stats(const cm_deform *def, cm_deform_stats *stats);
 cm_mls *cm_deform_get_mls(cm_deform *def);
 typedef struct cm_kdtree cm_kdtree;
 cm_status cm_kdtree_create(cm_context *ctx, const double *xyz, size_t n, cm_kdtree **tree);
+cm_status cm_kdtree_create_borrowed(cm_context *ctx, const double *xyz, size_t n,
+cm_kdtree **tree);
 void cm_kdtree_destroy(cm_kdtree **tree);
 size_t cm_kdtree_size(const cm_kdtree *tree);
 cm_status cm_kdtree_nearest(cm_context *ctx, const cm_kdtree *tree, const double *query,
