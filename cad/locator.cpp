@@ -57,10 +57,29 @@ double iso_length(BRepAdaptor_Surface &S, bool along_u, double fixed, double a, 
     return len;
 }
 
+// Longest u and v iso-lines of each face (5 of each): the face's extent in the metric.
+void face_extents(cmcad::adaptors &a, std::vector<double> &lu, std::vector<double> &lv)
+{
+    const cm_cad_model *m = a.model;
+    lu.assign((size_t)m->counts.faces, 0);
+    lv.assign((size_t)m->counts.faces, 0);
+    for (int f = 0; f < m->counts.faces; ++f) {
+        BRepAdaptor_Surface &S = a.surface(f);
+        const double *r = m->face_info[f].uv_range;
+        for (int i = 0; i <= 4; ++i) {
+            lv[(size_t)f] = std::max(
+                lv[(size_t)f], iso_length(S, false, r[0] + (r[1] - r[0]) * i / 4, r[2], r[3]));
+            lu[(size_t)f] = std::max(
+                lu[(size_t)f], iso_length(S, true, r[2] + (r[3] - r[2]) * i / 4, r[0], r[1]));
+        }
+    }
+}
+
 // Rows of the grid: the v step comes from the longest v iso-line, the u step of each row from
 // that row's own u iso-line, so that the 3D spacing is close to h everywhere (a sphere gets
 // fewer points per row near its poles). Returns the number of candidates.
-size_t plan_rows(cmcad::adaptors &a, double h, std::vector<row> &rows)
+size_t plan_rows(cmcad::adaptors &a, double h, const std::vector<double> &lvs,
+                 std::vector<row> &rows)
 {
     const cm_cad_model *m = a.model;
     rows.clear();
@@ -69,10 +88,7 @@ size_t plan_rows(cmcad::adaptors &a, double h, std::vector<row> &rows)
         const cm_cad_face_info &fi = m->face_info[f];
         BRepAdaptor_Surface &S = a.surface(f);
         const double *r = fi.uv_range;
-        double lv = 0;
-        for (int i = 0; i <= 4; ++i)
-            lv = std::max(lv, iso_length(S, false, r[0] + (r[1] - r[0]) * i / 4, r[2], r[3]));
-        long nv = std::max(1L, (long)std::ceil(lv / h));
+        long nv = std::max(1L, (long)std::ceil(lvs[(size_t)f] / h));
         for (long j = 0; j < nv; ++j) {
             double v = r[2] + (r[3] - r[2]) * (j + 0.5) / nv;
             double lu = iso_length(S, true, v, r[0], r[1]);
@@ -110,12 +126,26 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     double clock0 = cm_wtime();
     cmcad::adaptors a(m);
     std::vector<row> rows;
-    size_t total = plan_rows(a, h, rows) + count_edge_samples(m, h);
+    std::vector<double> lus, lvs;
+    face_extents(a, lus, lvs);
+    // The count h would give, from the faces' extents (the rows themselves cost an iso-line
+    // each: a mesh whose shortest edge asks for 10^10 samples must not plan them first).
+    double box = 0, edge_len = 0;
+    for (size_t f = 0; f < lus.size(); ++f) box += lus[f] * lvs[f];
+    for (size_t k = 0; k < m->wire_edge.size(); ++k) edge_len += m->edge_info[m->wire_edge[k]].length;
     const double h_asked = h;
-    const size_t total_asked = total;
+    const double estimate = box / (h * h) + edge_len / h;
+    if (estimate > 64 * (double)cap) {
+        // solve box / h^2 + edge_len / h = cap for h: the estimate bounds the count from above
+        // (the longest iso-lines), the loop below closes in on the cap
+        double c = (double)cap;
+        h = std::max(h, (edge_len + std::sqrt(edge_len * edge_len + 4 * c * box)) / (2 * c));
+    }
+    size_t total = plan_rows(a, h, lvs, rows) + count_edge_samples(m, h);
+    const size_t total_asked = h == h_asked ? total : (size_t)std::min(estimate, 1e18);
     for (int it = 0; total > cap && it < 20; ++it) {
         h *= std::sqrt((double)total / (double)cap) * 1.02;
-        total = plan_rows(a, h, rows) + count_edge_samples(m, h);
+        total = plan_rows(a, h, lvs, rows) + count_edge_samples(m, h);
     }
     if (total > cap)
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: cannot meet the cap of %zu samples", fn, cap);
@@ -284,9 +314,9 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
            cm_wtime() - clock2);
     if (h != h_asked)
         return cm_error(ctx, CM_WARNING,
-                        "%s: h = %g would give about %zu samples, over the cap of %zu: "
+                        "%s: h = %g would give about %.3g samples, over the cap of %zu: "
                         "h raised to %g (%zu samples)",
-                        fn, h_asked, total_asked, cap, h, L->face.size());
+                        fn, h_asked, (double)total_asked, cap, h, L->face.size());
     return CM_OK;
 }
 
@@ -299,6 +329,15 @@ void cm_cad_sample_options_init(cm_cad_sample_options *opt)
     if (!opt) return;
     opt->h = 0;
     opt->max_samples = default_cap;
+}
+
+size_t cm_cad_sample_cap(size_t boundary_nodes, size_t max_cap)
+{
+    size_t cap = boundary_nodes > CM_CAD_MIN_SAMPLES / CM_CAD_SAMPLES_PER_NODE
+                     ? boundary_nodes * CM_CAD_SAMPLES_PER_NODE
+                     : CM_CAD_MIN_SAMPLES;
+    if (boundary_nodes > SIZE_MAX / CM_CAD_SAMPLES_PER_NODE) cap = SIZE_MAX;
+    return max_cap && cap > max_cap ? max_cap : cap;
 }
 
 cm_status cm_cad_locator_create(cm_context *ctx, const cm_cad_model *model,

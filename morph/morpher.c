@@ -59,8 +59,18 @@ static cm_status make_locator(cm_context *ctx, const cm_morpher *mp, const cm_ca
     cm_cad_sample_options so;
     cm_cad_sample_options_init(&so);
     so.h = mp->info.h * (scale > 1 ? scale : 1);
-    so.max_samples = mp->opt.max_samples ? mp->opt.max_samples : CM_MORPH_MAX_SAMPLES;
-    return cm_cad_locator_create(ctx, g, &so, loc);
+    /* by default the samples scale with the boundary (cm_cad_sample_cap): a coarser h than the
+     * shortest edge asks for is the rule on real parts, not news (the projections are Newton's
+     * on the CAD faces); a cap the caller set is reported when it bites */
+    so.max_samples = mp->opt.max_samples
+                         ? mp->opt.max_samples
+                         : cm_cad_sample_cap(mp->b->n_nodes, CM_MORPH_MAX_SAMPLES);
+    cm_status s = cm_cad_locator_create(ctx, g, &so, loc);
+    if (s == CM_WARNING && !mp->opt.max_samples) {
+        cm_log(ctx, CM_LOG_DEBUG, "%s", cm_context_message(ctx));
+        s = CM_OK;
+    }
+    return s;
 }
 
 /* keep_offset: the surface morph of g onto itself puts every node on its point of g (the same
