@@ -8,7 +8,7 @@
 //
 // Prints "max_distance=<d> diagonal=<D> ratio=<d/D> node=<i>". With --compare FIGURE (the
 // largest distance a cadmorph command reported for the same nodes and model), exits 1 unless
-// |FIGURE - d| <= T (default 1e-9 x D): the reported figure must measure what it says.
+// |FIGURE - d| <= T x D (T default 1e-9): the reported figure must measure what it says.
 #include "cadmorph/core.h"
 #include "cadmorph/mesh.h"
 
@@ -86,7 +86,7 @@ int main(int argc, char **argv)
     cm_mesh_destroy(&mesh);
     cm_context_destroy(&ctx);
     if (figure >= 0) {
-        if (tol < 0) tol = 1e-9 * diag;
+        tol = (tol < 0 ? 1e-9 : tol) * diag;
         if (std::fabs(figure - worst) > tol) {
             std::printf("MISMATCH: the reported figure %.6g differs from BRepExtrema's %.6g by "
                         "%.3g (> %.3g)\n",
