@@ -252,8 +252,7 @@ CM_API void cm_cad_sample_options_init(cm_cad_sample_options *opt);
 /* The samples worth their memory for projecting the boundary nodes of a mesh: they only
  * start the Newton projections and name the candidate faces, so a few dozen per boundary node
  * suffice (CM_CAD_SAMPLES_PER_NODE, at least CM_CAD_MIN_SAMPLES), at most max_cap (0: no
- * upper bound). A sample costs about 60 bytes (benchmarks/RESULTS.md, "Sampling memory and the
- * boundary distance"). */
+ * upper bound). A sample costs about 60 bytes. */
 #define CM_CAD_SAMPLES_PER_NODE 64
 #define CM_CAD_MIN_SAMPLES ((size_t)250000)
 CM_API size_t cm_cad_sample_cap(size_t boundary_nodes, size_t max_cap);
