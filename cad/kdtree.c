@@ -11,7 +11,9 @@
 
 struct cm_kdtree {
     flann_index_t index;
-    double *xyz; /* FLANN keeps a pointer to the data set: the tree owns this copy */
+    const double *xyz; /* FLANN keeps a pointer to the data set: the tree's copy, or the
+                          caller's points (borrowed) */
+    int owns;
     size_t n;
     struct FLANNParameters params;
 };
@@ -32,7 +34,8 @@ static struct FLANNParameters kdtree_params(const cm_context *ctx)
     return p;
 }
 
-cm_status cm_kdtree_create(cm_context *ctx, const double *xyz, size_t n, cm_kdtree **tree)
+static cm_status create(cm_context *ctx, const double *xyz, size_t n, int borrow,
+                        cm_kdtree **tree)
 {
     if (!tree) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_kdtree_create: tree is NULL");
     *tree = NULL;
@@ -47,18 +50,27 @@ cm_status cm_kdtree_create(cm_context *ctx, const double *xyz, size_t n, cm_kdtr
                             i / 3);
     cm_kdtree *t = calloc(1, sizeof *t);
     if (!t) return cm_error(ctx, CM_ERR_NOMEM, "cm_kdtree_create: out of memory");
-    t->xyz = malloc(3 * n * sizeof *t->xyz);
-    if (!t->xyz) {
-        free(t);
-        return cm_error(ctx, CM_ERR_NOMEM, "cm_kdtree_create: out of memory for %zu points", n);
+    if (borrow) {
+        t->xyz = xyz;
+    } else {
+        double *copy = malloc(3 * n * sizeof *copy);
+        if (!copy) {
+            free(t);
+            return cm_error(ctx, CM_ERR_NOMEM, "cm_kdtree_create: out of memory for %zu points",
+                            n);
+        }
+        memcpy(copy, xyz, 3 * n * sizeof *copy);
+        t->xyz = copy;
+        t->owns = 1;
     }
-    memcpy(t->xyz, xyz, 3 * n * sizeof *t->xyz);
     t->n = n;
     t->params = kdtree_params(ctx);
     float speedup = 0.0f;
-    t->index = flann_build_index_double(t->xyz, (int)n, 3, &speedup, &t->params);
+    /* FLANN's C API takes a non-const pointer; it only reads the data set */
+    t->index = flann_build_index_double((double *)(uintptr_t)t->xyz, (int)n, 3, &speedup,
+                                        &t->params);
     if (!t->index) {
-        free(t->xyz);
+        if (t->owns) free((void *)(uintptr_t)t->xyz);
         free(t);
         return cm_error(ctx, CM_ERR_INTERNAL, "cm_kdtree_create: FLANN failed to build the index");
     }
@@ -66,12 +78,23 @@ cm_status cm_kdtree_create(cm_context *ctx, const double *xyz, size_t n, cm_kdtr
     return CM_OK;
 }
 
+cm_status cm_kdtree_create(cm_context *ctx, const double *xyz, size_t n, cm_kdtree **tree)
+{
+    return create(ctx, xyz, n, 0, tree);
+}
+
+cm_status cm_kdtree_create_borrowed(cm_context *ctx, const double *xyz, size_t n,
+                                    cm_kdtree **tree)
+{
+    return create(ctx, xyz, n, 1, tree);
+}
+
 void cm_kdtree_destroy(cm_kdtree **tree)
 {
     if (!tree || !*tree) return;
     cm_kdtree *t = *tree;
     if (t->index) flann_free_index_double(t->index, &t->params);
-    free(t->xyz);
+    if (t->owns) free((void *)(uintptr_t)t->xyz);
     free(t);
     *tree = NULL;
 }

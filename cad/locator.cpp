@@ -57,10 +57,29 @@ double iso_length(BRepAdaptor_Surface &S, bool along_u, double fixed, double a, 
     return len;
 }
 
+// Longest u and v iso-lines of each face (5 of each): the face's extent in the metric.
+void face_extents(cmcad::adaptors &a, std::vector<double> &lu, std::vector<double> &lv)
+{
+    const cm_cad_model *m = a.model;
+    lu.assign((size_t)m->counts.faces, 0);
+    lv.assign((size_t)m->counts.faces, 0);
+    for (int f = 0; f < m->counts.faces; ++f) {
+        BRepAdaptor_Surface &S = a.surface(f);
+        const double *r = m->face_info[f].uv_range;
+        for (int i = 0; i <= 4; ++i) {
+            lv[(size_t)f] = std::max(
+                lv[(size_t)f], iso_length(S, false, r[0] + (r[1] - r[0]) * i / 4, r[2], r[3]));
+            lu[(size_t)f] = std::max(
+                lu[(size_t)f], iso_length(S, true, r[2] + (r[3] - r[2]) * i / 4, r[0], r[1]));
+        }
+    }
+}
+
 // Rows of the grid: the v step comes from the longest v iso-line, the u step of each row from
 // that row's own u iso-line, so that the 3D spacing is close to h everywhere (a sphere gets
 // fewer points per row near its poles). Returns the number of candidates.
-size_t plan_rows(cmcad::adaptors &a, double h, std::vector<row> &rows)
+size_t plan_rows(cmcad::adaptors &a, double h, const std::vector<double> &lvs,
+                 std::vector<row> &rows)
 {
     const cm_cad_model *m = a.model;
     rows.clear();
@@ -69,10 +88,7 @@ size_t plan_rows(cmcad::adaptors &a, double h, std::vector<row> &rows)
         const cm_cad_face_info &fi = m->face_info[f];
         BRepAdaptor_Surface &S = a.surface(f);
         const double *r = fi.uv_range;
-        double lv = 0;
-        for (int i = 0; i <= 4; ++i)
-            lv = std::max(lv, iso_length(S, false, r[0] + (r[1] - r[0]) * i / 4, r[2], r[3]));
-        long nv = std::max(1L, (long)std::ceil(lv / h));
+        long nv = std::max(1L, (long)std::ceil(lvs[(size_t)f] / h));
         for (long j = 0; j < nv; ++j) {
             double v = r[2] + (r[3] - r[2]) * (j + 0.5) / nv;
             double lu = iso_length(S, true, v, r[0], r[1]);
@@ -110,25 +126,36 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     double clock0 = cm_wtime();
     cmcad::adaptors a(m);
     std::vector<row> rows;
-    size_t total = plan_rows(a, h, rows) + count_edge_samples(m, h);
+    std::vector<double> lus, lvs;
+    face_extents(a, lus, lvs);
+    // The count h would give, from the faces' extents (the rows themselves cost an iso-line
+    // each: a mesh whose shortest edge asks for 10^10 samples must not plan them first).
+    double box = 0, edge_len = 0;
+    for (size_t f = 0; f < lus.size(); ++f) box += lus[f] * lvs[f];
+    for (size_t k = 0; k < m->wire_edge.size(); ++k) edge_len += m->edge_info[m->wire_edge[k]].length;
     const double h_asked = h;
-    const size_t total_asked = total;
+    const double estimate = box / (h * h) + edge_len / h;
+    if (estimate > 64 * (double)cap) {
+        // solve box / h^2 + edge_len / h = cap for h: the estimate bounds the count from above
+        // (the longest iso-lines), the loop below closes in on the cap
+        double c = (double)cap;
+        h = std::max(h, (edge_len + std::sqrt(edge_len * edge_len + 4 * c * box)) / (2 * c));
+    }
+    size_t total = plan_rows(a, h, lvs, rows) + count_edge_samples(m, h);
+    const size_t total_asked = h == h_asked ? total : (size_t)std::min(estimate, 1e18);
     for (int it = 0; total > cap && it < 20; ++it) {
         h *= std::sqrt((double)total / (double)cap) * 1.02;
-        total = plan_rows(a, h, rows) + count_edge_samples(m, h);
+        total = plan_rows(a, h, lvs, rows) + count_edge_samples(m, h);
     }
     if (total > cap)
         return cm_error(ctx, CM_ERR_ARGUMENT, "%s: cannot meet the cap of %zu samples", fn, cap);
     L->h = h;
 
-    // Grid candidates in parallel over rows; each keeps its slot so the order is the same for
-    // any thread count.
+    // Two passes over the rows, in parallel, each row in its own slots so that the order is the
+    // same for any thread count: which grid points lie inside their face (one byte per
+    // candidate), then the points themselves, written straight into arrays of the exact size
+    // (no candidate-sized buffers: trimmed faces keep a fraction of their parameter box).
     const size_t ncand = rows.empty() ? 0 : rows.back().offset + (size_t)rows.back().nu;
-    // Candidates are written in place into the sample arrays and compacted afterwards (each
-    // fresh page costs a fault: one large buffer instead of two).
-    std::vector<double> &cxyz = L->xyz, &cuv = L->uv;
-    cxyz.resize(3 * ncand);
-    cuv.resize(2 * ncand);
     std::vector<char> keep(ncand, 0);
     cmcad::region_error err;
     cm_status st = cm_progress(ctx, "sample", 0, (double)rows.size());
@@ -138,12 +165,12 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     int stop = 0;
     std::vector<cmcad::scanline> scan((size_t)m->counts.faces);
     for (int f = 0; f < m->counts.faces; ++f) cmcad::scanline_build(m, f, scan[(size_t)f]);
-#pragma omp parallel num_threads(cm_context_threads_for(ctx, ncand, 4096)) if (ncand > 4096)
+    const int nthreads = cm_context_threads_for(ctx, ncand, 4096);
+#pragma omp parallel num_threads(nthreads) if (ncand > 4096)
     {
         cmcad::adaptors ta(m);
         const int nt = omp_get_num_threads();
         const bool master = omp_get_thread_num() == 0;
-        std::vector<char> in;
 #pragma omp for schedule(static)
         for (long r = 0; r < (long)rows.size(); ++r) {
             int stopped;
@@ -152,7 +179,7 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
             if (stopped) continue;
             // the calling thread reports: with a static schedule it owns the first 1/nt rows
             if (master && r % 64 == 0 &&
-                cm_progress(ctx, "sample", std::min((double)r * nt, (double)rows.size()),
+                cm_progress(ctx, "sample", std::min((double)r * nt / 2, (double)rows.size()),
                             (double)rows.size()) < 0) {
 #pragma omp atomic write
                 stop = 1;
@@ -161,19 +188,8 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
             try {
                 const row &rw = rows[r];
                 const double *ur = m->face_info[rw.face].uv_range;
-                BRepAdaptor_Surface &S = ta.surface(rw.face);
-                in.resize((size_t)rw.nu);
                 cmcad::scanline_row(ta, rw.face, scan[(size_t)rw.face], rw.v, ur[0], ur[1], rw.nu,
-                                    in.data());
-                for (int i = 0; i < rw.nu; ++i) {
-                    size_t c = rw.offset + (size_t)i;
-                    double u = ur[0] + (ur[1] - ur[0]) * (i + 0.5) / rw.nu;
-                    if (!in[(size_t)i]) continue;
-                    gp_Pnt p = S.Value(u, rw.v);
-                    cxyz[3 * c] = p.X(), cxyz[3 * c + 1] = p.Y(), cxyz[3 * c + 2] = p.Z();
-                    cuv[2 * c] = u, cuv[2 * c + 1] = rw.v;
-                    keep[c] = 1;
-                }
+                                    &keep[rw.offset]);
             } catch (...) {
                 err.capture();
             }
@@ -181,25 +197,20 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
     }
     if (err.status != CM_OK) return err.report(ctx, fn);
     if (stop) return CM_ERR_INTERRUPTED;  // the message is cm_progress's
-    if ((st = cm_progress(ctx, "sample", (double)rows.size(), (double)rows.size())) < 0) return st;
-    double clock1 = cm_wtime();
-    size_t nkeep = 0;
-    for (char k : keep) nkeep += (size_t)k;
-    L->face.resize(nkeep);
-    size_t j = 0;
-    for (const row &rw : rows)
-        for (size_t c = rw.offset; c < rw.offset + (size_t)rw.nu; ++c) {
-            if (!keep[c]) continue;
-            // j <= c: moving forward in place never overwrites a candidate still to be read
-            for (int d = 0; d < 3; ++d) cxyz[3 * j + d] = cxyz[3 * c + d];
-            cuv[2 * j] = cuv[2 * c], cuv[2 * j + 1] = cuv[2 * c + 1];
-            L->face[j++] = rw.face;
-        }
-    cxyz.resize(3 * nkeep);
-    cuv.resize(2 * nkeep);
+    // first kept sample of each row
+    std::vector<size_t> first(rows.size() + 1, 0);
+    for (size_t r = 0; r < rows.size(); ++r) {
+        size_t k = 0;
+        for (size_t c = rows[r].offset; c < rows[r].offset + (size_t)rows[r].nu; ++c)
+            k += (size_t)keep[c];
+        first[r + 1] = first[r] + k;
+    }
+    const size_t nkeep = first.back();
 
     // Edges: points on every occurrence of an edge in a face (uv from that face's pcurve, so
     // both copies of a seam), and once per edge for the edge tree.
+    std::vector<double> fexyz, feuv;
+    std::vector<int> feface;
     std::vector<char> edge_done(m->counts.edges, 0);
     for (int f = 0; f < m->counts.faces; ++f) {
         TopoDS_Face face = m->face(f);
@@ -220,9 +231,9 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
                 gp_Pnt p = C.Value(t);
                 if (!pc.IsNull()) {
                     gp_Pnt2d q = pc->Value(t);
-                    L->xyz.insert(L->xyz.end(), {p.X(), p.Y(), p.Z()});
-                    L->uv.insert(L->uv.end(), {q.X(), q.Y()});
-                    L->face.push_back(f);
+                    fexyz.insert(fexyz.end(), {p.X(), p.Y(), p.Z()});
+                    feuv.insert(feuv.end(), {q.X(), q.Y()});
+                    feface.push_back(f);
                 }
                 if (!edge_done[e]) {
                     L->exyz.insert(L->exyz.end(), {p.X(), p.Y(), p.Z()});
@@ -233,13 +244,63 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
             edge_done[e] = 1;
         }
     }
+    const size_t ns = nkeep + feface.size();
+    L->xyz.resize(3 * ns);
+    L->uv.resize(2 * ns);
+    L->face.resize(ns);
+    std::copy(fexyz.begin(), fexyz.end(), L->xyz.begin() + 3 * (std::ptrdiff_t)nkeep);
+    std::copy(feuv.begin(), feuv.end(), L->uv.begin() + 2 * (std::ptrdiff_t)nkeep);
+    std::copy(feface.begin(), feface.end(), L->face.begin() + (std::ptrdiff_t)nkeep);
+    double *xyz = L->xyz.data(), *uvs = L->uv.data();
+    int *fc = L->face.data();
+#pragma omp parallel num_threads(nthreads) if (ncand > 4096)
+    {
+        cmcad::adaptors ta(m);
+        const int nt = omp_get_num_threads();
+        const bool master = omp_get_thread_num() == 0;
+#pragma omp for schedule(static)
+        for (long r = 0; r < (long)rows.size(); ++r) {
+            int stopped;
+#pragma omp atomic read
+            stopped = stop;
+            if (stopped) continue;
+            if (master && r % 64 == 0 &&
+                cm_progress(ctx, "sample",
+                            std::min((double)rows.size() * 0.5 + (double)r * nt / 2,
+                                     (double)rows.size()),
+                            (double)rows.size()) < 0) {
+#pragma omp atomic write
+                stop = 1;
+                continue;
+            }
+            try {
+                const row &rw = rows[r];
+                const double *ur = m->face_info[rw.face].uv_range;
+                BRepAdaptor_Surface &S = ta.surface(rw.face);
+                size_t j = first[(size_t)r];
+                for (int i = 0; i < rw.nu; ++i) {
+                    if (!keep[rw.offset + (size_t)i]) continue;
+                    double u = ur[0] + (ur[1] - ur[0]) * (i + 0.5) / rw.nu;
+                    gp_Pnt p = S.Value(u, rw.v);
+                    xyz[3 * j] = p.X(), xyz[3 * j + 1] = p.Y(), xyz[3 * j + 2] = p.Z();
+                    uvs[2 * j] = u, uvs[2 * j + 1] = rw.v;
+                    fc[j++] = rw.face;
+                }
+            } catch (...) {
+                err.capture();
+            }
+        }
+    }
+    if (err.status != CM_OK) return err.report(ctx, fn);
+    if (stop) return CM_ERR_INTERRUPTED;
+    if ((st = cm_progress(ctx, "sample", (double)rows.size(), (double)rows.size())) < 0) return st;
+    std::vector<char>().swap(keep);
+    double clock1 = cm_wtime();
     if (L->face.empty())
         return cm_error(ctx, CM_ERR_CAD, "%s: no sample inside any face", fn);
     double clock2 = cm_wtime();
-    // the edges and the kD-trees take as long as the grid at 10^6 samples: points between
-    // them (the sampling's stage, at its end)
-    if ((st = cm_progress(ctx, "sample", (double)rows.size(), (double)rows.size())) < 0) return st;
-    st = cm_kdtree_create(ctx, L->xyz.data(), L->face.size(), &L->tree);
+    // the tree reads the locator's own samples (stored once: they live as long as the tree)
+    st = cm_kdtree_create_borrowed(ctx, L->xyz.data(), L->face.size(), &L->tree);
     if (st == CM_OK) st = cm_progress(ctx, "sample", (double)rows.size(), (double)rows.size());
     if (st == CM_OK && !L->eedge.empty())
         st = cm_kdtree_create(ctx, L->exyz.data(), L->eedge.size(), &L->etree);
@@ -247,15 +308,15 @@ cm_status build(cm_context *ctx, cm_cad_locator *L, const cm_cad_sample_options 
         st = cm_kdtree_create(ctx, m->vertex_xyz.data(), (size_t)m->counts.vertices, &L->vtree);
     if (st != CM_OK) return st;
     cm_log(ctx, CM_LOG_DEBUG,
-           "sampling: %zu samples (%zu on edges) at h = %g; grid %.3f s, compaction + edges %.3f s, "
+           "sampling: %zu samples (%zu on edges) at h = %g; grid and edges %.3f s, "
            "kD-trees %.3f s",
-           L->face.size(), L->eedge.size(), h, clock1 - clock0, clock2 - clock1,
+           L->face.size(), L->eedge.size(), h, clock1 - clock0,
            cm_wtime() - clock2);
     if (h != h_asked)
         return cm_error(ctx, CM_WARNING,
-                        "%s: h = %g would give about %zu samples, over the cap of %zu: "
+                        "%s: h = %g would give about %.3g samples, over the cap of %zu: "
                         "h raised to %g (%zu samples)",
-                        fn, h_asked, total_asked, cap, h, L->face.size());
+                        fn, h_asked, (double)total_asked, cap, h, L->face.size());
     return CM_OK;
 }
 
@@ -268,6 +329,15 @@ void cm_cad_sample_options_init(cm_cad_sample_options *opt)
     if (!opt) return;
     opt->h = 0;
     opt->max_samples = default_cap;
+}
+
+size_t cm_cad_sample_cap(size_t boundary_nodes, size_t max_cap)
+{
+    size_t cap = boundary_nodes > CM_CAD_MIN_SAMPLES / CM_CAD_SAMPLES_PER_NODE
+                     ? boundary_nodes * CM_CAD_SAMPLES_PER_NODE
+                     : CM_CAD_MIN_SAMPLES;
+    if (boundary_nodes > SIZE_MAX / CM_CAD_SAMPLES_PER_NODE) cap = SIZE_MAX;
+    return max_cap && cap > max_cap ? max_cap : cap;
 }
 
 cm_status cm_cad_locator_create(cm_context *ctx, const cm_cad_model *model,

@@ -60,8 +60,18 @@ static cm_status make_locator(cm_context *ctx, const cm_morpher *mp, const cm_ca
     cm_cad_sample_options so;
     cm_cad_sample_options_init(&so);
     so.h = mp->info.h * (scale > 1 ? scale : 1);
-    so.max_samples = mp->opt.max_samples ? mp->opt.max_samples : CM_MORPH_MAX_SAMPLES;
-    return cm_cad_locator_create(ctx, g, &so, loc);
+    /* by default the samples scale with the boundary (cm_cad_sample_cap): a coarser h than the
+     * shortest edge asks for is the rule on real parts, not news (the projections are Newton's
+     * on the CAD faces); a cap the caller set is reported when it bites */
+    so.max_samples = mp->opt.max_samples
+                         ? mp->opt.max_samples
+                         : cm_cad_sample_cap(mp->b->n_nodes, CM_MORPH_MAX_SAMPLES);
+    cm_status s = cm_cad_locator_create(ctx, g, &so, loc);
+    if (s == CM_WARNING && !mp->opt.max_samples) {
+        cm_log(ctx, CM_LOG_DEBUG, "%s", cm_context_message(ctx));
+        s = CM_OK;
+    }
+    return s;
 }
 
 /* keep_offset: the surface morph of g onto itself puts every node on its point of g (the same
@@ -196,7 +206,6 @@ void cm_morpher_destroy(cm_morpher **morpher)
     cm_morpher *mp = *morpher;
     drop_warps(mp);
     cm_cad_locator_destroy(&mp->loc);
-    cm_cad_locator_destroy(&mp->target_loc);
     cm_surface_nodes_destroy(&mp->nodes);
     cm_mesh_boundary_destroy(&mp->b);
     cm_mesh_destroy(&mp->mesh);
@@ -283,28 +292,21 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
  * again at a freed one's address is another model). */
 static int is_last_target(const cm_morpher *mp, const cm_cad_model *target)
 {
-    if (target != mp->target || !mp->target_loc) return 0;
+    if (target != mp->target) return 0;
     double bb[6];
     cm_cad_bbox(target, bb);
     return !memcmp(bb, mp->target_bb, sizeof bb);
 }
 
-/* The locator of target (for distances), kept while the same target comes back. */
-static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
-                            double *t_sample)
+/* The target, checked once to correspond to G (kept while the same target comes back). The
+ * distances to it are projections onto its entities (node_distance.c): no samples of it. */
+static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target)
 {
     if (is_last_target(mp, target)) return CM_OK;
     cm_status s = target == mp->g ? CM_OK : cm_cad_compare(ctx, mp->g, target, 5);
     if (s < 0) return cm_error_prefix(ctx, s, "the target does not correspond to G");
-    double t0 = cm_wtime();
-    cm_cad_locator_destroy(&mp->target_loc);
-    mp->target = NULL;
-    s = make_locator(ctx, mp, target, mp->opt.target_h_scale, &mp->target_loc);
-    if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
-    if (s < 0) return s;
     mp->target = target;
     cm_cad_bbox(target, mp->target_bb);
-    *t_sample = cm_wtime() - t0;
     return CM_OK;
 }
 
@@ -501,7 +503,8 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
            t_apply, row->t_evaluation - t_apply);
     double t2 = cm_wtime();
     if (s >= 0)
-        s = cm_surface_max_distance(ctx, mp->target_loc, mp->bxyz, nd->n, &row->max_dist, NULL);
+        s = cm_morph_node_distances(ctx, mp->target, nd, mp->bxyz, f == 1.0, &row->max_dist,
+                                    NULL);
     row->t_distance = cm_wtime() - t2;
     if (s < 0) return s;
     row->min_sj = all.min;
@@ -720,8 +723,7 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
         return cm_error(ctx, CM_ERR_ARGUMENT,
                         "cm_morpher_apply: the last cm_morpher_rebase failed; rebase again first");
     mp->n_rows = 0;
-    double t_sample = 0;
-    cm_status s = use_target(ctx, mp, target, &t_sample);
+    cm_status s = use_target(ctx, mp, target);
     if (s < 0) return s;
     double t0 = cm_wtime();
     s = cm_morpher_surface_positions(ctx, mp, target, method->surface, mp->bnew);
@@ -739,7 +741,6 @@ cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_
     if (s == CM_WARNING && !warning[0])
         snprintf(warning, sizeof warning, "%s", cm_context_message(ctx));
     if (mp->n_rows) {
-        mp->rows[0].t_sample += t_sample;
         mp->rows[0].t_surface += t_surface;
     }
     if (out_row && mp->n_rows) {
@@ -782,13 +783,7 @@ cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *mp, const cm_cad_model 
     if (g != mp->g) {
         cm_status s = cm_cad_compare(ctx, mp->g, g, 5);
         if (s < 0) return cm_error_prefix(ctx, s, "the new base does not correspond to G");
-        cm_cad_locator_destroy(&mp->loc);
-        if (is_last_target(mp, g) && !(mp->opt.target_h_scale > 1)) {
-            /* the usual case: rebase onto the last target, sampled at the classification h */
-            mp->loc = mp->target_loc;
-            mp->target_loc = NULL;
-            mp->target = NULL;
-        }
+        cm_cad_locator_destroy(&mp->loc); /* classify samples g */
         mp->g = g;
     }
     memcpy(mp->mesh->xyz, xyz, 3 * mp->mesh->n_nodes * sizeof *xyz);

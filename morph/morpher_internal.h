@@ -25,11 +25,10 @@ struct cm_morpher {
         cm_warp *warp1; /* with motion: pass 1, the slide nodes free; else NULL */
     } warps[CM_MORPHER_MAX_WARPS];
     int n_warps;
-    const cm_cad_model *target; /* the last target (borrowed), its bounding box (so that another
-                                   model read at the same address is not taken for it) and
-                                   its locator */
+    const cm_cad_model *target; /* the last target (borrowed, checked to correspond to g) and its
+                                   bounding box (so that another model read at the same
+                                   address is not taken for it) */
     double target_bb[6];
-    cm_cad_locator *target_loc;
     cm_mesh *work; /* a copy of mesh whose coordinates are the result being measured */
     double *sj;    /* work's scaled_jacobian field */
     double *disp;  /* #nodes x 3 */
@@ -73,5 +72,14 @@ cm_status cm_morpher_surface_positions(cm_context *ctx, cm_morpher *mp,
  * tets of different physical groups) and their nodes (interfaces.c); *n_added: how many. */
 cm_status cm_morph_add_interfaces(cm_context *ctx, const cm_mesh *mesh, cm_mesh_boundary *b,
                                   size_t *n_added);
+
+/* The largest distance of the boundary nodes at xyz (nd->n x 3, in nd's order) to G': each
+ * node to the vertex, edge or face of g2 that its entity of G corresponds to, projected onto
+ * the CAD entity itself (node_distance.c); *worst: its node (index into nd). thorough: the
+ * final positions, where a face node that Newton from its (u,v) on G leaves off the face is
+ * projected again from a grid start. */
+cm_status cm_morph_node_distances(cm_context *ctx, const cm_cad_model *g2,
+                                  const cm_surface_nodes *nd, const double *xyz, int thorough,
+                                  double *max_dist, size_t *worst);
 
 #endif

@@ -182,6 +182,7 @@ cm_status cm_surface_cad_sets(cm_context *ctx, const cm_cad_model *g, const cm_m
         cm_cad_sample_options so;
         cm_cad_sample_options_init(&so);
         so.h = hmin / 4;
+        so.max_samples = cm_cad_sample_cap(b->n_nodes, 0);
         s = cm_cad_locator_create(ctx, g, &so, &loc);
     }
     if (s >= 0) s = cm_surface_classify(ctx, g, loc, mesh, b, NULL, &sn);

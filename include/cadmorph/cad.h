@@ -274,6 +274,14 @@ typedef struct cm_cad_sample_options {
 
 CM_API void cm_cad_sample_options_init(cm_cad_sample_options *opt);
 
+/* The samples worth their memory for projecting the boundary nodes of a mesh: they only
+ * start the Newton projections and name the candidate faces, so a few dozen per boundary node
+ * suffice (CM_CAD_SAMPLES_PER_NODE, at least CM_CAD_MIN_SAMPLES), at most max_cap (0: no
+ * upper bound). A sample costs about 60 bytes. */
+#define CM_CAD_SAMPLES_PER_NODE 64
+#define CM_CAD_MIN_SAMPLES ((size_t)250000)
+CM_API size_t cm_cad_sample_cap(size_t boundary_nodes, size_t max_cap);
+
 /* Samples every face inside its trimmed domain on a grid whose step adapts to the surface
  * metric (3D spacing close to h) plus points on every edge (each with the uv of its pcurve in
  * each adjacent face), then builds the kD-trees. The model must outlive the locator. */

@@ -14,6 +14,10 @@ typedef struct cm_kdtree cm_kdtree;
 /* Builds the tree on n points. xyz: n x 3 double (copied; the tree does not keep it).
  * n must be at least 1 and below 2^31 (FLANN indexes with int). */
 CM_API cm_status cm_kdtree_create(cm_context *ctx, const double *xyz, size_t n, cm_kdtree **tree);
+/* The same on points the caller keeps alive and unchanged until the tree is destroyed (not
+ * copied: a locator's millions of samples are stored once). */
+CM_API cm_status cm_kdtree_create_borrowed(cm_context *ctx, const double *xyz, size_t n,
+                                           cm_kdtree **tree);
 CM_API void cm_kdtree_destroy(cm_kdtree **tree);
 
 /* Number of points in the tree. */

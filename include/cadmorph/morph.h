@@ -28,7 +28,7 @@ extern "C" {
 #endif
 
 /* Samples on G beyond this are not worth their memory for the meshes cadmorph morphs; the
- * locator grows h instead and says so (a warning, never silent). */
+ * locator grows h instead. */
 #define CM_MORPH_MAX_SAMPLES ((size_t)4000000)
 
 /* A morph method: how the boundary reaches G' and how the interior follows. */
@@ -87,14 +87,12 @@ typedef struct cm_morph_options {
     int escalate;
     cm_optimize_options optimize_options;
     const char *cad_unit; /* target unit of STEP files read by cm_morph_run; NULL = "mm" */
-    /* Samples of each model for the locators: h is a quarter of the shortest boundary edge,
-     * raised (with a warning) if that needs more than max_samples; 0: CM_MORPH_MAX_SAMPLES. */
+    /* Samples of G for its locator: h is a quarter of the shortest boundary edge, raised if
+     * that needs more than max_samples (with a warning when max_samples was set); 0:
+     * cm_cad_sample_cap(boundary nodes, CM_MORPH_MAX_SAMPLES), 64 per boundary node. */
     size_t max_samples;
-    /* h of the locators on target geometries, which only measure max_dist (points that the
-     * surface morph put on the target), as a multiple of the classification h; values <= 1
-     * mean 1 (the default). Absolute studies raise it: sampling each target at the fine h
-     * would cost more than the morph itself. A rebase onto a target sampled coarser samples
-     * it again at the classification h. */
+    /* Kept for compatibility, no longer used: targets are not sampled (max_dist projects each
+     * node onto its own entity of G'), a rebase samples its new G at the classification h. */
     double target_h_scale;
     cm_classify_options classify; /* its keep_off is set from off_cad */
     cm_surface_morph_options morph; /* its method field is replaced by method.surface */
@@ -125,9 +123,11 @@ typedef struct cm_morph_step {
     int step;
     double min_sj, mean_sj;
     size_t inverted, cells;
-    double max_dist; /* largest distance of the boundary nodes to G' after this step (by
-                        projection through a locator on G'); before the last step the
-                        boundary is a linear blend, so this is how far it still is */
+    double max_dist; /* largest distance of the boundary nodes to G' after this step: each
+                        node projected onto its own vertex, edge or face of G' (the CAD
+                        entity, not samples of it; an upper bound of the distance to G', exact
+                        for a node on its entity); before the last step the boundary is a
+                        linear blend, so this is how far it still is */
     size_t outside;  /* face nodes whose (u',v') left the trimmed face (cm_surface_morph_stats) */
     double residual; /* the warp's miss at the constrained nodes (cm_warp_residual) */
     double fraction; /* of the boundary motion this row reaches (1 for the last) */
@@ -265,7 +265,7 @@ typedef struct cm_morph_result {
     cm_morph_step *steps; /* n_steps rows: each leg's rows (of a --via chain) in order */
     size_t counts[3];     /* boundary nodes on vertices, edges, faces */
     cm_surface_morph_stats surface;
-    double max_dist; /* largest distance of the final boundary nodes to G' */
+    double max_dist; /* largest distance of the final boundary nodes to G' (as the steps') */
     double diagonal; /* bbox diagonal of G' (for relative tolerances) */
     double h;        /* sampling h actually used on G */
     size_t off_cad_nodes, off_cad_components; /* off G (CM_OFF_CAD_FIXED) */

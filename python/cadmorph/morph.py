@@ -265,9 +265,9 @@ class Morpher:
             (kept in place: whole boundary components off G, e.g. a wind tunnel).
         keep_offset [--keep-offset]: boundary nodes keep their offset from G (a mesh
             snapped near G) instead of landing on G'.
-        max_samples: cap on the samples of each model for the locators (None: the
-            library's 4e6); target_h_scale: the targets' sampling step as a multiple of
-            G's, >= 1 (studies raise it: distances only).
+        max_samples: cap on the samples of G for its locator (None: 64 per boundary
+            node, at least 250,000, at most 4e6); target_h_scale: no longer used (the
+            targets are not sampled), >= 1.
         surface_spacing (>= 0, 0: automatic), surface_min_per_edge (2..100000, default 8),
             surface_max_per_edge (default 200), affine_tol ([0, 1), default 1e-9; 0 off):
             the surface morph's options (surface.h).

@@ -72,3 +72,18 @@ add_test(NAME cad_cli_morph_nurbs_in_place COMMAND ${CM_PYTHON}
          ${CM_CAD_WORK}/part_nurbs_m.vtu 1e-9 diagonal)
 set_tests_properties(cad_cli_morph_nurbs_in_place PROPERTIES LABELS "cad;cli"
                      FIXTURES_REQUIRED cad_part_nurbs_m)
+
+# An independent distance of a mesh's boundary nodes to a STEP model (OpenCASCADE's reader and
+# BRepExtrema_DistShapeShape, no cadmorph CAD code): checks the distance figures cadmorph reports.
+add_executable(brep_distance brep_distance.cpp)
+target_link_libraries(brep_distance PRIVATE cm_warnings cm_occ cm_mesh cm_core)
+# The FreeCAD shaft's TetGen mesh asks for a sampling step of 1/6000 of the part: G is sampled
+# within its boundary-node budget, without a warning, and the largest distance to G' that the
+# morph reports is BRepExtrema's (benchmarks/RESULTS.md, "Sampling memory and the boundary
+# distance").
+foreach(mode samples distance)
+  add_test(NAME cad_morph_sampling_${mode} COMMAND ${CM_PYTHON}
+           ${CMAKE_CURRENT_LIST_DIR}/check_sampling.py $<TARGET_FILE:cadmorph>
+           $<TARGET_FILE:brep_distance> ${CM_TEST_DATA} ${CM_CAD_WORK} ${mode})
+  set_tests_properties(cad_morph_sampling_${mode} PROPERTIES LABELS "cad;cli")
+endforeach()

@@ -67,6 +67,13 @@ cm_morph_cli(cli_morph_unit ${CM_RUN_CLI} --exit 2 --stderr-lines 1
   --absent ${SW}/cli_bad3.vtu --
   $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
   --mesh ${SW}/hole_a_metres.msh -o ${SW}/cli_bad3.vtu)
+# the mesh in metres against the model in millimetres with --off-cad fixed: the run ends on the
+# contact error, and stderr has that one line (the sampling warned about its cap twice before,
+# once for G and once for G')
+cm_morph_cli(cli_morph_unit_once ${CM_RUN_CLI} --exit 2 --stderr-lines 1
+  --stderr "^cadmorph morph: .*touches the fixed surface off it" --
+  $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
+  --mesh ${SW}/hole_a_metres.msh -o ${SW}/cli_unit_once.vtu --off-cad fixed)
 cm_morph_cli(cli_morph_unit_fixed ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
   $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
   --mesh ${SW}/hole_a_metres.msh -o ${SW}/cli_metres.vtu --cad-unit m)
