@@ -8,6 +8,7 @@
 #include "cadmorph/optimize.h"
 #include "cadmorph/tetmesh.h"
 
+#include "gmsh_child.h"
 #include "tetgen_run.h"
 #include "tetmesh_assembly.h"
 #include "tetmesh_gmsh.h"
@@ -23,6 +24,8 @@
 #include <set>
 #include <string>
 #include <vector>
+
+using cmvol::orient;
 
 namespace {
 
@@ -40,15 +43,6 @@ struct mesh_guard {
     cm_mesh *m = nullptr;
     ~mesh_guard() { cm_mesh_destroy(&m); }
 };
-
-double orient(const double *a, const double *b, const double *c, const double *d)
-{
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0]);
-}
 
 // Projects the boundary nodes TetGen added (index >= first) onto the CAD model: onto the face
 // when all their boundary triangles lie on one face, else onto the nearest edge between

@@ -9,13 +9,7 @@
 
 #include "cadmorph/tetmesh.h"
 #include "child_process.h"
-
-// gmshc.h declares C functions without extern "C" of its own
-extern "C" {
-#include <gmshc.h>
-}
-
-#include <dlfcn.h>
+#include "gmsh_child.h"
 
 #include <algorithm>
 #include <array>
@@ -26,42 +20,9 @@ extern "C" {
 #include <set>
 #include <string>
 
-#ifndef CM_GMSH_SONAME
-#define CM_GMSH_SONAME "libgmsh.so"
-#endif
+using cmvol::orient;
 
 namespace {
-
-// gmsh's library is opened in the child only (see tetmesh_gmsh.cpp); the prototypes are
-// gmshc.h's own.
-#define CM_ASM_FUNCTIONS(X)                                                                        \
-    X(gmshInitialize) X(gmshFree) X(gmshLoggerGetLastError) X(gmshOptionSetNumber)                \
-    X(gmshOptionSetString) X(gmshModelOccImportShapes) X(gmshModelOccFragment)                    \
-    X(gmshModelOccSynchronize) X(gmshModelGetBoundingBox) X(gmshModelMeshGenerate)                \
-    X(gmshModelMeshGetNodes) X(gmshModelMeshGetElementsByType) X(gmshModelGetEntities)
-
-struct gmsh_api {
-#define CM_ASM_MEMBER(f) decltype(&::f) f = nullptr;
-    CM_ASM_FUNCTIONS(CM_ASM_MEMBER)
-#undef CM_ASM_MEMBER
-};
-
-int load_gmsh(gmsh_api *g, char *err, size_t n)
-{
-    void *lib = dlopen(CM_GMSH_SONAME, RTLD_NOW | RTLD_LOCAL);
-    if (!lib) {
-        std::snprintf(err, n, "cannot load gmsh's library (Debian package libgmsh4.8): %s", dlerror());
-        return 1;
-    }
-#define CM_ASM_LOAD(f)                                                                             \
-    if (!(g->f = reinterpret_cast<decltype(&::f)>(dlsym(lib, #f)))) {                              \
-        std::snprintf(err, n, "%s has no %s", CM_GMSH_SONAME, #f);                                 \
-        return 1;                                                                                  \
-    }
-    CM_ASM_FUNCTIONS(CM_ASM_LOAD)
-#undef CM_ASM_LOAD
-    return 0;
-}
 
 const uint64_t record_magic = 0x636d61736d626c79ULL;  // "cmasmbly"
 
@@ -88,31 +49,20 @@ int send_failure(int fd, const char *msg)
     return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
 }
 
-int send_error(const gmsh_api &G, int fd, const char *what)
+int send_error(const cmvol::gmsh_api &G, int fd, const char *what)
 {
-    char *err = nullptr;
-    int ierr = 0;
-    G.gmshLoggerGetLastError(&err, &ierr);
-    char msg[400];
-    std::snprintf(msg, sizeof msg, "%s%s%s", what, err && *err ? ": " : "", err ? err : "");
+    char msg[sizeof(header::msg)];
+    cmvol::gmsh_error_text(G, what, msg, sizeof msg);
     return send_failure(fd, msg);
 }
 
 int child_work(void *arg, int fd)
 {
     const job &j = *static_cast<const job *>(arg);
-    gmsh_api G;
-    char lerr[300];
-    if (load_gmsh(&G, lerr, sizeof lerr)) return send_failure(fd, lerr);
+    cmvol::gmsh_api G;
+    char msg0[sizeof(header::msg)];
+    if (cmvol::gmsh_start(&G, j.unit, msg0, sizeof msg0)) return send_failure(fd, msg0);
     int ierr = 0;
-    G.gmshInitialize(0, nullptr, 0, &ierr);
-    if (ierr) return send_error(G, fd, "initialisation failed");
-    G.gmshOptionSetNumber("General.Terminal", 0, &ierr);
-    G.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
-    G.gmshOptionSetNumber("Mesh.MaxNumThreads1D", 1, &ierr);
-    G.gmshOptionSetNumber("Mesh.MaxNumThreads2D", 1, &ierr);
-    G.gmshOptionSetNumber("Mesh.MaxNumThreads3D", 1, &ierr);
-    G.gmshOptionSetString("Geometry.OCCTargetUnit", j.unit, &ierr);
     int *dt = nullptr;
     size_t ndt = 0;
     G.gmshModelOccImportShapes(j.path, &dt, &ndt, 1, "", &ierr);
@@ -205,24 +155,6 @@ int child_work(void *arg, int fd)
     return 0;  // no gmshFinalize, no frees: the process ends here
 }
 
-const char *occ_unit(const char *u)
-{
-    static const char *const map[][2] = {{"mm", "MM"}, {"cm", "CM"}, {"m", "M"},   {"km", "KM"},
-                                         {"in", "INCH"}, {"ft", "FT"}, {"mi", "MI"}, {"um", "UM"}};
-    for (const auto &m : map)
-        if (u && !std::strcmp(u, m[0])) return m[1];
-    return "MM";
-}
-
-double orient(const double *a, const double *b, const double *c, const double *d)
-{
-    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    const double w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
-    return u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
-           u[2] * (v[0] * w[1] - v[1] * w[0]);
-}
-
 struct mesh_guard {
     cm_mesh *m = nullptr;
     ~mesh_guard() { cm_mesh_destroy(&m); }
@@ -243,7 +175,7 @@ struct raw {
 cm_status run_child(cm_context *ctx, const cm_cad_model *model, double h, double time_limit, raw *r)
 {
     const char *path = cm_cad_path(model);
-    job j = {path, occ_unit(cm_cad_unit(model)), h};
+    job j = {path, cm_cad_unit(model), h};
     char *data = nullptr;
     size_t size = 0;
     cm_child_outcome o;

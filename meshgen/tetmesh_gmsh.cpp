@@ -8,13 +8,7 @@
 #include "tetmesh_gmsh.h"
 
 #include "child_process.h"
-
-// gmshc.h declares C functions without extern "C" of its own
-extern "C" {
-#include <gmshc.h>
-}
-
-#include <dlfcn.h>
+#include "gmsh_child.h"
 
 #include <algorithm>
 #include <cctype>
@@ -25,44 +19,7 @@ extern "C" {
 #include <map>
 #include <string>
 
-#ifndef CM_GMSH_SONAME
-#define CM_GMSH_SONAME "libgmsh.so"
-#endif
-
 namespace {
-
-// gmsh's library is opened in the child only: linked into cadmorph it would load 60 more
-// shared libraries (FLTK, OpenGL, X11, ...) into every command, 0.15 s CPU each start.
-// The prototypes are gmshc.h's own.
-#define CM_GMSH_FUNCTIONS(X)                                                                       \
-    X(gmshInitialize) X(gmshFree) X(gmshLoggerGetLastError) X(gmshOptionSetNumber)                \
-    X(gmshOptionSetString) X(gmshModelOccImportShapes) X(gmshModelOccSynchronize)                 \
-    X(gmshModelGetBoundingBox) X(gmshModelMeshGenerate) X(gmshModelMeshGetNodes)                  \
-    X(gmshModelMeshGetElementsByType) X(gmshModelGetEntities)
-
-struct gmsh_api {
-#define CM_GMSH_MEMBER(f) decltype(&::f) f = nullptr;
-    CM_GMSH_FUNCTIONS(CM_GMSH_MEMBER)
-#undef CM_GMSH_MEMBER
-};
-
-// 0 on success, else the loader's message in err
-int load_gmsh(gmsh_api *g, char *err, size_t n)
-{
-    void *lib = dlopen(CM_GMSH_SONAME, RTLD_NOW | RTLD_LOCAL);
-    if (!lib) {
-        std::snprintf(err, n, "cannot load gmsh's library (Debian package libgmsh4.8): %s", dlerror());
-        return 1;
-    }
-#define CM_GMSH_LOAD(f)                                                                            \
-    if (!(g->f = reinterpret_cast<decltype(&::f)>(dlsym(lib, #f)))) {                              \
-        std::snprintf(err, n, "%s has no %s", CM_GMSH_SONAME, #f);                                 \
-        return 1;                                                                                  \
-    }
-    CM_GMSH_FUNCTIONS(CM_GMSH_LOAD)
-#undef CM_GMSH_LOAD
-    return 0;
-}
 
 const uint64_t record_magic = 0x636d676d73686d73ULL;  // "cmgmshms"
 
@@ -78,46 +35,34 @@ struct header {
 
 struct job {
     const char *path;
-    const char *unit;  // OpenCASCADE's name of the target unit ("MM", "M", "INCH", ...)
+    const char *unit;  // cm_cad_unit's name of the model's unit
     double h;
     double volume, max_tets;  // the model's volume (ours), the bound on the estimate
 };
 
-int send_error(const gmsh_api &G, int fd, const char *what)
+int send_failure(int fd, const char *msg)
 {
     header hd = {};
     hd.magic = record_magic;
     hd.failed = 1;
-    char *err = nullptr;
-    int ierr = 0;
-    G.gmshLoggerGetLastError(&err, &ierr);
-    std::snprintf(hd.msg, sizeof hd.msg, "%s%s%s", what, err && *err ? ": " : "", err ? err : "");
-    if (err) G.gmshFree(err);
+    std::snprintf(hd.msg, sizeof hd.msg, "%s", msg);
     return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
+}
+
+int send_error(const cmvol::gmsh_api &G, int fd, const char *what)
+{
+    char msg[sizeof(header::msg)];
+    cmvol::gmsh_error_text(G, what, msg, sizeof msg);
+    return send_failure(fd, msg);
 }
 
 int child_work(void *arg, int fd)
 {
     const job &j = *static_cast<const job *>(arg);
-    gmsh_api G;
-    char lerr[300];
-    if (load_gmsh(&G, lerr, sizeof lerr)) {
-        header hd = {};
-        hd.magic = record_magic;
-        hd.failed = 1;
-        std::snprintf(hd.msg, sizeof hd.msg, "%s", lerr);
-        return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
-    }
+    cmvol::gmsh_api G;
+    char msg[sizeof(header::msg)];
+    if (cmvol::gmsh_start(&G, j.unit, msg, sizeof msg)) return send_failure(fd, msg);
     int ierr = 0;
-    G.gmshInitialize(0, nullptr, 0, &ierr);
-    if (ierr) return send_error(G, fd, "initialisation failed");
-    // quiet (errors still reach the logger), one thread: the fork left no OpenMP pool behind
-    G.gmshOptionSetNumber("General.Terminal", 0, &ierr);
-    G.gmshOptionSetNumber("General.NumThreads", 1, &ierr);
-    G.gmshOptionSetNumber("Mesh.MaxNumThreads1D", 1, &ierr);
-    G.gmshOptionSetNumber("Mesh.MaxNumThreads2D", 1, &ierr);
-    G.gmshOptionSetNumber("Mesh.MaxNumThreads3D", 1, &ierr);
-    G.gmshOptionSetString("Geometry.OCCTargetUnit", j.unit, &ierr);
     int *dt = nullptr;
     size_t ndt = 0;
     G.gmshModelOccImportShapes(j.path, &dt, &ndt, 0, "", &ierr);
@@ -211,16 +156,6 @@ int child_work(void *arg, int fd)
     return 0;
 }
 
-// OpenCASCADE's unit names (xstep.cascade.unit) for cad.h's target units
-const char *occ_unit(const char *u)
-{
-    static const char *const map[][2] = {{"mm", "MM"}, {"cm", "CM"}, {"m", "M"},   {"km", "KM"},
-                                         {"in", "INCH"}, {"ft", "FT"}, {"mi", "MI"}, {"um", "UM"}};
-    for (const auto &m : map)
-        if (u && !std::strcmp(u, m[0])) return m[1];
-    return "MM";
-}
-
 }  // namespace
 
 double cmvol::surface_layers(const double *xyz, const int64_t *tri, size_t n_tri, double h)
@@ -243,7 +178,7 @@ cm_status cmvol::gmsh_mesh(cm_context *ctx, const cm_cad_model *model, double h,
                            double time_limit, double volume, double max_tets, raw_mesh *out)
 {
     const char *path = cm_cad_path(model);
-    job j = {path, occ_unit(cm_cad_unit(model)), h, volume, max_tets};
+    job j = {path, cm_cad_unit(model), h, volume, max_tets};
     char *data = nullptr;
     size_t size = 0;
     cm_child_outcome o;

@@ -1,0 +1,43 @@
+// What both gmsh children share (tetmesh_gmsh.cpp: one solid; tetmesh_assembly.cpp: solids
+// that touch): gmsh's C API opened by dlopen in the child only, its start with cadmorph's
+// settings, its last error as text; and the orientation of a tet. C++, private to meshgen/.
+#ifndef CADMORPH_MESHGEN_GMSH_CHILD_H
+#define CADMORPH_MESHGEN_GMSH_CHILD_H
+
+// gmshc.h declares C functions without extern "C" of its own
+extern "C" {
+#include <gmshc.h>
+}
+
+#include <cstddef>
+
+namespace cmvol {
+
+// gmsh's library is opened in the child only: linked into cadmorph it would load 60 more
+// shared libraries (FLTK, OpenGL, X11, ...) into every command, 0.15 s CPU each start.
+// The prototypes are gmshc.h's own.
+#define CM_GMSH_FUNCTIONS(X)                                                                       \
+    X(gmshInitialize) X(gmshFree) X(gmshLoggerGetLastError) X(gmshOptionSetNumber)                \
+    X(gmshOptionSetString) X(gmshModelOccImportShapes) X(gmshModelOccFragment)                    \
+    X(gmshModelOccSynchronize) X(gmshModelGetBoundingBox) X(gmshModelMeshGenerate)                \
+    X(gmshModelMeshGetNodes) X(gmshModelMeshGetElementsByType) X(gmshModelGetEntities)
+
+struct gmsh_api {
+#define CM_GMSH_MEMBER(f) decltype(&::f) f = nullptr;
+    CM_GMSH_FUNCTIONS(CM_GMSH_MEMBER)
+#undef CM_GMSH_MEMBER
+};
+
+// Opens gmsh's library into *g and initialises it quiet, on one thread (the fork left no
+// OpenMP pool behind), with OpenCASCADE's target unit for our unit name (cm_cad_unit: "mm",
+// "m", "in", ...). 0 on success, else 1 with the reason in msg.
+int gmsh_start(gmsh_api *g, const char *unit, char *msg, size_t n);
+
+// msg = "what: gmsh's last error" (or what alone when gmsh logged none).
+void gmsh_error_text(const gmsh_api &g, const char *what, char *msg, size_t n);
+
+// Six times the signed volume of tet abcd (> 0: positively oriented, as VTK's).
+double orient(const double *a, const double *b, const double *c, const double *d);
+
+}  // namespace cmvol
+#endif
