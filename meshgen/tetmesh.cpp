@@ -622,9 +622,13 @@ cm_status build(cm_context *ctx, const cm_cad_model *model, const cm_tetmesh_opt
     }
     const int first = o.mesher, second = first == CM_MESHER_GMSH ? CM_MESHER_TETGEN : CM_MESHER_GMSH;
     const double t0 = cm_wtime();
+    // half each: a mesher that hangs (gmsh on a 313-face plate: more than 600 s) leaves the
+    // other time enough (TetGen -Y: seconds; benchmarks/RESULTS.md, Meshers)
     const double first_limit = o.fallback ? CM_TETMESH_FIRST_SHARE * limit : limit;
     s = run_one(ctx, model, o, pl, first, first_limit, out);
-    if (s >= 0 || s == CM_ERR_INTERRUPTED) return s;
+    // a size beyond the tet limit is the size's fault, not the mesher's: the other mesher
+    // would refuse it too
+    if (s >= 0 || s == CM_ERR_INTERRUPTED || s == CM_ERR_NOMEM) return s;
     const std::string why1 = reason(ctx, pl.path);
     if (!o.fallback)
         return cm_error(ctx, s, "%s: %s (the other mesher: --mesher %s)", pl.path, why1.c_str(),

@@ -31,9 +31,9 @@ typedef struct cm_tetmesh_options {
     int optimize;
     /* Refused (CM_ERR_NOMEM, with the estimate) when the tets expected exceed this; <= 0:
      * CM_TETMESH_MAX_TETS. INFINITY lifts the limit. The estimate comes from OpenCASCADE's
-     * surface triangulation at `size` (what TetGen fills; a proxy of gmsh's surface mesh):
-     * its enclosed volume over the volume bound plus a layer of tets per boundary triangle
-     * (benchmarks/RESULTS.md, Meshers: within 3x of the real count on the measured parts). */
+     * surface triangulation at `size` for TetGen, from gmsh's own surface mesh for gmsh:
+     * the enclosed volume over the volume bound plus a layer of tets per boundary
+     * triangle. */
     double max_tets;
     /* Seconds of wall time the meshing may take (each mesher runs in a child process, killed
      * at its limit: CM_ERR_UNSUPPORTED "... did not finish in N s"); <= 0:
@@ -66,8 +66,7 @@ enum { CM_MESHER_TETGEN = 0, CM_MESHER_GMSH = 1 };
 #define CM_TETMESH_TIME_LIMIT 600.0
 
 /* Share of the time limit the first mesher gets when the other may follow: the rest is
- * the fallback's (TetGen's -Y fallback on a 313-face plate takes seconds where gmsh took
- * more than 600 s: benchmarks/RESULTS.md, Meshers). */
+ * the fallback's. */
 #define CM_TETMESH_FIRST_SHARE 0.5
 
 /* Scaled Jacobian below which a tet counts as flat (a millionth as high as it is wide):
