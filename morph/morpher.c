@@ -300,7 +300,7 @@ static int is_last_target(const cm_morpher *mp, const cm_cad_model *target)
 
 /* The target, checked once to correspond to G (kept while the same target comes back). The
  * distances to it are projections onto its entities (node_distance.c): no samples of it. */
-static cm_status use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target)
+cm_status cm_morpher_use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target)
 {
     if (is_last_target(mp, target)) return CM_OK;
     cm_status s = target == mp->g ? CM_OK : cm_cad_compare(ctx, mp->g, target, 5);
@@ -393,72 +393,6 @@ cm_status cm_morpher_surface_positions(cm_context *ctx, cm_morpher *mp,
     return s;
 }
 
-
-cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
-                                  const cm_morph_method *method, double *out_xyz,
-                                  cm_morph_step *out_row)
-{
-    if (!mp || !target || !method || !out_xyz)
-        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_apply: NULL input");
-    if ((int)method->warp.method < 0 || method->warp.method >= CM_WARP_N_METHODS)
-        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_apply: unknown warp method %d",
-                        (int)method->warp.method);
-    if (!mp->nodes)
-        return cm_error(ctx, CM_ERR_ARGUMENT,
-                        "cm_morpher_apply: the last cm_morpher_rebase failed; rebase again first");
-    mp->n_rows = 0;
-    cm_status s = use_target(ctx, mp, target);
-    if (s < 0) return s;
-    double t0 = cm_wtime();
-    s = cm_morpher_surface_positions(ctx, mp, target, method->surface, mp->bnew);
-    if (s < 0) return s;
-    double t_surface = cm_wtime() - t0;
-    char warning[1024] = "";
-    if (s == CM_WARNING) {
-        cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
-        snprintf(warning, sizeof warning, "%s", cm_context_message(ctx));
-    }
-    memcpy(out_xyz, mp->mesh->xyz, 3 * mp->mesh->n_nodes * sizeof *out_xyz);
-    s = mp->opt.steps == CM_MORPH_STEPS_AUTO ? cm_morph_auto_steps(ctx, mp, &method->warp, out_xyz)
-                                             : cm_morph_fixed_steps(ctx, mp, &method->warp, out_xyz);
-    /* allow_inverted finished an adaptive morph with inverted cells (logged already) */
-    if (s == CM_WARNING && !warning[0])
-        snprintf(warning, sizeof warning, "%s", cm_context_message(ctx));
-    if (mp->n_rows) {
-        mp->rows[0].t_surface += t_surface;
-    }
-    if (out_row && mp->n_rows) {
-        /* the last accepted row, with every row's stage times */
-        size_t last = mp->n_rows - 1;
-        while (last > 0 && !mp->rows[last].accepted)
-            --last;
-        *out_row = mp->rows[last];
-        out_row->t_sample = out_row->t_surface = out_row->t_volume_solve = 0;
-        out_row->t_evaluation = out_row->t_distance = 0;
-        for (size_t i = 0; i < mp->n_rows; ++i) {
-            out_row->t_sample += mp->rows[i].t_sample;
-            out_row->t_surface += mp->rows[i].t_surface;
-            out_row->t_volume_solve += mp->rows[i].t_volume_solve;
-            out_row->t_evaluation += mp->rows[i].t_evaluation;
-            out_row->t_distance += mp->rows[i].t_distance;
-        }
-    }
-    if (s < 0) return s;
-    return warning[0] ? cm_error(ctx, CM_WARNING, "%s", warning) : CM_OK;
-}
-
-cm_status cm_morpher_apply(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
-                           double *out_xyz, cm_morph_step *out_row)
-{
-    if (!mp) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_morpher_apply: NULL input");
-    return cm_morpher_apply_method(ctx, mp, target, &mp->opt.method, out_xyz, out_row);
-}
-
-const cm_morph_step *cm_morpher_steps(const cm_morpher *mp, size_t *n)
-{
-    if (n) *n = mp ? mp->n_rows : 0;
-    return mp ? mp->rows : NULL;
-}
 
 cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *mp, const cm_cad_model *g,
                             const double *xyz)

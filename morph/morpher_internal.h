@@ -1,6 +1,6 @@
 /* The morph engine's state, shared by the files of the morph module (morpher.c: create,
  * apply, rebase; velocity.c: the boundary positions and warp products behind the design
- * velocities, docs/DESIGN.md "Gradients"; morph_steps.c: the steps of an apply). Private to
+ * velocities, docs/DESIGN.md "Gradients"; morph_steps.c: an apply and its steps). Private to
  * the morph module. */
 #ifndef CM_MORPH_MORPHER_INTERNAL_H
 #define CM_MORPH_MORPHER_INTERNAL_H
@@ -74,14 +74,9 @@ cm_status cm_morpher_surface_positions(cm_context *ctx, cm_morpher *mp,
 cm_status cm_morpher_make_warps(cm_context *ctx, const cm_morpher *mp, const cm_mesh *mesh,
                                 const cm_warp_options *wo, cm_warp **w, cm_warp **w1);
 
-/* The steps of one apply from M's positions in xyz (morph_steps.c): K equal increments
- * (opt.steps >= 1; unless allow_inverted, the first increment that is not valid ends the
- * morph, xyz the increment before it) or the adaptive steps (CM_MORPH_STEPS_AUTO, see
- * cm_morph_options); xyz gets the last accepted mesh, the rows mp->rows. */
-cm_status cm_morph_fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
-                               double *xyz);
-cm_status cm_morph_auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
-                              double *xyz);
+/* The target, checked once to correspond to G (kept while the same target comes back;
+ * morpher.c). */
+cm_status cm_morpher_use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target);
 
 /* Appends to b the faces of an assembly's interfaces (a triangle of the mesh between two
  * tets of different physical groups) and their nodes (interfaces.c); *n_added: how many. */
