@@ -9,7 +9,11 @@ extern "C" {
 #include <gmshc.h>
 }
 
+#include "child_process.h"
+
 #include <cstddef>
+#include <cstdint>
+#include <cstdio>
 
 namespace cmvol {
 
@@ -35,6 +39,25 @@ int gmsh_start(gmsh_api *g, const char *unit, char *msg, size_t n);
 
 // msg = "what: gmsh's last error" (or what alone when gmsh logged none).
 void gmsh_error_text(const gmsh_api &g, const char *what, char *msg, size_t n);
+
+// Sends a child's failure record: a header H (a record type with magic, failed and a char
+// msg[]) with failed = 1 and msg; the exit status for cm_child_run (3: the pipe failed).
+template <class H> int send_failure(int fd, uint64_t magic, const char *msg)
+{
+    H hd = {};
+    hd.magic = magic;
+    hd.failed = 1;
+    std::snprintf(hd.msg, sizeof hd.msg, "%s", msg);
+    return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
+}
+
+// The failure record of `what` with gmsh's last error (gmsh_error_text).
+template <class H> int send_error(const gmsh_api &g, int fd, uint64_t magic, const char *what)
+{
+    char msg[sizeof(H::msg)];
+    gmsh_error_text(g, what, msg, sizeof msg);
+    return send_failure<H>(fd, magic, msg);
+}
 
 // Six times the signed volume of tet abcd (> 0: positively oriented, as VTK's).
 double orient(const double *a, const double *b, const double *c, const double *d);

@@ -40,20 +40,11 @@ struct job {
     double h;
 };
 
-int send_failure(int fd, const char *msg)
-{
-    header hd = {};
-    hd.magic = record_magic;
-    hd.failed = 1;
-    std::snprintf(hd.msg, sizeof hd.msg, "%s", msg);
-    return cm_child_write(fd, &hd, sizeof hd) ? 3 : 0;
-}
+int send_failure(int fd, const char *msg) { return cmvol::send_failure<header>(fd, record_magic, msg); }
 
 int send_error(const cmvol::gmsh_api &G, int fd, const char *what)
 {
-    char msg[sizeof(header::msg)];
-    cmvol::gmsh_error_text(G, what, msg, sizeof msg);
-    return send_failure(fd, msg);
+    return cmvol::send_error<header>(G, fd, record_magic, what);
 }
 
 int child_work(void *arg, int fd)
