@@ -80,7 +80,15 @@ cm_status cm_rbf_tick_finish(cm_rbf_tick *t);
  * without a tick, else about CM_RBF_TICK_PAIRS worth but at least 8 per thread. */
 long cm_rbf_tick_chunk(const cm_rbf_tick *tick, double per_item, long items, int threads);
 
-/* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (1..4), i < n.
+/* The most columns (weight vectors) one kernel-sum pass shares its entries phi_ij with:
+ * every sum of rbf/sum (plain, compensated, self product, treecode) takes any nc >= 1 and
+ * runs more than this in passes of this many. Each column's sum is the same bits whether
+ * it runs alone or with others (the columns ride along on the same entries, each in its
+ * own order of j), so callers may batch right-hand sides freely. Bounds the work space of
+ * a pass (the self product keeps about 2 (threads + 1) nc m doubles). */
+#define CM_RBF_SUM_MAX_NC 64
+
+/* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (any nc >= 1), i < n.
  * p: dim x n SoA with stride ldp (p + d * ldp is coordinate d), centres as in rbf (SoA,
  * stride m). The sum over j runs in the same order for every i whatever the thread count,
  * except in the r^3 self product on AVX-512 (p = c, n = m >= CM_RBF_SELF_MIN_M), which
@@ -91,7 +99,7 @@ void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                        double *out, size_t ldo, int threads);
 
 /* cm_rbf_kernel_sum of r's kernel and centres for any number of components (w: ncomp x m
- * SoA), four at a time; out: n x ncomp. */
+ * SoA), all in one pass (passes of CM_RBF_SUM_MAX_NC); out: n x ncomp. */
 void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
                            const double *p, size_t ldp, double *out, int threads);
 /* The same in chunks of points with tick (NULL: as cm_rbf_kernel_sum_all); nonzero when the

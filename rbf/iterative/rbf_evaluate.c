@@ -60,8 +60,8 @@ static int tree_sum_all(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree
                         size_t stride, double *out, int threads, cm_rbf_tick *tick)
 {
     const size_t m = r->m, nc = (size_t)r->ncomp;
-    for (size_t g = 0; g < nc; g += 4) {
-        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+    for (size_t g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
+        int gc = nc - g < CM_RBF_SUM_MAX_NC ? (int)(nc - g) : CM_RBF_SUM_MAX_NC;
         if (cm_rbf_tree_sum_targets_tick(t, tg, stride, r->w + g * m, gc, out + g, nc, threads,
                                          tick))
             return -1;
@@ -77,8 +77,8 @@ static double check_all(const cm_rbf *r, const cm_rbf_tree *t, size_t n, const d
 {
     const size_t m = r->m, nc = (size_t)r->ncomp;
     double err = 0.0;
-    for (size_t g = 0; g < nc; g += 4) {
-        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+    for (size_t g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
+        int gc = nc - g < CM_RBF_SUM_MAX_NC ? (int)(nc - g) : CM_RBF_SUM_MAX_NC;
         double e;
         cm_rbf_tree_check(t, r->w + g * m, gc, n, p, n, out + g, nc, samples, idx, &e, NULL,
                           threads);
@@ -121,8 +121,8 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
             for (int d = 0; d < 3; ++d)
                 sp[(size_t)d * ns + k] = p[(size_t)d * n + (size_t)((double)k * (double)n / (double)ns)];
         for (size_t j = 0; j < nc * m; ++j) aw[j] = fabs(r->w[j]);
-        for (size_t g = 0; g < nc; g += 4) {
-            int gc = nc - g < 4 ? (int)(nc - g) : 4;
+        for (size_t g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
+            int gc = nc - g < CM_RBF_SUM_MAX_NC ? (int)(nc - g) : CM_RBF_SUM_MAX_NC;
             cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw + g * m, gc, ns, sp, ns, ab + g,
                               nc, threads);
         }
@@ -153,7 +153,7 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
         const double th = coarse ? theta_c : theta;
         const cm_rbf_tree *t = cm_rbf_iterative_tree(r, o, th);
         if (tick) /* in whole sums; a second row starts over */
-            cm_rbf_tick_restart(tick, (double)((nc + 3) / 4));
+            cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC));
         if (!t || tree_sum_all(r, t, tg, 1, out, threads, tick)) break;
         const double err = check_all(r, t, n, p, out, CM_RBF_FAST_SAMPLES, NULL, threads);
         it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
@@ -184,9 +184,9 @@ int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double
     if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads, tick)) return 0;
     if (tick && tick->status < 0) return 1;
     /* direct sums: a tick of their own, in point-centre pairs */
-    if (tick) cm_rbf_tick_restart(tick, (double)((r->ncomp + 3) / 4) * (double)n * (double)r->m);
-    for (int g = 0; g < r->ncomp; g += 4) {
-        int nc = r->ncomp - g < 4 ? r->ncomp - g : 4;
+    if (tick) cm_rbf_tick_restart(tick, (double)((r->ncomp + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) * (double)n * (double)r->m);
+    for (int g = 0; g < r->ncomp; g += CM_RBF_SUM_MAX_NC) {
+        int nc = r->ncomp - g < CM_RBF_SUM_MAX_NC ? r->ncomp - g : CM_RBF_SUM_MAX_NC;
         if (cm_rbf_kernel_sum_acc_tick(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
                                        (size_t)r->ncomp, threads, tick))
             return 1;
@@ -218,8 +218,8 @@ static int transpose_fast(const cm_rbf *r, size_t n, const double *p, int ncomp,
             for (int d = 0; d < 3; ++d)
                 sp[(size_t)d * ns + k] = r->c[(size_t)d * m + (size_t)((double)k * (double)m / (double)ns)];
         for (size_t j = 0; j < nc * n; ++j) av[j] = fabs(v[j]);
-        for (size_t g = 0; g < nc; g += 4) {
-            int gc = nc - g < 4 ? (int)(nc - g) : 4;
+        for (size_t g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
+            int gc = nc - g < CM_RBF_SUM_MAX_NC ? (int)(nc - g) : CM_RBF_SUM_MAX_NC;
             cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, n, p, av + g * n, gc, ns, sp, ns, ab + g,
                               nc, threads);
             cm_rbf_kernel_sum_acc(n, p, v + g * n, gc, ns, sp, ns, ab + ns * nc + g, nc, threads);
@@ -240,10 +240,10 @@ static int transpose_fast(const cm_rbf *r, size_t n, const double *p, int ncomp,
     cm_rbf_tree *t = cm_rbf_tree_create(n, p, order, theta);
     cm_rbf_tree_targets *tg = t ? cm_rbf_tree_targets_create(m, r->c, m) : NULL;
     int fast = tg != NULL;
-    if (tick) cm_rbf_tick_restart(tick, (double)((nc + 3) / 4));
+    if (tick) cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC));
     double err = 0.0;
-    for (size_t g = 0; fast && g < nc; g += 4) {
-        int gc = nc - g < 4 ? (int)(nc - g) : 4;
+    for (size_t g = 0; fast && g < nc; g += CM_RBF_SUM_MAX_NC) {
+        int gc = nc - g < CM_RBF_SUM_MAX_NC ? (int)(nc - g) : CM_RBF_SUM_MAX_NC;
         if (cm_rbf_tree_sum_targets_tick(t, tg, 1, v + g * n, gc, out + g, nc, threads, tick)) {
             fast = 0;
             break;
@@ -277,9 +277,9 @@ int cm_rbf_iterative_evaluate_transpose(const cm_rbf *r, size_t n, const double 
 {
     if (cm_rbf_iterative_transpose_fast(r, n, p, nc, v, out, threads, tick)) return 0;
     if (tick && tick->status < 0) return 1;
-    if (tick) cm_rbf_tick_restart(tick, (double)((nc + 3) / 4) * (double)n * (double)r->m);
-    for (int g = 0; g < nc; g += 4) {
-        int gc = nc - g < 4 ? nc - g : 4;
+    if (tick) cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) * (double)n * (double)r->m);
+    for (int g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
+        int gc = nc - g < CM_RBF_SUM_MAX_NC ? nc - g : CM_RBF_SUM_MAX_NC;
         if (cm_rbf_kernel_sum_acc_tick(n, p, v + (size_t)g * n, gc, r->m, r->c, r->m, out + g,
                                        (size_t)nc, threads, tick))
             return 1;

@@ -7,12 +7,18 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 
 #define NB 16      /* points held in registers while streaming the centres */
 #define PB CM_RBF_SUM_PB /* points per parallel work item (a multiple of NB) */
 #define TILE 512   /* centres per tile: 7 x 512 doubles stay in L1 */
+#define FB_J 128   /* more than 4 columns: entries of this many centres x NB points kept */
 
 /* log(r2 + tiny) keeps phi(0) = 0 without a branch: r2 = 0 gives 0 * (-690); merged
  * centres are at least 1e-24 apart in r2, so the shift changes nothing else. */
@@ -52,6 +58,16 @@ static inline __attribute__((always_inline)) double log_positive(double x)
     return e * ln2_hi + (e * ln2_lo + (2.0 * s + 2.0 * s * z * p));
 }
 
+/* a + w f: by one FMA where the code is built for FMA hardware (hf), else rounded twice. The
+ * same spelled-out operation in every loop, so that the compiler's contraction cannot make
+ * the columns riding on kept entries (cols_body) round differently from the 4 in registers
+ * (tile_body). */
+static inline __attribute__((always_inline)) double madd(const int hf, double w, double f,
+                                                         double a)
+{
+    return hf ? fma(w, f, a) : a + w * f;
+}
+
 static inline __attribute__((always_inline)) double phi_of_r2(const int kern, double r2)
 {
     switch (kern) {
@@ -62,11 +78,12 @@ static inline __attribute__((always_inline)) double phi_of_r2(const int kern, do
 }
 
 /* Adds the contributions of centres [0, jn) to NB points. */
-static inline __attribute__((always_inline)) void tile_body(const int kern, const int dim,
+static inline __attribute__((always_inline)) void tile_body(const int hf, const int kern, const int dim,
                                                             const int nc, const double *c,
                                                             size_t ldc, const double *w,
                                                             size_t ldw, size_t jn,
-                                                            const double *pt, double *acc)
+                                                            const double *pt, double *acc,
+                                                            const int keep, double *fb)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     double x[NB], y[NB], z[NB], a[4][NB];
@@ -88,43 +105,92 @@ static inline __attribute__((always_inline)) void tile_body(const int kern, cons
                 r2 += dz * dz;
             }
             double f = phi_of_r2(kern, r2);
-            for (int q = 0; q < nc; ++q) a[q][l] += wj[q] * f;
+            if (keep) fb[j * NB + l] = f;
+            for (int q = 0; q < nc; ++q) a[q][l] = madd(hf, wj[q], f, a[q][l]);
         }
     }
     for (int l = 0; l < NB; ++l)
         for (int q = 0; q < nc; ++q) acc[q * PB + l] = a[q][l];
 }
 
-/* All centres against one block of PB points (pt: dim x PB SoA, acc: nc x PB). Tiles of
- * centres in order, so each point's sum has a fixed order. */
-static inline __attribute__((always_inline)) void block_body(const int kern, const int dim,
-                                                             const int nc, size_t m,
-                                                             const double *c, const double *w,
-                                                             const double *pt, double *acc)
+/* Columns [0, nc) (nc <= 4) over the entries of jn centres that the first column group
+ * left in fb: the same multiply-add per entry as tile_body, in the same order of j, so a
+ * column's sum is the same bits whatever group it rides in. */
+static inline __attribute__((always_inline)) void cols_body(const int hf, const int nc, const double *fb,
+                                                            const double *w, size_t ldw,
+                                                            size_t jn, double *acc)
 {
-    for (size_t t0 = 0; t0 < m; t0 += TILE) {
-        size_t jn = m - t0 < TILE ? m - t0 : TILE;
-        for (int b = 0; b < PB; b += NB)
-            tile_body(kern, dim, nc, c + t0, m, w + t0, m, jn, pt + b, acc + b);
+    double a[4][NB];
+    for (int l = 0; l < NB; ++l)
+        for (int q = 0; q < nc; ++q) a[q][l] = acc[q * PB + l];
+    for (size_t j = 0; j < jn; ++j) {
+        double wj[4];
+        for (int q = 0; q < nc; ++q) wj[q] = w[q * ldw + j];
+        for (int l = 0; l < NB; ++l) {
+            const double f = fb[j * NB + l];
+            for (int q = 0; q < nc; ++q) a[q][l] = madd(hf, wj[q], f, a[q][l]);
+        }
+    }
+    for (int l = 0; l < NB; ++l)
+        for (int q = 0; q < nc; ++q) acc[q * PB + l] = a[q][l];
+}
+
+/* More than 4 columns: per stretch of FB_J centres the first 4 compute the entries phi_ij
+ * (kept in fb, L1-resident) and the others run over them four at a time, so each entry is
+ * computed once for all columns. */
+static inline __attribute__((always_inline)) void tile_many(const int hf, const int kern, const int dim,
+                                                            int nc, const double *c, size_t ldc,
+                                                            const double *w, size_t ldw,
+                                                            size_t jn, const double *pt,
+                                                            double *acc, double *fb)
+{
+    for (size_t j0 = 0; j0 < jn; j0 += FB_J) {
+        const size_t jb = jn - j0 < FB_J ? jn - j0 : FB_J;
+        tile_body(hf, kern, dim, 4, c + j0, ldc, w + j0, ldw, jb, pt, acc, 1, fb);
+        for (int g = 4; g < nc; g += 4) {
+            const double *wg = w + (size_t)g * ldw + j0;
+            double *ag = acc + (size_t)g * PB;
+            switch (nc - g) {
+            case 1: cols_body(hf, 1, fb, wg, ldw, jb, ag); break;
+            case 2: cols_body(hf, 2, fb, wg, ldw, jb, ag); break;
+            case 3: cols_body(hf, 3, fb, wg, ldw, jb, ag); break;
+            default: cols_body(hf, 4, fb, wg, ldw, jb, ag); break;
+            }
+        }
     }
 }
 
-/* One instantiation per (kernel, nc) so that the inner loop has constant trip counts. */
-#define CM_BLOCK_DISPATCH                                                                      \
-    switch (kern * 4 + (nc - 1)) {                                                             \
-    case 0: block_body(0, 3, 1, m, c, w, pt, acc); break;                                      \
-    case 1: block_body(0, 3, 2, m, c, w, pt, acc); break;                                      \
-    case 2: block_body(0, 3, 3, m, c, w, pt, acc); break;                                      \
-    case 3: block_body(0, 3, 4, m, c, w, pt, acc); break;                                      \
-    case 4: block_body(1, 3, 1, m, c, w, pt, acc); break;                                      \
-    case 5: block_body(1, 3, 2, m, c, w, pt, acc); break;                                      \
-    case 6: block_body(1, 3, 3, m, c, w, pt, acc); break;                                      \
-    case 7: block_body(1, 3, 4, m, c, w, pt, acc); break;                                      \
-    case 8: block_body(2, 2, 1, m, c, w, pt, acc); break;                                      \
-    case 9: block_body(2, 2, 2, m, c, w, pt, acc); break;                                      \
-    case 10: block_body(2, 2, 3, m, c, w, pt, acc); break;                                     \
-    default: block_body(2, 2, 4, m, c, w, pt, acc); break;                                     \
+/* All centres against one block of PB points (pt: dim x PB SoA, acc: nc x PB). Tiles of
+ * centres in order, so each point's sum has a fixed order. */
+static inline __attribute__((always_inline)) void block_body(const int hf, const int kern, const int dim,
+                                                             const int nc, int ncm, size_t m,
+                                                             const double *c, const double *w,
+                                                             const double *pt, double *acc)
+{
+    double fb[FB_J * NB]; /* nc = 0: more than 4 columns (ncm), tile_many */
+    for (size_t t0 = 0; t0 < m; t0 += TILE) {
+        size_t jn = m - t0 < TILE ? m - t0 : TILE;
+        for (int b = 0; b < PB; b += NB) {
+            if (nc == 0) tile_many(hf, kern, dim, ncm, c + t0, m, w + t0, m, jn, pt + b, acc + b, fb);
+            else tile_body(hf, kern, dim, nc, c + t0, m, w + t0, m, jn, pt + b, acc + b, 0, NULL);
+        }
     }
+}
+
+/* One instantiation per (kernel, nc <= 4) so that the inner loop has constant trip counts;
+ * more columns share the 4-column body's entries (tile_many). */
+#define CM_NC_DISPATCH(k, d)                                                                   \
+    switch (nc) {                                                                              \
+    case 1: block_body(hf, k, d, 1, 1, m, c, w, pt, acc); break;                                   \
+    case 2: block_body(hf, k, d, 2, 2, m, c, w, pt, acc); break;                                   \
+    case 3: block_body(hf, k, d, 3, 3, m, c, w, pt, acc); break;                                   \
+    case 4: block_body(hf, k, d, 4, 4, m, c, w, pt, acc); break;                                   \
+    default: block_body(hf, k, d, 0, nc, m, c, w, pt, acc); break;                                 \
+    }
+#define CM_BLOCK_DISPATCH                                                                      \
+    if (kern == 0) CM_NC_DISPATCH(0, 3)                                                        \
+    else if (kern == 1) CM_NC_DISPATCH(1, 3)                                                   \
+    else CM_NC_DISPATCH(2, 2)
 
 typedef void (*block_fn)(int kern, int nc, size_t m, const double *c, const double *w,
                          const double *pt, double *acc);
@@ -132,6 +198,7 @@ typedef void (*block_fn)(int kern, int nc, size_t m, const double *c, const doub
 static void block_generic(int kern, int nc, size_t m, const double *c, const double *w,
                           const double *pt, double *acc)
 {
+    const int hf = 0;
     CM_BLOCK_DISPATCH
 }
 
@@ -139,6 +206,7 @@ __attribute__((target("avx2,fma"))) static void block_avx2(int kern, int nc, siz
                                                             const double *c, const double *w,
                                                             const double *pt, double *acc)
 {
+    const int hf = 1;
     CM_BLOCK_DISPATCH
 }
 
@@ -146,6 +214,7 @@ __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) static void
 block_avx512(int kern, int nc, size_t m, const double *c, const double *w, const double *pt,
              double *acc)
 {
+    const int hf = 1;
     CM_BLOCK_DISPATCH
 }
 
@@ -253,14 +322,24 @@ void cm_rbf_kernel_sum(cm_rbf_kernel kernel, int dim, size_t m, const double *c,
                           threads);
 }
 
-/* Points of blocks [b0, b1) of PB against all centres. */
+/* Points of blocks [b0, b1) of PB against all centres. work: threads x nc x PB sums for
+ * more than 4 columns (NULL: nc <= 4, on the stack). */
 static void sum_blocks(block_fn fn, int kern, int dim, size_t m, const double *c,
                        const double *w, int nc, size_t n, const double *p, size_t ldp,
-                       double *out, size_t ldo, int threads, int parallel, long b0, long b1)
+                       double *out, size_t ldo, int threads, int parallel, long b0, long b1,
+                       double *work)
 {
-#pragma omp parallel for schedule(static) num_threads(threads) if (parallel)
+#pragma omp parallel num_threads(threads) if (parallel)
+    {
+        double acc4[4 * PB], *acc = acc4;
+#ifdef _OPENMP
+        if (work) acc = work + (size_t)omp_get_thread_num() * (size_t)nc * PB;
+#else
+        if (work) acc = work;
+#endif
+#pragma omp for schedule(static)
     for (long b = b0; b < b1; ++b) {
-        double pt[3 * PB], acc[4 * PB];
+        double pt[3 * PB];
         const size_t i0 = (size_t)b * PB;
         const size_t cnt = n - i0 < PB ? n - i0 : PB;
         for (int d = 0; d < 3; ++d) {
@@ -270,10 +349,11 @@ static void sum_blocks(block_fn fn, int kern, int dim, size_t m, const double *c
                 pt[d * PB + l] = d < dim ? p[d * ldp + i] : 0.0;
             }
         }
-        memset(acc, 0, sizeof acc);
+        memset(acc, 0, (size_t)nc * PB * sizeof *acc);
         fn(kern, nc, m, c, w, pt, acc);
         for (size_t l = 0; l < cnt; ++l)
             for (int q = 0; q < nc; ++q) out[(i0 + l) * ldo + (size_t)q] = acc[q * PB + l];
+    }
     }
 }
 
@@ -283,6 +363,12 @@ static int sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m, cons
                    const double *w, int nc, size_t n, const double *p, size_t ldp, double *out,
                    size_t ldo, int threads, cm_rbf_tick *tick)
 {
+    if (nc > CM_RBF_SUM_MAX_NC) { /* passes of CM_RBF_SUM_MAX_NC: the same bits per column */
+        for (int g = 0; g < nc; g += CM_RBF_SUM_MAX_NC)
+            if (sum_isa(isa, kernel, dim, m, c, w + (size_t)g * m, nc - g < CM_RBF_SUM_MAX_NC ? nc - g : CM_RBF_SUM_MAX_NC, n, p, ldp, out + g, ldo, threads, tick))
+                return 1;
+        return 0;
+    }
     const block_fn fn = pick_block(isa);
     const long nblocks = (long)((n + PB - 1) / PB);
     const int kern = (int)kernel;
@@ -292,14 +378,28 @@ static int sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m, cons
         ldp == m && n == m && m >= CM_RBF_SELF_MIN_M &&
         !cm_rbf_r3_self_avx512(nc, m, c, w, NULL, out, ldo, parallel ? threads : 1))
         return cm_rbf_tick_add(tick, (double)n * (double)m);
-    const long chunk = cm_rbf_tick_chunk(tick, (double)PB * (double)m, nblocks, threads);
-    for (long b0 = 0; b0 < nblocks; b0 += chunk) {
-        const long b1 = nblocks - b0 < chunk ? nblocks : b0 + chunk;
-        sum_blocks(fn, kern, dim, m, c, w, nc, n, p, ldp, out, ldo, threads, parallel, b0, b1);
-        const size_t i1 = (size_t)b1 * PB < n ? (size_t)b1 * PB : n;
-        if (cm_rbf_tick_add(tick, (double)(i1 - (size_t)b0 * PB) * (double)m)) return 1;
+    double *work = NULL;
+    if (nc > 4) {
+        work = malloc((size_t)(parallel ? threads : 1) * (size_t)nc * PB * sizeof *work);
+        if (!work) { /* groups of 4 columns: slower, the same bits */
+            for (int g = 0; g < nc; g += 4)
+                if (sum_isa(isa, kernel, dim, m, c, w + (size_t)g * m, nc - g < 4 ? nc - g : 4,
+                            n, p, ldp, out + g, ldo, threads, tick))
+                    return 1;
+            return 0;
+        }
     }
-    return 0;
+    const long chunk = cm_rbf_tick_chunk(tick, (double)PB * (double)m, nblocks, threads);
+    int stop = 0;
+    for (long b0 = 0; b0 < nblocks && !stop; b0 += chunk) {
+        const long b1 = nblocks - b0 < chunk ? nblocks : b0 + chunk;
+        sum_blocks(fn, kern, dim, m, c, w, nc, n, p, ldp, out, ldo, threads, parallel, b0, b1,
+                   work);
+        const size_t i1 = (size_t)b1 * PB < n ? (size_t)b1 * PB : n;
+        stop = cm_rbf_tick_add(tick, (double)(i1 - (size_t)b0 * PB) * (double)m);
+    }
+    free(work);
+    return stop;
 }
 
 void cm_rbf_kernel_sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m,
@@ -452,7 +552,7 @@ const char *cm_rbf_kernel_name(cm_rbf_kernel k)
     return "unknown";
 }
 
-/* Kernel sums for any number of components, four at a time. */
+/* Kernel sums for any number of components, all in one pass (passes of CM_RBF_SUM_MAX_NC). */
 void cm_rbf_kernel_sum_all(const cm_rbf *r, const double *w, int ncomp, size_t n,
                            const double *p, size_t ldp, double *out, int threads)
 {
@@ -463,8 +563,8 @@ int cm_rbf_kernel_sum_all_tick(const cm_rbf *r, const double *w, int ncomp, size
                                const double *p, size_t ldp, double *out, int threads,
                                cm_rbf_tick *tick)
 {
-    for (int g = 0; g < ncomp; g += 4) {
-        int nc = ncomp - g < 4 ? ncomp - g : 4;
+    for (int g = 0; g < ncomp; g += CM_RBF_SUM_MAX_NC) {
+        int nc = ncomp - g < CM_RBF_SUM_MAX_NC ? ncomp - g : CM_RBF_SUM_MAX_NC;
         if (sum_isa(CM_RBF_ISA_AUTO, r->kernel, r->dim, r->m, r->c, w + (size_t)g * r->m, nc, n,
                     p, ldp, out + g, (size_t)ncomp, threads, tick))
             return 1;

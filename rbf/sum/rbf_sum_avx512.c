@@ -36,6 +36,13 @@
 
 #define NV 4       /* vectors of 8 points held in registers */
 #define TILE 512   /* centres per tile: 3 + 4 rows of 512 doubles stay in L1 */
+/* more than 4 columns: the entries of FB_J centres against the register block kept in an
+ * L1-resident buffer (16 KB plain, 8 KB compensated) for the further column groups */
+#define FB_J 64
+#define FBW (8 * NV)     /* doubles per centre in the plain block's buffer */
+#define PLAIN_CG 6       /* further columns per group, plain: 6 x 4 accumulators + 4 entries */
+#define ACC_FBW (8 * ACC_NV)
+#define ACC_CG 4         /* compensated: 4 x 2 x 2 accumulators + 2 entries + temporaries */
 #define ACC_NV 2   /* compensated (both kinds): vectors of points held in registers (2 accumulators each) */
 /* the candidate splits, vectors through vsqrtpd (the others through sqrt_fma): the two
  * measured best, on Zen 5 (the first) and on the Xeon (the second) */
@@ -52,7 +59,7 @@
 CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nsq, const int nc, const double *c,
                                     size_t ldc,
                                     const double *w, size_t ldw, size_t jn, const double *pt,
-                                    size_t ldp, double *acc)
+                                    size_t ldp, double *acc, const int keep, double *fb)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     __m512d x[NV], y[NV], z[NV], a[4][NV];
@@ -69,6 +76,7 @@ CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nsq, const int nc, c
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
         for (int v = 0; v < nv; ++v) {
             const __m512d f = cm_r3_of(nv == NV && v >= nsq, x[v], y[v], z[v], xj, yj, zj);
+            if (keep) _mm512_store_pd(fb + j * FBW + 8 * v, f);
             for (int q = 0; q < nc; ++q) a[q][v] = _mm512_fmadd_pd(wj[q], f, a[q][v]);
         }
     }
@@ -76,24 +84,79 @@ CM_AVX512 CM_INLINE void tile_plain(const int nv, const int nsq, const int nc, c
         for (int q = 0; q < nc; ++q) _mm512_storeu_pd(acc + q * ldp + 8 * v, a[q][v]);
 }
 
+/* Columns [0, nc) (nc <= PLAIN_CG, a constant) of a stretch of jn centres whose entries
+ * the first column group left in fb (fb[j FBW + 8 v]): one FMA per entry and column, the
+ * same as tile_plain's, in the same order of j, so a column's sum does not depend on the
+ * group it rides in. */
+CM_AVX512 CM_INLINE void cols_plain(const int nv, const int nc, const double *fb, size_t jn,
+                                    const double *w, size_t ldw, size_t ldp, double *acc)
+{
+    __m512d a[PLAIN_CG][NV];
+    for (int v = 0; v < nv; ++v)
+        for (int q = 0; q < nc; ++q) a[q][v] = _mm512_loadu_pd(acc + q * ldp + 8 * v);
+    for (size_t j = 0; j < jn; ++j) {
+        __m512d f[NV];
+        for (int v = 0; v < nv; ++v) f[v] = _mm512_load_pd(fb + j * FBW + 8 * v);
+        for (int q = 0; q < nc; ++q) {
+            const __m512d wj = _mm512_set1_pd(w[q * ldw + j]);
+            for (int v = 0; v < nv; ++v) a[q][v] = _mm512_fmadd_pd(wj, f[v], a[q][v]);
+        }
+    }
+    for (int v = 0; v < nv; ++v)
+        for (int q = 0; q < nc; ++q) _mm512_storeu_pd(acc + q * ldp + 8 * v, a[q][v]);
+}
+
+/* More than 4 columns on nv vectors of points: per stretch of FB_J centres the first 4
+ * columns compute the entries (into fb, L1-resident) and the others run over them in
+ * groups of PLAIN_CG, so each entry phi_ij is computed once for all columns. */
+CM_AVX512 CM_INLINE void tile_plain_many(const int nv, const int nsq, int nc, const double *c,
+                                         size_t ldc, const double *w, size_t ldw, size_t jn,
+                                         const double *pt, size_t ldp, double *acc, double *fb)
+{
+    for (size_t j0 = 0; j0 < jn; j0 += FB_J) {
+        const size_t jb = jn - j0 < FB_J ? jn - j0 : FB_J;
+        tile_plain(nv, nsq, 4, c + j0, ldc, w + j0, ldw, jb, pt, ldp, acc, 1, fb);
+        for (int g = 4; g < nc; g += PLAIN_CG) {
+            const double *wg = w + (size_t)g * ldw + j0;
+            double *ag = acc + (size_t)g * ldp;
+            switch (nc - g >= PLAIN_CG ? PLAIN_CG : nc - g) {
+            case 1: cols_plain(nv, 1, fb, jb, wg, ldw, ldp, ag); break;
+            case 2: cols_plain(nv, 2, fb, jb, wg, ldw, ldp, ag); break;
+            case 3: cols_plain(nv, 3, fb, jb, wg, ldw, ldp, ag); break;
+            case 4: cols_plain(nv, 4, fb, jb, wg, ldw, ldp, ag); break;
+            case 5: cols_plain(nv, 5, fb, jb, wg, ldw, ldp, ag); break;
+            default: cols_plain(nv, PLAIN_CG, fb, jb, wg, ldw, ldp, ag); break;
+            }
+        }
+    }
+}
+
 /* All m centres, tile by tile, against npt points (rounded up to a multiple of 8: pt and
  * acc must hold that many). One body for the direct sums (npt = ldp = CM_RBF_SUM_PB,
  * ldc = ldw = m) and the treecode (any strides), so both run the same kernel. */
-CM_AVX512 CM_INLINE void block_plain(const int nsq, const int nc, size_t m, const double *c,
-                                     size_t ldc, const double *w, size_t ldw, size_t npt,
-                                     const double *pt, size_t ldp, double *acc)
+CM_AVX512 CM_INLINE void block_plain(const int nsq, const int nc, int ncm, size_t m,
+                                     const double *c, size_t ldc, const double *w, size_t ldw,
+                                     size_t npt, const double *pt, size_t ldp, double *acc)
 {
+    double fb[FB_J * FBW] __attribute__((aligned(64))); /* used for more than 4 columns */
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         const size_t jn = m - t0 < TILE ? m - t0 : TILE;
         for (size_t b = 0; b < npt; b += 8 * NV) {
             const size_t left = (npt - b + 7) / 8;
             const double *cb = c + t0, *wb = w + t0, *pb = pt + b;
             double *ab = acc + b;
-            switch (left >= NV ? NV : (int)left) {
-            case 1: tile_plain(1, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
-            case 2: tile_plain(2, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
-            case 3: tile_plain(3, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
-            default: tile_plain(NV, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab); break;
+            /* nc = 0 here means "more than 4" (tile_plain_many, ncm columns) */
+            if (nc == 0) switch (left >= NV ? NV : (int)left) {
+            case 1: tile_plain_many(1, nsq, ncm, cb, ldc, wb, ldw, jn, pb, ldp, ab, fb); break;
+            case 2: tile_plain_many(2, nsq, ncm, cb, ldc, wb, ldw, jn, pb, ldp, ab, fb); break;
+            case 3: tile_plain_many(3, nsq, ncm, cb, ldc, wb, ldw, jn, pb, ldp, ab, fb); break;
+            default: tile_plain_many(NV, nsq, ncm, cb, ldc, wb, ldw, jn, pb, ldp, ab, fb); break;
+            }
+            else switch (left >= NV ? NV : (int)left) {
+            case 1: tile_plain(1, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab, 0, NULL); break;
+            case 2: tile_plain(2, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab, 0, NULL); break;
+            case 3: tile_plain(3, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab, 0, NULL); break;
+            default: tile_plain(NV, nsq, nc, cb, ldc, wb, ldw, jn, pb, ldp, ab, 0, NULL); break;
             }
         }
     }
@@ -104,10 +167,11 @@ CM_AVX512 CM_INLINE void dispatch_plain(const int nsq, int nc, size_t m, const d
                                         const double *pt, size_t ldp, double *acc)
 {
     switch (nc) {
-    case 1: block_plain(nsq, 1, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
-    case 2: block_plain(nsq, 2, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
-    case 3: block_plain(nsq, 3, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
-    default: block_plain(nsq, 4, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 1: block_plain(nsq, 1, 1, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 2: block_plain(nsq, 2, 2, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 3: block_plain(nsq, 3, 3, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    case 4: block_plain(nsq, 4, 4, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
+    default: block_plain(nsq, 0, nc, m, c, ldc, w, ldw, npt, pt, ldp, acc); break;
     }
 }
 
@@ -133,10 +197,28 @@ CM_AVX512 static void plain_split(int alt, int nc, size_t m, const double *c, co
  * fma, sub, fmsub, add per product where TwoProd + TwoSum take 10 (the vector operation
  * count was the limit: TwoSum ran at 0.4x the plain sum's throughput). This is the binned
  * summation of the reproducible-BLAS literature (Demmel and Nguyen) with a single bin. */
+/* s + e += w f: fixed binade (cm_accf) or TwoProd + TwoSum */
+CM_AVX512 CM_INLINE void acc_update(const int fixed, __m512d *s, __m512d *e, __m512d w,
+                                    __m512d f)
+{
+    if (fixed) {
+        cm_accf(s, e, w, f);
+    } else {
+        const __m512d p = _mm512_mul_pd(w, f);
+        const __m512d pe = _mm512_fmsub_pd(w, f, p); /* p + pe = w f exactly */
+        const __m512d t = _mm512_add_pd(*s, p);
+        const __m512d bv = _mm512_sub_pd(t, *s);
+        const __m512d te =
+            _mm512_add_pd(_mm512_sub_pd(*s, _mm512_sub_pd(t, bv)), _mm512_sub_pd(p, bv));
+        *s = t;
+        *e = _mm512_add_pd(*e, _mm512_add_pd(te, pe));
+    }
+}
+
 CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nsq, const int nv, const int nc,
                                   const double *c, size_t ldc, const double *w, size_t ldw,
                                   size_t jn, const double *pt, size_t ldp, double *hi,
-                                  double *lo)
+                                  double *lo, const int keep, double *fb)
 {
     const double *restrict cx = c, *restrict cy = c + ldc, *restrict cz = c + 2 * ldc;
     __m512d x[ACC_NV], y[ACC_NV], z[ACC_NV], s[4][ACC_NV], e[4][ACC_NV];
@@ -156,20 +238,8 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nsq, const int nv, 
         for (int q = 0; q < nc; ++q) wj[q] = _mm512_set1_pd(w[q * ldw + j]);
         for (int v = 0; v < nv; ++v) {
             const __m512d f = cm_r3_of(fixed && v >= nsq, x[v], y[v], z[v], xj, yj, zj);
-            for (int q = 0; q < nc; ++q) {
-                if (fixed) {
-                    cm_accf(&s[q][v], &e[q][v], wj[q], f);
-                } else {
-                    const __m512d p = _mm512_mul_pd(wj[q], f);
-                    const __m512d pe = _mm512_fmsub_pd(wj[q], f, p); /* p + pe = w f exactly */
-                    const __m512d t = _mm512_add_pd(s[q][v], p);
-                    const __m512d bv = _mm512_sub_pd(t, s[q][v]);
-                    const __m512d te = _mm512_add_pd(
-                        _mm512_sub_pd(s[q][v], _mm512_sub_pd(t, bv)), _mm512_sub_pd(p, bv));
-                    s[q][v] = t;
-                    e[q][v] = _mm512_add_pd(e[q][v], _mm512_add_pd(te, pe));
-                }
-            }
+            if (keep) _mm512_store_pd(fb + j * ACC_FBW + 8 * v, f);
+            for (int q = 0; q < nc; ++q) acc_update(fixed, &s[q][v], &e[q][v], wj[q], f);
         }
     }
     for (int v = 0; v < nv; ++v)
@@ -179,24 +249,78 @@ CM_AVX512 CM_INLINE void tile_acc(const int fixed, const int nsq, const int nv, 
         }
 }
 
+/* as cols_plain for the compensated blocks: columns [0, nc), nc <= ACC_CG */
+CM_AVX512 CM_INLINE void cols_acc(const int fixed, const int nv, const int nc, const double *fb,
+                                  size_t jn, const double *w, size_t ldw, size_t ldp, double *hi,
+                                  double *lo)
+{
+    __m512d s[ACC_CG][ACC_NV], e[ACC_CG][ACC_NV];
+    for (int v = 0; v < nv; ++v)
+        for (int q = 0; q < nc; ++q) {
+            s[q][v] = _mm512_loadu_pd(hi + q * ldp + 8 * v);
+            e[q][v] = _mm512_loadu_pd(lo + q * ldp + 8 * v);
+        }
+    for (size_t j = 0; j < jn; ++j) {
+        __m512d f[ACC_NV];
+        for (int v = 0; v < nv; ++v) f[v] = _mm512_load_pd(fb + j * ACC_FBW + 8 * v);
+        for (int q = 0; q < nc; ++q) {
+            const __m512d wj = _mm512_set1_pd(w[q * ldw + j]);
+            for (int v = 0; v < nv; ++v) acc_update(fixed, &s[q][v], &e[q][v], wj, f[v]);
+        }
+    }
+    for (int v = 0; v < nv; ++v)
+        for (int q = 0; q < nc; ++q) {
+            _mm512_storeu_pd(hi + q * ldp + 8 * v, s[q][v]);
+            _mm512_storeu_pd(lo + q * ldp + 8 * v, e[q][v]);
+        }
+}
+
+/* as tile_plain_many for the compensated blocks */
+CM_AVX512 CM_INLINE void tile_acc_many(const int fixed, const int nsq, const int nv, int nc,
+                                       const double *c, size_t ldc, const double *w, size_t ldw,
+                                       size_t jn, const double *pt, size_t ldp, double *hi,
+                                       double *lo, double *fb)
+{
+    for (size_t j0 = 0; j0 < jn; j0 += FB_J) {
+        const size_t jb = jn - j0 < FB_J ? jn - j0 : FB_J;
+        tile_acc(fixed, nsq, nv, 4, c + j0, ldc, w + j0, ldw, jb, pt, ldp, hi, lo, 1, fb);
+        for (int g = 4; g < nc; g += ACC_CG) {
+            const double *wg = w + (size_t)g * ldw + j0;
+            double *hg = hi + (size_t)g * ldp, *lg = lo + (size_t)g * ldp;
+            switch (nc - g >= ACC_CG ? ACC_CG : nc - g) {
+            case 1: cols_acc(fixed, nv, 1, fb, jb, wg, ldw, ldp, hg, lg); break;
+            case 2: cols_acc(fixed, nv, 2, fb, jb, wg, ldw, ldp, hg, lg); break;
+            case 3: cols_acc(fixed, nv, 3, fb, jb, wg, ldw, ldp, hg, lg); break;
+            default: cols_acc(fixed, nv, ACC_CG, fb, jb, wg, ldw, ldp, hg, lg); break;
+            }
+        }
+    }
+}
+
 /* as block_plain: one body for the direct sums (npt = ldp = CM_RBF_ACC_PB) and the
  * treecode's compensated products (any strides; a tail of one vector); nsq of the ACC_NV
  * vectors through vsqrtpd in the fixed-binade block (the TwoSum block keeps the FMA pipes
  * busy, so all of its vectors take vsqrtpd) */
-CM_AVX512 CM_INLINE void block_acc(const int fixed, const int nsq, const int nc, size_t m,
-                                   const double *c, size_t ldc, const double *w, size_t ldw,
-                                   size_t npt, const double *pt, size_t ldp, double *hi,
-                                   double *lo)
+CM_AVX512 CM_INLINE void block_acc(const int fixed, const int nsq, const int nc, int ncm,
+                                   size_t m, const double *c, size_t ldc, const double *w,
+                                   size_t ldw, size_t npt, const double *pt, size_t ldp,
+                                   double *hi, double *lo)
 {
+    double fb[FB_J * ACC_FBW] __attribute__((aligned(64))); /* used for more than 4 columns */
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         const size_t jn = m - t0 < TILE ? m - t0 : TILE;
         for (size_t b = 0; b < npt; b += 8 * ACC_NV) {
-            if (npt - b > 8 * (ACC_NV - 1))
-                tile_acc(fixed, nsq, ACC_NV, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp,
-                         hi + b, lo + b);
+            const double *cb = c + t0, *wb = w + t0, *pb = pt + b;
+            double *hb = hi + b, *lb = lo + b;
+            /* nc = 0: more than 4 columns (ncm) */
+            if (nc == 0 && npt - b > 8 * (ACC_NV - 1))
+                tile_acc_many(fixed, nsq, ACC_NV, ncm, cb, ldc, wb, ldw, jn, pb, ldp, hb, lb, fb);
+            else if (nc == 0)
+                tile_acc_many(fixed, nsq, 1, ncm, cb, ldc, wb, ldw, jn, pb, ldp, hb, lb, fb);
+            else if (npt - b > 8 * (ACC_NV - 1))
+                tile_acc(fixed, nsq, ACC_NV, nc, cb, ldc, wb, ldw, jn, pb, ldp, hb, lb, 0, NULL);
             else
-                tile_acc(fixed, nsq, 1, nc, c + t0, ldc, w + t0, ldw, jn, pt + b, ldp, hi + b,
-                         lo + b);
+                tile_acc(fixed, nsq, 1, nc, cb, ldc, wb, ldw, jn, pb, ldp, hb, lb, 0, NULL);
         }
     }
 }
@@ -207,10 +331,11 @@ CM_AVX512 CM_INLINE void dispatch_acc(const int fixed, const int nsq, int nc, si
                                       double *lo)
 {
     switch (nc) {
-    case 1: block_acc(fixed, nsq, 1, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
-    case 2: block_acc(fixed, nsq, 2, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
-    case 3: block_acc(fixed, nsq, 3, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
-    default: block_acc(fixed, nsq, 4, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 1: block_acc(fixed, nsq, 1, 1, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 2: block_acc(fixed, nsq, 2, 2, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 3: block_acc(fixed, nsq, 3, 3, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    case 4: block_acc(fixed, nsq, 4, 4, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
+    default: block_acc(fixed, nsq, 0, nc, m, c, ldc, w, ldw, npt, pt, ldp, hi, lo); break;
     }
 }
 

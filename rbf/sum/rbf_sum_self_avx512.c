@@ -28,6 +28,7 @@
  * (a few eps sum_j |w_j phi_ij|). Tiles go to threads in a fixed order (static schedule),
  * so a thread count gives the same bits every run. */
 #include "rbf_sum_isa.h"
+#include "rbf_internal.h" /* CM_RBF_SUM_MAX_NC */
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include "rbf_r3_avx512.h"
@@ -71,14 +72,17 @@ CM_AVX512 CM_INLINE void add(const int comp, __m512d *s, __m512d *e, __m512d w, 
  * split: half on the FMA pipes where it keeps half there (the Xeon: 1.47-1.65x the general
  * block at 4e4 against 1.30-1.34x all on vsqrtpd), all on vsqrtpd where it keeps 3 of 4. */
 CM_AVX512 CM_INLINE void sym_pass(const int comp, const int nsq, const int nv, const int nc,
-                                  const double *ic, const double *iw, size_t ldi, double *is,
-                                  double *ie, size_t lds, const double *rot, double *jac, int ng)
+                                  const int fm, int ncs, int q0, const double *ic,
+                                  const double *iw, size_t ldi, double *is, double *ie,
+                                  size_t lds, const double *rot, double *jac, int ng, double *fb)
 {
     __m512d x[2], y[2], z[2], wi[4][2], s[4][2], e[4][2];
     for (int v = 0; v < nv; ++v) {
-        x[v] = _mm512_loadu_pd(ic + 8 * v);
-        y[v] = _mm512_loadu_pd(ic + ldi + 8 * v);
-        z[v] = _mm512_loadu_pd(ic + 2 * ldi + 8 * v);
+        if (fm != 2) {
+            x[v] = _mm512_loadu_pd(ic + 8 * v);
+            y[v] = _mm512_loadu_pd(ic + ldi + 8 * v);
+            z[v] = _mm512_loadu_pd(ic + 2 * ldi + 8 * v);
+        }
         for (int q = 0; q < nc; ++q) {
             wi[q][v] = _mm512_loadu_pd(iw + q * ldi + 8 * v);
             s[q][v] = _mm512_loadu_pd(is + q * lds + 8 * v);
@@ -86,19 +90,25 @@ CM_AVX512 CM_INLINE void sym_pass(const int comp, const int nsq, const int nv, c
         }
     }
     for (int gr = 0; gr < 8 * ng; ++gr) {
-        const double *R = rot + (size_t)gr * RS(nc);
-        double *J = jac + (size_t)gr * JS(nc);
-        const __m512d xj = _mm512_load_pd(R), yj = _mm512_load_pd(R + 8);
-        const __m512d zj = _mm512_load_pd(R + 16);
+        const double *R = rot + (size_t)gr * RS(ncs), *Rw = R + 24 + 8 * q0;
+        double *J = jac + (size_t)gr * JS(ncs) + 16 * q0;
         __m512d js[4], je[4];
         for (int q = 0; q < nc; ++q) {
             js[q] = _mm512_load_pd(J + 16 * q);
             je[q] = comp ? _mm512_load_pd(J + 16 * q + 8) : _mm512_setzero_pd();
         }
         for (int v = 0; v < nv; ++v) {
-            const __m512d f = cm_r3_of(v >= nsq, x[v], y[v], z[v], xj, yj, zj);
+            __m512d f;
+            if (fm == 2) {
+                f = _mm512_load_pd(fb + (size_t)(gr * nv + v) * 8);
+            } else {
+                const __m512d xj = _mm512_load_pd(R), yj = _mm512_load_pd(R + 8);
+                const __m512d zj = _mm512_load_pd(R + 16);
+                f = cm_r3_of(v >= nsq, x[v], y[v], z[v], xj, yj, zj);
+                if (fm == 1) _mm512_store_pd(fb + (size_t)(gr * nv + v) * 8, f);
+            }
             for (int q = 0; q < nc; ++q) {
-                add(comp, &s[q][v], &e[q][v], _mm512_load_pd(R + 24 + 8 * q), f);
+                add(comp, &s[q][v], &e[q][v], _mm512_load_pd(Rw + 8 * q), f);
                 add(comp, &js[q], &je[q], wi[q][v], f);
             }
         }
@@ -114,10 +124,38 @@ CM_AVX512 CM_INLINE void sym_pass(const int comp, const int nsq, const int nv, c
         }
 }
 
+/* sym_pass for all ncs columns: up to 4 in registers computing the entries; more: the first
+ * 4 compute them (kept in fb) and the others, 4 at a time, run over them, each column with
+ * the same updates in the same order as alone. iw, is, ie: column 0's. */
+CM_AVX512 CM_INLINE void sym_all(const int comp, const int nsq, const int nv, int ncs,
+                                 const double *ic, const double *iw, size_t ldi, double *is,
+                                 double *ie, size_t lds, const double *rot, double *jac, int ng,
+                                 double *fb)
+{
+#define CM_SYM(g, fm, q0)                                                                      \
+    sym_pass(comp, nsq, nv, g, fm, ncs, q0, ic, iw + (size_t)(q0) * ldi, ldi,                  \
+             is + (size_t)(q0) * lds, ie + (size_t)(q0) * lds, lds, rot, jac, ng, fb)
+    switch (ncs) {
+    case 1: CM_SYM(1, 0, 0); return;
+    case 2: CM_SYM(2, 0, 0); return;
+    case 3: CM_SYM(3, 0, 0); return;
+    case 4: CM_SYM(4, 0, 0); return;
+    default: CM_SYM(4, 1, 0); break;
+    }
+    for (int g = 4; g < ncs; g += 4) switch (ncs - g) {
+        case 1: CM_SYM(1, 2, g); break;
+        case 2: CM_SYM(2, 2, g); break;
+        case 3: CM_SYM(3, 2, g); break;
+        default: CM_SYM(4, 2, g); break;
+        }
+#undef CM_SYM
+}
+
 /* Group g of a tile against itself, rotations 1..7 (every ordered pair of distinct lanes
- * once): the row side only. */
-CM_AVX512 CM_INLINE void own_group(const int comp, const int nc, const double *rot, double *is,
-                                   double *ie, size_t lds)
+ * once): the row side only, columns [q0, q0 + nc) of ncs (the entries recomputed per
+ * group of columns: 7 vectors a group, a small share). */
+CM_AVX512 CM_INLINE void own_group(const int comp, const int nc, int ncs, int q0,
+                                   const double *rot, double *is, double *ie, size_t lds)
 {
     const __m512d x = _mm512_load_pd(rot), y = _mm512_load_pd(rot + 8);
     const __m512d z = _mm512_load_pd(rot + 16);
@@ -127,11 +165,11 @@ CM_AVX512 CM_INLINE void own_group(const int comp, const int nc, const double *r
         e[q] = _mm512_loadu_pd(ie + q * lds);
     }
     for (int r = 1; r < 8; ++r) {
-        const double *R = rot + (size_t)r * RS(nc);
+        const double *R = rot + (size_t)r * RS(ncs);
         const __m512d f =
             cm_r3_of(0, x, y, z, _mm512_load_pd(R), _mm512_load_pd(R + 8), _mm512_load_pd(R + 16));
         for (int q = 0; q < nc; ++q)
-            add(comp, &s[q], &e[q], _mm512_load_pd(R + 24 + 8 * q), f);
+            add(comp, &s[q], &e[q], _mm512_load_pd(R + 24 + 8 * (q0 + q)), f);
     }
     for (int q = 0; q < nc; ++q) {
         _mm512_storeu_pd(is + q * lds, s[q]);
@@ -139,14 +177,28 @@ CM_AVX512 CM_INLINE void own_group(const int comp, const int nc, const double *r
     }
 }
 
+CM_AVX512 CM_INLINE void own_all(const int comp, int ncs, const double *rot, double *is,
+                                 double *ie, size_t lds)
+{
+    for (int g = 0; g < ncs; g += 4) {
+        double *sg = is + (size_t)g * lds, *eg = ie + (size_t)g * lds;
+        switch (ncs - g >= 4 ? 4 : ncs - g) {
+        case 1: own_group(comp, 1, ncs, g, rot, sg, eg, lds); break;
+        case 2: own_group(comp, 2, ncs, g, rot, sg, eg, lds); break;
+        case 3: own_group(comp, 3, ncs, g, rot, sg, eg, lds); break;
+        default: own_group(comp, 4, ncs, g, rot, sg, eg, lds); break;
+        }
+    }
+}
+
 /* One J tile [j0, j0 + jn): its rotations (a tail group padded with copies of the last
  * centre at weight 0, which adds exact zeros), the blocks of rows before it, its own
  * pairs, and its column sums un-rotated into the offsets cs - big and remainders ce (the
  * tile's own entries of those arrays, stride lds). is, ie: this thread's row sums. */
-CM_AVX512 CM_INLINE void tile(const int comp, const int nsq, const int nc, size_t m,
+CM_AVX512 CM_INLINE void tile(const int comp, const int nsq, int nc, size_t m,
                               const double *c, const double *w, const double *big, size_t j0,
                               size_t jn, double *rot, double *jac, double *is, double *ie,
-                              size_t lds, double *cs, double *ce)
+                              size_t lds, double *cs, double *ce, double *fb)
 {
     const int ng = (int)((jn + 7) / 8);
     for (int g = 0; g < ng; ++g)
@@ -171,13 +223,13 @@ CM_AVX512 CM_INLINE void tile(const int comp, const int nsq, const int nc, size_
         const double *R0 = rot + (size_t)8 * g * RS(nc);
         double *rs = is + j0 + 8 * (size_t)g, *re = ie + j0 + 8 * (size_t)g;
         if (g + 1 < ng)
-            sym_pass(comp, nsq, 1, nc, R0, R0 + 24, 8, rs, re, lds,
-                     rot + (size_t)8 * (g + 1) * RS(nc), jac + (size_t)8 * (g + 1) * JS(nc),
-                     ng - g - 1);
-        own_group(comp, nc, R0, rs, re, lds);
+            sym_all(comp, nsq, 1, nc, R0, R0 + 24, 8, rs, re, lds,
+                    rot + (size_t)8 * (g + 1) * RS(nc), jac + (size_t)8 * (g + 1) * JS(nc),
+                    ng - g - 1, fb);
+        own_all(comp, nc, R0, rs, re, lds);
     }
     for (size_t i0 = 0; i0 < j0; i0 += IB)
-        sym_pass(comp, nsq, 2, nc, c + i0, w + i0, m, is + i0, ie + i0, lds, rot, jac, ng);
+        sym_all(comp, nsq, 2, nc, c + i0, w + i0, m, is + i0, ie + i0, lds, rot, jac, ng, fb);
     for (int g = 0; g < ng; ++g)
         for (int k = 0; k < 8 && 8 * (size_t)g + (size_t)k < jn; ++k)
             for (int q = 0; q < nc; ++q) {
@@ -208,29 +260,17 @@ CM_AVX512 static void run_tiles(int mode, int nc, size_t m, const double *c, con
 #endif
         double *is = rows + (size_t)t * per, *ie = is + (size_t)nc * lds;
         double *rot = scratch + (size_t)t * tsz, *jac = rot + (size_t)8 * SELF_G * RS(nc);
+        double *fb = jac + (size_t)8 * SELF_G * JS(nc); /* the entries, more than 4 columns */
         /* the last tiles meet the most rows: dealt first, round robin (a fixed order) */
 #pragma omp for schedule(static, 1)
         for (long k = 0; k < nt; ++k) {
             const size_t j0 = (size_t)(nt - 1 - k) * SELF_T;
             const size_t jn = m - j0 < SELF_T ? m - j0 : SELF_T;
             double *cs = cols, *ce = cols + (size_t)nc * lds;
-#define CM_SELF_TILE(a, q, b) tile(a, q, b, m, c, w, big, j0, jn, rot, jac, is, ie, lds, cs, ce)
-            /* clang-format off */
-            switch (4 * mode + nc) { /* constants, so the register blocks stay in registers */
-            case 1: CM_SELF_TILE(0, 1, 1); break;
-            case 2: CM_SELF_TILE(0, 1, 2); break;
-            case 3: CM_SELF_TILE(0, 1, 3); break;
-            case 4: CM_SELF_TILE(0, 1, 4); break;
-            case 5: CM_SELF_TILE(0, 2, 1); break;
-            case 6: CM_SELF_TILE(0, 2, 2); break;
-            case 7: CM_SELF_TILE(0, 2, 3); break;
-            case 8: CM_SELF_TILE(0, 2, 4); break;
-            case 9: CM_SELF_TILE(1, 2, 1); break;
-            case 10: CM_SELF_TILE(1, 2, 2); break;
-            case 11: CM_SELF_TILE(1, 2, 3); break;
-            default: CM_SELF_TILE(1, 2, 4); break;
-            }
-            /* clang-format on */
+#define CM_SELF_TILE(a, q) tile(a, q, nc, m, c, w, big, j0, jn, rot, jac, is, ie, lds, cs, ce, fb)
+            if (mode == 0) CM_SELF_TILE(0, 1);
+            else if (mode == 1) CM_SELF_TILE(0, 2);
+            else CM_SELF_TILE(1, 2);
 #undef CM_SELF_TILE
         }
     }
@@ -240,12 +280,21 @@ int cm_rbf_r3_self_avx512(int nc, size_t m, const double *c, const double *w, co
                           double *out, size_t ldo, int threads)
 {
     if (threads < 1) threads = 1;
-    const double zero[4] = {0.0, 0.0, 0.0, 0.0};
+    if (nc > CM_RBF_SUM_MAX_NC) { /* passes of CM_RBF_SUM_MAX_NC: the same bits per column */
+        for (int g = 0; g < nc; g += CM_RBF_SUM_MAX_NC)
+            if (cm_rbf_r3_self_avx512(nc - g < CM_RBF_SUM_MAX_NC ? nc - g : CM_RBF_SUM_MAX_NC, m,
+                                      c, w + (size_t)g * m, big ? big + g : NULL, out + g, ldo,
+                                      threads))
+                return 1; /* (only the first pass can fail: sizes only shrink) */
+        return 0;
+    }
+    double zero[CM_RBF_SUM_MAX_NC] = {0.0};
     const int comp = big != NULL;
     if (!comp) big = zero;
     const size_t lds = (m + SELF_T - 1) / SELF_T * SELF_T;
     const size_t per = (size_t)2 * nc * lds;                   /* a thread's row sums s, e */
-    const size_t tsz = (size_t)8 * SELF_G * (RS(nc) + JS(nc)); /* its tile's rotations, sums */
+    /* its tile's rotations and sums, and the entries of a row block (2 vectors) */
+    const size_t tsz = (size_t)8 * SELF_G * (RS(nc) + JS(nc)) + (size_t)2 * 8 * 8 * SELF_G;
     double *rows = malloc(((size_t)threads * per + per) * sizeof(double));
     double *scratch = aligned_alloc(64, (size_t)threads * tsz * sizeof(double));
     if (!rows || !scratch) {

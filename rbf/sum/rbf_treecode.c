@@ -46,6 +46,7 @@
 #define CM_TREE_LEAF 160  /* centres per source leaf */
 #define CM_TREE_BATCH 192 /* targets per batch */
 #define NB 16             /* targets held in registers */
+#define FB_J 128          /* more than 4 columns: entries of this many sources x NB kept */
 
 typedef struct tnode {
     size_t begin, end;  /* range in tree order */
@@ -491,7 +492,7 @@ typedef struct seg {
     int direct; /* centres (1) or proxies (0) */
 } seg;
 
-static inline __attribute__((always_inline)) void block_sum(const int nc, const seg *s, int ns,
+static inline __attribute__((always_inline)) void block_sum(const int hf, const int nc, const seg *s, int ns,
                                                             const double *tx, const double *ty,
                                                             const double *tz, double *out)
 {
@@ -514,7 +515,7 @@ static inline __attribute__((always_inline)) void block_sum(const int nc, const 
                 double dx = x[l] - xj, dy = y[l] - yj, dz = z[l] - zj;
                 double r2 = dx * dx + dy * dy + dz * dz;
                 double f = r2 * sqrt(r2);
-                for (int q = 0; q < nc; ++q) a[q][l] += wj[q] * f;
+                for (int q = 0; q < nc; ++q) a[q][l] = hf ? fma(wj[q], f, a[q][l]) : a[q][l] + wj[q] * f;
             }
         }
     }
@@ -522,12 +523,79 @@ static inline __attribute__((always_inline)) void block_sum(const int nc, const 
         for (int l = 0; l < NB; ++l) out[q * NB + l] = a[q][l];
 }
 
+/* Columns [0, nc) (nc <= 4) of jn sources (coordinates sx.. or, keep = 2, their entries
+ * left in fb) against NB targets, sums in out (nc x NB): the same multiply-add per entry
+ * and column as block_sum, in the same order, so a column's sum does not depend on the
+ * columns beside it. keep = 1: also leave the entries in fb. */
+static inline __attribute__((always_inline)) void seg_part(const int hf, const int nc, const int keep,
+                                                           const double *sx, const double *sy,
+                                                           const double *sz, const double *sw,
+                                                           size_t ldw, size_t jn,
+                                                           const double *tx, const double *ty,
+                                                           const double *tz, double *fb,
+                                                           double *out)
+{
+    double x[NB], y[NB], z[NB], a[4][NB];
+    for (int l = 0; l < NB; ++l) {
+        x[l] = tx[l];
+        y[l] = ty[l];
+        z[l] = tz[l];
+        for (int q = 0; q < nc; ++q) a[q][l] = out[q * NB + l];
+    }
+    for (size_t j = 0; j < jn; ++j) {
+        double wj[4];
+        for (int q = 0; q < nc; ++q) wj[q] = sw[q * ldw + j];
+        for (int l = 0; l < NB; ++l) {
+            double f;
+            if (keep == 2) {
+                f = fb[j * NB + l];
+            } else {
+                double dx = x[l] - sx[j], dy = y[l] - sy[j], dz = z[l] - sz[j];
+                double r2 = dx * dx + dy * dy + dz * dz;
+                f = r2 * sqrt(r2);
+                if (keep) fb[j * NB + l] = f;
+            }
+            for (int q = 0; q < nc; ++q) a[q][l] = hf ? fma(wj[q], f, a[q][l]) : a[q][l] + wj[q] * f;
+        }
+    }
+    for (int q = 0; q < nc; ++q)
+        for (int l = 0; l < NB; ++l) out[q * NB + l] = a[q][l];
+}
+
+/* block_sum for more than 4 columns: per stretch of FB_J sources the first 4 columns
+ * compute the entries (kept in fb) and the others run over them 4 at a time. */
+static inline __attribute__((always_inline)) void block_many(const int hf, int nc, const seg *s, int ns,
+                                                             const double *tx, const double *ty,
+                                                             const double *tz, double *out)
+{
+    double fb[FB_J * NB];
+    memset(out, 0, (size_t)nc * NB * sizeof *out);
+    for (int g = 0; g < ns; ++g)
+        for (size_t j0 = 0; j0 < s[g].n; j0 += FB_J) {
+            const size_t jb = s[g].n - j0 < FB_J ? s[g].n - j0 : FB_J, ldw = s[g].ldw;
+            const double *sx = s[g].x + j0, *sy = s[g].y + j0, *sz = s[g].z + j0;
+            const double *sw = s[g].w + j0;
+            seg_part(hf, 4, 1, sx, sy, sz, sw, ldw, jb, tx, ty, tz, fb, out);
+            for (int k = 4; k < nc; k += 4) {
+                const double *wk = sw + (size_t)k * ldw;
+                double *ok = out + (size_t)k * NB;
+                switch (nc - k) {
+                case 1: seg_part(hf, 1, 2, sx, sy, sz, wk, ldw, jb, tx, ty, tz, fb, ok); break;
+                case 2: seg_part(hf, 2, 2, sx, sy, sz, wk, ldw, jb, tx, ty, tz, fb, ok); break;
+                case 3: seg_part(hf, 3, 2, sx, sy, sz, wk, ldw, jb, tx, ty, tz, fb, ok); break;
+                default: seg_part(hf, 4, 2, sx, sy, sz, wk, ldw, jb, tx, ty, tz, fb, ok); break;
+                }
+            }
+        }
+}
+
 #define CM_TREE_DISPATCH                                                                       \
     switch (nc) {                                                                              \
-    case 1: block_sum(1, s, ns, tx, ty, tz, out); break;                                       \
-    case 2: block_sum(2, s, ns, tx, ty, tz, out); break;                                       \
-    case 3: block_sum(3, s, ns, tx, ty, tz, out); break;                                       \
-    default: block_sum(4, s, ns, tx, ty, tz, out); break;                                      \
+    case 1: block_sum(hf, 1, s, ns, tx, ty, tz, out); break;                                       \
+    case 2: block_sum(hf, 2, s, ns, tx, ty, tz, out); break;                                       \
+    case 3: block_sum(hf, 3, s, ns, tx, ty, tz, out); break;                                       \
+    case 4: block_sum(hf, 4, s, ns, tx, ty, tz, out); break;                                       \
+    default: block_many(hf, nc, s, ns, tx, ty, tz, out); break;                                    \
     }
 
 typedef void (*block_fn)(int nc, const seg *s, int ns, const double *tx, const double *ty,
@@ -536,6 +604,7 @@ typedef void (*block_fn)(int nc, const seg *s, int ns, const double *tx, const d
 static void block_generic(int nc, const seg *s, int ns, const double *tx, const double *ty,
                           const double *tz, double *out)
 {
+    const int hf = 0; /* a + w f rounded twice; one FMA where built for it (as rbf_sum.c) */
     CM_TREE_DISPATCH
 }
 
@@ -543,6 +612,7 @@ __attribute__((target("avx2,fma"))) static void block_avx2(int nc, const seg *s,
                                                             const double *tx, const double *ty,
                                                             const double *tz, double *out)
 {
+    const int hf = 1;
     CM_TREE_DISPATCH
 }
 
@@ -550,6 +620,7 @@ __attribute__((target("avx512f,avx512dq,avx512vl,avx2,fma"))) static void
 block_avx512(int nc, const seg *s, int ns, const double *tx, const double *ty, const double *tz,
              double *out)
 {
+    const int hf = 1;
     CM_TREE_DISPATCH
 }
 
@@ -579,7 +650,8 @@ static void batch_avx512(int nc, const seg *s, int ns, size_t cnt, const double 
                                  CM_TREE_BATCH, acc);
 }
 
-/* The same with compensated (TwoSum) accumulation: hi, lo nc x CM_TREE_BATCH */
+/* The same with compensated (TwoSum) accumulation: hi, lo nc x CM_TREE_BATCH (any nc: the
+ * block shares each entry among the columns) */
 static void batch_acc_avx512(int nc, const seg *s, int ns, size_t cnt, const double *pt,
                              double *hi, double *lo)
 {
@@ -607,6 +679,15 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const 
                     int nc, size_t n, const double *p, size_t ldp, double *out, size_t ldo,
                     int threads, cm_rbf_tick *tick)
 {
+    if (nc > CM_RBF_SUM_MAX_NC) { /* passes of CM_RBF_SUM_MAX_NC: the same bits per column */
+        for (int g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
+            const int st = tree_sum(t, tg, stride, w + (size_t)g * t->m,
+                                    nc - g < CM_RBF_SUM_MAX_NC ? nc - g : CM_RBF_SUM_MAX_NC, n, p,
+                                    ldp, out + g, ldo, threads, tick);
+            if (st) return st;
+        }
+        return 0;
+    }
     const size_t m = t->m, P = (size_t)t->P, np = (size_t)t->nprox;
     double *ws = malloc((size_t)nc * (m ? m : 1) * sizeof *ws);
     /* compensated products only by the AVX-512 block; elsewhere the plain ones (callers
@@ -643,8 +724,16 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const 
             seg *sg = malloc((size_t)cap * sizeof *sg);
             int stack[512];
             double tx[CM_TREE_BATCH + NB], ty[CM_TREE_BATCH + NB], tz[CM_TREE_BATCH + NB];
-            double acc[4 * NB], pt[3 * CM_TREE_BATCH], bacc[4 * CM_TREE_BATCH];
-            double blo[4 * CM_TREE_BATCH];
+            double pt[3 * CM_TREE_BATCH];
+            /* the sums of a batch, any number of columns: acc nc x NB, bacc and blo nc x
+             * CM_TREE_BATCH */
+            double *acc = malloc((size_t)nc * (NB + 2 * CM_TREE_BATCH) * sizeof *acc);
+            double *bacc = acc ? acc + (size_t)nc * NB : NULL;
+            double *blo = bacc ? bacc + (size_t)nc * CM_TREE_BATCH : NULL;
+            if (!acc) {
+                free(sg);
+                sg = NULL;
+            }
             if (!sg) {
 #pragma omp atomic write
                 failed = 1;
@@ -723,6 +812,7 @@ static int tree_sum(const cm_rbf_tree *t, const order *tg, size_t stride, const 
                 }
             }
             free(sg);
+            free(acc);
         }
         /* in units of whole sums */
         if (cm_rbf_tick_add(tick, (double)(hi - lo) / (double)tg->nleaf)) break;
