@@ -138,12 +138,16 @@ int main(int argc, char **argv)
                     cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, w, nc, n, p, n, out,
                                       (size_t)nc, threads);
                     break;
-                case 1: cm_rbf_kernel_sum_acc(m, c, w, nc, n, p, n, out, (size_t)nc, threads); break;
+                case 1:
+                    cm_rbf_kernel_sum_acc(m, c, w, nc, n, p, n, out, (size_t)nc, threads);
+                    break;
                 case 2:
                     cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, c, w, nc, m, c, m, out,
                                       (size_t)nc, threads);
                     break;
-                case 3: cm_rbf_kernel_sum_acc(m, c, w, nc, m, c, m, out, (size_t)nc, threads); break;
+                case 3:
+                    cm_rbf_kernel_sum_acc(m, c, w, nc, m, c, m, out, (size_t)nc, threads);
+                    break;
                 default:
                     if (cm_rbf_tree_sum_targets(tree, tg, 1, w, nc, out, (size_t)nc, threads))
                         return 2;

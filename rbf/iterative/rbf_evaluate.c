@@ -184,7 +184,9 @@ int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double
     if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads, tick)) return 0;
     if (tick && tick->status < 0) return 1;
     /* direct sums: a tick of their own, in point-centre pairs */
-    if (tick) cm_rbf_tick_restart(tick, (double)((r->ncomp + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) * (double)n * (double)r->m);
+    if (tick)
+        cm_rbf_tick_restart(tick, (double)((r->ncomp + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) *
+                                      (double)n * (double)r->m);
     for (int g = 0; g < r->ncomp; g += CM_RBF_SUM_MAX_NC) {
         int nc = r->ncomp - g < CM_RBF_SUM_MAX_NC ? r->ncomp - g : CM_RBF_SUM_MAX_NC;
         if (cm_rbf_kernel_sum_acc_tick(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
@@ -277,7 +279,9 @@ int cm_rbf_iterative_evaluate_transpose(const cm_rbf *r, size_t n, const double 
 {
     if (cm_rbf_iterative_transpose_fast(r, n, p, nc, v, out, threads, tick)) return 0;
     if (tick && tick->status < 0) return 1;
-    if (tick) cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) * (double)n * (double)r->m);
+    if (tick)
+        cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) *
+                                      (double)n * (double)r->m);
     for (int g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
         int gc = nc - g < CM_RBF_SUM_MAX_NC ? nc - g : CM_RBF_SUM_MAX_NC;
         if (cm_rbf_kernel_sum_acc_tick(n, p, v + (size_t)g * n, gc, r->m, r->c, r->m, out + g,

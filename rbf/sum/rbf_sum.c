@@ -1,7 +1,11 @@
 /* The two O(m^2) loops of the RBF core: kernel sums (evaluation, A*w, A*V) and assembly of
  * the projected system ([SMB12 §3]). Both are written so that GCC vectorises
  * them at -O3 (points in the inner loop, no reductions), and both are compiled for AVX-512,
- * AVX2+FMA and baseline x86-64, chosen at run time: no global -march flag is needed. */
+ * AVX2+FMA and baseline x86-64, chosen at run time: no global -march flag is needed.
+ * The sums take any number of columns per pass: up to 4 in registers, more on the entries
+ * the first 4 leave in an L1-resident buffer (tile_many), each entry computed once and each
+ * column the same bits alone or in a batch (rbf_sum_avx512.c says how; rbf_internal.h,
+ * CM_RBF_SUM_MAX_NC). */
 #include "rbf_internal.h"
 #include "rbf_sum_isa.h"
 
@@ -78,7 +82,8 @@ static inline __attribute__((always_inline)) double phi_of_r2(const int kern, do
 }
 
 /* Adds the contributions of centres [0, jn) to NB points. */
-static inline __attribute__((always_inline)) void tile_body(const int hf, const int kern, const int dim,
+static inline __attribute__((always_inline)) void tile_body(const int hf, const int kern,
+                                                            const int dim,
                                                             const int nc, const double *c,
                                                             size_t ldc, const double *w,
                                                             size_t ldw, size_t jn,
@@ -116,7 +121,8 @@ static inline __attribute__((always_inline)) void tile_body(const int hf, const 
 /* Columns [0, nc) (nc <= 4) over the entries of jn centres that the first column group
  * left in fb: the same multiply-add per entry as tile_body, in the same order of j, so a
  * column's sum is the same bits whatever group it rides in. */
-static inline __attribute__((always_inline)) void cols_body(const int hf, const int nc, const double *fb,
+static inline __attribute__((always_inline)) void cols_body(const int hf, const int nc,
+                                                            const double *fb,
                                                             const double *w, size_t ldw,
                                                             size_t jn, double *acc)
 {
@@ -138,7 +144,8 @@ static inline __attribute__((always_inline)) void cols_body(const int hf, const 
 /* More than 4 columns: per stretch of FB_J centres the first 4 compute the entries phi_ij
  * (kept in fb, L1-resident) and the others run over them four at a time, so each entry is
  * computed once for all columns. */
-static inline __attribute__((always_inline)) void tile_many(const int hf, const int kern, const int dim,
+static inline __attribute__((always_inline)) void tile_many(const int hf, const int kern,
+                                                            const int dim,
                                                             int nc, const double *c, size_t ldc,
                                                             const double *w, size_t ldw,
                                                             size_t jn, const double *pt,
@@ -162,7 +169,8 @@ static inline __attribute__((always_inline)) void tile_many(const int hf, const 
 
 /* All centres against one block of PB points (pt: dim x PB SoA, acc: nc x PB). Tiles of
  * centres in order, so each point's sum has a fixed order. */
-static inline __attribute__((always_inline)) void block_body(const int hf, const int kern, const int dim,
+static inline __attribute__((always_inline)) void block_body(const int hf, const int kern,
+                                                             const int dim,
                                                              const int nc, int ncm, size_t m,
                                                              const double *c, const double *w,
                                                              const double *pt, double *acc)
@@ -171,7 +179,8 @@ static inline __attribute__((always_inline)) void block_body(const int hf, const
     for (size_t t0 = 0; t0 < m; t0 += TILE) {
         size_t jn = m - t0 < TILE ? m - t0 : TILE;
         for (int b = 0; b < PB; b += NB) {
-            if (nc == 0) tile_many(hf, kern, dim, ncm, c + t0, m, w + t0, m, jn, pt + b, acc + b, fb);
+            if (nc == 0)
+                tile_many(hf, kern, dim, ncm, c + t0, m, w + t0, m, jn, pt + b, acc + b, fb);
             else tile_body(hf, kern, dim, nc, c + t0, m, w + t0, m, jn, pt + b, acc + b, 0, NULL);
         }
     }
@@ -365,7 +374,9 @@ static int sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m, cons
 {
     if (nc > CM_RBF_SUM_MAX_NC) { /* passes of CM_RBF_SUM_MAX_NC: the same bits per column */
         for (int g = 0; g < nc; g += CM_RBF_SUM_MAX_NC)
-            if (sum_isa(isa, kernel, dim, m, c, w + (size_t)g * m, nc - g < CM_RBF_SUM_MAX_NC ? nc - g : CM_RBF_SUM_MAX_NC, n, p, ldp, out + g, ldo, threads, tick))
+            if (sum_isa(isa, kernel, dim, m, c, w + (size_t)g * m,
+                        nc - g < CM_RBF_SUM_MAX_NC ? nc - g : CM_RBF_SUM_MAX_NC, n, p, ldp,
+                        out + g, ldo, threads, tick))
                 return 1;
         return 0;
     }
@@ -375,7 +386,7 @@ static int sum_isa(cm_rbf_isa isa, cm_rbf_kernel kernel, int dim, size_t m, cons
     const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
     /* the r^3 self product computes each entry once for both rows (its sums come in parts) */
     if (fn == block_avx512_hand && kernel == CM_RBF_TRIHARMONIC && dim == 3 && p == c &&
-        ldp == m && n == m && m >= CM_RBF_SELF_MIN_M &&
+        ldp == m && n == m && m >= CM_RBF_SELF_MIN_M && nc <= CM_RBF_SELF_MAX_NC &&
         !cm_rbf_r3_self_avx512(nc, m, c, w, NULL, out, ldo, parallel ? threads : 1))
         return cm_rbf_tick_add(tick, (double)n * (double)m);
     double *work = NULL;

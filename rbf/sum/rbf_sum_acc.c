@@ -152,7 +152,7 @@ static inline __attribute__((always_inline)) void block_acc(const int fixed, con
     }
 }
 
-/* block_acc for nc = 1..4 as constants, more columns sharing the entries */
+/* block_acc for nc = 1..4 as constants; more columns share the first 4's entries */
 #define CM_ACC_DISPATCH(fixed)                                                                 \
     switch (nc) {                                                                              \
     case 1: block_acc(fixed, 1, 1, m, c, w, pt, hi, lo); break;                                \
@@ -319,7 +319,7 @@ static int acc_isa(cm_rbf_isa isa, size_t m, const double *c, const double *w, i
     const int parallel = (double)n * (double)m > CM_RBF_PARALLEL_MIN_PAIRS && threads > 1;
     /* the self product (the Krylov products) computes each entry once for both rows */
     if (fn == cm_rbf_r3_accf_block_avx512 && p == c && ldp == m && n == m &&
-        m >= CM_RBF_SELF_MIN_M &&
+        m >= CM_RBF_SELF_MIN_M && nc <= CM_RBF_SELF_MAX_NC &&
         !cm_rbf_r3_self_avx512(nc, m, c, w, big, out, ldo, parallel ? threads : 1))
         return cm_rbf_tick_add(tick, (double)n * (double)m);
     double *work = NULL;

@@ -22,6 +22,17 @@
  * (1.83e9 against 1.24e9 with 3 of 4), compensated 1 of 2 (1.30e9 against 0.93e9). So each
  * block is built for both splits and split_probe times them once per process (~11 ms).
  *
+ * Many columns (weight vectors; a study's variants x components). The entry phi_ij is the
+ * cost (distance, square root), a column only one FMA per entry (plain; 4 operations
+ * compensated). Up to 4 columns ride in registers beside the points; more: per stretch of
+ * FB_J centres the first 4 columns compute the entries and leave them in an L1-resident
+ * buffer, and the others run over it in register-sized groups (PLAIN_CG, ACC_CG), so each
+ * entry is computed once per pass for all columns. Every column does the same operation per
+ * entry in the same order of j in both ways, and the sqrt units return the same bits, so a
+ * column's sum does not depend on how many ride along (tests/rbf/test_rbf_sum_batch.c).
+ * Measured per column against the FMA bound: benchmarks/RESULTS.md, Study, "Kernel cost per
+ * column".
+ *
  * Built with -ffp-contract=off: the error-free transformations of the compensated block
  * need every rounding where it is written. */
 #include "rbf_sum_isa.h"

@@ -11,7 +11,9 @@
 #define CM_RBF_SUM_PB 128
 #define CM_RBF_ACC_PB 64
 
-/* acc[q * CM_RBF_SUM_PB + l] += sum_j |pt_l - c_j|^3 w[q * m + j], q < nc (1..4), in the
+/* acc[q * CM_RBF_SUM_PB + l] += sum_j |pt_l - c_j|^3 w[q * m + j], q < nc (any nc >= 1: up
+ * to 4 in registers, more on the entries of the first 4 kept in L1; the same bits per
+ * column whatever nc), in the
  * order j = 0, 1, ..., m - 1 for every point. c: 3 x m SoA (stride m), pt: 3 x PB SoA. */
 void cm_rbf_r3_block_avx512(int nc, size_t m, const double *c, const double *w,
                             const double *pt, double *acc);
@@ -44,12 +46,19 @@ void cm_rbf_r3_accf_block_avx512(int nc, size_t m, const double *c, const double
                                  const double *pt, double *hi, double *lo);
 
 /* The r^3 sums for the self product (targets = the m centres): out[i * ldo + q] =
- * sum_j |c_i - c_j|^3 w[q * m + j], q < nc (1..4), each entry computed once for rows i and j
+ * sum_j |c_i - c_j|^3 w[q * m + j], q < nc (any), each entry computed once for rows i and j
  * (rbf_sum_self_avx512.c). big: the offsets of cm_rbf_r3_accf_block_avx512 for the
  * fixed-binade compensated sums, or NULL for plain sums. OpenMP over threads. Returns 0, or
  * 1 if its work space (about 2 (threads + 1) nc m doubles) could not be allocated or this
  * build has no AVX-512 blocks: then nothing is written. */
 #define CM_RBF_SELF_MIN_M 1024 /* the self product from this many centres (fewer: few tiles) */
+/* ... and up to this many columns: beyond, the general blocks run (each further column costs
+ * them one FMA per entry, while the self product's per-tile column sums outgrow the caches:
+ * at 2e4 centres and 12 columns it took 1.3x, at 60 columns 2.5x the general blocks' CPU
+ * time; benchmarks/RESULTS.md, Study, "Kernel cost per column"). So a column's plain self
+ * product has other bits alone than in a batch of more than this (rounding: a few eps
+ * sum_j |w_j phi_ij|); compensated, the same bits up to the order of the remainders. */
+#define CM_RBF_SELF_MAX_NC 4
 int cm_rbf_r3_self_avx512(int nc, size_t m, const double *c, const double *w,
                           const double *big, double *out, size_t ldo, int threads);
 

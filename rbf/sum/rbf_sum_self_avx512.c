@@ -26,7 +26,13 @@
  * (eps^2-small; the same bits in every test so far). Plain sums are added in another order
  * than the general block's, so they differ from it, and between thread counts, by rounding
  * (a few eps sum_j |w_j phi_ij|). Tiles go to threads in a fixed order (static schedule),
- * so a thread count gives the same bits every run. */
+ * so a thread count gives the same bits every run.
+ *
+ * Any number of columns: the first 4 compute the entries of a row block against the tile
+ * (kept, 32 KB) and the others run over them 4 at a time, each column with its own updates
+ * in its own order (the same bits alone or in a batch). But the tile's rotated weights and
+ * column sums grow with the columns and leave the caches: the sums take this product only
+ * up to CM_RBF_SELF_MAX_NC columns (rbf_sum_isa.h). */
 #include "rbf_sum_isa.h"
 #include "rbf_internal.h" /* CM_RBF_SUM_MAX_NC */
 

@@ -492,7 +492,8 @@ typedef struct seg {
     int direct; /* centres (1) or proxies (0) */
 } seg;
 
-static inline __attribute__((always_inline)) void block_sum(const int hf, const int nc, const seg *s, int ns,
+static inline __attribute__((always_inline)) void block_sum(const int hf, const int nc,
+                                                            const seg *s, int ns,
                                                             const double *tx, const double *ty,
                                                             const double *tz, double *out)
 {
@@ -515,7 +516,8 @@ static inline __attribute__((always_inline)) void block_sum(const int hf, const 
                 double dx = x[l] - xj, dy = y[l] - yj, dz = z[l] - zj;
                 double r2 = dx * dx + dy * dy + dz * dz;
                 double f = r2 * sqrt(r2);
-                for (int q = 0; q < nc; ++q) a[q][l] = hf ? fma(wj[q], f, a[q][l]) : a[q][l] + wj[q] * f;
+                for (int q = 0; q < nc; ++q)
+                    a[q][l] = hf ? fma(wj[q], f, a[q][l]) : a[q][l] + wj[q] * f;
             }
         }
     }
@@ -527,7 +529,8 @@ static inline __attribute__((always_inline)) void block_sum(const int hf, const 
  * left in fb) against NB targets, sums in out (nc x NB): the same multiply-add per entry
  * and column as block_sum, in the same order, so a column's sum does not depend on the
  * columns beside it. keep = 1: also leave the entries in fb. */
-static inline __attribute__((always_inline)) void seg_part(const int hf, const int nc, const int keep,
+static inline __attribute__((always_inline)) void seg_part(const int hf, const int nc,
+                                                           const int keep,
                                                            const double *sx, const double *sy,
                                                            const double *sz, const double *sw,
                                                            size_t ldw, size_t jn,
@@ -555,7 +558,8 @@ static inline __attribute__((always_inline)) void seg_part(const int hf, const i
                 f = r2 * sqrt(r2);
                 if (keep) fb[j * NB + l] = f;
             }
-            for (int q = 0; q < nc; ++q) a[q][l] = hf ? fma(wj[q], f, a[q][l]) : a[q][l] + wj[q] * f;
+            for (int q = 0; q < nc; ++q)
+                a[q][l] = hf ? fma(wj[q], f, a[q][l]) : a[q][l] + wj[q] * f;
         }
     }
     for (int q = 0; q < nc; ++q)
@@ -564,7 +568,8 @@ static inline __attribute__((always_inline)) void seg_part(const int hf, const i
 
 /* block_sum for more than 4 columns: per stretch of FB_J sources the first 4 columns
  * compute the entries (kept in fb) and the others run over them 4 at a time. */
-static inline __attribute__((always_inline)) void block_many(const int hf, int nc, const seg *s, int ns,
+static inline __attribute__((always_inline)) void block_many(const int hf, int nc,
+                                                             const seg *s, int ns,
                                                              const double *tx, const double *ty,
                                                              const double *tz, double *out)
 {

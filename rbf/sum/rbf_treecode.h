@@ -37,7 +37,9 @@ void cm_rbf_tree_set_isa(cm_rbf_tree *t, cm_rbf_isa isa);
  * (RESULTS.md, RBF solvers, says what it buys). */
 void cm_rbf_tree_set_compensated(cm_rbf_tree *t, int level);
 
-/* out[i * ldo + q] ~ sum_j phi(|p_i - c_j|) w[q * m + j] for q < nc (1..4), i < n; p: 3 x n
+/* out[i * ldo + q] ~ sum_j phi(|p_i - c_j|) w[q * m + j] for q < nc (any nc >= 1: the
+ * proxy interpolation and every entry of the products shared by all columns, each column the
+ * same bits whatever columns ride along), i < n; p: 3 x n
  * SoA with stride ldp. 0 on success, -1 on allocation failure (out untouched). */
 int cm_rbf_tree_sum(const cm_rbf_tree *t, const double *w, int nc, size_t n, const double *p,
                     size_t ldp, double *out, size_t ldo, int threads);

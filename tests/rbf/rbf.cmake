@@ -52,7 +52,8 @@ cm_add_unit_test(test_rbf_treecode ${CMAKE_CURRENT_LIST_DIR}/test_rbf_treecode.c
 cm_add_unit_test(test_rbf_sum ${CMAKE_CURRENT_LIST_DIR}/test_rbf_sum.c LIBS cm_rbf_internal LABELS rbf)
 # many columns in one pass: each column's sum the same bits alone or in a batch (plain,
 # compensated, self product, treecode; every ISA this CPU runs), and against a reference
-cm_add_unit_test(test_rbf_sum_batch ${CMAKE_CURRENT_LIST_DIR}/test_rbf_sum_batch.c LIBS cm_rbf_internal LABELS rbf)
+cm_add_unit_test(test_rbf_sum_batch ${CMAKE_CURRENT_LIST_DIR}/test_rbf_sum_batch.c
+  LIBS cm_rbf_internal LABELS rbf)
 # AUTO's cost model: probe rates, growth of the costs, one crossover
 cm_add_unit_test(test_rbf_auto ${CMAKE_CURRENT_LIST_DIR}/test_rbf_auto.c LIBS cm_rbf_internal LABELS rbf)
 # stopping on request (cm_context_interrupt): sums in chunks are the bits of one pass;
