@@ -98,13 +98,6 @@ static const double relax_tree_tol[CM_RBF_RELAX_LEVELS] = {1e-6, 1e-9, 1e-11};
 #ifndef CM_RBF_SUM_MAX_NC
 #define CM_RBF_SUM_MAX_NC 4
 #endif
-/* Each column is solved to the tolerance relative to its own scale, max |f_c|, or this
- * fraction of max |f| over all columns if that is larger: so a column's iterates do not
- * depend on its batch-mates of similar size (a batch of variants solves each as alone),
- * while a column of round-off (a displacement component that is zero up to 1e-17) is not
- * chased to its own relative tolerance. Either way the residual is within the tolerance
- * x max |f| of all columns, as the header promises. */
-#define CM_RBF_COL_SCALE 1e-3
 
 enum { MV_COMP = 0, MV_PLAIN = 1, MV_FAST = 2 };
 
@@ -989,7 +982,14 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         for (int c = 0; c < g; ++c) {
             kcol *kc = &kr.col[c];
             const size_t o0 = (c0 + (size_t)c) * m;
-            kc->fnorm = fmax(norm_inf(m, f + o0), CM_RBF_COL_SCALE * fmax_all);
+            /* each column to the tolerance relative to its own scale, max |f_c|, or the
+             * fraction column_scale of max |f| over all columns if that is larger: so a
+             * column's iterates do not depend on its batch-mates of similar size (a batch
+             * of variants solves each as alone), while a column of round-off (a
+             * displacement component that is zero up to 1e-17) is not chased to its own
+             * relative tolerance. Either way the residual is within the tolerance x max |f|
+             * of all columns, as the header promises */
+            kc->fnorm = fmax(norm_inf(m, f + o0), tu->column_scale * fmax_all);
             kc->tol = o->tolerance;
             kc->warm = warm;
             kc->took = 0;
