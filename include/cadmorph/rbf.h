@@ -91,8 +91,9 @@ typedef struct cm_rbf_stats {
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
     int matvecs;           /* last solve: kernel-sum passes over the m x m matrix of every
-                            * kind (one per iteration, two at a restart plus one for the
-                            * floor estimate, all running components together; PETSC: the
+                            * kind (one per iteration and product kind in use, two at a
+                            * restart plus one for the floor estimate, all running
+                            * components together; PETSC: the
                             * components one after the other, each counted; fast sums: the
                             * treecode's products plus two exact ones per refinement step);
                             * the split by kind is in matvecs_compensated/plain/fast below */
