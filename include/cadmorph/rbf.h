@@ -72,9 +72,10 @@ typedef struct cm_rbf_options {
                            * (matvecs from 150,000 centres, evaluation from 2e9 point-centre
                            * pairs where its checked error is small enough) */
     int warm_start;       /* [1] a cm_rbf_solve with as many components as the previous one
-                           * on this rbf starts each component from its previous weights
-                           * where they leave a residual below |data| (else from zero); 0:
-                           * always from zero (stats: warm_columns) */
+                           * on this rbf starts each component from its previous weights,
+                           * scaled by the factor that fits the new data best, where they
+                           * leave a residual below |data| (else from zero); 0: always from
+                           * zero (stats: warm_columns) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);

@@ -135,10 +135,11 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             const int c = sel[u];
             kcol *k = &kr->col[c];
             const size_t o0 = (size_t)c * m;
-            for (size_t i = 0; i < m; ++i) rhs[o0 + i] = f[o0 + i] - aw[o0 + i];
-            cm_krylov_project(r->iter->q1, m, r->k, rhs + o0);
-            const double fn = cm_krylov_norm_inf(m, f + o0), rn = cm_krylov_norm_inf(m, rhs + o0);
-            if (rn < fn) k->warm_res = rn / fn, k->took = 1;
+            double alpha;
+            const double rn = cm_krylov_warm_fit(r, m, f + o0, w + o0, aw + o0, rhs + o0,
+                                                 dw + o0, &alpha);
+            const double fn = cm_krylov_norm_inf(m, f + o0);
+            if (rn < fn && alpha != 0.0) k->warm_res = rn / fn, k->took = 1;
             else {
                 memcpy(rhs + o0, f + o0, m * sizeof *rhs);
                 memset(w + o0, 0, m * sizeof *w);

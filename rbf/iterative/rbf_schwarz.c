@@ -795,18 +795,21 @@ static inline void local_row(const double *gd, const float *gf, size_t hd, size_
     for (int b = 0; b < nb; ++b) out[(size_t)b * ldo] += acc[b];
 }
 
-/* Kernel sums of nc columns in chunks the sums take (rbf_internal.h) */
+/* Kernel sums of nc columns in chunks the sums take (rbf_internal.h); with inner (the
+ * multilevel coarse space) each chunk first by its treecode to the fine centres (p = the
+ * centres, n = ldp), as one call of up to CM_RBF_SUM_MAX_NC columns would */
 #ifndef CM_RBF_SUM_MAX_NC
 #define CM_RBF_SUM_MAX_NC 4
 #endif
-static void sum_chunked(cm_rbf_kernel kernel, size_t ms, const double *cs, const double *w,
-                        int nc, size_t n, const double *p, size_t ldp, double *out,
-                        size_t ldo, int threads)
+static void sum_chunked(const cm_rbf_coarse_inner *inner, cm_rbf_kernel kernel, size_t ms,
+                        const double *cs, const double *w, int nc, size_t n, const double *p,
+                        size_t ldp, double *out, size_t ldo, int threads)
 {
     for (int c0 = 0; c0 < nc; c0 += CM_RBF_SUM_MAX_NC) {
         const int b = nc - c0 < CM_RBF_SUM_MAX_NC ? nc - c0 : CM_RBF_SUM_MAX_NC;
         if (b == nc) { /* one chunk: straight into out */
-            cm_rbf_kernel_sum(kernel, 3, ms, cs, w, nc, n, p, ldp, out, ldo, threads);
+            if (!inner || cm_rbf_coarse_inner_to_fine(inner, nc, w, n, p, out, threads) != 0)
+                cm_rbf_kernel_sum(kernel, 3, ms, cs, w, nc, n, p, ldp, out, ldo, threads);
             return;
         }
         double *tmp = malloc(n * (size_t)b * sizeof *tmp);
@@ -815,8 +818,10 @@ static void sum_chunked(cm_rbf_kernel kernel, size_t ms, const double *cs, const
                 for (int u = 0; u < b; ++u) out[i * ldo + (size_t)(c0 + u)] = 0.0;
             continue;
         }
-        cm_rbf_kernel_sum(kernel, 3, ms, cs, w + (size_t)c0 * ms, b, n, p, ldp, tmp, (size_t)b,
-                          threads);
+        if (!inner ||
+            cm_rbf_coarse_inner_to_fine(inner, b, w + (size_t)c0 * ms, n, p, tmp, threads) != 0)
+            cm_rbf_kernel_sum(kernel, 3, ms, cs, w + (size_t)c0 * ms, b, n, p, ldp, tmp,
+                              (size_t)b, threads);
         for (size_t i = 0; i < n; ++i)
             for (int u = 0; u < b; ++u) out[i * ldo + (size_t)(c0 + u)] = tmp[i * (size_t)b + (size_t)u];
         free(tmp);
@@ -850,10 +855,8 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
             coarse_solve(p, nc, wc, threads);
             /* the local solves see the residual of the coarse interpolant; its polynomial
              * part is left in, as the local solves annihilate linear functions exactly */
-            if (nc > CM_RBF_SUM_MAX_NC ||
-                cm_rbf_coarse_inner_to_fine(p->inner, nc, wc, m, r->c, ac, threads) != 0)
-                sum_chunked(r->kernel, ncs, p->c_xyz, wc, nc, m, r->c, m, ac, (size_t)nc,
-                            threads);
+            sum_chunked(p->inner, r->kernel, ncs, p->c_xyz, wc, nc, m, r->c, m, ac, (size_t)nc,
+                        threads);
             for (int c = 0; c < nc; ++c)
                 for (size_t i = 0; i < m; ++i)
                     r1[(size_t)c * m + i] = in[(size_t)c * m + i] - ac[i * (size_t)nc + (size_t)c];
@@ -917,7 +920,7 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
         wc = rc + ncs * (size_t)nc;
         double *aout = malloc(ncs * (size_t)nc * sizeof *aout);
         if (aout) {
-            sum_chunked(r->kernel, m, r->c, out, nc, ncs, p->c_xyz, ncs, aout, (size_t)nc,
+            sum_chunked(NULL, r->kernel, m, r->c, out, nc, ncs, p->c_xyz, ncs, aout, (size_t)nc,
                         threads);
             for (int c = 0; c < nc; ++c)
                 for (size_t a = 0; a < ncs; ++a)
