@@ -443,7 +443,6 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                 memcpy(w + o0, r->w + o0, m * sizeof *w);
                 cm_krylov_project(r->iter->q1, m, r->k, w + o0);
             }
-            kr.ia[c] = c;
         }
         if (fast)
             st = refine_group(ctx, r, &kr, f + c0 * m, w + c0 * m, aw + c0 * m, &steps, &first,
