@@ -549,6 +549,7 @@ double tolerance;
 int max_iterations;
 int restart;
 int fast_sum;
+int warm_start;
 } cm_rbf_options;
 void cm_rbf_options_init(cm_rbf_options *opt);
 typedef struct cm_rbf_stats {
@@ -576,6 +577,9 @@ double eval_theta;
 int matvecs_compensated;
 int matvecs_plain;
 int matvecs_fast;
+int column_groups;
+int warm_columns;
+double warm_residual;
 } cm_rbf_stats;
 void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats);
 cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,

@@ -62,12 +62,14 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->max_iterations = 300;
     opt->restart = 40;
     opt->fast_sum = -1;
+    opt->warm_start = 1;
 }
 
 void cm_rbf_tuning_init(cm_rbf_tuning *t)
 {
     if (!t) return;
     memset(t, 0, sizeof *t);
+    t->column_scale = 1e-3;
     t->leaf_size = 256;
     t->local_size = 700;
     t->coarse_size = 2000;
@@ -402,7 +404,9 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
     }
     for (size_t u = 0; u < m; ++u)
         for (size_t c = 0; c < nc; ++c) f[c * m + u] = values[rbf->first[u] * nc + c];
+    rbf->warm_ok = 1; /* this solve may start from the previous weights (options warm_start) */
     st = cm_rbf_solve_merged(ctx, rbf, nc, f, CM_RBF_REFINE_TOL, w, q);
+    rbf->warm_ok = 0;
     if (st >= CM_OK) { /* a warning keeps the weights: the message says how good they are */
         free(rbf->w);
         free(rbf->q);

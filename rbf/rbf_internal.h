@@ -38,6 +38,8 @@ struct cm_rbf {
     cm_rbf_stats stats;
     cm_rbf_iter *iter; /* iterative solver state, NULL for dense (then chol is set) */
     cm_rbf_petsc *petsc; /* PETSC solver (rbf_petsc.c): set with iter, NULL otherwise */
+    int warm_ok;      /* set by cm_rbf_solve around its solve: a warm start from w may be
+                       * tried (not by the transposed solve, whose data are another's) */
     int pc_part, pc_parts; /* Schwarz set-up split over ranks (rbf_petsc.c): this part of
                             * pc_parts builds only its subdomains; 0, 0: all */
 };
@@ -247,6 +249,9 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads);
 cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
                                  double *w, double *q, int threads);
 void cm_rbf_iterative_destroy(cm_rbf_iter **it);
+/* The last iterative solve's Krylov iterations of column c (over all its restarts and
+ * refinement steps), -1 if there is no such column (tests). */
+int cm_rbf_iterative_column_iterations(const cm_rbf *r, size_t c);
 /* out (n x ncomp) = sum_j w_j phi(|p_i - c_j|) by compensated sums; p: 3 x n SoA. tick
  * (NULL: none) reports the sums in chunks; nonzero when it said stop (out partly written). */
 int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
@@ -290,7 +295,7 @@ const cm_rbf_schwarz *cm_rbf_iterative_pc(const cm_rbf *r);
 cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
                                 cm_rbf_schwarz **pc);
 void cm_rbf_schwarz_destroy(cm_rbf_schwarz **pc);
-/* out = M in for nc (1..4) vectors, nc x m SoA each: coarse solve, coarse residual, then
+/* out = M in for nc vectors (any number), nc x m SoA each: coarse solve, coarse residual, then
  * the restricted local solves. out is not projected onto the null space of P'. */
 void cm_rbf_schwarz_apply(const cm_rbf_schwarz *pc, const cm_rbf *r, int nc, const double *in,
                           double *out, int threads);
@@ -317,6 +322,11 @@ int cm_rbf_projected_factor(const double *cg, size_t m, const size_t *idx, size_
                             double *work, int *rk, double *tau);
 int cm_rbf_projected_solve(const double *work, size_t n, int rk, const double *tau,
                            size_t nrhs, double *x);
+/* The same with each column's arithmetic in an order that does not depend on nrhs (a
+ * column's result is the same bits alone or with others); the coarse solve of the Schwarz
+ * preconditioner, whose columns are a batch's right-hand sides. */
+void cm_rbf_projected_solve_cols(const double *work, size_t n, int rk, const double *tau,
+                                 size_t nrhs, double *x);
 int cm_rbf_local_inverse(const double *cg, size_t m, const size_t *idx, size_t n, size_t n_in,
                          double *work, double *g);
 int cm_rbf_local_inverse_fast(const double *cg, size_t m, const size_t *idx, size_t n,

@@ -100,6 +100,14 @@ typedef struct cm_rbf_tuning {
                            * checked exactly at the end, and a restart follows if it fails.
                            * 0: every Krylov product compensated; 2: as 1 with the treecode at
                            * any m (for tests) */
+    double column_scale;  /* [1e-3] each column of an iterative solve is held to the
+                           * tolerance x max(max |f_c|, column_scale x max |f| of all columns)
+                           * (rbf_fgmres.c says why); 1: all to max |f| of all columns (a
+                           * column's stopping test then depends on its batch-mates) */
+    double krylov_budget; /* [0] bytes the iterative solve's per-column storage may take
+                           * (the Krylov bases of all columns solved at once); columns beyond
+                           * it are solved in groups (stats column_groups). 0: half the
+                           * machine's memory (cm_memory_budget) */
 } cm_rbf_tuning;
 
 void cm_rbf_tuning_init(cm_rbf_tuning *tuning);

@@ -61,13 +61,21 @@ typedef struct cm_rbf_options {
     cm_rbf_solver solver; /* [AUTO] */
     double tolerance;     /* [1e-10] stop when max_i |f_i - s(c_i)| <= tolerance * max |f|
                            * (max over all components), or at the attainable floor if that
-                           * is higher (see stats) */
+                           * is higher (see stats). The iterative solvers hold each component
+                           * to its own max |f_c| (at least 1e-3 max |f|), so that a
+                           * component's result does not depend on the others solved with
+                           * it */
     int max_iterations;   /* [300] Krylov iterations per component, over all restarts */
     int restart;          /* [40] FGMRES restart length (at most 63) */
     int fast_sum;         /* [-1] fast summation (the r^3 treecode) for the Krylov matvecs
                            * and for evaluation: 0 never (direct sums), 1 always, -1 auto
                            * (matvecs from 150,000 centres, evaluation from 2e9 point-centre
                            * pairs where its checked error is small enough) */
+    int warm_start;       /* [1] a cm_rbf_solve with as many components as the previous one
+                           * on this rbf starts each component from its previous weights,
+                           * scaled by the factor that fits the new data best, where they
+                           * leave a residual below |data| (else from zero); 0: always from
+                           * zero (stats: warm_columns) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
@@ -84,8 +92,9 @@ typedef struct cm_rbf_stats {
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
     int matvecs;           /* last solve: kernel-sum passes over the m x m matrix of every
-                            * kind (one per iteration, two at a restart plus one for the
-                            * floor estimate, all running components together; PETSC: the
+                            * kind (one per iteration and product kind in use, two at a
+                            * restart plus one for the floor estimate, all running
+                            * components together; PETSC: the
                             * components one after the other, each counted; fast sums: the
                             * treecode's products plus two exact ones per refinement step);
                             * the split by kind is in matvecs_compensated/plain/fast below */
@@ -120,6 +129,12 @@ typedef struct cm_rbf_stats {
     int matvecs_compensated; /* last iterative solve: matvecs split by kind (they add up to */
     int matvecs_plain;       /* matvecs): compensated direct sums (~1.45x a plain one), plain */
     int matvecs_fast;        /* direct sums, treecode sums (a loose one: ~0.1-0.3x) */
+    int column_groups;     /* last iterative solve: groups its components were solved in (1:
+                            * all at once; more when their Krylov storage, see cm_rbf_solve,
+                            * exceeded half the machine's memory) */
+    int warm_columns;      /* last iterative solve: components that started from the previous
+                            * solve's weights (options warm_start) */
+    double warm_residual;  /* ... and the largest |f_c - A w0| / |f_c| they started from */
 } cm_rbf_stats;
 
 CM_API void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats);
@@ -143,7 +158,11 @@ CM_API cm_status cm_rbf_create_opt(cm_context *ctx, cm_rbf_kernel kernel, int di
 CM_API void cm_rbf_destroy(cm_rbf **rbf);
 
 /* Solves for values at the m centres given to create (values: m x ncomp row-major) and keeps
- * the weights in rbf, replacing earlier ones. Merged duplicate centres whose values differ
+ * the weights in rbf, replacing earlier ones. The iterative solvers solve all ncomp
+ * components at once (one kernel pass per iteration for all, each converging on its own),
+ * keeping about (2 restart + 9) x 8 bytes per centre and component (with fast sums 4 x 8
+ * more): callers that choose how many components to hand over at once can size batches by
+ * that; past half the machine's memory they are solved in groups. Merged duplicate centres whose values differ
  * by more than 1e-8 of the largest value are an error naming both indices (smaller
  * differences are round-off, e.g. of projections that put two nodes on one point). */
 CM_API cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values);

@@ -21,6 +21,8 @@ struct cm_rbf_iter {
     double eval_theta;
     int transpose_fast; /* the last transposed evaluation took the treecode (for tests) */
     cm_rbf_tree *rtree[3]; /* loose treecodes for relaxed products (relax_tree_tol) */
+    int *col_iters;    /* the last solve's Krylov iterations per column (col_n of them) */
+    size_t col_n;
 };
 
 /* The treecode on the centres of r for (order, theta), made on first use and kept in

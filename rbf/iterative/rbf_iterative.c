@@ -21,6 +21,7 @@ void cm_rbf_iterative_destroy(cm_rbf_iter **it)
     cm_rbf_tree_destroy(&(*it)->rtree[1]);
     cm_rbf_tree_destroy(&(*it)->rtree[2]);
     free((*it)->q1);
+    free((*it)->col_iters);
     free(*it);
     *it = NULL;
 }

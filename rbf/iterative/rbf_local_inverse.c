@@ -210,3 +210,64 @@ int cm_rbf_poly_basis(const double *cg, size_t m, const size_t *idx, size_t n, d
     memcpy(q, pq, (size_t)rk * n * sizeof *q);
     return 0;
 }
+
+/* Columns of the coarse solve processed together (independent sums in flight). */
+#define CM_PSOLVE_COLS 4
+
+/* H_a x = x - tau_a v_a (v_a' x) (v_a: 1 at a, pq below it) for the nb columns of x */
+static void reflect(const double *pq, size_t n, int a, double tau, double *x, int nb)
+{
+    const double *v = pq + (size_t)a * n;
+    for (int b = 0; b < nb; ++b) {
+        double *xb = x + (size_t)b * n, s = xb[a];
+        for (size_t i = (size_t)a + 1; i < n; ++i) s += v[i] * xb[i];
+        s *= tau;
+        xb[a] -= s;
+        for (size_t i = (size_t)a + 1; i < n; ++i) xb[i] -= s * v[i];
+    }
+}
+
+/* cm_rbf_projected_solve with each column's arithmetic in a fixed order whatever nrhs, so a
+ * column's result is the same bits alone or among others (the iterative solve's columns
+ * then do not depend on their batch-mates; LAPACK's dormqr / dpotrs promise no such thing:
+ * their BLAS blocks the right-hand sides). The triangular solves stream the factor once for
+ * a block of CM_PSOLVE_COLS columns. */
+void cm_rbf_projected_solve_cols(const double *work, size_t n, int rk, const double *tau,
+                                 size_t nrhs, double *x)
+{
+    const double *a = work, *pq = work + n * n + 3 * n;
+    const size_t n2 = n - (size_t)rk;
+    const double *l = a + (size_t)rk * n + (size_t)rk; /* n2 x n2 lower, ld n */
+    for (size_t c0 = 0; c0 < nrhs; c0 += CM_PSOLVE_COLS) {
+        const int nb = nrhs - c0 < CM_PSOLVE_COLS ? (int)(nrhs - c0) : CM_PSOLVE_COLS;
+        double *xc = x + c0 * n;
+        for (int q = 0; q < rk; ++q) reflect(pq, n, q, tau[q], xc, nb); /* Q' x */
+        double *y[CM_PSOLVE_COLS];
+        for (int b = 0; b < nb; ++b) {
+            y[b] = xc + (size_t)b * n + (size_t)rk;
+            for (int i = 0; i < rk; ++i) xc[(size_t)b * n + (size_t)i] = 0.0;
+        }
+        /* L y = x2, by columns of L */
+        for (size_t j = 0; j < n2; ++j) {
+            const double *lj = l + j * n;
+            for (int b = 0; b < nb; ++b) {
+                double *yb = y[b];
+                const double t = yb[j] / lj[j];
+                yb[j] = t;
+                for (size_t i = j + 1; i < n2; ++i) yb[i] -= lj[i] * t;
+            }
+        }
+        /* L' x = y, by dot products with the columns of L */
+        for (size_t jj = n2; jj-- > 0;) {
+            const double *lj = l + jj * n;
+            double acc[CM_PSOLVE_COLS];
+            for (int b = 0; b < nb; ++b) acc[b] = y[b][jj];
+            for (size_t i = jj + 1; i < n2; ++i) {
+                const double li = lj[i];
+                for (int b = 0; b < nb; ++b) acc[b] -= li * y[b][i];
+            }
+            for (int b = 0; b < nb; ++b) y[b][jj] = acc[b] / lj[jj];
+        }
+        for (int q = rk; q-- > 0;) reflect(pq, n, q, tau[q], xc, nb); /* Q x */
+    }
+}

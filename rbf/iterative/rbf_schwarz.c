@@ -758,13 +758,74 @@ cm_status cm_rbf_schwarz_create(cm_context *ctx, const cm_rbf *r, int threads,
  * inner Krylov solve */
 static void coarse_solve(const cm_rbf_schwarz *p, int nc, double *wc, int threads)
 {
-    if (p->inner) cm_rbf_coarse_inner_solve(p->inner, nc, wc, threads);
-    else cm_rbf_projected_solve(p->gc, p->nc, p->c_rk, p->c_tau, (size_t)nc, wc);
+    /* the inner Krylov solve runs its columns in lock step (stopping when all are done), so
+     * it gets one column at a time: a column's correction then does not depend on its
+     * batch-mates */
+    if (p->inner)
+        for (int c = 0; c < nc; ++c)
+            cm_rbf_coarse_inner_solve(p->inner, 1, wc + (size_t)c * p->nc, threads);
+    else cm_rbf_projected_solve_cols(p->gc, p->nc, p->c_rk, p->c_tau, (size_t)nc, wc);
 }
 
 const cm_rbf_coarse_inner *cm_rbf_schwarz_inner(const cm_rbf_schwarz *pc)
 {
     return pc ? pc->inner : NULL;
+}
+
+/* One row of a local inverse (its double part gd, float part gf) times nb (1 or
+ * CM_SCHWARZ_COLS) columns of the local data x (stride n), added to out (stride ldo).
+ * Why blocks of columns and not dgemm: a row is read once for the whole block, and the
+ * block's independent sums fill the adder's pipeline (one column alone is a chain of
+ * dependent adds); each column's sum still runs in the same order as alone, so a column's
+ * preconditioned vector is the same bits whatever its batch-mates (dgemm promises no such
+ * thing: OpenBLAS hands one column to dgemv), and the float rows need no double copy. */
+#define CM_SCHWARZ_COLS 8
+static inline void local_row(const double *gd, const float *gf, size_t hd, size_t hf,
+                             const double *x, size_t n, int nb, double *out, size_t ldo)
+{
+    double acc[CM_SCHWARZ_COLS] = {0};
+    for (size_t i = 0; i < hd; ++i) {
+        const double gi = gd[i];
+        for (int b = 0; b < nb; ++b) acc[b] += gi * x[(size_t)b * n + i];
+    }
+    for (size_t i = 0; i < hf; ++i) {
+        const double gi = (double)gf[i];
+        for (int b = 0; b < nb; ++b) acc[b] += gi * x[(size_t)b * n + hd + i];
+    }
+    for (int b = 0; b < nb; ++b) out[(size_t)b * ldo] += acc[b];
+}
+
+/* Kernel sums of nc columns in chunks the sums take (rbf_internal.h); with inner (the
+ * multilevel coarse space) each chunk first by its treecode to the fine centres (p = the
+ * centres, n = ldp), as one call of up to CM_RBF_SUM_MAX_NC columns would */
+#ifndef CM_RBF_SUM_MAX_NC
+#define CM_RBF_SUM_MAX_NC 4
+#endif
+static void sum_chunked(const cm_rbf_coarse_inner *inner, cm_rbf_kernel kernel, size_t ms,
+                        const double *cs, const double *w, int nc, size_t n, const double *p,
+                        size_t ldp, double *out, size_t ldo, int threads)
+{
+    for (int c0 = 0; c0 < nc; c0 += CM_RBF_SUM_MAX_NC) {
+        const int b = nc - c0 < CM_RBF_SUM_MAX_NC ? nc - c0 : CM_RBF_SUM_MAX_NC;
+        if (b == nc) { /* one chunk: straight into out */
+            if (!inner || cm_rbf_coarse_inner_to_fine(inner, nc, w, n, p, out, threads) != 0)
+                cm_rbf_kernel_sum(kernel, 3, ms, cs, w, nc, n, p, ldp, out, ldo, threads);
+            return;
+        }
+        double *tmp = malloc(n * (size_t)b * sizeof *tmp);
+        if (!tmp) { /* out of memory: one column at a time in place is no option; zero */
+            for (size_t i = 0; i < n; ++i)
+                for (int u = 0; u < b; ++u) out[i * ldo + (size_t)(c0 + u)] = 0.0;
+            continue;
+        }
+        if (!inner ||
+            cm_rbf_coarse_inner_to_fine(inner, b, w + (size_t)c0 * ms, n, p, tmp, threads) != 0)
+            cm_rbf_kernel_sum(kernel, 3, ms, cs, w + (size_t)c0 * ms, b, n, p, ldp, tmp,
+                              (size_t)b, threads);
+        for (size_t i = 0; i < n; ++i)
+            for (int u = 0; u < b; ++u) out[i * ldo + (size_t)(c0 + u)] = tmp[i * (size_t)b + (size_t)u];
+        free(tmp);
+    }
 }
 
 int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
@@ -794,9 +855,8 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
             coarse_solve(p, nc, wc, threads);
             /* the local solves see the residual of the coarse interpolant; its polynomial
              * part is left in, as the local solves annihilate linear functions exactly */
-            if (cm_rbf_coarse_inner_to_fine(p->inner, nc, wc, m, r->c, ac, threads) != 0)
-                cm_rbf_kernel_sum(r->kernel, 3, ncs, p->c_xyz, wc, nc, m, r->c, m, ac,
-                                  (size_t)nc, threads);
+            sum_chunked(p->inner, r->kernel, ncs, p->c_xyz, wc, nc, m, r->c, m, ac, (size_t)nc,
+                        threads);
             for (int c = 0; c < nc; ++c)
                 for (size_t i = 0; i < m; ++i)
                     r1[(size_t)c * m + i] = in[(size_t)c * m + i] - ac[i * (size_t)nc + (size_t)c];
@@ -838,13 +898,13 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
             for (size_t j = 0; j < nin; ++j) {
                 const double *gd = p->g64 + p->d_ptr[l] + j * hd;
                 const float *gf = p->g32 + p->f_ptr[l] + j * hf;
-                for (int c = 0; c < nc; ++c) {
-                    const double *xc = x + (size_t)c * n;
-                    double acc = 0.0;
-                    for (size_t i = 0; i < hd; ++i) acc += gd[i] * xc[i];
-                    for (size_t i = 0; i < hf; ++i) acc += (double)gf[i] * xc[hd + i];
-                    out[(size_t)c * m + idx[j]] += acc;
-                }
+                int c = 0;
+                for (; c + CM_SCHWARZ_COLS <= nc; c += CM_SCHWARZ_COLS)
+                    local_row(gd, gf, hd, hf, x + (size_t)c * n, n, CM_SCHWARZ_COLS,
+                              out + (size_t)c * m + idx[j], m);
+                for (; c < nc; ++c)
+                    local_row(gd, gf, hd, hf, x + (size_t)c * n, n, 1,
+                              out + (size_t)c * m + idx[j], m);
             }
         }
         free(loc);
@@ -860,8 +920,8 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
         wc = rc + ncs * (size_t)nc;
         double *aout = malloc(ncs * (size_t)nc * sizeof *aout);
         if (aout) {
-            cm_rbf_kernel_sum(r->kernel, 3, m, r->c, out, nc, ncs, p->c_xyz, ncs, aout,
-                              (size_t)nc, threads);
+            sum_chunked(NULL, r->kernel, m, r->c, out, nc, ncs, p->c_xyz, ncs, aout, (size_t)nc,
+                        threads);
             for (int c = 0; c < nc; ++c)
                 for (size_t a = 0; a < ncs; ++a)
                     rc[(size_t)c * ncs + a] = in[(size_t)c * m + p->c_idx[a]] -

@@ -62,3 +62,6 @@ cm_add_unit_test(test_rbf_interrupt ${CMAKE_CURRENT_LIST_DIR}/test_rbf_interrupt
 # the reverse product of solve-then-evaluate: the dot-product test (dense r^3, r, thin plate;
 # iterative with direct and treecode sums; merged duplicates), iterative against dense
 cm_add_unit_test(test_rbf_transpose ${CMAKE_CURRENT_LIST_DIR}/test_rbf_transpose.c LIBS cm_rbf_internal LABELS rbf)
+# many right-hand sides in one iterative solve against each alone (direct and treecode
+# sums), a slow column beside smooth ones, warm starts, columns in groups of a memory budget
+cm_add_unit_test(test_rbf_batch ${CMAKE_CURRENT_LIST_DIR}/test_rbf_batch.c LIBS cm_rbf_internal LABELS rbf)

@@ -170,6 +170,9 @@ static void test_solve(cm_context *ctx, stopper *st)
     cm_rbf_options_init(&o);
     o.solver = CM_RBF_SOLVER_ITERATIVE;
     o.tolerance = 1e-9;
+    /* from zero: a warm start would begin from the weights of g, kept by the interrupted
+     * solves, where a fresh fit has none */
+    o.warm_start = 0;
     cm_rbf *r = NULL, *fresh = NULL;
     arm(st, 0);
     cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, c, &o, &r);

@@ -11,6 +11,7 @@
 #include "test_stopper.h"
 #include "test_util.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -85,8 +86,17 @@ static void test_method(cm_context *ctx, stopper *st, const cm_mesh *m, const cm
         arm(st, 0);
         boundary_motion(m, b, got);
         s = cm_warp_apply(ctx, w, got);
-        CHECK_MSG(s >= 0 && !memcmp(got, want, n3 * sizeof *got),
-                  "%s: apply after an interrupted one differs (status %d)", name, (int)s);
+        /* the iterative RBF solve starts warm from the weights of the last completed solve
+         * (cm_rbf_options warm_start), so a repeated apply is the first one's to the solver's
+         * tolerance, not its bits (the weights it starts from are those an interrupted
+         * apply left untouched); every other warp repeats the bits */
+        double diff = 0.0, range = 0.0;
+        for (size_t i = 0; i < n3; ++i)
+            diff = fmax(diff, fabs(got[i] - want[i])), range = fmax(range, fabs(want[i]));
+        const int same = !strcmp(name, "rbf iterative") ? diff <= 1e-8 * range
+                                                        : !memcmp(got, want, n3 * sizeof *got);
+        CHECK_MSG(s >= 0 && same, "%s: apply after an interrupted one differs (status %d, by "
+                  "%.3g of %.3g)", name, (int)s, diff, range);
     }
 
     /* asked before the call: stopped at the first point; cleared: runs */

@@ -1,0 +1,100 @@
+/* The state of the iterative solve shared by its two files: the Krylov iteration of many
+ * columns at once (rbf_fgmres.c) and the driver around it, with the refinement of the fast
+ * solve and the memory groups (rbf_fgmres_solve.c). Not a public header. */
+#ifndef CADMORPH_RBF_KRYLOV_H
+#define CADMORPH_RBF_KRYLOV_H
+
+#include "rbf_iter.h"
+
+/* The rounding error of one direct sum A w is at most about eps sum_j |w_j phi_ij|; the
+ * error of a whole solve, observed, stays within this factor of that estimate. */
+#define CM_RBF_FLOOR_SLACK 10.0
+/* plain direct sums err by at most this x S(z) (rbf_fgmres.c, relaxed products) */
+#define CM_RBF_PLAIN_ERR 1e-13
+/* The kernel sums take at most this many columns per call (rbf_internal.h may raise it):
+ * cm_krylov_product() is the one place that cuts the active columns into such chunks. */
+#ifndef CM_RBF_SUM_MAX_NC
+#define CM_RBF_SUM_MAX_NC 4
+#endif
+
+enum { MV_COMP = 0, MV_PLAIN = 1, MV_FAST = 2 };
+
+/* One column's Krylov space and state: every column runs its own FGMRES (its own basis,
+ * Hessenberg, rotations, relaxation budget and stopping test), so its iterates are those of
+ * a solve of that column alone; the columns share only the passes of the kernel sums and of
+ * the preconditioner. */
+typedef struct kcol {
+    double *v;      /* (R+1) x m */
+    double *z;      /* R x m */
+    double *h;      /* (R+1) x R col-major */
+    double cs[64], sn[64], gv[65];
+    double eb[64];  /* bound on the error of each product of the cycle (max-norm) */
+    double gv0[64]; /* |GMRES residual| before each step */
+    double grow;    /* largest |y_i| / |r_{i-1}| of the solve so far */
+    int exact;      /* 1: the products stay compensated (a cycle's gap bound exceeded the
+                     * budget: its Krylov space needs huge coefficients) */
+    /* the solve */
+    double fnorm;   /* the column's scale (CM_RBF_COL_SCALE) */
+    double tol;     /* relative tolerance of this (inner) solve */
+    double prev, res, target, est, cycle0, goal, floor;
+    double sz, allow, tau; /* relaxed product of the current step */
+    int kind, lev;
+    int state;      /* 0 running, 1 converged, 2 floor, 3 stagnated, 4 max iterations */
+    int jn, iters;
+    int warm;       /* in: w holds a start to try */
+    int took;       /* the start was taken (set by the solve, cleared by the caller) */
+    double warm_res; /* |f - A w0| / |f| of a start taken */
+    /* the refinement (fast sums) */
+    int done, last, total_it, status;
+    double rprev, pb, rres;
+} kcol;
+
+typedef struct krylov {
+    size_t m;
+    int R;          /* restart length */
+    int g;          /* columns of this group */
+    kcol *col;      /* g */
+    double *soa, *rowm; /* CM_RBF_SUM_MAX_NC x m: one chunk of a kernel sum */
+    double *pin, *aux;  /* g x m: the preconditioner's input and output; scratch */
+    double *wlo;    /* g x m: low parts of the weights (double-double accumulation) */
+    double *awlo;   /* g x m: A wlo; scratch during the steps */
+    int *ia, *ib, *ic; /* g: column lists */
+    double **pa, **pb, **pc, **pd, **pe, **pf; /* g: vector lists */
+    const cm_rbf_tree *tree; /* fast matvecs (treecode) if set, else compensated direct */
+    int relax;      /* relaxed products (direct-matvec solves only) */
+    int relax_tree; /* the loose treecodes 0..relax_tree-1 may serve them */
+    double diam3;   /* diam^3 of the centres: S(z) <= diam3 sum |z| */
+    int *mv;        /* products by kind (MV_COMP, MV_PLAIN, MV_FAST) */
+} krylov;
+
+/* v -= Q1 (Q1' v), twice (the second pass removes what round-off left of the first). */
+void cm_krylov_project(const double *q1, size_t m, int k, double *v);
+double cm_krylov_norm_inf(size_t m, const double *v);
+/* out_u = A in_u for n columns: kind MV_FAST by tree (if that fails: fallback, or zeros
+ * for fallback < 0), MV_PLAIN or MV_COMP by direct sums. The one place where the columns
+ * are cut into the chunks the kernel sums take. Returns the kind used. Counts nothing. */
+int cm_krylov_product(const cm_rbf *r, krylov *kr, int kind, const cm_rbf_tree *tree,
+                      int fallback, int n, double *const *in, double *const *out, int threads);
+/* The fast solve's treecode (compensated sums if it fails), else compensated sums; counted. */
+void cm_krylov_matvec(const cm_rbf *r, krylov *kr, int n, double *const *in,
+                      double *const *out, int threads);
+/* By a named kind (the loose treecode lev for MV_FAST, plain sums if it cannot be made);
+ * counted; returns the kind used. */
+int cm_krylov_matvec_kind(const cm_rbf *r, krylov *kr, int kind, int lev, int n,
+                          double *const *in, double *const *out, int threads);
+/* A warm start: w0 and aw = A w0 (m each) scaled by the alpha that minimises |Pi(f - alpha
+ * A w0)|_2, that residual into rv; returns its max-norm. Why the factor: along a path of
+ * targets the data grow or shrink nearly in proportion (a study's G(t), a continuation),
+ * and the previous weights scaled start far nearer than as they are (one dot product, on
+ * the product the start needs anyway). scratch: m doubles. */
+double cm_krylov_warm_fit(const cm_rbf *r, size_t m, const double *f, double *w0, double *aw,
+                          double *rv, double *scratch, double *alpha);
+/* Solves the ns columns sel[] of f (g x m SoA) into w + kr->wlo (high and low parts), each
+ * to its own col[c].tol relative to col[c].fnorm; a column with col[c].warm starts from the
+ * w it holds if that leaves a residual below |f_c| (then col[c].took = 1; else from zero).
+ * Per column: iters, floor, state. aw = A(w + wlo) from the last true residual. CM_OK, or
+ * the status of a progress report that said stop. */
+cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
+                                int ns, const int *sel, double *w, double *aw, int threads);
+
+#endif

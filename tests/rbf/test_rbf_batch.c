@@ -1,0 +1,293 @@
+/* Many right-hand sides in one iterative solve: each column solved with the others equals
+ * its solve alone (weights, evaluation and iteration count), a slowly converging column
+ * does not hold back the others, warm starts, and the columns solved in groups when the
+ * Krylov storage exceeds its budget. */
+#include "cadmorph/rbf.h"
+#include "rbf_internal.h"
+#include "rbf_tuning.h"
+#include "rbf_test_sets.h"
+#include "test_util.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+enum { NC = 10, ROUGH = 9 };
+
+/* NC columns on the bore set's centres (m x NC row-major): the bore's motion (3), the same
+ * motion about two shifted axes (3 + 3), and rough random data (ROUGH), which converges
+ * more slowly. */
+static double *columns(size_t m, const double *x, unsigned seed)
+{
+    double *v = malloc(m * NC * sizeof *v), *d = malloc(m * 3 * sizeof *d);
+    if (!v || !d) {
+        free(v), free(d);
+        return NULL;
+    }
+    bore_motion(m, x, 2.0, 1.0, d);
+    for (size_t i = 0; i < m; ++i)
+        for (int e = 0; e < 3; ++e) v[i * NC + (size_t)e] = d[3 * i + (size_t)e];
+    bore_motion(m, x, 2.1, 0.95, d);
+    for (size_t i = 0; i < m; ++i)
+        for (int e = 0; e < 3; ++e) v[i * NC + 3 + (size_t)e] = 0.8 * d[3 * i + (size_t)e];
+    bore_motion(m, x, 1.9, 1.05, d);
+    for (size_t i = 0; i < m; ++i)
+        for (int e = 0; e < 3; ++e) v[i * NC + 6 + (size_t)e] = 1.2 * d[3 * i + (size_t)e];
+    unsigned s = seed;
+    for (size_t i = 0; i < m; ++i) {
+        s = s * 1103515245u + 12345u;
+        v[i * NC + ROUGH] = 0.05 * ((double)((s >> 8) & 0xffff) / 65535.0 - 0.5);
+    }
+    free(d);
+    return v;
+}
+
+typedef struct solved {
+    double *w, *q; /* nc x m, nc x k: as kept in the cm_rbf */
+    int iters[NC];
+    cm_rbf_stats st;
+    cm_status status;
+} solved;
+
+/* Solves the nc columns cols[] of v (m x NC) together on r; copies what r keeps. */
+static solved solve_cols(cm_context *ctx, cm_rbf *r, size_t m, const double *v, int nc,
+                         const int *cols)
+{
+    solved o;
+    memset(&o, 0, sizeof o);
+    double *f = malloc(m * (size_t)nc * sizeof *f);
+    for (size_t i = 0; i < m; ++i)
+        for (int u = 0; u < nc; ++u) f[i * (size_t)nc + (size_t)u] = v[i * NC + (size_t)cols[u]];
+    o.status = cm_rbf_solve(ctx, r, nc, f);
+    free(f);
+    cm_rbf_get_stats(r, &o.st);
+    const size_t mm = cm_rbf_centre_count(r), k = (size_t)r->k;
+    o.w = malloc(mm * (size_t)nc * sizeof *o.w);
+    o.q = malloc(k * (size_t)nc * sizeof *o.q);
+    memcpy(o.w, r->w, mm * (size_t)nc * sizeof *o.w);
+    memcpy(o.q, r->q, k * (size_t)nc * sizeof *o.q);
+    for (int u = 0; u < nc; ++u) o.iters[u] = cm_rbf_iterative_column_iterations(r, (size_t)u);
+    return o;
+}
+
+static double rel_diff(size_t n, const double *a, const double *b)
+{
+    double d = 0.0, s = 0.0;
+    for (size_t i = 0; i < n; ++i) d = fmax(d, fabs(a[i] - b[i])), s = fmax(s, fabs(b[i]));
+    return s > 0.0 ? d / s : d;
+}
+
+/* The interpolant of column u of a against column 0 of b (one column) at p:
+ * max difference / max |data of the column|. */
+static double eval_diff(cm_rbf *r, size_t m, size_t np, const double *p, const solved *a,
+                        int u, const solved *b, double scale)
+{
+    const size_t k = (size_t)r->k;
+    double worst = 0.0;
+    for (size_t i = 0; i < np; ++i) {
+        double s[3], ea = 0.0, eb = 0.0;
+        for (int e = 0; e < 3; ++e) s[e] = (p[3 * i + (size_t)e] - r->shift[e]) * r->scale;
+        (void)s;
+        ea = a->q[(size_t)u * k];
+        eb = b->q[0];
+        for (int e = 0; e < 3; ++e) {
+            ea += a->q[(size_t)u * k + 1 + (size_t)e] * s[e];
+            eb += b->q[1 + (size_t)e] * s[e];
+        }
+        for (size_t j = 0; j < m; ++j) {
+            double dx = s[0] - r->c[j], dy = s[1] - r->c[m + j], dz = s[2] - r->c[2 * m + j];
+            double rr = sqrt(dx * dx + dy * dy + dz * dz), phi = rr * rr * rr;
+            ea += a->w[(size_t)u * m + j] * phi;
+            eb += b->w[j] * phi;
+        }
+        worst = fmax(worst, fabs(ea - eb));
+    }
+    return worst / scale;
+}
+
+static void release(solved *s) { free(s->w), free(s->q); }
+
+#ifndef CM_RBF_SUM_MAX_NC
+#define CM_RBF_SUM_MAX_NC 4
+#endif
+
+/* 1 if the kernel sums (plain and compensated) give each column the same bits whatever the
+ * number of columns of the call: then a batch must equal its columns' solos bit for bit. */
+static int sums_column_exact(const cm_rbf *r, size_t m)
+{
+    const int nc = NC < CM_RBF_SUM_MAX_NC ? NC : CM_RBF_SUM_MAX_NC;
+    double *w = malloc(m * (size_t)nc * sizeof *w), *o1 = malloc(m * sizeof *o1);
+    double *on = malloc(m * (size_t)nc * sizeof *on);
+    unsigned s = 3u;
+    for (size_t i = 0; i < m * (size_t)nc; ++i) {
+        s = s * 1103515245u + 12345u;
+        w[i] = (double)((s >> 8) & 0xffff) / 65535.0 - 0.5;
+    }
+    int same = nc > 1;
+    for (int acc = 0; acc < 2 && same; ++acc) {
+        if (acc) cm_rbf_kernel_sum_acc(m, r->c, w, nc, m, r->c, m, on, (size_t)nc, 2);
+        else cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, w, nc, m, r->c, m, on, (size_t)nc, 2);
+        for (int u = 0; u < nc && same; ++u) {
+            if (acc) cm_rbf_kernel_sum_acc(m, r->c, w + (size_t)u * m, 1, m, r->c, m, o1, 1, 2);
+            else cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, w + (size_t)u * m, 1, m, r->c,
+                                   m, o1, 1, 2);
+            for (size_t i = 0; i < m && same; ++i) same = o1[i] == on[i * (size_t)nc + (size_t)u];
+        }
+    }
+    free(w), free(o1), free(on);
+    return same;
+}
+
+int main(void)
+{
+    cm_context *ctx = NULL;
+    if (cm_context_create(&ctx) != CM_OK) return 1;
+    cm_context_set_threads(ctx, 2);
+    double *x = NULL, *d = NULL;
+    const size_t m_in = bore_set(0.09, &x, &d);
+    double *v = columns(m_in, x, 7u);
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.warm_start = 0;
+    cm_rbf *r = NULL;
+    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m_in, x, &o, &r);
+    CHECK_MSG(s == CM_OK && v, "%s", cm_context_message(ctx));
+    if (s != CM_OK || !v) return TEST_REPORT();
+    const size_t m = cm_rbf_centre_count(r);
+    int all[NC];
+    for (int u = 0; u < NC; ++u) all[u] = u;
+
+    /* all columns at once against each alone */
+    solved b = solve_cols(ctx, r, m, v, NC, all);
+    CHECK_MSG(b.status == CM_OK, "batch: %s", cm_context_message(ctx));
+    CHECK(b.st.column_groups == 1 && b.st.warm_columns == 0);
+    int same_bits = 0;
+    size_t np;
+    double *p = eval_points(0, x, 300, 1.8, &np);
+    for (int u = 0; u < NC; ++u) {
+        solved a = solve_cols(ctx, r, m, v, 1, &u);
+        CHECK_MSG(a.status == CM_OK, "column %d alone: %s", u, cm_context_message(ctx));
+        double fmx = 0.0;
+        for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v[i * NC + (size_t)u]));
+        const int bits = !memcmp(a.w, b.w + (size_t)u * m, m * sizeof *a.w) &&
+                         !memcmp(a.q, b.q + (size_t)u * (size_t)r->k, (size_t)r->k * sizeof *a.q);
+        same_bits += bits;
+        const double ed = eval_diff(r, m, np, p, &b, u, &a, fmx);
+        printf("column %d: %d iterations alone, %d in the batch; weights %s (%.3g), "
+               "interpolants differ by %.3g of max |f|\n", u, a.iters[0], b.iters[u],
+               bits ? "the same bits" : "differ", rel_diff(m, b.w + (size_t)u * m, a.w), ed);
+        /* the solve's tolerance, 1e-10, at the centres; inside, the interpolants of two
+         * solutions within it: a few times that */
+        CHECK_MSG(ed <= 1e-8, "column %d: %.3g", u, ed);
+        /* a slowly converging batch-mate does not change a column's iterations */
+        CHECK_MSG(a.iters[0] == b.iters[u], "column %d: %d alone, %d in the batch", u,
+                  a.iters[0], b.iters[u]);
+        release(&a);
+    }
+    const int exact_sums = sums_column_exact(r, m);
+    printf("%d of %d columns the same bits in the batch as alone (the kernel sums %s the "
+           "same bits per column whatever the columns of a call)\n", same_bits, NC,
+           exact_sums ? "give" : "do not give");
+    /* the solve adds nothing of its own: each column's arithmetic is its solo solve's */
+    if (exact_sums) CHECK(same_bits == NC);
+    CHECK_MSG(b.iters[ROUGH] > b.iters[0], "the rough column took %d iterations, the smooth "
+              "%d", b.iters[ROUGH], b.iters[0]);
+    CHECK(b.st.iterations == b.iters[ROUGH]);
+
+    /* a tiny budget for the Krylov storage: one column per group, the same result */
+    {
+        r->tun.krylov_budget = 1.0;
+        {
+            solved g = solve_cols(ctx, r, m, v, NC, all);
+            r->tun.krylov_budget = 0.0;
+            CHECK_MSG(g.status == CM_OK && g.st.column_groups == NC, "%d groups",
+                      g.st.column_groups);
+            const double wd = rel_diff(m * NC, g.w, b.w);
+            const int bits = !memcmp(g.w, b.w, m * NC * sizeof *g.w);
+            printf("in %d groups: weights %s (%.3g)\n", g.st.column_groups,
+                   bits ? "the same bits" : "differ", wd);
+            if (exact_sums) CHECK(bits);
+            for (int u = 0; u < NC; ++u) {
+                double fmx = 0.0;
+                for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v[i * NC + (size_t)u]));
+                solved one = {.w = g.w + (size_t)u * m, .q = g.q + (size_t)u * (size_t)r->k};
+                const double ed = eval_diff(r, m, np, p, &b, u, &one, fmx);
+                CHECK_MSG(ed <= 1e-8, "column %d in groups: %.3g", u, ed);
+                CHECK(g.iters[u] == b.iters[u]);
+            }
+            release(&g);
+        }
+    }
+
+    /* warm start: nearby data (the shifted axis moved a little) after a solve */
+    {
+        r->opt.warm_start = 1;
+        {
+            const int smooth[6] = {0, 1, 2, 3, 4, 5};
+            solved w0 = solve_cols(ctx, r, m, v, 6, smooth); /* 6 columns after 10: cold */
+            CHECK(w0.st.warm_columns == 0);
+            double *v2 = malloc(m_in * NC * sizeof *v2), *d2 = malloc(m_in * 3 * sizeof *d2);
+            memcpy(v2, v, m_in * NC * sizeof *v2);
+            bore_motion(m_in, x, 2.11, 0.955, d2);
+            for (size_t i = 0; i < m_in; ++i)
+                for (int e = 0; e < 3; ++e) v2[i * NC + 3 + (size_t)e] = 0.8 * d2[3 * i + (size_t)e];
+            solved w1 = solve_cols(ctx, r, m, v2, 6, smooth); /* warm */
+            r->opt.warm_start = 0;
+            solved c1 = solve_cols(ctx, r, m, v2, 6, smooth); /* cold */
+            r->opt.warm_start = 1;
+            CHECK_MSG(w1.status == CM_OK && c1.status == CM_OK, "%s", cm_context_message(ctx));
+            printf("warm start: %d columns warm from a residual of %.3g at most; iterations "
+                   "warm / cold:", w1.st.warm_columns, w1.st.warm_residual);
+            for (int u = 0; u < 6; ++u) printf(" %d/%d", w1.iters[u], c1.iters[u]);
+            printf("\n");
+            CHECK(w1.st.warm_columns == 6 && w1.st.warm_residual > 0.0 &&
+                  w1.st.warm_residual < 1.0);
+            CHECK(c1.st.warm_columns == 0);
+            /* unchanged columns start at their solution; the moved ones near it */
+            for (int u = 0; u < 6; ++u) {
+                CHECK_MSG(w1.iters[u] < c1.iters[u], "column %d: warm %d, cold %d", u,
+                          w1.iters[u], c1.iters[u]);
+                double fmx = 0.0;
+                for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v2[i * NC + (size_t)u]));
+                solved one = {.w = c1.w + (size_t)u * m, .q = c1.q + (size_t)u * (size_t)r->k};
+                const double ed = eval_diff(r, m, np, p, &w1, u, &one, fmx);
+                CHECK_MSG(ed <= 1e-8, "column %d warm against cold: %.3g", u, ed);
+            }
+            CHECK(w1.st.iterations < c1.st.iterations);
+            /* another number of columns: from zero */
+            solved w2 = solve_cols(ctx, r, m, v2, 3, smooth);
+            CHECK(w2.st.warm_columns == 0);
+            release(&w0), release(&w1), release(&c1), release(&w2);
+            free(v2), free(d2);
+        }
+        r->opt.warm_start = 0;
+    }
+
+    /* fast (treecode) matvecs with refinement: the batch against each column alone */
+    {
+        r->opt.fast_sum = 1;
+        cm_rbf *rf = r;
+        {
+            const int cols[4] = {0, 3, 4, ROUGH};
+            solved fb = solve_cols(ctx, rf, m, v, 4, cols);
+            CHECK_MSG(fb.status == CM_OK && fb.st.fast_sum == 1, "%s", cm_context_message(ctx));
+            for (int u = 0; u < 4; ++u) {
+                solved a = solve_cols(ctx, rf, m, v, 1, cols + u);
+                double fmx = 0.0;
+                for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v[i * NC + (size_t)cols[u]]));
+                const double ed = eval_diff(r, m, np, p, &fb, u, &a, fmx);
+                printf("fast sums, column %d: %d iterations alone, %d in the batch, "
+                       "interpolants differ by %.3g\n", cols[u], a.iters[0], fb.iters[u], ed);
+                CHECK_MSG(ed <= 1e-8, "fast, column %d: %.3g", cols[u], ed);
+                CHECK(a.iters[0] == fb.iters[u]);
+                release(&a);
+            }
+            release(&fb);
+        }
+    }
+    release(&b);
+    free(p), free(v), free(x), free(d);
+    cm_rbf_destroy(&r);
+    cm_context_destroy(&ctx);
+    return TEST_REPORT();
+}
