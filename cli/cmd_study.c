@@ -37,31 +37,15 @@ static study_args args;
 
 static int print_help(void);
 
-/* --steps K (1..1000) or --steps auto */
-static int parse_steps(const cli_parser *p, const cli_option *o, const char *v, void *dest)
+/* --steps and --batch: K (1..1000) or auto (0: CM_MORPH_STEPS_AUTO, the automatic batch) */
+static int parse_count(const cli_parser *p, const cli_option *o, const char *v, void *dest)
 {
-    (void)o;
-    char *end;
-    const long n = strtol(v, &end, 10);
-    if (!strcmp(v, "auto"))
-        *(int *)dest = CM_MORPH_STEPS_AUTO;
-    else if (end == v || *end || n < 1 || n > 1000)
-        return cli_usage(p->cmd, p->usage, "--steps: expected 1..1000 or auto, got '%s'", v);
-    else
-        *(int *)dest = (int)n;
-    return 0;
-}
-
-/* --batch K (1..1000) or --batch auto */
-static int parse_batch(const cli_parser *p, const cli_option *o, const char *v, void *dest)
-{
-    (void)o;
     char *end;
     const long n = strtol(v, &end, 10);
     if (!strcmp(v, "auto"))
         *(int *)dest = 0;
     else if (end == v || *end || n < 1 || n > 1000)
-        return cli_usage(p->cmd, p->usage, "--batch: expected 1..1000 or auto, got '%s'", v);
+        return cli_usage(p->cmd, p->usage, "%s: expected 1..1000 or auto, got '%s'", o->name, v);
     else
         *(int *)dest = (int)n;
     return 0;
@@ -107,7 +91,7 @@ static const cli_option options[] = {
      .label = "--write-meshes W",
      .help = "none, all (default) or failed (results with inverted cells:\n"
              "with --allow-inverted)"},
-    {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_steps,
+    {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_count,
      .dest = &args.steps, .label = "--steps auto|K",
      .help = "each morph's steps, as in morph: adaptive (auto, the default)\n"
              "or K equal increments (1: the plain one-step morph); a variant\n"
@@ -127,7 +111,7 @@ static const cli_option options[] = {
      .help = "boundary nodes not on G0: refuse (default) or fixed (kept, or\n"
              "sliding on their patch: see below), as in morph --off-cad"},
     CLI_PATCH_MOTION_OPTIONS(args.patches),
-    {.name = "--batch", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_batch,
+    {.name = "--batch", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_count,
      .dest = &args.batch, .label = "--batch auto|K",
      .help = "absolute variants morphed together: their warps share one\n"
              "multi-column solve and evaluation (the same rows as one at a\n"
