@@ -74,6 +74,8 @@ static int compare(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m,
                    fabs(it->row.mean_sj - row.mean_sj) <= 10 * tol,
                "%s, target %d: min SJ %.15g vs %.15g, mean %.15g vs %.15g", what, j,
                it->row.min_sj, row.min_sj, it->row.mean_sj, row.mean_sj);
+        EXPECT(fabs(it->row.residual - row.residual) <= tol * diag,
+               "%s, target %d: residual %g vs %g", what, j, it->row.residual, row.residual);
         EXPECT(fabs(it->row.max_dist - row.max_dist) <= 1e-9 * diag,
                "%s, target %d: distance %g vs %g", what, j, it->row.max_dist, row.max_dist);
         double worst = 0;
