@@ -16,13 +16,16 @@ static const char *const usage_line =
     "[--mode absolute|relative|both] [--methods LIST] [--write-meshes none|all|failed] "
     "[--steps auto|K] [--allow-inverted] [--optimize] [--cad-unit U] "
     "[--off-cad refuse|fixed [--slide P,..] "
-    "[--fixed-patches P,..] [--no-slide]] [--threads N] [--verbose]";
+    "[--fixed-patches P,..] [--no-slide]] [--batch auto|K] [--solver S] [--threads N] "
+    "[--verbose]";
 
 enum { MAX_METHODS = 16 };
 
 typedef struct study_args {
     const char *from, *mesh, *variants, *out, *unit, *methods;
     int modes, write_meshes, threads, verbose, steps, optimize, off_cad, allow_inverted;
+    int batch;  /* cm_study_options.batch: 0 auto */
+    int solver; /* the RBF warps' solver of every method (cm_rbf_solver) */
     cli_patch_motion patches; /* the motion of the nodes off G0 */
     int rank, ranks; /* under mpirun (cli_mpi_ranks) */
     cm_study_method list[MAX_METHODS];
@@ -34,16 +37,15 @@ static study_args args;
 
 static int print_help(void);
 
-/* --steps K (1..1000) or --steps auto */
-static int parse_steps(const cli_parser *p, const cli_option *o, const char *v, void *dest)
+/* --steps and --batch: K (1..1000) or auto (0: CM_MORPH_STEPS_AUTO, the automatic batch) */
+static int parse_count(const cli_parser *p, const cli_option *o, const char *v, void *dest)
 {
-    (void)o;
     char *end;
     const long n = strtol(v, &end, 10);
     if (!strcmp(v, "auto"))
-        *(int *)dest = CM_MORPH_STEPS_AUTO;
+        *(int *)dest = 0;
     else if (end == v || *end || n < 1 || n > 1000)
-        return cli_usage(p->cmd, p->usage, "--steps: expected 1..1000 or auto, got '%s'", v);
+        return cli_usage(p->cmd, p->usage, "%s: expected 1..1000 or auto, got '%s'", o->name, v);
     else
         *(int *)dest = (int)n;
     return 0;
@@ -89,7 +91,7 @@ static const cli_option options[] = {
      .label = "--write-meshes W",
      .help = "none, all (default) or failed (results with inverted cells:\n"
              "with --allow-inverted)"},
-    {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_steps,
+    {.name = "--steps", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_count,
      .dest = &args.steps, .label = "--steps auto|K",
      .help = "each morph's steps, as in morph: adaptive (auto, the default)\n"
              "or K equal increments (1: the plain one-step morph); a variant\n"
@@ -109,6 +111,13 @@ static const cli_option options[] = {
      .help = "boundary nodes not on G0: refuse (default) or fixed (kept, or\n"
              "sliding on their patch: see below), as in morph --off-cad"},
     CLI_PATCH_MOTION_OPTIONS(args.patches),
+    {.name = "--batch", .kind = CLI_CUSTOM, .takes_value = 1, .parse = parse_count,
+     .dest = &args.batch, .label = "--batch auto|K",
+     .help = "absolute variants morphed together: their warps share one\n"
+             "multi-column solve and evaluation (the same rows as one at a\n"
+             "time, to the solver's tolerance); auto (default): as many as\n"
+             "half the free memory holds, at most 20; 1: one at a time"},
+    {CLI_SOLVER_OPTION, .dest = &args.solver},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
      .help = "threads (default: all)"},
     {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
@@ -129,13 +138,20 @@ static int print_help(void)
         "status and message), study.svg (min scaled Jacobian per variant; solid absolute,\n"
         "dashed relative) and <method>_<mode>_<variant>.vtu (with 'scaled_jacobian' and\n"
         "'displacement'; <variant>: the STEP file's name without extension).\n\n"
-        "mpirun -n K cadmorph study --mode absolute ... (builds with -DCADMORPH_WITH_PETSC=ON):\n"
-        "variant i runs on rank i mod K; rank 0 writes study.csv and study.svg.\n\n"
+        "Absolute variants run in batches (--batch): the warps of a batch share one solve\n"
+        "and one evaluation with a column per variant and direction, so a study costs a\n"
+        "fraction of its morphs; a variant whose one-step morph is not valid is morphed\n"
+        "again alone (its adaptive steps), so the rows are those of one at a time.\n\n"
+        "mpirun -n K cadmorph study ... (builds with -DCADMORPH_WITH_PETSC=ON): the absolute\n"
+        "morph of variant i runs on rank i mod K (each rank in its own batches), the relative\n"
+        "series of the m-th method on rank m mod K (a series is one chain: relative studies\n"
+        "spread by method); rank 0 writes study.csv and study.svg.\n\n"
         "options:\n");
     cli_print_options(stdout, options, 22);
     printf("\n" CLI_PATCH_MOTION_OFF_CAD
            "Every variant shares the factorisations of the two warp passes.\n");
-    printf("\nProgress (on a terminal): the variant count and an estimate of the time left.\n"
+    printf("\nProgress (on a terminal): variants done of all, the last batch's time per variant\n"
+           "and an estimate of the time left.\n"
            "exit codes: 0 every row done, 1 usage, 2 bad input (G0, M0 or the list: one line\n"
            "naming the file), 3 some rows failed (a variant that cannot be read or does not\n"
            "match G0, a morph that reached no valid mesh): the study ran to the end, each\n"
@@ -164,12 +180,18 @@ static int parse_args(int argc, char **argv, study_args *a)
         return cli_usage(cmd, usage_line,
                          "--slide, --fixed-patches and --no-slide go with --off-cad fixed (the "
                          "nodes on G0 follow the CAD)");
+    if (a->solver == CM_RBF_SOLVER_PETSC)
+        return cli_usage(cmd, usage_line,
+                         "--solver petsc: a study spreads its variants over the MPI ranks "
+                         "(mpirun -n K cadmorph study), each rank solving its own");
     if (!a->from || !a->mesh || !a->variants || !a->out)
         return cli_usage(cmd, usage_line, "--from, --mesh, --variants and -o are required");
     cm_context *ctx = NULL;
     if (cm_context_create(&ctx) != CM_OK) return cli_usage(cmd, usage_line, "out of memory");
     cm_status s = cm_study_methods_parse(ctx, a->methods, a->list, MAX_METHODS, &a->n_methods);
     if (s < 0) cli_usage(cmd, usage_line, "--methods: %s", cm_context_message(ctx));
+    for (size_t k = 0; k < a->n_methods; ++k)
+        a->list[k].method.warp.solver = (cm_rbf_solver)a->solver;
     cm_context_destroy(&ctx);
     return s < 0 ? CLI_EXIT_USAGE : -1;
 }
@@ -258,6 +280,7 @@ static int run(cm_context *ctx, const study_args *a)
             so.morph.allow_inverted = a->allow_inverted;
             so.morph.off_cad = (cm_off_cad)a->off_cad;
             cli_patch_motion_options(&args.patches, &so.morph.motion);
+            so.batch = a->batch;
             so.rank = a->rank;
             so.ranks = a->ranks;
             s = cm_study_run(ctx, g0, mesh, &fam, &so, &r);
@@ -306,13 +329,9 @@ int cli_cmd_study(int argc, char **argv)
     if (rc >= 0) return rc;
     cm_context *ctx = cli_context_create("study", a.verbose, a.threads);
     if (!ctx) return CLI_EXIT_INTERNAL;
-    /* mpirun -n K cadmorph study: the variants of an absolute study over the K ranks */
+    /* mpirun -n K cadmorph study: the absolute variants and the relative series over the K
+     * ranks (cm_study_options.rank) */
     rc = cli_mpi_ranks(ctx, "study", &a.rank, &a.ranks);
-    if (rc == 0 && a.ranks > 1 && (a.modes & CM_STUDY_RELATIVE)) {
-        fprintf(stderr, "cadmorph study: under mpirun only --mode absolute (relative steps "
-                "chain the variants)\n");
-        rc = CLI_EXIT_USAGE;
-    }
     if (rc == 0) rc = run(ctx, &a);
     cm_context_destroy(&ctx);
     return rc;

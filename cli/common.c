@@ -18,6 +18,8 @@ typedef struct cli_sink {
      * inner stages (a morph of each variant) should stay off the line */
     int in_study;
     double study_start, study_done, study_total;
+    double study_mark, per_variant; /* the last report's time; seconds per variant since the
+                                       one before (a batch reports once for its variants) */
 } cli_sink;
 
 static cli_sink sink;
@@ -45,18 +47,27 @@ static void format_duration(double sec, char *buf, size_t size)
         snprintf(buf, size, "%ldh%02ldm", s / 3600, (s % 3600) / 60);
 }
 
-/* "study 3/20 variants, about 1m20s left": the time left from the mean time per variant so
- * far (variants of one study cost about the same). */
+/* "study 3/20 variants, last 4.1 s per variant, about 1m20s left": the time left from the
+ * mean time per variant so far (variants of one study cost about the same). */
 static void draw_study(cli_sink *s, double now)
 {
-    char left[48] = "estimating the time left";
+    char left[48] = "estimating the time left", last[48] = "";
     if (s->study_done > 0) {
         char d[24];
         format_duration((now - s->study_start) / s->study_done * (s->study_total - s->study_done),
                         d, sizeof d);
         snprintf(left, sizeof left, "about %s left", d);
     }
-    fprintf(stderr, "\r\033[Kstudy %.0f/%.0f variants, %s", s->study_done, s->study_total, left);
+    if (s->per_variant > 0) {
+        char d[24];
+        if (s->per_variant < 10)
+            snprintf(d, sizeof d, "%.2g s", s->per_variant);
+        else
+            format_duration(s->per_variant, d, sizeof d);
+        snprintf(last, sizeof last, "last %s per variant, ", d);
+    }
+    fprintf(stderr, "\r\033[Kstudy %.0f/%.0f variants, %s%s", s->study_done, s->study_total,
+            last, left);
 }
 
 static void progress_to_stderr(void *user, const char *stage, double done, double total)
@@ -66,7 +77,13 @@ static void progress_to_stderr(void *user, const char *stage, double done, doubl
     double now = cm_wtime();
     int finished = done >= total;
     if (!strcmp(stage, "study")) {
-        if (!s->in_study || done < s->study_done) s->study_start = now;
+        if (!s->in_study || done < s->study_done) {
+            s->study_start = s->study_mark = now;
+            s->per_variant = 0;
+        } else if (done > s->study_done) {
+            s->per_variant = (now - s->study_mark) / (done - s->study_done);
+            s->study_mark = now;
+        }
         s->in_study = !finished;
         s->study_done = done;
         s->study_total = total;

@@ -12,9 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A new row of the last apply (zeroed); NULL when out of memory. Rows move when the array
- * grows: fill one before asking for the next. */
-static cm_morph_step *new_row(cm_context *ctx, cm_morpher *mp)
+cm_morph_step *cm_morph_new_row(cm_context *ctx, cm_morpher *mp)
 {
     if (mp->n_rows == mp->cap_rows) {
         size_t cap = mp->cap_rows ? 2 * mp->cap_rows : 16;
@@ -52,6 +50,20 @@ static cm_status slide_pass(cm_context *ctx, cm_morpher *mp, cm_warp *w1, const 
     return CM_OK;
 }
 
+void cm_morph_boundary_move(cm_morpher *mp, const double *bnew, double f, const double *from,
+                            double *disp)
+{
+    const cm_surface_nodes *nd = mp->nodes;
+    memset(disp, 0, 3 * mp->mesh->n_nodes * sizeof *disp);
+    for (size_t i = 0; i < nd->n; ++i)
+        for (int c = 0; c < 3; ++c) {
+            double want = nd->xyz[3 * i + c] + f * (bnew[3 * i + c] - nd->xyz[3 * i + c]);
+            if (f == 1.0) want = bnew[3 * i + c];
+            mp->bxyz[3 * i + c] = want;
+            disp[3 * nd->node[i] + c] = want - from[3 * nd->node[i] + c];
+        }
+}
+
 /* The mesh at fraction f of the boundary motion: the boundary blended linearly from M's
  * boundary to the surface morph's positions (exactly those at f = 1), the interior by the
  * warp of the move from `from` (the shared factorisation when from is the start mesh, else
@@ -60,16 +72,8 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
                        int shared, int optimize, const double *from, double *xyz,
                        cm_morph_step *row)
 {
-    const cm_surface_nodes *nd = mp->nodes;
     size_t nn = mp->mesh->n_nodes;
-    memset(mp->disp, 0, 3 * nn * sizeof *mp->disp);
-    for (size_t i = 0; i < nd->n; ++i)
-        for (int c = 0; c < 3; ++c) {
-            double want = nd->xyz[3 * i + c] + f * (mp->bnew[3 * i + c] - nd->xyz[3 * i + c]);
-            if (f == 1.0) want = mp->bnew[3 * i + c];
-            mp->bxyz[3 * i + c] = want;
-            mp->disp[3 * nd->node[i] + c] = want - from[3 * nd->node[i] + c];
-        }
+    cm_morph_boundary_move(mp, mp->bnew, f, from, mp->disp);
     cm_warp *w = NULL, *w1 = NULL, *own = NULL, *own1 = NULL;
     double t0 = cm_wtime();
     cm_status s;
@@ -92,8 +96,21 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     cm_warp_destroy(&own);
     cm_warp_destroy(&own1);
     if (s < 0) return s;
+    row->outside = mp->surface.outside;
+    s = cm_morph_trial_finish(ctx, mp, mp->target, f, optimize, from, mp->disp, xyz, row);
+    row->t_evaluation += t_apply;
+    return s;
+}
+
+cm_status cm_morph_trial_finish(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
+                                double f, int optimize, const double *from, const double *disp,
+                                double *xyz, cm_morph_step *row)
+{
+    const cm_surface_nodes *nd = mp->nodes;
+    size_t nn = mp->mesh->n_nodes;
+    double t1 = cm_wtime();
     for (size_t i = 0; i < 3 * nn; ++i)
-        xyz[i] = from[i] + mp->disp[i];
+        xyz[i] = from[i] + disp[i];
     /* boundary nodes exactly where they were sent (no round-off from the increments), those
      * off G exactly where they were (the warp's residual there is not zero) unless they slide
      * (their normal motion is exactly 0 already) */
@@ -104,6 +121,7 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
                                CM_MOTION_SLIDE_PLANE)
             memcpy(xyz + 3 * nd->off[i], mp->mesh->xyz + 3 * nd->off[i], 3 * sizeof(double));
     memcpy(mp->work->xyz, xyz, 3 * nn * sizeof *xyz);
+    cm_status s;
     if (optimize) {
         cm_optimize_stats st;
         s = cm_mesh_optimize(ctx, mp->work, mp->fixed, &mp->opt.optimize_options, &st);
@@ -115,20 +133,18 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     s = cm_mesh_quality(ctx, mp->work, mp->sj);
     if (s >= 0) s = cm_quality_summarize(ctx, mp->work, mp->sj, NULL, &all);
     row->t_evaluation = cm_wtime() - t1;
-    /* t_evaluation holds the warp's apply (for an iterative RBF its Krylov solve too) */
-    cm_log(ctx, CM_LOG_DEBUG, "morph: warp apply %.3f s, optimisation and quality %.3f s",
-           t_apply, row->t_evaluation - t_apply);
+    /* t_evaluation holds the warp's apply (for an iterative RBF its Krylov solve too), added
+     * by the caller */
+    cm_log(ctx, CM_LOG_DEBUG, "morph: optimisation and quality %.3f s", row->t_evaluation);
     double t2 = cm_wtime();
     if (s >= 0)
-        s = cm_morph_node_distances(ctx, mp->target, nd, mp->bxyz, f == 1.0, &row->max_dist,
-                                    NULL);
+        s = cm_morph_node_distances(ctx, target, nd, mp->bxyz, f == 1.0, &row->max_dist, NULL);
     row->t_distance = cm_wtime() - t2;
     if (s < 0) return s;
     row->min_sj = all.min;
     row->mean_sj = all.mean;
     row->inverted = all.inverted;
     row->cells = all.count;
-    row->outside = mp->surface.outside;
     row->fraction = f;
     row->accepted = 1;
     return CM_OK;
@@ -215,7 +231,7 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
     for (int k = 1; k <= n; ++k) {
         cm_status p = cm_progress(ctx, "morph", k - 1, n);
         if (p < 0) return p;
-        cm_morph_step *row = new_row(ctx, mp);
+        cm_morph_step *row = cm_morph_new_row(ctx, mp);
         if (!row) return CM_ERR_NOMEM;
         cm_status s =
             trial(ctx, mp, wo, (double)k / n, k == 1, mp->opt.optimize, xyz, mp->next, row);
@@ -242,6 +258,26 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
     return cm_progress(ctx, "morph", n, n);
 }
 
+/* The floor of a valid adaptive step of length step: min_sj, raised to keep_fraction x M's
+ * while steps can still shrink. */
+static double auto_floor(const cm_morpher *mp, double step, double min_step)
+{
+    const cm_morph_options *o = &mp->opt;
+    double floor = o->min_sj;
+    if (o->keep_fraction > 0 && step > min_step && o->keep_fraction * mp->min_sj0 > floor)
+        floor = o->keep_fraction * mp->min_sj0;
+    return floor;
+}
+
+int cm_morph_whole_motion_final(const cm_morpher *mp, const cm_morph_step *row)
+{
+    const cm_morph_options *o = &mp->opt;
+    if (o->steps == 1) return o->allow_inverted || valid(row, o->min_sj);
+    if (o->steps != CM_MORPH_STEPS_AUTO) return 0;
+    double min_step = o->min_fraction > 0 ? o->min_fraction : 1.0 / 256;
+    return valid(row, auto_floor(mp, 1, min_step));
+}
+
 /* Adaptive steps (CM_MORPH_STEPS_AUTO), see cm_morph_options. */
 static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_options *wo,
                             double *xyz)
@@ -254,13 +290,11 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
         if (f > 1 - 1e-12) f = 1;
         cm_status p = cm_progress(ctx, "morph", done, 1);
         if (p < 0) return p;
-        cm_morph_step *row = new_row(ctx, mp);
+        cm_morph_step *row = cm_morph_new_row(ctx, mp);
         if (!row) return CM_ERR_NOMEM;
         cm_status s = trial(ctx, mp, wo, f, done == 0, optimize, xyz, mp->next, row);
         if (s < 0) return cm_error_prefix(ctx, s, "step to %.4g %%", 100 * f);
-        double floor = o->min_sj;
-        if (o->keep_fraction > 0 && step > min_step && o->keep_fraction * mp->min_sj0 > floor)
-            floor = o->keep_fraction * mp->min_sj0;
+        double floor = auto_floor(mp, step, min_step);
         if (valid(row, floor)) {
             memcpy(xyz, mp->next, 3 * mp->mesh->n_nodes * sizeof *xyz);
             done = f;
@@ -287,7 +321,7 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
         if (step < min_step && o->allow_inverted) {
             /* asked for: the rest of the motion in one step, whatever its cells */
             double from = done;
-            row = new_row(ctx, mp);
+            row = cm_morph_new_row(ctx, mp);
             if (!row) return CM_ERR_NOMEM;
             s = trial(ctx, mp, wo, 1, done == 0, optimize, xyz, mp->next, row);
             if (s < 0) return cm_error_prefix(ctx, s, "step to 100 %%");

@@ -78,6 +78,29 @@ cm_status cm_morpher_make_warps(cm_context *ctx, const cm_morpher *mp, const cm_
  * morpher.c). */
 cm_status cm_morpher_use_target(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target);
 
+/* A new row of the last apply (zeroed); NULL when out of memory. Rows move when the array
+ * grows: fill one before asking for the next (morph_steps.c). */
+cm_morph_step *cm_morph_new_row(cm_context *ctx, cm_morpher *mp);
+
+/* The move of the boundary nodes on G to fraction f of the way from M's boundary to bnew
+ * (nodes->n x 3; exactly bnew at f = 1): their positions into mp->bxyz, disp (#nodes x 3) the
+ * move from `from` there, 0 elsewhere (morph_steps.c). */
+void cm_morph_boundary_move(cm_morpher *mp, const double *bnew, double f, const double *from,
+                            double *disp);
+
+/* The rest of a trial once the warp has filled disp (the move from `from`): xyz = from + disp
+ * with the boundary nodes exactly at mp->bxyz (those off G where they were unless they
+ * slide), optimised if `optimize`, its quality (mp->work, mp->sj) and distance to target
+ * measured into row (t_evaluation: this part only; outside and residual are the caller's). */
+cm_status cm_morph_trial_finish(cm_context *ctx, cm_morpher *mp, const cm_cad_model *target,
+                                double f, int optimize, const double *from, const double *disp,
+                                double *xyz, cm_morph_step *row);
+
+/* Whether row, the whole-motion trial with the shared warp (the first trial of steps auto or
+ * steps 1), is the whole morph as cm_morpher_apply judges it: valid (auto: under its floor;
+ * 1: or allow_inverted). 0 for fixed steps > 1. */
+int cm_morph_whole_motion_final(const cm_morpher *mp, const cm_morph_step *row);
+
 /* Appends to b the faces of an assembly's interfaces (a triangle of the mesh between two
  * tets of different physical groups) and their nodes (interfaces.c); *n_added: how many. */
 cm_status cm_morph_add_interfaces(cm_context *ctx, const cm_mesh *mesh, cm_mesh_boundary *b,

@@ -4,6 +4,7 @@
 #define CM_CAD_MIN_SAMPLES 250000
 #define CM_MORPH_MAX_SAMPLES 4000000
 #define CM_MORPH_STEPS_AUTO 0
+#define CM_STUDY_BATCH_MAX 20
 #define CM_STUDY_METHOD_NAME 48
 typedef enum cm_status {
 CM_OK = 0,
@@ -1009,6 +1010,16 @@ double *out_xyz, cm_morph_step *out_row);
 cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *morpher,
 const cm_cad_model *target, const cm_morph_method *method,
 double *out_xyz, cm_morph_step *out_row);
+typedef struct cm_morph_batch_item {
+cm_status status;
+char message[512];
+cm_morph_step row;
+int batched;
+} cm_morph_batch_item;
+cm_status cm_morpher_apply_batch(cm_context *ctx, cm_morpher *morpher, size_t k,
+const cm_cad_model *const *targets,
+const cm_morph_method *method, double *const *out_xyz,
+cm_morph_batch_item *items);
 const cm_morph_step *cm_morpher_steps(const cm_morpher *morpher, size_t *n);
 cm_status cm_morpher_rebase(cm_context *ctx, cm_morpher *morpher, const cm_cad_model *g,
 const double *xyz);
@@ -1193,6 +1204,7 @@ const char *out_dir;
 const char *model;
 const char *mesh;
 int rank, ranks;
+int batch;
 } cm_study_options;
 void cm_study_options_init(cm_study_options *opt);
 typedef struct cm_study_row {

@@ -47,14 +47,18 @@ typedef struct study {
     const cm_cad_model *g0;
     const cm_mesh *mesh0;
     cm_morpher *abs;
-    /* Variant geometries the morphers still point at: the absolute morpher's last target, the
-     * relative morphers' base (NULL: G0 or none). A morpher recognises its last target by its
-     * address, so a model it may remember is freed only once it has moved on (keep). */
-    cm_cad_model *last, *base;
+    /* The variant geometry the relative morphers are based on (NULL: G0 or none): a morpher
+     * recognises its last target by its address, so that model is freed only once they have
+     * moved on. The absolute morpher keeps none (cm_morpher_apply_batch). */
+    cm_cad_model *base;
     cm_mesh *work; /* M0 with the output fields, coordinates of the row being written */
     double *sj, *dfield, *xyz;
     series *s;
     size_t n_series;
+    size_t batch;    /* variants per batch of the absolute morphs */
+    double **bxyz;   /* batch results (#nodes x 3 each) */
+    cm_morph_batch_item *items;
+    int rel_ranked;  /* relative series over the ranks: series of method m on rank m % ranks */
 } study;
 
 static cm_status add_row(cm_context *ctx, cm_study_result *r, const cm_study_row *row)
@@ -90,16 +94,21 @@ static int wants_mesh(const study *w, const cm_study_row *row)
 
 /* The result in w->xyz as <out_dir>/<method>_<mode>_<label>.vtu, with the morpher's scaled
  * Jacobian and the displacement from M0. */
-static cm_status write_mesh(cm_context *ctx, study *w, const cm_morpher *mp, const char *label,
-                            cm_study_row *row)
+static cm_status write_mesh(cm_context *ctx, study *w, const double *xyz, const double *sj,
+                            const char *label, cm_study_row *row)
 {
     double t0 = cm_wtime();
     cm_mesh *m = w->work;
     size_t nn = m->n_nodes;
-    memcpy(m->xyz, w->xyz, 3 * nn * sizeof *m->xyz);
+    memcpy(m->xyz, xyz, 3 * nn * sizeof *m->xyz);
     for (size_t i = 0; i < 3 * nn; ++i)
-        w->dfield[i] = w->xyz[i] - w->mesh0->xyz[i];
-    memcpy(w->sj, cm_morpher_quality(mp), w->work->n_cells * sizeof *w->sj);
+        w->dfield[i] = xyz[i] - w->mesh0->xyz[i];
+    if (sj)
+        memcpy(w->sj, sj, w->work->n_cells * sizeof *w->sj);
+    else { /* what the morph measured on these nodes */
+        cm_status e = cm_mesh_quality(ctx, m, w->sj);
+        if (e < 0) return e;
+    }
     char path[4096];
     snprintf(path, sizeof path, "%s/%s_%s_%s.vtu", w->o->out_dir, w->r->methods[row->method].name,
              cm_study_mode_name(row->mode), label);
@@ -108,8 +117,32 @@ static cm_status write_mesh(cm_context *ctx, study *w, const cm_morpher *mp, con
     return s;
 }
 
-/* One morph of series se onto g: the row's figures from the morph engine's (its steps added
- * up, the quality of the last). */
+/* A row's figures from a morph's status, message and row (its steps added up, the quality
+ * of the last). */
+static cm_status fill_row(cm_study_row *row, cm_status s, const char *msg, const cm_morph_step *st)
+{
+    row->t_sample += st->t_sample;
+    row->t_surface += st->t_surface;
+    row->t_volume_solve += st->t_volume_solve;
+    row->t_evaluation += st->t_evaluation;
+    row->t_distance += st->t_distance;
+    row->residual = st->residual;
+    if (s < 0) {
+        row_error(row, s, msg);
+        return s;
+    }
+    row->status = s;
+    if (s == CM_WARNING) row_error(row, s, msg);
+    row->min_sj = st->min_sj;
+    row->mean_sj = st->mean_sj;
+    row->inverted = st->inverted;
+    row->cells = st->cells;
+    row->max_dist = st->max_dist;
+    row->outside = st->outside;
+    return s;
+}
+
+/* One morph of series se onto g (relative: its own morpher). */
 static cm_status morph(cm_context *ctx, study *w, series *se, cm_morpher *mp,
                        const cm_cad_model *g, const char *label, cm_study_row *row)
 {
@@ -117,44 +150,29 @@ static cm_status morph(cm_context *ctx, study *w, series *se, cm_morpher *mp,
     cm_morph_step st;
     memset(&st, 0, sizeof st);
     cm_status s = cm_morpher_apply_method(ctx, mp, g, &m->method, w->xyz, &st);
-    row->t_sample += st.t_sample;
-    row->t_surface += st.t_surface;
-    row->t_volume_solve += st.t_volume_solve;
-    row->t_evaluation += st.t_evaluation;
-    row->t_distance += st.t_distance;
-    row->residual = st.residual;
-    if (s < 0) {
-        row_error(row, s, cm_context_message(ctx));
-        return s;
-    }
-    row->status = s;
-    if (s == CM_WARNING) row_error(row, s, cm_context_message(ctx));
-    row->min_sj = st.min_sj;
-    row->mean_sj = st.mean_sj;
-    row->inverted = st.inverted;
-    row->cells = st.cells;
-    row->max_dist = st.max_dist;
-    row->outside = st.outside;
-    if (wants_mesh(w, row)) {
-        cm_status e = write_mesh(ctx, w, mp, label, row);
+    s = fill_row(row, s, cm_context_message(ctx), &st);
+    if (s >= 0 && wants_mesh(w, row)) {
+        cm_status e = write_mesh(ctx, w, w->xyz, cm_morpher_quality(mp), label, row);
         if (e < 0) return e;
     }
     return s;
 }
 
 typedef struct row_key {
-    size_t variant, at;
+    size_t variant, mode, method, at;
 } row_key;
 
 static int cmp_key(const void *a, const void *b)
 {
     const row_key *x = a, *y = b;
     if (x->variant != y->variant) return x->variant < y->variant ? -1 : 1;
+    if (x->mode != y->mode) return x->mode < y->mode ? -1 : 1;
+    if (x->method != y->method) return x->method < y->method ? -1 : 1;
     return x->at < y->at ? -1 : x->at > y->at;
 }
 
 /* A distributed study: every rank's rows into r, variant-major as a serial study has them
- * (the rows of one variant come from one rank, in their order). */
+ * (per variant in series order: mode, then method). */
 static cm_status gather_rows(cm_context *ctx, cm_study_result *r)
 {
     void *all = NULL;
@@ -168,7 +186,8 @@ static cm_status gather_rows(cm_context *ctx, cm_study_result *r)
         free(all), free(key), free(rows);
         return cm_error(ctx, CM_ERR_NOMEM, "cm_study_run: out of memory");
     }
-    for (size_t i = 0; i < n; ++i) key[i] = (row_key){got[i].variant, i};
+    for (size_t i = 0; i < n; ++i)
+        key[i] = (row_key){got[i].variant, (size_t)got[i].mode, got[i].method, i};
     qsort(key, n, sizeof *key, cmp_key);
     r->n_failed = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -196,111 +215,189 @@ static void log_row(cm_context *ctx, const study *w, const cm_study_row *row, co
            cm_study_mode_name(row->mode), label, row->message);
 }
 
-/* Every method and mode of variant i. *g: the variant's geometry (NULL if it could not be
- * used); *abs_used, *rel_used: whether the absolute morpher and live relative morphers now
- * point at it. */
-static cm_status run_variant(cm_context *ctx, study *w, size_t i, cm_cad_model **gout,
-                             int *abs_used, int *rel_used)
+/* A variant loaded for a batch: its model (NULL when it could not be used: its rows are
+ * made already) and what every row of it starts with. */
+typedef struct variant {
+    cm_cad_model *g;
+    char label[256];
+    cm_study_row base;
+    int abs; /* this rank runs its absolute rows */
+} variant;
+
+/* Whether this rank runs series se's row of variant i: absolute rows by variant (i mod
+ * ranks), relative series by method (a chain cannot be split: method m's on rank m mod
+ * ranks). */
+static int owns(const study *w, const series *se, size_t i)
+{
+    const int ranks = w->o->ranks > 1 ? w->o->ranks : 1;
+    if (ranks == 1) return 1;
+    if (se->mode == CM_STUDY_ABSOLUTE) return (int)(i % (size_t)ranks) == w->o->rank;
+    return (int)(se->method % (size_t)ranks) == w->o->rank;
+}
+
+/* Reads variant i and checks it against G0; one that cannot be used is a row with its error
+ * for each series this rank runs. */
+static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
 {
     const cm_study_family *f = w->fam;
-    char label[256];
-    f->label(f->user, i, label, sizeof label);
-    double t = f->param ? f->param(f->user, i) : (double)(i + 1) / (double)f->n;
-    cm_study_row base_row;
-    memset(&base_row, 0, sizeof base_row);
-    base_row.variant = i;
-    snprintf(base_row.label, sizeof base_row.label, "%.63s", label);
-    base_row.t = t;
-
+    memset(v, 0, sizeof *v);
+    f->label(f->user, i, v->label, sizeof v->label);
+    v->base.variant = i;
+    snprintf(v->base.label, sizeof v->base.label, "%.63s", v->label);
+    v->base.t = f->param ? f->param(f->user, i) : (double)(i + 1) / (double)f->n;
     double t0 = cm_wtime();
     cm_cad_model *g = NULL;
     cm_status s = f->load(ctx, f->user, i, &g);
-    if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "study: %s: %s", label, cm_context_message(ctx));
+    if (s == CM_WARNING)
+        cm_log(ctx, CM_LOG_WARNING, "study: %s: %s", v->label, cm_context_message(ctx));
     /* checked here, before any morpher sees g: a variant of another topology touches none */
     if (s >= 0) {
         s = cm_cad_match(ctx, w->g0, g, 5, NULL); /* renumbers the variant like G0 */
         if (s < 0) s = cm_error_prefix(ctx, s, "not a variant of G0");
     }
-    double t_load = cm_wtime() - t0;
-    if (s < 0) {
-        cm_cad_destroy(&g);
-        if (s == CM_ERR_NOMEM || s == CM_ERR_INTERRUPTED) return s;
-        cm_log(ctx, CM_LOG_WARNING, "study: variant %s: %s", label, cm_context_message(ctx));
-        for (size_t k = 0; k < w->n_series; ++k) {
-            cm_study_row row = base_row;
-            row.mode = w->s[k].mode;
-            row.method = w->s[k].method;
-            row.t_sample = t_load;
-            row_error(&row, s, cm_context_message(ctx));
-            cm_status e = add_row(ctx, w->r, &row);
-            if (e < 0) return e;
-        }
+    v->base.t_sample = cm_wtime() - t0;
+    if (s >= 0) {
+        v->g = g;
         return CM_OK;
     }
-
-    *gout = g;
-    for (size_t k = 0; k < w->n_series; ++k) {
-        series *se = &w->s[k];
-        cm_study_row row = base_row;
-        row.mode = se->mode;
-        row.method = se->method;
-        row.t_sample = t_load;
-        if (se->mode == CM_STUDY_ABSOLUTE) {
-            const cm_morpher_info *info = cm_morpher_get_info(w->abs);
-            if (!se->reported) {
-                row.t_classify = info->t_sample + info->t_classify;
-                se->reported = 1;
-            }
-            s = morph(ctx, w, se, w->abs, g, label, &row);
-            *abs_used = 1;
-        } else if (!se->mp) {
-            row_error(&row, se->stopped, se->why);
-            s = CM_OK;
-        } else {
-            if (!se->reported) {
-                const cm_morpher_info *info = cm_morpher_get_info(se->mp);
-                row.t_classify = info->t_sample + info->t_classify;
-                se->reported = 1;
-            }
-            row.t_classify += se->t_rebase;
-            s = morph(ctx, w, se, se->mp, g, label, &row);
-            if (s >= 0) {
-                double t1 = cm_wtime();
-                s = cm_morpher_rebase(ctx, se->mp, g, w->xyz);
-                se->t_rebase = cm_wtime() - t1;
-                if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
-                if (s < 0)
-                    snprintf(se->why, sizeof se->why, "not run: re-basing on variant %s failed: %s",
-                             label, cm_context_message(ctx));
-            } else if (!fatal(s)) {
-                snprintf(se->why, sizeof se->why, "not run: the relative series stopped at "
-                         "variant %s: %s", label, cm_context_message(ctx));
-            }
-            if (s < 0) {
-                se->stopped = s;
-                cm_morpher_destroy(&se->mp);
-            } else {
-                *rel_used = 1;
-            }
-        }
-        if (fatal(s)) return s;
-        if (row.status < 0) log_row(ctx, w, &row, label);
-        if ((s = add_row(ctx, w->r, &row)) < 0) return s;
-    }
+    cm_cad_destroy(&g);
+    if (s == CM_ERR_NOMEM || s == CM_ERR_INTERRUPTED) return s;
+    cm_log(ctx, CM_LOG_WARNING, "study: variant %s: %s", v->label, cm_context_message(ctx));
+    row_error(&v->base, s, cm_context_message(ctx)); /* every row of it */
     return CM_OK;
 }
 
-/* After a variant: g becomes what the morphers point at, and what they no longer point at
- * is freed. */
-static void keep(study *w, cm_cad_model *g, int abs_used, int rel_used)
+/* The absolute rows of series se (mode absolute) for the batch's variants that this rank
+ * runs, into rows[j] (one per variant; the meshes written): one cm_morpher_apply_batch per
+ * w->batch variants. */
+static cm_status absolute_rows(cm_context *ctx, study *w, series *se, variant *v, size_t n,
+                               cm_study_row *rows)
 {
-    cm_cad_model *old_last = w->last, *old_base = w->base;
-    if (abs_used) w->last = g;
-    if (rel_used) w->base = g;
-    if (old_base == old_last) old_base = NULL; /* one model, freed once */
-    if (old_last && old_last != w->last && old_last != w->base) cm_cad_destroy(&old_last);
-    if (old_base && old_base != w->last && old_base != w->base) cm_cad_destroy(&old_base);
-    if (g && g != w->last && g != w->base) cm_cad_destroy(&g);
+    const cm_study_method *m = &w->r->methods[se->method];
+    const cm_cad_model **targets = malloc((n ? n : 1) * sizeof *targets);
+    size_t *of = malloc((n ? n : 1) * sizeof *of), k = 0;
+    cm_status s = targets && of ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");
+    for (size_t j = 0; j < n && s >= 0; ++j)
+        if (v[j].abs && v[j].g) {
+            targets[k] = v[j].g;
+            of[k++] = j;
+        }
+    if (s >= 0) s = cm_morpher_apply_batch(ctx, w->abs, k, targets, &m->method, w->bxyz, w->items);
+    for (size_t q = 0; q < k && s >= 0; ++q) {
+        cm_study_row *row = &rows[of[q]];
+        const cm_morph_batch_item *it = &w->items[q];
+        if (!se->reported) {
+            const cm_morpher_info *info = cm_morpher_get_info(w->abs);
+            row->t_classify = info->t_sample + info->t_classify;
+            se->reported = 1;
+        }
+        if (fill_row(row, it->status, it->message, &it->row) >= 0 && wants_mesh(w, row))
+            s = write_mesh(ctx, w, w->bxyz[q], NULL, v[of[q]].label, row);
+        if (fatal(it->status)) s = it->status;
+    }
+    free(targets);
+    free(of);
+    return s;
+}
+
+/* Series se's (relative) row of variant v: the morph from its last result, then the re-base
+ * onto it; a failure stops the series (its later rows say why). *used: the morpher is now
+ * based on v's model. */
+static cm_status relative_row(cm_context *ctx, study *w, series *se, const variant *v,
+                              cm_study_row *row, int *used)
+{
+    if (!se->mp) {
+        row_error(row, se->stopped, se->why);
+        return CM_OK;
+    }
+    if (!se->reported) {
+        const cm_morpher_info *info = cm_morpher_get_info(se->mp);
+        row->t_classify = info->t_sample + info->t_classify;
+        se->reported = 1;
+    }
+    row->t_classify += se->t_rebase;
+    cm_status s = morph(ctx, w, se, se->mp, v->g, v->label, row);
+    if (s >= 0) {
+        double t1 = cm_wtime();
+        s = cm_morpher_rebase(ctx, se->mp, v->g, w->xyz);
+        se->t_rebase = cm_wtime() - t1;
+        if (s == CM_WARNING) cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
+        if (s < 0)
+            snprintf(se->why, sizeof se->why, "not run: re-basing on variant %s failed: %s",
+                     v->label, cm_context_message(ctx));
+    } else if (!fatal(s)) {
+        snprintf(se->why, sizeof se->why, "not run: the relative series stopped at "
+                 "variant %s: %s", v->label, cm_context_message(ctx));
+    }
+    if (s < 0) {
+        se->stopped = s;
+        cm_morpher_destroy(&se->mp);
+    } else {
+        *used = 1;
+    }
+    return s;
+}
+
+/* Variants first .. first + n - 1 that this rank needs: loaded, the absolute rows in
+ * batches, then per variant in order its rows (series order), the relative ones morphed
+ * there. Frees the batch's models but the relative morphers' base. */
+static cm_status run_batch(cm_context *ctx, study *w, const size_t *idx, size_t n)
+{
+    const int ranks = w->o->ranks > 1 ? w->o->ranks : 1;
+    variant *v = calloc(n ? n : 1, sizeof *v);
+    cm_study_row *rows = calloc((n ? n : 1) * w->n_series, sizeof *rows);
+    cm_status s = v && rows ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");
+    size_t loaded = 0;
+    for (size_t j = 0; j < n && s >= 0; ++j, ++loaded) {
+        s = load_variant(ctx, w, idx[j], &v[j]);
+        v[j].abs = ranks == 1 || (int)(idx[j] % (size_t)ranks) == w->o->rank;
+        for (size_t q = 0; q < w->n_series; ++q) {
+            cm_study_row *row = &rows[j * w->n_series + q];
+            *row = v[j].base;
+            row->mode = w->s[q].mode;
+            row->method = w->s[q].method;
+        }
+    }
+    /* the absolute series, in batches over the variants (their rows kept for the order) */
+    cm_study_row *col = malloc((n ? n : 1) * sizeof *col);
+    if (s >= 0 && !col) s = cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");
+    for (size_t q = 0; q < w->n_series && s >= 0; ++q) {
+        if (w->s[q].mode != CM_STUDY_ABSOLUTE) continue;
+        for (size_t j = 0; j < n; ++j)
+            col[j] = rows[j * w->n_series + q];
+        s = absolute_rows(ctx, w, &w->s[q], v, n, col);
+        for (size_t j = 0; j < n; ++j)
+            rows[j * w->n_series + q] = col[j];
+    }
+    free(col);
+    /* per variant: the relative series from their last results, then every row in order */
+    for (size_t j = 0; j < n && s >= 0; ++j) {
+        int used = 0;
+        for (size_t q = 0; q < w->n_series && s >= 0; ++q) {
+            series *se = &w->s[q];
+            cm_study_row *row = &rows[j * w->n_series + q];
+            if (!owns(w, se, idx[j])) continue;
+            if (se->mode == CM_STUDY_RELATIVE && v[j].g) {
+                cm_status e = relative_row(ctx, w, se, &v[j], row, &used);
+                if (fatal(e)) s = e;
+            }
+            if (s < 0) break;
+            if (row->status < 0) log_row(ctx, w, row, v[j].label);
+            s = add_row(ctx, w->r, row);
+        }
+        if (used && v[j].g != w->base) { /* the relative morphers moved on to this variant */
+            int in_batch = 0;
+            for (size_t k = 0; k < n; ++k)
+                in_batch |= v[k].g == w->base;
+            if (!in_batch) cm_cad_destroy(&w->base);
+            w->base = v[j].g;
+        }
+    }
+    for (size_t j = 0; j < loaded; ++j)
+        if (v[j].g != w->base) cm_cad_destroy(&v[j].g);
+    free(v);
+    free(rows);
+    return s;
 }
 
 static void study_free(study *w)
@@ -311,10 +408,49 @@ static void study_free(study *w)
     free(w->s);
     cm_mesh_destroy(&w->work);
     free(w->xyz);
-    cm_cad_model *last = w->last, *base = w->base;
-    w->last = w->base = NULL;
-    if (last != base) cm_cad_destroy(&base);
-    cm_cad_destroy(&last);
+    if (w->bxyz)
+        for (size_t j = 0; j < w->batch; ++j)
+            free(w->bxyz[j]);
+    free(w->bxyz);
+    free(w->items);
+    cm_cad_destroy(&w->base);
+}
+
+/* Bytes free for the study's batches: the kernel's MemAvailable where it says, else the
+ * library's dense budget (cm_memory_budget). */
+static double available_memory(void)
+{
+    double avail = 0;
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (f) {
+        char line[256];
+        while (fgets(line, sizeof line, f)) {
+            double kb = 0;
+            if (sscanf(line, "MemAvailable: %lf kB", &kb) == 1) {
+                avail = 1024 * kb;
+                break;
+            }
+        }
+        fclose(f);
+    }
+    return avail > 0 ? avail : cm_memory_budget();
+}
+
+/* Variants per batch: o->batch, or (0) as many as half the available memory holds, up to
+ * CM_STUDY_BATCH_MAX. Per variant: for each of its 3 columns of an iterative RBF solve the
+ * Krylov basis and its preconditioned copies, (2 restart + 6) doubles per boundary node (the
+ * default restart, 40); the apply's fields, the evaluation's values and the result (3 doubles
+ * per node each); its loaded model (a few MB: 8 MB counted). */
+static size_t batch_size(const cm_study_options *o, size_t nodes, size_t boundary)
+{
+    if (!(o->modes & CM_STUDY_ABSOLUTE)) return 1;
+    if (o->batch > 0) return (size_t)o->batch;
+    const double restart = 40;
+    const double per = 8.0 * (3 * (2 * restart + 6) * (double)boundary + 9.0 * (double)nodes +
+                              3.0 * (double)boundary) + 8e6;
+    double k = 0.5 * available_memory() / per;
+    if (!(k >= 1)) return 1;
+    return k < CM_STUDY_BATCH_MAX ? (size_t)k : CM_STUDY_BATCH_MAX;
 }
 
 /* M0's quality, the morphers, the series and the scratch arrays. */
@@ -346,6 +482,7 @@ static cm_status setup(cm_context *ctx, study *w)
             se->mode = mode;
             se->method = m;
             if (mode == CM_STUDY_ABSOLUTE && w->abs) continue;
+            if (mode == CM_STUDY_RELATIVE && !owns(w, se, 0)) continue; /* another rank's */
             cm_morpher **mp = mode == CM_STUDY_ABSOLUTE ? &w->abs : &se->mp;
             cm_morph_options mo = o->morph;
             /* absolute: the targets are sampled only to measure the distance of the boundary
@@ -362,6 +499,16 @@ static cm_status setup(cm_context *ctx, study *w)
             r->boundary_nodes = info->boundary_nodes;
         }
     }
+    w->batch = batch_size(o, nn, r->boundary_nodes);
+    cm_log(ctx, CM_LOG_DEBUG, "study: absolute morphs in batches of up to %zu variants%s",
+           w->batch, o->batch > 0 ? " (asked for)" : " (memory, CM_STUDY_BATCH_MAX)");
+    w->bxyz = calloc(w->batch, sizeof *w->bxyz);
+    w->items = malloc(w->batch * sizeof *w->items);
+    if (!w->bxyz || !w->items) return cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");
+    for (size_t j = 0; j < w->batch; ++j)
+        if (!(w->bxyz[j] = malloc(3 * (nn ? nn : 1) * sizeof *w->bxyz[j])))
+            return cm_error(ctx, CM_ERR_NOMEM, "study: out of memory for %zu batch results",
+                            w->batch);
     return CM_OK;
 }
 
@@ -376,11 +523,11 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_run: modes %d, steps %d, %zu methods",
                         opt->modes, opt->morph.steps, opt->n_methods);
     const int ranks = opt->ranks > 1 ? opt->ranks : 1;
-    if (ranks > 1 && ((opt->modes & CM_STUDY_RELATIVE) || opt->rank < 0 || opt->rank >= ranks))
-        return cm_error(ctx, CM_ERR_ARGUMENT,
-                        "cm_study_run: over %d ranks only absolute studies (relative steps "
-                        "chain the variants); rank %d",
-                        ranks, opt->rank);
+    if (ranks > 1 && (opt->rank < 0 || opt->rank >= ranks))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_run: rank %d of %d", opt->rank, ranks);
+    if (opt->batch < 0)
+        return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_run: batch %d (0: auto, K >= 1)",
+                        opt->batch);
     if (opt->write_meshes == CM_STUDY_WRITE_LISTED && !opt->write_listed)
         return cm_error(ctx, CM_ERR_ARGUMENT, "cm_study_run: listed meshes without a list");
     double t_start = cm_wtime();
@@ -431,18 +578,21 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
     if (r->threads <= 0) r->threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
 
     cm_status s = setup(ctx, &w);
-    for (size_t i = 0; i < family->n && s >= 0; ++i) {
-        if (ranks > 1 && (int)(i % (size_t)ranks) != opt->rank) continue; /* another rank's */
-        if ((s = cm_progress(ctx, "study", (double)i, (double)family->n)) < 0) break;
-        cm_cad_model *g = NULL;
-        int abs_used = 0, rel_used = 0;
-        s = run_variant(ctx, &w, i, &g, &abs_used, &rel_used);
-        if (s < 0) { /* study_free: the morphers first, then last and base */
-            if (g != w.last && g != w.base) cm_cad_destroy(&g);
-            break;
-        }
-        keep(&w, g, abs_used, rel_used);
+    /* the variants this rank needs (its absolute ones; all for a relative series it runs), in
+     * batches of w.batch */
+    size_t *idx = s >= 0 ? malloc((w.batch ? w.batch : 1) * sizeof *idx) : NULL;
+    if (s >= 0 && !idx) s = cm_error(ctx, CM_ERR_NOMEM, "cm_study_run: out of memory");
+    for (size_t i = 0, n = 0; i < family->n && s >= 0; ++i) {
+        int need = 0;
+        for (size_t q = 0; q < w.n_series; ++q)
+            need |= owns(&w, &w.s[q], i);
+        if (need) idx[n++] = i;
+        if (n < w.batch && i + 1 < family->n) continue;
+        if (n && (s = cm_progress(ctx, "study", (double)idx[0], (double)family->n)) >= 0)
+            s = run_batch(ctx, &w, idx, n);
+        n = 0;
     }
+    free(idx);
     if (s >= 0) s = cm_progress(ctx, "study", (double)family->n, (double)family->n);
     study_free(&w);
     /* every rank gathers, also one that failed: the others would wait for it */

@@ -180,6 +180,41 @@ CM_API cm_status cm_morpher_apply_method(cm_context *ctx, cm_morpher *morpher,
                                   const cm_cad_model *target, const cm_morph_method *method,
                                   double *out_xyz, cm_morph_step *out_row);
 
+/* ---- batches: several targets, one warp apply ----
+ * An absolute study morphs many targets from one morpher: their whole-motion fields can share
+ * one multi-column warp apply (cm_warp_apply_many: for the RBF warps one solve and one
+ * evaluation of all columns). Per target: */
+typedef struct cm_morph_batch_item {
+    cm_status status;  /* what cm_morpher_apply_method returns for this target alone */
+    char message[512]; /* the message of that status ("" for CM_OK) */
+    cm_morph_step row; /* its out_row (zeroed when the morph stopped before a step) */
+    int batched;       /* 1: the result of the shared apply; 0: morphed alone */
+} cm_morph_batch_item;
+
+/* Morphs onto the k targets with method: out_xyz[j] (#nodes x 3 each) and items[j] receive
+ * what cm_morpher_apply_method(targets[j]) gives (result, row, status and message), equal to
+ * rounding (dense RBF) or to the iterative solver's tolerance. Batched: the targets' surface
+ * morphs, then one apply of the shared warp for all whole-motion fields, then each result
+ * judged as apply judges its first trial (steps auto: valid under the floor; steps 1: valid
+ * or allow_inverted); a result that one step does not finish is morphed again alone (its
+ * steps, its rejection). Alone throughout: k < 2, a warp other than rbf and rbf-biharmonic
+ * (their apply_many shares the kernel passes; the others' applies one field at a time, so
+ * there is nothing to share), slides of nodes off G (two-pass warp), nodes on G touching a
+ * fixed surface off G (checked per step), steps > 1. Times: a batched row has its own surface
+ * morph, optimisation, quality and distance times; the shared apply's time (for an iterative
+ * RBF its Krylov solve) is divided equally over the batched rows' t_evaluation, and a
+ * factorisation made by the call is in the first row that used it, as the first apply's
+ * would be. Warnings of batched targets are logged as apply logs them. cm_morpher_steps,
+ * cm_morpher_quality and cm_morpher_surface_stats afterwards: those of the last target morphed
+ * (its step rows when morphed alone). The morpher keeps no target: the caller may free them
+ * after the call. Returns CM_ERR_NOMEM or CM_ERR_INTERRUPTED when one stopped the batch
+ * (items from there on unset), CM_ERR_ARGUMENT for NULL inputs, else CM_OK (each target's
+ * status in its item). */
+CM_API cm_status cm_morpher_apply_batch(cm_context *ctx, cm_morpher *morpher, size_t k,
+                                        const cm_cad_model *const *targets,
+                                        const cm_morph_method *method, double *const *out_xyz,
+                                        cm_morph_batch_item *items);
+
 /* The rows of the last apply, in order (accepted and rejected steps); *n their count. Valid
  * until the next apply. */
 CM_API const cm_morph_step *cm_morpher_steps(const cm_morpher *morpher, size_t *n);

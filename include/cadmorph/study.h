@@ -4,13 +4,15 @@
  * SVG plot of the results. Conventions: see core.h.
  *
  *   absolute: one cm_morpher on M0 (one classification, one factorisation per warp method)
- *             shared by every variant: cm_morpher_apply_method onto each G(i);
+ *             shared by every variant: cm_morpher_apply_batch onto batches of G(i) (one
+ *             multi-column warp apply per batch; cm_study_options.batch);
  *   relative: G(i-1) -> G(i) step by step, one morpher per method re-based
  *             (cm_morpher_rebase) on its previous result and that result's geometry.
  * The family comes from a callback (cm_study_family: the built-in models of models.h use one
  * through cm_sweep_run) or from a list of STEP files (cm_study_family_files). A variant that
  * cannot be read or whose topology differs from G0 is a row with its error, not the end of
- * the study. Progress: cm_progress stage "study", done/total = variants.
+ * the study. Progress: cm_progress stage "study", done/total = variants (before each batch:
+ * done jumps by the batch size).
  */
 #ifndef CADMORPH_STUDY_H
 #define CADMORPH_STUDY_H
@@ -26,6 +28,11 @@ enum { CM_STUDY_ABSOLUTE = 1, CM_STUDY_RELATIVE = 2, CM_STUDY_BOTH = 3 };
 /* Sampling of the absolute study's targets (cm_morph_options.target_h_scale): they are only
  * sampled to measure the boundary's distance to them. */
 #define CM_STUDY_TARGET_H_SCALE 4.0
+
+/* The largest automatic batch of absolute variants (cm_study_options.batch 0): 3 columns per
+ * variant, and the kernel's per-column cost flattens by 60 columns (benchmarks/RESULTS.md,
+ * "Study"). */
+#define CM_STUDY_BATCH_MAX 20
 
 /* "absolute" / "relative" ("?" otherwise). */
 CM_API const char *cm_study_mode_name(int mode);
@@ -146,11 +153,20 @@ typedef struct cm_study_options {
                                per-cell scaled_jacobian and per-node displacement (from M0) */
     const char *model;      /* names for the CSV columns model and mesh and the plot title */
     const char *mesh;       /*   (NULL: "G0", "file") */
-    int rank, ranks;        /* distributed over MPI ranks (ranks > 1, absolute mode only;
-                               default 0, 1): this process runs variants i with
-                               i mod ranks = rank and writes their meshes; the result, on
-                               every rank, has all rows (cm_parallel_allgather). Every
-                               rank calls cm_study_run with the same inputs. */
+    int rank, ranks;        /* distributed over MPI ranks (ranks > 1; default 0, 1): this
+                               process runs the absolute rows of variants i with
+                               i mod ranks = rank, and the relative series of method m when
+                               m mod ranks = rank (a relative series is one chain: it cannot
+                               be split, so a relative study spreads over the ranks by
+                               method), and writes their meshes; the result, on every rank,
+                               has all rows in the serial order (cm_parallel_allgather).
+                               Every rank calls cm_study_run with the same inputs. */
+    /* Absolute variants morphed together (cm_morpher_apply_batch: one multi-column warp
+     * apply for the batch; rows equal to one-at-a-time to the solver's tolerance, in the same
+     * order). 0 (default): as many as half the available memory holds, up to
+     * CM_STUDY_BATCH_MAX (docs/DESIGN.md, "Studies in batches"); 1: one variant at a time;
+     * K: K variants. Relative series run one variant at a time whatever it is. */
+    int batch;
 } cm_study_options;
 
 CM_API void cm_study_options_init(cm_study_options *opt);

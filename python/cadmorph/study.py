@@ -169,6 +169,13 @@ def _steps(steps: Union[int, str], what: str) -> int:
     return integer(what, "steps", steps, 1, 1000)
 
 
+def _batch(batch: Union[int, str], what: str) -> int:
+    if isinstance(batch, str):
+        choice(what, "batch", batch, ("auto",))
+        return 0
+    return integer(what, "batch", batch, 1, 1000)
+
+
 def _stem(path: bytes) -> str:
     base = os.path.basename(path)
     stem = os.path.splitext(base)[0] if not base.startswith(b".") else base
@@ -179,7 +186,8 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
           methods: Union[None, str, Sequence[str]] = None, mode: str = "absolute",
           steps: Union[int, str] = "auto", optimize: bool = False, write_meshes: str = "none",
           out_dir: Optional[PathLike] = None, model_name: Optional[str] = None,
-          mesh_name: Optional[str] = None, *, allow_inverted: bool = False, threads: int = 0,
+          mesh_name: Optional[str] = None, *, allow_inverted: bool = False,
+          batch: Union[int, str] = "auto", threads: int = 0,
           progress: Progress = None) -> StudyResult:
     """Morphs mesh (a cadmorph.Mesh of g0, a cadmorph.Geometry) onto every target, as
     `cadmorph study --from G0.step --mesh M0 --variants LIST -o DIR`.
@@ -198,6 +206,10 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     optimisation after each step. write_meshes: "none" (default here; the CLI's is "all"), "all" or "failed"; the
     meshes go to out_dir (created if missing) as <method>_<mode>_<label>.vtu. model_name,
     mesh_name: the CSV's model and mesh columns (default: g0's file name and "file").
+    batch: absolute variants morphed together, as `--batch` ("auto", the default: as many as
+    half the free memory holds, up to 20; 1: one at a time; K: K): their warps share one
+    multi-column solve and evaluation; the rows are those of one at a time to the solver's
+    tolerance, in the same order. Relative series run one variant at a time.
 
     Errors that end the study (mesh not a mesh of g0, ...) raise; failed rows are a
     CadmorphWarning and rows with status < 0 (n_failed > 0: where the CLI exits 3).
@@ -219,6 +231,7 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     so.morph.steps = _steps(steps, what)
     so.morph.optimize = bool(optimize)
     so.morph.allow_inverted = flag(what, "allow_inverted", allow_inverted)
+    so.batch = _batch(batch, what)
     so.write_meshes = _WRITE[choice(what, "write_meshes", write_meshes, tuple(_WRITE))]
     keep = [ms]
     if so.write_meshes != lib.CM_STUDY_WRITE_NONE:

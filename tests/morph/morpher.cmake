@@ -17,3 +17,8 @@ cm_add_unit_test(test_morph_interrupt test_morph_interrupt.c LIBS cm_morph cm_st
 add_test(NAME test_off_cad_slide
   COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_SOURCE_DIR}/test_off_cad_slide.py $<TARGET_FILE:cadmorph> ${CM_TEST_WORK})
 set_tests_properties(test_off_cad_slide PROPERTIES LABELS "cad;cli" TIMEOUT 120)
+
+# cm_morpher_apply_batch against cm_morpher_apply_method per target on the built-in bore (dense
+# and iterative RBF solves): statuses, rows and coordinates, with a mismatched target and
+# results morphed again alone
+cm_add_unit_test(test_morph_batch test_morph_batch.c LIBS cm_morph cm_study LABELS cad)

@@ -108,6 +108,27 @@ def test_study_errors(bore):
         cadmorph.study(cadmorph.model("pipe", 0.0), mesh, t, progress=False)
 
 
+def test_study_batch(bore):
+    """batch: the rows of one at a time (to rounding: the small mesh's dense solve), in the
+    same order, whatever the batch size; bad sizes are ValueErrors before the library."""
+    g0 = cadmorph.read_step(bore / "bore_0.step")
+    mesh = cadmorph.read_mesh(bore / "M0.vtu")
+    t = [bore / "bore_0.5.step", bore / "bore_1.step", bore / "bore_0.5.step"]
+    rows = {}
+    for b in (1, 3, "auto"):
+        r = cadmorph.study(g0, mesh, t, methods="rbf-s,project", batch=b, progress=False)
+        rows[b] = r.rows
+    assert len(rows[1]) == 3 * 2
+    for b in (3, "auto"):
+        for x, y in zip(rows[1], rows[b]):
+            assert (x.label, x.method, x.mode, x.status, x.inverted) == \
+                (y.label, y.method, y.mode, y.status, y.inverted)
+            assert abs(x.min_sj - y.min_sj) < 1e-9 and abs(x.mean_sj - y.mean_sj) < 1e-9
+    for bad in (0, -2, 1001, "many", 2.5):
+        with pytest.raises((ValueError, TypeError), match="batch"):
+            cadmorph.study(g0, mesh, t, batch=bad)
+
+
 def test_sweep_equals_cli(cli, work):
     run(cli, "sweep", "bore", "--mesh", "hex", "--steps", "2", "--size", "0.5", "--methods",
         "project,rbf-s", "--mode", "absolute", "-o", work / "cli")
