@@ -11,11 +11,8 @@
 #define CM_RBF_FLOOR_SLACK 10.0
 /* plain direct sums err by at most this x S(z) (rbf_fgmres.c, relaxed products) */
 #define CM_RBF_PLAIN_ERR 1e-13
-/* The kernel sums take at most this many columns per call (rbf_internal.h may raise it):
+/* The kernel sums take at most CM_RBF_SUM_MAX_NC columns per call (rbf_internal.h):
  * cm_krylov_product() is the one place that cuts the active columns into such chunks. */
-#ifndef CM_RBF_SUM_MAX_NC
-#define CM_RBF_SUM_MAX_NC 4
-#endif
 
 enum { MV_COMP = 0, MV_PLAIN = 1, MV_FAST = 2 };
 

@@ -798,9 +798,6 @@ static inline void local_row(const double *gd, const float *gf, size_t hd, size_
 /* Kernel sums of nc columns in chunks the sums take (rbf_internal.h); with inner (the
  * multilevel coarse space) each chunk first by its treecode to the fine centres (p = the
  * centres, n = ldp), as one call of up to CM_RBF_SUM_MAX_NC columns would */
-#ifndef CM_RBF_SUM_MAX_NC
-#define CM_RBF_SUM_MAX_NC 4
-#endif
 static void sum_chunked(const cm_rbf_coarse_inner *inner, cm_rbf_kernel kernel, size_t ms,
                         const double *cs, const double *w, int nc, size_t n, const double *p,
                         size_t ldp, double *out, size_t ldo, int threads)
