@@ -825,6 +825,15 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
 const cm_surface_nodes *nodes,
 const cm_surface_morph_options *opt, double *xyz,
 cm_surface_morph_stats *stats);
+typedef struct cm_surface_morph_cache cm_surface_morph_cache;
+cm_status cm_surface_morph_cache_create(cm_context *ctx, cm_surface_morph_cache **cache);
+void cm_surface_morph_cache_clear(cm_surface_morph_cache *cache);
+void cm_surface_morph_cache_destroy(cm_surface_morph_cache **cache);
+cm_status cm_surface_morph_cached(cm_context *ctx, cm_surface_morph_cache *cache,
+const cm_cad_model *g, const cm_cad_model *g2,
+const cm_surface_nodes *nodes,
+const cm_surface_morph_options *opt, double *xyz,
+cm_surface_morph_stats *stats);
 cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *locator,
 const double *xyz, size_t n, double *max_dist,
 size_t *worst);
