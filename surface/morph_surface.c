@@ -27,7 +27,7 @@ static int cmp_double(const void *a, const void *b)
 /* Per face of G: its boundary samples and the thin-plate system of its parameter warp on
  * their (u,v), factorised. Neither depends on G': a study of many targets factors each face
  * once and pays per target only the samples of G', one solve and the evaluation
- * (docs/DESIGN.md, "Surface morph"). */
+ * (docs/DESIGN.md, "Surface morph across targets"). */
 typedef struct face_fit {
     cm_cad_boundary *ba;
     cm_rbf *rbf;

@@ -126,10 +126,10 @@ CM_API cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const 
 /* What the surface morph computes from G and the nodes alone, kept across targets: the
  * boundary samples of every face of G, the factorised thin-plate system of its parameter warp
  * (only the right-hand side depends on G': each target is one solve with the factor) and the
- * nodes grouped by entity (docs/DESIGN.md, "Surface morph"). Filled on first use; a call with
- * another G, other nodes or other sampling options empties it first. G and the nodes are
- * identified by address: empty it (cm_surface_morph_cache_clear) before they are freed or
- * changed in place. Not for concurrent calls. */
+ * nodes grouped by entity (docs/DESIGN.md, "Surface morph across targets"). Filled on first
+ * use; a call with another G, other nodes or other sampling options empties it first. G and
+ * the nodes are identified by address: empty it (cm_surface_morph_cache_clear) before they
+ * are freed or changed in place. Not for concurrent calls. */
 typedef struct cm_surface_morph_cache cm_surface_morph_cache;
 
 CM_API cm_status cm_surface_morph_cache_create(cm_context *ctx, cm_surface_morph_cache **cache);

@@ -1,8 +1,8 @@
 /* The surface morph's per-study cache (cm_surface_morph_cached, docs/DESIGN.md "Surface
- * morph"): the faces' thin-plate systems factorised once on G give the same positions, bit
- * for bit, as a fresh morph, for one target, for targets in a row through one cache, after
- * the sampling options or G and its nodes change under the cache, and through a morpher that
- * applies several targets in a row. */
+ * morph across targets"): the faces' thin-plate systems factorised once on G give the same
+ * positions, bit for bit, as a fresh morph, for one target, for targets in a row through one
+ * cache, after the sampling options or G and its nodes change under the cache, and through a
+ * morpher that applies several targets in a row. */
 #include "surface_fixture.h"
 
 #include "cadmorph/morph.h"
