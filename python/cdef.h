@@ -219,6 +219,9 @@ const double *xyz, size_t n, const double *uv0, double *uv,
 double *dist, double *foot);
 cm_status cm_cad_project_edge(cm_context *ctx, const cm_cad_model *model, int edge,
 const double *xyz, size_t n, double *t, double *dist);
+cm_status cm_cad_project_each(cm_context *ctx, const cm_cad_model *model, size_t n,
+const int *kind, const int *entity, const double *xyz,
+const double *uv0, double *dist);
 typedef struct cm_cad_locator cm_cad_locator;
 typedef struct cm_cad_sample_options {
 double h;

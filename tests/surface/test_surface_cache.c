@@ -2,7 +2,9 @@
  * morph across targets"): the faces' thin-plate systems factorised once on G give the same
  * positions, bit for bit, as a fresh morph, for one target, for targets in a row through one
  * cache, after the sampling options or G and its nodes change under the cache, and through a
- * morpher that applies several targets in a row. */
+ * morpher that applies several targets in a row. And the one-pass projection of each node
+ * onto its own entity (cm_cad_project_each, the distance check's) against the projections
+ * entity by entity. */
 #include "surface_fixture.h"
 
 #include "cadmorph/morph.h"
@@ -145,6 +147,55 @@ done:
     cm_cad_destroy(&hr);
 }
 
+/* cm_cad_project_each gives the distances of cm_cad_project_edge / _face per entity, bit for
+ * bit, seeded and unseeded; it refuses an entity out of range. */
+static void test_project_each(cm_context *ctx)
+{
+    setup s;
+    CHECK(setup_create(ctx, "holes2_a", &s));
+    cm_cad_model *g2 = fx_model(ctx, "holes2_b");
+    if (!s.nodes || !g2) goto done;
+    const cm_surface_nodes *nd = s.nodes;
+    size_t n = nd->n;
+    double *xyz = malloc(3 * n * sizeof *xyz), *a = malloc(n * sizeof *a),
+           *b = malloc(n * sizeof *b);
+    int *kind = malloc(2 * n * sizeof *kind), *ent = kind + n;
+    CHECK(cm_surface_morph(ctx, s.g, g2, nd, NULL, xyz, NULL) >= 0);
+    for (size_t i = 0; i < n; ++i) {
+        kind[i] = (int)nd->kind[i], ent[i] = nd->entity[i];
+        xyz[3 * i] += 1e-3 * (double)(i % 7); /* some nodes off their entity */
+    }
+    for (int seeded = 0; seeded < 2; ++seeded) {
+        for (size_t i = 0; i < n; ++i)
+            a[i] = b[i] = -1;
+        CHECK(cm_cad_project_each(ctx, g2, n, kind, ent, xyz, seeded ? nd->param : NULL, b) ==
+              CM_OK);
+        size_t projected = 0;
+        for (size_t i = 0; i < n; ++i) {
+            if (kind[i] == 1) {
+                CHECK(cm_cad_project_edge(ctx, g2, ent[i], xyz + 3 * i, 1, NULL, a + i) == CM_OK);
+            } else if (kind[i] == 2) {
+                CHECK(cm_cad_project_face(ctx, g2, ent[i], xyz + 3 * i, 1,
+                                          seeded ? nd->param + 2 * i : NULL, NULL, a + i,
+                                          NULL) == CM_OK);
+            }
+            projected += kind[i] == 1 || kind[i] == 2;
+        }
+        CHECK(projected > 100);
+        CHECK_MSG(!memcmp(a, b, n * sizeof *a), "cm_cad_project_each (seeded %d) differs", seeded);
+    }
+    ent[n - 1] = 1000000;
+    kind[n - 1] = 2;
+    CHECK(cm_cad_project_each(ctx, g2, n, kind, ent, xyz, NULL, b) == CM_ERR_ARGUMENT);
+    free(xyz);
+    free(a);
+    free(b);
+    free(kind);
+done:
+    cm_cad_destroy(&g2);
+    setup_destroy(&s);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3) return 2;
@@ -154,6 +205,7 @@ int main(int argc, char **argv)
     cm_context_create(&ctx);
     test_targets(ctx);
     test_morpher(ctx);
+    test_project_each(ctx);
     cm_context_destroy(&ctx);
     return TEST_REPORT();
 }
