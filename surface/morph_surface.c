@@ -51,7 +51,8 @@ cm_status cm_surface_morph_cache_create(cm_context *ctx, cm_surface_morph_cache 
 {
     if (!cache) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_surface_morph_cache_create: NULL output");
     *cache = calloc(1, sizeof **cache);
-    return *cache ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph_cache_create: out of memory");
+    return *cache ? CM_OK
+                  : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph_cache_create: out of memory");
 }
 
 void cm_surface_morph_cache_clear(cm_surface_morph_cache *c)
