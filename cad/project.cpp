@@ -393,4 +393,60 @@ cm_status cm_cad_project_edge(cm_context *ctx, const cm_cad_model *model, int ed
     });
 }
 
+cm_status cm_cad_project_each(cm_context *ctx, const cm_cad_model *model, size_t n,
+                              const int *kind, const int *entity, const double *xyz,
+                              const double *uv0, double *dist)
+{
+    const char *fn = "cm_cad_project_each";
+    if (!model) return cm_error(ctx, CM_ERR_ARGUMENT, "%s: model is NULL", fn);
+    if (n && (!kind || !entity || !xyz || !dist))
+        return cm_error(ctx, CM_ERR_ARGUMENT, "%s: NULL kind, entity, xyz or dist", fn);
+    for (size_t i = 0; i < n; ++i) {
+        cm_status st = CM_OK;
+        if (kind[i] == 1) {
+            st = cmcad::check_edge(ctx, model, entity[i], fn);
+            if (st == CM_OK && model->edge_info[entity[i]].degenerate)
+                st = cm_error(ctx, CM_ERR_ARGUMENT, "%s: edge %d is degenerate (a point)", fn,
+                              entity[i]);
+        } else if (kind[i] == 2) {
+            st = cmcad::check_face(ctx, model, entity[i], fn);
+        }
+        if (st != CM_OK) return st;
+    }
+    return cmcad::guard(ctx, fn, [&]() -> cm_status {
+        cmcad::region_error err;
+        // dynamic: the points of one entity are contiguous in the callers' order, and the
+        // cost of a point varies by entity (an edge's global search, a face's Newton)
+#pragma omp parallel num_threads(cm_context_threads_for(ctx, n, 64)) if (n > 64)
+        {
+            cmcad::adaptors a(model);
+#pragma omp for schedule(dynamic, 64)
+            for (long i = 0; i < (long)n; ++i) {
+                try {
+                    gp_Pnt p(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+                    if (kind[i] == 1) {
+                        gp_Pnt q;
+                        double ti;
+                        dist[i] = cmcad::project_on_edge(a, entity[i], p,
+                                                         std::numeric_limits<double>::quiet_NaN(),
+                                                         ti, q);
+                    } else if (kind[i] == 2) {
+                        double u, v;
+                        if (uv0)
+                            u = uv0[2 * i], v = uv0[2 * i + 1];
+                        else
+                            cmcad::seed_on_face(a, entity[i], p, u, v);
+                        cmcad::foot r;
+                        cmcad::project_on_face(a, entity[i], p, u, v, r);
+                        dist[i] = r.dist;
+                    }
+                } catch (...) {
+                    err.capture();
+                }
+            }
+        }
+        return err.report(ctx, fn);
+    });
+}
+
 }  // extern "C"

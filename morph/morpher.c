@@ -134,6 +134,7 @@ static cm_status classify(cm_context *ctx, cm_morpher *mp, held_warnings *held)
 {
     double t0 = cm_wtime();
     cm_status s = CM_OK;
+    cm_surface_morph_cache_clear(mp->scache); /* its fits are on the old nodes and g */
     if (!mp->loc) {
         s = make_locator(ctx, mp, mp->g, 1, &mp->loc);
         if (s < 0) return s;
@@ -205,6 +206,7 @@ void cm_morpher_destroy(cm_morpher **morpher)
     if (!morpher || !*morpher) return;
     cm_morpher *mp = *morpher;
     drop_warps(mp);
+    cm_surface_morph_cache_destroy(&mp->scache);
     cm_cad_locator_destroy(&mp->loc);
     cm_surface_nodes_destroy(&mp->nodes);
     cm_mesh_boundary_destroy(&mp->b);
@@ -241,6 +243,7 @@ cm_status cm_morpher_create(cm_context *ctx, const cm_cad_model *g, const cm_mes
                       ? cm_mesh_copy(ctx, mesh, &mp->mesh)
                       : cm_error(ctx, CM_ERR_ARGUMENT,
                                  "cm_morpher_create: steps must be >= 1 or auto");
+    if (s >= 0) s = cm_surface_morph_cache_create(ctx, &mp->scache);
     if (s >= 0) s = cm_mesh_boundary_create(ctx, mp->mesh, &mp->b);
     hold(ctx, &held, s);
     size_t n_interface = 0; /* an assembly's interfaces move onto G' as the boundary does */
@@ -381,7 +384,8 @@ cm_status cm_morpher_surface_positions(cm_context *ctx, cm_morpher *mp,
     cm_surface_morph_options mo = mp->opt.morph;
     mo.method = surface;
     memset(&mp->surface, 0, sizeof mp->surface);
-    cm_status s = cm_surface_morph(ctx, mp->g, target, mp->nodes, &mo, bnew, &mp->surface);
+    cm_status s =
+        cm_surface_morph_cached(ctx, mp->scache, mp->g, target, mp->nodes, &mo, bnew, &mp->surface);
     if (s < 0) return s;
     if (mp->opt.keep_offset)
         for (size_t i = 0; i < 3 * mp->nodes->n; ++i)

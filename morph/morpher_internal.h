@@ -18,6 +18,9 @@ struct cm_morpher {
     cm_mesh_boundary *b;
     cm_cad_locator *loc; /* on g */
     cm_surface_nodes *nodes;
+    /* the surface morph's per-face fits on g and nodes, factorised once for every target;
+     * emptied whenever g or nodes change (classify) */
+    cm_surface_morph_cache *scache;
     /* warps on mesh, made when first used, one per set of warp options (a study may compare
      * one method with several settings, e.g. lattice sizes) */
     struct {

@@ -38,55 +38,75 @@ static double dist3(const double *a, const double *b)
                 (a[2] - b[2]) * (a[2] - b[2]));
 }
 
-/* Face nodes: Newton from the node's (u,v) on G (the morph moves (u,v) little); where that
- * does not reach the node (another parameterisation of the face in G'), from the projection's
- * own start on a grid of the face, keeping the nearer foot. */
-static cm_status face_distances(cm_context *ctx, const cm_cad_model *g2, int f,
-                                const cm_surface_nodes *nd, const size_t *in, size_t k,
-                                const double *xyz, double slack, double *d)
+/* Face nodes whose projection from their (u,v) on G did not reach them (d above slack:
+ * another parameterisation of the face in G'): projected again from the projection's own
+ * start on a grid of the face, keeping the nearer foot. */
+static cm_status face_again(cm_context *ctx, const cm_cad_model *g2, int f, const size_t *in,
+                            size_t k, const double *xyz, double slack, double *d)
 {
-    double *q = malloc(3 * k * sizeof *q), *uv = malloc(2 * k * sizeof *uv),
-           *d2 = malloc(k * sizeof *d2);
-    size_t *again = malloc(k * sizeof *again);
-    cm_status r = q && uv && d2 && again ? CM_OK
-                                        : cm_error(ctx, CM_ERR_NOMEM, "morph: out of memory");
-    for (size_t j = 0; j < k && r == CM_OK; ++j) {
-        memcpy(q + 3 * j, xyz + 3 * in[j], 3 * sizeof *q);
-        memcpy(uv + 2 * j, nd->param + 2 * in[j], 2 * sizeof *uv);
-    }
-    if (r == CM_OK) r = cm_cad_project_face(ctx, g2, f, q, k, uv, NULL, d2, NULL);
     size_t n2 = 0;
-    for (size_t j = 0; j < k && r >= 0; ++j) {
-        d[in[j]] = d2[j];
-        if (!(d2[j] <= slack)) again[n2++] = j;
-    }
-    if (r >= 0 && n2) {
-        for (size_t j = 0; j < n2; ++j)
-            memcpy(q + 3 * j, xyz + 3 * in[again[j]], 3 * sizeof *q);
-        r = cm_cad_project_face(ctx, g2, f, q, n2, NULL, NULL, d2, NULL);
-        for (size_t j = 0; j < n2 && r >= 0; ++j)
-            if (d2[j] < d[in[again[j]]]) d[in[again[j]]] = d2[j];
-    }
+    for (size_t j = 0; j < k; ++j)
+        n2 += !(d[in[j]] <= slack);
+    if (!n2) return CM_OK;
+    double *q = malloc(3 * n2 * sizeof *q), *d2 = malloc(n2 * sizeof *d2);
+    size_t *again = malloc(n2 * sizeof *again);
+    cm_status r = q && d2 && again ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "morph: out of memory");
+    n2 = 0;
+    for (size_t j = 0; j < k && r == CM_OK; ++j)
+        if (!(d[in[j]] <= slack)) {
+            memcpy(q + 3 * n2, xyz + 3 * in[j], 3 * sizeof *q);
+            again[n2++] = in[j];
+        }
+    if (r == CM_OK) r = cm_cad_project_face(ctx, g2, f, q, n2, NULL, NULL, d2, NULL);
+    for (size_t j = 0; j < n2 && r >= 0; ++j)
+        if (d2[j] < d[again[j]]) d[again[j]] = d2[j];
     free(q);
-    free(uv);
     free(d2);
     free(again);
     return r;
 }
 
-static cm_status edge_distances(cm_context *ctx, const cm_cad_model *g2, int e,
-                                const size_t *in, size_t k, const double *xyz, double *d)
+/* Edge and face nodes, each onto its own entity of g2 (faces by Newton from the node's (u,v)
+ * on G, which the morph moves little), in one pass over every entity: a part with many small
+ * faces and edges would otherwise start a team of threads per entity, for a few nodes each
+ * (benchmarks/RESULTS.md, "Study"). In chunks with a progress point between them. */
+static cm_status project_all(cm_context *ctx, const cm_cad_model *g2, const cm_surface_nodes *nd,
+                             size_t *const *first, size_t *const *idx, const int *count,
+                             const double *xyz, double *d)
 {
-    double *q = malloc(3 * k * sizeof *q), *d2 = malloc(k * sizeof *d2);
-    cm_status r =
-        q && d2 ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "morph: out of memory");
-    for (size_t j = 0; j < k && r == CM_OK; ++j)
-        memcpy(q + 3 * j, xyz + 3 * in[j], 3 * sizeof *q);
-    if (r == CM_OK) r = cm_cad_project_edge(ctx, g2, e, q, k, NULL, d2);
-    for (size_t j = 0; j < k && r >= 0; ++j)
-        d[in[j]] = d2[j];
+    size_t m = first[1][count[1]] + first[2][count[2]];
+    if (!m) return CM_OK;
+    int *kind = malloc(2 * m * sizeof *kind);
+    double *q = malloc(6 * m * sizeof *q);
+    size_t *which = malloc(m * sizeof *which);
+    cm_status r = kind && q && which ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "morph: out of memory");
+    if (r < 0) goto done;
+    int *ent = kind + m;
+    double *uv = q + 3 * m, *dd = uv + 2 * m;
+    size_t j = 0;
+    for (int k = 1; k <= 2; ++k) /* grouped by entity: each thread meets few entities */
+        for (int e = 0; e < count[k]; ++e)
+            for (size_t p = first[k][e]; p < first[k][e + 1]; ++p, ++j) {
+                size_t i = idx[k][p];
+                which[j] = i, kind[j] = k, ent[j] = e;
+                memcpy(q + 3 * j, xyz + 3 * i, 3 * sizeof *q);
+                memcpy(uv + 2 * j, nd->param + 2 * i, 2 * sizeof *uv);
+            }
+    const size_t chunk = 16384;
+    for (size_t j0 = 0; j0 < m && r >= 0; j0 += chunk) {
+        if (j0) r = cm_progress(ctx, "distance", (double)j0, (double)m);
+        size_t c = m - j0 < chunk ? m - j0 : chunk;
+        if (r >= 0)
+            r = cm_cad_project_each(ctx, g2, c, kind + j0, ent + j0, q + 3 * j0, uv + 2 * j0,
+                                    dd + j0);
+    }
+    if (r >= 0 && m > chunk) r = cm_progress(ctx, "distance", (double)m, (double)m);
+    for (size_t p = 0; p < m && r >= 0; ++p)
+        d[which[p]] = dd[p];
+done:
+    free(kind);
     free(q);
-    free(d2);
+    free(which);
     return r;
 }
 
@@ -119,16 +139,11 @@ cm_status cm_morph_node_distances(cm_context *ctx, const cm_cad_model *g2,
             d[i] = dist3(xyz + 3 * i, p);
         }
     }
-    for (int e = 0; e < c.edges && r >= 0; ++e) {
-        size_t k = first[1][e + 1] - first[1][e];
-        if (k) r = edge_distances(ctx, g2, e, idx[1] + first[1][e], k, xyz, d);
-    }
+    if (r >= 0) r = project_all(ctx, g2, nd, first, idx, count, xyz, d);
     for (int f = 0; f < c.faces && r >= 0; ++f) {
         size_t k = first[2][f + 1] - first[2][f];
-        if (k) r = face_distances(ctx, g2, f, nd, idx[2] + first[2][f], k, xyz, slack, d);
-        if (r >= 0 && f % 64 == 63) r = cm_progress(ctx, "distance", f, c.faces);
+        if (k) r = face_again(ctx, g2, f, idx[2] + first[2][f], k, xyz, slack, d);
     }
-    if (r >= 0 && c.faces > 64) r = cm_progress(ctx, "distance", c.faces, c.faces);
     for (size_t i = 0; i < nd->n && r >= 0; ++i)
         if (d[i] > *max_dist) {
             *max_dist = d[i];

@@ -220,6 +220,9 @@ const double *xyz, size_t n, const double *uv0, double *uv,
 double *dist, double *foot);
 cm_status cm_cad_project_edge(cm_context *ctx, const cm_cad_model *model, int edge,
 const double *xyz, size_t n, double *t, double *dist);
+cm_status cm_cad_project_each(cm_context *ctx, const cm_cad_model *model, size_t n,
+const int *kind, const int *entity, const double *xyz,
+const double *uv0, double *dist);
 typedef struct cm_cad_locator cm_cad_locator;
 typedef struct cm_cad_sample_options {
 double h;
@@ -827,6 +830,15 @@ int affine;
 double affine_residual;
 } cm_surface_morph_stats;
 cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
+const cm_surface_nodes *nodes,
+const cm_surface_morph_options *opt, double *xyz,
+cm_surface_morph_stats *stats);
+typedef struct cm_surface_morph_cache cm_surface_morph_cache;
+cm_status cm_surface_morph_cache_create(cm_context *ctx, cm_surface_morph_cache **cache);
+void cm_surface_morph_cache_clear(cm_surface_morph_cache *cache);
+void cm_surface_morph_cache_destroy(cm_surface_morph_cache **cache);
+cm_status cm_surface_morph_cached(cm_context *ctx, cm_surface_morph_cache *cache,
+const cm_cad_model *g, const cm_cad_model *g2,
 const cm_surface_nodes *nodes,
 const cm_surface_morph_options *opt, double *xyz,
 cm_surface_morph_stats *stats);

@@ -24,6 +24,61 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* Per face of G: its boundary samples and the thin-plate system of its parameter warp on
+ * their (u,v), factorised. Neither depends on G': a study of many targets factors each face
+ * once and pays per target only the samples of G', one solve and the evaluation
+ * (docs/DESIGN.md, "Surface morph across targets"). */
+typedef struct face_fit {
+    cm_cad_boundary *ba;
+    cm_rbf *rbf;
+} face_fit;
+
+struct cm_surface_morph_cache {
+    /* the key: what everything below was computed from */
+    const cm_cad_model *g;
+    const cm_surface_nodes *s;
+    size_t n;
+    double spacing;
+    int min_per_edge, max_per_edge;
+    int filled;
+    int faces;
+    int *per_edge;                 /* boundary samples per edge */
+    size_t *first[3], *idx[3];     /* the nodes grouped by vertex, edge, face */
+    face_fit *face;                /* faces entries, filled when a face is first warped */
+};
+
+cm_status cm_surface_morph_cache_create(cm_context *ctx, cm_surface_morph_cache **cache)
+{
+    if (!cache) return cm_error(ctx, CM_ERR_ARGUMENT, "cm_surface_morph_cache_create: NULL output");
+    *cache = calloc(1, sizeof **cache);
+    return *cache ? CM_OK
+                  : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph_cache_create: out of memory");
+}
+
+void cm_surface_morph_cache_clear(cm_surface_morph_cache *c)
+{
+    if (!c) return;
+    for (int f = 0; c->face && f < c->faces; ++f) {
+        cm_cad_boundary_destroy(&c->face[f].ba);
+        cm_rbf_destroy(&c->face[f].rbf);
+    }
+    free(c->face);
+    free(c->per_edge);
+    for (int k = 0; k < 3; ++k) {
+        free(c->first[k]);
+        free(c->idx[k]);
+    }
+    memset(c, 0, sizeof *c);
+}
+
+void cm_surface_morph_cache_destroy(cm_surface_morph_cache **cache)
+{
+    if (!cache || !*cache) return;
+    cm_surface_morph_cache_clear(*cache);
+    free(*cache);
+    *cache = NULL;
+}
+
 /* Boundary samples per edge: about length / spacing, from G's lengths so G and G' agree. */
 static cm_status samples_per_edge(cm_context *ctx, const cm_cad_model *g, const cm_surface_nodes *s,
                                   const cm_surface_morph_options *o, int *per_edge)
@@ -161,10 +216,9 @@ static cm_status affine_face(cm_context *ctx, const cm_cad_model *g, const cm_ca
 static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2, int f,
                             const int *per_edge, const cm_surface_nodes *s, const size_t *idx,
                             size_t k, double *xyz, cm_surface_morph_stats *st,
-                            const cm_surface_affine *aff, const int *affine_edge)
+                            const cm_surface_affine *aff, const int *affine_edge, face_fit *ff)
 {
-    cm_cad_boundary *ba = NULL, *bb = NULL;
-    cm_rbf *rbf = NULL;
+    cm_cad_boundary *bb = NULL;
     double *uv = malloc(2 * k * sizeof *uv), *d = malloc(2 * k * sizeof *d);
     double *p = malloc(3 * k * sizeof *p), *values = NULL;
     int *inside = malloc(k * sizeof *inside);
@@ -173,7 +227,8 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
                       : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
     cm_cad_face_info fi;
     if (r == CM_OK) r = cm_cad_face_get_info(ctx, g2, f, &fi);
-    if (r == CM_OK) r = cm_cad_face_boundary(ctx, g, f, per_edge, 0, &ba);
+    if (r == CM_OK && !ff->ba) r = cm_cad_face_boundary(ctx, g, f, per_edge, 0, &ff->ba);
+    const cm_cad_boundary *ba = ff->ba;
     int candidate = affine_edge != NULL && r == CM_OK;
     for (size_t j = 0; candidate && j < ba->n; ++j)
         if (!affine_edge[ba->edge[j]]) candidate = 0;
@@ -191,9 +246,10 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
             values[i] = bb->uv[i] - ba->uv[i];
         for (size_t j = 0; j < k; ++j)
             memcpy(uv + 2 * j, s->param + 2 * idx[j], 2 * sizeof(double));
-        r = cm_rbf_create(ctx, CM_RBF_THIN_PLATE, 2, ba->n, ba->uv, &rbf);
-        if (r >= 0) r = cm_rbf_solve(ctx, rbf, 2, values);
-        if (r >= 0) r = cm_rbf_evaluate(ctx, rbf, k, uv, d);
+        if (!ff->rbf) r = cm_rbf_create(ctx, CM_RBF_THIN_PLATE, 2, ba->n, ba->uv, &ff->rbf);
+        /* the factor of create serves every target: a solve is two triangular solves */
+        if (r >= 0) r = cm_rbf_solve(ctx, ff->rbf, 2, values);
+        if (r >= 0) r = cm_rbf_evaluate(ctx, ff->rbf, k, uv, d);
         if (r < 0) r = cm_error_prefix(ctx, r, "face %d: parameter warp", f);
     }
     if (r >= 0) {
@@ -220,8 +276,6 @@ static cm_status morph_face(cm_context *ctx, const cm_cad_model *g, const cm_cad
             st->worst_outside_node = s->node[idx[j]];
         }
     }
-    cm_rbf_destroy(&rbf);
-    cm_cad_boundary_destroy(&ba);
     cm_cad_boundary_destroy(&bb);
     free(uv);
     free(d);
@@ -283,9 +337,49 @@ static cm_status project_face(cm_context *ctx, const cm_cad_model *g2, int f,
     return r;
 }
 
+/* The cache for g, s and the sampling options o: kept when it was made for them, else emptied
+ * and refilled with the nodes' groups and the samples per edge (the faces' fits come on
+ * first use, in morph_face). */
+static cm_status cache_prepare(cm_context *ctx, cm_surface_morph_cache *c, const cm_cad_model *g,
+                               const cm_surface_nodes *s, const cm_surface_morph_options *o,
+                               const cm_cad_counts *cc)
+{
+    if (c->filled && c->g == g && c->s == s && c->n == s->n && c->spacing == o->spacing &&
+        c->min_per_edge == o->min_per_edge && c->max_per_edge == o->max_per_edge &&
+        c->faces == cc->faces)
+        return CM_OK;
+    cm_surface_morph_cache_clear(c);
+    int count[3] = {cc->vertices, cc->edges, cc->faces};
+    c->per_edge = malloc((cc->edges > 0 ? (size_t)cc->edges : 1) * sizeof *c->per_edge);
+    c->face = calloc(cc->faces > 0 ? (size_t)cc->faces : 1, sizeof *c->face);
+    c->faces = cc->faces;
+    cm_status r = c->per_edge && c->face
+                      ? CM_OK
+                      : cm_error(ctx, CM_ERR_NOMEM, "cm_surface_morph: out of memory");
+    for (int k = 0; k < 3 && r == CM_OK; ++k)
+        r = cm_surface_group(ctx, s, (cm_surface_kind)k, count[k], &c->first[k], &c->idx[k]);
+    if (r == CM_OK) r = samples_per_edge(ctx, g, s, o, c->per_edge);
+    if (r != CM_OK) {
+        cm_surface_morph_cache_clear(c);
+        return r;
+    }
+    c->g = g, c->s = s, c->n = s->n;
+    c->spacing = o->spacing, c->min_per_edge = o->min_per_edge, c->max_per_edge = o->max_per_edge;
+    c->filled = 1;
+    return CM_OK;
+}
+
 cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_model *g2,
                            const cm_surface_nodes *s, const cm_surface_morph_options *opt,
                            double *xyz, cm_surface_morph_stats *stats)
+{
+    return cm_surface_morph_cached(ctx, NULL, g, g2, s, opt, xyz, stats);
+}
+
+cm_status cm_surface_morph_cached(cm_context *ctx, cm_surface_morph_cache *cache,
+                                  const cm_cad_model *g, const cm_cad_model *g2,
+                                  const cm_surface_nodes *s, const cm_surface_morph_options *opt,
+                                  double *xyz, cm_surface_morph_stats *stats)
 {
     const char *fn = "cm_surface_morph";
     cm_surface_morph_stats st = {0, 0, 0, -1, 0, 0, 0, 0, INFINITY};
@@ -302,13 +396,13 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
     cm_cad_get_counts(g2, &c2);
     if (c.faces != c2.faces || c.edges != c2.edges || c.vertices != c2.vertices)
         return cm_error(ctx, CM_ERR_MISMATCH, "%s: G and G' have different topology", fn);
-    size_t *first[3] = {NULL, NULL, NULL}, *idx[3] = {NULL, NULL, NULL};
-    int count[3] = {c.vertices, c.edges, c.faces};
-    int *per_edge = malloc((c.edges > 0 ? c.edges : 1) * sizeof *per_edge);
-    cm_status r = per_edge ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "%s: out of memory", fn);
-    for (int k = 0; k < 3 && r == CM_OK; ++k)
-        r = cm_surface_group(ctx, s, (cm_surface_kind)k, count[k], &first[k], &idx[k]);
-    if (r == CM_OK) r = samples_per_edge(ctx, g, s, &o, per_edge);
+    /* without a cache of the caller's, one for this call: the same code either way */
+    cm_surface_morph_cache local;
+    memset(&local, 0, sizeof local);
+    cm_surface_morph_cache *cache_used = cache ? cache : &local;
+    cm_status r = cache_prepare(ctx, cache_used, g, s, &o, &c);
+    size_t *const *first = cache_used->first, *const *idx = cache_used->idx;
+    const int *per_edge = cache_used->per_edge;
     /* affine edits: the map from the vertices, then which edges it maps onto G' */
     cm_surface_affine aff;
     int *affine_edge = NULL;
@@ -360,7 +454,8 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
             continue;
         }
         if (o.method == CM_SURFACE_RBF) {
-            r = morph_face(ctx, g, g2, f, per_edge, s, in, k, xyz, &st, &aff, affine_edge);
+            r = morph_face(ctx, g, g2, f, per_edge, s, in, k, xyz, &st, &aff, affine_edge,
+                           &cache_used->face[f]);
             st.faces_warped++;
         } else {
             r = project_face(ctx, g2, f, s, in, k, xyz);
@@ -370,11 +465,7 @@ cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const cm_cad_
         cm_status p = cm_progress(ctx, "surface", c.faces, c.faces);
         if (p < 0) r = p;
     }
-    for (int k = 0; k < 3; ++k) {
-        free(first[k]);
-        free(idx[k]);
-    }
-    free(per_edge);
+    cm_surface_morph_cache_clear(&local);
     free(affine_edge);
     if (stats) *stats = st;
     if (r < 0) return r;

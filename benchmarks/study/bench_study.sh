@@ -6,7 +6,8 @@
 # --mode absolute --methods rbf-s --write-meshes none` on both lists and prints one table row
 # per mesh size (wall and CPU seconds from /usr/bin/time; one-time and per-variant stages from
 # study.csv: one-time = classify + factorise, per variant = the median over variants of
-# sample + surface + evaluation + distance).
+# sample + surface + evaluation + distance; then the medians of those four stages of the
+# 20-variant study, sample = STEP read + cm_cad_match).
 # usage: bench_study.sh BUILD_DIR [WORK_DIR] [THREADS] [SIZE...]   (sizes default 0.25 0.15)
 set -eu
 build=${1:?usage: bench_study.sh BUILD_DIR [WORK_DIR] [THREADS] [SIZE...]}
@@ -23,8 +24,8 @@ done
 cp "$work/v20/bore_20.step" "$work/v1/"
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "BLAS: $(OPENBLAS_VERBOSE=2 "$cadmorph" info "$work/G0.step" 2>&1 | grep -m1 '^Core' || echo 'core not reported'), threads $threads"
-echo "| mesh size | nodes | boundary nodes | variants | wall s | CPU s | one-time s | per variant s | wall ratio | CPU ratio |"
-echo "|---|---|---|---|---|---|---|---|---|---|"
+echo "| mesh size | nodes | boundary nodes | variants | wall s | CPU s | one-time s | per variant s | wall ratio | CPU ratio | sample / surface / evaluation / distance s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for size in $sizes; do
     mesh=$work/M0_$size.vtu
     "$cadmorph" mesh "$work/G0.step" -o "$mesh" --size "$size" --mesher tetgen >/dev/null
@@ -47,7 +48,9 @@ for n in (1, 20):
     per = statistics.median(sum(float(r[k]) for k in ("t_sample", "t_surface", "t_evaluation",
                                                         "t_distance")) for r in rows)
     w, c = times(n)
+    split = " / ".join(f"{statistics.median(float(r['t_' + k]) for r in rows):.3f}"
+                       for k in ("sample", "surface", "evaluation", "distance"))
     print(f"| {size} | {rows[0]['nodes']} | {rows[0]['boundary_nodes']} | {len(rows)} | {w:.1f} "
-          f"| {c:.1f} | {once:.2f} | {per:.3f} | {w / w1:.2f} | {c / c1:.2f} |")
+          f"| {c:.1f} | {once:.2f} | {per:.3f} | {w / w1:.2f} | {c / c1:.2f} | {split} |")
 PY
 done

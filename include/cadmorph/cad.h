@@ -261,6 +261,16 @@ CM_API cm_status cm_cad_project_face(cm_context *ctx, const cm_cad_model *model,
 CM_API cm_status cm_cad_project_edge(cm_context *ctx, const cm_cad_model *model, int edge,
                               const double *xyz, size_t n, double *t, double *dist);
 
+/* Each point onto its own entity in one pass: kind[i] 1 an edge, 2 a face (the values of
+ * cm_surface_kind; any other kind is skipped and its dist[i] left as it was), entity[i] its
+ * index; uv0 (n x 2, may be NULL: grid seeds) the face points' seeds; dist: n. The distances
+ * are those of cm_cad_project_edge and cm_cad_project_face called entity by entity, bit for
+ * bit, but all points share one team of threads: a check over many small entities does not
+ * start one per entity. */
+CM_API cm_status cm_cad_project_each(cm_context *ctx, const cm_cad_model *model, size_t n,
+                                     const int *kind, const int *entity, const double *xyz,
+                                     const double *uv0, double *dist);
+
 /* Dense samples of the trimmed faces plus a kD-tree on them, for projections of many points. */
 typedef struct cm_cad_locator cm_cad_locator;
 

@@ -123,6 +123,27 @@ CM_API cm_status cm_surface_morph(cm_context *ctx, const cm_cad_model *g, const 
                                   const cm_surface_morph_options *opt, double *xyz,
                                   cm_surface_morph_stats *stats);
 
+/* What the surface morph computes from G and the nodes alone, kept across targets: the
+ * boundary samples of every face of G, the factorised thin-plate system of its parameter warp
+ * (only the right-hand side depends on G': each target is one solve with the factor) and the
+ * nodes grouped by entity (docs/DESIGN.md, "Surface morph across targets"). Filled on first
+ * use; a call with another G, other nodes or other sampling options empties it first. G and
+ * the nodes are identified by address: empty it (cm_surface_morph_cache_clear) before they
+ * are freed or changed in place. Not for concurrent calls. */
+typedef struct cm_surface_morph_cache cm_surface_morph_cache;
+
+CM_API cm_status cm_surface_morph_cache_create(cm_context *ctx, cm_surface_morph_cache **cache);
+CM_API void cm_surface_morph_cache_clear(cm_surface_morph_cache *cache);
+CM_API void cm_surface_morph_cache_destroy(cm_surface_morph_cache **cache);
+
+/* cm_surface_morph with a cache (NULL: none, as cm_surface_morph): the same positions, bit
+ * for bit, whatever the cache held before. */
+CM_API cm_status cm_surface_morph_cached(cm_context *ctx, cm_surface_morph_cache *cache,
+                                         const cm_cad_model *g, const cm_cad_model *g2,
+                                         const cm_surface_nodes *nodes,
+                                         const cm_surface_morph_options *opt, double *xyz,
+                                         cm_surface_morph_stats *stats);
+
 /* Distance of points (n x 3) to the model of the locator: the largest, and the index of the
  * point where it occurs (either may be NULL). */
 CM_API cm_status cm_surface_max_distance(cm_context *ctx, const cm_cad_locator *locator,

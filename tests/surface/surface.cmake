@@ -12,3 +12,6 @@ set_tests_properties(test_surface PROPERTIES FIXTURES_REQUIRED surface_meshes)
 
 cm_add_unit_test(test_cad_sets test_cad_sets.c LIBS cm_surface LABELS cad)
 set_tests_properties(test_cad_sets PROPERTIES FIXTURES_REQUIRED surface_meshes)
+
+cm_add_unit_test(test_surface_cache test_surface_cache.c LIBS cm_morph cm_surface LABELS cad)
+set_tests_properties(test_surface_cache PROPERTIES FIXTURES_REQUIRED surface_meshes)
