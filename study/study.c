@@ -5,6 +5,7 @@
 #include "cadmorph/study.h"
 #include "cadmorph/parallel.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -436,19 +437,24 @@ static double available_memory(void)
     return avail > 0 ? avail : cm_memory_budget();
 }
 
-/* Variants per batch: o->batch, or (0) as many as half the available memory holds, up to
- * CM_STUDY_BATCH_MAX. Per variant: for each of its 3 columns of an iterative RBF solve the
- * Krylov basis and its preconditioned copies, (2 restart + 6) doubles per boundary node (the
- * default restart, 40); the apply's fields, the evaluation's values and the result (3 doubles
- * per node each); its loaded model (a few MB: 8 MB counted). */
-static size_t batch_size(const cm_study_options *o, size_t nodes, size_t boundary)
+/* Variants per batch: o->batch, or (0) at most a quarter of the variants this rank runs, as
+ * many as half the available memory holds, up to CM_STUDY_BATCH_MAX. Why a quarter: a batch
+ * solves with as many columns as the one before starts warm (each column from the previous
+ * batch's weights, cm_rbf_options.warm_start), which saves more than a larger batch shares
+ * (bracket, 10^5 boundary nodes, 20 variants: batches of 5 the fastest, 20 the slowest;
+ * benchmarks/RESULTS.md, "Study"). Memory per variant: for each of its 3 columns of an
+ * iterative RBF solve the Krylov storage, (2 restart + 9) doubles per boundary node (rbf.h,
+ * cm_rbf_solve; the default restart, 40); the apply's fields, the evaluation's values and
+ * the result (3 doubles per node each); its loaded model (a few MB: 8 MB counted). */
+static size_t batch_size(const cm_study_options *o, size_t variants, size_t nodes,
+                         size_t boundary)
 {
     if (!(o->modes & CM_STUDY_ABSOLUTE)) return 1;
     if (o->batch > 0) return (size_t)o->batch;
     const double restart = 40;
-    const double per = 8.0 * (3 * (2 * restart + 6) * (double)boundary + 9.0 * (double)nodes +
+    const double per = 8.0 * (3 * (2 * restart + 9) * (double)boundary + 9.0 * (double)nodes +
                               3.0 * (double)boundary) + 8e6;
-    double k = 0.5 * available_memory() / per;
+    double k = fmin(0.5 * available_memory() / per, ceil((double)variants / 4.0));
     if (!(k >= 1)) return 1;
     return k < CM_STUDY_BATCH_MAX ? (size_t)k : CM_STUDY_BATCH_MAX;
 }
@@ -484,24 +490,18 @@ static cm_status setup(cm_context *ctx, study *w)
             if (mode == CM_STUDY_ABSOLUTE && w->abs) continue;
             if (mode == CM_STUDY_RELATIVE && !owns(w, se, 0)) continue; /* another rank's */
             cm_morpher **mp = mode == CM_STUDY_ABSOLUTE ? &w->abs : &se->mp;
-            cm_morph_options mo = o->morph;
-            /* absolute: the targets are sampled only to measure the distance of the boundary
-             * to them, at 16 times fewer samples than the classification needs (the cost that
-             * would otherwise dominate a variant); relative: the fine sampling of a target is
-             * reused by the rebase onto it */
-            if (mode == CM_STUDY_ABSOLUTE && !(mo.target_h_scale > 0))
-                mo.target_h_scale = CM_STUDY_TARGET_H_SCALE;
-            s = cm_morpher_create(ctx, w->g0, w->mesh0, &mo, mp);
+            s = cm_morpher_create(ctx, w->g0, w->mesh0, &o->morph, mp);
             if (s < 0) return cm_error_prefix(ctx, s, "M0 on G0");
-            if (s == CM_WARNING && mode == CM_STUDY_ABSOLUTE)
-                cm_log(ctx, CM_LOG_WARNING, "%s", cm_context_message(ctx));
+            /* a CM_WARNING is logged by cm_morpher_create already */
             const cm_morpher_info *info = cm_morpher_get_info(*mp);
             r->boundary_nodes = info->boundary_nodes;
         }
     }
-    w->batch = batch_size(o, nn, r->boundary_nodes);
+    const int ranks = o->ranks > 1 ? o->ranks : 1;
+    w->batch = batch_size(o, (w->fam->n + (size_t)ranks - 1) / (size_t)ranks, nn,
+                          r->boundary_nodes);
     cm_log(ctx, CM_LOG_DEBUG, "study: absolute morphs in batches of up to %zu variants%s",
-           w->batch, o->batch > 0 ? " (asked for)" : " (memory, CM_STUDY_BATCH_MAX)");
+           w->batch, o->batch > 0 ? " (asked for)" : " (a quarter of the variants, memory, CM_STUDY_BATCH_MAX)");
     w->bxyz = calloc(w->batch, sizeof *w->bxyz);
     w->items = malloc(w->batch * sizeof *w->items);
     if (!w->bxyz || !w->items) return cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");

@@ -17,16 +17,6 @@
 
 #define MAX_SETS 64
 
-static double *read_raw(const char *prefix, const char *ext, size_t *n)
-{
-    char path[4096];
-    size_t bytes = 0;
-    snprintf(path, sizeof path, "%s.%s", prefix, ext);
-    double *x = bench_read_raw(path, &bytes);
-    *n = bytes / (3 * sizeof(double));
-    return x;
-}
-
 /* f (m x K row-major): column c as above, from vals[s] (m x 3 each, S sets) */
 static void make_columns(size_t m, int S, double *const *vals, int K, double *f)
 {
@@ -88,10 +78,10 @@ int main(int argc, char **argv)
         nk = 4;
     }
     size_t m = 0;
-    double *x = read_raw(prefix[0], "centres", &m), *vals[MAX_SETS];
+    double *x = bench_read_xyz(prefix[0], "centres", &m), *vals[MAX_SETS];
     for (int s = 0; s < S; ++s) {
         size_t n = 0;
-        vals[s] = read_raw(prefix[s], "values", &n);
+        vals[s] = bench_read_xyz(prefix[s], "values", &n);
         if (!vals[s] || n != m) {
             fprintf(stderr, "bench_rbf_columns: %s.values: not %zu x 3\n", prefix[s], m);
             return 1;

@@ -19,17 +19,6 @@
 
 
 
-/* PREFIX.ext as n x 3 doubles */
-static double *read_raw(const char *prefix, const char *ext, size_t *n)
-{
-    char path[4096];
-    size_t bytes = 0;
-    snprintf(path, sizeof path, "%s.%s", prefix, ext);
-    double *x = bench_read_raw(path, &bytes);
-    *n = bytes / (3 * sizeof(double));
-    return x;
-}
-
 static void log_stderr(void *user, cm_log_level level, const char *message)
 {
     (void)user;
@@ -178,8 +167,8 @@ int main(int argc, char **argv)
         }
     }
     size_t m = 0, mv = 0, ni = 0;
-    double *x = read_raw(prefix, "centres", &m), *v = read_raw(prefix, "values", &mv);
-    double *p = read_raw(prefix, "interior", &ni);
+    double *x = bench_read_xyz(prefix, "centres", &m), *v = bench_read_xyz(prefix, "values", &mv);
+    double *p = bench_read_xyz(prefix, "interior", &ni);
     if (!x || !v || mv != m) {
         fprintf(stderr, "cannot read %s.centres / .values\n", prefix);
         return 1;

@@ -56,4 +56,15 @@ static inline double *bench_read_raw(const char *path, size_t *bytes)
     return x;
 }
 
+/* The set file PREFIX.ext as n x 3 doubles (*n: the rows); NULL if it cannot be read. */
+static inline double *bench_read_xyz(const char *prefix, const char *ext, size_t *n)
+{
+    char path[4096];
+    size_t bytes = 0;
+    snprintf(path, sizeof path, "%s.%s", prefix, ext);
+    double *x = bench_read_raw(path, &bytes);
+    *n = bytes / (3 * sizeof(double));
+    return x;
+}
+
 #endif

@@ -162,9 +162,10 @@ CM_API void cm_rbf_destroy(cm_rbf **rbf);
  * components at once (one kernel pass per iteration for all, each converging on its own),
  * keeping about (2 restart + 9) x 8 bytes per centre and component (with fast sums 4 x 8
  * more): callers that choose how many components to hand over at once can size batches by
- * that; past half the machine's memory they are solved in groups. Merged duplicate centres whose values differ
- * by more than 1e-8 of the largest value are an error naming both indices (smaller
- * differences are round-off, e.g. of projections that put two nodes on one point). */
+ * that; past half the machine's memory they are solved in groups. Merged duplicate centres
+ * whose values differ by more than 1e-8 of the largest value are an error naming both
+ * indices (smaller differences are round-off, e.g. of projections that put two nodes on one
+ * point). */
 CM_API cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *values);
 
 /* Evaluates the current interpolant at n points (points: n x dim) into out (n x ncomp).

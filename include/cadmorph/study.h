@@ -25,13 +25,13 @@ extern "C" {
 
 enum { CM_STUDY_ABSOLUTE = 1, CM_STUDY_RELATIVE = 2, CM_STUDY_BOTH = 3 };
 
-/* Sampling of the absolute study's targets (cm_morph_options.target_h_scale): they are only
- * sampled to measure the boundary's distance to them. */
+/* No longer used (targets are not sampled: the distance check projects each boundary node
+ * onto its own CAD entity of the target); kept so that code naming it still compiles. */
 #define CM_STUDY_TARGET_H_SCALE 4.0
 
 /* The largest automatic batch of absolute variants (cm_study_options.batch 0): 3 columns per
- * variant, and the kernel's per-column cost flattens by 60 columns (benchmarks/RESULTS.md,
- * "Study"). */
+ * variant, and the kernel sums' cost per column has flattened by 60 columns
+ * (benchmarks/RESULTS.md, "Study"). */
 #define CM_STUDY_BATCH_MAX 20
 
 /* "absolute" / "relative" ("?" otherwise). */
@@ -144,9 +144,7 @@ typedef struct cm_study_options {
     size_t n_methods;
     cm_morph_options morph; /* everything but the method (default cm_morph_options_init:
                                adaptive steps, a morph that reaches no valid mesh a row with
-                               CM_ERR_REJECTED and no mesh; its target_h_scale 0 means
-                               CM_STUDY_TARGET_H_SCALE for the absolute morpher, 1 for the
-                               relative ones) */
+                               CM_ERR_REJECTED and no mesh) */
     int write_meshes;       /* CM_STUDY_WRITE_* (default NONE) */
     const unsigned char *write_listed; /* #variants flags for CM_STUDY_WRITE_LISTED */
     const char *out_dir;    /* meshes go to <out_dir>/<method>_<mode>_<label>.vtu, with
@@ -163,8 +161,9 @@ typedef struct cm_study_options {
                                Every rank calls cm_study_run with the same inputs. */
     /* Absolute variants morphed together (cm_morpher_apply_batch: one multi-column warp
      * apply for the batch; rows equal to one-at-a-time to the solver's tolerance, in the same
-     * order). 0 (default): as many as half the available memory holds, up to
-     * CM_STUDY_BATCH_MAX (docs/DESIGN.md, "Studies in batches"); 1: one variant at a time;
+     * order). 0 (default): a quarter of the variants (later batches start warm from the
+     * one before), as many as half the available memory holds, up to CM_STUDY_BATCH_MAX
+     * (docs/DESIGN.md, "Studies in batches"); 1: one variant at a time;
      * K: K variants. Relative series run one variant at a time whatever it is. */
     int batch;
 } cm_study_options;
