@@ -29,9 +29,7 @@ enum { CM_STUDY_ABSOLUTE = 1, CM_STUDY_RELATIVE = 2, CM_STUDY_BOTH = 3 };
  * onto its own CAD entity of the target); kept so that code naming it still compiles. */
 #define CM_STUDY_TARGET_H_SCALE 4.0
 
-/* The largest automatic batch of absolute variants (cm_study_options.batch 0): 3 columns per
- * variant, and the kernel sums' cost per column has flattened by 60 columns
- * (benchmarks/RESULTS.md, "Study"). */
+/* The largest automatic batch of absolute variants (cm_study_options.batch 0): 60 columns. */
 #define CM_STUDY_BATCH_MAX 20
 
 /* "absolute" / "relative" ("?" otherwise). */
