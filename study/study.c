@@ -444,10 +444,10 @@ static double available_memory(void)
  * (bracket, 10^5 boundary nodes, 20 variants: batches of 5 the fastest, 20 the slowest;
  * benchmarks/RESULTS.md, "Study"); CM_STUDY_BATCH_MAX because the kernel sums' cost per
  * column has flattened by 60 columns (the same section, "Kernel cost per column"). Memory
- * per variant: for each of its 3 columns of an
- * iterative RBF solve the Krylov storage, (2 restart + 9) doubles per boundary node (rbf.h,
- * cm_rbf_solve; the default restart, 40); the apply's fields, the evaluation's values and
- * the result (3 doubles per node each); its loaded model (a few MB: 8 MB counted). */
+ * per variant: for each of its 3 columns of an iterative RBF solve the Krylov storage,
+ * (2 restart + 9) doubles per boundary node (rbf.h, cm_rbf_solve; the default restart, 40);
+ * the apply's fields, the evaluation's values and the result (3 doubles per node each); its
+ * loaded model (a few MB: 8 MB counted). */
 static size_t batch_size(const cm_study_options *o, size_t variants, size_t nodes,
                          size_t boundary)
 {
