@@ -327,6 +327,24 @@ double cm_memory_budget(void)
     return pages > 0 && psize > 0 ? 0.5 * (double)pages * (double)psize : 0.0;
 }
 
+double cm_memory_available(void)
+{
+    double avail = 0;
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (f) {
+        char line[256];
+        while (fgets(line, sizeof line, f)) {
+            double kb = 0;
+            if (sscanf(line, "MemAvailable: %lf kB", &kb) == 1) {
+                avail = 1024 * kb;
+                break;
+            }
+        }
+        fclose(f);
+    }
+    return avail > 0 ? avail : cm_memory_budget();
+}
+
 double cm_wtime(void)
 {
     struct timespec ts;

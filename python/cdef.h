@@ -48,6 +48,7 @@ int cm_context_threads_for(const cm_context *ctx, size_t n, size_t min_per_threa
 double cm_bbox_diagonal(const double bb[6]);
 double cm_wtime(void);
 double cm_memory_budget(void);
+double cm_memory_available(void);
 cm_status cm_file_read(cm_context *ctx, const char *path, char **data, size_t *size);
 cm_status cm_file_read_text(cm_context *ctx, const char *path, size_t max_line,
 const char *what, char **data, size_t *size);

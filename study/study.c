@@ -93,8 +93,8 @@ static int wants_mesh(const study *w, const cm_study_row *row)
     }
 }
 
-/* The result in w->xyz as <out_dir>/<method>_<mode>_<label>.vtu, with the morpher's scaled
- * Jacobian and the displacement from M0. */
+/* The result xyz as <out_dir>/<method>_<mode>_<label>.vtu, with its scaled Jacobian sj
+ * and the displacement from M0. */
 static cm_status write_mesh(cm_context *ctx, study *w, const double *xyz, const double *sj,
                             const char *label, cm_study_row *row)
 {
@@ -417,26 +417,6 @@ static void study_free(study *w)
     cm_cad_destroy(&w->base);
 }
 
-/* Bytes free for the study's batches: the kernel's MemAvailable where it says, else the
- * library's dense budget (cm_memory_budget). */
-static double available_memory(void)
-{
-    double avail = 0;
-    FILE *f = fopen("/proc/meminfo", "r");
-    if (f) {
-        char line[256];
-        while (fgets(line, sizeof line, f)) {
-            double kb = 0;
-            if (sscanf(line, "MemAvailable: %lf kB", &kb) == 1) {
-                avail = 1024 * kb;
-                break;
-            }
-        }
-        fclose(f);
-    }
-    return avail > 0 ? avail : cm_memory_budget();
-}
-
 /* Variants per batch: o->batch, or (0) at most a quarter of the variants this rank runs, as
  * many as half the available memory holds, up to CM_STUDY_BATCH_MAX. Why a quarter: a batch
  * solves with as many columns as the one before starts warm (each column from the previous
@@ -456,7 +436,7 @@ static size_t batch_size(const cm_study_options *o, size_t variants, size_t node
     const double restart = 40;
     const double per = 8.0 * (3 * (2 * restart + 9) * (double)boundary + 9.0 * (double)nodes +
                               3.0 * (double)boundary) + 8e6;
-    double k = fmin(0.5 * available_memory() / per, ceil((double)variants / 4.0));
+    double k = fmin(0.5 * cm_memory_available() / per, ceil((double)variants / 4.0));
     if (!(k >= 1)) return 1;
     return k < CM_STUDY_BATCH_MAX ? (size_t)k : CM_STUDY_BATCH_MAX;
 }

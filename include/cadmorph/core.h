@@ -141,6 +141,11 @@ CM_API double cm_wtime(void);
  * instead of thrashing. 0 if the system does not say. */
 CM_API double cm_memory_budget(void);
 
+/* Bytes the system says are available now (Linux: MemAvailable, what can be allocated
+ * without swapping), or cm_memory_budget() where it does not say: for sizing work that
+ * may use what other processes leave free (a study's batches). */
+CM_API double cm_memory_available(void);
+
 /* ---- files ---- */
 
 /* Every input is opened by the functions below (docs/DESIGN.md, "Reading input"): regular
