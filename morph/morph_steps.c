@@ -258,6 +258,12 @@ static cm_status fixed_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_opti
     return cm_progress(ctx, "morph", n, n);
 }
 
+/* The smallest adaptive step: min_fraction, or the default's 1/256 when unset. */
+static double min_step_of(const cm_morph_options *o)
+{
+    return o->min_fraction > 0 ? o->min_fraction : 1.0 / 256;
+}
+
 /* The floor of a valid adaptive step of length step: min_sj, raised to keep_fraction x M's
  * while steps can still shrink. */
 static double auto_floor(const cm_morpher *mp, double step, double min_step)
@@ -274,8 +280,7 @@ int cm_morph_whole_motion_final(const cm_morpher *mp, const cm_morph_step *row)
     const cm_morph_options *o = &mp->opt;
     if (o->steps == 1) return o->allow_inverted || valid(row, o->min_sj);
     if (o->steps != CM_MORPH_STEPS_AUTO) return 0;
-    double min_step = o->min_fraction > 0 ? o->min_fraction : 1.0 / 256;
-    return valid(row, auto_floor(mp, 1, min_step));
+    return valid(row, auto_floor(mp, 1, min_step_of(o)));
 }
 
 /* Adaptive steps (CM_MORPH_STEPS_AUTO), see cm_morph_options. */
@@ -283,7 +288,7 @@ static cm_status auto_steps(cm_context *ctx, cm_morpher *mp, const cm_warp_optio
                             double *xyz)
 {
     const cm_morph_options *o = &mp->opt;
-    double done = 0, step = 1, min_step = o->min_fraction > 0 ? o->min_fraction : 1.0 / 256;
+    double done = 0, step = 1, min_step = min_step_of(o);
     int easy = 0, optimize = o->optimize;
     while (done < 1) {
         double f = done + step;
