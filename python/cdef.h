@@ -585,6 +585,7 @@ int matvecs_fast;
 int column_groups;
 int warm_columns;
 double warm_residual;
+int warm_basis;
 } cm_rbf_stats;
 void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats);
 cm_status cm_rbf_create(cm_context *ctx, cm_rbf_kernel kernel, int dim, size_t m,

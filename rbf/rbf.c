@@ -70,6 +70,7 @@ void cm_rbf_tuning_init(cm_rbf_tuning *t)
     if (!t) return;
     memset(t, 0, sizeof *t);
     t->column_scale = 1e-3;
+    t->warm_history = 64;
     t->leaf_size = 256;
     t->local_size = 700;
     t->coarse_size = 2000;

@@ -108,6 +108,10 @@ typedef struct cm_rbf_tuning {
                            * (the Krylov bases of all columns solved at once); columns beyond
                            * it are solved in groups (stats column_groups). 0: half the
                            * machine's memory (cm_memory_budget) */
+    int warm_history;     /* [64] earlier solutions an iterative fit keeps for the starts of
+                           * its next solves (options warm_start; rbf_iter.h, cm_rbf_history),
+                           * at most what an eighth of cm_memory_budget holds (2 m doubles
+                           * each); the oldest gives way */
 } cm_rbf_tuning;
 
 void cm_rbf_tuning_init(cm_rbf_tuning *tuning);

@@ -71,11 +71,14 @@ typedef struct cm_rbf_options {
                            * and for evaluation: 0 never (direct sums), 1 always, -1 auto
                            * (matvecs from 150,000 centres, evaluation from 2e9 point-centre
                            * pairs where its checked error is small enough) */
-    int warm_start;       /* [1] a cm_rbf_solve with as many components as the previous one
-                           * on this rbf starts each component from its previous weights,
-                           * scaled by the factor that fits the new data best, where they
-                           * leave a residual below |data| (else from zero); 0: always from
-                           * zero (stats: warm_columns) */
+    int warm_start;       /* [1] iterative solvers: the fit keeps its solutions (the last
+                           * 64 components, fewer if they would take more than an eighth of
+                           * the memory budget) and every cm_rbf_solve starts each component
+                           * from the combination of them that fits its data best (least
+                           * squares), where that leaves a residual below |data| (else from
+                           * zero). Along a family of targets (a study, an optimiser's
+                           * steps) this saves most of the iterations; any component count.
+                           * 0: always from zero, nothing kept (stats: warm_columns) */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);
@@ -132,9 +135,11 @@ typedef struct cm_rbf_stats {
     int column_groups;     /* last iterative solve: groups its components were solved in (1:
                             * all at once; more when their Krylov storage, see cm_rbf_solve,
                             * exceeded half the machine's memory) */
-    int warm_columns;      /* last iterative solve: components that started from the previous
-                            * solve's weights (options warm_start) */
-    double warm_residual;  /* ... and the largest |f_c - A w0| / |f_c| they started from */
+    int warm_columns;      /* last iterative solve: components that started from earlier
+                            * solutions (options warm_start) */
+    double warm_residual;  /* ... the largest |f_c - A w0| / |f_c| they started from */
+    int warm_basis;        /* ... and the independent earlier solutions they were combined
+                            * from */
 } cm_rbf_stats;
 
 CM_API void cm_rbf_get_stats(const cm_rbf *rbf, cm_rbf_stats *stats);

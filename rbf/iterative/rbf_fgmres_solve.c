@@ -135,11 +135,12 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             const int c = sel[u];
             kcol *k = &kr->col[c];
             const size_t o0 = (size_t)c * m;
-            double alpha;
-            const double rn = cm_krylov_warm_fit(r, m, f + o0, w + o0, aw + o0, rhs + o0,
-                                                 dw + o0, &alpha);
+            for (size_t i = 0; i < m; ++i) rhs[o0 + i] = f[o0 + i] - aw[o0 + i];
+            memcpy(dw + o0, rhs + o0, m * sizeof *dw);
+            cm_krylov_project(r->iter->q1, m, r->k, dw + o0);
+            const double rn = cm_krylov_norm_inf(m, dw + o0);
             const double fn = cm_krylov_norm_inf(m, f + o0);
-            if (rn < fn && alpha != 0.0) k->warm_res = rn / fn, k->took = 1;
+            if (rn < fn) k->warm_res = rn / fn, k->took = 1;
             else {
                 memcpy(rhs + o0, f + o0, m * sizeof *rhs);
                 memset(w + o0, 0, m * sizeof *w);
@@ -341,6 +342,20 @@ static int krylov_alloc(krylov *kr, int g)
                : -1;
 }
 
+/* The fit's history of solutions, made on first use: warm_history pairs, at most what an
+ * eighth of the memory budget holds; NULL if none (warm_history 0, out of memory). */
+static cm_rbf_history *history_of(cm_rbf *r)
+{
+    cm_rbf_iter *it = r->iter;
+    if (!it->hist && r->tun.warm_history > 0) {
+        const double budget = cm_memory_budget(), pair = 2.0 * (double)r->m * sizeof(double);
+        size_t cap = (size_t)r->tun.warm_history;
+        if (budget > 0.0 && (double)cap * pair > budget / 8.0) cap = (size_t)(budget / 8.0 / pair);
+        it->hist = cm_rbf_history_create(r->m, cap);
+    }
+    return it->hist;
+}
+
 int cm_rbf_iterative_column_iterations(const cm_rbf *r, size_t c)
 {
     if (!r || !r->iter || c >= r->iter->col_n) return -1;
@@ -412,10 +427,11 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         }
         kr.diam3 = d2 * sqrt(d2);
     }
-    /* warm starts: the previous solve's weights of the same column, when cm_rbf_solve comes
-     * again with as many columns (tried in the first cycle, kept if they leave a residual
-     * below the data's) */
-    const int warm = o->warm_start && r->warm_ok && r->w && (size_t)r->ncomp == nc;
+    /* warm starts: each column from the combination of the earlier solutions that fits its
+     * data best (rbf_iter.h, cm_rbf_history; tried in the first cycle, kept if it leaves a
+     * residual below the data's) */
+    cm_rbf_history *hist = o->warm_start && r->warm_ok ? history_of(r) : NULL;
+    const size_t basis = hist ? hist->n : 0;
     int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, steps = 0, direct = 0, groups = 0;
     int nwarm = 0;
     double floor_max = 0.0, first = 0.0, warm_worst = 0.0;
@@ -436,11 +452,14 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
              * of all columns, as the header promises */
             kc->fnorm = fmax(cm_krylov_norm_inf(m, f + o0), tu->column_scale * fmax_all);
             kc->tol = o->tolerance;
-            kc->warm = warm;
+            kc->warm = basis > 0;
             kc->took = 0;
             kc->warm_res = 0.0;
-            if (warm) {
-                memcpy(w + o0, r->w + o0, m * sizeof *w);
+            if (basis > 0) {
+                double *pf = kc->v; /* scratch until the solve */
+                memcpy(pf, f + o0, m * sizeof *pf);
+                cm_krylov_project(r->iter->q1, m, r->k, pf);
+                cm_rbf_history_start(hist, pf, w + o0);
                 cm_krylov_project(r->iter->q1, m, r->k, w + o0);
             }
         }
@@ -495,6 +514,15 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         }
         worst = fmax(worst, fn > 0.0 ? e / fn : 0.0);
     }
+    /* the solutions join the history (their exact products: a pair is right whatever the
+     * residual of its solve) */
+    if (hist)
+        for (size_t c = 0; c < nc; ++c) {
+            double *pb = kr.pin;
+            memcpy(pb, aw + c * m, m * sizeof *pb);
+            cm_krylov_project(r->iter->q1, m, r->k, pb);
+            cm_rbf_history_add(hist, w + c * m, pb);
+        }
     /* the attainable exactness of plain direct sums of these weights (what cm_rbf_evaluate
      * gives at the centres): eps max_i sum_j |w_j| phi_ij, for all columns in one pass (per
      * group of the memory budget). An estimate: the treecode's error on positive weights is
@@ -531,10 +559,12 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                             cm_rbf_tree_bytes(kr.tree) +
                             cm_rbf_tree_bytes(r->iter->rtree[0]) +
                             cm_rbf_tree_bytes(r->iter->rtree[1]) +
-                            cm_rbf_tree_bytes(r->iter->rtree[2]);
+                            cm_rbf_tree_bytes(r->iter->rtree[2]) +
+                            cm_rbf_history_bytes(r->iter->hist);
     r->stats.column_groups = groups;
     r->stats.warm_columns = nwarm;
     r->stats.warm_residual = warm_worst;
+    r->stats.warm_basis = (int)basis;
     if (worst > o->tolerance && !r->stats.floor_limited)
         st = cm_error(ctx, CM_WARNING,
                       "cm_rbf_solve: the iterative solver %s after %d iterations at a relative "

@@ -22,6 +22,7 @@ void cm_rbf_iterative_destroy(cm_rbf_iter **it)
     cm_rbf_tree_destroy(&(*it)->rtree[2]);
     free((*it)->q1);
     free((*it)->col_iters);
+    cm_rbf_history_destroy(&(*it)->hist);
     free(*it);
     *it = NULL;
 }
@@ -40,6 +41,7 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
         tu->local_float < 0 || tu->local_float > 2 || o->fast_sum < -1 || o->fast_sum > 1 ||
         !(tu->fast_tol > 0.0 && tu->fast_tol <= 1e-3) || tu->fast_refine < 0 ||
         tu->fast_refine > 10 || !(tu->fast_eval_tol > 0.0) || tu->relax < 0 || tu->relax > 2 ||
+        tu->warm_history < 0 ||
         !(tu->thin_reach >= 0.0) || (tu->thin_reach > 0.0 && (!(tu->thin_cell > 0.0) ||
                                                             tu->thin_max < tu->leaf_size)))
         return cm_error(ctx, CM_ERR_ARGUMENT,
@@ -47,11 +49,12 @@ cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads)
                         "restart %d, leaf_size %d, local_size %d, coarse_size %d, coarse_post "
                         "%d, overlap %g, local_max %d, coarse_max %d, fast_sum %d, fast_tol %g, "
                         "fast_refine %d, fast_eval_tol %g, relax %d, thin_reach %g, "
-                        "thin_cell %g, thin_max %d)",
+                        "thin_cell %g, thin_max %d, warm_history %d)",
                         o->tolerance, o->max_iterations, o->restart, tu->leaf_size,
                         tu->local_size, tu->coarse_size, tu->coarse_post, tu->overlap, tu->local_max,
                         tu->coarse_max, o->fast_sum, tu->fast_tol, tu->fast_refine,
-                        tu->fast_eval_tol, tu->relax, tu->thin_reach, tu->thin_cell, tu->thin_max);
+                        tu->fast_eval_tol, tu->relax, tu->thin_reach, tu->thin_cell, tu->thin_max,
+                        tu->warm_history);
     cm_rbf_iter *it = calloc(1, sizeof *it);
     if (!it) return cm_error(ctx, CM_ERR_NOMEM, "cm_rbf_create: out of memory");
     it->q1 = malloc(m * k * sizeof *it->q1);

@@ -79,13 +79,6 @@ void cm_krylov_matvec(const cm_rbf *r, krylov *kr, int n, double *const *in,
  * counted; returns the kind used. */
 int cm_krylov_matvec_kind(const cm_rbf *r, krylov *kr, int kind, int lev, int n,
                           double *const *in, double *const *out, int threads);
-/* A warm start: w0 and aw = A w0 (m each) scaled by the alpha that minimises |Pi(f - alpha
- * A w0)|_2, that residual into rv; returns its max-norm. Why the factor: along a path of
- * targets the data grow or shrink nearly in proportion (a study's G(t), a continuation),
- * and the previous weights scaled start far nearer than as they are (one dot product, on
- * the product the start needs anyway). scratch: m doubles. */
-double cm_krylov_warm_fit(const cm_rbf *r, size_t m, const double *f, double *w0, double *aw,
-                          double *rv, double *scratch, double *alpha);
 /* Solves the ns columns sel[] of f (g x m SoA) into w + kr->wlo (high and low parts), each
  * to its own col[c].tol relative to col[c].fnorm; a column with col[c].warm starts from the
  * w it holds if that leaves a residual below |f_c| (then col[c].took = 1; else from zero).

@@ -254,11 +254,34 @@ int main(void)
                 CHECK_MSG(ed <= 1e-8, "column %d warm against cold: %.3g", u, ed);
             }
             CHECK(w1.st.iterations < c1.st.iterations);
-            /* another number of columns: from zero */
-            solved w2 = solve_cols(ctx, r, m, v2, 3, smooth);
-            CHECK(w2.st.warm_columns == 0);
-            release(&w0), release(&w1), release(&c1), release(&w2);
-            free(v2), free(d2);
+            /* another number of columns, data in the span of earlier ones (two solves
+             * back and one back): the history's combination starts at their solution */
+            double *v3 = malloc(m_in * NC * sizeof *v3);
+            for (size_t i = 0; i < m_in; ++i)
+                for (size_t u = 0; u < NC; ++u)
+                    v3[i * NC + u] = 0.5 * v[i * NC + u % 6] - 2.0 * v2[i * NC + (u + 3) % 6];
+            solved w2 = solve_cols(ctx, r, m, v3, 3, smooth);
+            r->opt.warm_start = 0;
+            solved c2 = solve_cols(ctx, r, m, v3, 3, smooth);
+            r->opt.warm_start = 1;
+            printf("data in the span of the history: %d columns warm from %.3g, %d earlier "
+                   "solutions; iterations %d (from zero %d)\n", w2.st.warm_columns,
+                   w2.st.warm_residual, w2.st.warm_basis, w2.st.iterations, c2.st.iterations);
+            CHECK(w2.status == CM_OK && w2.st.warm_columns == 3);
+            CHECK_MSG(w2.st.warm_residual < 1e-6, "%.3g", w2.st.warm_residual);
+            /* of the 12 solutions, the first 6 are independent; of the second 6 the
+             * unchanged ones lie in their span and are not kept */
+            CHECK_MSG(w2.st.warm_basis > 6 && w2.st.warm_basis < 12, "%d", w2.st.warm_basis);
+            CHECK(w2.st.iterations <= 2 && w2.st.iterations < c2.st.iterations);
+            for (int u = 0; u < 3; ++u) {
+                double fmx = 0.0;
+                for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v3[i * NC + (size_t)u]));
+                solved one = {.w = c2.w + (size_t)u * m, .q = c2.q + (size_t)u * (size_t)r->k};
+                const double ed = eval_diff(r, m, np, p, &w2, u, &one, fmx);
+                CHECK_MSG(ed <= 1e-8, "column %d from the history against cold: %.3g", u, ed);
+            }
+            release(&w0), release(&w1), release(&c1), release(&w2), release(&c2);
+            free(v2), free(d2), free(v3);
         }
         r->opt.warm_start = 0;
     }
