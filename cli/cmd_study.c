@@ -116,8 +116,8 @@ static const cli_option options[] = {
      .help = "absolute variants morphed together: their warps share one\n"
              "multi-column solve and evaluation (the same rows as one at a\n"
              "time, to the solver's tolerance); auto (default): a quarter\n"
-             "of the variants (later batches start from the last one's\n"
-             "solution), at most what half the free memory holds and 20;\n"
+             "of the variants (later batches start from the earlier ones'\n"
+             "solutions), at most what half the free memory holds and 20;\n"
              "1: one at a time"},
     {CLI_SOLVER_OPTION, .dest = &args.solver},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",

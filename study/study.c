@@ -418,9 +418,9 @@ static void study_free(study *w)
 }
 
 /* Variants per batch: o->batch, or (0) at most a quarter of the variants this rank runs, as
- * many as half the available memory holds, up to CM_STUDY_BATCH_MAX. Why a quarter: a batch
- * solves with as many columns as the one before starts warm (each column from the previous
- * batch's weights, cm_rbf_options.warm_start), which saves more than a larger batch shares
+ * many as half the available memory holds, up to CM_STUDY_BATCH_MAX. Why a quarter: every
+ * batch after the first starts warm (each column from the earlier batches' solutions,
+ * cm_rbf_options.warm_start), which saves more than a larger batch shares
  * (bracket, 10^5 boundary nodes, 20 variants: batches of 5 the fastest, 20 the slowest;
  * benchmarks/RESULTS.md, "Study"); CM_STUDY_BATCH_MAX because the kernel sums' cost per
  * column has flattened by 60 columns (the same section, "Kernel cost per column"). Memory

@@ -41,8 +41,9 @@ int main(int argc, char **argv)
         "Iterative RBF solves on the sets PREFIX.centres / .values (raw float64, n x 3, all\n"
         "with the same centres): --columns: one solve of K columns per K (default 3,15,30,60),\n"
         "solve CPU s per column; --sequence: each set's 3 columns after the previous set's,\n"
-        "from zero and warm (iterations and CPU s of both). --column-scale, --budget: the\n"
-        "tuning knobs column_scale and krylov_budget (rbf_tuning.h).\n";
+        "from zero and warm from the earlier sets' solutions (iterations and CPU s of both).\n"
+        "--column-scale, --budget: the tuning knobs column_scale and krylov_budget\n"
+        "(rbf_tuning.h).\n";
     if (argc < 2 || !strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) {
         fputs(usage, argc < 2 ? stderr : stdout);
         return argc < 2 ? 2 : 0;
@@ -134,8 +135,8 @@ int main(int argc, char **argv)
         free(f);
     }
     if (sequence) {
-        /* each set after the previous one: warm (from the previous set's weights), then from
-         * zero (whose weights the next warm solve starts from: the same to the tolerance) */
+        /* each set after the previous one: warm (from the fit's history, which holds the warm
+         * solves of the sets before), then from zero (not kept: warm_start 0) */
         double tw = 0.0, tc = 0.0;
         int iw = 0, ic = 0;
         for (int s = 0; s < S; ++s) {
@@ -151,9 +152,10 @@ int main(int argc, char **argv)
             const double cc = bench_cpu_seconds() - c0;
             cm_rbf_get_stats(r, &sc);
             printf("set=%s status=%d/%d iterations_cold=%d iterations_warm=%d warm_columns=%d "
-                   "warm_residual=%.3g cpu_cold_s=%.2f cpu_warm_s=%.2f residual_warm=%.3g\n",
+                   "warm_basis=%d warm_residual=%.3g cpu_cold_s=%.2f cpu_warm_s=%.2f "
+                   "residual_warm=%.3g\n",
                    prefix[s], (int)b, (int)a, sc.iterations, sw.iterations, sw.warm_columns,
-                   sw.warm_residual, cc, cw, sw.residual);
+                   sw.warm_basis, sw.warm_residual, cc, cw, sw.residual);
             fflush(stdout);
             if (s > 0) tw += cw, tc += cc, iw += sw.iterations, ic += sc.iterations;
         }

@@ -12,7 +12,9 @@
 # study, and from study.csv (seconds of wall time, per variant the median over the variants):
 # the factorisation (t_volume_solve, once), the warp apply (t_evaluation: the iterative solve
 # and the evaluation at the interior nodes, a batch's shared apply divided over its variants,
-# plus the quality), the surface morph (t_surface) and the distance check (t_distance).
+# plus the quality), the surface morph (t_surface) and the distance check (t_distance); from the
+# study's --verbose log (log_TAG.txt), the warp's solves and evaluations at the interior nodes
+# (wall s, every warp apply of the study summed, per variant).
 # usage: bench_study_batch.sh BUILD_DIR WORK_DIR [THREADS] [bracket|bore|all]
 # environment: BRACKET_MESH=M.vtu reuses a TetGen mesh of bracket 0 at that size (meshing it
 # takes minutes); BATCHES="1 5 10 20" and NVAR=20 (the bracket's batch sizes and variants);
@@ -44,13 +46,13 @@ study() {
     /usr/bin/time -f "wall_s=%e user_s=%U sys_s=%S max_kb=%M" -o "$1/time_$4.txt" \
         "$cadmorph" study --from "$1/G0.step" --mesh "$2" --variants "$3" -o "$1/out_$4" \
         --mode absolute --methods rbf-s --write-meshes none --batch "$5" \
-        --threads "$threads" >/dev/null || [ $? -eq 3 ]
+        --threads "$threads" --verbose >/dev/null 2>"$1/log_$4.txt" || [ $? -eq 3 ]
 }
 
 # The table rows of DIR's studies TAG... (the first: the one-variant study)
 table() {
     /usr/bin/python3 - "$@" <<'PY'
-import csv, statistics, sys
+import csv, re, statistics, sys
 work, label, tags = sys.argv[1], sys.argv[2], sys.argv[3:]
 def times(tag):
     kv = dict(f.split("=") for f in open(f"{work}/time_{tag}.txt").read().split())
@@ -61,17 +63,21 @@ for tag in tags:
     med = lambda k: statistics.median(float(r[k]) for r in rows)
     w, c, kb = times(tag)
     n, batch = tag.split("_")
+    applies = re.findall(r"solve ([0-9.]+) s \(.*evaluation at [0-9]+ nodes ([0-9.]+) s",
+                         open(f"{work}/log_{tag}.txt").read())
+    solve = sum(float(a) for a, _ in applies) / len(rows)
+    ev = sum(float(b) for _, b in applies) / len(rows)
     print(f"| {label} | {rows[0]['nodes']} | {rows[0]['boundary_nodes']} | {len(rows)} | {batch} "
           f"| {w:.1f} | {c:.1f} | {w / w1:.2f} | {c / c1:.2f} | {kb / 1048576:.1f} "
           f"| {sum(float(r['t_volume_solve']) for r in rows):.2f} | {med('t_evaluation'):.3f} "
-          f"| {med('t_surface'):.3f} | {med('t_distance'):.3f} |")
+          f"| {solve:.3f} | {ev:.3f} | {med('t_surface'):.3f} | {med('t_distance'):.3f} |")
 PY
 }
 
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "BLAS: OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE:-unset}, threads $threads"
-echo "| case | nodes | boundary nodes | variants | batch | wall s | CPU s | wall ratio | CPU ratio | max GB | factorisation s | apply s/variant | surface s/variant | distance s/variant |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| case | nodes | boundary nodes | variants | batch | wall s | CPU s | wall ratio | CPU ratio | max GB | factorisation s | apply s/variant | solve s/variant | evaluation s/variant | surface s/variant | distance s/variant |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 
 if [ "$part" = bracket ] || [ "$part" = all ]; then
     d=$work/bracket

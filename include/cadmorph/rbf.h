@@ -91,7 +91,8 @@ typedef struct cm_rbf_stats {
     int coarse_size;       /* iterative: coarse centres */
     double setup_seconds;  /* create: factorisation or preconditioner set-up */
     double solve_seconds;  /* last solve */
-    size_t memory_bytes;   /* factor or preconditioner + Krylov storage of the last solve */
+    size_t memory_bytes;   /* factor or preconditioner + Krylov storage of the last solve +
+                            * the solutions kept for warm starts */
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
     int matvecs;           /* last solve: kernel-sum passes over the m x m matrix of every

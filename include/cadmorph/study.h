@@ -160,7 +160,8 @@ typedef struct cm_study_options {
     /* Absolute variants morphed together (cm_morpher_apply_batch: one multi-column warp
      * apply for the batch; rows equal to one-at-a-time to the solver's tolerance, in the same
      * order). 0 (default): a quarter of the variants (later batches start warm from the
-     * one before), as many as half the available memory holds, up to CM_STUDY_BATCH_MAX
+     * earlier ones' solutions), as many as half the available memory holds, up to
+     * CM_STUDY_BATCH_MAX
      * (docs/DESIGN.md, "Studies in batches"); 1: one variant at a time;
      * K: K variants. Relative series run one variant at a time whatever it is. */
     int batch;

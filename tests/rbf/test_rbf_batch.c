@@ -1,7 +1,8 @@
 /* Many right-hand sides in one iterative solve: each column solved with the others equals
  * its solve alone (weights, evaluation and iteration count), a slowly converging column
- * does not hold back the others, warm starts, and the columns solved in groups when the
- * Krylov storage exceeds its budget. */
+ * does not hold back the others, warm starts from the fit's history of solutions (its cap,
+ * and in the refinement of fast sums), and the columns solved in groups when the Krylov
+ * storage exceeds its budget. */
 #include "cadmorph/rbf.h"
 #include "rbf_internal.h"
 #include "rbf_tuning.h"
@@ -286,6 +287,24 @@ int main(void)
         r->opt.warm_start = 0;
     }
 
+    /* a history of 2 solutions: the oldest gives way, the starts use the 2 kept */
+    {
+        cm_rbf_tuning tu;
+        cm_rbf_tuning_init(&tu);
+        tu.warm_history = 2;
+        cm_rbf_options o2 = o;
+        o2.warm_start = 1;
+        cm_rbf *r2 = NULL;
+        CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m_in, x, &o2, &tu, &r2) == CM_OK);
+        for (int u = 0; r2 && u < 4; ++u) {
+            solved a = solve_cols(ctx, r2, m, v, 1, &u);
+            CHECK_MSG(a.status == CM_OK && a.st.warm_basis == (u < 2 ? u : 2),
+                      "solve %d: %d earlier solutions", u, a.st.warm_basis);
+            release(&a);
+        }
+        cm_rbf_destroy(&r2);
+    }
+
     /* fast (treecode) matvecs with refinement: the batch against each column alone */
     {
         r->opt.fast_sum = 1;
@@ -305,6 +324,22 @@ int main(void)
                 CHECK(a.iters[0] == fb.iters[u]);
                 release(&a);
             }
+            /* a warm start in the refinement: the same data again start at their solution */
+            r->opt.warm_start = 1;
+            solved f1 = solve_cols(ctx, rf, m, v, 4, cols);
+            solved f2 = solve_cols(ctx, rf, m, v, 4, cols);
+            r->opt.warm_start = 0;
+            printf("fast sums, the same data again: %d columns warm from %.3g, %d iterations "
+                   "(from zero %d)\n", f2.st.warm_columns, f2.st.warm_residual,
+                   f2.st.iterations, fb.st.iterations);
+            CHECK(f2.status == CM_OK && f2.st.warm_columns == 4 && f2.st.warm_residual < 1e-6);
+            CHECK(f2.st.iterations < fb.st.iterations);
+            for (int u = 0; u < 4; ++u) {
+                double fmx = 0.0;
+                for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v[i * NC + (size_t)cols[u]]));
+                CHECK(eval_diff(r, m, np, p, &f1, u, &f2, fmx) <= 1e-8);
+            }
+            release(&f1), release(&f2);
             release(&fb);
         }
     }
