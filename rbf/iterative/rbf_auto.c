@@ -28,23 +28,31 @@
 #define CM_RBF_COST_DENSE_M3 7.9e-12
 #define CM_RBF_COST_ITER_M 5.5e-5 /* the old 3.5e-4 and 1.3e-8 scaled as S and N */
 #define CM_RBF_COST_ITER_M2 9e-9
+/* Each further solve (cm_rbf_options.solves) PROVISIONAL */
+#define CM_RBF_AUTO_DS 2.0
+#define CM_RBF_AUTO_NW 4.3
+#define CM_RBF_COST_DENSE_M2 (CM_RBF_AUTO_DS * CM_RBF_COST_ITER_M2 / CM_RBF_AUTO_N)
+#define CM_RBF_COST_WARM_M2 (CM_RBF_AUTO_NW * CM_RBF_COST_ITER_M2 / CM_RBF_AUTO_N)
 
-int cm_rbf_auto_costs(size_t m, double *dense, double *iter)
+int cm_rbf_auto_costs(size_t m, int solves, double *dense, double *iter)
 {
-    const double x = (double)m;
+    const double x = (double)m, more = solves > 1 ? (double)(solves - 1) : 0.0;
     double g, kp, ka;
     cm_rbf_auto_rates(&g, &kp, &ka);
     if (g > 0.0 && kp > 0.0 && ka > 0.0) {
-        *dense = x * x * x / 3.0 / (CM_RBF_AUTO_E * g) + CM_RBF_AUTO_D * x * x / kp;
-        *iter = CM_RBF_AUTO_S * x / g + CM_RBF_AUTO_N * x * x / ka;
+        *dense = x * x * x / 3.0 / (CM_RBF_AUTO_E * g) + CM_RBF_AUTO_D * x * x / kp +
+                 more * CM_RBF_AUTO_DS * x * x / kp;
+        *iter = CM_RBF_AUTO_S * x / g + CM_RBF_AUTO_N * x * x / ka +
+                more * CM_RBF_AUTO_NW * x * x / ka;
         return 1;
     }
-    *dense = CM_RBF_COST_DENSE_M3 * x * x * x;
-    *iter = CM_RBF_COST_ITER_M * x + CM_RBF_COST_ITER_M2 * x * x;
+    *dense = CM_RBF_COST_DENSE_M3 * x * x * x + more * CM_RBF_COST_DENSE_M2 * x * x;
+    *iter = CM_RBF_COST_ITER_M * x + CM_RBF_COST_ITER_M2 * x * x +
+            more * CM_RBF_COST_WARM_M2 * x * x;
     return 0;
 }
 
-int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
+int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m, int solves)
 {
     if (kernel != CM_RBF_TRIHARMONIC) return 1;
     const double x = (double)m;
@@ -53,7 +61,6 @@ int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
     if (m < 1000) return 1;
     if (m > 60000) return 0;
     double dense, iter;
-    cm_rbf_auto_costs(m, &dense, &iter);
+    cm_rbf_auto_costs(m, solves, &dense, &iter);
     return dense <= iter;
 }
-
