@@ -1,5 +1,6 @@
 /* AUTO's choice between the dense and the iterative solver: a cost model in seconds of one
- * thread, from the rates rbf_auto_probe.c times once per process. */
+ * thread, from the rates rbf_auto_probe.c times once per process, for the count of solves
+ * the caller expects on the fit. */
 #include "rbf_internal.h"
 
 /* Cost model for AUTO, in seconds of one thread, from rates timed in this process
@@ -28,10 +29,25 @@
 #define CM_RBF_COST_DENSE_M3 7.9e-12
 #define CM_RBF_COST_ITER_M 5.5e-5 /* the old 3.5e-4 and 1.3e-8 scaled as S and N */
 #define CM_RBF_COST_ITER_M2 9e-9
-/* Each further solve (cm_rbf_options.solves) PROVISIONAL */
-#define CM_RBF_AUTO_DS 2.0
+/* Each further solve on the same fit (cm_rbf_options.solves: the right-hand sides a caller
+ * expects, an absolute study's variants): dense DS plain passes of m^2 pairs (the packed
+ * triangular solves streaming the factor, the residual's kernel sums, one refinement step),
+ * iterative NW compensated passes (a warm Krylov solve from the fit's earlier solutions:
+ * 3-4 iterations instead of 6-7, and the final residual). Fitted to the bore studies of 20
+ * variants in batches of 5 on 5.7k, 10.7k and 20.6k centres (benchmarks/RESULTS.md, "AUTO
+ * solver choice", Counting the solves): a variant's share of the batches' solves after the
+ * first, relative to the factorisation's time measured in the same runs, times the model's
+ * factorisation: DS 3.2-4.2, NW 4.0-4.7. Why relative to the factorisation, not to the
+ * cold iterative solve (NW 2.8-3.4 that way): the one-solve model weighs the factorisation
+ * 1.2-1.7x heavier against a Krylov solve than these runs do, and the choice for many solves
+ * is factorisation against solves; so fitted, the model's dense/iterative ratio of a whole
+ * study is within 10 % of the measured one at all three sizes (crossover for 20 variants
+ * near 5,500 centres: at 5.7k the two tie). For one solve nothing changes. */
+#define CM_RBF_AUTO_DS 3.7
 #define CM_RBF_AUTO_NW 4.3
-#define CM_RBF_COST_DENSE_M2 (CM_RBF_AUTO_DS * CM_RBF_COST_ITER_M2 / CM_RBF_AUTO_N)
+/* the fallback's: as the passes of its m^2 term, a plain pass at 0.55 of a compensated one
+ * (the probe's ratio of the two rates) */
+#define CM_RBF_COST_DENSE_M2 (0.55 * CM_RBF_AUTO_DS * CM_RBF_COST_ITER_M2 / CM_RBF_AUTO_N)
 #define CM_RBF_COST_WARM_M2 (CM_RBF_AUTO_NW * CM_RBF_COST_ITER_M2 / CM_RBF_AUTO_N)
 
 int cm_rbf_auto_costs(size_t m, int solves, double *dense, double *iter)
