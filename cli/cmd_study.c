@@ -119,7 +119,11 @@ static const cli_option options[] = {
              "of the variants (later batches start from the earlier ones'\n"
              "solutions), at most what half the free memory holds and 20;\n"
              "1: one at a time"},
-    {CLI_SOLVER_OPTION, .dest = &args.solver},
+    {CLI_SOLVER_FIELDS, .dest = &args.solver,
+     .help = "RBF warps: auto (default: a cost model that counts the variants,\n"
+             "as they share one fit: dense to more boundary nodes than the\n"
+             "~3,500 of one morph, iterative above), dense or iterative\n"
+             "(FGMRES + Schwarz); petsc: use mpirun -n K instead"},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
      .help = "threads (default: all)"},
     {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,

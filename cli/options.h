@@ -75,10 +75,12 @@ extern const char *const cli_solver_names[];
 extern const int cli_solver_values[];
 /* The fields of --solver and --rbf-tol that warp and morph share (each adds its .dest), so
  * that the help's figures (the AUTO crossover) are written once. */
-#define CLI_SOLVER_OPTION                                                                      \
+#define CLI_SOLVER_FIELDS                                                                      \
     .name = "--solver", .kind = CLI_ENUM, .names = cli_solver_names,                           \
     .values = cli_solver_values,                                                               \
-    .bad = "%.0sunknown solver '%s' (auto, dense, iterative, petsc)", .label = "--solver S",   \
+    .bad = "%.0sunknown solver '%s' (auto, dense, iterative, petsc)", .label = "--solver S"
+#define CLI_SOLVER_OPTION                                                                      \
+    CLI_SOLVER_FIELDS,                                                                         \
     .help = "RBF warps: auto (default: dense below ~3,500 boundary nodes,\n"                   \
             "iterative above), dense, iterative (FGMRES + Schwarz) or petsc\n"                 \
             "(the same distributed over MPI ranks: mpirun -n K; builds\n"                      \

@@ -80,8 +80,12 @@ static cm_status trial(cm_context *ctx, cm_morpher *mp, const cm_warp_options *w
     if (shared) {
         s = cm_morpher_shared_warps(ctx, mp, wo, &w, &w1, &row->t_volume_solve);
     } else {
+        /* a warp of its own serves this one apply: the caller's count of solves
+         * (cm_warp_options.solves) is the shared warp's */
+        cm_warp_options once = *wo;
+        once.solves = 0;
         memcpy(mp->work->xyz, from, 3 * nn * sizeof *from);
-        s = cm_morpher_make_warps(ctx, mp, mp->work, wo, &own, &own1);
+        s = cm_morpher_make_warps(ctx, mp, mp->work, &once, &own, &own1);
         w = own, w1 = own1;
         row->t_volume_solve = cm_wtime() - t0;
     }

@@ -555,6 +555,7 @@ int max_iterations;
 int restart;
 int fast_sum;
 int warm_start;
+int solves;
 } cm_rbf_options;
 void cm_rbf_options_init(cm_rbf_options *opt);
 typedef struct cm_rbf_stats {
@@ -695,6 +696,7 @@ cm_deform_method method;
 cm_rbf_kernel kernel;
 cm_rbf_solver solver;
 double tolerance;
+int solves;
 int lattice;
 double clamp;
 cm_mls_options mls;
@@ -926,6 +928,7 @@ typedef struct cm_warp_options {
 cm_warp_method method;
 cm_rbf_solver solver;
 double tolerance;
+int solves;
 int lattice;
 double clamp;
 cm_mls_options mls;

@@ -63,6 +63,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     opt->restart = 40;
     opt->fast_sum = -1;
     opt->warm_start = 1;
+    opt->solves = 1;
 }
 
 void cm_rbf_tuning_init(cm_rbf_tuning *t)
@@ -251,7 +252,8 @@ cm_status cm_rbf_create_tuned(cm_context *ctx, cm_rbf_kernel kernel, int dim, si
     if (st == CM_OK) st = factor_polynomial(ctx, r);
     cm_rbf_solver solver = r->opt.solver;
     if (solver == CM_RBF_SOLVER_AUTO)
-        solver = cm_rbf_auto_dense(kernel, r->m) ? CM_RBF_SOLVER_DENSE : CM_RBF_SOLVER_ITERATIVE;
+        solver = cm_rbf_auto_dense(kernel, r->m, r->opt.solves) ? CM_RBF_SOLVER_DENSE
+                                                                 : CM_RBF_SOLVER_ITERATIVE;
     r->stats.solver = solver;
     r->stats.centres = r->m;
     if (st == CM_OK)

@@ -233,15 +233,17 @@ void cm_rbf_probe_data(size_t m, double *c, double *w, size_t n, double *p);
 
 /* ---- iterative solver (iterative/) ---- */
 
-/* 1 if AUTO picks the dense solver for m centres of this kernel (cost model). */
-int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m);
+/* 1 if AUTO picks the dense solver for m centres of this kernel (cost model) when the fit
+ * will serve `solves` solves (cm_rbf_options.solves; <= 1: one). */
+int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m, int solves);
 /* dgemm flops per second and r^3 kernel-sum pairs per second (plain, compensated; 3 weight
  * vectors) of one thread, timed once per process (rbf_auto_probe.c); 0 if the probe could
  * not allocate its 3.6 MB. cm_rbf_create calls it with one BLAS thread set. */
 void cm_rbf_auto_rates(double *gemm, double *plain, double *acc);
-/* The model's seconds (of one thread) for m centres, dense and iterative; returns 1 if they
- * come from the measured rates, 0 from the fixed fallback constants. */
-int cm_rbf_auto_costs(size_t m, double *dense, double *iter);
+/* The model's seconds (of one thread) for m centres and `solves` solves (<= 1: one), dense
+ * and iterative; returns 1 if they come from the measured rates, 0 from the fixed fallback
+ * constants. */
+int cm_rbf_auto_costs(size_t m, int solves, double *dense, double *iter);
 
 /* Builds r->iter (preconditioner) for the centres in r (placed, P factored). */
 cm_status cm_rbf_iterative_setup(cm_context *ctx, cm_rbf *r, int threads);

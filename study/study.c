@@ -268,6 +268,23 @@ static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
     return CM_OK;
 }
 
+/* The solves the shared warp of method q will serve (cm_warp_options.solves, for AUTO's
+ * choice of the RBF solver): one per variant this rank runs, for each method with the same
+ * warp options (the morpher keeps one warp per set of options: rbf and rbf-s share one).
+ * Variants that fail to load are counted too: the count is known before the first. */
+static int abs_solves(const study *w, size_t q)
+{
+    const cm_study_method *ms = w->r->methods;
+    const int ranks = w->o->ranks > 1 ? w->o->ranks : 1;
+    size_t variants = w->fam->n / (size_t)ranks +
+                      ((size_t)w->o->rank < w->fam->n % (size_t)ranks ? 1 : 0);
+    size_t sharing = 0;
+    for (size_t j = 0; j < w->r->n_methods; ++j)
+        sharing += !memcmp(&ms[j].method.warp, &ms[q].method.warp, sizeof ms[q].method.warp);
+    const double solves = (double)variants * (double)sharing;
+    return solves < 1e9 ? (int)solves : 1000000000;
+}
+
 /* The absolute rows of series se (mode absolute) for the batch's variants that this rank
  * runs, into rows[j] (one per variant; the meshes written): one cm_morpher_apply_batch per
  * w->batch variants. */
@@ -275,6 +292,8 @@ static cm_status absolute_rows(cm_context *ctx, study *w, series *se, variant *v
                                cm_study_row *rows)
 {
     const cm_study_method *m = &w->r->methods[se->method];
+    cm_morph_method method = m->method;
+    method.warp.solves = abs_solves(w, se->method);
     const cm_cad_model **targets = malloc((n ? n : 1) * sizeof *targets);
     size_t *of = malloc((n ? n : 1) * sizeof *of), k = 0;
     cm_status s = targets && of ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");
@@ -283,7 +302,7 @@ static cm_status absolute_rows(cm_context *ctx, study *w, series *se, variant *v
             targets[k] = v[j].g;
             of[k++] = j;
         }
-    if (s >= 0) s = cm_morpher_apply_batch(ctx, w->abs, k, targets, &m->method, w->bxyz, w->items);
+    if (s >= 0) s = cm_morpher_apply_batch(ctx, w->abs, k, targets, &method, w->bxyz, w->items);
     for (size_t q = 0; q < k && s >= 0; ++q) {
         cm_study_row *row = &rows[of[q]];
         const cm_morph_batch_item *it = &w->items[q];

@@ -116,8 +116,8 @@ static cm_status split_component(cm_context *ctx, const unsigned char *constrain
 /* The RBF of component k; its errors (coplanar centres, failed factorisation) get the
  * component number in front. */
 static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel,
-                               cm_rbf_solver solver, double tolerance, size_t k,
-                               warp_component *wc)
+                               cm_rbf_solver solver, double tolerance, int solves,
+                               size_t k, warp_component *wc)
 {
     if (wc->n_free == 0) return CM_OK; /* nothing to interpolate: every node is prescribed */
     if (wc->n_fixed == 0)
@@ -143,11 +143,18 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
     o.kernel = kernel;
     o.solver = solver;
     o.tolerance = tolerance;
+    o.solves = solves;
     cm_status s = cm_deform_create(ctx, &o, np, xyz, con, NULL, &wc->def);
     free(xyz), free(con);
     if (s < 0)
         return cm_error_prefix(ctx, s, "cm_warp_create: component %zu (%zu constrained nodes)", k,
                                wc->n_fixed);
+    cm_deform_stats st;
+    cm_deform_get_stats(wc->def, &st);
+    cm_log(ctx, CM_LOG_DEBUG, "cm_warp_create: component %zu: %zu centres, %s solver%s, for %d "
+           "solve(s)", k, wc->n_fixed, st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" :
+           st.rbf.solver == CM_RBF_SOLVER_PETSC ? "petsc" : "iterative",
+           solver == CM_RBF_SOLVER_AUTO ? " (auto)" : "", solves > 1 ? solves : 1);
     return CM_OK;
 }
 
@@ -155,7 +162,7 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
  * one pass per component with a stamp array deduplicates its nodes. */
 static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                                   const unsigned char *constrained, cm_rbf_kernel kernel,
-                                  cm_rbf_solver solver, double tolerance,
+                                  cm_rbf_solver solver, double tolerance, int solves,
                                   rbf_warp *w, size_t *n_shared_free)
 {
     size_t nc = b->n_components, nn = mesh->n_nodes;
@@ -199,7 +206,7 @@ static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm
         s = split_component(ctx, constrained, (int)k, list, vis.n, owner, &w->comp[k],
                             n_shared_free);
         if (s < 0) goto done;
-        s = fit_component(ctx, mesh, kernel, solver, tolerance, k, &w->comp[k]);
+        s = fit_component(ctx, mesh, kernel, solver, tolerance, solves, k, &w->comp[k]);
         if (s < 0) goto done;
         if ((s = cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc)) < 0) goto done;
     }
@@ -225,7 +232,8 @@ done:
 
 static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                             const unsigned char *constrained, cm_rbf_kernel kernel,
-                            cm_rbf_solver solver, double tolerance, void **state)
+                            cm_rbf_solver solver, double tolerance, int solves,
+                            void **state)
 {
     if (b->n_components > (size_t)(~0u >> 1))
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_warp_create: too many components");
@@ -240,7 +248,8 @@ static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
         goto fail;
     }
     size_t n_shared_free = 0;
-    s = build_components(ctx, mesh, b, constrained, kernel, solver, tolerance, w, &n_shared_free);
+    s = build_components(ctx, mesh, b, constrained, kernel, solver, tolerance, solves, w,
+                         &n_shared_free);
     if (s < 0) goto fail;
     if (n_shared_free)
         cm_log(ctx, CM_LOG_WARNING,
@@ -383,7 +392,7 @@ static cm_status triharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                     const cm_warp_options *opt, void **state)
 {
     return rbf_create(ctx, mesh, b, constrained, CM_RBF_TRIHARMONIC, opt->solver, opt->tolerance,
-                      state);
+                      opt->solves, state);
 }
 
 static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
@@ -391,7 +400,7 @@ static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                    const cm_warp_options *opt, void **state)
 {
     return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, opt->solver, opt->tolerance,
-                      state);
+                      opt->solves, state);
 }
 
 const cm_warp_method_ops cm_warp_rbf_triharmonic = {

@@ -205,9 +205,9 @@ int main(int argc, char **argv)
            g * 1e-9, kp, ka);
     for (size_t m = 2500; m <= 40000; m *= 2) {
         double d, it;
-        int measured = cm_rbf_auto_costs(m, &d, &it);
+        int measured = cm_rbf_auto_costs(m, 1, &d, &it);
         printf("auto_model m=%zu dense_s=%.2f iterative_s=%.2f choice=%s rates=%s\n", m, d, it,
-               cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, m) ? "dense" : "iterative",
+               cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, m, 1) ? "dense" : "iterative",
                measured ? "measured" : "fallback");
     }
     free(c), free(w), free(p), free(out), free(ref), free(absum);

@@ -7,7 +7,9 @@
 #            then of all 20 with --batch 1, 5, 10, 20 (heavy: about 2.5 GB and 40 s per
 #            variant one at a time on 2 cores).
 #   bore:    `cadmorph model bore` meshed by TetGen at sizes 0.25 0.15 0.12 (as bench_study.sh),
-#            the last variant alone and all 20 with --batch 1 and auto.
+#            the last variant alone and all 20 with --batch 1 and auto; with SOLVERS="auto dense
+#            iterative" instead the last variant alone and all 20 (batch auto) with each
+#            --solver, side by side (the solver AUTO took is in the table's solver column).
 # One table row per study: wall and CPU seconds (/usr/bin/time), their ratios to the one-variant
 # study, and from study.csv (seconds of wall time, per variant the median over the variants):
 # the factorisation (t_volume_solve, once), the warp apply (t_evaluation: the iterative solve
@@ -18,7 +20,7 @@
 # usage: bench_study_batch.sh BUILD_DIR WORK_DIR [THREADS] [bracket|bore|all]
 # environment: BRACKET_MESH=M.vtu reuses a TetGen mesh of bracket 0 at that size (meshing it
 # takes minutes); BATCHES="1 5 10 20" and NVAR=20 (the bracket's batch sizes and variants);
-# CADMORPH=path of the CLI.
+# SOLVERS (bore, above); CADMORPH=path of the CLI.
 set -eu
 usage="usage: bench_study_batch.sh BUILD_DIR WORK_DIR [THREADS] [bracket|bore|all]"
 build=${1:?$usage}
@@ -41,12 +43,13 @@ variants() { # MODEL DIR
     cp "$2/vN/$1_$(printf %02d "$nvar").step" "$2/v1/"
 }
 
-# One study: DIR MESH LIST TAG BATCH
+# One study: DIR MESH LIST TAG BATCH [SOLVER] (its debug log in DIR/log_TAG.txt)
 study() {
     /usr/bin/time -f "wall_s=%e user_s=%U sys_s=%S max_kb=%M" -o "$1/time_$4.txt" \
         "$cadmorph" study --from "$1/G0.step" --mesh "$2" --variants "$3" -o "$1/out_$4" \
         --mode absolute --methods rbf-s --write-meshes none --batch "$5" \
-        --threads "$threads" --verbose >/dev/null 2>"$1/log_$4.txt" || [ $? -eq 3 ]
+        --solver "${6:-auto}" --threads "$threads" --verbose >/dev/null 2>"$1/log_$4.txt" ||
+        [ $? -eq 3 ]
 }
 
 # The table rows of DIR's studies TAG... (the first: the one-variant study)
@@ -62,12 +65,15 @@ for tag in tags:
     rows = list(csv.DictReader(open(f"{work}/out_{tag}/study.csv")))
     med = lambda k: statistics.median(float(r[k]) for r in rows)
     w, c, kb = times(tag)
-    n, batch = tag.split("_")
+    n, batch = tag.split("_")[:2]
+    # the RBF solver the warp was created with (its debug line)
+    solver = next((ln.split(", ")[1].split(" ")[0] for ln in open(f"{work}/log_{tag}.txt")
+                   if ln.startswith("cm_warp_create: component 0:")), "?")
     applies = re.findall(r"solve ([0-9.]+) s \(.*evaluation at [0-9]+ nodes ([0-9.]+) s",
                          open(f"{work}/log_{tag}.txt").read())
     solve = sum(float(a) for a, _ in applies) / len(rows)
     ev = sum(float(b) for _, b in applies) / len(rows)
-    print(f"| {label} | {rows[0]['nodes']} | {rows[0]['boundary_nodes']} | {len(rows)} | {batch} "
+    print(f"| {label} | {solver} | {rows[0]['nodes']} | {rows[0]['boundary_nodes']} | {len(rows)} | {batch} "
           f"| {w:.1f} | {c:.1f} | {w / w1:.2f} | {c / c1:.2f} | {kb / 1048576:.1f} "
           f"| {sum(float(r['t_volume_solve']) for r in rows):.2f} | {med('t_evaluation'):.3f} "
           f"| {solve:.3f} | {ev:.3f} | {med('t_surface'):.3f} | {med('t_distance'):.3f} |")
@@ -76,8 +82,8 @@ PY
 
 echo "machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), load $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "BLAS: OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE:-unset}, threads $threads"
-echo "| case | nodes | boundary nodes | variants | batch | wall s | CPU s | wall ratio | CPU ratio | max GB | factorisation s | apply s/variant | solve s/variant | evaluation s/variant | surface s/variant | distance s/variant |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| case | solver | nodes | boundary nodes | variants | batch | wall s | CPU s | wall ratio | CPU ratio | max GB | factorisation s | apply s/variant | solve s/variant | evaluation s/variant | surface s/variant | distance s/variant |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 
 if [ "$part" = bracket ] || [ "$part" = all ]; then
     d=$work/bracket
@@ -100,10 +106,19 @@ if [ "$part" = bore ] || [ "$part" = all ]; then
     variants bore "$d"
     for size in 0.25 0.15 0.12; do
         mesh=$d/M0_$size.vtu
-        "$cadmorph" mesh "$d/G0.step" -o "$mesh" --size "$size" --mesher tetgen >/dev/null
-        study "$d" "$mesh" "$d/v1/*.step" 1_1 1
-        study "$d" "$mesh" "$d/vN/*.step" "${nvar}_1" 1
-        study "$d" "$mesh" "$d/vN/*.step" "${nvar}_auto" auto
-        table "$d" "bore $size" 1_1 "${nvar}_1" "${nvar}_auto"
+        [ -e "$mesh" ] || "$cadmorph" mesh "$d/G0.step" -o "$mesh" --size "$size" \
+            --mesher tetgen >/dev/null
+        if [ -z "${SOLVERS:-}" ]; then
+            study "$d" "$mesh" "$d/v1/*.step" 1_1 1
+            study "$d" "$mesh" "$d/vN/*.step" "${nvar}_1" 1
+            study "$d" "$mesh" "$d/vN/*.step" "${nvar}_auto" auto
+            table "$d" "bore $size" 1_1 "${nvar}_1" "${nvar}_auto"
+            continue
+        fi
+        for sv in $SOLVERS; do
+            study "$d" "$mesh" "$d/v1/*.step" "1_1_$sv" 1 "$sv"
+            study "$d" "$mesh" "$d/vN/*.step" "${nvar}_auto_$sv" auto "$sv"
+            table "$d" "bore $size, --solver $sv" "1_1_$sv" "${nvar}_auto_$sv"
+        done
     done
 fi

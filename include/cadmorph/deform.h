@@ -235,6 +235,10 @@ typedef struct cm_deform_options {
     cm_rbf_kernel kernel;
     cm_rbf_solver solver;
     double tolerance;
+    /* rbf, AUTO solver: displacement fields the caller expects to apply on this deformation
+     * over its life (cm_deform_apply_many's k counting k; cm_rbf_options.solves); 0 or 1
+     * (default): one */
+    int solves;
     /* dmffd: control points per axis (4..200; 0 = 10) of the lattice whose domain is the
      * points' bounding box grown by 1e-3 of its diagonal; singular values <= clamp x sigma_max
      * are truncated (0 = 1e-10) */

@@ -37,8 +37,10 @@ typedef struct cm_rbf cm_rbf;
  *   O(m^2) per iteration with direct sums. Evaluation of a large n x m takes the treecode
  *   where a sampled check shows its error within 1e-9 x max |data| (stats: eval_fast).
  * AUTO: a cost model from BLAS and kernel-sum rates timed once per process puts the
- *   crossover near 3,500 centres: dense below (while 4 m^2 bytes fit in half the memory),
- *   iterative above; dense for the other kernels.
+ *   crossover near 3,500 centres for one solve: dense below (while 4 m^2 bytes fit in half
+ *   the memory), iterative above; dense for the other kernels. The model counts the solves
+ *   the caller expects on the fit (options solves): the dense factorisation, paid once,
+ *   wins to more centres when many solves share it.
  * PETSC: the ITERATIVE solver distributed over the MPI ranks of PETSC_COMM_WORLD through
  *   PETSc (only in builds with -DCADMORPH_WITH_PETSC=ON; otherwise create fails with
  *   CM_ERR_UNSUPPORTED): the kernel-sum rows and the Schwarz subdomains are split over the
@@ -79,6 +81,13 @@ typedef struct cm_rbf_options {
                            * zero). Along a family of targets (a study, an optimiser's
                            * steps) this saves most of the iterations; any component count.
                            * 0: always from zero, nothing kept (stats: warm_columns) */
+    int solves;           /* [1] AUTO only: how many right-hand sides the caller expects to
+                           * solve on this fit over its life, one cm_rbf_solve of k sets of
+                           * components (k displacement fields side by side) counting k. The
+                           * dense factorisation is paid once and then each solve is cheap;
+                           * the iterative set-up is cheap and each solve costs Krylov
+                           * iterations (fewer when warm): more solves move the crossover up
+                           * (an absolute study counts its variants). <= 1: one solve */
 } cm_rbf_options;
 
 CM_API void cm_rbf_options_init(cm_rbf_options *opt);

@@ -49,7 +49,7 @@ CM_API const char *cm_warp_method_list(void);
 typedef struct cm_warp_options {
     cm_warp_method method; /* default CM_WARP_RBF */
     /* RBF methods: CM_RBF_SOLVER_AUTO (0, default: dense below a measured size, the
-     * iterative solver above), DENSE, ITERATIVE or PETSC (rbf.h; PETSC makes create and
+     * iterative solver above; see solves), DENSE, ITERATIVE or PETSC (rbf.h; PETSC makes create and
      * apply collective over the MPI ranks) */
     cm_rbf_solver solver;
     /* RBF methods, iterative solvers: stop when the largest miss at the centres is
@@ -58,6 +58,11 @@ typedef struct cm_warp_options {
      * anyway, so a looser tolerance only perturbs the interior by about tolerance x the
      * motion: 1e-6 of a 0.02 motion is 2e-8, far below any cell. */
     double tolerance;
+    /* RBF methods, AUTO solver: how many displacement fields the caller expects to apply
+     * with this warp over its life (cm_warp_apply_many's k fields counting k), weighed by
+     * AUTO's cost model (cm_rbf_options.solves): an absolute study's variants share one warp,
+     * so dense wins to more centres than for one apply. 0 or 1 (default): one apply */
+    int solves;
     /* DM-FFD: control points per axis of the lattice whose domain is the mesh's bounding box
      * (grown by 1e-3 of its diagonal): 5, 10, 15, 25 in the paper; 0 = 10 */
     int lattice;

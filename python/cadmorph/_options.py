@@ -26,13 +26,14 @@ class WarpSettings:
     Warp, Morpher and Morpher.apply take them."""
 
     NAMES = ("method", "kernel", "solver", "tolerance", "lattice", "clamp", "samples",
-             "cubature", "cover", "stretch", "bend", "blend", "graded")
+             "cubature", "cover", "stretch", "bend", "blend", "graded", "solves")
 
     def __init__(self, what: str, method: str = "rbf", kernel: Optional[str] = None,
                  solver: str = "auto", tolerance: float = 0.0, lattice: Optional[int] = None,
                  clamp: Optional[float] = None, samples: Optional[int] = None,
                  cubature: Optional[int] = None, cover: int = 5, stretch: float = 1.0,
-                 bend: float = 1.0, blend: float = 1.5, graded: float = 0.0) -> None:
+                 bend: float = 1.0, blend: float = 1.5, graded: float = 0.0,
+                 solves: int = 1) -> None:
         self.method = choice(what, "method", method, warp_methods())
         if kernel is not None:
             # --kernel of the CLI: another name for the two RBF methods
@@ -46,6 +47,8 @@ class WarpSettings:
             raise ValueError("%s: solver='petsc': this libcadmorph was built without PETSc"
                              % what)
         self.tolerance = number(what, "tolerance", tolerance, 0.0, 0.5)
+        # the fields the caller expects to apply with one warp (cm_warp_options.solves)
+        self.solves = integer(what, "solves", solves, 1, 2 ** 31 - 1)
         # None: the library's default (a lattice of 10, clamp 1e-10), passed as its 0
         self.lattice = None if lattice is None else integer(what, "lattice", lattice, 4, 200)
         self.clamp = None if clamp is None else number(what, "clamp", clamp, 0.0, 1.0,
@@ -74,6 +77,8 @@ class WarpSettings:
         w.method = lib.cm_warp_method_from_name(self.method.encode())
         w.solver = SOLVERS[self.solver]
         w.tolerance = self.tolerance
+        # 1 is the library's 0 (one apply), so that the options match those of the CLI bytewise
+        w.solves = self.solves if self.solves > 1 else 0
         if self.lattice is not None:
             w.lattice = self.lattice
         if self.clamp is not None:

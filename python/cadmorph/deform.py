@@ -55,7 +55,8 @@ class Deformer:
         mesh, the border edges of a surface mesh), or None.
     method: "rbf" (default), "mls", "shell" or "dmffd". Options, as `cadmorph deform`:
         kernel ("triharmonic" | "biharmonic"), solver ("auto" | "dense" | "iterative" |
-        "petsc") and tolerance (0: the RBF's default) for rbf; lattice (4..200 control points
+        "petsc"), tolerance (0: the RBF's default) and solves (the fields you expect to apply,
+        >= 1, weighed by "auto": cm_deform_options.solves) for rbf; lattice (4..200 control points
         per axis, default 10) and clamp (singular values <= clamp x the largest are dropped,
         default 1e-10) for dmffd; samples, cubature, cover, stretch, bend, fix, blend, graded,
         seed and exact_constraints (True, the library's default: the handle and fixed points
@@ -73,7 +74,8 @@ class Deformer:
     def __init__(self, points: Union[Mesh, np.ndarray], handles: Any,
                  fixed: Union[None, str, Any] = None, method: str = "rbf", *,
                  kernel: Optional[str] = None, solver: Optional[str] = None,
-                 tolerance: Optional[float] = None, lattice: Optional[int] = None,
+                 tolerance: Optional[float] = None, solves: Optional[int] = None,
+                 lattice: Optional[int] = None,
                  clamp: Optional[float] = None, samples: Optional[int] = None,
                  cubature: Optional[int] = None, cover: Optional[int] = None,
                  stretch: Optional[float] = None, bend: Optional[float] = None,
@@ -117,6 +119,8 @@ class Deformer:
             opt.solver = SOLVERS[choice(what, "solver", solver, tuple(SOLVERS))]
         if tolerance is not None:
             opt.tolerance = number(what, "tolerance", tolerance, 0, 1, hi_open=True)
+        if solves is not None:
+            opt.solves = integer(what, "solves", solves, 1, 2 ** 31 - 1)
         opt.lattice = integer(what, "lattice", 10 if lattice is None else lattice, 4, 200)
         if clamp is not None:
             opt.clamp = number(what, "clamp", clamp, 0, 1, lo_open=True, hi_open=True)

@@ -158,7 +158,8 @@ def _morph_options(what: str, method: str = "rbf", kernel: Optional[str] = None,
                    lattice: Optional[int] = None, clamp: Optional[float] = None,
                    samples: Optional[int] = None, cubature: Optional[int] = None,
                    cover: int = 5, stretch: float = 1.0, bend: float = 1.0,
-                   blend: float = 1.5, graded: float = 0.0, cad_tol: float = 1e-6,
+                   blend: float = 1.5, graded: float = 0.0, solves: int = 1,
+                   cad_tol: float = 1e-6,
                    cad_abs_tol: float = 1e-9, off_cad: str = "refuse",
                    keep_offset: bool = False, max_samples: Optional[int] = None,
                    target_h_scale: float = 1.0, surface_spacing: float = 0.0,
@@ -169,7 +170,7 @@ def _morph_options(what: str, method: str = "rbf", kernel: Optional[str] = None,
     warp = WarpSettings(what, method=method, kernel=kernel, solver=solver,
                         tolerance=tolerance, lattice=lattice, clamp=clamp, samples=samples,
                         cubature=cubature, cover=cover, stretch=stretch, bend=bend,
-                        blend=blend, graded=graded)
+                        blend=blend, graded=graded, solves=solves)
     surface_ = choice(what, "surface", surface, list(_SURFACES))
     o = ffi.new("cm_morph_options *")
     lib.cm_morph_options_init(o)
@@ -234,7 +235,9 @@ class Morpher:
             face, the method) or "project" (closest point, the baseline).
         solver [--solver], tolerance [--rbf-tol], lattice [--lattice], clamp [--clamp],
             samples, cubature, cover, stretch, bend, blend, graded [the MLS options]: as
-            cadmorph.Warp.
+            cadmorph.Warp; solves: as cadmorph.Warp, the targets you will apply from G0
+            (their warps share one fit: a loop over many targets, as `cadmorph study`
+            counts its variants; later steps of an adaptive morph count one).
     Steps (a result is valid when no cell is inverted and, for min_sj > 0, every scaled
     Jacobian is above min_sj; apply returns valid meshes only, unless allow_inverted):
         steps [--steps]: "auto" (the default): adaptive steps, the whole motion first (a
@@ -307,7 +310,8 @@ class Morpher:
                  lattice: Optional[int] = None, clamp: Optional[float] = None,
                  samples: Optional[int] = None, cubature: Optional[int] = None, cover: int = 5,
                  stretch: float = 1.0, bend: float = 1.0, blend: float = 1.5,
-                 graded: float = 0.0, cad_tol: float = 1e-6, cad_abs_tol: float = 1e-9,
+                 graded: float = 0.0, solves: int = 1, cad_tol: float = 1e-6,
+                 cad_abs_tol: float = 1e-9,
                  off_cad: str = "refuse", keep_offset: bool = False,
                  max_samples: Optional[int] = None, target_h_scale: float = 1.0,
                  surface_spacing: float = 0.0, surface_min_per_edge: int = 8,

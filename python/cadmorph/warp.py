@@ -38,6 +38,10 @@ class Warp:
             "iterative", "petsc" (only in a build with PETSc).
         tolerance: RBF, iterative solvers: the CLI's --rbf-tol, in [0, 0.5]; 0 = the
             library's 1e-10.
+        solves: RBF methods, solver "auto": how many displacement fields you expect to apply
+            with this warp (apply_many's k counting k), >= 1 (default 1); the dense
+            factorisation, shared by them all, then wins to more nodes
+            (cm_warp_options.solves).
         lattice: dmffd: control points per axis, 4..200 (None: 10); clamp: dmffd: singular
             values <= clamp x the largest are dropped, in (0, 1) (None: 1e-10).
         samples, cubature (None: automatic), cover (1..64), stretch, bend, blend (>= 0),
@@ -60,7 +64,8 @@ class Warp:
                  lattice: Optional[int] = None, clamp: Optional[float] = None,
                  samples: Optional[int] = None, cubature: Optional[int] = None, cover: int = 5,
                  stretch: float = 1.0, bend: float = 1.0, blend: float = 1.5,
-                 graded: float = 0.0, threads: int = 0, progress: Progress = None) -> None:
+                 graded: float = 0.0, solves: int = 1, threads: int = 0,
+                 progress: Progress = None) -> None:
         what = "cadmorph.Warp"
         self._warp = None
         self._lock = threading.Lock()  # the C API: one call at a time on a warp
@@ -69,7 +74,8 @@ class Warp:
         settings = WarpSettings(what, method=method, kernel=kernel, solver=solver,
                                 tolerance=tolerance, lattice=lattice, clamp=clamp,
                                 samples=samples, cubature=cubature, cover=cover,
-                                stretch=stretch, bend=bend, blend=blend, graded=graded)
+                                stretch=stretch, bend=bend, blend=blend, graded=graded,
+                                solves=solves)
         self._ctx = ctx = Context(threads, progress, what)
         opt = ffi.new("cm_warp_options *")
         settings.fill(opt)

@@ -1,5 +1,6 @@
 /* AUTO's choice between the dense and the iterative solver: a cost model in seconds of one
- * thread, from the rates rbf_auto_probe.c times once per process. */
+ * thread, from the rates rbf_auto_probe.c times once per process, for the count of solves
+ * the caller expects on the fit. */
 #include "rbf_internal.h"
 
 /* Cost model for AUTO, in seconds of one thread, from rates timed in this process
@@ -28,23 +29,46 @@
 #define CM_RBF_COST_DENSE_M3 7.9e-12
 #define CM_RBF_COST_ITER_M 5.5e-5 /* the old 3.5e-4 and 1.3e-8 scaled as S and N */
 #define CM_RBF_COST_ITER_M2 9e-9
+/* Each further solve on the same fit (cm_rbf_options.solves: the right-hand sides a caller
+ * expects, an absolute study's variants): dense DS plain passes of m^2 pairs (the packed
+ * triangular solves streaming the factor, the residual's kernel sums, one refinement step),
+ * iterative NW compensated passes (a warm Krylov solve from the fit's earlier solutions:
+ * 3-4 iterations instead of 6-7, and the final residual). Fitted to the bore studies of 20
+ * variants in batches of 5 on 5.7k, 10.7k and 20.6k centres (benchmarks/RESULTS.md, "AUTO
+ * solver choice", Counting the solves): a variant's share of the batches' solves after the
+ * first, relative to the factorisation's time measured in the same runs, times the model's
+ * factorisation: DS 3.2-4.2, NW 4.0-4.7. Why relative to the factorisation, not to the
+ * cold iterative solve (NW 2.8-3.4 that way): the one-solve model weighs the factorisation
+ * 1.2-1.7x heavier against a Krylov solve than these runs do, and the choice for many solves
+ * is factorisation against solves; so fitted, the model's dense/iterative ratio of a whole
+ * study is within 10 % of the measured one at all three sizes (crossover for 20 variants
+ * near 5,500 centres: at 5.7k the two tie). For one solve nothing changes. */
+#define CM_RBF_AUTO_DS 3.7
+#define CM_RBF_AUTO_NW 4.3
+/* the fallback's: as the passes of its m^2 term, a plain pass at 0.55 of a compensated one
+ * (the probe's ratio of the two rates) */
+#define CM_RBF_COST_DENSE_M2 (0.55 * CM_RBF_AUTO_DS * CM_RBF_COST_ITER_M2 / CM_RBF_AUTO_N)
+#define CM_RBF_COST_WARM_M2 (CM_RBF_AUTO_NW * CM_RBF_COST_ITER_M2 / CM_RBF_AUTO_N)
 
-int cm_rbf_auto_costs(size_t m, double *dense, double *iter)
+int cm_rbf_auto_costs(size_t m, int solves, double *dense, double *iter)
 {
-    const double x = (double)m;
+    const double x = (double)m, more = solves > 1 ? (double)(solves - 1) : 0.0;
     double g, kp, ka;
     cm_rbf_auto_rates(&g, &kp, &ka);
     if (g > 0.0 && kp > 0.0 && ka > 0.0) {
-        *dense = x * x * x / 3.0 / (CM_RBF_AUTO_E * g) + CM_RBF_AUTO_D * x * x / kp;
-        *iter = CM_RBF_AUTO_S * x / g + CM_RBF_AUTO_N * x * x / ka;
+        *dense = x * x * x / 3.0 / (CM_RBF_AUTO_E * g) + CM_RBF_AUTO_D * x * x / kp +
+                 more * CM_RBF_AUTO_DS * x * x / kp;
+        *iter = CM_RBF_AUTO_S * x / g + CM_RBF_AUTO_N * x * x / ka +
+                more * CM_RBF_AUTO_NW * x * x / ka;
         return 1;
     }
-    *dense = CM_RBF_COST_DENSE_M3 * x * x * x;
-    *iter = CM_RBF_COST_ITER_M * x + CM_RBF_COST_ITER_M2 * x * x;
+    *dense = CM_RBF_COST_DENSE_M3 * x * x * x + more * CM_RBF_COST_DENSE_M2 * x * x;
+    *iter = CM_RBF_COST_ITER_M * x + CM_RBF_COST_ITER_M2 * x * x +
+            more * CM_RBF_COST_WARM_M2 * x * x;
     return 0;
 }
 
-int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
+int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m, int solves)
 {
     if (kernel != CM_RBF_TRIHARMONIC) return 1;
     const double x = (double)m;
@@ -53,7 +77,6 @@ int cm_rbf_auto_dense(cm_rbf_kernel kernel, size_t m)
     if (m < 1000) return 1;
     if (m > 60000) return 0;
     double dense, iter;
-    cm_rbf_auto_costs(m, &dense, &iter);
+    cm_rbf_auto_costs(m, solves, &dense, &iter);
     return dense <= iter;
 }
-

@@ -92,6 +92,8 @@ def test_warp_constrained_nodes_and_properties(bore_mesh):
     assert wd.method == "dmffd" and wd.residual > 0
     # kernel= is the CLI's other name for the RBF methods
     assert cadmorph.Warp(mesh, kernel="biharmonic", progress=False).method == "rbf-biharmonic"
+    # solves= only weighs AUTO's choice: 1728 centres are dense either way, the same warp
+    assert np.array_equal(cadmorph.Warp(mesh, solves=20, progress=False).apply(D), out)
 
 
 def test_warp_accepts_array_likes_without_copy(bore_mesh):
@@ -172,6 +174,7 @@ def test_warp_bad_options(bore_mesh):
                           ({"stretch": -1}, ValueError, "stretch"),
                           ({"graded": 2}, ValueError, "graded"),
                           ({"samples": 0}, ValueError, "samples"),
+                          ({"solves": 0}, ValueError, "solves"),
                           ({"threads": -1}, ValueError, "threads"),
                           ({"threads": 1.5}, TypeError, "threads"),
                           ({"progress": 5}, TypeError, "progress must be a callable")]:

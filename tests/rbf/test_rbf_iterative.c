@@ -338,9 +338,9 @@ static void test_choice(cm_context *ctx)
     CHECK(cm_rbf_create_tuned(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &tun, &r) == CM_ERR_ARGUMENT);
     /* the cost model: dense at 2k, iterative at 20k (measured with subdomains of 700 and an
      * overlap of 2 H: the crossover near 3.5k, iterative 5x faster at 10k) */
-    CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 2000) == 1);
-    CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 20000) == 0);
-    CHECK(cm_rbf_auto_dense(CM_RBF_BIHARMONIC, 20000) == 1);
+    CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 2000, 1) == 1);
+    CHECK(cm_rbf_auto_dense(CM_RBF_TRIHARMONIC, 20000, 1) == 0);
+    CHECK(cm_rbf_auto_dense(CM_RBF_BIHARMONIC, 20000, 1) == 1);
     /* the coarse space: 2000 up to 2e4 centres (m/4 below 8000), then grown as sqrt(m) up
      * to coarse_max */
     cm_rbf_options_init(&o);

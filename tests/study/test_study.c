@@ -3,8 +3,10 @@
  * complete with the boundary on their G (1e-9 x diagonal) and, for RBF-S, no inverted cell;
  * absolute and relative both run; the absolute factorisation is made once for the family;
  * the relative series chains (its first step is the absolute one, later ones differ); failed
- * meshes are written exactly for the rows with inverted cells. Also the variant lists (list
- * file, glob, the bad ones) and the method names.
+ * meshes are written exactly for the rows with inverted cells. The RBF warps' AUTO choice
+ * counts the solves of their fit (cm_warp_options.solves, from the debug log of warp
+ * create): the shared absolute warp one per variant and method sharing it, each relative
+ * warp one. Also the variant lists (list file, glob, the bad ones) and the method names.
  * usage: test_study DIR   (DIR from make_variants.py) */
 #include "cadmorph/study.h"
 
@@ -50,6 +52,26 @@ static void on_progress(void *user, const char *stage, double done, double total
     ++p->calls;
     p->last_done = done;
     p->last_total = total;
+}
+
+/* The solve counts the RBF warps were created for ("... for N solve(s)" in the debug log). */
+typedef struct solves_log {
+    int creates, shared, single, other;
+    int expect; /* the shared warp's count */
+} solves_log;
+
+static void on_log(void *user, cm_log_level level, const char *msg)
+{
+    solves_log *l = user;
+    (void)level;
+    const char *p = strstr(msg, " solve(s)");
+    if (!strstr(msg, "cm_warp_create: component") || !p) return;
+    while (p > msg && p[-1] >= '0' && p[-1] <= '9') --p;
+    const int n = atoi(p);
+    ++l->creates;
+    if (n == l->expect) ++l->shared;
+    else if (n == 1) ++l->single;
+    else ++l->other;
 }
 
 static void test_lists(cm_context *ctx)
@@ -152,9 +174,16 @@ static void test_study(cm_context *ctx)
     so.morph.steps = 1;
     so.morph.allow_inverted = 1;
     progress_log pl = {0, 1, 0, 0};
+    solves_log sl = {0, 0, 0, 0, (int)fam.n * 2}; /* rbf-s and rbf share the warp */
     cm_context_set_progress(ctx, on_progress, &pl);
+    cm_context_set_log(ctx, on_log, &sl);
     s = cm_study_run(ctx, g0, mesh, &fam, &so, &r);
     cm_context_set_progress(ctx, NULL, NULL);
+    cm_context_set_log(ctx, NULL, NULL);
+    /* one shared absolute warp (one component); the relative series' warps count one each */
+    EXPECT(sl.shared == 1 && sl.single >= 1 && sl.other == 0,
+           "warp creates: %d for %d solves, %d for one, %d other", sl.shared, sl.expect,
+           sl.single, sl.other);
     EXPECT(s == CM_WARNING && r, "run: %d %s", s, cm_context_message(ctx));
     EXPECT(strstr(cm_context_message(ctx), "v3_hole"), "warning names the odd variant: %s",
            cm_context_message(ctx));
