@@ -337,7 +337,8 @@ int main(void)
             for (int u = 0; u < 4; ++u) {
                 double fmx = 0.0;
                 for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v[i * NC + (size_t)cols[u]]));
-                CHECK(eval_diff(r, m, np, p, &f1, u, &f2, fmx) <= 1e-8);
+                solved one = {.w = f2.w + (size_t)u * m, .q = f2.q + (size_t)u * (size_t)r->k};
+                CHECK(eval_diff(r, m, np, p, &f1, u, &one, fmx) <= 1e-8);
             }
             release(&f1), release(&f2);
             release(&fb);
