@@ -407,7 +407,7 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
     }
     for (size_t u = 0; u < m; ++u)
         for (size_t c = 0; c < nc; ++c) f[c * m + u] = values[rbf->first[u] * nc + c];
-    rbf->warm_ok = 1; /* this solve may start from the previous weights (options warm_start) */
+    rbf->warm_ok = 1; /* this solve may start from earlier solutions (options warm_start) */
     st = cm_rbf_solve_merged(ctx, rbf, nc, f, CM_RBF_REFINE_TOL, w, q);
     rbf->warm_ok = 0;
     if (st >= CM_OK) { /* a warning keeps the weights: the message says how good they are */

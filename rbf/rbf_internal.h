@@ -38,8 +38,10 @@ struct cm_rbf {
     cm_rbf_stats stats;
     cm_rbf_iter *iter; /* iterative solver state, NULL for dense (then chol is set) */
     cm_rbf_petsc *petsc; /* PETSC solver (rbf_petsc.c): set with iter, NULL otherwise */
-    int warm_ok;      /* set by cm_rbf_solve around its solve: a warm start from w may be
-                       * tried (not by the transposed solve, whose data are another's) */
+    int warm_ok;      /* set by cm_rbf_solve around its solve: it may start from the fit's
+                       * history of solutions and joins it (not the transposed solve: its
+                       * data, a gradient, lie far from the displacements the history spans
+                       * and would only take their places) */
     int pc_part, pc_parts; /* Schwarz set-up split over ranks (rbf_petsc.c): this part of
                             * pc_parts builds only its subdomains; 0, 0: all */
 };
