@@ -69,6 +69,14 @@ void cm_krylov_project(const double *q1, size_t m, int k, double *v)
         }
 }
 
+double cm_krylov_residual(const cm_rbf *r, size_t m, const double *f, const double *aw,
+                          double *rv)
+{
+    for (size_t i = 0; i < m; ++i) rv[i] = f[i] - aw[i];
+    cm_krylov_project(r->iter->q1, m, r->k, rv);
+    return cm_krylov_norm_inf(m, rv);
+}
+
 /* out_u = A in_u for n columns: kind MV_FAST by tree (if that fails: fallback, or zeros
  * for fallback < 0), MV_PLAIN or MV_COMP by direct sums. The one place where the columns
  * are cut into the chunks the kernel sums take. Returns the kind used (the fallback's if a
@@ -331,10 +339,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             kcol *k = &kr->col[c];
             double *rv = k->v, *ax = aw + (size_t)c * m; /* the residual is built in V_0 */
             const double *fc = f + (size_t)c * m;
-            double rn;
-            for (size_t i = 0; i < m; ++i) rv[i] = fc[i] - ax[i];
-            cm_krylov_project(r->iter->q1, m, r->k, rv);
-            rn = cm_krylov_norm_inf(m, rv);
+            double rn = cm_krylov_residual(r, m, fc, ax, rv);
             if (cycle == 0 && k->warm) {
                 /* the start is kept if its residual is below the zero start's |f| */
                 const double fn = cm_krylov_norm_inf(m, fc);
@@ -343,9 +348,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
                     k->warm = 0;
                     memset(w + (size_t)c * m, 0, m * sizeof(double));
                     memset(ax, 0, m * sizeof(double));
-                    memcpy(rv, fc, m * sizeof(double));
-                    cm_krylov_project(r->iter->q1, m, r->k, rv);
-                    rn = cm_krylov_norm_inf(m, rv);
+                    rn = cm_krylov_residual(r, m, fc, ax, rv);
                 }
             }
             k->res = k->fnorm > 0.0 ? rn / k->fnorm : 0.0;

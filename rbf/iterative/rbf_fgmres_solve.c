@@ -135,10 +135,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             const int c = sel[u];
             kcol *k = &kr->col[c];
             const size_t o0 = (size_t)c * m;
-            for (size_t i = 0; i < m; ++i) rhs[o0 + i] = f[o0 + i] - aw[o0 + i];
-            memcpy(dw + o0, rhs + o0, m * sizeof *dw);
-            cm_krylov_project(r->iter->q1, m, r->k, dw + o0);
-            const double rn = cm_krylov_norm_inf(m, dw + o0);
+            const double rn = cm_krylov_residual(r, m, f + o0, aw + o0, rhs + o0);
             const double fn = cm_krylov_norm_inf(m, f + o0);
             if (rn < fn) k->warm_res = rn / fn, k->took = 1;
             else {
@@ -222,12 +219,9 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             kcol *k = &kr->col[c];
             const size_t o0 = (size_t)c * m;
             double *rv = rhs + o0;
-            for (size_t i = 0; i < m; ++i) {
-                aw[o0 + i] += adw[o0 + i];
-                rv[i] = f[o0 + i] - aw[o0 + i];
-            }
-            cm_krylov_project(r->iter->q1, m, r->k, rv);
-            const double res = k->fnorm > 0.0 ? cm_krylov_norm_inf(m, rv) / k->fnorm : 0.0;
+            for (size_t i = 0; i < m; ++i) aw[o0 + i] += adw[o0 + i];
+            const double rn = cm_krylov_residual(r, m, f + o0, aw + o0, rv);
+            const double res = k->fnorm > 0.0 ? rn / k->fnorm : 0.0;
             if (step == 0) *first = fmax(*first, res);
             cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: column %d, refinement %d: %d "
                    "iterations (%s matvecs), exact residual %.3g", c, step + 1, k->iters,

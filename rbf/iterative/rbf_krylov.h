@@ -67,6 +67,10 @@ typedef struct krylov {
 /* v -= Q1 (Q1' v), twice (the second pass removes what round-off left of the first). */
 void cm_krylov_project(const double *q1, size_t m, int k, double *v);
 double cm_krylov_norm_inf(size_t m, const double *v);
+/* rv = Pi (f - aw), the projected residual of a column whose product is aw (m each); returns
+ * its max-norm. */
+double cm_krylov_residual(const cm_rbf *r, size_t m, const double *f, const double *aw,
+                          double *rv);
 /* out_u = A in_u for n columns: kind MV_FAST by tree (if that fails: fallback, or zeros
  * for fallback < 0), MV_PLAIN or MV_COMP by direct sums. The one place where the columns
  * are cut into the chunks the kernel sums take. Returns the kind used. Counts nothing. */
