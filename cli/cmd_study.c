@@ -16,7 +16,8 @@ static const char *const usage_line =
     "[--mode absolute|relative|both] [--methods LIST] [--write-meshes none|all|failed] "
     "[--steps auto|K] [--allow-inverted] [--optimize] [--cad-unit U] "
     "[--off-cad refuse|fixed [--slide P,..] "
-    "[--fixed-patches P,..] [--no-slide]] [--batch auto|K] [--solver S] [--threads N] "
+    "[--fixed-patches P,..] [--no-slide]] [--batch auto|K] [--solver S] [--rbf-tol T] "
+    "[--threads N] "
     "[--verbose]";
 
 enum { MAX_METHODS = 16 };
@@ -26,6 +27,7 @@ typedef struct study_args {
     int modes, write_meshes, threads, verbose, steps, optimize, off_cad, allow_inverted;
     int batch;  /* cm_study_options.batch: 0 auto */
     int solver; /* the RBF warps' solver of every method (cm_rbf_solver) */
+    double rbf_tol; /* and their iterative solvers' tolerance (0: the default) */
     cli_patch_motion patches; /* the motion of the nodes off G0 */
     int rank, ranks; /* under mpirun (cli_mpi_ranks) */
     cm_study_method list[MAX_METHODS];
@@ -124,6 +126,7 @@ static const cli_option options[] = {
              "as they share one fit: dense to more boundary nodes than the\n"
              "~3,500 of one morph, iterative above), dense or iterative\n"
              "(FGMRES + Schwarz); petsc: use mpirun -n K instead"},
+    {CLI_RBF_TOL_OPTION, .dest = &args.rbf_tol},
     {.name = "--threads", .kind = CLI_THREADS, .dest = &args.threads, .label = "--threads N",
      .help = "threads (default: all)"},
     {.name = "--verbose", .alias = "-v", .kind = CLI_FLAG, .dest = &args.verbose,
@@ -196,8 +199,10 @@ static int parse_args(int argc, char **argv, study_args *a)
     if (cm_context_create(&ctx) != CM_OK) return cli_usage(cmd, usage_line, "out of memory");
     cm_status s = cm_study_methods_parse(ctx, a->methods, a->list, MAX_METHODS, &a->n_methods);
     if (s < 0) cli_usage(cmd, usage_line, "--methods: %s", cm_context_message(ctx));
-    for (size_t k = 0; k < a->n_methods; ++k)
+    for (size_t k = 0; k < a->n_methods; ++k) {
         a->list[k].method.warp.solver = (cm_rbf_solver)a->solver;
+        a->list[k].method.warp.tolerance = a->rbf_tol;
+    }
     cm_context_destroy(&ctx);
     return s < 0 ? CLI_EXIT_USAGE : -1;
 }

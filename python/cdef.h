@@ -577,6 +577,7 @@ int fast_direct;
 double fast_residual;
 double fast_bound;
 int eval_fast;
+int eval_plain;
 double eval_error;
 int eval_order;
 double eval_theta;

@@ -416,6 +416,7 @@ cm_status cm_rbf_solve(cm_context *ctx, cm_rbf *rbf, int ncomp, const double *va
         rbf->w = w;
         rbf->q = q;
         rbf->ncomp = ncomp;
+        if (rbf->iter) cm_rbf_iterative_commit(rbf);
         w = q = NULL;
     }
 done:

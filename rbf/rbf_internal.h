@@ -284,9 +284,13 @@ int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, d
 /* The last evaluation's fast-sum figures (eval_fast, eval_error, eval_order, eval_theta) into
  * stats; nothing for a dense fit. */
 void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats);
-/* The data scale (max |f| of the last solve) that fast_eval_tol is relative to: set by the
- * serial solve, and by the PETSc one, so that both evaluate alike. */
-void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax);
+/* The scales of a solve's weights that the evaluation goes by (rbf_iter.h, cm_rbf_scales):
+ * a solve begins them with the data scale fmax that fast_eval_tol is relative to (the serial
+ * solve and the PETSc one alike, so that both evaluate alike) and, for nc > 0, room for its
+ * columns' scales, which it then fills (0 out of memory: -1, and none by column; PETSc: nc
+ * 0). cm_rbf_solve commits them with the weights it keeps. */
+int cm_rbf_iterative_scales_begin(cm_rbf *r, size_t nc, double fmax);
+void cm_rbf_iterative_commit(cm_rbf *r);
 
 typedef struct cm_rbf_schwarz cm_rbf_schwarz;
 

@@ -198,11 +198,8 @@ cm_status cm_rbf_evaluate_transpose(cm_context *ctx, cm_rbf *rbf, size_t n, cons
     }
     for (size_t u = 0; u < m; ++u)
         for (size_t c = 0; c < nc; ++c) f[c * m + u] = g[u * nc + c];
-    /* the solve moves the scale the iterative evaluation's fast sums are judged by: put it
-     * back, so that evaluate behaves as after the last cm_rbf_solve */
-    const double fmax = rbf->iter ? rbf->iter->fmax : 0.0;
+    /* (its scales are not committed: evaluate behaves as after the last cm_rbf_solve) */
     st = cm_rbf_solve_merged(ctx, rbf, nc, f, CM_RBF_TRANSPOSE_REFINE_TOL, w, q);
-    if (rbf->iter) cm_rbf_iterative_set_scale(rbf, fmax);
     if (st < 0) goto done;
     cm_log(ctx, CM_LOG_DEBUG,
            "cm_rbf_evaluate_transpose: %zu points x %zu centres: transposed sums %.3f s (%s), "

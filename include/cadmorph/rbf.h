@@ -49,7 +49,9 @@ typedef struct cm_rbf cm_rbf;
  *   cm_parallel_initialize (parallel.h).
  * cm_rbf_evaluate works for all; an iterative fit evaluates with compensated sums too (about
  * 1.5x the time of plain sums), so it reproduces the data at the centres to its residual,
- * where plain sums, as the dense path uses, stop at the floor in cm_rbf_stats. */
+ * where plain sums, as the dense path uses, stop at the floor in cm_rbf_stats; with plain
+ * sums where their rounding is within a tenth of its tolerance (a loose one, such as 1e-6:
+ * stats eval_plain). */
 typedef enum cm_rbf_solver {
     CM_RBF_SOLVER_AUTO = 0,
     CM_RBF_SOLVER_DENSE = 1,
@@ -131,6 +133,8 @@ typedef struct cm_rbf_stats {
     double fast_bound;     /* last solve with fast sums: the treecode's error bound on a
                             * product with these weights, relative to the data */
     int eval_fast;         /* last cm_rbf_evaluate: 1 if it used the fast sum */
+    int eval_plain;        /* last cm_rbf_evaluate of an iterative fit: 1 if by plain direct
+                            * sums (the tolerance allowed them), 0 compensated or fast */
     double eval_error;     /* last cm_rbf_evaluate that tried the fast sum: its estimated
                             * max error / max |data| (sampled against compensated direct
                             * sums, x4). The fast sum is taken if this is within 1e-9 or

@@ -1,6 +1,7 @@
-/* Evaluation of an iterative fit: compensated direct sums, or the r^3 treecode where n x m is
- * large and a sampled check (after a pilot that may pick a cheaper treecode) shows its error
- * within fast_eval_tol x max |data|. */
+/* Evaluation of an iterative fit: compensated direct sums, plain ones where the solve's
+ * tolerance allows them, or the r^3 treecode where n x m is large and a sampled check (after
+ * a pilot that may pick a cheaper treecode) shows its error within fast_eval_tol x max
+ * |data|. */
 #include "rbf_iter.h"
 
 #include <float.h>
@@ -26,7 +27,17 @@
  * (sum |w| of 1e6..1e7 x max |d| on the bracket and on two bodies far apart), and plain sums
  * then reproduce the data at the centres only to eps sum |w_j phi_ij| (bracket, m = 59k:
  * 1e-7 of the range, although the residual is 6e-11). The dense path keeps plain sums: its
- * callers at m <= ~3,500 do not see that floor, and it is 2.4x faster. */
+ * callers at m <= ~3,500 do not see that floor, and it is 2.4x faster.
+ * A fit solved to a loose tolerance does not need them: plain sums are taken where their
+ * rounding, at most CM_RBF_PLAIN_ERR x S_c(x) with S_c(x) = sum_j |w_cj| phi(|x - c_j|),
+ * is within CM_RBF_PLAIN_RES_SHARE of the tolerance x the column's scale, for every column
+ * (as the solve takes plain products for its exact residuals). S_c is convex in x (each
+ * |x - c_j|^3 is), so over the convex hull of the centres, where a warp's interior nodes
+ * lie, it is largest at a centre: the solve's smax (cm_rbf_scales). CM_RBF_FAST_SAMPLES
+ * points spread over the others stand for any outside it. So with the default tolerance
+ * (1e-10) the sums stay compensated (S_c is 1e4..1e9 x the data on real sets), and at 1e-6
+ * (a study's --rbf-tol) they are plain on the bore (20.6k centres: S_c 6e4..6e5 x the data,
+ * RESULTS.md, Study). */
 /* Evaluation by the treecode if its error can be shown to be within fast_eval_tol x max
  * |data|: the order is chosen from sum_j |w_j| phi_ij at a few of the points (the scale of
  * its bound, which the cancellation of the weights makes 1e4..1e7 x the result), then the
@@ -102,33 +113,43 @@ static int pilot_passes(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree
     return pass;
 }
 
-static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads,
-                         cm_rbf_tick *tick)
+/* s[c] = max sum_j |w_cj| phi_ij over ns of the n points p (spread over them), for the
+ * fit's columns c; -1 out of memory. */
+static int sampled_abs_sums(const cm_rbf *r, size_t n, const double *p, size_t ns, double *s,
+                            int threads)
 {
-    cm_rbf_iter *it = r->iter;
     const size_t m = r->m, nc = (size_t)r->ncomp;
-    const double target = r->tun.fast_eval_tol * it->fmax;
-    it->eval_fast = 0;
-    it->eval_error = 0.0;
-    if (!(target > 0.0)) return 0;
-    const size_t ns = n < 64 ? n : 64;
+    ns = n < ns ? n : ns;
     double *sp = malloc(3 * ns * sizeof *sp), *aw = malloc(nc * m * sizeof *aw);
     double *ab = malloc(ns * nc * sizeof *ab);
-    int ok = sp && aw && ab;
-    double smax = 0.0;
+    const int ok = sp && aw && ab;
     if (ok) {
         for (size_t k = 0; k < ns; ++k)
             for (int d = 0; d < 3; ++d)
                 sp[(size_t)d * ns + k] = p[(size_t)d * n + (size_t)((double)k * (double)n / (double)ns)];
         for (size_t j = 0; j < nc * m; ++j) aw[j] = fabs(r->w[j]);
-        for (size_t g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
-            int gc = nc - g < CM_RBF_SUM_MAX_NC ? (int)(nc - g) : CM_RBF_SUM_MAX_NC;
-            cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw + g * m, gc, ns, sp, ns, ab + g,
-                              nc, threads);
-        }
-        for (size_t i = 0; i < ns * nc; ++i) smax = fmax(smax, ab[i]);
+        cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw, (int)nc, ns, sp, ns, ab, nc,
+                          threads);
+        for (size_t c = 0; c < nc; ++c) s[c] = 0.0;
+        for (size_t i = 0; i < ns * nc; ++i) s[i % nc] = fmax(s[i % nc], ab[i]);
     }
     free(sp), free(aw), free(ab);
+    return ok ? 0 : -1;
+}
+
+static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads,
+                         cm_rbf_tick *tick)
+{
+    cm_rbf_iter *it = r->iter;
+    const size_t nc = (size_t)r->ncomp;
+    const double target = r->tun.fast_eval_tol * it->scales.fmax;
+    it->eval_fast = 0;
+    it->eval_error = 0.0;
+    if (!(target > 0.0)) return 0;
+    double *s = malloc(nc * sizeof *s), smax = 0.0;
+    const int ok = s && sampled_abs_sums(r, n, p, 64, s, threads) == 0;
+    for (size_t c = 0; ok && c < nc; ++c) smax = fmax(smax, s[c]);
+    free(s);
     if (!ok) return 0;
     /* what the direct fallback itself can promise (see above) */
     const double accept = fmax(target, CM_RBF_PHI_ROUND * DBL_EPSILON * smax);
@@ -156,7 +177,7 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
             cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC));
         if (!t || tree_sum_all(r, t, tg, 1, out, threads, tick)) break;
         const double err = check_all(r, t, n, p, out, CM_RBF_FAST_SAMPLES, NULL, threads);
-        it->eval_error = CM_RBF_FAST_SAFETY * err / it->fmax;
+        it->eval_error = CM_RBF_FAST_SAFETY * err / it->scales.fmax;
         it->eval_fast = CM_RBF_FAST_SAFETY * err <= accept;
         it->eval_order = o;
         it->eval_theta = th;
@@ -176,17 +197,36 @@ int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, d
     return 0;
 }
 
-void cm_rbf_iterative_set_scale(cm_rbf *r, double fmax) { r->iter->fmax = fmax; }
+/* 1 if plain direct sums of the fit's weights at the n points p are within its tolerance
+ * (see the top of the file). */
+static int plain_enough(const cm_rbf *r, size_t n, const double *p, int threads)
+{
+    const cm_rbf_scales *sc = &r->iter->scales;
+    const size_t nc = (size_t)r->ncomp;
+    if (sc->n != nc || !(r->opt.tolerance > 0.0)) return 0;
+    double *s = malloc(nc * sizeof *s);
+    int ok = s && sampled_abs_sums(r, n, p, CM_RBF_FAST_SAMPLES, s, threads) == 0;
+    for (size_t c = 0; ok && c < nc; ++c)
+        ok = CM_RBF_PLAIN_ERR * fmax(s[c], sc->smax[c]) <=
+             CM_RBF_PLAIN_RES_SHARE * r->opt.tolerance * sc->fnorm[c];
+    free(s);
+    return ok;
+}
 
 int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
                               int threads, cm_rbf_tick *tick)
 {
+    r->iter->eval_plain = 0;
     if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads, tick)) return 0;
     if (tick && tick->status < 0) return 1;
     /* direct sums: a tick of their own, in point-centre pairs */
     if (tick)
         cm_rbf_tick_restart(tick, (double)((r->ncomp + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) *
                                       (double)n * (double)r->m);
+    if (plain_enough(r, n, p, threads)) {
+        r->iter->eval_plain = 1;
+        return cm_rbf_kernel_sum_all_tick(r, r->w, r->ncomp, n, p, n, out, threads, tick);
+    }
     for (int g = 0; g < r->ncomp; g += CM_RBF_SUM_MAX_NC) {
         int nc = r->ncomp - g < CM_RBF_SUM_MAX_NC ? r->ncomp - g : CM_RBF_SUM_MAX_NC;
         if (cm_rbf_kernel_sum_acc_tick(r->m, r->c, r->w + (size_t)g * r->m, nc, n, p, n, out + g,
@@ -295,6 +335,7 @@ void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats)
 {
     if (!r->iter) return;
     stats->eval_fast = r->iter->eval_fast;
+    stats->eval_plain = r->iter->eval_plain;
     stats->eval_error = r->iter->eval_error;
     stats->eval_order = r->iter->eval_order;
     stats->eval_theta = r->iter->eval_theta;

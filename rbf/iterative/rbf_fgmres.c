@@ -274,6 +274,46 @@ static void relaxed_products(cm_context *ctx, const cm_rbf *r, krylov *kr, int c
     }
 }
 
+/* A w exactly for the n columns cols[] (in, out: their w and A w), the check of a start or of
+ * a cycle's end: compensated, or plain where that is exact enough. A loose tolerance does not
+ * need the compensated product (1.5-2x a plain one): from CM_RBF_PLAIN_RES_TOL, w and |w| are
+ * summed plainly in one pass (|w| rides along on the same kernel entries), and a column
+ * keeps its plain product if its bound, CM_RBF_PLAIN_ERR x S(w) / fnorm, is within
+ * CM_RBF_PLAIN_RES_SHARE of its tolerance (col.cb: its residual is judged with the bound
+ * added); the others are summed again, compensated. S(w) (col.smax) then gives the floor and
+ * the evaluation's scale without a pass of their own. */
+static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
+                           double *const *in, double *const *out, int threads)
+{
+    const size_t m = kr->m;
+    const int plain = r->opt.tolerance >= CM_RBF_PLAIN_RES_TOL && kr->R >= 2;
+    double **pi = plain ? malloc(4 * (size_t)n * sizeof *pi) : NULL;
+    if (!pi) {
+        cm_krylov_matvec_kind(r, kr, MV_COMP, 0, n, in, out, threads);
+        return;
+    }
+    double **po = pi + 2 * n;
+    for (int u = 0; u < n; ++u) {
+        kcol *k = &kr->col[cols[u]];
+        pi[u] = in[u];
+        po[u] = out[u];
+        pi[n + u] = k->z; /* Z is free between cycles */
+        po[n + u] = k->z + m;
+        for (size_t i = 0; i < m; ++i) k->z[i] = fabs(in[u][i]);
+    }
+    cm_krylov_matvec_kind(r, kr, MV_PLAIN, 0, 2 * n, pi, po, threads);
+    int nc = 0;
+    for (int u = 0; u < n; ++u) {
+        kcol *k = &kr->col[cols[u]];
+        k->smax = cm_krylov_norm_inf(m, po[n + u]);
+        const double bound = k->fnorm > 0.0 ? CM_RBF_PLAIN_ERR * k->smax / k->fnorm : 0.0;
+        if (bound <= CM_RBF_PLAIN_RES_SHARE * k->tol) k->cb = bound;
+        else pi[nc] = in[u], po[nc++] = out[u];
+    }
+    cm_krylov_matvec_kind(r, kr, MV_COMP, 0, nc, pi, po, threads);
+    free(pi);
+}
+
 /* Solves the ns columns sel[] of f (g x m SoA) into w + kr->wlo (high and low parts), each
  * to its own col[c].tol relative to col[c].fnorm; a column with col[c].warm starts from the
  * w it holds if that leaves a residual below |f_c| (else from zero, and warm is cleared).
@@ -312,11 +352,14 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
         int nw = 0;
         for (int u = 0; u < n; ++u) {
             const int c = list[u];
+            kr->col[c].cb = 0.0;
+            kr->col[c].smax = -1.0;
             if (cycle == 0 && !kr->col[c].warm) continue;
             in[nw] = w + (size_t)c * m;
             out[nw] = aw + (size_t)c * m;
             p3[nw] = kr->wlo + (size_t)c * m;
             p4[nw] = kr->awlo + (size_t)c * m;
+            fl[nw] = c;
             ++nw;
         }
         if (nw > 0) {
@@ -324,7 +367,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
              * |w| small, by plain sums or the loosest treecode (its error, 1e-6 S(wlo), is
              * 1e-22 S(w)) */
             if (kr->tree) cm_krylov_matvec(r, kr, nw, in, out, threads);
-            else cm_krylov_matvec_kind(r, kr, MV_COMP, 0, nw, in, out, threads);
+            else check_products(r, kr, nw, fl, in, out, threads);
             if (cycle > 0) {
                 if (kr->tree) cm_krylov_matvec(r, kr, nw, p3, p4, threads);
                 else cm_krylov_matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, nw, p3, p4,
@@ -352,25 +395,31 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
                 }
             }
             k->res = k->fnorm > 0.0 ? rn / k->fnorm : 0.0;
-            if (k->res <= k->tol) k->state = 1;
+            if (k->res + k->cb <= k->tol) k->state = 1;
             else if (cycle > 0) fl[nfl++] = c;
         }
-        /* the attainable floor: the rounding error of the sums A w themselves */
+        /* the attainable floor: the rounding error of the sums A w themselves (S(w) of a
+         * plain check is already summed) */
         if (nfl > 0) {
+            int ns = 0;
             for (int u = 0; u < nfl; ++u) {
-                const int c = fl[u];
-                p3[u] = kr->col[c].z; /* Z is free between cycles */
-                p4[u] = kr->col[c].z + m;
-                for (size_t i = 0; i < m; ++i) p3[u][i] = fabs(w[(size_t)c * m + i]);
+                const kcol *k = &kr->col[fl[u]];
+                if (k->smax >= 0.0) continue;
+                p3[ns] = k->z; /* Z is free between cycles */
+                p4[ns] = k->z + m;
+                for (size_t i = 0; i < m; ++i) p3[ns][i] = fabs(w[(size_t)fl[u] * m + i]);
+                ++ns;
             }
             /* positive weights: plain sums are exact to ~1e-14 of the result, the loosest
              * treecode to 1e-6, enough for an estimate */
-            if (kr->tree) cm_krylov_matvec(r, kr, nfl, p3, p4, threads);
-            else cm_krylov_matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, nfl, p3, p4,
+            if (ns == 0);
+            else if (kr->tree) cm_krylov_matvec(r, kr, ns, p3, p4, threads);
+            else cm_krylov_matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, ns, p3, p4,
                              threads);
-            for (int u = 0; u < nfl; ++u) {
+            for (int u = 0, v = 0; u < nfl; ++u) {
                 kcol *k = &kr->col[fl[u]];
-                k->floor = DBL_EPSILON * cm_krylov_norm_inf(m, p4[u]) / k->fnorm;
+                if (k->smax < 0.0) k->smax = cm_krylov_norm_inf(m, p4[v++]);
+                k->floor = DBL_EPSILON * k->smax / k->fnorm;
                 /* a cycle that does not halve the residual has stagnated: at the floor if
                  * within CM_RBF_FLOOR_SLACK of it, else a failure to converge */
                 if (k->res > 0.5 * k->prev)

@@ -48,10 +48,7 @@
  * residual, 320 of 1,044 CPU s on Zen 5, where S(w) is 1.9e5 x max |f| and the bound 1.9e-8
  * (measured plain errors are 7x below it; RESULTS.md, RBF solvers). The caller adds the
  * bound to the residual it compares with the tolerance. Only tried from a relative
- * tolerance of CM_RBF_PLAIN_RES_TOL: on real sets S(w) is 1e4..1e9 x max |f|, so below it
- * the loose treecode's product on |w| would be spent for nothing. absw, out: g x m scratch. */
-#define CM_RBF_PLAIN_RES_TOL 1e-8
-#define CM_RBF_PLAIN_RES_SHARE 0.1
+ * tolerance of CM_RBF_PLAIN_RES_TOL (rbf_iter.h). absw, out: g x m scratch. */
 static void plain_bounds(const cm_rbf *r, krylov *kr, int n, const int *list, const double *w,
                          double tol, double *absw, double *out, int threads)
 {
@@ -364,7 +361,6 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     const cm_rbf_tuning *tu = &r->tun;
     const int R = o->restart < 63 ? o->restart : 63;
     /* put back if the solve fails or stops: the weights stay the last solve's */
-    const double fmax_before = r->iter->fmax;
     const int fast = o->fast_sum == 1 || (o->fast_sum < 0 && m >= CM_RBF_FAST_MIN_M);
     /* the columns in groups that fit the memory budget (half the machine's by default) */
     const double budget = tu->krylov_budget > 0.0 ? tu->krylov_budget : cm_memory_budget();
@@ -389,7 +385,9 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         goto done;
     }
     const double fmax_all = cm_krylov_norm_inf(nc * m, f);
-    cm_rbf_iterative_set_scale(r, fmax_all);
+    /* out of memory there only costs the evaluation its plain sums */
+    cm_rbf_scales *scales =
+        cm_rbf_iterative_scales_begin(r, nc, fmax_all) == 0 ? &r->iter->next : NULL;
     if (fast) {
         int order;
         double theta;
@@ -476,6 +474,10 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         for (int c = 0; c < g; ++c) {
             const kcol *kc = &kr.col[c];
             col_iters[c0 + (size_t)c] = kc->iters;
+            if (scales) { /* S(w) if a plain check summed it (not an inner solve's) */
+                scales->fnorm[c0 + (size_t)c] = kc->fnorm;
+                scales->smax[c0 + (size_t)c] = fast ? -1.0 : kc->smax;
+            }
             if (kc->iters > maxit) maxit = kc->iters;
             if (kc->floor * kc->fnorm > floor_max * fmax_all)
                 floor_max = fmax_all > 0.0 ? kc->floor * kc->fnorm / fmax_all : 0.0;
@@ -517,21 +519,29 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             cm_krylov_project(r->iter->q1, m, r->k, pb);
             cm_rbf_history_add(hist, w + c * m, pb);
         }
-    /* the attainable exactness of plain direct sums of these weights (what cm_rbf_evaluate
-     * gives at the centres): eps max_i sum_j |w_j| phi_ij, for all columns in one pass (per
-     * group of the memory budget). An estimate: the treecode's error on positive weights is
+    /* the attainable exactness of plain direct sums of these weights: S(w) = max_i sum_j
+     * |w_j| phi_ij, for all columns in one pass (per group of the memory budget) but those
+     * whose plain check summed it: the floor, eps S(w), and each column's smax (whether the
+     * evaluation may sum plainly). An estimate: the treecode's error on positive weights is
      * fast_tol (or, the loosest relaxed one, 1e-6) of the sum; counted with the products */
     for (size_t c0 = 0; c0 < nc; c0 += gsize) {
         const int g = nc - c0 < gsize ? (int)(nc - c0) : (int)gsize;
+        int ns = 0;
         for (int u = 0; u < g; ++u) {
-            kr.pa[u] = kr.aux + (size_t)u * m;
-            kr.pb[u] = kr.awlo + (size_t)u * m;
-            for (size_t i = 0; i < m; ++i) kr.pa[u][i] = fabs(w[(c0 + (size_t)u) * m + i]);
+            if (scales && scales->smax[c0 + (size_t)u] >= 0.0) continue;
+            kr.pa[ns] = kr.aux + (size_t)ns * m;
+            kr.pb[ns] = kr.awlo + (size_t)ns * m;
+            for (size_t i = 0; i < m; ++i) kr.pa[ns][i] = fabs(w[(c0 + (size_t)u) * m + i]);
+            ++ns;
         }
-        if (kr.tree) cm_krylov_matvec(r, &kr, g, kr.pa, kr.pb, threads);
-        else cm_krylov_matvec_kind(r, &kr, kr.relax_tree ? MV_FAST : MV_PLAIN, 0, g, kr.pa, kr.pb, threads);
-        if (fmax_all > 0.0)
-            floor_max = fmax(floor_max, DBL_EPSILON * cm_krylov_norm_inf((size_t)g * m, kr.awlo) / fmax_all);
+        if (kr.tree) cm_krylov_matvec(r, &kr, ns, kr.pa, kr.pb, threads);
+        else cm_krylov_matvec_kind(r, &kr, kr.relax_tree ? MV_FAST : MV_PLAIN, 0, ns, kr.pa, kr.pb, threads);
+        for (int u = 0, v = 0; u < g; ++u) {
+            double *s = scales ? &scales->smax[c0 + (size_t)u] : NULL;
+            const double sm = s && *s >= 0.0 ? *s : cm_krylov_norm_inf(m, kr.pb[v++]);
+            if (s) *s = sm;
+            if (fmax_all > 0.0) floor_max = fmax(floor_max, DBL_EPSILON * sm / fmax_all);
+        }
     }
     r->stats.iterations = maxit;
     r->stats.matvecs = mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST];
@@ -566,7 +576,6 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                       stagnated ? "stagnated" : maxed ? "reached max_iterations" : "stopped",
                       maxit, worst, o->tolerance, floor_max);
 done:
-    if (st < 0) cm_rbf_iterative_set_scale(r, fmax_before);
     krylov_free(&kr);
     free(aw);
     return st;

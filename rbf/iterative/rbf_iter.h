@@ -43,15 +43,41 @@ size_t cm_rbf_history_start(const cm_rbf_history *h, double *pf, double *w0);
 int cm_rbf_history_add(cm_rbf_history *h, const double *w, const double *pb);
 size_t cm_rbf_history_bytes(const cm_rbf_history *h);
 
+/* Plain direct sums err by at most this x S(z) = max_i sum_j |z_j| phi_ij (rbf_fgmres.c,
+ * relaxed products); where a result need only be exact to a tolerance they may take this
+ * share of it (the solve's exact residuals, rbf_fgmres_solve.c; the evaluation,
+ * rbf_evaluate.c). */
+#define CM_RBF_PLAIN_ERR 1e-13
+#define CM_RBF_PLAIN_RES_SHARE 0.1
+/* ... tried only from this relative tolerance: on real sets S(w) is 1e4..1e9 x max |f|, so
+ * below it the product on |w| that bounds them would be spent for nothing */
+#define CM_RBF_PLAIN_RES_TOL 1e-8
+
+/* What the evaluation needs to know of a solve's weights, by column: the data scale its
+ * tolerances are relative to, and how far plain direct sums of the weights can be trusted.
+ * A solve writes them into cm_rbf_iter.next; cm_rbf_solve commits them to .scales with the
+ * weights (cm_rbf_iterative_commit), so a solve that fails or that is not the fit's (the
+ * transposed one) leaves the evaluation as it was. */
+typedef struct cm_rbf_scales {
+    double fmax;   /* max |data| over all columns: the scale of fast_eval_tol */
+    size_t n;      /* columns below; 0 if unknown (a PETSc solve) */
+    double *fnorm; /* column c: the scale of its tolerance (max |data_c|, or the share
+                    * column_scale of fmax if that is larger) */
+    double *smax;  /* column c: max_i sum_j |w_j| phi_ij at the centres, the scale of the
+                    * rounding of plain sums (rbf_evaluate.c) */
+} cm_rbf_scales;
+
 struct cm_rbf_iter {
     cm_rbf_schwarz *pc;
     double *q1; /* m x k col-major, orthonormal basis of the polynomials at the centres */
     cm_rbf_tree *tree; /* treecode on the centres, for the order below (NULL: none yet) */
     int tree_order;
     double tree_theta;
-    double fmax;       /* max |data| of the last solve: the scale of fast_eval_tol */
+    cm_rbf_scales scales; /* of the fit's weights (committed by cm_rbf_solve) */
+    cm_rbf_scales next;   /* of the last solve's, until committed */
     int eval_fast;     /* the last evaluation's choice and estimate (evaluation gets a
                         * const cm_rbf, the iterative state is where it can leave them) */
+    int eval_plain;    /* the last evaluation by plain direct sums */
     double eval_error;
     int eval_order;    /* the row it took */
     double eval_theta;

@@ -12,6 +12,28 @@ const double *cm_rbf_iterative_q1(const cm_rbf *r) { return r->iter ? r->iter->q
 
 const cm_rbf_schwarz *cm_rbf_iterative_pc(const cm_rbf *r) { return r->iter ? r->iter->pc : NULL; }
 
+int cm_rbf_iterative_scales_begin(cm_rbf *r, size_t nc, double fmax)
+{
+    cm_rbf_scales *s = &r->iter->next;
+    s->fmax = fmax;
+    s->n = 0;
+    if (nc == 0) return 0;
+    double *a = realloc(s->fnorm, 2 * nc * sizeof *a); /* fnorm and smax in one block */
+    if (!a) return -1;
+    s->fnorm = a;
+    s->smax = a + nc;
+    for (size_t c = 0; c < 2 * nc; ++c) a[c] = 0.0;
+    s->n = nc;
+    return 0;
+}
+
+void cm_rbf_iterative_commit(cm_rbf *r)
+{
+    const cm_rbf_scales t = r->iter->scales;
+    r->iter->scales = r->iter->next;
+    r->iter->next = t;
+}
+
 void cm_rbf_iterative_destroy(cm_rbf_iter **it)
 {
     if (!it || !*it) return;
@@ -22,6 +44,8 @@ void cm_rbf_iterative_destroy(cm_rbf_iter **it)
     cm_rbf_tree_destroy(&(*it)->rtree[2]);
     free((*it)->q1);
     free((*it)->col_iters);
+    free((*it)->scales.fnorm);
+    free((*it)->next.fnorm);
     cm_rbf_history_destroy(&(*it)->hist);
     free(*it);
     *it = NULL;

@@ -9,8 +9,6 @@
 /* The rounding error of one direct sum A w is at most about eps sum_j |w_j phi_ij|; the
  * error of a whole solve, observed, stays within this factor of that estimate. */
 #define CM_RBF_FLOOR_SLACK 10.0
-/* plain direct sums err by at most this x S(z) (rbf_fgmres.c, relaxed products) */
-#define CM_RBF_PLAIN_ERR 1e-13
 /* The kernel sums take at most CM_RBF_SUM_MAX_NC columns per call (rbf_internal.h):
  * cm_krylov_product() is the one place that cuts the active columns into such chunks. */
 
@@ -32,6 +30,8 @@ typedef struct kcol {
                      * budget: its Krylov space needs huge coefficients) */
     /* the solve */
     double fnorm;   /* the column's scale (CM_RBF_COL_SCALE) */
+    double cb;      /* bound on the error of the last exact residual (a plain check), else 0 */
+    double smax;    /* max_i sum_j |w_j| phi_ij of w at the last check, -1 if not summed */
     double tol;     /* relative tolerance of this (inner) solve */
     double prev, res, target, est, cycle0, goal, floor;
     double sz, allow, tau; /* relaxed product of the current step */

@@ -397,7 +397,7 @@ cm_status cm_rbf_petsc_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double
     for (size_t i = 0; i < nc * m; ++i) fmax_all = fmax(fmax_all, fabs(f[i]));
     /* without it the evaluation would never take the treecode where the serial one does:
      * interior nodes 1.1e-9 of the range apart on bracket 60.6k (RESULTS.md, RBF solvers) */
-    cm_rbf_iterative_set_scale(r, fmax_all);
+    cm_rbf_iterative_scales_begin(r, 0, fmax_all);
     ps->matvecs = 0;
     int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, gmax = 0;
     double worst = 0.0, floor_max = 0.0;

@@ -1,12 +1,14 @@
 /* Tests of the iterative RBF solver (FGMRES + two-level restricted Schwarz): agreement with
  * the dense solver on a box-with-bore boundary set, affine data, two bodies far apart,
- * thread-count independence, the solver choice and the option checks. */
+ * thread-count independence, plain evaluation at a loose tolerance, the solver choice and the
+ * option checks. */
 #include "cadmorph/rbf.h"
 #include "rbf_internal.h"
 #include "rbf_tuning.h"
 #include "rbf_test_sets.h"
 #include "test_util.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -233,6 +235,57 @@ static void test_storage(cm_context *ctx)
     free(x), free(d), free(p);
 }
 
+/* A loose tolerance evaluates with plain sums (their rounding, a tenth of it at most, is all
+ * the fit needs: rbf_evaluate.c), checks its residuals by plain sums, and still reproduces
+ * the data to the tolerance; the default stays compensated. The scales that choice goes by are the forward solve's: a transposed
+ * evaluation in between changes neither the choice nor a bit of the result. */
+static void test_loose_evaluation(cm_context *ctx)
+{
+    double *x = NULL, *d = NULL;
+    size_t m = bore_set(0.09, &x, &d), np;
+    double *p = eval_points(m, x, 500, 0.3, &np);
+    double *out = malloc(np * 3 * sizeof *out), *again = malloc(np * 3 * sizeof *again);
+    double *ref = malloc(np * 3 * sizeof *ref), *v = malloc(np * 3 * sizeof *v);
+    double *g = malloc(m * 3 * sizeof *g);
+    for (size_t i = 0; i < np * 3; ++i) v[i] = sin(0.37 * (double)i);
+    const double range = range_of(m * 3, d);
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    cm_rbf_stats st0;
+    cm_status s0 = fit_eval(ctx, CM_RBF_SOLVER_ITERATIVE, m, x, d, np, p, ref, &st0);
+    o.tolerance = 1e-6;
+    cm_rbf *r = NULL;
+    cm_status s = cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m, x, &o, &r);
+    if (s == CM_OK) s = cm_rbf_solve(ctx, r, 3, d);
+    if (s == CM_OK) s = cm_rbf_evaluate(ctx, r, np, p, out);
+    cm_rbf_stats st;
+    cm_rbf_get_stats(r, &st);
+    CHECK_MSG(s0 == CM_OK && s == CM_OK, "%s", cm_context_message(ctx));
+    const double at_centres = max_diff(m * 3, out, d) / range;
+    const double to_exact = max_diff(np * 3, out, ref) / range;
+    printf("loose evaluation: m = %zu, tolerance 1e-6: %s sums, residual %.3g, data missed by "
+           "%.3g, %.3g from the 1e-10 fit (%s sums); floor %.3g; products compensated + plain "
+           "%d + %d (1e-10: %d + %d)\n", m,
+           st.eval_plain ? "plain" : "compensated", st.residual, at_centres, to_exact,
+           st0.eval_plain ? "plain" : "compensated", st.floor, st.matvecs_compensated,
+           st.matvecs_plain, st0.matvecs_compensated, st0.matvecs_plain);
+    CHECK(st.eval_plain == 1 && st0.eval_plain == 0 && st.eval_fast == 0);
+    /* the exact residuals of a loose solve are plain sums too */
+    CHECK_MSG(st.matvecs_compensated < st0.matvecs_compensated, "%d, 1e-10: %d",
+              st.matvecs_compensated, st0.matvecs_compensated);
+    CHECK_MSG(at_centres <= 1.1e-6, "%.3g", at_centres);
+    /* the interior moves by about the tolerance x the motion, no more */
+    CHECK_MSG(to_exact <= 1e-5, "%.3g", to_exact);
+    if (s == CM_OK) s = cm_rbf_evaluate_transpose(ctx, r, np, p, 3, v, g);
+    if (s == CM_OK) s = cm_rbf_evaluate(ctx, r, np, p, again);
+    cm_rbf_get_stats(r, &st);
+    CHECK_MSG(s == CM_OK, "%s", cm_context_message(ctx));
+    CHECK(st.eval_plain == 1 && memcmp(out, again, np * 3 * sizeof *out) == 0);
+    cm_rbf_destroy(&r);
+    free(x), free(d), free(p), free(out), free(again), free(ref), free(v), free(g);
+}
+
 /* Two parts far apart (10 part sizes): the coarse space and the subdomains must not couple
  * them wrongly, and the null space is that of the whole set. */
 static void test_two_bodies(cm_context *ctx)
@@ -372,6 +425,7 @@ int main(void)
     test_against_dense(ctx);
     test_affine(ctx);
     test_storage(ctx);
+    test_loose_evaluation(ctx);
     test_two_bodies(ctx);
     test_choice(ctx);
     cm_context_destroy(&ctx);
