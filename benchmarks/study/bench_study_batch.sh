@@ -9,7 +9,9 @@
 #   bore:    `cadmorph model bore` meshed by TetGen at sizes 0.25 0.15 0.12 (as bench_study.sh),
 #            the last variant alone and all 20 with --batch 1 and auto; with SOLVERS="auto dense
 #            iterative" instead the last variant alone and all 20 (batch auto) with each
-#            --solver, side by side (the solver AUTO took is in the table's solver column).
+#            --solver, side by side (the solver AUTO took is in the table's solver column);
+#            with TOLS="default 1e-6" the studies of each size once per warp tolerance
+#            (--rbf-tol; default: none given), side by side.
 # One table row per study: wall and CPU seconds (/usr/bin/time), their ratios to the one-variant
 # study, and from study.csv (seconds of wall time, per variant the median over the variants):
 # the factorisation (t_volume_solve, once), the warp apply (t_evaluation: the iterative solve
@@ -20,7 +22,7 @@
 # usage: bench_study_batch.sh BUILD_DIR WORK_DIR [THREADS] [bracket|bore|all]
 # environment: BRACKET_MESH=M.vtu reuses a TetGen mesh of bracket 0 at that size (meshing it
 # takes minutes); BATCHES="1 5 10 20" and NVAR=20 (the bracket's batch sizes and variants);
-# SOLVERS (bore, above); CADMORPH=path of the CLI.
+# SOLVERS and TOLS (bore, above); CADMORPH=path of the CLI.
 set -eu
 usage="usage: bench_study_batch.sh BUILD_DIR WORK_DIR [THREADS] [bracket|bore|all]"
 build=${1:?$usage}
@@ -43,13 +45,16 @@ variants() { # MODEL DIR
     cp "$2/vN/$1_$(printf %02d "$nvar").step" "$2/v1/"
 }
 
-# One study: DIR MESH LIST TAG BATCH [SOLVER] (its debug log in DIR/log_TAG.txt)
+# One study: DIR MESH LIST TAG BATCH [SOLVER [TOL]] (its debug log in DIR/log_TAG.txt)
 study() {
+    tolopt=
+    [ "${7:-default}" = default ] || tolopt="--rbf-tol $7"
+    # shellcheck disable=SC2086
     /usr/bin/time -f "wall_s=%e user_s=%U sys_s=%S max_kb=%M" -o "$1/time_$4.txt" \
         "$cadmorph" study --from "$1/G0.step" --mesh "$2" --variants "$3" -o "$1/out_$4" \
         --mode absolute --methods rbf-s --write-meshes none --batch "$5" \
-        --solver "${6:-auto}" --threads "$threads" --verbose >/dev/null 2>"$1/log_$4.txt" ||
-        [ $? -eq 3 ]
+        --solver "${6:-auto}" $tolopt --threads "$threads" --verbose >/dev/null \
+        2>"$1/log_$4.txt" || [ $? -eq 3 ]
 }
 
 # The table rows of DIR's studies TAG... (the first: the one-variant study)
@@ -109,10 +114,13 @@ if [ "$part" = bore ] || [ "$part" = all ]; then
         [ -e "$mesh" ] || "$cadmorph" mesh "$d/G0.step" -o "$mesh" --size "$size" \
             --mesher tetgen >/dev/null
         if [ -z "${SOLVERS:-}" ]; then
-            study "$d" "$mesh" "$d/v1/*.step" 1_1 1
-            study "$d" "$mesh" "$d/vN/*.step" "${nvar}_1" 1
-            study "$d" "$mesh" "$d/vN/*.step" "${nvar}_auto" auto
-            table "$d" "bore $size" 1_1 "${nvar}_1" "${nvar}_auto"
+            for tol in ${TOLS:-default}; do
+                study "$d" "$mesh" "$d/v1/*.step" "1_1_$tol" 1 auto "$tol"
+                study "$d" "$mesh" "$d/vN/*.step" "${nvar}_1_$tol" 1 auto "$tol"
+                study "$d" "$mesh" "$d/vN/*.step" "${nvar}_auto_$tol" auto auto "$tol"
+                table "$d" "bore $size, --rbf-tol $tol" "1_1_$tol" "${nvar}_1_$tol" \
+                    "${nvar}_auto_$tol"
+            done
             continue
         fi
         for sv in $SOLVERS; do
