@@ -280,38 +280,50 @@ static void relaxed_products(cm_context *ctx, const cm_rbf *r, krylov *kr, int c
  * summed plainly in one pass (|w| rides along on the same kernel entries), and a column
  * keeps its plain product if its bound, CM_RBF_PLAIN_ERR x S(w) / fnorm, is within
  * CM_RBF_PLAIN_RES_SHARE of its tolerance (col.cb: its residual is judged with the bound
- * added); the others are summed again, compensated. S(w) (col.smax) then gives the floor and
- * the evaluation's scale without a pass of their own. */
+ * added); the others are summed again, compensated, and so are their later checks in this
+ * solve (col.comp_only: S(w) changes little from cycle to cycle). S(w) (col.smax) then gives
+ * the floor and the evaluation's scale without a pass of their own. */
 static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
                            double *const *in, double *const *out, int threads)
 {
     const size_t m = kr->m;
     const int plain = r->opt.tolerance >= CM_RBF_PLAIN_RES_TOL && kr->R >= 2;
-    double **pi = plain ? malloc(4 * (size_t)n * sizeof *pi) : NULL;
-    if (!pi) {
+    double **pi = plain ? malloc(6 * (size_t)n * sizeof *pi) : NULL;
+    int *at = plain ? malloc((size_t)n * sizeof *at) : NULL;
+    if (!pi || !at) {
+        free(pi), free(at);
         cm_krylov_matvec_kind(r, kr, MV_COMP, 0, n, in, out, threads);
         return;
     }
-    double **po = pi + 2 * n;
-    for (int u = 0; u < n; ++u) {
-        kcol *k = &kr->col[cols[u]];
-        pi[u] = in[u];
-        po[u] = out[u];
-        pi[n + u] = k->z; /* Z is free between cycles */
-        po[n + u] = k->z + m;
-        for (size_t i = 0; i < m; ++i) k->z[i] = fabs(in[u][i]);
+    double **po = pi + 2 * n, **ci = pi + 4 * n, **co = pi + 5 * n;
+    int np = 0, nc = 0;
+    for (int u = 0; u < n; ++u) /* the columns tried plainly: w, then |w| (in Z) */
+        if (!kr->col[cols[u]].comp_only) at[np++] = u;
+    for (int v = 0; v < np; ++v) {
+        kcol *k = &kr->col[cols[at[v]]];
+        pi[v] = in[at[v]];
+        po[v] = out[at[v]];
+        pi[np + v] = k->z; /* Z is free between cycles */
+        po[np + v] = k->z + m;
+        for (size_t i = 0; i < m; ++i) k->z[i] = fabs(in[at[v]][i]);
     }
-    cm_krylov_matvec_kind(r, kr, MV_PLAIN, 0, 2 * n, pi, po, threads);
-    int nc = 0;
-    for (int u = 0; u < n; ++u) {
+    cm_krylov_matvec_kind(r, kr, MV_PLAIN, 0, 2 * np, pi, po, threads);
+    for (int u = 0, v = 0; u < n; ++u) {
         kcol *k = &kr->col[cols[u]];
-        k->smax = cm_krylov_norm_inf(m, po[n + u]);
-        const double bound = k->fnorm > 0.0 ? CM_RBF_PLAIN_ERR * k->smax / k->fnorm : 0.0;
-        if (bound <= CM_RBF_PLAIN_RES_SHARE * k->tol) k->cb = bound;
-        else pi[nc] = in[u], po[nc++] = out[u];
+        if (v < np && at[v] == u) {
+            k->smax = cm_krylov_norm_inf(m, po[np + v++]);
+            const double bound = k->fnorm > 0.0 ? CM_RBF_PLAIN_ERR * k->smax / k->fnorm : 0.0;
+            if (bound <= CM_RBF_PLAIN_RES_SHARE * k->tol) {
+                k->cb = bound;
+                continue;
+            }
+            k->comp_only = 1;
+        }
+        ci[nc] = in[u];
+        co[nc++] = out[u];
     }
-    cm_krylov_matvec_kind(r, kr, MV_COMP, 0, nc, pi, po, threads);
-    free(pi);
+    cm_krylov_matvec_kind(r, kr, MV_COMP, 0, nc, ci, co, threads);
+    free(pi), free(at);
 }
 
 /* Solves the ns columns sel[] of f (g x m SoA) into w + kr->wlo (high and low parts), each
@@ -336,6 +348,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
         k->est = 0.0;
         k->grow = 1.0;
         k->exact = 0;
+        k->comp_only = 0;
         k->jn = 0;
         if (!k->warm) memset(w + (size_t)c * m, 0, m * sizeof(double));
         memset(aw + (size_t)c * m, 0, m * sizeof(double));
@@ -412,8 +425,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             }
             /* positive weights: plain sums are exact to ~1e-14 of the result, the loosest
              * treecode to 1e-6, enough for an estimate */
-            if (ns == 0);
-            else if (kr->tree) cm_krylov_matvec(r, kr, ns, p3, p4, threads);
+            if (kr->tree) cm_krylov_matvec(r, kr, ns, p3, p4, threads);
             else cm_krylov_matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, ns, p3, p4,
                              threads);
             for (int u = 0, v = 0; u < nfl; ++u) {

@@ -360,7 +360,6 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     const cm_rbf_options *o = &r->opt;
     const cm_rbf_tuning *tu = &r->tun;
     const int R = o->restart < 63 ? o->restart : 63;
-    /* put back if the solve fails or stops: the weights stay the last solve's */
     const int fast = o->fast_sum == 1 || (o->fast_sum < 0 && m >= CM_RBF_FAST_MIN_M);
     /* the columns in groups that fit the memory budget (half the machine's by default) */
     const double budget = tu->krylov_budget > 0.0 ? tu->krylov_budget : cm_memory_budget();

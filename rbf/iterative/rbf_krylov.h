@@ -32,6 +32,8 @@ typedef struct kcol {
     double fnorm;   /* the column's scale (CM_RBF_COL_SCALE) */
     double cb;      /* bound on the error of the last exact residual (a plain check), else 0 */
     double smax;    /* max_i sum_j |w_j| phi_ij of w at the last check, -1 if not summed */
+    int comp_only;  /* its checks in this solve are compensated (a plain one was not exact
+                     * enough) */
     double tol;     /* relative tolerance of this (inner) solve */
     double prev, res, target, est, cycle0, goal, floor;
     double sz, allow, tau; /* relaxed product of the current step */
