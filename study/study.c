@@ -266,6 +266,17 @@ static int owns(const study *w, const series *se, size_t i)
     return (int)(se->method % (size_t)ranks) == w->o->rank;
 }
 
+/* Whether this rank says what is wrong with variant i itself: of the ranks that load it, one
+ * (a serial study says it once): the rank of its absolute rows, or without those rank 0 (the
+ * first method's relative series: every variant). */
+static int says_variant(const study *w, size_t i)
+{
+    const int ranks = w->o->ranks > 1 ? w->o->ranks : 1;
+    if (ranks == 1) return 1;
+    if (w->o->modes & CM_STUDY_ABSOLUTE) return (int)(i % (size_t)ranks) == w->o->rank;
+    return w->o->rank == 0;
+}
+
 /* Reads variant i and checks it against G0; one that cannot be used is a row with its error
  * for each series this rank runs. */
 static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
@@ -279,7 +290,7 @@ static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
     double t0 = cm_wtime();
     cm_cad_model *g = NULL;
     cm_status s = f->load(ctx, f->user, i, &g);
-    if (s == CM_WARNING)
+    if (s == CM_WARNING && says_variant(w, i))
         cm_log(ctx, CM_LOG_WARNING, "study: %s: %s", v->label, cm_context_message(ctx));
     /* checked here, before any morpher sees g: a variant of another topology touches none */
     if (s >= 0) {
@@ -293,7 +304,8 @@ static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
     }
     cm_cad_destroy(&g);
     if (s == CM_ERR_NOMEM || s == CM_ERR_INTERRUPTED) return s;
-    cm_log(ctx, CM_LOG_WARNING, "study: variant %s: %s", v->label, cm_context_message(ctx));
+    if (says_variant(w, i))
+        cm_log(ctx, CM_LOG_WARNING, "study: variant %s: %s", v->label, cm_context_message(ctx));
     row_error(&v->base, s, cm_context_message(ctx)); /* every row of it */
     return CM_OK;
 }
