@@ -172,6 +172,36 @@ static int cmp_key(const void *a, const void *b)
     return x->at < y->at ? -1 : x->at > y->at;
 }
 
+/* How one rank's part of a distributed study ended. */
+typedef struct rank_outcome {
+    cm_status status;
+    char message[512];
+} rank_outcome;
+
+/* A distributed study ends as a serial one would: a rank's error (out of memory, a mesh that
+ * could not be written, an interrupt) ends every rank's study, or rank 0 would write the rows
+ * it has as the study's, the failed rank's missing. s: this rank's status; the result, the
+ * first error over the ranks (this rank's own when it has one: its message is in ctx). */
+static cm_status agree_status(cm_context *ctx, cm_status s)
+{
+    rank_outcome mine = {s, ""};
+    if (s < 0) snprintf(mine.message, sizeof mine.message, "%s", cm_context_message(ctx));
+    void *all = NULL;
+    size_t n = 0;
+    cm_status g = cm_parallel_allgather(ctx, &mine, 1, sizeof mine, &all, &n);
+    if (s < 0) {
+        free(all);
+        return s;
+    }
+    if (g < 0) return g;
+    const rank_outcome *got = all;
+    for (size_t q = 0; q < n && s >= 0; ++q)
+        if (got[q].status < 0)
+            s = cm_error(ctx, got[q].status, "rank %zu of %zu: %s", q, n, got[q].message);
+    free(all);
+    return s;
+}
+
 /* A distributed study: every rank's rows into r, variant-major as a serial study has them
  * (per variant in series order: mode, then method). */
 static cm_status gather_rows(cm_context *ctx, cm_study_result *r)
@@ -236,6 +266,17 @@ static int owns(const study *w, const series *se, size_t i)
     return (int)(se->method % (size_t)ranks) == w->o->rank;
 }
 
+/* Whether this rank says what is wrong with variant i itself: of the ranks that load it, one
+ * (a serial study says it once): the rank of its absolute rows, or without those rank 0 (the
+ * first method's relative series: every variant). */
+static int says_variant(const study *w, size_t i)
+{
+    const int ranks = w->o->ranks > 1 ? w->o->ranks : 1;
+    if (ranks == 1) return 1;
+    if (w->o->modes & CM_STUDY_ABSOLUTE) return (int)(i % (size_t)ranks) == w->o->rank;
+    return w->o->rank == 0;
+}
+
 /* Reads variant i and checks it against G0; one that cannot be used is a row with its error
  * for each series this rank runs. */
 static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
@@ -249,7 +290,7 @@ static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
     double t0 = cm_wtime();
     cm_cad_model *g = NULL;
     cm_status s = f->load(ctx, f->user, i, &g);
-    if (s == CM_WARNING)
+    if (s == CM_WARNING && says_variant(w, i))
         cm_log(ctx, CM_LOG_WARNING, "study: %s: %s", v->label, cm_context_message(ctx));
     /* checked here, before any morpher sees g: a variant of another topology touches none */
     if (s >= 0) {
@@ -263,7 +304,8 @@ static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
     }
     cm_cad_destroy(&g);
     if (s == CM_ERR_NOMEM || s == CM_ERR_INTERRUPTED) return s;
-    cm_log(ctx, CM_LOG_WARNING, "study: variant %s: %s", v->label, cm_context_message(ctx));
+    if (says_variant(w, i))
+        cm_log(ctx, CM_LOG_WARNING, "study: variant %s: %s", v->label, cm_context_message(ctx));
     row_error(&v->base, s, cm_context_message(ctx)); /* every row of it */
     return CM_OK;
 }
@@ -600,6 +642,7 @@ cm_status cm_study_run(cm_context *ctx, const cm_cad_model *g0, const cm_mesh *m
     if (ranks > 1) {
         cm_status g = gather_rows(ctx, w.r);
         if (s >= 0 && g < 0) s = g;
+        s = agree_status(ctx, s);
     }
     if (s < 0) {
         cm_study_result_destroy(&w.r);

@@ -156,7 +156,9 @@ typedef struct cm_study_options {
                                be split, so a relative study spreads over the ranks by
                                method), and writes their meshes; the result, on every rank,
                                has all rows in the serial order (cm_parallel_allgather).
-                               Every rank calls cm_study_run with the same inputs. */
+                               Every rank calls cm_study_run with the same inputs; an
+                               error on any rank is every rank's (its message names the
+                               rank), as it would end a serial study. */
     /* Absolute variants morphed together (cm_morpher_apply_batch: one multi-column warp
      * apply for the batch; rows equal to one-at-a-time to the solver's tolerance, in the same
      * order). 0 (default): a quarter of the variants (later batches start warm from the
