@@ -153,8 +153,10 @@ static int print_help(void)
         "again alone (its adaptive steps), so the rows are those of one at a time.\n\n"
         "mpirun -n K cadmorph study ... (builds with -DCADMORPH_WITH_PETSC=ON): the absolute\n"
         "morph of variant i runs on rank i mod K (each rank in its own batches), the relative\n"
-        "series of the m-th method on rank m mod K (a series is one chain: relative studies\n"
-        "spread by method); rank 0 writes study.csv and study.svg.\n\n"
+        "series of method m on rank m mod K (i and m counted from 0 in list order; a series is\n"
+        "one chain: relative studies spread by method); each rank writes its rows' meshes into\n"
+        "DIR, rank 0 study.csv and study.svg; an error on any rank ends the study. --threads is\n"
+        "per rank (give K x N no more than the cores).\n\n"
         "options:\n");
     cli_print_options(stdout, options, 22);
     printf("\n" CLI_PATCH_MOTION_OFF_CAD
