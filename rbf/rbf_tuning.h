@@ -89,8 +89,7 @@ typedef struct cm_rbf_tuning {
                            * residuals around the fast-matvec Krylov solve; 0: none (the final
                            * residual is then the treecode's, cheaper but not exact) */
     double fast_eval_tol; /* [1e-9] evaluation takes the fast sum only if its estimated error
-                           * is at most fast_eval_tol x max |data| (or a tenth of a looser
-                           * solve tolerance x max |data|), or at most the rounding
+                           * is at most fast_eval_tol x max |data|, or at most the rounding
                            * that direct sums have too (eval_error; else direct compensated
                            * sums) */
     int relax;            /* [1] relaxed-accuracy Krylov products (direct-matvec solves):

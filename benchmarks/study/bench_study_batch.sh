@@ -11,7 +11,7 @@
 #            iterative" instead the last variant alone and all 20 (batch auto) with each
 #            --solver, side by side (the solver AUTO took is in the table's solver column);
 #            with TOLS="default 1e-6" the studies of each size once per warp tolerance
-#            (--rbf-tol; default: none given), side by side.
+#            (--rbf-tol; default: none given), side by side (the bracket's too).
 # One table row per study: wall and CPU seconds (/usr/bin/time), their ratios to the one-variant
 # study, and from study.csv (seconds of wall time, per variant the median over the variants):
 # the factorisation (t_volume_solve, once), the warp apply (t_evaluation: the iterative solve
@@ -96,14 +96,16 @@ if [ "$part" = bracket ] || [ "$part" = all ]; then
     mesh=${BRACKET_MESH:-$d/M0_0.0528.vtu}
     [ -e "$mesh" ] || "$cadmorph" mesh "$d/G0.step" -o "$mesh" --size 0.0528 --mesher tetgen \
         --no-optimize >/dev/null
-    study "$d" "$mesh" "$d/v1/*.step" 1_1 1
-    tags=1_1
-    for b in ${BATCHES:-1 5 10 20}; do
-        study "$d" "$mesh" "$d/vN/*.step" "${nvar}_$b" "$b"
-        tags="$tags ${nvar}_$b"
+    for tol in ${TOLS:-default}; do
+        study "$d" "$mesh" "$d/v1/*.step" "1_1_$tol" 1 auto "$tol"
+        tags=1_1_$tol
+        for b in ${BATCHES:-1 5 10 20}; do
+            study "$d" "$mesh" "$d/vN/*.step" "${nvar}_${b}_$tol" "$b" auto "$tol"
+            tags="$tags ${nvar}_${b}_$tol"
+        done
+        # shellcheck disable=SC2086
+        table "$d" "bracket 0.0528, --rbf-tol $tol" $tags
     done
-    # shellcheck disable=SC2086
-    table "$d" "bracket 0.0528" $tags
 fi
 
 if [ "$part" = bore ] || [ "$part" = all ]; then

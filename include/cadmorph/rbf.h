@@ -35,8 +35,7 @@ typedef struct cm_rbf cm_rbf;
  *   treecode for r^3 [WK19], O(m log m), inside refinement steps on exact residuals, so the
  *   residual reported is the exact one. Memory O(m) times the subdomain size, time
  *   O(m^2) per iteration with direct sums. Evaluation of a large n x m takes the treecode
- *   where a sampled check shows its error within 1e-9 x max |data|, or a tenth of a looser
- *   tolerance (stats: eval_fast).
+ *   where a sampled check shows its error within 1e-9 x max |data| (stats: eval_fast).
  * AUTO: a cost model from BLAS and kernel-sum rates timed once per process puts the
  *   crossover near 3,500 centres for one solve: dense below (while 4 m^2 bytes fit in half
  *   the memory), iterative above; dense for the other kernels. The model counts the solves
@@ -138,11 +137,10 @@ typedef struct cm_rbf_stats {
                             * sums (the tolerance allowed them), 0 compensated or fast */
     double eval_error;     /* last cm_rbf_evaluate that tried the fast sum: its estimated
                             * max error / max |data| (sampled against compensated direct
-                            * sums, x4). The fast sum is taken if this is within 1e-9 (a
-                            * tenth of a looser tolerance) or within the direct sums' own
-                            * rounding (about 4 eps sum_j |w_j| phi_ij / max |data|: weights
-                            * that cancel 1e8-fold leave 1e-8 there, for any summation in
-                            * doubles) */
+                            * sums, x4). The fast sum is taken if this is within 1e-9 or
+                            * within the direct sums' own rounding (about 4 eps sum_j |w_j|
+                            * phi_ij / max |data|: weights that cancel 1e8-fold leave 1e-8
+                            * there, for any summation in doubles) */
     int eval_order;        /* ... and the treecode's order and opening angle it took (the */
     double eval_theta;     /* cheapest whose error on a pilot passed the same test) */
     int matvecs_compensated; /* last iterative solve: matvecs split by kind (they add up to */

@@ -39,7 +39,7 @@
  * (a study's --rbf-tol) they are plain on the bore (20.6k centres: S_c 6e4..6e5 x the data,
  * RESULTS.md, Study). */
 /* Evaluation by the treecode if its error can be shown to be within fast_eval_tol x max
- * |data| (or CM_RBF_PLAIN_RES_SHARE x a looser tolerance, as plain sums): the order is chosen from sum_j |w_j| phi_ij at a few of the points (the scale of
+ * |data|: the order is chosen from sum_j |w_j| phi_ij at a few of the points (the scale of
  * its bound, which the cancellation of the weights makes 1e4..1e7 x the result), then the
  * fast result is checked against compensated direct sums at CM_RBF_FAST_SAMPLES points.
  * Those are exact for the rounded entries phi_ij, not for the true ones, so they err by up
@@ -142,9 +142,7 @@ static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out
 {
     cm_rbf_iter *it = r->iter;
     const size_t nc = (size_t)r->ncomp;
-    /* a loose tolerance asks no more of the treecode than of plain sums */
-    const double target =
-        fmax(r->tun.fast_eval_tol, CM_RBF_PLAIN_RES_SHARE * r->opt.tolerance) * it->scales.fmax;
+    const double target = r->tun.fast_eval_tol * it->scales.fmax;
     it->eval_fast = 0;
     it->eval_error = 0.0;
     if (!(target > 0.0)) return 0;
@@ -205,12 +203,14 @@ static int plain_enough(const cm_rbf *r, size_t n, const double *p, int threads)
 {
     const cm_rbf_scales *sc = &r->iter->scales;
     const size_t nc = (size_t)r->ncomp;
-    if (sc->n != nc || !(r->opt.tolerance > 0.0)) return 0;
-    double *s = malloc(nc * sizeof *s);
-    int ok = s && sampled_abs_sums(r, n, p, CM_RBF_FAST_SAMPLES, s, threads) == 0;
+    const double share = CM_RBF_PLAIN_RES_SHARE * r->opt.tolerance;
+    int ok = sc->n == nc; /* the centres first: the sampled points cost more */
     for (size_t c = 0; ok && c < nc; ++c)
-        ok = CM_RBF_PLAIN_ERR * fmax(s[c], sc->smax[c]) <=
-             CM_RBF_PLAIN_RES_SHARE * r->opt.tolerance * sc->fnorm[c];
+        ok = CM_RBF_PLAIN_ERR * sc->smax[c] <= share * sc->fnorm[c];
+    double *s = ok ? malloc(nc * sizeof *s) : NULL;
+    ok = s && sampled_abs_sums(r, n, p, CM_RBF_FAST_SAMPLES, s, threads) == 0;
+    for (size_t c = 0; ok && c < nc; ++c)
+        ok = CM_RBF_PLAIN_ERR * s[c] <= share * sc->fnorm[c];
     free(s);
     return ok;
 }

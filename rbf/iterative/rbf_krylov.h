@@ -36,6 +36,8 @@ typedef struct kcol {
                      * enough) */
     double tol;     /* relative tolerance of this (inner) solve */
     double prev, res, target, est, cycle0, goal, floor;
+    int cut;        /* this cycle ends at CM_RBF_CYCLE_GAIN of its start (the tolerance is
+                     * further), else at the tolerance */
     double sz, allow, tau; /* relaxed product of the current step */
     int kind, lev;
     int state;      /* 0 running, 1 converged, 2 floor, 3 stagnated, 4 max iterations */
