@@ -281,8 +281,8 @@ int cm_rbf_iterative_transpose_fast(const cm_rbf *r, size_t n, const double *p, 
  * weights, so every rank that calls it gets the same out. */
 int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out,
                                    int threads, cm_rbf_tick *tick);
-/* The last evaluation's fast-sum figures (eval_fast, eval_error, eval_order, eval_theta) into
- * stats; nothing for a dense fit. */
+/* The last evaluation's figures (eval_fast, eval_plain, eval_error, eval_order, eval_theta)
+ * into stats; nothing for a dense fit. */
 void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats);
 /* The scales of a solve's weights that the evaluation goes by (rbf_iter.h, cm_rbf_scales):
  * a solve begins them with the data scale fmax that fast_eval_tol is relative to (the serial

@@ -45,8 +45,8 @@ size_t cm_rbf_history_bytes(const cm_rbf_history *h);
 
 /* Plain direct sums err by at most this x S(z) = max_i sum_j |z_j| phi_ij (rbf_fgmres.c,
  * relaxed products); where a result need only be exact to a tolerance they may take this
- * share of it (the solve's exact residuals, rbf_fgmres_solve.c; the evaluation,
- * rbf_evaluate.c). */
+ * share of it (the solve's exact residuals, rbf_fgmres.c and rbf_fgmres_solve.c; the
+ * evaluation, rbf_evaluate.c). */
 #define CM_RBF_PLAIN_ERR 1e-13
 #define CM_RBF_PLAIN_RES_SHARE 0.1
 /* ... tried only from this relative tolerance: on real sets S(w) is 1e4..1e9 x max |f|, so
