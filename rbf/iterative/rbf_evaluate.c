@@ -203,14 +203,14 @@ static int plain_enough(const cm_rbf *r, size_t n, const double *p, int threads)
 {
     const cm_rbf_scales *sc = &r->iter->scales;
     const size_t nc = (size_t)r->ncomp;
-    const double share = CM_RBF_PLAIN_RES_SHARE * r->opt.tolerance;
+    const double tol = r->opt.tolerance;
     int ok = sc->n == nc; /* the centres first: the sampled points cost more */
     for (size_t c = 0; ok && c < nc; ++c)
-        ok = CM_RBF_PLAIN_ERR * sc->smax[c] <= share * sc->fnorm[c];
+        ok = cm_rbf_plain_bound(sc->smax[c], sc->fnorm[c], tol) >= 0.0;
     double *s = ok ? malloc(nc * sizeof *s) : NULL;
     ok = s && sampled_abs_sums(r, n, p, CM_RBF_FAST_SAMPLES, s, threads) == 0;
     for (size_t c = 0; ok && c < nc; ++c)
-        ok = CM_RBF_PLAIN_ERR * s[c] <= share * sc->fnorm[c];
+        ok = cm_rbf_plain_bound(s[c], sc->fnorm[c], tol) >= 0.0;
     free(s);
     return ok;
 }

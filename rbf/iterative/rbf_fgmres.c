@@ -118,6 +118,13 @@ void cm_krylov_matvec(const cm_rbf *r, krylov *kr, int n, double *const *in, dou
     ++kr->mv[kr->tree ? MV_FAST : MV_COMP];
 }
 
+void cm_krylov_matvec_loose(const cm_rbf *r, krylov *kr, int n, double *const *in,
+                            double *const *out, int threads)
+{
+    if (kr->tree) cm_krylov_matvec(r, kr, n, in, out, threads);
+    else cm_krylov_matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, n, in, out, threads);
+}
+
 /* The same by a named kind: compensated or plain direct sums, or the loose treecode lev.
  * The treecode falls back to plain sums if it cannot be made (kept in r->iter: studies solve
  * again on the same centres). Returns the kind used. */
@@ -338,8 +345,8 @@ static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
         kcol *k = &kr->col[cols[u]];
         if (v < np && at[v] == u) {
             k->smax = cm_krylov_norm_inf(m, po[np + v++]);
-            const double bound = k->fnorm > 0.0 ? CM_RBF_PLAIN_ERR * k->smax / k->fnorm : 0.0;
-            if (bound <= CM_RBF_PLAIN_RES_SHARE * k->tol) {
+            const double bound = cm_rbf_plain_bound(k->smax, k->fnorm, k->tol);
+            if (bound >= 0.0) {
                 k->cb = bound;
                 continue;
             }
@@ -408,9 +415,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             if (kr->tree) cm_krylov_matvec(r, kr, nw, in, out, threads);
             else check_products(r, kr, nw, fl, in, out, threads);
             if (cycle > 0) {
-                if (kr->tree) cm_krylov_matvec(r, kr, nw, p3, p4, threads);
-                else cm_krylov_matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, nw, p3, p4,
-                                 threads);
+                cm_krylov_matvec_loose(r, kr, nw, p3, p4, threads);
                 for (int u = 0; u < nw; ++u)
                     for (size_t i = 0; i < m; ++i) out[u][i] += p4[u][i];
             }
@@ -451,9 +456,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             }
             /* positive weights: plain sums are exact to ~1e-14 of the result, the loosest
              * treecode to 1e-6, enough for an estimate */
-            if (kr->tree) cm_krylov_matvec(r, kr, ns, p3, p4, threads);
-            else cm_krylov_matvec_kind(r, kr, kr->relax_tree ? MV_FAST : MV_PLAIN, 0, ns, p3, p4,
-                             threads);
+            cm_krylov_matvec_loose(r, kr, ns, p3, p4, threads);
             for (int u = 0, v = 0; u < nfl; ++u) {
                 kcol *k = &kr->col[fl[u]];
                 if (k->smax < 0.0) k->smax = cm_krylov_norm_inf(m, p4[v++]);

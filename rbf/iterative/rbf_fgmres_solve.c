@@ -67,8 +67,7 @@ static void plain_bounds(const cm_rbf *r, krylov *kr, int n, const int *list, co
     for (int u = 0; u < n; ++u) {
         kcol *k = &kr->col[list[u]];
         if (!(k->fnorm > 0.0)) continue;
-        const double bound = CM_RBF_PLAIN_ERR * cm_krylov_norm_inf(m, res[u]) / k->fnorm;
-        k->pb = bound <= CM_RBF_PLAIN_RES_SHARE * tol ? bound : -1.0;
+        k->pb = cm_rbf_plain_bound(cm_krylov_norm_inf(m, res[u]), k->fnorm, tol);
     }
 }
 
@@ -533,8 +532,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             for (size_t i = 0; i < m; ++i) kr.pa[ns][i] = fabs(w[(c0 + (size_t)u) * m + i]);
             ++ns;
         }
-        if (kr.tree) cm_krylov_matvec(r, &kr, ns, kr.pa, kr.pb, threads);
-        else cm_krylov_matvec_kind(r, &kr, kr.relax_tree ? MV_FAST : MV_PLAIN, 0, ns, kr.pa, kr.pb, threads);
+        cm_krylov_matvec_loose(r, &kr, ns, kr.pa, kr.pb, threads);
         for (int u = 0, v = 0; u < g; ++u) {
             double *s = scales ? &scales->smax[c0 + (size_t)u] : NULL;
             const double sm = s && *s >= 0.0 ? *s : cm_krylov_norm_inf(m, kr.pb[v++]);

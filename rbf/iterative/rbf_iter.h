@@ -52,6 +52,14 @@ size_t cm_rbf_history_bytes(const cm_rbf_history *h);
 /* ... tried only from this relative tolerance: on real sets S(w) is 1e4..1e9 x max |f|, so
  * below it the product on |w| that bounds them would be spent for nothing */
 #define CM_RBF_PLAIN_RES_TOL 1e-8
+/* The rule all three go by: the bound on the error of plain sums of weights whose
+ * max_i sum_j |w_j| phi_ij is smax, relative to scale (a column's data), if it is within
+ * CM_RBF_PLAIN_RES_SHARE of tol; else -1 (compensated sums are needed). */
+static inline double cm_rbf_plain_bound(double smax, double scale, double tol)
+{
+    const double b = scale > 0.0 ? CM_RBF_PLAIN_ERR * smax / scale : 0.0;
+    return b <= CM_RBF_PLAIN_RES_SHARE * tol ? b : -1.0;
+}
 
 /* What the evaluation needs to know of a solve's weights, by column: the data scale its
  * tolerances are relative to, and how far plain direct sums of the weights can be trusted.

@@ -83,6 +83,12 @@ int cm_krylov_product(const cm_rbf *r, krylov *kr, int kind, const cm_rbf_tree *
 /* The fast solve's treecode (compensated sums if it fails), else compensated sums; counted. */
 void cm_krylov_matvec(const cm_rbf *r, krylov *kr, int n, double *const *in,
                       double *const *out, int threads);
+/* A product whose result need only be good to ~1e-6 of the sums (A |w| for the floor, A wlo
+ * of the low parts, both from positive or tiny weights): the fast solve's treecode if it
+ * has one, else the loosest relaxed treecode where the solve uses them, else plain sums;
+ * counted. */
+void cm_krylov_matvec_loose(const cm_rbf *r, krylov *kr, int n, double *const *in,
+                            double *const *out, int threads);
 /* By a named kind (the loose treecode lev for MV_FAST, plain sums if it cannot be made);
  * counted; returns the kind used. */
 int cm_krylov_matvec_kind(const cm_rbf *r, krylov *kr, int kind, int lev, int n,
