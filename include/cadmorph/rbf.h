@@ -107,8 +107,9 @@ typedef struct cm_rbf_stats {
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
     int matvecs;           /* last solve: kernel-sum passes over the m x m matrix of every
-                            * kind (one per iteration and product kind in use, two at a
-                            * restart plus one for the floor estimate, all running
+                            * kind (one per iteration and product kind in use, one or two
+                            * at a restart, plus one for the floor estimate unless the
+                            * solve met a tolerance below 1e-8, all running
                             * components together; PETSC: the
                             * components one after the other, each counted; fast sums: the
                             * treecode's products plus two exact ones per refinement step);
@@ -119,7 +120,8 @@ typedef struct cm_rbf_stats {
     double floor;          /* iterative: eps max_i sum_j |w_j| phi(|c_i - c_j|) / max |f|, the
                             * rounding error of plain direct sums of these weights, so about
                             * how exactly cm_rbf_evaluate reproduces the data at the centres
-                            * (for either solver: the weights are the same) */
+                            * (for either solver: the weights are the same); the max over
+                            * 1,024 of the centres if the solve met a tolerance below 1e-8 */
     int floor_limited;     /* 1 if the solve stagnated above the tolerance but within 10x
                             * the floor: the attainable accuracy, not a failure */
     int fast_sum;          /* iterative: 1 if the last solve's Krylov matvecs were fast sums */

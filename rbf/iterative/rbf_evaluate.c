@@ -113,28 +113,38 @@ static int pilot_passes(const cm_rbf *r, const cm_rbf_tree *t, const cm_rbf_tree
     return pass;
 }
 
-/* s[c] = max sum_j |w_cj| phi_ij over ns of the n points p (spread over them), for the
- * fit's columns c; -1 out of memory. */
+int cm_rbf_abs_sums(const cm_rbf *r, const double *a, int nc, size_t n, const double *p,
+                    size_t ns, double *s, int threads)
+{
+    const size_t m = r->m;
+    ns = n < ns ? n : ns;
+    double *sp = calloc(3 * ns, sizeof *sp), *ab = malloc(ns * (size_t)nc * sizeof *ab);
+    if (!sp || !ab) {
+        free(sp), free(ab);
+        return -1;
+    }
+    for (size_t k = 0; k < ns; ++k)
+        for (int d = 0; d < 3; ++d)
+            sp[(size_t)d * ns + k] = p[(size_t)d * n + (size_t)((double)k * (double)n / (double)ns)];
+    cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, a, nc, ns, sp, ns, ab, (size_t)nc, threads);
+    for (int c = 0; c < nc; ++c) s[c] = 0.0;
+    for (size_t i = 0; i < ns * (size_t)nc; ++i)
+        s[i % (size_t)nc] = fmax(s[i % (size_t)nc], ab[i]);
+    free(sp), free(ab);
+    return 0;
+}
+
+/* cm_rbf_abs_sums of the fit's weights */
 static int sampled_abs_sums(const cm_rbf *r, size_t n, const double *p, size_t ns, double *s,
                             int threads)
 {
-    const size_t m = r->m, nc = (size_t)r->ncomp;
-    ns = n < ns ? n : ns;
-    double *sp = malloc(3 * ns * sizeof *sp), *aw = malloc(nc * m * sizeof *aw);
-    double *ab = malloc(ns * nc * sizeof *ab);
-    const int ok = sp && aw && ab;
-    if (ok) {
-        for (size_t k = 0; k < ns; ++k)
-            for (int d = 0; d < 3; ++d)
-                sp[(size_t)d * ns + k] = p[(size_t)d * n + (size_t)((double)k * (double)n / (double)ns)];
-        for (size_t j = 0; j < nc * m; ++j) aw[j] = fabs(r->w[j]);
-        cm_rbf_kernel_sum(CM_RBF_TRIHARMONIC, 3, m, r->c, aw, (int)nc, ns, sp, ns, ab, nc,
-                          threads);
-        for (size_t c = 0; c < nc; ++c) s[c] = 0.0;
-        for (size_t i = 0; i < ns * nc; ++i) s[i % nc] = fmax(s[i % nc], ab[i]);
-    }
-    free(sp), free(aw), free(ab);
-    return ok ? 0 : -1;
+    const size_t nw = (size_t)r->ncomp * r->m;
+    double *aw = malloc(nw * sizeof *aw);
+    if (!aw) return -1;
+    for (size_t j = 0; j < nw; ++j) aw[j] = fabs(r->w[j]);
+    const int st = cm_rbf_abs_sums(r, aw, r->ncomp, n, p, ns, s, threads);
+    free(aw);
+    return st;
 }
 
 static int evaluate_fast(const cm_rbf *r, size_t n, const double *p, double *out, int threads,
@@ -205,8 +215,8 @@ static int plain_enough(const cm_rbf *r, size_t n, const double *p, int threads)
     const size_t nc = (size_t)r->ncomp;
     const double tol = r->opt.tolerance;
     int ok = sc->n == nc; /* the centres first: the sampled points cost more */
-    for (size_t c = 0; ok && c < nc; ++c)
-        ok = cm_rbf_plain_bound(sc->smax[c], sc->fnorm[c], tol) >= 0.0;
+    for (size_t c = 0; ok && c < nc; ++c) /* (smax unknown, -1: compensated) */
+        ok = sc->smax[c] >= 0.0 && cm_rbf_plain_bound(sc->smax[c], sc->fnorm[c], tol) >= 0.0;
     double *s = ok ? malloc(nc * sizeof *s) : NULL;
     ok = s && sampled_abs_sums(r, n, p, CM_RBF_FAST_SAMPLES, s, threads) == 0;
     for (size_t c = 0; ok && c < nc; ++c)

@@ -359,6 +359,70 @@ static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
     free(pi), free(at);
 }
 
+/* dh + dl = Z y, the cycle's step of a column (jn directions), in double-double (each term
+ * y_i z_i by TwoProduct, their sum by TwoSum): the terms are much larger than their sum (the
+ * preconditioned directions cancel), and a plain sum's rounding left the true residual of a
+ * cycle 10-100x above GMRES's estimate, which cost a whole restart cycle (bracket 59k: 7 of
+ * 21 iterations). dh is the step rounded to double. */
+static void step_of(const krylov *kr, const kcol *k, const double *y, double *dh, double *dl)
+{
+    const size_t m = kr->m;
+    for (size_t q = 0; q < m; ++q) {
+        double hi = 0.0, lo = 0.0;
+        for (int i = 0; i < k->jn; ++i) {
+            const double zi = k->z[(size_t)i * m + q], p = y[i] * zi, pe = fma(y[i], zi, -p);
+            const double t = hi + p, bv = t - hi;
+            lo += ((hi - (t - bv)) + (p - bv)) + pe;
+            hi = t;
+        }
+        const double t = hi + lo; /* to double, the remainder kept */
+        dl[q] = lo - (t - hi);
+        dh[q] = t;
+    }
+}
+
+/* The checks of the n columns list[] that have an exact A w from an earlier check (has_aw)
+ * and whose step dw (its high part, kr->aux) is small: A w += A dw by plain sums, their
+ * error bounded by CM_RBF_PLAIN_ERR x S(dw) <= CM_RBF_PLAIN_ERR x diam^3 sum |dw| (and the
+ * step's low part, A dl, by eps x that), added to col.cb where that stays within
+ * CM_RBF_PLAIN_RES_SHARE of the tolerance. Why: near the tolerance a step is 1e-8..1e-6 of w, so its product needs no
+ * compensated sums even at 1e-10, where the whole w's does (S(w) is 1e4..1e9 x |f|); on the
+ * bore (20.6k centres) a warm solve's last check went from a compensated product of w plus
+ * a plain one of its low part to one plain product. The others lose has_aw (a full check). */
+static void step_products(const cm_rbf *r, krylov *kr, int n, const int *list, double *aw,
+                          int threads)
+{
+    const size_t m = kr->m;
+    double **in = kr->pe, **out = kr->pf;
+    int ns = 0;
+    for (int u = 0; u < n; ++u) {
+        kcol *k = &kr->col[list[u]];
+        if (!k->has_aw) continue;
+        const double *dw = kr->aux + (size_t)list[u] * m;
+        double l1 = 0.0;
+        for (size_t i = 0; i < m; ++i) l1 += fabs(dw[i]);
+        const double b = cm_rbf_plain_bound(kr->diam3 * l1, k->fnorm, k->tol);
+        const double cb = k->cb + b + 2.0 * DBL_EPSILON * kr->diam3 * l1 / k->fnorm;
+        if (k->jn == 0 || b < 0.0 || cb > CM_RBF_PLAIN_RES_SHARE * k->tol) {
+            k->has_aw = 0;
+            continue;
+        }
+        k->cb = cb;
+        if (k->smax >= 0.0) k->smax += kr->diam3 * l1; /* S(w + dw) <= S(w) + S(dw) */
+        in[ns] = kr->aux + (size_t)list[u] * m;
+        out[ns] = kr->awlo + (size_t)list[u] * m;
+        ++ns;
+    }
+    cm_krylov_matvec_kind(r, kr, MV_PLAIN, 0, ns, in, out, threads);
+    for (int u = 0, v = 0; u < n; ++u) {
+        const int c = list[u];
+        if (!kr->col[c].has_aw) continue;
+        double *a = aw + (size_t)c * m;
+        for (size_t i = 0; i < m; ++i) a[i] += out[v][i];
+        ++v;
+    }
+}
+
 /* Solves the ns columns sel[] of f (g x m SoA) into w + kr->wlo (high and low parts), each
  * to its own col[c].tol relative to col[c].fnorm; a column with col[c].warm starts from the
  * w it holds if that leaves a residual below |f_c| (else from zero, and warm is cleared).
@@ -383,6 +447,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
         k->exact = 0;
         k->comp_only = 0;
         k->jn = 0;
+        k->has_aw = 0;
         if (!k->warm) memset(w + (size_t)c * m, 0, m * sizeof(double));
         memset(aw + (size_t)c * m, 0, m * sizeof(double));
         memset(kr->wlo + (size_t)c * m, 0, m * sizeof(double));
@@ -392,12 +457,15 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
         for (int s = 0; s < ns; ++s)
             if (kr->col[sel[s]].state == 0) list[n++] = sel[s];
         if (n == 0) break;
-        /* A w: of every running column after a cycle, of a warm one at the start (exactly:
-         * the history's own residual is good to the rounding of its pairs only, which
-         * their combination amplifies: 3e-9 of |f| on the bore, above the tolerance) */
+        /* A w: of every running column after a cycle (of its step where that is small), of
+         * a warm one at the start (exactly: the history's own residual is good to the
+         * rounding of its pairs only, which their combination amplifies: 3e-9 of |f| on the
+         * bore, above the tolerance) */
+        if (!kr->tree && cycle > 0) step_products(r, kr, n, list, aw, threads);
         int nw = 0;
         for (int u = 0; u < n; ++u) {
             const int c = list[u];
+            if (kr->col[c].has_aw) continue; /* summed by its step */
             kr->col[c].cb = 0.0;
             kr->col[c].smax = -1.0;
             if (cycle == 0 && !kr->col[c].warm) continue;
@@ -427,6 +495,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             double *rv = k->v, *ax = aw + (size_t)c * m; /* the residual is built in V_0 */
             const double *fc = f + (size_t)c * m;
             double rn = cm_krylov_residual(r, m, fc, ax, rv);
+            k->has_aw = !kr->tree && (cycle > 0 || k->warm);
             if (cycle == 0 && k->warm) {
                 /* the start is kept if its residual is below the zero start's |f| */
                 const double fn = cm_krylov_norm_inf(m, fc);
@@ -572,10 +641,6 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             if (k->jn == 0) continue;
             double y[64];
             ls_solve(kr, c, k->jn, y);
-            /* w += Z y in double-double: the terms y_i z_i are much larger than their sum
-             * (the preconditioned directions cancel), and the rounding of a plain daxpy
-             * then left the true residual of a cycle 10-100x above GMRES's estimate, which
-             * cost a whole restart cycle (bracket 59k: 7 of 21 iterations) */
             if (kr->relax) { /* the bound on what the inexact products moved the residual */
                 double gap = 0.0;
                 for (int i = 0; i < k->jn; ++i) {
@@ -589,17 +654,15 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
                        "the relaxed products %.3g (the cycle's goal %.3g)", c, cycle,
                        gap / k->fnorm, k->goal / k->fnorm);
             }
+            /* the step dw = Z y (high part in aux, for the next check; low part in awlo,
+             * free until then), added to w = wh + wl */
             double *wh = w + (size_t)c * m, *wl = kr->wlo + (size_t)c * m;
-            for (int i = 0; i < k->jn; ++i) {
-                const double yi = y[i], *zi = k->z + (size_t)i * m;
-                for (size_t q = 0; q < m; ++q) {
-                    double p = yi * zi[q];
-                    double pe = fma(yi, zi[q], -p);
-                    double t = wh[q] + p, bv = t - wh[q];
-                    double te = (wh[q] - (t - bv)) + (p - bv);
-                    wh[q] = t;
-                    wl[q] += te + pe;
-                }
+            double *dh = kr->aux + (size_t)c * m, *dl = kr->awlo + (size_t)c * m;
+            step_of(kr, k, y, dh, dl);
+            for (size_t q = 0; q < m; ++q) {
+                const double t = wh[q] + dh[q], bv = t - wh[q];
+                wl[q] += ((wh[q] - (t - bv)) + (dh[q] - bv)) + dl[q];
+                wh[q] = t;
             }
         }
     }

@@ -71,8 +71,9 @@ typedef struct cm_rbf_scales {
     size_t n;      /* columns below; 0 if unknown (a PETSc solve) */
     double *fnorm; /* column c: the scale of its tolerance (max |data_c|, or the share
                     * column_scale of fmax if that is larger) */
-    double *smax;  /* column c: max_i sum_j |w_j| phi_ij at the centres, the scale of the
-                    * rounding of plain sums (rbf_evaluate.c) */
+    double *smax;  /* column c: max_i sum_j |w_j| phi_ij at the centres (or a bound on it),
+                    * the scale of the rounding of plain sums (rbf_evaluate.c); -1 if the
+                    * solve did not sum it (below CM_RBF_PLAIN_RES_TOL: compensated sums) */
 } cm_rbf_scales;
 
 struct cm_rbf_iter {
@@ -99,5 +100,10 @@ struct cm_rbf_iter {
 /* The treecode on the centres of r for (order, theta), made on first use and kept in
  * r->iter (studies solve and evaluate again on the same centres); NULL out of memory. */
 cm_rbf_tree *cm_rbf_iterative_tree(const cm_rbf *r, int order, double theta);
+/* s[c] = max over ns of the n points p (SoA, spread over them; all of them if ns >= n) of
+ * sum_j a_cj phi(|p - c_j|), for the nc columns of a (nc x m, non-negative: |w|); -1 out of
+ * memory. */
+int cm_rbf_abs_sums(const cm_rbf *r, const double *a, int nc, size_t n, const double *p,
+                    size_t ns, double *s, int threads);
 
 #endif

@@ -30,8 +30,12 @@ typedef struct kcol {
                      * budget: its Krylov space needs huge coefficients) */
     /* the solve */
     double fnorm;   /* the column's scale (CM_RBF_COL_SCALE) */
-    double cb;      /* bound on the error of the last exact residual (a plain check), else 0 */
-    double smax;    /* max_i sum_j |w_j| phi_ij of w at the last check, -1 if not summed */
+    double cb;      /* bound on the error of the last exact residual (a plain check, and the
+                     * step products added since), else 0 */
+    double smax;    /* max_i sum_j |w_j| phi_ij of w at the last check (a bound after a step
+                     * product), -1 if not summed */
+    int has_aw;     /* aw holds A w from a check of this solve (exactly, within cb), so the
+                     * next check may add the product of the cycle's step (kr->aux) */
     int comp_only;  /* its checks in this solve are compensated (a plain one was not exact
                      * enough) */
     double tol;     /* relative tolerance of this (inner) solve */
@@ -56,9 +60,10 @@ typedef struct krylov {
     int g;          /* columns of this group */
     kcol *col;      /* g */
     double *soa, *rowm; /* CM_RBF_SUM_MAX_NC x m: one chunk of a kernel sum */
-    double *pin, *aux;  /* g x m: the preconditioner's input and output; scratch */
+    double *pin, *aux;  /* g x m: the preconditioner's input and output; scratch; from a
+                         * cycle's update to the next check, each column's step dw */
     double *wlo;    /* g x m: low parts of the weights (double-double accumulation) */
-    double *awlo;   /* g x m: A wlo; scratch during the steps */
+    double *awlo;   /* g x m: A wlo; scratch during the steps and the update */
     int *ia, *ib, *ic; /* g: column lists */
     double **pa, **pb, **pc, **pd, **pe, **pf; /* g: vector lists */
     const cm_rbf_tree *tree; /* fast matvecs (treecode) if set, else compensated direct */

@@ -281,6 +281,32 @@ int main(void)
                 const double ed = eval_diff(r, m, np, p, &w2, u, &one, fmx);
                 CHECK_MSG(ed <= 1e-8, "column %d from the history against cold: %.3g", u, ed);
             }
+            /* data near the span (a further motion 1e-4 its size added): the starts'
+             * check is the one compensated product, as the last check sums the step, small
+             * against w, plainly within a tenth of the tolerance */
+            double *v5 = malloc(m_in * NC * sizeof *v5);
+            bore_motion(m_in, x, 2.12, 0.96, d2);
+            for (size_t i = 0; i < m_in; ++i)
+                for (size_t u = 0; u < NC; ++u)
+                    v5[i * NC + u] = v3[i * NC + u] + (u < 3 ? 1e-4 * d2[3 * i + u] : 0.0);
+            solved n1 = solve_cols(ctx, r, m, v5, 3, smooth);
+            printf("near the span: warm from %.3g, %d iterations, products %d compensated + %d "
+                   "plain, residual %.3g\n", n1.st.warm_residual, n1.st.iterations,
+                   n1.st.matvecs_compensated, n1.st.matvecs_plain, n1.st.residual);
+            CHECK(n1.status == CM_OK && n1.st.iterations >= 1 && n1.st.residual <= 1e-10);
+            CHECK_MSG(n1.st.matvecs_compensated == 1, "%d", n1.st.matvecs_compensated);
+            for (int u = 0; u < 3; ++u) {
+                double fmx = 0.0;
+                for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v5[i * NC + (size_t)u]));
+                r->opt.warm_start = 0;
+                solved a = solve_cols(ctx, r, m, v5, 1, &u);
+                r->opt.warm_start = 1;
+                const double ed = eval_diff(r, m, np, p, &n1, u, &a, fmx);
+                CHECK_MSG(ed <= 1e-8, "column %d near the span against cold: %.3g", u, ed);
+                release(&a);
+            }
+            release(&n1);
+            free(v5);
             release(&w0), release(&w1), release(&c1), release(&w2), release(&c2);
             free(v2), free(d2), free(v3);
         }
