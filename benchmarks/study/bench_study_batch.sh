@@ -47,6 +47,9 @@ variants() { # MODEL DIR
     cp "$2/vN/$1_$(printf %02d "$nvar").step" "$2/v1/"
 }
 
+# The wall seconds of a /usr/bin/time file
+wall() { sed 's/.*wall_s=\([0-9.]*\).*/\1/' "$1"; }
+
 # One study: DIR MESH LIST TAG BATCH [SOLVER [TOL]] (its debug log in DIR/log_TAG.txt)
 study() {
     tolopt=
@@ -59,8 +62,8 @@ study() {
             --solver "${6:-auto}" $tolopt --threads "$threads" --verbose >/dev/null \
             2>"$1/log_$4.try" || [ $? -eq 3 ]
         # the fastest run's
-        if [ "$rep" -eq 1 ] || awk -v a="$(sed 's/.*wall_s=\([0-9.]*\).*/\1/' "$1/time_$4.try")" \
-            -v b="$(sed 's/.*wall_s=\([0-9.]*\).*/\1/' "$1/time_$4.txt")" 'BEGIN { exit !(a < b) }'; then
+        if [ "$rep" -eq 1 ] || awk -v a="$(wall "$1/time_$4.try")" -v b="$(wall "$1/time_$4.txt")" \
+            'BEGIN { exit !(a < b) }'; then
             mv "$1/time_$4.try" "$1/time_$4.txt"
             mv "$1/log_$4.try" "$1/log_$4.txt"
             rm -rf "$1/out_$4"

@@ -385,10 +385,11 @@ static void step_of(const krylov *kr, const kcol *k, const double *y, double *dh
  * and whose step dw (its high part, kr->aux) is small: A w += A dw by plain sums, their
  * error bounded by CM_RBF_PLAIN_ERR x S(dw) <= CM_RBF_PLAIN_ERR x diam^3 sum |dw| (and the
  * step's low part, A dl, by eps x that), added to col.cb where that stays within
- * CM_RBF_PLAIN_RES_SHARE of the tolerance. Why: near the tolerance a step is 1e-8..1e-6 of w, so its product needs no
- * compensated sums even at 1e-10, where the whole w's does (S(w) is 1e4..1e9 x |f|); on the
- * bore (20.6k centres) a warm solve's last check went from a compensated product of w plus
- * a plain one of its low part to one plain product. The others lose has_aw (a full check). */
+ * CM_RBF_PLAIN_RES_SHARE of the tolerance. Why: near the tolerance a step is 1e-8..1e-6 of
+ * w, so its product needs no compensated sums even at 1e-10, where the whole w's does (S(w)
+ * is 1e4..1e9 x |f|); on the bore (20.6k centres) a warm solve's last check went from a
+ * compensated product of w plus a plain one of its low part to one plain product. The
+ * others lose has_aw (a full check). */
 static void step_products(const cm_rbf *r, krylov *kr, int n, const int *list, double *aw,
                           int threads)
 {
