@@ -165,6 +165,15 @@ double cm_krylov_norm_inf(size_t m, const double *v)
     return s;
 }
 
+void cm_krylov_add_dd(size_t m, double *wh, double *wl, const double *dh, const double *dl)
+{
+    for (size_t q = 0; q < m; ++q) {
+        const double t = wh[q] + dh[q], bv = t - wh[q];
+        wl[q] += ((wh[q] - (t - bv)) + (dh[q] - bv)) + dl[q];
+        wh[q] = t;
+    }
+}
+
 /* The cheapest product kind whose error bound, relative to S(z), is within tau. */
 static int relax_pick(const krylov *kr, double tau, int *lev)
 {
@@ -660,11 +669,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             double *wh = w + (size_t)c * m, *wl = kr->wlo + (size_t)c * m;
             double *dh = kr->aux + (size_t)c * m, *dl = kr->awlo + (size_t)c * m;
             step_of(kr, k, y, dh, dl);
-            for (size_t q = 0; q < m; ++q) {
-                const double t = wh[q] + dh[q], bv = t - wh[q];
-                wl[q] += ((wh[q] - (t - bv)) + (dh[q] - bv)) + dl[q];
-                wh[q] = t;
-            }
+            cm_krylov_add_dd(m, wh, wl, dh, dl);
         }
     }
     /* the low parts stay in kr->wlo for the caller to fold in (or to keep, in a refinement) */

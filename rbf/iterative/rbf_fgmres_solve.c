@@ -172,11 +172,7 @@ static cm_status refine_group(cm_context *ctx, const cm_rbf *r, krylov *kr, cons
             if (k->done) continue;
             sel[n++] = c;
             const size_t o0 = (size_t)c * m;
-            for (size_t i = o0; i < o0 + m; ++i) { /* w += dw + dw_lo in double-double */
-                double t = w[i] + dw[i], bv = t - w[i];
-                wl[i] += (w[i] - (t - bv)) + (dw[i] - bv) + kr->wlo[i];
-                w[i] = t;
-            }
+            cm_krylov_add_dd(m, w + o0, wl + o0, dw + o0, kr->wlo + o0); /* w += dw + dw_lo */
             k->total_it += k->iters;
         }
         if (tu->fast_refine == 0) { /* the treecode's own residual: A w = A dw here */
@@ -332,8 +328,8 @@ static int krylov_alloc(krylov *kr, int g)
                : -1;
 }
 
-/* Centres at which a solve that met its tolerance estimates S(w) for the reported floor
- * (spread over them; all of them below this many) */
+/* Centres at which a solve that met a tolerance below CM_RBF_PLAIN_RES_TOL estimates S(w)
+ * for the reported floor (spread over them; all of them below this many) */
 #define CM_RBF_FLOOR_SAMPLES 1024
 
 /* The fit's history of solutions, made on first use: warm_history pairs, at most what an
@@ -545,7 +541,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             for (size_t i = 0; i < m; ++i) kr.pa[ns][i] = fabs(w[(c0 + (size_t)u) * m + i]);
             ++ns;
         }
-        /* the sampled estimates go where the full sums would (kr.pb[v][0]) */
+        /* the full sums into kr.pb[], or the sampled maxima into kr.awlo[0..ns) */
         if (!sampled) cm_krylov_matvec_loose(r, &kr, ns, kr.pa, kr.pb, threads);
         else if (ns > 0 && cm_rbf_abs_sums(r, kr.aux, ns, m, r->c, CM_RBF_FLOOR_SAMPLES,
                                            kr.awlo, threads) != 0)

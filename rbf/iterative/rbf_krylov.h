@@ -76,6 +76,9 @@ typedef struct krylov {
 /* v -= Q1 (Q1' v), twice (the second pass removes what round-off left of the first). */
 void cm_krylov_project(const double *q1, size_t m, int k, double *v);
 double cm_krylov_norm_inf(size_t m, const double *v);
+/* (wh, wl) += (dh, dl), m entries: double-double weights plus a double-double step (TwoSum of
+ * the high parts, the rest into wl) */
+void cm_krylov_add_dd(size_t m, double *wh, double *wl, const double *dh, const double *dl);
 /* rv = Pi (f - aw), the projected residual of a column whose product is aw (m each); returns
  * its max-norm. */
 double cm_krylov_residual(const cm_rbf *r, size_t m, const double *f, const double *aw,
