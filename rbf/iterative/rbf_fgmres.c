@@ -324,7 +324,9 @@ static double gmres_residual_inf(const krylov *kr, const kcol *k, int j)
  * CM_RBF_PLAIN_RES_SHARE of its tolerance (col.cb: its residual is judged with the bound
  * added); the others are summed again, compensated, and so are their later checks in this
  * solve (col.comp_only: S(w) changes little from cycle to cycle). S(w) (col.smax) then gives
- * the floor and the evaluation's scale without a pass of their own. */
+ * the floor and the evaluation's scale without a pass of their own. A start whose bound on
+ * S(w) (col.sbound) already allows plain sums is summed without |w|: half the columns of a
+ * warm start's check. */
 static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
                            double *const *in, double *const *out, int threads)
 {
@@ -338,22 +340,26 @@ static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
         return;
     }
     double **po = pi + 2 * n, **ci = pi + 4 * n, **co = pi + 5 * n;
-    int np = 0, nc = 0;
+    int np = 0, nc = 0, na = 0;
     for (int u = 0; u < n; ++u) /* the columns tried plainly: w, then |w| (in Z) */
         if (!kr->col[cols[u]].comp_only) at[np++] = u;
     for (int v = 0; v < np; ++v) {
         kcol *k = &kr->col[cols[at[v]]];
         pi[v] = in[at[v]];
         po[v] = out[at[v]];
-        pi[np + v] = k->z; /* Z is free between cycles */
-        po[np + v] = k->z + m;
+        /* S(w) is summed unless a start's bound on it already allows plain sums */
+        if (k->sbound >= 0.0 && cm_rbf_plain_bound(k->sbound, k->fnorm, k->tol) >= 0.0) continue;
+        k->sbound = -1.0;
+        pi[np + na] = k->z; /* Z is free between cycles */
+        po[np + na++] = k->z + m;
         for (size_t i = 0; i < m; ++i) k->z[i] = fabs(in[at[v]][i]);
     }
-    cm_krylov_matvec_kind(r, kr, MV_PLAIN, 0, 2 * np, pi, po, threads);
-    for (int u = 0, v = 0; u < n; ++u) {
+    cm_krylov_matvec_kind(r, kr, MV_PLAIN, 0, np + na, pi, po, threads);
+    for (int u = 0, v = 0, a = 0; u < n; ++u) {
         kcol *k = &kr->col[cols[u]];
         if (v < np && at[v] == u) {
-            k->smax = cm_krylov_norm_inf(m, po[np + v++]);
+            ++v;
+            k->smax = k->sbound >= 0.0 ? k->sbound : cm_krylov_norm_inf(m, po[np + a++]);
             const double bound = cm_rbf_plain_bound(k->smax, k->fnorm, k->tol);
             if (bound >= 0.0) {
                 k->cb = bound;
@@ -505,6 +511,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             double *rv = k->v, *ax = aw + (size_t)c * m; /* the residual is built in V_0 */
             const double *fc = f + (size_t)c * m;
             double rn = cm_krylov_residual(r, m, fc, ax, rv);
+            k->sbound = -1.0; /* of the start only */
             k->has_aw = !kr->tree && (cycle > 0 || k->warm);
             if (cycle == 0 && k->warm) {
                 /* the start is kept if its residual is below the zero start's |f| */

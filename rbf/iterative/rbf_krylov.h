@@ -34,6 +34,8 @@ typedef struct kcol {
                      * step products added since), else 0 */
     double smax;    /* max_i sum_j |w_j| phi_ij of w at the last check (a bound after a step
                      * product), -1 if not summed */
+    double sbound;  /* a bound on S(w) of the start, from the fit's earlier weights (the
+                     * caller's; -1: none): its plain check then sums w alone */
     int has_aw;     /* aw holds A w from a check of this solve (exactly, within cb), so the
                      * next check may add the product of the cycle's step (kr->aux) */
     int comp_only;  /* its checks in this solve are compensated (a plain one was not exact
