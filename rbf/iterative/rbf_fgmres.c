@@ -326,9 +326,9 @@ static double gmres_residual_inf(const krylov *kr, const kcol *k, int j)
  * solve (col.comp_only: S(w) changes little from cycle to cycle). S(w) (col.smax) then gives
  * the floor and the evaluation's scale without a pass of their own. A start whose bound on
  * S(w) (col.sbound) already allows plain sums is summed without |w|: half the columns of a
- * warm start's check. */
-static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
-                           double *const *in, double *const *out, int threads)
+ * warm start's check. Returns the columns whose S(w) it summed. */
+static int check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
+                          double *const *in, double *const *out, int threads)
 {
     const size_t m = kr->m;
     const int plain = r->opt.tolerance >= CM_RBF_PLAIN_RES_TOL && kr->R >= 2;
@@ -337,7 +337,7 @@ static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
     if (!pi || !at) {
         free(pi), free(at);
         cm_krylov_matvec_kind(r, kr, MV_COMP, 0, n, in, out, threads);
-        return;
+        return 0;
     }
     double **po = pi + 2 * n, **ci = pi + 4 * n, **co = pi + 5 * n;
     int np = 0, nc = 0, na = 0;
@@ -372,6 +372,7 @@ static void check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
     }
     cm_krylov_matvec_kind(r, kr, MV_COMP, 0, nc, ci, co, threads);
     free(pi), free(at);
+    return na;
 }
 
 /* dh + dl = Z y, the cycle's step of a column (jn directions), in double-double (each term
@@ -497,7 +498,12 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
              * |w| small, by plain sums or the loosest treecode (its error, 1e-6 S(wlo), is
              * 1e-22 S(w)) */
             if (kr->tree) cm_krylov_matvec(r, kr, nw, in, out, threads);
-            else check_products(r, kr, nw, fl, in, out, threads);
+            else {
+                const int nsum = check_products(r, kr, nw, fl, in, out, threads);
+                if (cycle == 0 && r->opt.tolerance >= CM_RBF_PLAIN_RES_TOL)
+                    cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: the check of %d starts summed "
+                           "S(w) for %d (the others: bounded by the fit's last weights)", nw, nsum);
+            }
             if (cycle > 0) {
                 cm_krylov_matvec_loose(r, kr, nw, p3, p4, threads);
                 for (int u = 0; u < nw; ++u)
