@@ -397,6 +397,56 @@ static void step_of(const krylov *kr, const kcol *k, const double *y, double *dh
     }
 }
 
+/* The rounding of the Arnoldi relation A Z y = V H y + Q1 Q1' A Z y in the max-norm, per
+ * product and step: at most this x (steps + 2) x eps x |A z_j|_2 (classical Gram-Schmidt
+ * twice, the projection, the rotations; a safe multiple of the textbook bound) */
+#define CM_RBF_ARNOLDI_ROUND 4.0
+
+/* A w += A dw for column c without a pass, from the cycle's own products: its step dw = Z y
+ * has A dw = V_{jn+1} Hbar y + Q1 (Q1' A Z) y, and V Hbar y = r0 - r_jn, the cycle's starting
+ * residual less GMRES's own (V_{jn+1} times the rotations undone on (0.., g_jn)). What that
+ * errs by: the products' own errors, sum_j |y_j| eb_j (relaxed products; compensated ones
+ * count nothing, as in the relaxation's budget), and the rounding of the relation. 1 if that,
+ * added to col.cb, stays within CM_RBF_PLAIN_RES_SHARE of the tolerance (aw, cb and smax
+ * updated), else 0. Why: a step's plain product is a pass over the kernel's m^2 pairs for
+ * what the cycle already summed; at 1e-10 on the bore (20.6k centres) the relation errs by
+ * about 1e-15 of |f|. l1: sum |dw| (the step's high part). */
+static int arnoldi_step(const cm_rbf *r, const krylov *kr, int c, double *aw, double l1)
+{
+    const size_t m = kr->m;
+    kcol *k = &kr->col[c];
+    const int jn = k->jn;
+    double y[64];
+    ls_solve(kr, c, jn, y);
+    double err = 0.0;
+    for (int i = 0; i < jn; ++i)
+        err += fabs(y[i]) * ((kr->relax ? k->eb[i] : 0.0) +
+                             CM_RBF_ARNOLDI_ROUND * (jn + 2) * DBL_EPSILON * k->an[i]);
+    const double cb = k->cb + err / k->fnorm;
+    if (!(cb <= CM_RBF_PLAIN_RES_SHARE * k->tol)) return 0;
+    /* t: GMRES's residual in the basis V_{jn+1}, less the start's (cycle0 v_0) */
+    double t[66] = {0}, qa[4] = {0, 0, 0, 0};
+    t[jn] = k->gv[jn];
+    for (int i = jn - 1; i >= 0; --i) {
+        const double a = t[i], b = t[i + 1];
+        t[i] = k->cs[i] * a - k->sn[i] * b;
+        t[i + 1] = k->sn[i] * a + k->cs[i] * b;
+    }
+    t[0] -= k->cycle0;
+    for (int i = 0; i < jn; ++i)
+        for (int a = 0; a < r->k; ++a) qa[a] += y[i] * k->qaz[i][a];
+    double *ac = aw + (size_t)c * m;
+    for (size_t q = 0; q < m; ++q) {
+        double s = 0.0;
+        for (int i = 0; i <= jn; ++i) s += t[i] * k->v[(size_t)i * m + q];
+        ac[q] -= s;
+    }
+    for (int a = 0; a < r->k; ++a) cblas_daxpy((int)m, qa[a], r->iter->q1 + (size_t)a * m, 1, ac, 1);
+    k->cb = cb;
+    if (k->smax >= 0.0) k->smax += kr->diam3 * l1; /* S(w + dw) <= S(w) + S(dw) */
+    return 1;
+}
+
 /* The checks of the n columns list[] that have an exact A w from an earlier check (has_aw)
  * and whose step dw (its high part, kr->aux) is small: A w += A dw by plain sums, their
  * error bounded by CM_RBF_PLAIN_ERR x S(dw) <= CM_RBF_PLAIN_ERR x diam^3 sum |dw| (and the
@@ -406,18 +456,23 @@ static void step_of(const krylov *kr, const kcol *k, const double *y, double *dh
  * is 1e4..1e9 x |f|); on the bore (20.6k centres) a warm solve's last check went from a
  * compensated product of w plus a plain one of its low part to one plain product. The
  * others lose has_aw (a full check). */
-static void step_products(const cm_rbf *r, krylov *kr, int n, const int *list, double *aw,
-                          int threads)
+static int step_products(const cm_rbf *r, krylov *kr, int n, const int *list, double *aw,
+                         int threads)
 {
     const size_t m = kr->m;
     double **in = kr->pe, **out = kr->pf;
-    int ns = 0;
+    int ns = 0, na = 0;
     for (int u = 0; u < n; ++u) {
         kcol *k = &kr->col[list[u]];
         if (!k->has_aw) continue;
         const double *dw = kr->aux + (size_t)list[u] * m;
         double l1 = 0.0;
         for (size_t i = 0; i < m; ++i) l1 += fabs(dw[i]);
+        k->by_arnoldi = k->jn > 0 && arnoldi_step(r, kr, list[u], aw, l1);
+        if (k->by_arnoldi) {
+            ++na;
+            continue;
+        }
         const double b = cm_rbf_plain_bound(kr->diam3 * l1, k->fnorm, k->tol);
         const double cb = k->cb + b + 2.0 * DBL_EPSILON * kr->diam3 * l1 / k->fnorm;
         if (k->jn == 0 || b < 0.0 || cb > CM_RBF_PLAIN_RES_SHARE * k->tol) {
@@ -433,11 +488,12 @@ static void step_products(const cm_rbf *r, krylov *kr, int n, const int *list, d
     cm_krylov_matvec_kind(r, kr, MV_PLAIN, 0, ns, in, out, threads);
     for (int u = 0, v = 0; u < n; ++u) {
         const int c = list[u];
-        if (!kr->col[c].has_aw) continue;
+        if (!kr->col[c].has_aw || kr->col[c].by_arnoldi) continue;
         double *a = aw + (size_t)c * m;
         for (size_t i = 0; i < m; ++i) a[i] += out[v][i];
         ++v;
     }
+    return na;
 }
 
 /* Solves the ns columns sel[] of f (g x m SoA) into w + kr->wlo (high and low parts), each
@@ -478,7 +534,11 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
          * a warm one at the start (exactly: the history's own residual is good to the
          * rounding of its pairs only, which their combination amplifies: 3e-9 of |f| on the
          * bore, above the tolerance) */
-        if (!kr->tree && cycle > 0) step_products(r, kr, n, list, aw, threads);
+        if (!kr->tree && cycle > 0) {
+            const int na = step_products(r, kr, n, list, aw, threads);
+            cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: cycle %d: %d checks by the Arnoldi "
+                   "relation", cycle, na);
+        }
         int nw = 0;
         for (int u = 0; u < n; ++u) {
             const int c = list[u];
@@ -611,6 +671,10 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
                 const int c = act[u];
                 kcol *k = &kr->col[c];
                 double *wv = p3[u], *h = k->h + (size_t)j * (size_t)(R + 1);
+                /* what a check by the Arnoldi relation needs of the product (arnoldi_step) */
+                k->an[j] = cblas_dnrm2((int)m, wv, 1);
+                for (int a = 0; a < r->k; ++a)
+                    k->qaz[j][a] = cblas_ddot((int)m, r->iter->q1 + (size_t)a * m, 1, wv, 1);
                 cm_krylov_project(r->iter->q1, m, r->k, wv);
                 for (int pass = 0; pass < 2; ++pass) /* classical Gram-Schmidt, twice */
                     for (int i = 0; i <= j; ++i) {

@@ -25,6 +25,8 @@ typedef struct kcol {
     double cs[64], sn[64], gv[65];
     double eb[64];  /* bound on the error of each product of the cycle (max-norm) */
     double gv0[64]; /* |GMRES residual| before each step */
+    double an[64];  /* |A z_j|_2 of each product of the cycle (before its projection) */
+    double qaz[64][4]; /* Q1' A z_j: the part of each product the projection removes */
     double grow;    /* largest |y_i| / |r_{i-1}| of the solve so far */
     int exact;      /* 1: the products stay compensated (a cycle's gap bound exceeded the
                      * budget: its Krylov space needs huge coefficients) */
@@ -38,6 +40,7 @@ typedef struct kcol {
                      * caller's; -1: none): its plain check then sums w alone */
     int has_aw;     /* aw holds A w from a check of this solve (exactly, within cb), so the
                      * next check may add the product of the cycle's step (kr->aux) */
+    int by_arnoldi; /* its last check came from the cycle's own products (arnoldi_step) */
     int comp_only;  /* its checks in this solve are compensated (a plain one was not exact
                      * enough) */
     double tol;     /* relative tolerance of this (inner) solve */

@@ -108,14 +108,40 @@ static double eval_diff(cm_rbf *r, size_t m, size_t np, const double *p, const s
 
 static void release(solved *s) { free(s->w), free(s->q); }
 
-/* The log's count of warm starts whose plain check summed S(w) (rbf_fgmres.c,
- * check_products): the last solve's, -1 if none was logged. */
-static void count_s_sums(void *user, cm_log_level level, const char *msg)
+/* What a solve's debug log says of its checks (rbf_fgmres.c): the warm starts whose plain
+ * check summed S(w) (the last logged; -1: none), and the checks after a cycle that came from
+ * the Arnoldi relation (summed over the cycles). */
+typedef struct {
+    int s_summed, arnoldi;
+} check_log;
+
+static void count_checks(void *user, cm_log_level level, const char *msg)
 {
     (void)level;
-    int nw, ns;
-    if (sscanf(msg, "cm_rbf_solve: the check of %d starts summed S(w) for %d", &nw, &ns) == 2)
-        *(int *)user = ns;
+    check_log *cl = user;
+    int a, b;
+    if (sscanf(msg, "cm_rbf_solve: the check of %d starts summed S(w) for %d", &a, &b) == 2)
+        cl->s_summed = b;
+    if (sscanf(msg, "cm_rbf_solve: cycle %d: %d checks by the Arnoldi relation", &a, &b) == 2)
+        cl->arnoldi += b;
+}
+
+/* solve_cols with the solve's log counted into cl */
+static solved solve_logged(cm_rbf *r, size_t m, const double *v, int nc, const int *cols,
+                           check_log *cl)
+{
+    cm_context *lc = NULL;
+    solved o;
+    memset(&o, 0, sizeof o);
+    o.status = CM_ERR_NOMEM;
+    cl->s_summed = -1;
+    cl->arnoldi = 0;
+    if (cm_context_create(&lc) != CM_OK) return o;
+    cm_context_set_threads(lc, 2);
+    cm_context_set_log(lc, count_checks, cl);
+    o = solve_cols(lc, r, m, v, nc, cols);
+    cm_context_destroy(&lc);
+    return o;
 }
 
 #ifndef CM_RBF_SUM_MAX_NC
@@ -293,19 +319,33 @@ int main(void)
                 CHECK_MSG(ed <= 1e-8, "column %d from the history against cold: %.3g", u, ed);
             }
             /* data near the span (a further motion 1e-4 its size added): the starts'
-             * check is the one compensated product, as the last check sums the step, small
-             * against w, plainly within a tenth of the tolerance */
+             * check is the one compensated product, as the last check takes the step's
+             * product from the cycle's own (the Arnoldi relation, within a tenth of the
+             * tolerance); the data met at the centres by an evaluation, which knows none of
+             * that */
             double *v5 = malloc(m_in * NC * sizeof *v5);
             bore_motion(m_in, x, 2.12, 0.96, d2);
             for (size_t i = 0; i < m_in; ++i)
                 for (size_t u = 0; u < NC; ++u)
                     v5[i * NC + u] = v3[i * NC + u] + (u < 3 ? 1e-4 * d2[3 * i + u] : 0.0);
-            solved n1 = solve_cols(ctx, r, m, v5, 3, smooth);
+            check_log cl;
+            solved n1 = solve_logged(r, m, v5, 3, smooth, &cl);
+            double *at = malloc(m_in * 3 * sizeof *at), miss = 0.0, fall = 0.0;
+            CHECK(cm_rbf_evaluate(ctx, r, m_in, x, at) == CM_OK);
+            for (size_t i = 0; i < m_in; ++i)
+                for (size_t u = 0; u < 3; ++u) {
+                    miss = fmax(miss, fabs(at[i * 3 + u] - v5[i * NC + (size_t)smooth[u]]));
+                    fall = fmax(fall, fabs(v5[i * NC + (size_t)smooth[u]]));
+                }
+            free(at);
             printf("near the span: warm from %.3g, %d iterations, products %d compensated + %d "
-                   "plain, residual %.3g\n", n1.st.warm_residual, n1.st.iterations,
-                   n1.st.matvecs_compensated, n1.st.matvecs_plain, n1.st.residual);
+                   "plain, %d checks by the Arnoldi relation, residual %.3g, the data missed by "
+                   "%.3g\n", n1.st.warm_residual, n1.st.iterations, n1.st.matvecs_compensated,
+                   n1.st.matvecs_plain, cl.arnoldi, n1.st.residual, miss / fall);
             CHECK(n1.status == CM_OK && n1.st.iterations >= 1 && n1.st.residual <= 1e-10);
             CHECK_MSG(n1.st.matvecs_compensated == 1, "%d", n1.st.matvecs_compensated);
+            CHECK_MSG(cl.arnoldi >= 1, "%d", cl.arnoldi);
+            CHECK_MSG(miss <= 2e-10 * fall, "%.3g", miss / fall);
             for (int u = 0; u < 3; ++u) {
                 double fmx = 0.0;
                 for (size_t i = 0; i < m_in; ++i) fmx = fmax(fmx, fabs(v5[i * NC + (size_t)u]));
@@ -327,12 +367,8 @@ int main(void)
             for (int pass = 0; pass < 2; ++pass) {
                 for (size_t i = 0; i < m_in; ++i)
                     for (size_t u = 0; u < 3; ++u) v6[i * NC + u] += 1e-3 * d2[3 * i + u];
-                cm_context *lc = NULL;
-                CHECK(cm_context_create(&lc) == CM_OK);
-                cm_context_set_threads(lc, 2);
-                cm_context_set_log(lc, count_s_sums, &summed[pass]);
-                solved l1 = solve_cols(lc, r, m, v6, 3, smooth);
-                cm_context_destroy(&lc);
+                solved l1 = solve_logged(r, m, v6, 3, smooth, &cl);
+                summed[pass] = cl.s_summed;
                 CHECK(l1.status == CM_OK && l1.st.warm_columns == 3 && l1.st.residual <= 1e-6);
                 for (int u = 0; pass == 1 && u < 3; ++u) {
                     double fmx = 0.0;
