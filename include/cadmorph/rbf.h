@@ -107,7 +107,7 @@ typedef struct cm_rbf_stats {
     int iterations;        /* last solve: Krylov iterations (largest over components);
                             * dense: refinement steps */
     int matvecs;           /* last solve: kernel-sum passes over the m x m matrix of every
-                            * kind (one per iteration and product kind in use, one or two
+                            * kind (one per iteration and product kind in use, none to two
                             * at a restart, plus one for the floor estimate unless the
                             * solve met a tolerance below 1e-8, all running
                             * components together; PETSC: the
