@@ -326,12 +326,15 @@ static double gmres_residual_inf(const krylov *kr, const kcol *k, int j)
  * solve (col.comp_only: S(w) changes little from cycle to cycle). S(w) (col.smax) then gives
  * the floor and the evaluation's scale without a pass of their own. A start whose bound on
  * S(w) (col.sbound) already allows plain sums is summed without |w|: half the columns of a
- * warm start's check. Returns the columns whose S(w) it summed. */
+ * warm start's check; one whose estimate from below (col.slow) already forbids them is
+ * summed compensated at once (the bracket at 1e-6: S(w) 1e7 x |f|, where the plain pass of w
+ * and |w| went for nothing). Returns the columns whose S(w) it summed; *at_once: those. */
 static int check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
-                          double *const *in, double *const *out, int threads)
+                          double *const *in, double *const *out, int *at_once, int threads)
 {
     const size_t m = kr->m;
     const int plain = r->opt.tolerance >= CM_RBF_PLAIN_RES_TOL && kr->R >= 2;
+    *at_once = 0;
     double **pi = plain ? malloc(6 * (size_t)n * sizeof *pi) : NULL;
     int *at = plain ? malloc((size_t)n * sizeof *at) : NULL;
     if (!pi || !at) {
@@ -341,8 +344,15 @@ static int check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
     }
     double **po = pi + 2 * n, **ci = pi + 4 * n, **co = pi + 5 * n;
     int np = 0, nc = 0, na = 0;
-    for (int u = 0; u < n; ++u) /* the columns tried plainly: w, then |w| (in Z) */
-        if (!kr->col[cols[u]].comp_only) at[np++] = u;
+    for (int u = 0; u < n; ++u) { /* the columns tried plainly: w, then |w| (in Z) */
+        kcol *k = &kr->col[cols[u]];
+        if (k->slow >= 0.0 && cm_rbf_plain_bound(k->slow, k->fnorm, k->tol) < 0.0) {
+            k->comp_only = 1;
+            ++*at_once;
+        }
+        k->slow = -1.0;
+        if (!k->comp_only) at[np++] = u;
+    }
     for (int v = 0; v < np; ++v) {
         kcol *k = &kr->col[cols[at[v]]];
         pi[v] = in[at[v]];
@@ -559,10 +569,13 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
              * 1e-22 S(w)) */
             if (kr->tree) cm_krylov_matvec(r, kr, nw, in, out, threads);
             else {
-                const int nsum = check_products(r, kr, nw, fl, in, out, threads);
+                int once;
+                const int nsum = check_products(r, kr, nw, fl, in, out, &once, threads);
                 if (cycle == 0 && r->opt.tolerance >= CM_RBF_PLAIN_RES_TOL)
                     cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: the check of %d starts summed "
-                           "S(w) for %d (the others: bounded by the fit's last weights)", nw, nsum);
+                           "S(w) for %d, bounded it by the fit's last weights for %d, and was "
+                           "compensated at once for %d (S too large for plain sums)", nw, nsum,
+                           nw - nsum - once, once);
             }
             if (cycle > 0) {
                 cm_krylov_matvec_loose(r, kr, nw, p3, p4, threads);
@@ -577,7 +590,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             double *rv = k->v, *ax = aw + (size_t)c * m; /* the residual is built in V_0 */
             const double *fc = f + (size_t)c * m;
             double rn = cm_krylov_residual(r, m, fc, ax, rv);
-            k->sbound = -1.0; /* of the start only */
+            k->sbound = k->slow = -1.0; /* of the start only */
             k->has_aw = !kr->tree && (cycle > 0 || k->warm);
             if (cycle == 0 && k->warm) {
                 /* the start is kept if its residual is below the zero start's |f| */

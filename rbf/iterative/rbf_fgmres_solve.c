@@ -336,13 +336,17 @@ static int krylov_alloc(krylov *kr, int g)
  * phi_ij <= diam^3, so S(w0) <= S(v) + diam^3 sum |w0 - v| for any of the fit's last weights
  * v whose S its solve summed (cm_rbf_scales), the nearest taken. Why: a start's plain check
  * summed |w0| beside w0 to bound its rounding, half of the check's columns; the starts of a
- * study's batch lie near the last batch's solutions (bore, 20.6k centres: within 1.2-2x
- * S(w0), RESULTS.md, Study), and the check needs S only within the plain bound's margin. */
-static double start_sbound(const cm_rbf *r, const double *w0, double diam3)
+ * study's batch lie near the last batch's solutions (bore, 20.6k centres: 1.05-1.5x S(w0),
+ * RESULTS.md, Study), and the check needs S only within the plain bound's margin. *low: the
+ * other side, S(v) - diam^3 sum |w0 - v| at best (-1: none), an estimate only (the smax of a
+ * solve that summed steps is itself a bound from above), which decides no more than whether
+ * a plain check is worth trying. */
+static double start_sbound(const cm_rbf *r, const double *w0, double diam3, double *low)
 {
     const cm_rbf_scales *sc = &r->iter->scales;
-    if (!r->w || sc->n != (size_t)r->ncomp) return -1.0;
     double best = -1.0;
+    *low = -1.0;
+    if (!r->w || sc->n != (size_t)r->ncomp) return -1.0;
     for (size_t v = 0; v < sc->n; ++v) {
         if (!(sc->smax[v] >= 0.0)) continue;
         const double *wv = r->w + v * r->m;
@@ -351,6 +355,7 @@ static double start_sbound(const cm_rbf *r, const double *w0, double diam3)
         /* smax: plain sums of |w| or the loosest treecode's (1e-6 of the sums) */
         const double b = 1.01 * sc->smax[v] + diam3 * l1;
         if (best < 0.0 || b < best) best = b;
+        *low = fmax(*low, 0.99 * sc->smax[v] - diam3 * l1);
     }
     return best;
 }
@@ -466,7 +471,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             kc->fnorm = fmax(cm_krylov_norm_inf(m, f + o0), tu->column_scale * fmax_all);
             kc->tol = o->tolerance;
             kc->warm = basis > 0;
-            kc->sbound = -1.0;
+            kc->sbound = kc->slow = -1.0;
             kc->took = 0;
             kc->warm_res = 0.0;
             if (basis > 0) {
@@ -476,7 +481,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                 cm_rbf_history_start(hist, pf, w + o0);
                 cm_krylov_project(r->iter->q1, m, r->k, w + o0);
                 if (o->tolerance >= CM_RBF_PLAIN_RES_TOL && !fast)
-                    kc->sbound = start_sbound(r, w + o0, kr.diam3);
+                    kc->sbound = start_sbound(r, w + o0, kr.diam3, &kc->slow);
             }
         }
         if (fast)

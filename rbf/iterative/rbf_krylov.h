@@ -38,6 +38,8 @@ typedef struct kcol {
                      * product), -1 if not summed */
     double sbound;  /* a bound on S(w) of the start, from the fit's earlier weights (the
                      * caller's; -1: none): its plain check then sums w alone */
+    double slow;    /* ... and an estimate from below (-1: none): above the plain bound, its
+                     * check is compensated at once */
     int has_aw;     /* aw holds A w from a check of this solve (exactly, within cb), so the
                      * next check may add the product of the cycle's step (kr->aux) */
     int by_arnoldi; /* its last check came from the cycle's own products (arnoldi_step) */

@@ -112,16 +112,18 @@ static void release(solved *s) { free(s->w), free(s->q); }
  * check summed S(w) (the last logged; -1: none), and the checks after a cycle that came from
  * the Arnoldi relation (summed over the cycles). */
 typedef struct {
-    int s_summed, arnoldi;
+    int s_summed, at_once, arnoldi;
 } check_log;
 
 static void count_checks(void *user, cm_log_level level, const char *msg)
 {
     (void)level;
     check_log *cl = user;
-    int a, b;
-    if (sscanf(msg, "cm_rbf_solve: the check of %d starts summed S(w) for %d", &a, &b) == 2)
-        cl->s_summed = b;
+    int a, b, c, d;
+    if (sscanf(msg, "cm_rbf_solve: the check of %d starts summed S(w) for %d, bounded it by the "
+               "fit's last weights for %d, and was compensated at once for %d", &a, &b, &c,
+               &d) == 4)
+        cl->s_summed = b, cl->at_once = d;
     if (sscanf(msg, "cm_rbf_solve: cycle %d: %d checks by the Arnoldi relation", &a, &b) == 2)
         cl->arnoldi += b;
 }
@@ -134,7 +136,7 @@ static solved solve_logged(cm_rbf *r, size_t m, const double *v, int nc, const i
     solved o;
     memset(&o, 0, sizeof o);
     o.status = CM_ERR_NOMEM;
-    cl->s_summed = -1;
+    cl->s_summed = cl->at_once = -1;
     cl->arnoldi = 0;
     if (cm_context_create(&lc) != CM_OK) return o;
     cm_context_set_threads(lc, 2);
@@ -386,6 +388,19 @@ int main(void)
             printf("loose warm starts: S(w) summed at the check of 3 starts for %d, then %d\n",
                    summed[0], summed[1]);
             CHECK_MSG(summed[1] == 0, "%d, %d", summed[0], summed[1]);
+            /* where S(w) of the last weights is far above what plain sums allow (1e4 |f| at
+             * 1e-8), the starts' check goes compensated at once */
+            for (double tl = 1e-7; tl >= 1e-8; tl *= 0.1) {
+                r->opt.tolerance = tl;
+                for (size_t i = 0; i < m_in; ++i)
+                    for (size_t u = 0; u < 3; ++u) v6[i * NC + u] += 1e-3 * d2[3 * i + u];
+                solved l2 = solve_logged(r, m, v6, 3, smooth, &cl);
+                printf("tolerance %.0e: the check of 3 starts summed S(w) for %d, compensated at "
+                       "once %d; residual %.3g\n", tl, cl.s_summed, cl.at_once, l2.st.residual);
+                CHECK(l2.status == CM_OK && l2.st.residual <= tl);
+                if (tl < 5e-8) CHECK_MSG(cl.at_once >= 1, "%d", cl.at_once);
+                release(&l2);
+            }
             r->opt.tolerance = o.tolerance;
             free(v6);
             release(&n1);
