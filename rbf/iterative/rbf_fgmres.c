@@ -348,6 +348,7 @@ static int check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
         kcol *k = &kr->col[cols[u]];
         if (k->slow >= 0.0 && cm_rbf_plain_bound(k->slow, k->fnorm, k->tol) < 0.0) {
             k->comp_only = 1;
+            k->smin = k->slow;
             ++*at_once;
         }
         k->slow = -1.0;
@@ -370,6 +371,7 @@ static int check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
         if (v < np && at[v] == u) {
             ++v;
             k->smax = k->sbound >= 0.0 ? k->sbound : cm_krylov_norm_inf(m, po[np + a++]);
+            k->smin = k->sbound >= 0.0 ? -1.0 : k->smax; /* plain sums of |w|: exact to 1e-14 */
             const double bound = cm_rbf_plain_bound(k->smax, k->fnorm, k->tol);
             if (bound >= 0.0) {
                 k->cb = bound;
@@ -405,6 +407,13 @@ static void step_of(const krylov *kr, const kcol *k, const double *y, double *dh
         dl[q] = lo - (t - hi);
         dh[q] = t;
     }
+}
+
+/* S(w + dw) between S(w) - S(dw) and S(w) + S(dw), S(dw) <= diam^3 sum |dw| = diam3 l1 */
+static void step_s(const krylov *kr, kcol *k, double l1)
+{
+    if (k->smax >= 0.0) k->smax += kr->diam3 * l1;
+    if (k->smin >= 0.0) k->smin = k->smin > kr->diam3 * l1 ? k->smin - kr->diam3 * l1 : -1.0;
 }
 
 /* The rounding of the Arnoldi relation A Z y = V H y + Q1 Q1' A Z y in the max-norm, per
@@ -453,19 +462,20 @@ static int arnoldi_step(const cm_rbf *r, const krylov *kr, int c, double *aw, do
     }
     for (int a = 0; a < r->k; ++a) cblas_daxpy((int)m, qa[a], r->iter->q1 + (size_t)a * m, 1, ac, 1);
     k->cb = cb;
-    if (k->smax >= 0.0) k->smax += kr->diam3 * l1; /* S(w + dw) <= S(w) + S(dw) */
+    step_s(kr, k, l1);
     return 1;
 }
 
 /* The checks of the n columns list[] that have an exact A w from an earlier check (has_aw)
- * and whose step dw (its high part, kr->aux) is small: A w += A dw by plain sums, their
- * error bounded by CM_RBF_PLAIN_ERR x S(dw) <= CM_RBF_PLAIN_ERR x diam^3 sum |dw| (and the
- * step's low part, A dl, by eps x that), added to col.cb where that stays within
- * CM_RBF_PLAIN_RES_SHARE of the tolerance. Why: near the tolerance a step is 1e-8..1e-6 of
- * w, so its product needs no compensated sums even at 1e-10, where the whole w's does (S(w)
- * is 1e4..1e9 x |f|); on the bore (20.6k centres) a warm solve's last check went from a
- * compensated product of w plus a plain one of its low part to one plain product. The
- * others lose has_aw (a full check). */
+ * and whose step dw (its high part, kr->aux) is small: A w += A dw from the cycle's own
+ * products (arnoldi_step) where its bound fits, else by plain sums, their error bounded by
+ * CM_RBF_PLAIN_ERR x S(dw) <= CM_RBF_PLAIN_ERR x diam^3 sum |dw| (and the step's low part,
+ * A dl, by eps x that), added to col.cb where that stays within CM_RBF_PLAIN_RES_SHARE of
+ * the tolerance. Why: near the tolerance a step is 1e-8..1e-6 of w, so its product needs no
+ * compensated sums even at 1e-10, where the whole w's does (S(w) is 1e4..1e9 x |f|); on the
+ * bore (20.6k centres) a warm solve's last check went from a compensated product of w plus a
+ * plain one of its low part to one plain product, then to none. The others lose has_aw (a
+ * full check). Returns the checks by the Arnoldi relation. */
 static int step_products(const cm_rbf *r, krylov *kr, int n, const int *list, double *aw,
                          int threads)
 {
@@ -490,7 +500,7 @@ static int step_products(const cm_rbf *r, krylov *kr, int n, const int *list, do
             continue;
         }
         k->cb = cb;
-        if (k->smax >= 0.0) k->smax += kr->diam3 * l1; /* S(w + dw) <= S(w) + S(dw) */
+        step_s(kr, k, l1);
         in[ns] = kr->aux + (size_t)list[u] * m;
         out[ns] = kr->awlo + (size_t)list[u] * m;
         ++ns;
@@ -554,7 +564,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             const int c = list[u];
             if (kr->col[c].has_aw) continue; /* summed by its step */
             kr->col[c].cb = 0.0;
-            kr->col[c].smax = -1.0;
+            kr->col[c].smax = kr->col[c].smin = -1.0;
             if (cycle == 0 && !kr->col[c].warm) continue;
             in[nw] = w + (size_t)c * m;
             out[nw] = aw + (size_t)c * m;
@@ -624,7 +634,10 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             cm_krylov_matvec_loose(r, kr, ns, p3, p4, threads);
             for (int u = 0, v = 0; u < nfl; ++u) {
                 kcol *k = &kr->col[fl[u]];
-                if (k->smax < 0.0) k->smax = cm_krylov_norm_inf(m, p4[v++]);
+                if (k->smax < 0.0) {
+                    k->smax = cm_krylov_norm_inf(m, p4[v++]);
+                    k->smin = CM_RBF_LOOSE_LOW * k->smax;
+                }
                 k->floor = DBL_EPSILON * k->smax / k->fnorm;
                 /* a cycle that does not halve the residual has stagnated: at the floor if
                  * within CM_RBF_FLOOR_SLACK of it, else a failure to converge */

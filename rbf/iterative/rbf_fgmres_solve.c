@@ -338,9 +338,8 @@ static int krylov_alloc(krylov *kr, int g)
  * summed |w0| beside w0 to bound its rounding, half of the check's columns; the starts of a
  * study's batch lie near the last batch's solutions (bore, 20.6k centres: 1.05-1.5x S(w0),
  * RESULTS.md, Study), and the check needs S only within the plain bound's margin. *low: the
- * other side, S(v) - diam^3 sum |w0 - v| at best (-1: none), an estimate only (the smax of a
- * solve that summed steps is itself a bound from above), which decides no more than whether
- * a plain check is worth trying. */
+ * other side, S(w0) >= S(v) - diam^3 sum |w0 - v| with S(v) bounded from below (smin; -1:
+ * none): where even that forbids plain sums, a plain check would go for nothing. */
 static double start_sbound(const cm_rbf *r, const double *w0, double diam3, double *low)
 {
     const cm_rbf_scales *sc = &r->iter->scales;
@@ -355,7 +354,7 @@ static double start_sbound(const cm_rbf *r, const double *w0, double diam3, doub
         /* smax: plain sums of |w| or the loosest treecode's (1e-6 of the sums) */
         const double b = 1.01 * sc->smax[v] + diam3 * l1;
         if (best < 0.0 || b < best) best = b;
-        *low = fmax(*low, 0.99 * sc->smax[v] - diam3 * l1);
+        if (sc->smin[v] >= 0.0) *low = fmax(*low, sc->smin[v] - diam3 * l1);
     }
     return best;
 }
@@ -506,6 +505,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             if (scales) { /* S(w) if a plain check summed it (not an inner solve's) */
                 scales->fnorm[c0 + (size_t)c] = kc->fnorm;
                 scales->smax[c0 + (size_t)c] = fast ? -1.0 : kc->smax;
+                scales->smin[c0 + (size_t)c] = fast ? -1.0 : kc->smin;
             }
             if (kc->iters > maxit) maxit = kc->iters;
             if (kc->floor * kc->fnorm > floor_max * fmax_all)
@@ -584,7 +584,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             else if (sampled) sm = kr.awlo[v++];
             else {
                 sm = cm_krylov_norm_inf(m, kr.pb[v++]);
-                if (s) *s = sm;
+                if (s) *s = sm, scales->smin[c0 + (size_t)u] = CM_RBF_LOOSE_LOW * sm;
             }
             if (fmax_all > 0.0) floor_max = fmax(floor_max, DBL_EPSILON * sm / fmax_all);
         }

@@ -14,6 +14,10 @@
 
 enum { MV_COMP = 0, MV_PLAIN = 1, MV_FAST = 2 };
 
+/* A sum of positive terms by cm_krylov_matvec_loose (the loosest treecode errs by 1e-6 of
+ * it, plain sums by 1e-14) is at least this x its value */
+#define CM_RBF_LOOSE_LOW (1.0 - 1e-5)
+
 /* One column's Krylov space and state: every column runs its own FGMRES (its own basis,
  * Hessenberg, rotations, relaxation budget and stopping test), so its iterates are those of
  * a solve of that column alone; the columns share only the passes of the kernel sums and of
@@ -36,10 +40,11 @@ typedef struct kcol {
                      * step products added since), else 0 */
     double smax;    /* max_i sum_j |w_j| phi_ij of w at the last check (a bound after a step
                      * product), -1 if not summed */
+    double smin;    /* ... a bound from below, -1 if none */
     double sbound;  /* a bound on S(w) of the start, from the fit's earlier weights (the
                      * caller's; -1: none): its plain check then sums w alone */
-    double slow;    /* ... and an estimate from below (-1: none): above the plain bound, its
-                     * check is compensated at once */
+    double slow;    /* ... and one from below (-1: none): above the plain bound, its check
+                     * is compensated at once */
     int has_aw;     /* aw holds A w from a check of this solve (exactly, within cb), so the
                      * next check may add the product of the cycle's step (kr->aux) */
     int by_arnoldi; /* its last check came from the cycle's own products (arnoldi_step) */
