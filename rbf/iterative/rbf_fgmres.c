@@ -428,8 +428,9 @@ static void step_s(const krylov *kr, kcol *k, double l1)
  * count nothing, as in the relaxation's budget), and the rounding of the relation. 1 if that,
  * added to col.cb, stays within CM_RBF_PLAIN_RES_SHARE of the tolerance (aw, cb and smax
  * updated), else 0. Why: a step's plain product is a pass over the kernel's m^2 pairs for
- * what the cycle already summed; at 1e-10 on the bore (20.6k centres) the relation errs by
- * about 1e-15 of |f|. l1: sum |dw| (the step's high part). */
+ * what the cycle already summed (the bore's and the bracket's warm solves take nearly all
+ * their checks after a cycle this way: RESULTS.md, Study). l1: sum |dw| (the step's high
+ * part). */
 static int arnoldi_step(const cm_rbf *r, const krylov *kr, int c, double *aw, double l1)
 {
     const size_t m = kr->m;

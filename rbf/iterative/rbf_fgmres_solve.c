@@ -332,15 +332,16 @@ static int krylov_alloc(krylov *kr, int g)
  * for the reported floor (spread over them; all of them below this many) */
 #define CM_RBF_FLOOR_SAMPLES 1024
 
-/* A bound on S(w0) = max_i sum_j |w0_j| phi_ij of a start w0 (m), or -1: S is subadditive and
- * phi_ij <= diam^3, so S(w0) <= S(v) + diam^3 sum |w0 - v| for any of the fit's last weights
- * v whose S its solve summed (cm_rbf_scales), the nearest taken. Why: a start's plain check
- * summed |w0| beside w0 to bound its rounding, half of the check's columns; the starts of a
- * study's batch lie near the last batch's solutions (bore, 20.6k centres: 1.05-1.5x S(w0),
- * RESULTS.md, Study), and the check needs S only within the plain bound's margin. *low: the
- * other side, S(w0) >= S(v) - diam^3 sum |w0 - v| with S(v) bounded from below (smin; -1:
- * none): where even that forbids plain sums, a plain check would go for nothing. */
-static double start_sbound(const cm_rbf *r, const double *w0, double diam3, double *low)
+/* Bounds on S(w0) = max_i sum_j |w0_j| phi_ij of a start w0 (m): the one from above returned,
+ * the one from below in *low (-1: none). S is subadditive and phi_ij <= diam^3, so for any of
+ * the fit's last weights v whose S its solve knew (cm_rbf_scales), S(w0) <= S(v) + diam^3
+ * sum |w0 - v| (the nearest v taken) and S(w0) >= S_min(v) - diam^3 sum |w0 - v|. Why: a
+ * start's plain check summed |w0| beside w0 to bound its rounding, half of the check's
+ * columns; the starts of a study's batch lie near the last batch's solutions (bore, 20.6k
+ * centres: 1.05-1.5x S(w0), RESULTS.md, Study), and the check needs S only within the plain
+ * bound's margin. Where even the bound from below forbids plain sums, a plain check would go
+ * for nothing (rbf_fgmres.c, check_products). */
+static double start_s_bounds(const cm_rbf *r, const double *w0, double diam3, double *low)
 {
     const cm_rbf_scales *sc = &r->iter->scales;
     double best = -1.0;
@@ -480,7 +481,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                 cm_rbf_history_start(hist, pf, w + o0);
                 cm_krylov_project(r->iter->q1, m, r->k, w + o0);
                 if (o->tolerance >= CM_RBF_PLAIN_RES_TOL && !fast)
-                    kc->sbound = start_sbound(r, w + o0, kr.diam3, &kc->slow);
+                    kc->sbound = start_s_bounds(r, w + o0, kr.diam3, &kc->slow);
             }
         }
         if (fast)
@@ -584,7 +585,10 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
             else if (sampled) sm = kr.awlo[v++];
             else {
                 sm = cm_krylov_norm_inf(m, kr.pb[v++]);
-                if (s) *s = sm, scales->smin[c0 + (size_t)u] = CM_RBF_LOOSE_LOW * sm;
+                if (s) {
+                    *s = sm;
+                    scales->smin[c0 + (size_t)u] = CM_RBF_LOOSE_LOW * sm;
+                }
             }
             if (fmax_all > 0.0) floor_max = fmax(floor_max, DBL_EPSILON * sm / fmax_all);
         }

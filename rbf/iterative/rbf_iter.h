@@ -71,11 +71,11 @@ typedef struct cm_rbf_scales {
     size_t n;      /* columns below; 0 if unknown (a PETSc solve) */
     double *fnorm; /* column c: the scale of its tolerance (max |data_c|, or the share
                     * column_scale of fmax if that is larger) */
-    double *smin;  /* column c: a bound from below on that sum, -1 if none (the next solve's
-                    * starts near these weights judge by it whether plain sums can serve) */
     double *smax;  /* column c: max_i sum_j |w_j| phi_ij at the centres (or a bound on it),
                     * the scale of the rounding of plain sums (rbf_evaluate.c); -1 if the
                     * solve did not sum it (below CM_RBF_PLAIN_RES_TOL: compensated sums) */
+    double *smin;  /* column c: a bound from below on that sum, -1 if none (the next solve's
+                    * starts near these weights judge by it whether plain sums can serve) */
 } cm_rbf_scales;
 
 struct cm_rbf_iter {
