@@ -290,6 +290,19 @@ static void relaxed_products(cm_context *ctx, const cm_rbf *r, krylov *kr, int c
     }
 }
 
+/* t (n + 1) = the coefficients in V_{n+1} of the residual GMRES has after n steps of column
+ * k: Q' (0, .., 0, g_n), the rotations Q undone */
+static void gmres_residual_coefs(const kcol *k, int n, double *t)
+{
+    for (int i = 0; i < n; ++i) t[i] = 0.0;
+    t[n] = k->gv[n];
+    for (int i = n - 1; i >= 0; --i) {
+        const double a = t[i], b = t[i + 1];
+        t[i] = k->cs[i] * a - k->sn[i] * b;
+        t[i + 1] = k->sn[i] * a + k->cs[i] * b;
+    }
+}
+
 /* The max-norm of the residual GMRES has after step j of column k, V_{j+1} Q' (0, .., 0,
  * g_{j+1}) (Q: the Givens rotations, undone), in O(j m) (a product is O(m^2)). Why: the
  * tolerance is on the max-norm, GMRES minimises the 2-norm, and their ratio changes as the
@@ -300,13 +313,8 @@ static void relaxed_products(cm_context *ctx, const cm_rbf *r, krylov *kr, int c
 static double gmres_residual_inf(const krylov *kr, const kcol *k, int j)
 {
     const size_t m = kr->m;
-    double t[66] = {0};
-    t[j + 1] = k->gv[j + 1];
-    for (int i = j; i >= 0; --i) {
-        const double a = t[i], b = t[i + 1];
-        t[i] = k->cs[i] * a - k->sn[i] * b;
-        t[i + 1] = k->sn[i] * a + k->cs[i] * b;
-    }
+    double t[66];
+    gmres_residual_coefs(k, j + 1, t);
     double mx = 0.0;
     for (size_t q = 0; q < m; ++q) {
         double s = 0.0;
@@ -351,7 +359,6 @@ static int check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
             k->smin = k->slow;
             ++*at_once;
         }
-        k->slow = -1.0;
         if (!k->comp_only) at[np++] = u;
     }
     for (int v = 0; v < np; ++v) {
@@ -445,13 +452,8 @@ static int arnoldi_step(const cm_rbf *r, const krylov *kr, int c, double *aw, do
     const double cb = k->cb + err / k->fnorm;
     if (!(cb <= CM_RBF_PLAIN_RES_SHARE * k->tol)) return 0;
     /* t: GMRES's residual in the basis V_{jn+1}, less the start's (cycle0 v_0) */
-    double t[66] = {0}, qa[4] = {0, 0, 0, 0};
-    t[jn] = k->gv[jn];
-    for (int i = jn - 1; i >= 0; --i) {
-        const double a = t[i], b = t[i + 1];
-        t[i] = k->cs[i] * a - k->sn[i] * b;
-        t[i + 1] = k->sn[i] * a + k->cs[i] * b;
-    }
+    double t[66], qa[4] = {0, 0, 0, 0};
+    gmres_residual_coefs(k, jn, t);
     t[0] -= k->cycle0;
     for (int i = 0; i < jn; ++i)
         for (int a = 0; a < r->k; ++a) qa[a] += y[i] * k->qaz[i][a];
@@ -482,6 +484,7 @@ static int step_products(const cm_rbf *r, krylov *kr, int n, const int *list, do
 {
     const size_t m = kr->m;
     double **in = kr->pe, **out = kr->pf;
+    int *plain = kr->ic; /* the columns summed plainly (fl of the caller, not yet in use) */
     int ns = 0, na = 0;
     for (int u = 0; u < n; ++u) {
         kcol *k = &kr->col[list[u]];
@@ -489,8 +492,7 @@ static int step_products(const cm_rbf *r, krylov *kr, int n, const int *list, do
         const double *dw = kr->aux + (size_t)list[u] * m;
         double l1 = 0.0;
         for (size_t i = 0; i < m; ++i) l1 += fabs(dw[i]);
-        k->by_arnoldi = k->jn > 0 && arnoldi_step(r, kr, list[u], aw, l1);
-        if (k->by_arnoldi) {
+        if (k->jn > 0 && arnoldi_step(r, kr, list[u], aw, l1)) {
             ++na;
             continue;
         }
@@ -504,15 +506,12 @@ static int step_products(const cm_rbf *r, krylov *kr, int n, const int *list, do
         step_s(kr, k, l1);
         in[ns] = kr->aux + (size_t)list[u] * m;
         out[ns] = kr->awlo + (size_t)list[u] * m;
-        ++ns;
+        plain[ns++] = list[u];
     }
     cm_krylov_matvec_kind(r, kr, MV_PLAIN, 0, ns, in, out, threads);
-    for (int u = 0, v = 0; u < n; ++u) {
-        const int c = list[u];
-        if (!kr->col[c].has_aw || kr->col[c].by_arnoldi) continue;
-        double *a = aw + (size_t)c * m;
+    for (int v = 0; v < ns; ++v) {
+        double *a = aw + (size_t)plain[v] * m;
         for (size_t i = 0; i < m; ++i) a[i] += out[v][i];
-        ++v;
     }
     return na;
 }

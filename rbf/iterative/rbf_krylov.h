@@ -47,7 +47,6 @@ typedef struct kcol {
                      * is compensated at once */
     int has_aw;     /* aw holds A w from a check of this solve (exactly, within cb), so the
                      * next check may add the product of the cycle's step (kr->aux) */
-    int by_arnoldi; /* its last check came from the cycle's own products (arnoldi_step) */
     int comp_only;  /* its checks in this solve are compensated (a plain one was not exact
                      * enough) */
     double tol;     /* relative tolerance of this (inner) solve */
