@@ -331,10 +331,18 @@ int cm_rbf_projected_factor(const double *cg, size_t m, const size_t *idx, size_
 int cm_rbf_projected_solve(const double *work, size_t n, int rk, const double *tau,
                            size_t nrhs, double *x);
 /* The same with each column's arithmetic in an order that does not depend on nrhs (a
- * column's result is the same bits alone or with others); the coarse solve of the Schwarz
- * preconditioner, whose columns are a batch's right-hand sides. */
+ * column's result is the same bits alone or with others), its columns over threads; the
+ * coarse solve of the Schwarz preconditioner, whose columns are a batch's right-hand sides
+ * (rbf_schwarz_rows.c). */
 void cm_rbf_projected_solve_cols(const double *work, size_t n, int rk, const double *tau,
-                                 size_t nrhs, double *x);
+                                 size_t nrhs, double *x, int threads);
+/* The local solves of the Schwarz preconditioner for one subdomain (rbf_schwarz_rows.c):
+ * out[c * ldo + idx[j]] += sum_i G_ji x[c * n + i] for its nin leaf rows j and nc columns c,
+ * row j of G being hd doubles at gd + j hd, then hf = n - hd floats at gf + j hf. Each
+ * column the same bits whatever nc. */
+void cm_rbf_local_rows(const double *gd, const float *gf, size_t hd, size_t hf, size_t nin,
+                       const double *x, size_t n, int nc, double *out, size_t ldo,
+                       const size_t *idx);
 int cm_rbf_local_inverse(const double *cg, size_t m, const size_t *idx, size_t n, size_t n_in,
                          double *work, double *g);
 int cm_rbf_local_inverse_fast(const double *cg, size_t m, const size_t *idx, size_t n,

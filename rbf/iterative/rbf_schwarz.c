@@ -764,35 +764,12 @@ static void coarse_solve(const cm_rbf_schwarz *p, int nc, double *wc, int thread
     if (p->inner)
         for (int c = 0; c < nc; ++c)
             cm_rbf_coarse_inner_solve(p->inner, 1, wc + (size_t)c * p->nc, threads);
-    else cm_rbf_projected_solve_cols(p->gc, p->nc, p->c_rk, p->c_tau, (size_t)nc, wc);
+    else cm_rbf_projected_solve_cols(p->gc, p->nc, p->c_rk, p->c_tau, (size_t)nc, wc, threads);
 }
 
 const cm_rbf_coarse_inner *cm_rbf_schwarz_inner(const cm_rbf_schwarz *pc)
 {
     return pc ? pc->inner : NULL;
-}
-
-/* One row of a local inverse (its double part gd, float part gf) times nb (1 or
- * CM_SCHWARZ_COLS) columns of the local data x (stride n), added to out (stride ldo).
- * Why blocks of columns and not dgemm: a row is read once for the whole block, and the
- * block's independent sums fill the adder's pipeline (one column alone is a chain of
- * dependent adds); each column's sum still runs in the same order as alone, so a column's
- * preconditioned vector is the same bits whatever its batch-mates (dgemm promises no such
- * thing: OpenBLAS hands one column to dgemv), and the float rows need no double copy. */
-#define CM_SCHWARZ_COLS 8
-static inline void local_row(const double *gd, const float *gf, size_t hd, size_t hf,
-                             const double *x, size_t n, int nb, double *out, size_t ldo)
-{
-    double acc[CM_SCHWARZ_COLS] = {0};
-    for (size_t i = 0; i < hd; ++i) {
-        const double gi = gd[i];
-        for (int b = 0; b < nb; ++b) acc[b] += gi * x[(size_t)b * n + i];
-    }
-    for (size_t i = 0; i < hf; ++i) {
-        const double gi = (double)gf[i];
-        for (int b = 0; b < nb; ++b) acc[b] += gi * x[(size_t)b * n + hd + i];
-    }
-    for (int b = 0; b < nb; ++b) out[(size_t)b * ldo] += acc[b];
 }
 
 /* Kernel sums of nc columns in chunks the sums take (rbf_internal.h); with inner (the
@@ -892,17 +869,8 @@ int cm_rbf_schwarz_apply_sum(const cm_rbf_schwarz *p, const cm_rbf *r, int nc,
                     }
                 }
             }
-            for (size_t j = 0; j < nin; ++j) {
-                const double *gd = p->g64 + p->d_ptr[l] + j * hd;
-                const float *gf = p->g32 + p->f_ptr[l] + j * hf;
-                int c = 0;
-                for (; c + CM_SCHWARZ_COLS <= nc; c += CM_SCHWARZ_COLS)
-                    local_row(gd, gf, hd, hf, x + (size_t)c * n, n, CM_SCHWARZ_COLS,
-                              out + (size_t)c * m + idx[j], m);
-                for (; c < nc; ++c)
-                    local_row(gd, gf, hd, hf, x + (size_t)c * n, n, 1,
-                              out + (size_t)c * m + idx[j], m);
-            }
+            cm_rbf_local_rows(p->g64 + p->d_ptr[l], p->g32 + p->f_ptr[l], hd, hf, nin, x, n, nc,
+                              out, m, idx);
         }
         free(loc);
     }

@@ -65,3 +65,6 @@ cm_add_unit_test(test_rbf_transpose ${CMAKE_CURRENT_LIST_DIR}/test_rbf_transpose
 # many right-hand sides in one iterative solve against each alone (direct and treecode
 # sums), a slow column beside smooth ones, warm starts, columns in groups of a memory budget
 cm_add_unit_test(test_rbf_batch ${CMAKE_CURRENT_LIST_DIR}/test_rbf_batch.c LIBS cm_rbf_internal LABELS rbf)
+# the Schwarz preconditioner's dense arithmetic for a batch of columns (local rows, coarse
+# solves) against plain references, each column the same bits whatever its batch
+cm_add_unit_test(test_schwarz_rows ${CMAKE_CURRENT_LIST_DIR}/test_schwarz_rows.c LIBS cm_rbf_internal LABELS rbf)
