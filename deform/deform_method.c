@@ -91,6 +91,7 @@ static cm_status rbf_create(cm_context *ctx, cm_deform *d, const double *xyz)
     ro.solver = d->opt.solver;
     if (d->opt.tolerance > 0) ro.tolerance = d->opt.tolerance;
     if (d->opt.solves > 1) ro.solves = d->opt.solves;
+    if (d->opt.warm_groups > 1) ro.warm_groups = d->opt.warm_groups;
     if (s >= 0) s = cm_rbf_create_opt(ctx, d->opt.kernel, 3, d->n_constrained, c, &ro, &d->rbf);
     free(c);
     return s;

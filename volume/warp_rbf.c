@@ -116,8 +116,7 @@ static cm_status split_component(cm_context *ctx, const unsigned char *constrain
 /* The RBF of component k; its errors (coplanar centres, failed factorisation) get the
  * component number in front. */
 static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel,
-                               cm_rbf_solver solver, double tolerance, int solves,
-                               size_t k, warp_component *wc)
+                               const cm_warp_options *opt, size_t k, warp_component *wc)
 {
     if (wc->n_free == 0) return CM_OK; /* nothing to interpolate: every node is prescribed */
     if (wc->n_fixed == 0)
@@ -141,9 +140,10 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
     cm_deform_options_init(&o);
     o.method = CM_DEFORM_RBF;
     o.kernel = kernel;
-    o.solver = solver;
-    o.tolerance = tolerance;
-    o.solves = solves;
+    o.solver = opt->solver;
+    o.tolerance = opt->tolerance;
+    o.solves = opt->solves;
+    o.warm_groups = opt->warm_groups;
     cm_status s = cm_deform_create(ctx, &o, np, xyz, con, NULL, &wc->def);
     free(xyz), free(con);
     if (s < 0)
@@ -154,7 +154,7 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
     cm_log(ctx, CM_LOG_DEBUG, "cm_warp_create: component %zu: %zu centres, %s solver%s, for %d "
            "solve(s)", k, wc->n_fixed, st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" :
            st.rbf.solver == CM_RBF_SOLVER_PETSC ? "petsc" : "iterative",
-           solver == CM_RBF_SOLVER_AUTO ? " (auto)" : "", solves > 1 ? solves : 1);
+           opt->solver == CM_RBF_SOLVER_AUTO ? " (auto)" : "", opt->solves > 1 ? opt->solves : 1);
     return CM_OK;
 }
 
@@ -162,8 +162,8 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
  * one pass per component with a stamp array deduplicates its nodes. */
 static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                                   const unsigned char *constrained, cm_rbf_kernel kernel,
-                                  cm_rbf_solver solver, double tolerance, int solves,
-                                  rbf_warp *w, size_t *n_shared_free)
+                                  const cm_warp_options *opt, rbf_warp *w,
+                                  size_t *n_shared_free)
 {
     size_t nc = b->n_components, nn = mesh->n_nodes;
     size_t *start = calloc(nc + 1, sizeof *start);
@@ -206,7 +206,7 @@ static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm
         s = split_component(ctx, constrained, (int)k, list, vis.n, owner, &w->comp[k],
                             n_shared_free);
         if (s < 0) goto done;
-        s = fit_component(ctx, mesh, kernel, solver, tolerance, solves, k, &w->comp[k]);
+        s = fit_component(ctx, mesh, kernel, opt, k, &w->comp[k]);
         if (s < 0) goto done;
         if ((s = cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc)) < 0) goto done;
     }
@@ -232,8 +232,7 @@ done:
 
 static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_boundary *b,
                             const unsigned char *constrained, cm_rbf_kernel kernel,
-                            cm_rbf_solver solver, double tolerance, int solves,
-                            void **state)
+                            const cm_warp_options *opt, void **state)
 {
     if (b->n_components > (size_t)(~0u >> 1))
         return cm_error(ctx, CM_ERR_UNSUPPORTED, "cm_warp_create: too many components");
@@ -248,8 +247,7 @@ static cm_status rbf_create(cm_context *ctx, const cm_mesh *mesh, const cm_mesh_
         goto fail;
     }
     size_t n_shared_free = 0;
-    s = build_components(ctx, mesh, b, constrained, kernel, solver, tolerance, solves, w,
-                         &n_shared_free);
+    s = build_components(ctx, mesh, b, constrained, kernel, opt, w, &n_shared_free);
     if (s < 0) goto fail;
     if (n_shared_free)
         cm_log(ctx, CM_LOG_WARNING,
@@ -393,16 +391,14 @@ static cm_status triharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                     const cm_mesh_boundary *b, const unsigned char *constrained,
                                     const cm_warp_options *opt, void **state)
 {
-    return rbf_create(ctx, mesh, b, constrained, CM_RBF_TRIHARMONIC, opt->solver, opt->tolerance,
-                      opt->solves, state);
+    return rbf_create(ctx, mesh, b, constrained, CM_RBF_TRIHARMONIC, opt, state);
 }
 
 static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
                                    const cm_mesh_boundary *b, const unsigned char *constrained,
                                    const cm_warp_options *opt, void **state)
 {
-    return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, opt->solver, opt->tolerance,
-                      opt->solves, state);
+    return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, opt, state);
 }
 
 const cm_warp_method_ops cm_warp_rbf_triharmonic = {

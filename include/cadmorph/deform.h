@@ -239,6 +239,10 @@ typedef struct cm_deform_options {
      * over its life (cm_deform_apply_many's k counting k; cm_rbf_options.solves); 0 or 1
      * (default): one */
     int solves;
+    /* rbf, iterative solver: cm_deform_apply_many's k fields solved in this many groups,
+     * each starting from the solutions of those before it (cm_rbf_options.warm_groups); 0 or
+     * 1 (default): all at once */
+    int warm_groups;
     /* dmffd: control points per axis (4..200; 0 = 10) of the lattice whose domain is the
      * points' bounding box grown by 1e-3 of its diagonal; singular values <= clamp x sigma_max
      * are truncated (0 = 1e-10) */

@@ -83,6 +83,13 @@ typedef struct cm_rbf_options {
                            * zero). Along a family of targets (a study, an optimiser's
                            * steps) this saves most of the iterations; any component count.
                            * 0: always from zero, nothing kept (stats: warm_columns) */
+    int warm_groups;      /* [1] iterative solvers with warm_start: a cm_rbf_solve of several
+                           * fields (ncomp a multiple of dim, each field's dim components side
+                           * by side) solves them in this many groups of whole fields, in
+                           * order, each group starting from the solutions of those before it
+                           * as successive solves would, and keeps them all for one
+                           * evaluation (whose kernel sums cost less per column the more
+                           * columns they carry). <= 1: all at once */
     int solves;           /* [1] AUTO only: how many right-hand sides the caller expects to
                            * solve on this fit over its life, one cm_rbf_solve of k sets of
                            * components (k displacement fields side by side) counting k. The

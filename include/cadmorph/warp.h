@@ -63,6 +63,10 @@ typedef struct cm_warp_options {
      * AUTO's cost model (cm_rbf_options.solves): an absolute study's variants share one warp,
      * so dense wins to more centres than for one apply. 0 or 1 (default): one apply */
     int solves;
+    /* RBF methods, iterative solver: cm_warp_apply_many's k fields solved in this many
+     * groups, each starting from the solutions of those before it, and evaluated together
+     * (cm_rbf_options.warm_groups): an absolute study's batch. 0 or 1 (default): all at once */
+    int warm_groups;
     /* DM-FFD: control points per axis of the lattice whose domain is the mesh's bounding box
      * (grown by 1e-3 of its diagonal): 5, 10, 15, 25 in the paper; 0 = 10 */
     int lattice;

@@ -334,30 +334,109 @@ static int krylov_alloc(krylov *kr, int g)
 
 /* Bounds on S(w0) = max_i sum_j |w0_j| phi_ij of a start w0 (m): the one from above returned,
  * the one from below in *low (-1: none). S is subadditive and phi_ij <= diam^3, so for any of
- * the fit's last weights v whose S its solve knew (cm_rbf_scales), S(w0) <= S(v) + diam^3
+ * the fit's last weights v whose S its solve knew (cm_rbf_scales), or of this solve's
+ * earlier groups (wnow, now: their nnow columns), S(w0) <= S(v) + diam^3
  * sum |w0 - v| (the nearest v taken) and S(w0) >= S_min(v) - diam^3 sum |w0 - v|. Why: a
  * start's plain check summed |w0| beside w0 to bound its rounding, half of the check's
  * columns; the starts of a study's batch lie near the last batch's solutions (bore, 20.6k
  * centres: 1.05-1.5x S(w0), RESULTS.md, Study), and the check needs S only within the plain
  * bound's margin. Where even the bound from below forbids plain sums, a plain check would go
  * for nothing (rbf_fgmres.c, check_products). */
-static double start_s_bounds(const cm_rbf *r, const double *w0, double diam3, double *low)
+static double start_s_bounds(const cm_rbf *r, const double *w0, double diam3,
+                             const double *wnow, const cm_rbf_scales *now, size_t nnow,
+                             double *low)
 {
-    const cm_rbf_scales *sc = &r->iter->scales;
     double best = -1.0;
     *low = -1.0;
-    if (!r->w || sc->n != (size_t)r->ncomp) return -1.0;
-    for (size_t v = 0; v < sc->n; ++v) {
-        if (!(sc->smax[v] >= 0.0)) continue;
-        const double *wv = r->w + v * r->m;
-        double l1 = 0.0;
-        for (size_t i = 0; i < r->m; ++i) l1 += fabs(w0[i] - wv[i]);
-        /* smax: plain sums of |w| or the loosest treecode's (1e-6 of the sums) */
-        const double b = 1.01 * sc->smax[v] + diam3 * l1;
-        if (best < 0.0 || b < best) best = b;
-        if (sc->smin[v] >= 0.0) *low = fmax(*low, sc->smin[v] - diam3 * l1);
+    for (int src = 0; src < 2; ++src) { /* the fit's last weights, this solve's earlier groups */
+        const cm_rbf_scales *sc = src ? now : &r->iter->scales;
+        const double *wv0 = src ? wnow : r->w;
+        const size_t n = !sc || !wv0 ? 0 : src ? nnow : sc->n == (size_t)r->ncomp ? sc->n : 0;
+        for (size_t v = 0; v < n; ++v) {
+            if (!(sc->smax[v] >= 0.0)) continue;
+            const double *wv = wv0 + v * r->m;
+            double l1 = 0.0;
+            for (size_t i = 0; i < r->m; ++i) l1 += fabs(w0[i] - wv[i]);
+            /* smax: plain sums of |w| or the loosest treecode's (1e-6 of the sums) */
+            const double b = 1.01 * sc->smax[v] + diam3 * l1;
+            if (best < 0.0 || b < best) best = b;
+            if (sc->smin[v] >= 0.0) *low = fmax(*low, sc->smin[v] - diam3 * l1);
+        }
     }
     return best;
+}
+
+/* The polynomial part of the g columns at c0, R q = Q1'(f - A w), then their residual at
+ * the centres, exactly (from A w): the largest, relative to fscale. */
+static double finish_columns(const cm_rbf *r, krylov *kr, const double *f, const double *aw,
+                             double *q, size_t c0, int g, double fscale)
+{
+    const size_t m = r->m, k = (size_t)r->k;
+    double worst = 0.0;
+    for (size_t c = c0; c < c0 + (size_t)g; ++c) {
+        const double *fc = f + c * m, *ac = aw + c * m;
+        double *qc = q + c * k, t[4];
+        double *d = kr->pin;
+        for (size_t i = 0; i < m; ++i) d[i] = fc[i] - ac[i];
+        for (size_t a = 0; a < k; ++a) t[a] = cblas_ddot((int)m, r->iter->q1 + a * m, 1, d, 1);
+        for (int i = (int)k - 1; i >= 0; --i) {
+            double s = t[i];
+            for (size_t j = (size_t)i + 1; j < k; ++j) s -= r->qr[j * m + (size_t)i] * qc[j];
+            qc[i] = s / r->qr[(size_t)i * m + (size_t)i];
+        }
+        double e = 0.0;
+        for (size_t i = 0; i < m; ++i) {
+            double p = qc[0] + qc[1] * r->c[i] + qc[2] * r->c[m + i] + qc[3] * r->c[2 * m + i];
+            e = fmax(e, fabs(d[i] - p));
+        }
+        worst = fmax(worst, fscale > 0.0 ? e / fscale : 0.0);
+    }
+    return worst;
+}
+
+/* The attainable exactness of plain direct sums of the g columns' weights at c0: S(w) =
+ * max_i sum_j |w_j| phi_ij, in one pass for those whose checks did not sum or bound it: the
+ * floor, eps S(w), and each column's smax (whether the evaluation may sum plainly, and the
+ * bound on the next starts near these weights, start_s_bounds). An estimate: the treecode's
+ * error on positive weights is fast_tol (or, the loosest relaxed one, 1e-6) of the sum;
+ * counted with the products. sampled (every column met a tolerance below
+ * CM_RBF_PLAIN_RES_TOL, where the evaluation sums compensated whatever smax): the floor is
+ * only reported, estimated at CM_RBF_FLOOR_SAMPLES of the centres, and smax left unknown, a
+ * pass fewer per solve (0.1 s of a 1.4 s warm solve of 15 columns on the bore, 20.6k
+ * centres). Returns the largest eps S(w) relative to fscale. */
+static double s_pass(const cm_rbf *r, krylov *kr, const double *w, size_t c0, int g,
+                     cm_rbf_scales *scales, int sampled, double fscale, int threads)
+{
+    const size_t m = r->m;
+    double floor_max = 0.0;
+    int ns = 0;
+    for (int u = 0; u < g; ++u) {
+        if (scales && scales->smax[c0 + (size_t)u] >= 0.0) continue;
+        kr->pa[ns] = kr->aux + (size_t)ns * m;
+        kr->pb[ns] = kr->awlo + (size_t)ns * m;
+        for (size_t i = 0; i < m; ++i) kr->pa[ns][i] = fabs(w[(c0 + (size_t)u) * m + i]);
+        ++ns;
+    }
+    /* the full sums into kr->pb[], or the sampled maxima into kr->awlo[0..ns) */
+    if (!sampled) cm_krylov_matvec_loose(r, kr, ns, kr->pa, kr->pb, threads);
+    else if (ns > 0 && cm_rbf_abs_sums(r, kr->aux, ns, m, r->c, CM_RBF_FLOOR_SAMPLES,
+                                       kr->awlo, threads) != 0)
+        memset(kr->awlo, 0, (size_t)ns * sizeof *kr->awlo); /* out of memory: none */
+    for (int u = 0, v = 0; u < g; ++u) {
+        double *sp = scales ? &scales->smax[c0 + (size_t)u] : NULL;
+        double sm;
+        if (sp && *sp >= 0.0) sm = *sp;
+        else if (sampled) sm = kr->awlo[v++];
+        else {
+            sm = cm_krylov_norm_inf(m, kr->pb[v++]);
+            if (sp) {
+                *sp = sm;
+                scales->smin[c0 + (size_t)u] = CM_RBF_LOOSE_LOW * sm;
+            }
+        }
+        if (fscale > 0.0) floor_max = fmax(floor_max, DBL_EPSILON * sm / fscale);
+    }
+    return floor_max;
 }
 
 /* The fit's history of solutions, made on first use: warm_history pairs, at most what an
@@ -394,6 +473,14 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     size_t gsize = nc;
     if (budget > 0.0 && (double)nc * per_col > budget)
         gsize = budget / per_col >= 1.0 ? (size_t)(budget / per_col) : 1;
+    /* warm groups (options warm_groups): fields of dim columns each, in groups that each
+     * start from the solutions of the groups before them */
+    if (o->warm_start && o->warm_groups > 1 && nc > 1) {
+        const size_t d = r->dim > 0 ? (size_t)r->dim : 1, ng = (size_t)o->warm_groups;
+        size_t per = (nc + ng - 1) / ng;
+        per = (per + d - 1) / d * d;
+        if (per < gsize) gsize = per;
+    }
     krylov kr;
     memset(&kr, 0, sizeof kr);
     kr.m = m;
@@ -449,15 +536,16 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
      * data best (rbf_iter.h, cm_rbf_history; tried in the first cycle, kept if it leaves a
      * residual below the data's) */
     cm_rbf_history *hist = o->warm_start && r->warm_ok ? history_of(r) : NULL;
-    const size_t basis = hist ? hist->n : 0;
+    size_t basis = 0;
     int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, steps = 0, direct = 0, groups = 0;
     int nwarm = 0;
-    double floor_max = 0.0, first = 0.0, warm_worst = 0.0;
+    double floor_max = 0.0, first = 0.0, warm_worst = 0.0, worst = 0.0;
     for (size_t c0 = 0; c0 < nc; c0 += gsize) {
         const int g = nc - c0 < gsize ? (int)(nc - c0) : (int)gsize;
         const int gall = kr.g;
         kr.g = g;
         ++groups;
+        basis = hist ? hist->n : 0;
         for (int c = 0; c < g; ++c) {
             kcol *kc = &kr.col[c];
             const size_t o0 = (c0 + (size_t)c) * m;
@@ -481,7 +569,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                 cm_rbf_history_start(hist, pf, w + o0);
                 cm_krylov_project(r->iter->q1, m, r->k, w + o0);
                 if (o->tolerance >= CM_RBF_PLAIN_RES_TOL && !fast)
-                    kc->sbound = start_s_bounds(r, w + o0, kr.diam3, &kc->slow);
+                    kc->sbound = start_s_bounds(r, w + o0, kr.diam3, w, scales, c0, &kc->slow);
             }
         }
         if (fast)
@@ -500,6 +588,21 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         }
         kr.g = gall;
         if (st != CM_OK) goto done;
+        /* the group's solutions join the history (their exact products: a pair is right
+         * whatever the residual of its solve), so the next group starts from them, but for
+         * those that took no step: such a w is the history's own combination, so what
+         * Gram-Schmidt leaves of its product is rounding alone, and normalised that would be
+         * a pair whose product is not its w's (on the bore at 1e-6 it made the fourth
+         * batch's starts err by 1e-6 of |f|) */
+        for (int c = 0; hist && c < g; ++c) {
+            if (kr.col[c].iters == 0) continue;
+            double *pb = kr.pin;
+            memcpy(pb, aw + (c0 + (size_t)c) * m, m * sizeof *pb);
+            cm_krylov_project(r->iter->q1, m, r->k, pb);
+            cm_rbf_history_add(hist, w + (c0 + (size_t)c) * m, pb);
+        }
+        const double gworst = finish_columns(r, &kr, f, aw, q, c0, g, fmax_all);
+        worst = fmax(worst, gworst);
         for (int c = 0; c < g; ++c) {
             const kcol *kc = &kr.col[c];
             col_iters[c0 + (size_t)c] = kc->iters;
@@ -519,79 +622,9 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                 warm_worst = fmax(warm_worst, kc->warm_res);
             }
         }
-    }
-    /* polynomial: R q = Q1'(f - A w); then the residual at the centres, exactly */
-    double worst = 0.0;
-    for (size_t c = 0; c < nc; ++c) {
-        const double *fc = f + c * m, *ac = aw + c * m;
-        double *qc = q + c * k, t[4];
-        double *g = kr.pin;
-        for (size_t i = 0; i < m; ++i) g[i] = fc[i] - ac[i];
-        for (size_t a = 0; a < k; ++a) t[a] = cblas_ddot((int)m, r->iter->q1 + a * m, 1, g, 1);
-        for (int i = (int)k - 1; i >= 0; --i) {
-            double s = t[i];
-            for (size_t j = (size_t)i + 1; j < k; ++j) s -= r->qr[j * m + (size_t)i] * qc[j];
-            qc[i] = s / r->qr[(size_t)i * m + (size_t)i];
-        }
-        double fn = fmax_all, e = 0.0;
-        for (size_t i = 0; i < m; ++i) {
-            double p = qc[0] + qc[1] * r->c[i] + qc[2] * r->c[m + i] + qc[3] * r->c[2 * m + i];
-            e = fmax(e, fabs(g[i] - p));
-        }
-        worst = fmax(worst, fn > 0.0 ? e / fn : 0.0);
-    }
-    /* the solutions join the history (their exact products: a pair is right whatever the
-     * residual of its solve), but for those that took no step: such a w is the history's
-     * own combination, so what Gram-Schmidt leaves of its product is rounding alone, and
-     * normalised that would be a pair whose product is not its w's (on the bore at 1e-6
-     * it made the fourth batch's starts err by 1e-6 of |f|) */
-    if (hist)
-        for (size_t c = 0; c < nc; ++c) {
-            if (col_iters[c] == 0) continue;
-            double *pb = kr.pin;
-            memcpy(pb, aw + c * m, m * sizeof *pb);
-            cm_krylov_project(r->iter->q1, m, r->k, pb);
-            cm_rbf_history_add(hist, w + c * m, pb);
-        }
-    /* the attainable exactness of plain direct sums of these weights: S(w) = max_i sum_j
-     * |w_j| phi_ij, for all columns in one pass (per group of the memory budget) but those
-     * whose plain check summed it: the floor, eps S(w), and each column's smax (whether the
-     * evaluation may sum plainly). An estimate: the treecode's error on positive weights is
-     * fast_tol (or, the loosest relaxed one, 1e-6) of the sum; counted with the products.
-     * Below CM_RBF_PLAIN_RES_TOL the evaluation sums compensated whatever smax, so when
-     * every column met that tolerance the floor is only reported: it is estimated at
-     * CM_RBF_FLOOR_SAMPLES of the centres and smax left unknown, a pass fewer per solve
-     * (0.1 s of a 1.4 s warm solve of 15 columns on the bore, 20.6k centres) */
-    const int sampled = worst <= o->tolerance && o->tolerance < CM_RBF_PLAIN_RES_TOL;
-    for (size_t c0 = 0; c0 < nc; c0 += gsize) {
-        const int g = nc - c0 < gsize ? (int)(nc - c0) : (int)gsize;
-        int ns = 0;
-        for (int u = 0; u < g; ++u) {
-            if (scales && scales->smax[c0 + (size_t)u] >= 0.0) continue;
-            kr.pa[ns] = kr.aux + (size_t)ns * m;
-            kr.pb[ns] = kr.awlo + (size_t)ns * m;
-            for (size_t i = 0; i < m; ++i) kr.pa[ns][i] = fabs(w[(c0 + (size_t)u) * m + i]);
-            ++ns;
-        }
-        /* the full sums into kr.pb[], or the sampled maxima into kr.awlo[0..ns) */
-        if (!sampled) cm_krylov_matvec_loose(r, &kr, ns, kr.pa, kr.pb, threads);
-        else if (ns > 0 && cm_rbf_abs_sums(r, kr.aux, ns, m, r->c, CM_RBF_FLOOR_SAMPLES,
-                                           kr.awlo, threads) != 0)
-            memset(kr.awlo, 0, (size_t)ns * sizeof *kr.awlo); /* out of memory: none */
-        for (int u = 0, v = 0; u < g; ++u) {
-            double *s = scales ? &scales->smax[c0 + (size_t)u] : NULL;
-            double sm;
-            if (s && *s >= 0.0) sm = *s;
-            else if (sampled) sm = kr.awlo[v++];
-            else {
-                sm = cm_krylov_norm_inf(m, kr.pb[v++]);
-                if (s) {
-                    *s = sm;
-                    scales->smin[c0 + (size_t)u] = CM_RBF_LOOSE_LOW * sm;
-                }
-            }
-            if (fmax_all > 0.0) floor_max = fmax(floor_max, DBL_EPSILON * sm / fmax_all);
-        }
+        const int sampled = gworst <= o->tolerance && o->tolerance < CM_RBF_PLAIN_RES_TOL;
+        floor_max = fmax(floor_max, s_pass(r, &kr, w, c0, g, scales, sampled, fmax_all,
+                                           threads));
     }
     r->stats.iterations = maxit;
     r->stats.matvecs = mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST];
