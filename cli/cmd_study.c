@@ -117,10 +117,11 @@ static const cli_option options[] = {
      .dest = &args.batch, .label = "--batch auto|K",
      .help = "absolute variants morphed together: their warps share one\n"
              "multi-column solve and evaluation (the same rows as one at a\n"
-             "time, to the solver's tolerance); auto (default): a quarter\n"
-             "of the variants (later batches start from the earlier ones'\n"
-             "solutions), at most what half the free memory holds and 20;\n"
-             "1: one at a time"},
+             "time, to the solver's tolerance); auto (default): all the\n"
+             "variants, at most what half the free memory holds and 20,\n"
+             "solved in 4 groups (each later group starts from the\n"
+             "solutions before it) and evaluated in one pass; 1: one at a\n"
+             "time"},
     {CLI_SOLVER_FIELDS, .dest = &args.solver,
      .help = "RBF warps: auto (default: a cost model that counts the variants,\n"
              "as they share one fit: dense to more boundary nodes than the\n"

@@ -310,6 +310,14 @@ static cm_status load_variant(cm_context *ctx, study *w, size_t i, variant *v)
     return CM_OK;
 }
 
+/* The groups the warp solves a batch in (cm_warp_options.warm_groups): the first from zero
+ * (or warm from the batches before), each later one warm from the solutions before it, which
+ * saves more than a larger group's passes share (bracket, 10^5 boundary nodes, 20 variants:
+ * batches of 5 the fastest, 20 the slowest, before batches were grouped; benchmarks/
+ * RESULTS.md, "Study"), while the evaluation at the interior nodes sums the whole batch in one
+ * pass, where each column costs less the more ride along ("Kernel cost per column"). */
+#define CM_STUDY_WARM_GROUPS 4
+
 /* The solves the shared warp of method q will serve (cm_warp_options.solves, for AUTO's
  * choice of the RBF solver): one per variant this rank runs, for each method with the same
  * warp options (the morpher keeps one warp per set of options: rbf and rbf-s share one).
@@ -336,6 +344,7 @@ static cm_status absolute_rows(cm_context *ctx, study *w, series *se, variant *v
     const cm_study_method *m = &w->r->methods[se->method];
     cm_morph_method method = m->method;
     method.warp.solves = abs_solves(w, se->method);
+    method.warp.warm_groups = CM_STUDY_WARM_GROUPS;
     const cm_cad_model **targets = malloc((n ? n : 1) * sizeof *targets);
     size_t *of = malloc((n ? n : 1) * sizeof *of), k = 0;
     cm_status s = targets && of ? CM_OK : cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");
@@ -478,17 +487,14 @@ static void study_free(study *w)
     cm_cad_destroy(&w->base);
 }
 
-/* Variants per batch: o->batch, or (0) at most a quarter of the variants this rank runs, as
- * many as half the available memory holds, up to CM_STUDY_BATCH_MAX. Why a quarter: every
- * batch after the first starts warm (each column from the earlier batches' solutions,
- * cm_rbf_options.warm_start), which saves more than a larger batch shares
- * (bracket, 10^5 boundary nodes, 20 variants: batches of 5 the fastest, 20 the slowest;
- * benchmarks/RESULTS.md, "Study"); CM_STUDY_BATCH_MAX because the kernel sums' cost per
- * column has flattened by 60 columns (the same section, "Kernel cost per column"). Memory
- * per variant: for each of its 3 columns of an iterative RBF solve the Krylov storage,
- * (2 restart + 9) doubles per boundary node (rbf.h, cm_rbf_solve; the default restart, 40);
- * the apply's fields, the evaluation's values and the result (3 doubles per node each); its
- * loaded model (a few MB: 8 MB counted). */
+/* Variants per batch: o->batch, or (0) all the variants this rank runs, as many as half the
+ * available memory holds, up to CM_STUDY_BATCH_MAX (the kernel sums' cost per column has
+ * flattened by 60 columns, the same section). Memory per variant: for each of its 3 columns
+ * of an iterative RBF solve the Krylov storage, (2 restart + 9) doubles per boundary node
+ * (rbf.h, cm_rbf_solve; the default restart, 40), while its group solves (one in
+ * CM_STUDY_WARM_GROUPS at a time: counted for all, a margin); the apply's fields, the
+ * evaluation's values and the result (3 doubles per node each); its loaded model (a few MB:
+ * 8 MB counted). */
 static size_t batch_size(const cm_study_options *o, size_t variants, size_t nodes,
                          size_t boundary)
 {
@@ -497,7 +503,7 @@ static size_t batch_size(const cm_study_options *o, size_t variants, size_t node
     const double restart = 40;
     const double per = 8.0 * (3 * (2 * restart + 9) * (double)boundary + 9.0 * (double)nodes +
                               3.0 * (double)boundary) + 8e6;
-    double k = fmin(0.5 * cm_memory_available() / per, ceil((double)variants / 4.0));
+    double k = fmin(0.5 * cm_memory_available() / per, (double)variants);
     if (!(k >= 1)) return 1;
     return k < CM_STUDY_BATCH_MAX ? (size_t)k : CM_STUDY_BATCH_MAX;
 }
@@ -543,8 +549,9 @@ static cm_status setup(cm_context *ctx, study *w)
     const int ranks = o->ranks > 1 ? o->ranks : 1;
     w->batch = batch_size(o, (w->fam->n + (size_t)ranks - 1) / (size_t)ranks, nn,
                           r->boundary_nodes);
-    cm_log(ctx, CM_LOG_DEBUG, "study: absolute morphs in batches of up to %zu variants%s",
-           w->batch, o->batch > 0 ? " (asked for)" : " (a quarter of the variants, memory, CM_STUDY_BATCH_MAX)");
+    cm_log(ctx, CM_LOG_DEBUG, "study: absolute morphs in batches of up to %zu variants%s, "
+           "solved in %d groups", w->batch, o->batch > 0 ? " (asked for)"
+           : " (the variants, memory, CM_STUDY_BATCH_MAX)", CM_STUDY_WARM_GROUPS);
     w->bxyz = calloc(w->batch, sizeof *w->bxyz);
     w->items = malloc(w->batch * sizeof *w->items);
     if (!w->bxyz || !w->items) return cm_error(ctx, CM_ERR_NOMEM, "study: out of memory");

@@ -161,9 +161,9 @@ typedef struct cm_study_options {
                                rank), as it would end a serial study. */
     /* Absolute variants morphed together (cm_morpher_apply_batch: one multi-column warp
      * apply for the batch; rows equal to one-at-a-time to the solver's tolerance, in the same
-     * order). 0 (default): a quarter of the variants (later batches start warm from the
-     * earlier ones' solutions), as many as half the available memory holds, up to
-     * CM_STUDY_BATCH_MAX
+     * order; the warp solves a batch in 4 groups, each later group warm from the solutions
+     * before it, cm_warp_options.warm_groups). 0 (default): all the variants, as many as half
+     * the available memory holds, up to CM_STUDY_BATCH_MAX
      * (docs/DESIGN.md, "Studies in batches"); 1: one variant at a time;
      * K: K variants. Relative series run one variant at a time whatever it is. */
     int batch;

@@ -206,9 +206,10 @@ def study(g0: Geometry, mesh: Mesh, targets: Sequence[Union[PathLike, Geometry]]
     optimisation after each step. write_meshes: "none" (default here; the CLI's is "all"), "all" or "failed"; the
     meshes go to out_dir (created if missing) as <method>_<mode>_<label>.vtu. model_name,
     mesh_name: the CSV's model and mesh columns (default: g0's file name and "file").
-    batch: absolute variants morphed together, as `--batch` ("auto", the default: a quarter of
-    the variants, at most what half the free memory holds and 20; 1: one at a time; K: K): their warps share one
-    multi-column solve and evaluation; the rows are those of one at a time to the solver's
+    batch: absolute variants morphed together, as `--batch` ("auto", the default: all the
+    variants, at most what half the free memory holds and 20, solved in 4 groups, each later
+    group starting from the solutions before it; 1: one at a time; K: K): their warps share
+    one multi-column solve and evaluation; the rows are those of one at a time to the solver's
     tolerance, in the same order. Relative series run one variant at a time.
 
     Errors that end the study (mesh not a mesh of g0, ...) raise; failed rows are a
