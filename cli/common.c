@@ -20,6 +20,9 @@ typedef struct cli_sink {
     double study_start, study_done, study_total;
     double study_mark, per_variant; /* the last report's time; seconds per variant since the
                                        one before (a batch reports once for its variants) */
+    char inner[32];                 /* the inner stage last reported in a study, and its part
+                                       done: a batch of variants is one long step of the study */
+    double inner_part;
 } cli_sink;
 
 static cli_sink sink;
@@ -68,6 +71,7 @@ static void draw_study(cli_sink *s, double now)
     }
     fprintf(stderr, "\r\033[Kstudy %.0f/%.0f variants, %s%s", s->study_done, s->study_total,
             last, left);
+    if (s->inner[0]) fprintf(stderr, " (%s %.0f%%)", s->inner, 100.0 * s->inner_part);
 }
 
 static void progress_to_stderr(void *user, const char *stage, double done, double total)
@@ -87,7 +91,10 @@ static void progress_to_stderr(void *user, const char *stage, double done, doubl
         s->in_study = !finished;
         s->study_done = done;
         s->study_total = total;
+        s->inner[0] = '\0';
     } else if (s->in_study) {
+        snprintf(s->inner, sizeof s->inner, "%s", stage);
+        s->inner_part = total > 0 ? fmin(done / total, 1.0) : 1.0;
         if (now - s->last_draw < 1.0) return; /* the estimate moves with the variants */
     }
     if (!finished && now - s->last_draw < 0.1) return;
