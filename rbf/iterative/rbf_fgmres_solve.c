@@ -342,27 +342,32 @@ static int krylov_alloc(krylov *kr, int g)
  * centres: 1.05-1.5x S(w0), RESULTS.md, Study), and the check needs S only within the plain
  * bound's margin. Where even the bound from below forbids plain sums, a plain check would go
  * for nothing (rbf_fgmres.c, check_products). */
+/* The bounds of start_s_bounds from the n columns of weights wv (m each) whose S sc knew:
+ * the least from above into *best, the largest from below into *low (both -1: none yet). */
+static void nearest_bounds(const double *w0, size_t m, double diam3, const double *wv,
+                           const cm_rbf_scales *sc, size_t n, double *best, double *low)
+{
+    for (size_t v = 0; v < n; ++v) {
+        if (!(sc->smax[v] >= 0.0)) continue;
+        double l1 = 0.0;
+        for (size_t i = 0; i < m; ++i) l1 += fabs(w0[i] - wv[v * m + i]);
+        /* smax: plain sums of |w| or the loosest treecode's (1e-6 of the sums) */
+        const double b = 1.01 * sc->smax[v] + diam3 * l1;
+        if (*best < 0.0 || b < *best) *best = b;
+        if (sc->smin[v] >= 0.0) *low = fmax(*low, sc->smin[v] - diam3 * l1);
+    }
+}
+
 static double start_s_bounds(const cm_rbf *r, const double *w0, double diam3,
                              const double *wnow, const cm_rbf_scales *now, size_t nnow,
                              double *low)
 {
     double best = -1.0;
     *low = -1.0;
-    for (int src = 0; src < 2; ++src) { /* the fit's last weights, this solve's earlier groups */
-        const cm_rbf_scales *sc = src ? now : &r->iter->scales;
-        const double *wv0 = src ? wnow : r->w;
-        const size_t n = !sc || !wv0 ? 0 : src ? nnow : sc->n == (size_t)r->ncomp ? sc->n : 0;
-        for (size_t v = 0; v < n; ++v) {
-            if (!(sc->smax[v] >= 0.0)) continue;
-            const double *wv = wv0 + v * r->m;
-            double l1 = 0.0;
-            for (size_t i = 0; i < r->m; ++i) l1 += fabs(w0[i] - wv[i]);
-            /* smax: plain sums of |w| or the loosest treecode's (1e-6 of the sums) */
-            const double b = 1.01 * sc->smax[v] + diam3 * l1;
-            if (best < 0.0 || b < best) best = b;
-            if (sc->smin[v] >= 0.0) *low = fmax(*low, sc->smin[v] - diam3 * l1);
-        }
-    }
+    const cm_rbf_scales *last = &r->iter->scales;
+    if (r->w && last->n == (size_t)r->ncomp)
+        nearest_bounds(w0, r->m, diam3, r->w, last, last->n, &best, low);
+    if (now) nearest_bounds(w0, r->m, diam3, wnow, now, nnow, &best, low);
     return best;
 }
 

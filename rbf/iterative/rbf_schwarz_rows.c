@@ -239,8 +239,10 @@ void cm_rbf_projected_solve_cols(const double *work, size_t n, int rk, const dou
     size_t bs = (nrhs + nt - 1) / nt;
     bs = bs < 1 ? 1 : bs > PSOLVE_COLS ? PSOLVE_COLS : bs;
     const long nblk = (long)((nrhs + bs - 1) / bs);
-    const int avx2 = CM_ROWS_X86 && cm_rbf_isa_supported(CM_RBF_ISA_AVX2);
-    (void)avx2; /* used on x86-64 only */
+    void (*chol_solve)(const double *, size_t, size_t, double *const *, int) = chol_solve_plain;
+#if CM_ROWS_X86
+    if (cm_rbf_isa_supported(CM_RBF_ISA_AVX2)) chol_solve = chol_solve_avx2;
+#endif
 #pragma omp parallel for num_threads(threads) if (threads > 1 && nblk > 1) schedule(dynamic, 1)
     for (long q = 0; q < nblk; ++q) {
         const size_t c0 = (size_t)q * bs;
@@ -252,11 +254,7 @@ void cm_rbf_projected_solve_cols(const double *work, size_t n, int rk, const dou
             y[b] = xc + (size_t)b * n + (size_t)rk;
             for (int i = 0; i < rk; ++i) xc[(size_t)b * n + (size_t)i] = 0.0;
         }
-#if CM_ROWS_X86
-        if (avx2) chol_solve_avx2(l, n, n2, y, nb);
-        else
-#endif
-            chol_solve_plain(l, n, n2, y, nb);
+        chol_solve(l, n, n2, y, nb);
         for (int h = rk; h-- > 0;) reflect(pq, n, h, tau[h], xc, nb); /* Q x */
     }
 }
