@@ -579,6 +579,7 @@ double fast_residual;
 double fast_bound;
 int eval_fast;
 int eval_plain;
+int eval_combined;
 double eval_error;
 int eval_order;
 double eval_theta;

@@ -310,12 +310,12 @@ static cm_status apply_fields(cm_context *ctx, rbf_warp *warp, size_t k, double 
         cm_deform_get_stats(wc->def, &st);
         cm_log(ctx, CM_LOG_DEBUG,
                "%s: component %zu: %zu field(s), %zu centres, solve %.3f s (%s, %d iterations), "
-               "evaluation at %zu nodes %.3f s (%s)",
+               "evaluation at %zu nodes %.3f s (%s; %d columns combined from the others)",
                fn, c, k, wc->n_fixed, st.t_solve,
                st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" : "iterative", st.rbf.iterations,
                wc->n_free, st.t_evaluate,
                st.rbf.solver == CM_RBF_SOLVER_DENSE || st.rbf.eval_plain ? "plain sums"
-               : st.rbf.eval_fast ? "treecode" : "compensated sums");
+               : st.rbf.eval_fast ? "treecode" : "compensated sums", st.rbf.eval_combined);
         for (size_t j = 0; j < k; ++j) {
             const double *out = pv + j * np3 + 3 * wc->n_fixed;
             for (size_t i = 0; i < wc->n_free; ++i)

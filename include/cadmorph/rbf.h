@@ -144,6 +144,10 @@ typedef struct cm_rbf_stats {
     int eval_fast;         /* last cm_rbf_evaluate: 1 if it used the fast sum */
     int eval_plain;        /* last cm_rbf_evaluate of an iterative fit: 1 if by plain direct
                             * sums (the tolerance allowed them), 0 compensated or fast */
+    int eval_combined;     /* ... its components whose values were combined from those of the
+                            * components the solve started from zero (they started from
+                            * earlier solutions: warm_start), with what that leaves summed
+                            * plainly or within the tolerance; the others were summed */
     double eval_error;     /* last cm_rbf_evaluate that tried the fast sum: its estimated
                             * max error / max |data| (sampled against compensated direct
                             * sums, x4). The fast sum is taken if this is within 1e-9 or

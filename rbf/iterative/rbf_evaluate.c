@@ -18,10 +18,6 @@
  * compensated sums cost ~1 % of a 10^6-point evaluation */
 #define CM_RBF_FAST_SAMPLES 1024
 #define CM_RBF_FAST_SAFETY 4.0
-/* relative rounding of one entry phi_ij = r2 sqrt(r2) (the differences, r2's three terms,
- * the root and the product), so compensated sums of the rounded entries err by up to about
- * this x eps sum_j |w_j| phi_ij against the true kernel */
-#define CM_RBF_PHI_ROUND 4.0
 
 /* Why compensated sums for evaluation too: the weights of large or spread sets are large
  * (sum |w| of 1e6..1e7 x max |d| on the bracket and on two bodies far apart), and plain sums
@@ -208,20 +204,16 @@ int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, d
 }
 
 /* 1 if plain direct sums of the fit's weights at the n points p are within its tolerance
- * (see the top of the file). */
-static int plain_enough(const cm_rbf *r, size_t n, const double *p, int threads)
+ * (see the top of the file), given s (their sampled sums of |w| phi, NULL: unknown). */
+static int plain_enough(const cm_rbf *r, const double *s)
 {
     const cm_rbf_scales *sc = &r->iter->scales;
     const size_t nc = (size_t)r->ncomp;
     const double tol = r->opt.tolerance;
-    int ok = sc->n == nc; /* the centres first: the sampled points cost more */
+    int ok = sc->n == nc && s;
     for (size_t c = 0; ok && c < nc; ++c) /* (smax unknown, -1: compensated) */
-        ok = sc->smax[c] >= 0.0 && cm_rbf_plain_bound(sc->smax[c], sc->fnorm[c], tol) >= 0.0;
-    double *s = ok ? malloc(nc * sizeof *s) : NULL;
-    ok = s && sampled_abs_sums(r, n, p, CM_RBF_FAST_SAMPLES, s, threads) == 0;
-    for (size_t c = 0; ok && c < nc; ++c)
-        ok = cm_rbf_plain_bound(s[c], sc->fnorm[c], tol) >= 0.0;
-    free(s);
+        ok = sc->smax[c] >= 0.0 && cm_rbf_plain_bound(sc->smax[c], sc->fnorm[c], tol) >= 0.0 &&
+             cm_rbf_plain_bound(s[c], sc->fnorm[c], tol) >= 0.0;
     return ok;
 }
 
@@ -229,13 +221,24 @@ int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double
                               int threads, cm_rbf_tick *tick)
 {
     r->iter->eval_plain = 0;
+    r->iter->eval_combined = 0;
     if (cm_rbf_iterative_evaluate_fast(r, n, p, out, threads, tick)) return 0;
     if (tick && tick->status < 0) return 1;
     /* direct sums: a tick of their own, in point-centre pairs */
     if (tick)
         cm_rbf_tick_restart(tick, (double)((r->ncomp + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) *
                                       (double)n * (double)r->m);
-    if (plain_enough(r, n, p, threads)) {
+    /* sum |w| phi at sampled points: whether plain sums serve, and the span's error bounds */
+    double *s = malloc((size_t)r->ncomp * sizeof *s);
+    if (s && sampled_abs_sums(r, n, p, CM_RBF_FAST_SAMPLES, s, threads) != 0) free(s), s = NULL;
+    const int plain = plain_enough(r, s);
+    const int span = cm_rbf_iterative_evaluate_span(r, n, p, s, plain, out, threads, tick);
+    free(s);
+    if (span >= 0) {
+        r->iter->eval_plain = plain;
+        return span;
+    }
+    if (plain) {
         r->iter->eval_plain = 1;
         return cm_rbf_kernel_sum_all_tick(r, r->w, r->ncomp, n, p, n, out, threads, tick);
     }
@@ -348,6 +351,7 @@ void cm_rbf_iterative_stats(const cm_rbf *r, cm_rbf_stats *stats)
     if (!r->iter) return;
     stats->eval_fast = r->iter->eval_fast;
     stats->eval_plain = r->iter->eval_plain;
+    stats->eval_combined = r->iter->eval_combined;
     stats->eval_error = r->iter->eval_error;
     stats->eval_order = r->iter->eval_order;
     stats->eval_theta = r->iter->eval_theta;

@@ -6,6 +6,7 @@
 #include <cblas.h>
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -464,28 +465,40 @@ int cm_rbf_iterative_column_iterations(const cm_rbf *r, size_t c)
     return r->iter->col_iters[c];
 }
 
-cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
-                                 double *w, double *q, int threads)
+/* The solve's Krylov restart, whether it takes fast sums, and its columns per group: what
+ * fits the memory budget (half the machine's by default, per_col bytes a column), and with
+ * warm groups (options warm_groups) fields of dim columns each, in groups that each start
+ * from the solutions of the groups before them. */
+static size_t column_groups(const cm_rbf *r, size_t nc, int *R, int *fast, double *per_col)
 {
-    const size_t m = r->m, k = (size_t)r->k;
     const cm_rbf_options *o = &r->opt;
-    const cm_rbf_tuning *tu = &r->tun;
-    const int R = o->restart < 63 ? o->restart : 63;
-    const int fast = o->fast_sum == 1 || (o->fast_sum < 0 && m >= CM_RBF_FAST_MIN_M);
-    /* the columns in groups that fit the memory budget (half the machine's by default) */
-    const double budget = tu->krylov_budget > 0.0 ? tu->krylov_budget : cm_memory_budget();
-    const double per_col = bytes_per_column(m, R, fast);
+    const double budget =
+        r->tun.krylov_budget > 0.0 ? r->tun.krylov_budget : cm_memory_budget();
+    *R = o->restart < 63 ? o->restart : 63;
+    *fast = o->fast_sum == 1 || (o->fast_sum < 0 && r->m >= CM_RBF_FAST_MIN_M);
+    *per_col = bytes_per_column(r->m, *R, *fast);
     size_t gsize = nc;
-    if (budget > 0.0 && (double)nc * per_col > budget)
-        gsize = budget / per_col >= 1.0 ? (size_t)(budget / per_col) : 1;
-    /* warm groups (options warm_groups): fields of dim columns each, in groups that each
-     * start from the solutions of the groups before them */
+    if (budget > 0.0 && (double)nc * *per_col > budget)
+        gsize = budget / *per_col >= 1.0 ? (size_t)(budget / *per_col) : 1;
     if (o->warm_start && o->warm_groups > 1 && nc > 1) {
         const size_t d = r->dim > 0 ? (size_t)r->dim : 1, ng = (size_t)o->warm_groups;
         size_t per = (nc + ng - 1) / ng;
         per = (per + d - 1) / d * d;
         if (per < gsize) gsize = per;
     }
+    return gsize;
+}
+
+/* The solve of the nc columns f (m each) in groups of consecutive columns. */
+static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
+                                double *w, double *q, int threads)
+{
+    const size_t m = r->m, k = (size_t)r->k;
+    const cm_rbf_options *o = &r->opt;
+    const cm_rbf_tuning *tu = &r->tun;
+    int R, fast;
+    double per_col;
+    const size_t gsize = column_groups(r, nc, &R, &fast, &per_col);
     krylov kr;
     memset(&kr, 0, sizeof kr);
     kr.m = m;
@@ -550,6 +563,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         const int gall = kr.g;
         kr.g = g;
         ++groups;
+        const double tg = cm_wtime();
+        const int mv0 = mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST];
         basis = hist ? hist->n : 0;
         for (int c = 0; c < g; ++c) {
             kcol *kc = &kr.col[c];
@@ -593,6 +608,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         }
         kr.g = gall;
         if (st != CM_OK) goto done;
+        cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: group %d: %d columns, %d products, %.3f s",
+               groups, g, mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST] - mv0, cm_wtime() - tg);
         /* the group's solutions join the history (their exact products: a pair is right
          * whatever the residual of its solve), so the next group starts from them, but for
          * those that took no step: such a w is the history's own combination, so what
@@ -615,6 +632,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
                 scales->fnorm[c0 + (size_t)c] = kc->fnorm;
                 scales->smax[c0 + (size_t)c] = fast ? -1.0 : kc->smax;
                 scales->smin[c0 + (size_t)c] = fast ? -1.0 : kc->smin;
+                scales->start[c0 + (size_t)c] = kc->took ? kc->iters : -1.0;
             }
             if (kc->iters > maxit) maxit = kc->iters;
             if (kc->floor * kc->fnorm > floor_max * fmax_all)
@@ -666,5 +684,69 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
 done:
     krylov_free(&kr);
     free(aw);
+    return st;
+}
+
+/* a (nf fields of d entries of size bytes each, field i the caller's order[i]) into the
+ * caller's order, through t (as large) */
+static void fields_back(void *a, size_t size, const size_t *order, size_t nf, size_t d, void *t)
+{
+    const size_t fb = d * size;
+    for (size_t i = 0; i < nf; ++i) memcpy((char *)t + order[i] * fb, (char *)a + i * fb, fb);
+    memcpy(a, t, nf * fb);
+}
+
+/* The columns in the order of cm_rbf_history_order when they are solved in groups with warm
+ * starts (each whole field of dim columns in one group, the fields that span the others first),
+ * else as given. The results (w, q, the columns' iterations and scales) in the callers' order. */
+cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const double *f,
+                                 double *w, double *q, int threads)
+{
+    const size_t m = r->m, k = (size_t)r->k, d = r->dim > 0 ? (size_t)r->dim : 1;
+    int R, fast;
+    double per_col;
+    const size_t gsize = column_groups(r, nc, &R, &fast, &per_col);
+    cm_rbf_history *hist = r->opt.warm_start && r->warm_ok ? history_of(r) : NULL;
+    if (!hist || gsize >= nc || nc % d != 0) return solve_in_order(ctx, r, nc, f, w, q, threads);
+    /* the fields before the last group's start are picked; the rest is the last group */
+    const size_t nf = nc / d, picks = ((nc - 1) / gsize * gsize + d - 1) / d;
+    double *fp = malloc(2 * nc * m * sizeof *fp), *wp = fp ? fp + nc * m : NULL;
+    double *qp = malloc(nc * k * sizeof *qp), *scale = malloc(nc * sizeof *scale);
+    size_t *order = malloc(nf * sizeof *order);
+    if (!fp || !qp || !scale || !order) { /* out of memory: the columns as they come */
+        free(fp), free(qp), free(scale), free(order);
+        return solve_in_order(ctx, r, nc, f, w, q, threads);
+    }
+    const double fmax_all = cm_krylov_norm_inf(nc * m, f);
+    for (size_t c = 0; c < nc; ++c) {
+        memcpy(fp + c * m, f + c * m, m * sizeof *fp);
+        cm_krylov_project(r->iter->q1, m, r->k, fp + c * m);
+        /* the columns' own scales, as the solve's tolerances (a column of round-off none) */
+        const double fn = cm_krylov_norm_inf(m, f + c * m);
+        scale[c] = fn >= r->tun.column_scale * fmax_all ? cblas_dnrm2((int)m, fp + c * m, 1) : 0.0;
+    }
+    cm_rbf_history_order(hist, m, nf, d, picks, fp, scale, order);
+    char line[120];
+    int len = 0;
+    for (size_t i = 0; i < nf && len < (int)sizeof line - 24; ++i)
+        len += snprintf(line + len, sizeof line - (size_t)len, " %zu", order[i]);
+    cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: groups of %zu columns, the fields in the order%s%s "
+           "(the columns below numbered in it)", gsize, line,
+           len >= (int)sizeof line - 24 ? " ..." : "");
+    for (size_t i = 0; i < nf; ++i)
+        memcpy(fp + i * d * m, f + order[i] * d * m, d * m * sizeof *fp);
+    cm_status st = solve_in_order(ctx, r, nc, fp, wp, qp, threads);
+    if (st == CM_OK || st == CM_WARNING) {
+        for (size_t i = 0; i < nf; ++i) {
+            memcpy(w + order[i] * d * m, wp + i * d * m, d * m * sizeof *w);
+            memcpy(q + order[i] * d * k, qp + i * d * k, d * k * sizeof *q);
+        }
+        cm_rbf_scales *sc = &r->iter->next;
+        double *by_column[4] = {sc->fnorm, sc->smax, sc->smin, sc->start};
+        for (int a = 0; a < 4 && sc->n == nc; ++a)
+            fields_back(by_column[a], sizeof(double), order, nf, d, fp);
+        fields_back(r->iter->col_iters, sizeof(int), order, nf, d, fp);
+    }
+    free(fp), free(qp), free(scale), free(order);
     return st;
 }

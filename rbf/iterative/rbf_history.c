@@ -77,3 +77,52 @@ size_t cm_rbf_history_bytes(const cm_rbf_history *h)
 {
     return h ? (2 * h->cap + 2) * h->m * sizeof(double) : 0;
 }
+
+/* Greedy, as a block QR with pivoting: the fields' columns are kept orthogonal to the span
+ * so far (modified Gram-Schmidt, in place), so a remaining column's norm is what the span
+ * leaves of it. */
+void cm_rbf_history_order(const cm_rbf_history *h, size_t m, size_t nf, size_t d, size_t picks,
+                          double *pf, const double *scale, size_t *order)
+{
+    const size_t nc = nf * d;
+    for (size_t c = 0; c < nc; ++c)
+        for (size_t j = 0; h && j < h->n; ++j) {
+            double *pc = pf + c * m;
+            const double t = cblas_ddot((int)m, h->b + j * m, 1, pc, 1);
+            cblas_daxpy((int)m, -t, h->b + j * m, 1, pc, 1);
+        }
+    for (size_t f = 0; f < nf; ++f) order[f] = f;
+    if (picks > nf) picks = nf;
+    for (size_t p = 0; p < picks; ++p) {
+        /* the remaining field whose data the span fits worst, relative to their scales */
+        size_t best = p;
+        double worst = -1.0;
+        for (size_t q = p; q < nf; ++q) {
+            double e = 0.0;
+            for (size_t j = 0; j < d; ++j) {
+                const size_t c = order[q] * d + j;
+                if (scale[c] > 0.0) e = fmax(e, cblas_dnrm2((int)m, pf + c * m, 1) / scale[c]);
+            }
+            if (e > worst) worst = e, best = q;
+        }
+        const size_t f = order[best];
+        order[best] = order[p];
+        order[p] = f;
+        /* its columns join the span: normalised, and taken out of the fields after it */
+        for (size_t j = 0; j < d; ++j) {
+            double *u = pf + (f * d + j) * m;
+            const double un = cblas_dnrm2((int)m, u, 1);
+            if (!(un > CM_RBF_HISTORY_DROP * scale[f * d + j])) continue;
+            cblas_dscal((int)m, 1.0 / un, u, 1);
+            for (size_t jj = j + 1; jj < d; ++jj) {
+                double *v = pf + (f * d + jj) * m;
+                cblas_daxpy((int)m, -cblas_ddot((int)m, u, 1, v, 1), u, 1, v, 1);
+            }
+            for (size_t q = p + 1; q < nf; ++q)
+                for (size_t jj = 0; jj < d; ++jj) {
+                    double *v = pf + (order[q] * d + jj) * m;
+                    cblas_daxpy((int)m, -cblas_ddot((int)m, u, 1, v, 1), u, 1, v, 1);
+                }
+        }
+    }
+}

@@ -42,12 +42,27 @@ size_t cm_rbf_history_start(const cm_rbf_history *h, double *pf, double *w0);
  * CM_RBF_HISTORY_DROP of their span (or is zero). */
 int cm_rbf_history_add(cm_rbf_history *h, const double *w, const double *pb);
 size_t cm_rbf_history_bytes(const cm_rbf_history *h);
+/* The order in which to solve nf fields of d columns each (warm groups: options
+ * warm_groups): order[0..nf) a permutation of 0..nf-1 whose first picks fields are chosen one
+ * by one, each the field whose data the history h (NULL: none) and the fields before it fit
+ * worst, relative to its columns' scale (nf x d, 0: a column not counted); pf (nf x d
+ * columns of m, field by field) holds the fields' projected data and is overwritten. Why:
+ * each warm group starts from the history's combination, so its start is as near as its data lie to the span
+ * of the groups before it; groups in list order extrapolate along a family, these interpolate
+ * (20 bore variants, 20,642 centres, groups of 5 at 1e-10: the warm groups' starts, relative
+ * to their data, 2e-9..1.6e-6 in list order, 1e-10..1.5e-8 so; RESULTS.md, Study). */
+void cm_rbf_history_order(const cm_rbf_history *h, size_t m, size_t nf, size_t d, size_t picks,
+                          double *pf, const double *scale, size_t *order);
 
 /* Plain direct sums err by at most this x S(z) = max_i sum_j |z_j| phi_ij (rbf_fgmres.c,
  * relaxed products); where a result need only be exact to a tolerance they may take this
  * share of it (the solve's exact residuals, rbf_fgmres.c and rbf_fgmres_solve.c; the
  * evaluation, rbf_evaluate.c). */
 #define CM_RBF_PLAIN_ERR 1e-13
+/* Relative rounding of one entry phi_ij = r2 sqrt(r2) (the differences, r2's three terms,
+ * the root and the product), so compensated sums of the rounded entries err by up to about
+ * this x eps sum_j |w_j| phi_ij against the true kernel (rbf_evaluate.c) */
+#define CM_RBF_PHI_ROUND 4.0
 #define CM_RBF_PLAIN_RES_SHARE 0.1
 /* ... tried only from this relative tolerance: on real sets S(w) is 1e4..1e9 x max |f|, so
  * below it the product on |w| that bounds them would be spent for nothing */
@@ -76,6 +91,9 @@ typedef struct cm_rbf_scales {
                     * solve did not sum it (below CM_RBF_PLAIN_RES_TOL: compensated sums) */
     double *smin;  /* column c: a bound from below on that sum, -1 if none (the next solve's
                     * starts near these weights judge by it whether plain sums can serve) */
+    double *start; /* column c: the iterations its solve took from a warm start, -1 if it
+                    * started from zero (the evaluation through the span of others,
+                    * rbf_evaluate_span.c) */
 } cm_rbf_scales;
 
 struct cm_rbf_iter {
@@ -97,7 +115,17 @@ struct cm_rbf_iter {
     int *col_iters;    /* the last solve's Krylov iterations per column (col_n of them) */
     size_t col_n;
     cm_rbf_history *hist; /* NULL until a solve with warm_start records its solutions */
+    int eval_combined;    /* the last evaluation's columns combined from the cold ones' */
 };
+
+/* The direct sums of cm_rbf_iterative_evaluate (plain: plain sums, else compensated) into out
+ * (n x ncomp), a column whose solve started warm as its least-squares combination of a basis
+ * of other columns, plus what the combination leaves by plain sums or not at all, where that
+ * is within the direct sums' bound on the column (rbf_evaluate_span.c); s: the columns' sum_j
+ * |w_j| phi_ij at sampled points (cm_rbf_abs_sums). 0 done, 1 stopped (tick), -1 not taken
+ * (no column to combine or none to combine from, no column gains, out of memory). */
+int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, const double *s,
+                                   int plain, double *out, int threads, cm_rbf_tick *tick);
 
 /* The treecode on the centres of r for (order, theta), made on first use and kept in
  * r->iter (studies solve and evaluate again on the same centres); NULL out of memory. */

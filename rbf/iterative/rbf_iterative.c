@@ -18,13 +18,14 @@ int cm_rbf_iterative_scales_begin(cm_rbf *r, size_t nc, double fmax)
     s->fmax = fmax;
     s->n = 0;
     if (nc == 0) return 0;
-    double *a = realloc(s->fnorm, 3 * nc * sizeof *a); /* fnorm, smax, smin in one block */
+    double *a = realloc(s->fnorm, 4 * nc * sizeof *a); /* fnorm, smax, smin, start: a block */
     if (!a) return -1;
     s->fnorm = a;
     s->smax = a + nc;
     s->smin = a + 2 * nc;
+    s->start = a + 3 * nc;
     for (size_t c = 0; c < 2 * nc; ++c) a[c] = 0.0;
-    for (size_t c = 0; c < nc; ++c) s->smin[c] = -1.0;
+    for (size_t c = 2 * nc; c < 4 * nc; ++c) a[c] = -1.0;
     s->n = nc;
     return 0;
 }

@@ -68,3 +68,6 @@ cm_add_unit_test(test_rbf_batch ${CMAKE_CURRENT_LIST_DIR}/test_rbf_batch.c LIBS 
 # the Schwarz preconditioner's dense arithmetic for a batch of columns (local rows, coarse
 # solves) against plain references, each column the same bits whatever its batch
 cm_add_unit_test(test_schwarz_rows ${CMAKE_CURRENT_LIST_DIR}/test_schwarz_rows.c LIBS cm_rbf_internal LABELS rbf)
+# a family's fields in warm groups: the order they are solved in, and the warm columns
+# evaluated through the span of the cold ones, against direct sums and each field alone
+cm_add_unit_test(test_rbf_span ${CMAKE_CURRENT_LIST_DIR}/test_rbf_span.c LIBS cm_rbf_internal LABELS rbf)
