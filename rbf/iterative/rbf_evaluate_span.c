@@ -5,9 +5,9 @@
  * weights, so its values are the basis' values combined by a_c plus the sums of res_c alone.
  * A study's batch is solved in warm groups (docs/DESIGN.md, "Studies in batches"), so three
  * quarters of its columns start warm. Where the sums are plain (a loose tolerance, as a
- * study's 1e-6), the basis is every column that took a Krylov step, so a column that took
- * none (its start met the tolerance) is the history's combination of them: res_c is rounding
- * and is not summed at all. Where they are compensated (the default tolerance, at which every
+ * study's 1e-6) or by the treecode, the basis is every column that took a Krylov step, so a
+ * column that took none (its start met the tolerance) is the history's combination of them:
+ * res_c is rounding and is not summed at all. Where they are compensated (the default tolerance, at which every
  * warm column takes a few steps), the basis is the columns that started from zero, and res_c,
  * the warm columns' steps and their starts' share of the earlier groups' steps, about 1e-8 of
  * w_c, is summed plainly: its rounding is far below the tolerance where w_c's needs
@@ -30,6 +30,7 @@
  * basis (dependent up to rounding: a zero displacement component, a repeated variant) */
 #define CM_RBF_SPAN_RANK 1e-12
 
+/* how a column is evaluated: summed, combined, combined with its rest summed */
 enum { SPAN_DIRECT, SPAN_ONLY, SPAN_RES };
 
 /* (diameter of the box around the centres and the points)^3: no phi_ij exceeds it, so
@@ -55,7 +56,7 @@ static double diam3(const cm_rbf *r, size_t n, const double *p)
 /* the kernel sums' passes over nw columns */
 static size_t passes(size_t nw) { return (nw + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC; }
 
-/* The direct sums of the nw columns w (m each) into out (n x nw). */
+/* The direct sums of the nw columns w (m each) into out (n x nw), plain or compensated. */
 static int sums(const cm_rbf *r, const double *w, size_t nw, size_t n, const double *p,
                 int plain, double *out, int threads, cm_rbf_tick *tick)
 {
@@ -71,19 +72,21 @@ static int sums(const cm_rbf *r, const double *w, size_t nw, size_t n, const dou
 }
 
 int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, const double *s,
-                                   int plain, double *out, int threads, cm_rbf_tick *tick)
+                                   int kind, double *out, int threads, cm_rbf_tick *tick)
 {
     const cm_rbf_scales *sc = &r->iter->scales;
     const size_t m = r->m, nc = (size_t)r->ncomp;
     r->iter->eval_combined = 0;
     if (sc->n != nc || !s) return -1;
-    /* the basis: the columns that started from zero, and with plain sums those that took
-     * steps (summing one costs what summing its rest would) */
+    /* the basis: the columns that started from zero, and with plain sums or the treecode
+     * those that took steps (summing one costs what summing its rest would) */
+    const int one = kind != CM_RBF_SUMS_COMPENSATED; /* the sums of the basis and the rests
+                                                        in one pass */
     unsigned char *basis = malloc(nc);
     if (!basis) return -1;
     size_t nb = 0;
     for (size_t c = 0; c < nc; ++c) {
-        basis[c] = sc->start[c] < 0.0 || (plain && sc->start[c] > 0.0);
+        basis[c] = sc->start[c] < 0.0 || (one && sc->start[c] > 0.0);
         nb += basis[c];
     }
     const size_t nw = nc - nb;
@@ -93,12 +96,12 @@ int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, c
     }
     int ret = -1;
     size_t *col = malloc(nc * sizeof *col); /* the basis, then the others */
-    int *kind = calloc(nc, sizeof *kind);
+    int *how = calloc(nc, sizeof *how);
     lapack_int *piv = calloc(nb, sizeof *piv);
     double *wb = malloc(m * nb * sizeof *wb), *x = malloc(m * nw * sizeof *x);
     double *tau = malloc(nb * sizeof *tau), *a = calloc(nb * nw, sizeof *a);
     double *outd = NULL, *outr = NULL, *outk = NULL, *wr = NULL, *coef = NULL;
-    if (!col || !kind || !piv || !wb || !x || !tau || !a) goto done;
+    if (!col || !how || !piv || !wb || !x || !tau || !a) goto done;
     for (size_t c = 0, ib = 0, iw = nb; c < nc; ++c) col[basis[c] ? ib++ : iw++] = c;
     for (size_t b = 0; b < nb; ++b) memcpy(wb + b * m, r->w + col[b] * m, m * sizeof *wb);
     for (size_t j = 0; j < nw; ++j) memcpy(x + j * m, r->w + col[nb + j] * m, m * sizeof *x);
@@ -122,55 +125,68 @@ int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, c
     for (size_t j = 0; j < nw; ++j) memcpy(x + j * m, r->w + col[nb + j] * m, m * sizeof *x);
     cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, (int)m, (int)nw, (int)nb, -1.0, wb,
                 (int)m, a, (int)nw, 1.0, x, (int)m);
-    /* each other column: combined alone, combined with its rest summed plainly, or summed */
-    const double err = plain ? CM_RBF_PLAIN_ERR : CM_RBF_PHI_ROUND * DBL_EPSILON;
+    /* each other column: combined alone, combined with its rest summed, or summed. The
+     * sums' error bounds: plain and compensated ones relative to the column's sum |w| phi,
+     * the treecode's what its check accepts, the same for every column */
+    double smax = 0.0;
+    for (size_t b = 0; b < nb; ++b) smax = fmax(smax, s[col[b]]);
+    const double err = kind == CM_RBF_SUMS_PLAIN ? CM_RBF_PLAIN_ERR
+                       : kind == CM_RBF_SUMS_COMPENSATED ? CM_RBF_PHI_ROUND * DBL_EPSILON
+                                                         : 0.0;
+    const double accept = kind == CM_RBF_SUMS_FAST ? cm_rbf_iterative_fast_accept(r, smax) : 0.0;
     const double dia3 = diam3(r, n, p);
     size_t nd = nb, nr = 0;
     for (size_t j = 0; j < nw; ++j) {
         const size_t c = col[nb + j];
         double comb = 0.0;
-        for (size_t b = 0; b < nb; ++b) comb += fabs(a[b * nw + j]) * s[col[b]];
-        comb *= err;
+        for (size_t b = 0; b < nb; ++b) comb += fabs(a[b * nw + j]) * (err * s[col[b]] + accept);
         const double rest = dia3 * cblas_dasum((int)m, x + j * m, 1);
+        const double rest_err = kind == CM_RBF_SUMS_FAST ? accept : CM_RBF_PLAIN_ERR * rest;
         const double bound = fmax(CM_RBF_PLAIN_RES_SHARE * r->opt.tolerance * sc->fnorm[c],
-                                  CM_RBF_SPAN_GROWTH * err * s[c]);
-        kind[c] = comb + rest <= bound                     ? SPAN_ONLY
-                  : comb + CM_RBF_PLAIN_ERR * rest <= bound ? SPAN_RES
-                                                           : SPAN_DIRECT;
-        nd += kind[c] == SPAN_DIRECT;
-        nr += kind[c] == SPAN_RES;
+                                  CM_RBF_SPAN_GROWTH * (err * s[c] + accept));
+        how[c] = comb + rest <= bound       ? SPAN_ONLY
+                 : comb + rest_err <= bound ? SPAN_RES
+                                            : SPAN_DIRECT;
+        nd += how[c] == SPAN_DIRECT;
+        nr += how[c] == SPAN_RES;
     }
     if (nd == nc) goto done; /* nothing gains */
-    /* the direct columns (the basis first) and the rests: in one plain pass, or the
-     * direct ones compensated and the rests plain (a pass costs its pairs' distances before
-     * its columns: bore, 47,661 nodes x 20,642 centres, plain sums of 15 columns 0.3 s, of
-     * 60 columns 1.0 s) */
+    /* the direct columns (the basis first) and the rests: in one plain or treecode pass, or
+     * the direct ones compensated and the rests plain (a pass costs its pairs' distances
+     * before its columns: bore, 47,661 nodes x 20,642 centres, plain sums of 15 columns 0.3 s,
+     * of 60 columns 1.0 s) */
     const size_t nk = nc - nd, ns = nd + nr;
-    const size_t ldd = plain ? ns : nd, ldr = plain ? ns : nr;
+    const size_t ldd = one ? ns : nd, ldr = one ? ns : nr;
     outd = malloc(n * ns * sizeof *outd);
     outk = malloc(n * nk * sizeof *outk);
-    outr = plain || !nr ? NULL : malloc(n * nr * sizeof *outr);
+    outr = one || !nr ? NULL : malloc(n * nr * sizeof *outr);
     wr = malloc(m * ns * sizeof *wr);
     coef = malloc(nb * nk * sizeof *coef);
-    if (!outd || !outk || (!plain && nr && !outr) || !wr || !coef) goto done;
-    if (tick) /* in point-centre pairs, per pass of up to CM_RBF_SUM_MAX_NC columns */
-        cm_rbf_tick_restart(tick, (double)(plain ? passes(ns) : passes(nd) + passes(nr)) *
-                                      (double)n * (double)m);
+    if (!outd || !outk || (!one && nr && !outr) || !wr || !coef) goto done;
     size_t v = 0;
     for (size_t u = 0; u < nc; ++u)
-        if (kind[col[u]] == SPAN_DIRECT) memcpy(wr + v++ * m, r->w + col[u] * m, m * sizeof *wr);
+        if (how[col[u]] == SPAN_DIRECT) memcpy(wr + v++ * m, r->w + col[u] * m, m * sizeof *wr);
     for (size_t j = 0; j < nw; ++j)
-        if (kind[col[nb + j]] == SPAN_RES) memcpy(wr + v++ * m, x + j * m, m * sizeof *wr);
+        if (how[col[nb + j]] == SPAN_RES) memcpy(wr + v++ * m, x + j * m, m * sizeof *wr);
     ret = 1;
-    if (plain) {
-        if (sums(r, wr, ns, n, p, 1, outd, threads, tick)) goto done;
-    } else if (sums(r, wr, nd, n, p, 0, outd, threads, tick) ||
-               sums(r, wr + nd * m, nr, n, p, 1, outr, threads, tick))
-        goto done;
-    const double *rests = plain ? outd + nd : outr;
+    const int fast = kind == CM_RBF_SUMS_FAST &&
+                     cm_rbf_iterative_sum_fast(r, wr, ns, smax, n, p, outd, threads, tick);
+    if (tick && tick->status < 0) goto done;
+    /* direct sums (after a treecode that failed its check: compensated, as the evaluation
+     * would sum without the span) */
+    if (!fast) {
+        if (tick) /* in point-centre pairs, per pass of up to CM_RBF_SUM_MAX_NC columns */
+            cm_rbf_tick_restart(tick, (double)(one ? passes(ns) : passes(nd) + passes(nr)) *
+                                          (double)n * (double)m);
+        if (one ? sums(r, wr, ns, n, p, kind == CM_RBF_SUMS_PLAIN, outd, threads, tick)
+                : sums(r, wr, nd, n, p, 0, outd, threads, tick) ||
+                      sums(r, wr + nd * m, nr, n, p, 1, outr, threads, tick))
+            goto done;
+    }
+    const double *rests = one ? outd + nd : outr;
     /* the combined columns' coefficients, nb x nk, over the basis columns' values */
     for (size_t j = 0, u = 0; j < nw; ++j)
-        if (kind[col[nb + j]] != SPAN_DIRECT) {
+        if (how[col[nb + j]] != SPAN_DIRECT) {
             for (size_t b = 0; b < nb; ++b) coef[b * nk + u] = a[b * nw + j];
             ++u;
         }
@@ -180,7 +196,7 @@ int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, c
     size_t id = 0, ik = 0, ir = 0;
     for (size_t u = 0; u < nc; ++u) {
         const size_t c = col[u];
-        const int kc = kind[c];
+        const int kc = how[c];
         for (size_t i = 0; i < n; ++i) {
             double *o = out + i * nc + c;
             if (kc == SPAN_DIRECT) *o = outd[i * ldd + id];
@@ -196,7 +212,7 @@ int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, c
     r->iter->eval_combined = (int)nk;
     ret = 0;
 done:
-    free(basis), free(col), free(kind), free(piv), free(wb), free(x), free(tau), free(a);
+    free(basis), free(col), free(how), free(piv), free(wb), free(x), free(tau), free(a);
     free(outd), free(outk), free(outr), free(wr), free(coef);
     return ret;
 }

@@ -118,14 +118,43 @@ struct cm_rbf_iter {
     int eval_combined;    /* the last evaluation's columns combined from the cold ones' */
 };
 
-/* The direct sums of cm_rbf_iterative_evaluate (plain: plain sums, else compensated) into out
- * (n x ncomp), a column whose solve started warm as its least-squares combination of a basis
- * of other columns, plus what the combination leaves by plain sums or not at all, where that
- * is within the direct sums' bound on the column (rbf_evaluate_span.c); s: the columns' sum_j
- * |w_j| phi_ij at sampled points (cm_rbf_abs_sums). 0 done, 1 stopped (tick), -1 not taken
- * (no column to combine or none to combine from, no column gains, out of memory). */
+/* fast_sum = -1 (auto): evaluation by the treecode from this many point-centre pairs
+ * (rbf_evaluate_tree.c, rbf_evaluate.c) */
+#define CM_RBF_FAST_EVAL_PAIRS 2e9
+/* samples for the a-posteriori error estimate of a fast evaluation, and the factor on the
+ * largest sampled error (the sampled max was within it of the true max on the real sets).
+ * The treecode's errors are spiky below its finest orders: over 32,768 of the two-body
+ * interior points at order 10, every 256-point subset found at least 1/6.4 of their
+ * largest error, every 1,024-point one 1/2.2 (RESULTS.md, RBF solvers); 1,024
+ * compensated sums cost ~1 % of a 10^6-point evaluation */
+#define CM_RBF_FAST_SAMPLES 1024
+#define CM_RBF_FAST_SAFETY 4.0
+
+/* How an evaluation sums the kernel: plain direct sums (the tolerance allows them), compensated
+ * ones, or the treecode (rbf_evaluate.c) */
+enum { CM_RBF_SUMS_PLAIN, CM_RBF_SUMS_COMPENSATED, CM_RBF_SUMS_FAST };
+
+/* The sums of cm_rbf_iterative_evaluate by kind (CM_RBF_SUMS_*) into out (n x ncomp), a
+ * column whose solve started warm as its least-squares combination of a basis of other
+ * columns, plus what the combination leaves by the same sums or not at all, where that is
+ * within the sums' bound on the column (rbf_evaluate_span.c); s: the columns' sum_j |w_j|
+ * phi_ij at sampled points (cm_rbf_abs_sums). 0 done, 1 stopped (tick), -1 not taken (no
+ * column to combine or none to combine from, no column gains, out of memory). */
 int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, const double *s,
-                                   int plain, double *out, int threads, cm_rbf_tick *tick);
+                                   int kind, double *out, int threads, cm_rbf_tick *tick);
+/* 1 if an evaluation at n points tries the treecode (fast_sum, and n x m large) */
+int cm_rbf_iterative_takes_fast(const cm_rbf *r, size_t n);
+/* The error the treecode's result must be shown within, for weights whose sampled sum_j |w_j|
+ * phi_ij is at most smax: fast_eval_tol x the data scale, or the direct sums' own rounding
+ * if larger; 0 if the treecode is not to be tried */
+double cm_rbf_iterative_fast_accept(const cm_rbf *r, double smax);
+/* The treecode sums of the nc columns w (m each) at the n points p into out (n x nc), its row
+ * chosen for that error after a pilot and the result checked at sampled points (rbf_evaluate.c):
+ * 1 if accepted, 0 if direct sums must do it (or tick, if not NULL, said stop: then
+ * tick->status < 0). Sets the fit's eval_fast, eval_error, eval_order, eval_theta. */
+int cm_rbf_iterative_sum_fast(const cm_rbf *r, const double *w, size_t nc, double smax,
+                              size_t n, const double *p, double *out, int threads,
+                              cm_rbf_tick *tick);
 
 /* The treecode on the centres of r for (order, theta), made on first use and kept in
  * r->iter (studies solve and evaluate again on the same centres); NULL out of memory. */

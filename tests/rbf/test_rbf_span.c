@@ -78,7 +78,11 @@ static double *family(size_t m, const double *x, double eps)
 static void direct(const cm_rbf *r, size_t np, const double *p, double *out)
 {
     const size_t m = r->m, nc = (size_t)r->ncomp, k = (size_t)r->k;
-    double *s = malloc(3 * np * sizeof *s);
+    double *s = calloc(3 * np, sizeof *s);
+    if (!s) {
+        memset(out, 0, np * nc * sizeof *out);
+        return;
+    }
     for (size_t i = 0; i < np; ++i)
         for (int d = 0; d < 3; ++d)
             s[(size_t)d * np + i] = (p[3 * i + (size_t)d] - r->shift[d]) * r->scale;
@@ -117,6 +121,49 @@ static void read_order(void *user, cm_log_level level, const char *msg)
     if (t) sscanf(t, "the fields in the order %d %d", &ol->first[0], &ol->first[1]);
 }
 
+/* A combination that would amplify the basis' rounding is summed instead: three columns
+ * solved from zero, then their weights made w0 = u, w1 = u + 1e-10 v, w2 = v (v, u two of
+ * the solutions) with w2 marked as a warm start that took no step: w2 = 1e10 (w1 - w0)
+ * exactly, but 1e10 times the sums' rounding is above the tolerance, so it is not combined,
+ * and the evaluation matches direct sums. */
+static void ill_conditioned(cm_context *ctx, size_t m_in, const double *x, size_t np,
+                            const double *p)
+{
+    cm_rbf_options o;
+    cm_rbf_options_init(&o);
+    o.solver = CM_RBF_SOLVER_ITERATIVE;
+    o.tolerance = 1e-6;
+    cm_rbf *r = NULL;
+    double *f = malloc(m_in * 3 * sizeof *f), *ev = malloc(np * 3 * sizeof *ev);
+    double *ed = malloc(np * 3 * sizeof *ed);
+    bore_motion(m_in, x, 2.0, 1.0, f);
+    CHECK(f && ev && ed && cm_rbf_create_opt(ctx, CM_RBF_TRIHARMONIC, 3, m_in, x, &o, &r) == CM_OK);
+    if (r && cm_rbf_solve(ctx, r, 3, f) == CM_OK) {
+        const size_t m = r->m;
+        double *w = r->w;
+        for (size_t i = 0; i < m; ++i) {
+            const double u = w[i], v = w[m + i];
+            w[i] = u, w[m + i] = u + 1e-10 * v, w[2 * m + i] = v;
+        }
+        r->iter->scales.start[0] = r->iter->scales.start[1] = -1.0;
+        r->iter->scales.start[2] = 0.0;
+        CHECK(cm_rbf_evaluate(ctx, r, np, p, ev) == CM_OK);
+        cm_rbf_stats st;
+        cm_rbf_get_stats(r, &st);
+        direct(r, np, p, ed);
+        double e = 0.0, fm = 0.0;
+        for (size_t i = 0; i < np * 3; ++i) e = fmax(e, fabs(ev[i] - ed[i]));
+        for (size_t i = 0; i < np * 3; ++i) fm = fmax(fm, fabs(ed[i]));
+        printf("ill-conditioned: %d combined, against direct sums %.3g of the values\n",
+               st.eval_combined, e / fm);
+        CHECK_MSG(st.eval_combined == 0, "%d", st.eval_combined);
+        CHECK_MSG(e <= 1e-7 * fm, "%.3g", e / fm);
+    } else
+        CHECK_MSG(0, "%s", cm_context_message(ctx));
+    cm_rbf_destroy(&r);
+    free(f), free(ev), free(ed);
+}
+
 int main(void)
 {
     order_known();
@@ -131,6 +178,7 @@ int main(void)
     double *ev = malloc(np * NCOL * sizeof *ev), *ed = malloc(np * NCOL * sizeof *ed);
     double *ec = malloc(np * NCOL * sizeof *ec), *e1 = malloc(np * 3 * sizeof *e1);
     CHECK(p && f && one && ev && ed && ec && e1);
+    ill_conditioned(ctx, m_in, x, np, p);
     const double tols[2] = {1e-10, 1e-6}, eps[2] = {1e-5, 1e-8};
     for (int t = 0; t < 2; ++t) {
         double *v = family(m_in, x, eps[t]);
@@ -191,6 +239,21 @@ int main(void)
         CHECK_MSG(vs_direct <= 0.1 * tols[t], "%.3g", vs_direct);
         /* two solutions within the tolerance at the centres: a few times it inside */
         CHECK_MSG(vs_alone <= (t ? 2e-6 : 1e-8), "%.3g", vs_alone);
+        /* the treecode's evaluation (forced: at this size it would sum directly): the basis is
+         * then every column that took a step, so the warm columns whose starts met the
+         * tolerance are combined (at 1e-6 all; at the default those wholly in the span) */
+        int no_step = 0;
+        for (size_t c = 0; c < NCOL; ++c) no_step += cm_rbf_iterative_column_iterations(r, c) == 0;
+        r->opt.fast_sum = 1;
+        CHECK(cm_rbf_evaluate(ctx, r, np, p, ev) == CM_OK);
+        cm_rbf_get_stats(r, &st);
+        const double fast_vs_direct = worst_rel(np, ev, ed, m_in, v);
+        printf("  by the treecode: %d combined, its estimated error %.3g of the data scale; "
+               "against direct sums %.3g\n", st.eval_combined, st.eval_error, fast_vs_direct);
+        CHECK(st.eval_fast == 1 && st.eval_plain == 0);
+        CHECK_MSG(st.eval_combined == no_step && (t == 0 || no_step == st.warm_columns),
+                  "%d combined, %d without a step", st.eval_combined, no_step);
+        CHECK_MSG(fast_vs_direct <= 1e-8, "%.3g", fast_vs_direct);
         cm_rbf_destroy(&r);
         free(v);
     }
