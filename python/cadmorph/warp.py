@@ -1,6 +1,6 @@
 """Warp: a volume warp of a mesh, factorised once (cm_warp_create), applied to any motion of
-its constrained nodes (cm_warp_apply) and, for adjoint gradients, its reverse product
-(cm_warp_apply_transpose); warp(): the one-shot form.
+its constrained nodes (cm_warp_apply), to many at once (cm_warp_apply_many) and, for adjoint
+gradients, its reverse product (cm_warp_apply_transpose); warp(): the one-shot form.
 
 A warp carries a prescribed displacement of some nodes (by default the boundary nodes) into
 every other node of the volume cells, by one of the library's methods (docs/DESIGN.md, "The
@@ -14,7 +14,7 @@ import numpy as np
 
 from ._capi import ffi, lib
 from ._context import Context, Progress
-from ._inputs import index_array, mesh_of, points
+from ._inputs import index_array, integer, mesh_of, points
 from ._options import MAX_DISPLACEMENT, WarpSettings
 from .mesh import Mesh
 
@@ -42,6 +42,10 @@ class Warp:
             with this warp (apply_many's k counting k), >= 1 (default 1); the dense
             factorisation, shared by them all, then wins to more nodes
             (cm_warp_options.solves).
+        warm_groups: RBF methods, iterative solver: apply_many's k fields solved in this many
+            groups, each starting from the solutions of the groups before it, the fields that
+            span the others first (cm_warp_options.warm_groups: what a study does with its
+            variants); 0 or 1 (default 0): all at once.
         lattice: dmffd: control points per axis, 4..200 (None: 10); clamp: dmffd: singular
             values <= clamp x the largest are dropped, in (0, 1) (None: 1e-10).
         samples, cubature (None: automatic), cover (1..64), stretch, bend, blend (>= 0),
@@ -64,8 +68,8 @@ class Warp:
                  lattice: Optional[int] = None, clamp: Optional[float] = None,
                  samples: Optional[int] = None, cubature: Optional[int] = None, cover: int = 5,
                  stretch: float = 1.0, bend: float = 1.0, blend: float = 1.5,
-                 graded: float = 0.0, solves: int = 1, threads: int = 0,
-                 progress: Progress = None) -> None:
+                 graded: float = 0.0, solves: int = 1, warm_groups: int = 0,
+                 threads: int = 0, progress: Progress = None) -> None:
         what = "cadmorph.Warp"
         self._warp = None
         self._lock = threading.Lock()  # the C API: one call at a time on a warp
@@ -76,9 +80,11 @@ class Warp:
                                 samples=samples, cubature=cubature, cover=cover,
                                 stretch=stretch, bend=bend, blend=blend, graded=graded,
                                 solves=solves)
+        groups = integer(what, "warm_groups", warm_groups, 0, 2 ** 31 - 1)
         self._ctx = ctx = Context(threads, progress, what)
         opt = ffi.new("cm_warp_options *")
         settings.fill(opt)
+        opt.warm_groups = groups
         b = ctx.create(lib.cm_mesh_boundary_create, "cm_mesh_boundary",
                        lib.cm_mesh_boundary_destroy, m)
         if nodes is None:
@@ -142,6 +148,37 @@ class Warp:
         if self._n:
             with self._lock:
                 self._ctx.call(lib.cm_warp_apply, self._warp, ffi.from_buffer("double[]", out))
+        return out
+
+    def apply_many(self, Ds: Any) -> np.ndarray:
+        """The displacement of every node for k motions of the constrained nodes at once: a
+        (k, n_nodes, 3) float64 array whose [j] is what apply(Ds[j]) returns. Ds: an
+        array-like of shape (k, len(nodes), 3), or a sequence of k array-likes each as
+        apply's D (checked as there; k >= 0).
+
+        The RBF methods solve and evaluate the 3k columns together (cm_warp_apply_many):
+        their kernel passes serve every column, so k fields cost a fraction of k applies;
+        the result equals k applies to rounding with the dense solver and to the tolerance
+        with the iterative one (warm_groups: its fields in groups, each starting from the
+        solutions before it). The other methods apply field by field. The library holds
+        3k values per node of the largest component besides the result: k up to tens.
+        """
+        what = "cadmorph.Warp.apply_many"
+        try:
+            fields = Ds if isinstance(Ds, np.ndarray) and Ds.ndim == 3 else list(Ds)
+        except TypeError:
+            raise TypeError("%s: Ds must be an array-like (k, %d, 3) or a sequence of k "
+                            "array-likes, not %s" % (what, len(self._nodes),
+                                                     type(Ds).__name__)) from None
+        k = len(fields)
+        out = np.zeros((k, self._n, 3), np.float64)
+        for j in range(k):
+            out[j, self._nodes] = points(what, "Ds[%d]" % j, fields[j], len(self._nodes),
+                                         MAX_DISPLACEMENT)
+        if self._n and k:
+            with self._lock:
+                self._ctx.call(lib.cm_warp_apply_many, self._warp, k,
+                               ffi.from_buffer("double[]", out))
         return out
 
     def apply_transpose(self, V: Any) -> np.ndarray:

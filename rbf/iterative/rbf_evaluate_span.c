@@ -127,9 +127,10 @@ int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, c
                 (int)m, a, (int)nw, 1.0, x, (int)m);
     /* each other column: combined alone, combined with its rest summed, or summed. The
      * sums' error bounds: plain and compensated ones relative to the column's sum |w| phi,
-     * the treecode's what its check accepts, the same for every column */
+     * the treecode's what its check accepts, the same for every column (its scale the
+     * largest sum |w| phi of all, as for the fit's own columns) */
     double smax = 0.0;
-    for (size_t b = 0; b < nb; ++b) smax = fmax(smax, s[col[b]]);
+    for (size_t c = 0; c < nc; ++c) smax = fmax(smax, s[c]);
     const double err = kind == CM_RBF_SUMS_PLAIN ? CM_RBF_PLAIN_ERR
                        : kind == CM_RBF_SUMS_COMPENSATED ? CM_RBF_PHI_ROUND * DBL_EPSILON
                                                          : 0.0;

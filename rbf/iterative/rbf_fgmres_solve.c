@@ -717,7 +717,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         free(fp), free(qp), free(scale), free(order);
         return solve_in_order(ctx, r, nc, f, w, q, threads);
     }
-    const double fmax_all = cm_krylov_norm_inf(nc * m, f);
+    const double t0 = cm_wtime(), fmax_all = cm_krylov_norm_inf(nc * m, f);
     for (size_t c = 0; c < nc; ++c) {
         memcpy(fp + c * m, f + c * m, m * sizeof *fp);
         cm_krylov_project(r->iter->q1, m, r->k, fp + c * m);
@@ -731,8 +731,8 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
     for (size_t i = 0; i < nf && len < (int)sizeof line - 24; ++i)
         len += snprintf(line + len, sizeof line - (size_t)len, " %zu", order[i]);
     cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: groups of %zu columns, the fields in the order%s%s "
-           "(the columns below numbered in it)", gsize, line,
-           len >= (int)sizeof line - 24 ? " ..." : "");
+           "(the columns below numbered in it; %.3f s)", gsize, line,
+           len >= (int)sizeof line - 24 ? " ..." : "", cm_wtime() - t0);
     for (size_t i = 0; i < nf; ++i)
         memcpy(fp + i * d * m, f + order[i] * d * m, d * m * sizeof *fp);
     cm_status st = solve_in_order(ctx, r, nc, fp, wp, qp, threads);

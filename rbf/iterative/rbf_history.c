@@ -78,51 +78,67 @@ size_t cm_rbf_history_bytes(const cm_rbf_history *h)
     return h ? (2 * h->cap + 2) * h->m * sizeof(double) : 0;
 }
 
-/* Greedy, as a block QR with pivoting: the fields' columns are kept orthogonal to the span
- * so far (modified Gram-Schmidt, in place), so a remaining column's norm is what the span
- * leaves of it. */
+/* Greedy, as a block QR with pivoting, done on the Gram matrix of what the history leaves of
+ * the columns (a pivoted Cholesky by whole fields): a column's squared norm outside the span
+ * so far is G_cc - sum_k L_ck^2. The squares lose what lies below 1e-8 of a column, where
+ * its start is good whatever the order. A few BLAS-3 calls instead of a Gram-Schmidt pass per
+ * pair of columns: bore, 60 columns of 20,642, 0.08 s that way. */
 void cm_rbf_history_order(const cm_rbf_history *h, size_t m, size_t nf, size_t d, size_t picks,
                           double *pf, const double *scale, size_t *order)
 {
     const size_t nc = nf * d;
-    for (size_t c = 0; c < nc; ++c)
-        for (size_t j = 0; h && j < h->n; ++j) {
-            double *pc = pf + c * m;
-            const double t = cblas_ddot((int)m, h->b + j * m, 1, pc, 1);
-            cblas_daxpy((int)m, -t, h->b + j * m, 1, pc, 1);
-        }
     for (size_t f = 0; f < nf; ++f) order[f] = f;
+    double *g = malloc(nc * nc * sizeof *g), *l = malloc(nc * nc * sizeof *l);
+    double *e = malloc(nc * sizeof *e);
+    double *c = h && h->n > 0 ? malloc(h->n * nc * sizeof *c) : NULL;
+    if (!g || !l || !e || (h && h->n > 0 && !c)) { /* out of memory: the order as given */
+        free(g), free(l), free(e), free(c);
+        return;
+    }
+    if (c) { /* pf -= B (B' pf): what the history's orthonormal b_j leave */
+        cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)h->n, (int)nc, (int)m, 1.0,
+                    h->b, (int)m, pf, (int)m, 0.0, c, (int)h->n);
+        cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (int)m, (int)nc, (int)h->n, -1.0,
+                    h->b, (int)m, c, (int)h->n, 1.0, pf, (int)m);
+    }
+    cblas_dsyrk(CblasColMajor, CblasUpper, CblasTrans, (int)nc, (int)m, 1.0, pf, (int)m, 0.0, g,
+                (int)nc);
+    for (size_t u = 0; u < nc; ++u) {
+        e[u] = g[u * nc + u];
+        for (size_t v = 0; v < u; ++v) g[v * nc + u] = g[u * nc + v]; /* the lower half */
+    }
+    size_t rank = 0;
     if (picks > nf) picks = nf;
     for (size_t p = 0; p < picks; ++p) {
         /* the remaining field whose data the span fits worst, relative to their scales */
         size_t best = p;
         double worst = -1.0;
         for (size_t q = p; q < nf; ++q) {
-            double e = 0.0;
+            double r = 0.0;
             for (size_t j = 0; j < d; ++j) {
-                const size_t c = order[q] * d + j;
-                if (scale[c] > 0.0) e = fmax(e, cblas_dnrm2((int)m, pf + c * m, 1) / scale[c]);
+                const size_t u = order[q] * d + j;
+                if (scale[u] > 0.0) r = fmax(r, sqrt(fmax(e[u], 0.0)) / scale[u]);
             }
-            if (e > worst) worst = e, best = q;
+            if (r > worst * (1.0 + 1e-9)) worst = r, best = q; /* ties: the first */
         }
         const size_t f = order[best];
         order[best] = order[p];
         order[p] = f;
-        /* its columns join the span: normalised, and taken out of the fields after it */
+        /* its columns join the span: a column of L each */
         for (size_t j = 0; j < d; ++j) {
-            double *u = pf + (f * d + j) * m;
-            const double un = cblas_dnrm2((int)m, u, 1);
-            if (!(un > CM_RBF_HISTORY_DROP * scale[f * d + j])) continue;
-            cblas_dscal((int)m, 1.0 / un, u, 1);
-            for (size_t jj = j + 1; jj < d; ++jj) {
-                double *v = pf + (f * d + jj) * m;
-                cblas_daxpy((int)m, -cblas_ddot((int)m, u, 1, v, 1), u, 1, v, 1);
+            const size_t u = f * d + j;
+            const double piv = e[u], lim = CM_RBF_HISTORY_DROP * scale[u];
+            if (!(piv > lim * lim)) continue;
+            double *lk = l + rank * nc;
+            for (size_t v = 0; v < nc; ++v) {
+                double t = g[u * nc + v];
+                for (size_t k = 0; k < rank; ++k) t -= l[k * nc + v] * l[k * nc + u];
+                lk[v] = t / sqrt(piv);
             }
-            for (size_t q = p + 1; q < nf; ++q)
-                for (size_t jj = 0; jj < d; ++jj) {
-                    double *v = pf + (order[q] * d + jj) * m;
-                    cblas_daxpy((int)m, -cblas_ddot((int)m, u, 1, v, 1), u, 1, v, 1);
-                }
+            for (size_t v = 0; v < nc; ++v) e[v] -= lk[v] * lk[v];
+            e[u] = 0.0;
+            ++rank;
         }
     }
+    free(g), free(l), free(e), free(c);
 }

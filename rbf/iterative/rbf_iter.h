@@ -47,8 +47,9 @@ size_t cm_rbf_history_bytes(const cm_rbf_history *h);
  * by one, each the field whose data the history h (NULL: none) and the fields before it fit
  * worst, relative to its columns' scale (nf x d, 0: a column not counted); pf (nf x d
  * columns of m, field by field) holds the fields' projected data and is overwritten. Why:
- * each warm group starts from the history's combination, so its start is as near as its data lie to the span
- * of the groups before it; groups in list order extrapolate along a family, these interpolate
+ * each warm group starts from the history's combination, so its start is as near as its data
+ * lie to the span of the groups before it; groups in list order extrapolate along a family,
+ * these interpolate
  * (20 bore variants, 20,642 centres, groups of 5 at 1e-10: the warm groups' starts, relative
  * to their data, 2e-9..1.6e-6 in list order, 1e-10..1.5e-8 so; RESULTS.md, Study). */
 void cm_rbf_history_order(const cm_rbf_history *h, size_t m, size_t nf, size_t d, size_t picks,

@@ -96,6 +96,37 @@ def test_warp_constrained_nodes_and_properties(bore_mesh):
     assert np.array_equal(cadmorph.Warp(mesh, solves=20, progress=False).apply(D), out)
 
 
+def test_warp_apply_many_equals_applies(bore_mesh):
+    """k motions in one call: each as apply gives it (to rounding with the dense solver, to
+    the tolerance with the iterative one, also in warm groups), from a (k, n, 3) array or a
+    sequence; checked as apply checks D."""
+    mesh = cadmorph.read_mesh(bore_mesh)
+    w = cadmorph.Warp(mesh, progress=False)
+    D = motion(mesh.points[w.nodes])
+    Ds = np.stack([D, 2 * D + 0.01, -D, D[::-1]])
+    many = w.apply_many(Ds)
+    assert many.shape == (4, mesh.n_nodes, 3) and many.dtype == np.float64
+    for j in range(4):
+        one = w.apply(Ds[j])
+        assert np.array_equal(many[j, w.nodes], Ds[j])
+        # the same weights but for the rounding of a multi-column solve (its blocked
+        # triangular solves), which the interpolant's sums of large weights amplify
+        assert np.abs(many[j] - one).max() <= 1e-9 * np.abs(Ds[j]).max()
+    assert np.array_equal(w.apply_many(list(Ds)), many)  # a sequence
+    assert w.apply_many([]).shape == (0, mesh.n_nodes, 3)
+    wi = cadmorph.Warp(mesh, solver="iterative", warm_groups=2, progress=False)
+    many = wi.apply_many(Ds)
+    for j in range(4):
+        one = wi.apply(Ds[j])
+        assert np.abs(many[j] - one).max() <= 1e-8 * np.abs(Ds[j]).max()
+    with pytest.raises(ValueError, match=r"Ds\[1\] must have shape \(1728, 3\)"):
+        w.apply_many([D, D[:5]])
+    with pytest.raises(TypeError, match="Ds must be an array-like"):
+        w.apply_many(3.0)
+    with pytest.raises(ValueError, match="warm_groups"):
+        cadmorph.Warp(mesh, warm_groups=-1)
+
+
 def test_warp_accepts_array_likes_without_copy(bore_mesh):
     mesh = cadmorph.read_mesh(bore_mesh)
     w = cadmorph.Warp(mesh, progress=False)
