@@ -96,6 +96,14 @@ static int plain_enough(const cm_rbf *r, const double *s)
     return ok;
 }
 
+/* sum |w| phi of the fit's columns at ns sampled points, malloc'ed (NULL: out of memory) */
+static double *sampled(const cm_rbf *r, size_t n, const double *p, size_t ns, int threads)
+{
+    double *s = malloc((size_t)r->ncomp * sizeof *s);
+    if (s && sampled_abs_sums(r, n, p, ns, s, threads) != 0) free(s), s = NULL;
+    return s;
+}
+
 int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double *out,
                               int threads, cm_rbf_tick *tick)
 {
@@ -104,25 +112,27 @@ int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double
     it->eval_plain = 0;
     it->eval_combined = 0;
     it->eval_fast = 0; /* eval_error stays that of the last evaluation that tried */
-    /* sum |w| phi at sampled points: the treecode's scale, whether plain sums serve, the
-     * span's error bounds */
+    /* sum |w| phi at sampled points: the treecode's scale, or whether plain sums serve; and
+     * the span's error bounds */
     const int fast = cm_rbf_iterative_takes_fast(r, n);
-    double *s = malloc(nc * sizeof *s);
-    if (s && sampled_abs_sums(r, n, p, fast ? CM_RBF_FAST_SMAX_SAMPLES : CM_RBF_FAST_SAMPLES, s,
-                              threads) != 0)
-        free(s), s = NULL;
-    const int kind = fast ? CM_RBF_SUMS_FAST : plain_enough(r, s) ? CM_RBF_SUMS_PLAIN
-                                                                  : CM_RBF_SUMS_COMPENSATED;
+    double *s = sampled(r, n, p, fast ? CM_RBF_FAST_SMAX_SAMPLES : CM_RBF_FAST_SAMPLES, threads);
+    int kind = fast ? CM_RBF_SUMS_FAST : plain_enough(r, s) ? CM_RBF_SUMS_PLAIN
+                                                            : CM_RBF_SUMS_COMPENSATED;
     int done = cm_rbf_iterative_evaluate_span(r, n, p, s, kind, out, threads, tick);
     if (done < 0 && fast && s &&
         cm_rbf_iterative_sum_fast(r, r->w, nc, largest(s, nc), n, p, out, threads, tick))
         done = 0;
     free(s);
     if (done >= 0) {
-        it->eval_plain = kind == CM_RBF_SUMS_PLAIN && !it->eval_fast;
+        it->eval_plain = kind == CM_RBF_SUMS_PLAIN;
         return done;
     }
     if (tick && tick->status < 0) return 1;
+    if (fast) { /* the treecode failed its check: plain direct sums if they serve */
+        s = sampled(r, n, p, CM_RBF_FAST_SAMPLES, threads);
+        kind = plain_enough(r, s) ? CM_RBF_SUMS_PLAIN : CM_RBF_SUMS_COMPENSATED;
+        free(s);
+    }
     /* direct sums: a tick of their own, in point-centre pairs */
     if (tick)
         cm_rbf_tick_restart(tick, (double)((r->ncomp + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) *

@@ -7,12 +7,12 @@
  * quarters of its columns start warm. Where the sums are plain (a loose tolerance, as a
  * study's 1e-6) or by the treecode, the basis is every column that took a Krylov step, so a
  * column that took none (its start met the tolerance) is the history's combination of them:
- * res_c is rounding and is not summed at all. Where they are compensated (the default tolerance, at which every
- * warm column takes a few steps), the basis is the columns that started from zero, and res_c,
- * the warm columns' steps and their starts' share of the earlier groups' steps, about 1e-8 of
- * w_c, is summed plainly: its rounding is far below the tolerance where w_c's needs
- * compensated sums. A column is taken so only where both parts' error bounds stay within what
- * the direct sums would promise for it. */
+ * res_c is rounding and is not summed at all. Where they are compensated (the default
+ * tolerance, at which every warm column takes a few steps), the basis is the columns that
+ * started from zero, and res_c, the warm columns' steps and their starts' share of the
+ * earlier groups' steps, about 1e-8 of w_c, is summed plainly: its rounding is far below the
+ * tolerance where w_c's needs compensated sums. A column is taken so only where both parts'
+ * error bounds stay within what the direct sums would promise for it. */
 #include "rbf_iter.h"
 
 #include <cblas.h>
@@ -173,8 +173,7 @@ int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, c
     const int fast = kind == CM_RBF_SUMS_FAST &&
                      cm_rbf_iterative_sum_fast(r, wr, ns, smax, n, p, outd, threads, tick);
     if (tick && tick->status < 0) goto done;
-    /* direct sums (after a treecode that failed its check: compensated, as the evaluation
-     * would sum without the span) */
+    /* direct sums (after a treecode that failed its check, a rare case: compensated) */
     if (!fast) {
         if (tick) /* in point-centre pairs, per pass of up to CM_RBF_SUM_MAX_NC columns */
             cm_rbf_tick_restart(tick, (double)(one ? passes(ns) : passes(nd) + passes(nr)) *

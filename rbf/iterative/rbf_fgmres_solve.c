@@ -726,7 +726,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         scale[c] = fn >= r->tun.column_scale * fmax_all ? cblas_dnrm2((int)m, fp + c * m, 1) : 0.0;
     }
     cm_rbf_history_order(hist, m, nf, d, picks, fp, scale, order);
-    char line[120];
+    char line[120] = "";
     int len = 0;
     for (size_t i = 0; i < nf && len < (int)sizeof line - 24; ++i)
         len += snprintf(line + len, sizeof line - (size_t)len, " %zu", order[i]);
