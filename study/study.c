@@ -492,8 +492,10 @@ static void study_free(study *w)
  * flattened by 60 columns, the same section). Memory per variant: for each of its 3 columns
  * of an iterative RBF solve the Krylov storage, (2 restart + 9) doubles per boundary node
  * (rbf.h, cm_rbf_solve; the default restart, 40), while its group solves (one in
- * CM_STUDY_WARM_GROUPS at a time: counted for all, a margin); the apply's fields, the
- * evaluation's values and the result (3 doubles per node each); its loaded model (a few MB:
+ * CM_STUDY_WARM_GROUPS at a time: counted for all, a margin), and its columns' data and
+ * weights once more in the order the groups take them; the apply's fields, the evaluation's
+ * values, the result and, where the evaluation goes through the span of others, the summed
+ * and the combined columns' values (3 doubles per node each); its loaded model (a few MB:
  * 8 MB counted). */
 static size_t batch_size(const cm_study_options *o, size_t variants, size_t nodes,
                          size_t boundary)
@@ -501,8 +503,8 @@ static size_t batch_size(const cm_study_options *o, size_t variants, size_t node
     if (!(o->modes & CM_STUDY_ABSOLUTE)) return 1;
     if (o->batch > 0) return (size_t)o->batch;
     const double restart = 40;
-    const double per = 8.0 * (3 * (2 * restart + 9) * (double)boundary + 9.0 * (double)nodes +
-                              3.0 * (double)boundary) + 8e6;
+    const double per = 8.0 * (3 * (2 * restart + 9) * (double)boundary + 15.0 * (double)nodes +
+                              9.0 * (double)boundary) + 8e6;
     double k = fmin(0.5 * cm_memory_available() / per, (double)variants);
     if (!(k >= 1)) return 1;
     return k < CM_STUDY_BATCH_MAX ? (size_t)k : CM_STUDY_BATCH_MAX;
