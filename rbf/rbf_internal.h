@@ -371,6 +371,39 @@ typedef struct cm_rbf_keyed {
     double key;
     size_t idx;
 } cm_rbf_keyed;
+/* The Schwarz preconditioner's subdomains (rbf_schwarz_leaves.c): the centres c (3 x m SoA)
+ * split by a kD-tree into leaves of at most leaf_size, each leaf a range of perm and its
+ * bounding box. */
+typedef struct cm_rbf_leaf {
+    size_t lo, hi; /* range of perm */
+    double bmin[3], bmax[3];
+} cm_rbf_leaf;
+typedef struct cm_rbf_leaves {
+    const double *c; /* 3 x m SoA */
+    size_t m;
+    size_t *perm;
+    cm_rbf_leaf *leaves;
+    int nleaves, cap;
+    size_t leaf_size;
+} cm_rbf_leaves;
+/* Splits perm[lo, hi) into leaves (recursively, at the median of the widest box side);
+ * 0, or -1 out of memory. */
+int cm_rbf_leaves_split(cm_rbf_leaves *t, size_t lo, size_t hi);
+/* Squared distance from the point x to the box [bmin, bmax]. */
+double cm_rbf_box_dist2(const double *x, const double *bmin, const double *bmax);
+/* The local set of leaf l: its own centres, then up to nloc in all of the centres nearest its
+ * box (at least nmin, beyond that those within reach2 of it), into out; returns the count.
+ * Scratch: lk (nleaves), cand (m). */
+size_t cm_rbf_leaves_grow(const cm_rbf_leaves *t, int l, size_t nloc, size_t nmin,
+                          double reach2, cm_rbf_keyed *lk, cm_rbf_keyed *cand, size_t *out);
+/* The thinned far band of leaf l's local set, appended to its n near centres in out (the
+ * thin_reach option; cm_rbf_thin_pick); returns the new count, 0 out of memory. */
+size_t cm_rbf_leaves_thin(const cm_rbf_leaves *t, int l, size_t n, double far2, double fill,
+                          double cell, size_t cap, cm_rbf_keyed *cand, size_t *out);
+/* Farthest-point sampling of nc of the m centres c into out (d2: m scratch); returns the
+ * largest distance from a centre to its nearest pick (the fill distance). */
+double cm_rbf_farthest_points(const double *c, size_t m, size_t nc, size_t *out, double *d2,
+                              int threads);
 /* The thinned far band of a subdomain (rbf_thin.c): of the nc candidates cand (sorted by
  * key ascending, each at distance d >= d0 > 0 from the leaf's box; c: 3 x m SoA), one per
  * voxel of the grid of cell cell x d0 x 2^k in distance band k = floor(log2(d / d0)) (grid
