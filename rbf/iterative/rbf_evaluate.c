@@ -82,18 +82,37 @@ int cm_rbf_iterative_evaluate_fast(const cm_rbf *r, size_t n, const double *p, d
     return ok && cm_rbf_iterative_sum_fast(r, r->w, nc, smax, n, p, out, threads, tick);
 }
 
+/* 1 if the solve's sums of |w| phi at the centres allow plain sums of every column (the
+ * centres first: the sampled points cost more) */
+static int plain_at_centres(const cm_rbf *r)
+{
+    const cm_rbf_scales *sc = &r->iter->scales;
+    int ok = sc->n == (size_t)r->ncomp;
+    for (size_t c = 0; ok && c < sc->n; ++c) /* (smax unknown, -1: compensated) */
+        ok = sc->smax[c] >= 0.0 &&
+             cm_rbf_plain_bound(sc->smax[c], sc->fnorm[c], r->opt.tolerance) >= 0.0;
+    return ok;
+}
+
 /* 1 if plain direct sums of the fit's weights at the n points p are within its tolerance
  * (see the top of the file), given s (their sampled sums of |w| phi, NULL: unknown). */
 static int plain_enough(const cm_rbf *r, const double *s)
 {
     const cm_rbf_scales *sc = &r->iter->scales;
     const size_t nc = (size_t)r->ncomp;
-    const double tol = r->opt.tolerance;
-    int ok = sc->n == nc && s;
-    for (size_t c = 0; ok && c < nc; ++c) /* (smax unknown, -1: compensated) */
-        ok = sc->smax[c] >= 0.0 && cm_rbf_plain_bound(sc->smax[c], sc->fnorm[c], tol) >= 0.0 &&
-             cm_rbf_plain_bound(s[c], sc->fnorm[c], tol) >= 0.0;
+    int ok = s && plain_at_centres(r);
+    for (size_t c = 0; ok && c < nc; ++c)
+        ok = cm_rbf_plain_bound(s[c], sc->fnorm[c], r->opt.tolerance) >= 0.0;
     return ok;
+}
+
+/* 1 if a column's solve started warm: the evaluation through the span may combine it */
+static int any_warm(const cm_rbf *r)
+{
+    const cm_rbf_scales *sc = &r->iter->scales;
+    for (size_t c = 0; sc->n == (size_t)r->ncomp && c < sc->n; ++c)
+        if (sc->start[c] >= 0.0) return 1;
+    return 0;
 }
 
 /* sum |w| phi of the fit's columns at ns sampled points, malloc'ed (NULL: out of memory) */
@@ -113,9 +132,12 @@ int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double
     it->eval_combined = 0;
     it->eval_fast = 0; /* eval_error stays that of the last evaluation that tried */
     /* sum |w| phi at sampled points: the treecode's scale, or whether plain sums serve; and
-     * the span's error bounds */
+     * the span's error bounds (none of them: a compensated evaluation of cold columns) */
     const int fast = cm_rbf_iterative_takes_fast(r, n);
-    double *s = sampled(r, n, p, fast ? CM_RBF_FAST_SMAX_SAMPLES : CM_RBF_FAST_SAMPLES, threads);
+    double *s = fast || any_warm(r) || plain_at_centres(r)
+                    ? sampled(r, n, p, fast ? CM_RBF_FAST_SMAX_SAMPLES : CM_RBF_FAST_SAMPLES,
+                              threads)
+                    : NULL;
     int kind = fast ? CM_RBF_SUMS_FAST : plain_enough(r, s) ? CM_RBF_SUMS_PLAIN
                                                             : CM_RBF_SUMS_COMPENSATED;
     int done = cm_rbf_iterative_evaluate_span(r, n, p, s, kind, out, threads, tick);
@@ -134,20 +156,9 @@ int cm_rbf_iterative_evaluate(const cm_rbf *r, size_t n, const double *p, double
         free(s);
     }
     /* direct sums: a tick of their own, in point-centre pairs */
-    if (tick)
-        cm_rbf_tick_restart(tick, (double)((r->ncomp + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) *
-                                      (double)n * (double)r->m);
-    if (kind == CM_RBF_SUMS_PLAIN) {
-        it->eval_plain = 1;
-        return cm_rbf_kernel_sum_all_tick(r, r->w, r->ncomp, n, p, n, out, threads, tick);
-    }
-    for (int g = 0; g < r->ncomp; g += CM_RBF_SUM_MAX_NC) {
-        int gc = r->ncomp - g < CM_RBF_SUM_MAX_NC ? r->ncomp - g : CM_RBF_SUM_MAX_NC;
-        if (cm_rbf_kernel_sum_acc_tick(r->m, r->c, r->w + (size_t)g * r->m, gc, n, p, n, out + g,
-                                       (size_t)r->ncomp, threads, tick))
-            return 1;
-    }
-    return 0;
+    if (tick) cm_rbf_tick_restart(tick, (double)cm_rbf_sum_passes(nc) * (double)n * (double)r->m);
+    it->eval_plain = kind == CM_RBF_SUMS_PLAIN;
+    return cm_rbf_iterative_sum_direct(r, r->w, nc, n, p, it->eval_plain, out, threads, tick);
 }
 
 
@@ -196,7 +207,7 @@ static int transpose_fast(const cm_rbf *r, size_t n, const double *p, int ncomp,
     cm_rbf_tree *t = cm_rbf_tree_create(n, p, order, theta);
     cm_rbf_tree_targets *tg = t ? cm_rbf_tree_targets_create(m, r->c, m) : NULL;
     int fast = tg != NULL;
-    if (tick) cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC));
+    if (tick) cm_rbf_tick_restart(tick, (double)cm_rbf_sum_passes(nc));
     double err = 0.0;
     for (size_t g = 0; fast && g < nc; g += CM_RBF_SUM_MAX_NC) {
         int gc = nc - g < CM_RBF_SUM_MAX_NC ? (int)(nc - g) : CM_RBF_SUM_MAX_NC;
@@ -234,7 +245,7 @@ int cm_rbf_iterative_evaluate_transpose(const cm_rbf *r, size_t n, const double 
     if (cm_rbf_iterative_transpose_fast(r, n, p, nc, v, out, threads, tick)) return 0;
     if (tick && tick->status < 0) return 1;
     if (tick)
-        cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC) *
+        cm_rbf_tick_restart(tick, (double)cm_rbf_sum_passes(nc) *
                                       (double)n * (double)r->m);
     for (int g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
         int gc = nc - g < CM_RBF_SUM_MAX_NC ? nc - g : CM_RBF_SUM_MAX_NC;

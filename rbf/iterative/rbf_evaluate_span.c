@@ -33,44 +33,6 @@
 /* how a column is evaluated: summed, combined, combined with its rest summed */
 enum { SPAN_DIRECT, SPAN_ONLY, SPAN_RES };
 
-/* (diameter of the box around the centres and the points)^3: no phi_ij exceeds it, so
- * |sum_j res_j phi_ij| <= diam^3 sum_j |res_j| at every point */
-static double diam3(const cm_rbf *r, size_t n, const double *p)
-{
-    double d2 = 0.0;
-    for (int d = 0; d < 3; ++d) {
-        double lo = INFINITY, hi = -INFINITY;
-        for (size_t i = 0; i < r->m; ++i) {
-            lo = fmin(lo, r->c[(size_t)d * r->m + i]);
-            hi = fmax(hi, r->c[(size_t)d * r->m + i]);
-        }
-        for (size_t i = 0; i < n; ++i) {
-            lo = fmin(lo, p[(size_t)d * n + i]);
-            hi = fmax(hi, p[(size_t)d * n + i]);
-        }
-        d2 += (hi - lo) * (hi - lo);
-    }
-    return d2 * sqrt(d2);
-}
-
-/* the kernel sums' passes over nw columns */
-static size_t passes(size_t nw) { return (nw + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC; }
-
-/* The direct sums of the nw columns w (m each) into out (n x nw), plain or compensated. */
-static int sums(const cm_rbf *r, const double *w, size_t nw, size_t n, const double *p,
-                int plain, double *out, int threads, cm_rbf_tick *tick)
-{
-    if (nw == 0) return 0;
-    if (plain) return cm_rbf_kernel_sum_all_tick(r, w, (int)nw, n, p, n, out, threads, tick);
-    for (size_t g = 0; g < nw; g += CM_RBF_SUM_MAX_NC) {
-        const int gc = nw - g < CM_RBF_SUM_MAX_NC ? (int)(nw - g) : CM_RBF_SUM_MAX_NC;
-        if (cm_rbf_kernel_sum_acc_tick(r->m, r->c, w + g * r->m, gc, n, p, n, out + g, nw,
-                                       threads, tick))
-            return 1;
-    }
-    return 0;
-}
-
 int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, const double *s,
                                    int kind, double *out, int threads, cm_rbf_tick *tick)
 {
@@ -135,7 +97,7 @@ int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, c
                        : kind == CM_RBF_SUMS_COMPENSATED ? CM_RBF_PHI_ROUND * DBL_EPSILON
                                                          : 0.0;
     const double accept = kind == CM_RBF_SUMS_FAST ? cm_rbf_iterative_fast_accept(r, smax) : 0.0;
-    const double dia3 = diam3(r, n, p);
+    const double dia3 = cm_rbf_diam3(r, n, p);
     size_t nd = nb, nr = 0;
     for (size_t j = 0; j < nw; ++j) {
         const size_t c = col[nb + j];
@@ -176,11 +138,14 @@ int cm_rbf_iterative_evaluate_span(const cm_rbf *r, size_t n, const double *p, c
     /* direct sums (after a treecode that failed its check, a rare case: compensated) */
     if (!fast) {
         if (tick) /* in point-centre pairs, per pass of up to CM_RBF_SUM_MAX_NC columns */
-            cm_rbf_tick_restart(tick, (double)(one ? passes(ns) : passes(nd) + passes(nr)) *
+            cm_rbf_tick_restart(tick, (double)(one ? cm_rbf_sum_passes(ns)
+                                                    : cm_rbf_sum_passes(nd) + cm_rbf_sum_passes(nr)) *
                                           (double)n * (double)m);
-        if (one ? sums(r, wr, ns, n, p, kind == CM_RBF_SUMS_PLAIN, outd, threads, tick)
-                : sums(r, wr, nd, n, p, 0, outd, threads, tick) ||
-                      sums(r, wr + nd * m, nr, n, p, 1, outr, threads, tick))
+        if (one ? cm_rbf_iterative_sum_direct(r, wr, ns, n, p, kind == CM_RBF_SUMS_PLAIN, outd,
+                                              threads, tick)
+                : cm_rbf_iterative_sum_direct(r, wr, nd, n, p, 0, outd, threads, tick) ||
+                      cm_rbf_iterative_sum_direct(r, wr + nd * m, nr, n, p, 1, outr, threads,
+                                                  tick))
             goto done;
     }
     const double *rests = one ? outd + nd : outr;

@@ -1,7 +1,8 @@
-/* Evaluation of an iterative fit by the r^3 treecode (rbf_iter.h, cm_rbf_iterative_sum_fast):
- * where n x m is large, its row chosen for the error it must be shown within, after a pilot
- * that may pick a cheaper row, and its result checked against compensated direct sums at
- * sampled points. */
+/* The sums of an evaluation of an iterative fit for any set of columns (rbf_iter.h): direct
+ * ones (cm_rbf_iterative_sum_direct), or the r^3 treecode (cm_rbf_iterative_sum_fast) where
+ * n x m is large, its row chosen for the error it must be shown within, after a pilot that
+ * may pick a cheaper row, and its result checked against compensated direct sums at sampled
+ * points. */
 #include "rbf_iter.h"
 
 #include <float.h>
@@ -128,7 +129,7 @@ int cm_rbf_iterative_sum_fast(const cm_rbf *r, const double *w, size_t nc, doubl
         const double th = coarse ? theta_c : theta;
         const cm_rbf_tree *t = cm_rbf_iterative_tree(r, o, th);
         if (tick) /* in whole sums; a second row starts over */
-            cm_rbf_tick_restart(tick, (double)((nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC));
+            cm_rbf_tick_restart(tick, (double)cm_rbf_sum_passes(nc));
         if (!t || tree_sum_all(r, wc, t, tg, 1, out, threads, tick)) break;
         const double err = check_all(r, wc, t, n, p, out, CM_RBF_FAST_SAMPLES, NULL, threads);
         it->eval_error = CM_RBF_FAST_SAFETY * err / it->scales.fmax;
@@ -145,4 +146,19 @@ int cm_rbf_iterative_takes_fast(const cm_rbf *r, size_t n)
 {
     const int fs = r->opt.fast_sum;
     return fs == 1 || (fs < 0 && (double)n * (double)r->m >= CM_RBF_FAST_EVAL_PAIRS);
+}
+
+int cm_rbf_iterative_sum_direct(const cm_rbf *r, const double *w, size_t nc, size_t n,
+                                const double *p, int plain, double *out, int threads,
+                                cm_rbf_tick *tick)
+{
+    if (nc == 0) return 0;
+    if (plain) return cm_rbf_kernel_sum_all_tick(r, w, (int)nc, n, p, n, out, threads, tick);
+    for (size_t g = 0; g < nc; g += CM_RBF_SUM_MAX_NC) {
+        const int gc = nc - g < CM_RBF_SUM_MAX_NC ? (int)(nc - g) : CM_RBF_SUM_MAX_NC;
+        if (cm_rbf_kernel_sum_acc_tick(r->m, r->c, w + g * r->m, gc, n, p, n, out + g, nc,
+                                       threads, tick))
+            return 1;
+    }
+    return 0;
 }

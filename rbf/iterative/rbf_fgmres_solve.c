@@ -538,18 +538,7 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
                     : m >= CM_RBF_RELAX_TREE11_M || tu->relax == 2 ? 3
                     : m >= CM_RBF_RELAX_TREE9_M ? 2
                     : m >= CM_RBF_RELAX_TREE_M ? 1 : 0;
-    {
-        double d2 = 0.0;
-        for (int d = 0; d < 3; ++d) {
-            double lo = INFINITY, hi = -INFINITY;
-            for (size_t i = 0; i < m; ++i) {
-                lo = fmin(lo, r->c[(size_t)d * m + i]);
-                hi = fmax(hi, r->c[(size_t)d * m + i]);
-            }
-            d2 += (hi - lo) * (hi - lo);
-        }
-        kr.diam3 = d2 * sqrt(d2);
-    }
+    kr.diam3 = cm_rbf_diam3(r, 0, NULL);
     /* warm starts: each column from the combination of the earlier solutions that fits its
      * data best (rbf_iter.h, cm_rbf_history; tried in the first cycle, kept if it leaves a
      * residual below the data's) */

@@ -131,6 +131,21 @@ struct cm_rbf_iter {
 #define CM_RBF_FAST_SAMPLES 1024
 #define CM_RBF_FAST_SAFETY 4.0
 
+/* The passes of the kernel sums over nc columns (CM_RBF_SUM_MAX_NC at a time) */
+static inline size_t cm_rbf_sum_passes(size_t nc)
+{
+    return (nc + CM_RBF_SUM_MAX_NC - 1) / CM_RBF_SUM_MAX_NC;
+}
+/* (the diameter of the box around the centres and the n points p, 3 x n SoA)^3: no phi_ij
+ * between them exceeds it (rbf_iterative.c) */
+double cm_rbf_diam3(const cm_rbf *r, size_t n, const double *p);
+/* The direct sums of the nc columns w (m each) at the n points p into out (n x nc), plain or
+ * compensated, in passes of CM_RBF_SUM_MAX_NC; tick as the kernel sums'. Nonzero: stopped
+ * (rbf_evaluate_tree.c). */
+int cm_rbf_iterative_sum_direct(const cm_rbf *r, const double *w, size_t nc, size_t n,
+                                const double *p, int plain, double *out, int threads,
+                                cm_rbf_tick *tick);
+
 /* How an evaluation sums the kernel: plain direct sums (the tolerance allows them), compensated
  * ones, or the treecode (rbf_evaluate.c) */
 enum { CM_RBF_SUMS_PLAIN, CM_RBF_SUMS_COMPENSATED, CM_RBF_SUMS_FAST };

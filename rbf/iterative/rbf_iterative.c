@@ -5,12 +5,31 @@
 #include "rbf_iter.h"
 
 #include <lapacke.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 const double *cm_rbf_iterative_q1(const cm_rbf *r) { return r->iter ? r->iter->q1 : NULL; }
 
 const cm_rbf_schwarz *cm_rbf_iterative_pc(const cm_rbf *r) { return r->iter ? r->iter->pc : NULL; }
+
+double cm_rbf_diam3(const cm_rbf *r, size_t n, const double *p)
+{
+    double d2 = 0.0;
+    for (int d = 0; d < 3; ++d) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < r->m; ++i) {
+            lo = fmin(lo, r->c[(size_t)d * r->m + i]);
+            hi = fmax(hi, r->c[(size_t)d * r->m + i]);
+        }
+        for (size_t i = 0; i < n; ++i) {
+            lo = fmin(lo, p[(size_t)d * n + i]);
+            hi = fmax(hi, p[(size_t)d * n + i]);
+        }
+        d2 += (hi - lo) * (hi - lo);
+    }
+    return d2 * sqrt(d2);
+}
 
 int cm_rbf_iterative_scales_begin(cm_rbf *r, size_t nc, double fmax)
 {
