@@ -45,7 +45,8 @@ set_tests_properties(cad_cli_freecad_shoulder_one_step PROPERTIES LABELS "cad;cl
 add_test(NAME cad_cli_freecad_shoulder_one_step_report COMMAND ${CM_PYTHON}
          ${PROJECT_SOURCE_DIR}/tests/surface/check_morph.py report ${FC_WORK}/bracket_2_1.csv rejected)
 set_tests_properties(cad_cli_freecad_shoulder_one_step_report PROPERTIES LABELS "cad;cli"
-                     DEPENDS cad_cli_freecad_shoulder_one_step FIXTURES_REQUIRED cad_freecad_guard)
+                     FIXTURES_REQUIRED cad_freecad_guard)
+cm_test_reads(cad_cli_freecad_shoulder_one_step_report cad_cli_freecad_shoulder_one_step)
 # asked for: --allow-inverted writes the inverted mesh, exit 0 with the warning naming them
 add_test(NAME cad_cli_freecad_shoulder_one_step_allowed COMMAND ${CM_RUN_CLI} --exit 0
          --stderr "warning: [1-9][0-9]* inverted cells? \\(scaled Jacobian <= 0\\); the worst is cell"
@@ -59,8 +60,9 @@ add_test(NAME cad_cli_freecad_shoulder_one_step_allowed_written COMMAND ${CM_RUN
          --stdout "inverted=[1-9][0-9]* cells=" --
          $<TARGET_FILE:cadmorph> quality ${FC_WORK}/bracket_2_allowed.vtu)
 set_tests_properties(cad_cli_freecad_shoulder_one_step_allowed_written PROPERTIES LABELS "cad;cli"
-                     DEPENDS cad_cli_freecad_shoulder_one_step_allowed
                      FIXTURES_REQUIRED cad_freecad_guard)
+cm_test_reads(cad_cli_freecad_shoulder_one_step_allowed_written
+              cad_cli_freecad_shoulder_one_step_allowed)
 # the default (--steps auto): no step length saves the squeezed interior cell, so the rest of
 # the motion is morphed with interior optimisation (a warning) and the mesh is valid;
 # --no-escalate keeps the refusal: exit 3, nothing written

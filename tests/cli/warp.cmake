@@ -24,8 +24,8 @@ cm_warp_cli_test(cli_warp_medit ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
 add_test(NAME cli_warp_output
   COMMAND ${CM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/volume/warp_sphere.py check ${CM_TEST_WORK}
           cli_from_msh.vtu cli_from_vtu.msh cli_from_medit.vtk)
-set_tests_properties(cli_warp_output PROPERTIES LABELS "cli" FIXTURES_REQUIRED warp_sphere
-  DEPENDS "cli_warp_msh;cli_warp_vtu;cli_warp_medit")
+set_tests_properties(cli_warp_output PROPERTIES LABELS "cli" FIXTURES_REQUIRED warp_sphere)
+cm_test_reads(cli_warp_output cli_warp_msh cli_warp_vtu cli_warp_medit)
 
 # bad tables: exit 2, one stderr line naming file:line, no output written
 foreach(case header:1 columns:3 number:2 node:4 range:3 duplicate:4 nan:2 inf:3)

@@ -32,11 +32,13 @@ foreach(mesh tets hexes)
   add_test(NAME cli_warp_femwarp_scipy_${mesh}
     COMMAND ${CHK} femwarp ${CM_TEST_WORK} ${mesh} ${SW}/cli_femwarp_${mesh}.vtu)
   set_tests_properties(cli_warp_femwarp_scipy_${mesh} PROPERTIES LABELS "cli;volume"
-    FIXTURES_REQUIRED warp_staten DEPENDS cli_warp_femwarp_${mesh})
+    FIXTURES_REQUIRED warp_staten)
+  cm_test_reads(cli_warp_femwarp_scipy_${mesh} cli_warp_femwarp_${mesh})
 endforeach()
 add_test(NAME cli_warp_methods_affine COMMAND ${CHK} affine ${SW}/tets.msh ${affine_outputs})
 set_tests_properties(cli_warp_methods_affine PROPERTIES LABELS "cli;volume"
-  FIXTURES_REQUIRED warp_staten DEPENDS "${affine_tests}")
+  FIXTURES_REQUIRED warp_staten)
+cm_test_reads(cli_warp_methods_affine ${affine_tests})
 
 add_test(NAME cli_warp_method_unknown
   COMMAND ${RUN} --exit 1 --stderr "unknown method 'femwrap' \\(rbf\\|rbf-biharmonic\\|femwarp\\|lbwarp\\|simplex"

@@ -18,8 +18,7 @@ if(CADMORPH_WITH_PETSC)
   set_tests_properties(cli_warp_petsc_2ranks cli_warp_petsc_serial cli_warp_petsc_same
     PROPERTIES LABELS "cli;petsc" FIXTURES_REQUIRED warp_sphere
     ENVIRONMENT "OMPI_ALLOW_RUN_AS_ROOT=1;OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1")
-  set_tests_properties(cli_warp_petsc_same PROPERTIES
-    DEPENDS "cli_warp_petsc_2ranks;cli_warp_petsc_serial")
+  cm_test_reads(cli_warp_petsc_same cli_warp_petsc_2ranks cli_warp_petsc_serial)
 else()
   add_test(NAME cli_warp_petsc_missing
     COMMAND ${CM_RUN_CLI} --exit 1 --stderr "built without PETSc .*-DCADMORPH_WITH_PETSC=ON"

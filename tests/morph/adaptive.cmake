@@ -37,7 +37,7 @@ set_tests_properties(cli_morph_one_step_inverts cli_morph_one_step_refused
 cm_adaptive_cli(cli_morph_one_step_partial_is_m0 ${CM_PYTHON}
   ${PROJECT_SOURCE_DIR}/tests/cli/compare_moved.py ${AW}/hole_0.msh ${AW}/one_step_partial.vtu
   0 diagonal)
-set_tests_properties(cli_morph_one_step_partial_is_m0 PROPERTIES DEPENDS cli_morph_one_step_partial)
+cm_test_reads(cli_morph_one_step_partial_is_m0 cli_morph_one_step_partial)
 # asked for (--allow-inverted): written, exit 0, and one warning line naming the count and the
 # worst cell (the summary line alone is easy to miss)
 cm_adaptive_cli(cli_morph_one_step_warns ${CM_RUN_CLI} --exit 0 --stderr-lines 1
@@ -47,7 +47,7 @@ cm_adaptive_cli(cli_morph_one_step_warns ${CM_RUN_CLI} --exit 0 --stderr-lines 1
 cm_adaptive_cli(cli_morph_auto ${CM_RUN_CLI} --exit 0 --stdout "${CLEAN}" --
   ${MORPH_MOVED} -o ${AW}/auto.vtu --steps auto --report ${AW}/auto.csv)
 cm_adaptive_cli(cli_morph_auto_report ${CHECK} report ${AW}/auto.csv auto+2)
-set_tests_properties(cli_morph_auto_report PROPERTIES DEPENDS cli_morph_auto)
+cm_test_reads(cli_morph_auto_report cli_morph_auto)
 cm_adaptive_cli(cli_morph_auto_optimize ${CM_RUN_CLI} --exit 0 --stdout "${CLEAN}" --
   ${MORPH_MOVED} -o ${AW}/auto_opt.vtu --steps auto --optimize)
 
@@ -59,7 +59,7 @@ add_test(NAME cli_morph_auto_easy COMMAND ${CM_RUN_CLI} --exit 0 --stdout "${CLE
 set_tests_properties(cli_morph_auto_easy PROPERTIES LABELS cli
   FIXTURES_REQUIRED "adaptive;surface_meshes")
 cm_adaptive_cli(cli_morph_auto_easy_report ${CHECK} report ${AW}/easy.csv 1)
-set_tests_properties(cli_morph_auto_easy_report PROPERTIES DEPENDS cli_morph_auto_easy)
+cm_test_reads(cli_morph_auto_easy_report cli_morph_auto_easy)
 
 # forced by the boundary: exit 3, the worst cell named, nothing written; --keep-partial writes
 # the last valid mesh (no inverted cell) and the report has the rejected steps
@@ -72,7 +72,7 @@ cm_adaptive_cli(cli_morph_auto_partial ${CM_RUN_CLI} --exit 3 --stderr "no valid
   ${MORPH_TILT} -o ${AW}/partial.vtu --keep-partial --report ${AW}/partial.csv)
 cm_adaptive_cli(cli_morph_auto_partial_valid ${CM_RUN_CLI} --exit 0 --stdout "${CLEAN}" --
   $<TARGET_FILE:cadmorph> quality ${AW}/partial.vtu)
-set_tests_properties(cli_morph_auto_partial_valid PROPERTIES DEPENDS cli_morph_auto_partial)
+cm_test_reads(cli_morph_auto_partial_valid cli_morph_auto_partial)
 cm_adaptive_cli(cli_morph_keep_partial_allow_inverted ${CM_RUN_CLI} --exit 1
   --stderr "--keep-partial .* and --allow-inverted .*: one or the other" --
   $<TARGET_FILE:cadmorph> morph --from ${AW}/tilt_0.step --to ${AW}/tilt_15.step

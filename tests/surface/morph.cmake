@@ -25,7 +25,7 @@ foreach(case hole:vtu holes2:msh cyl:vtk sphere:vtu cone:mesh torus:msh)
     --mesh ${SW}/${m}_a.msh -o ${SW}/cli_${m}.${ext} --fail-on-inverted)
   cm_morph_cli(cli_morph_${m}_on_g1 ${CHECK} ongeom ${SW}/${m}_a.msh ${SW}/cli_${m}.${ext}
     ${SD}/${m}_b.step 1e-9)
-  set_tests_properties(cli_morph_${m}_on_g1 PROPERTIES DEPENDS cli_morph_${m})
+  cm_test_reads(cli_morph_${m}_on_g1 cli_morph_${m})
 endforeach()
 
 # second order: mid-edge nodes are boundary nodes too
@@ -34,7 +34,7 @@ cm_morph_cli(cli_morph_cyl_o2 ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
   --mesh ${SW}/cyl_a_o2.msh -o ${SW}/cli_cyl_o2.vtu)
 cm_morph_cli(cli_morph_cyl_o2_on_g1 ${CHECK} ongeom ${SW}/cyl_a_o2.msh ${SW}/cli_cyl_o2.vtu
   ${SD}/cyl_b.step 1e-9)
-set_tests_properties(cli_morph_cyl_o2_on_g1 PROPERTIES DEPENDS cli_morph_cyl_o2)
+cm_test_reads(cli_morph_cyl_o2_on_g1 cli_morph_cyl_o2)
 
 # increments, the other kernel, a report with one row per step
 cm_morph_cli(cli_morph_steps ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
@@ -42,7 +42,7 @@ cm_morph_cli(cli_morph_steps ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
   --mesh ${SW}/hole_a.msh -o ${SW}/cli_steps.msh --steps 3 --kernel biharmonic --threads 1
   --report ${SW}/cli_steps.csv)
 cm_morph_cli(cli_morph_steps_report ${CHECK} report ${SW}/cli_steps.csv 3)
-set_tests_properties(cli_morph_steps_report PROPERTIES DEPENDS cli_morph_steps)
+cm_test_reads(cli_morph_steps_report cli_morph_steps)
 
 # the baseline inverts cells on the bore edit in one step: exit 3, nothing written
 cm_morph_cli(cli_morph_fail_on_inverted ${CM_RUN_CLI} --exit 3 --stderr-lines 1
@@ -104,7 +104,7 @@ cm_morph_cli(cli_morph_via ${CM_RUN_CLI} --exit 0 --stdout "${SUMMARY}" --
   --mesh ${SW}/hole_a.msh -o ${SW}/cli_via.vtu --relative --via ${SD}/hole_b.step
   --steps 2 --report ${SW}/cli_via.csv)
 cm_morph_cli(cli_morph_via_report ${CHECK} report ${SW}/cli_via.csv 4)
-set_tests_properties(cli_morph_via_report PROPERTIES DEPENDS cli_morph_via)
+cm_test_reads(cli_morph_via_report cli_morph_via)
 cm_morph_cli(cli_morph_via_topology ${CM_RUN_CLI} --exit 2 --stderr-lines 1
   --stderr "^cadmorph morph: .*hole_b.step and .*holes2_a.step do not correspond"
   --absent ${SW}/cli_bad5.vtu --
@@ -120,7 +120,7 @@ cm_morph_cli(cli_morph_solver_iterative ${CM_RUN_CLI} --exit 0 --stdout "${SUMMA
   --mesh ${SW}/hole_a.msh -o ${SW}/cli_solver.vtu --solver iterative)
 cm_morph_cli(cli_morph_solver_on_g1 ${CHECK} ongeom ${SW}/hole_a.msh ${SW}/cli_solver.vtu
   ${SD}/hole_b.step 1e-9)
-set_tests_properties(cli_morph_solver_on_g1 PROPERTIES DEPENDS cli_morph_solver_iterative)
+cm_test_reads(cli_morph_solver_on_g1 cli_morph_solver_iterative)
 cm_morph_cli(cli_morph_bad_solver ${CM_RUN_CLI} --exit 1 --stderr "unknown solver 'fast'" --
   $<TARGET_FILE:cadmorph> morph --from ${SD}/hole_a.step --to ${SD}/hole_b.step
   --mesh ${SW}/hole_a.msh -o ${SW}/x.vtu --solver fast)
