@@ -516,6 +516,26 @@ static int step_products(const cm_rbf *r, krylov *kr, int n, const int *list, do
     return na;
 }
 
+/* The solve's progress (stage "rbf solve", in columns): each of the ns columns sel[] counts
+ * log(its residual) / log(its tolerance) done (from zero 0, converged 1; a warm start comes
+ * in part done), those of the groups before it whole; never less than shown before (an
+ * exact residual after a restart may lie above GMRES's estimate). Why not iterations: how
+ * many a solve takes is not known ahead, while its residual falls about geometrically. */
+static cm_status solve_progress(cm_context *ctx, krylov *kr, int ns, const int *sel)
+{
+    double done = (double)kr->before;
+    for (int s = 0; s < ns; ++s) {
+        const kcol *k = &kr->col[sel[s]];
+        /* the cycle's start residual, less what GMRES has taken of it since */
+        double res = k->res;
+        if (k->jn > 0 && k->cycle0 > 0.0) res *= fabs(k->gv[k->jn]) / k->cycle0;
+        done += k->state != 0 || res <= k->tol ? 1.0
+                : res >= 1.0 || !(k->tol > 0.0) ? 0.0 : log(res) / log(k->tol);
+    }
+    if (done > kr->shown) kr->shown = fmin(done, (double)kr->all);
+    return cm_progress(ctx, "rbf solve", kr->shown, (double)kr->all);
+}
+
 /* Solves the ns columns sel[] of f (g x m SoA) into w + kr->wlo (high and low parts), each
  * to its own col[c].tol relative to col[c].fnorm; a column with col[c].warm starts from the
  * w it holds if that leaves a residual below |f_c| (else from zero, and warm is cleared).
@@ -687,12 +707,8 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             precondition(r, kr, na, in, out, threads);
             /* between the preconditioner and the product too: each is 0.1-0.5 s from 10^5
              * centres (the caller may stop; w is its scratch) */
-            {
-                int most = 0;
-                for (int c = 0; c < kr->g; ++c) most = kr->col[c].iters > most ? kr->col[c].iters : most;
-                cm_status ps = cm_progress(ctx, "rbf solve", (double)most, (double)o->max_iterations);
-                if (ps < 0) return ps;
-            }
+            cm_status ps = solve_progress(ctx, kr, ns, sel);
+            if (ps < 0) return ps;
             if (!kr->relax) cm_krylov_matvec(r, kr, na, out, p3, threads);
             else relaxed_products(ctx, r, kr, cycle, j, na, act, out, p3, threads);
             int keep = 0;
@@ -745,10 +761,7 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
             }
             na = keep;
             /* one preconditioned product per column and iteration done */
-            int most = 0;
-            for (int c = 0; c < kr->g; ++c) most = kr->col[c].iters > most ? kr->col[c].iters : most;
-            cm_status ps = cm_progress(ctx, "rbf solve", (double)most, (double)o->max_iterations);
-            if (ps < 0) return ps;
+            if ((ps = solve_progress(ctx, kr, ns, sel)) < 0) return ps;
         }
         /* w += Z y, H y = g (upper triangular after the rotations) */
         for (int u = 0; u < n; ++u) {

@@ -503,6 +503,7 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
     memset(&kr, 0, sizeof kr);
     kr.m = m;
     kr.R = R;
+    kr.all = nc;
     double *aw = malloc(nc * m * sizeof *aw);
     int *col_iters = realloc(r->iter->col_iters, nc * sizeof *col_iters);
     if (col_iters) {
@@ -551,6 +552,7 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
         const int g = nc - c0 < gsize ? (int)(nc - c0) : (int)gsize;
         const int gall = kr.g;
         kr.g = g;
+        kr.before = c0;
         ++groups;
         const double tg = cm_wtime();
         const int mv0 = mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST];
@@ -637,6 +639,14 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
         const int sampled = gworst <= o->tolerance && o->tolerance < CM_RBF_PLAIN_RES_TOL;
         floor_max = fmax(floor_max, s_pass(r, &kr, w, c0, g, scales, sampled, fmax_all,
                                            threads));
+    }
+    /* the end (a column met at a restart's check took no step that reported it) */
+    if (kr.shown < (double)nc) {
+        const cm_status ps = cm_progress(ctx, "rbf solve", (double)nc, (double)nc);
+        if (ps < 0) {
+            st = ps;
+            goto done;
+        }
     }
     r->stats.iterations = maxit;
     r->stats.matvecs = mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST];

@@ -82,6 +82,8 @@ typedef struct krylov {
     int relax_tree; /* the loose treecodes 0..relax_tree-1 may serve them */
     double diam3;   /* diam^3 of the centres: S(z) <= diam3 sum |z| */
     int *mv;        /* products by kind (MV_COMP, MV_PLAIN, MV_FAST) */
+    size_t before, all; /* the solve's progress: columns of the groups before this one, all */
+    double shown;       /* the progress reported so far (in columns) */
 } krylov;
 
 /* v -= Q1 (Q1' v), twice (the second pass removes what round-off left of the first). */

@@ -63,7 +63,8 @@ cm_add_unit_test(test_rbf_interrupt ${CMAKE_CURRENT_LIST_DIR}/test_rbf_interrupt
 # iterative with direct and treecode sums; merged duplicates), iterative against dense
 cm_add_unit_test(test_rbf_transpose ${CMAKE_CURRENT_LIST_DIR}/test_rbf_transpose.c LIBS cm_rbf_internal LABELS rbf)
 # many right-hand sides in one iterative solve against each alone (direct and treecode
-# sums), a slow column beside smooth ones, warm starts, columns in groups of a memory budget
+# sums), a slow column beside smooth ones, warm starts, columns in groups of a memory budget,
+# the solve's progress in columns
 cm_add_unit_test(test_rbf_batch ${CMAKE_CURRENT_LIST_DIR}/test_rbf_batch.c LIBS cm_rbf_internal LABELS rbf)
 # the Schwarz preconditioner's dense arithmetic for a batch of columns (local rows, coarse
 # solves) against plain references, each column the same bits whatever its batch

@@ -2,7 +2,8 @@
  * its solve alone (weights, evaluation and iteration count), a slowly converging column
  * does not hold back the others, warm starts from the fit's history of solutions (its cap,
  * and in the refinement of fast sums), the columns solved in groups when the Krylov
- * storage exceeds its budget, and in warm groups (options warm_groups). */
+ * storage exceeds its budget, and in warm groups (options warm_groups), the solve's progress
+ * counted in columns. */
 #include "cadmorph/rbf.h"
 #include "rbf_internal.h"
 #include "rbf_tuning.h"
@@ -153,6 +154,26 @@ static double data_miss(cm_context *ctx, const cm_rbf *r, size_t m_in, const dou
 typedef struct {
     int s_summed, at_once, arnoldi;
 } check_log;
+
+/* The reports of stage "rbf solve": how many, the last done, whether done ever fell,
+ * whether any came inside the first group (0 < done < first) and inside the last (last_from
+ * < done < columns), and a total other than the solve's columns. */
+typedef struct progress_seen {
+    int n, fell, inside, late, other_total;
+    double first_group, last_from, columns, last;
+} progress_seen;
+
+static void see_progress(void *user, const char *stage, double done, double total)
+{
+    progress_seen *ps = user;
+    if (strcmp(stage, "rbf solve") != 0) return;
+    ps->fell |= ps->n > 0 && done < ps->last;
+    ps->inside |= done > 0.0 && done < ps->first_group;
+    ps->late |= done > ps->last_from && done < ps->columns;
+    ps->other_total |= total != ps->columns;
+    ps->last = done;
+    ++ps->n;
+}
 
 static void count_checks(void *user, cm_log_level level, const char *msg)
 {
@@ -446,7 +467,16 @@ int main(void)
                     vf[i * NC + (size_t)(3 * k + e)] = (1.0 + 0.1 * k) * df[3 * i + (size_t)e];
         }
         const int smooth[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+        /* its progress: in columns, never back, within the cold group too, to the end */
+        progress_seen ps = {.first_group = 3.0, .last_from = 6.0, .columns = 9.0};
+        cm_context_set_progress(ctx, see_progress, &ps);
         solved g = solve_cols(ctx, rg, m, vf, 9, smooth);
+        cm_context_set_progress(ctx, NULL, NULL);
+        printf("warm groups' progress: %d reports, last %g of 9, inside the first group %s, "
+               "the last %s, %s\n", ps.n, ps.last, ps.inside ? "yes" : "no",
+               ps.late ? "yes" : "no", ps.fell ? "fell" : "never fell");
+        CHECK(ps.n >= 3 && !ps.fell && ps.inside && ps.late && !ps.other_total &&
+              ps.last == 9.0);
         int its[3] = {0, 0, 0};
         printf("warm groups: %d groups, %d columns warm, iterations", g.st.column_groups,
                g.st.warm_columns);
