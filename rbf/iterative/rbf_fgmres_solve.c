@@ -736,6 +736,7 @@ cm_status cm_rbf_iterative_solve(cm_context *ctx, cm_rbf *r, size_t nc, const do
         memcpy(fp + i * d * m, f + order[i] * d * m, d * m * sizeof *fp);
     cm_status st = solve_in_order(ctx, r, nc, fp, wp, qp, threads);
     if (st == CM_OK || st == CM_WARNING) {
+        r->stats.memory_bytes += (2 * nc * m + nc * k) * sizeof(double); /* the copies */
         for (size_t i = 0; i < nf; ++i) {
             memcpy(w + order[i] * d * m, wp + i * d * m, d * m * sizeof *w);
             memcpy(q + order[i] * d * k, qp + i * d * k, d * k * sizeof *q);
