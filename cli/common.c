@@ -51,10 +51,16 @@ static void format_duration(double sec, char *buf, size_t size)
 }
 
 /* "study 3/20 variants, last 4.1 s per variant, about 1m20s left": the time left from the
- * mean time per variant so far (variants of one study cost about the same). */
+ * mean time per variant so far (variants of one study cost about the same). Before the first
+ * batch is done, the time it has run ("1m12s so far"): one batch may be the whole study. */
 static void draw_study(cli_sink *s, double now)
 {
-    char left[48] = "estimating the time left", last[48] = "";
+    char left[64] = "estimating the time left", last[48] = "";
+    if (s->study_done <= 0 && now - s->study_start >= 1.0) {
+        char d[24];
+        format_duration(now - s->study_start, d, sizeof d);
+        snprintf(left, sizeof left, "%s so far, estimating the time left", d);
+    }
     if (s->study_done > 0) {
         char d[24];
         format_duration((now - s->study_start) / s->study_done * (s->study_total - s->study_done),
