@@ -560,10 +560,12 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
         k->exact = 0;
         k->comp_only = 0;
         k->jn = 0;
-        k->has_aw = 0;
+        k->has_aw = k->warm && k->preset; /* its start's A w given, within cb */
         if (!k->warm) memset(w + (size_t)c * m, 0, m * sizeof(double));
-        memset(aw + (size_t)c * m, 0, m * sizeof(double));
-        memset(kr->wlo + (size_t)c * m, 0, m * sizeof(double));
+        if (!k->has_aw) {
+            memset(aw + (size_t)c * m, 0, m * sizeof(double));
+            memset(kr->wlo + (size_t)c * m, 0, m * sizeof(double));
+        }
     }
     for (int cycle = 0;; ++cycle) {
         int n = 0;
@@ -631,7 +633,9 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
                 if (rn < fn) k->warm_res = rn / fn, k->took = 1;
                 else {
                     k->warm = 0;
+                    k->cb = 0.0;
                     memset(w + (size_t)c * m, 0, m * sizeof(double));
+                    memset(kr->wlo + (size_t)c * m, 0, m * sizeof(double));
                     memset(ax, 0, m * sizeof(double));
                     rn = cm_krylov_residual(r, m, fc, ax, rv);
                 }

@@ -546,7 +546,9 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
     cm_rbf_history *hist = o->warm_start && r->warm_ok ? history_of(r) : NULL;
     size_t basis = 0;
     int maxit = 0, floor_hit = 0, stagnated = 0, maxed = 0, steps = 0, direct = 0, groups = 0;
-    int nwarm = 0;
+    int nwarm = 0, exact = 0;
+    cm_rbf_exact_starts es;
+    memset(&es, 0, sizeof es);
     double floor_max = 0.0, first = 0.0, warm_worst = 0.0, worst = 0.0;
     for (size_t c0 = 0; c0 < nc; c0 += gsize) {
         const int g = nc - c0 < gsize ? (int)(nc - c0) : (int)gsize;
@@ -573,6 +575,18 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
             kc->sbound = kc->slow = -1.0;
             kc->took = 0;
             kc->warm_res = 0.0;
+            kc->preset = 0;
+            if (es.n > 0) { /* a start whose product is known: taken if known well enough */
+                const double b = cm_rbf_exact_start(r, &es, f + o0, w + o0,
+                                                    kr.wlo + (size_t)c * m, aw + o0);
+                if (b >= 0.0 && b <= CM_RBF_PLAIN_RES_SHARE * kc->tol * kc->fnorm) {
+                    kc->warm = kc->preset = 1;
+                    kc->cb = b / kc->fnorm;
+                    kc->smax = kc->smin = -1.0;
+                    ++exact;
+                    continue;
+                }
+            }
             if (basis > 0) {
                 double *pf = kc->v; /* scratch until the solve */
                 memcpy(pf, f + o0, m * sizeof *pf);
@@ -595,12 +609,19 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
                                  threads);
                 free(sel);
             }
+            /* the first group's weights and products, the later groups' starts where their
+             * checks would be compensated (rbf_exact_start.c) */
+            if (st == CM_OK && c0 == 0 && (size_t)g < nc && hist &&
+                o->tolerance < CM_RBF_PLAIN_RES_TOL)
+                cm_rbf_exact_starts_make(r, &kr, g, w, kr.wlo, aw, &es);
             for (size_t i = 0; i < (size_t)g * m; ++i) w[c0 * m + i] += kr.wlo[i];
         }
         kr.g = gall;
         if (st != CM_OK) goto done;
-        cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: group %d: %d columns, %d products, %.3f s",
-               groups, g, mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST] - mv0, cm_wtime() - tg);
+        cm_log(ctx, CM_LOG_DEBUG, "cm_rbf_solve: group %d: %d columns, %d products, %.3f s; %d "
+               "starts from the first group's products, unchecked", groups, g,
+               mvk[MV_COMP] + mvk[MV_PLAIN] + mvk[MV_FAST] - mv0, cm_wtime() - tg, exact);
+        exact = 0;
         /* the group's solutions join the history (their exact products: a pair is right
          * whatever the residual of its solve), so the next group starts from them, but for
          * those that took no step: such a w is the history's own combination, so what
@@ -669,7 +690,7 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
                             cm_rbf_tree_bytes(r->iter->rtree[0]) +
                             cm_rbf_tree_bytes(r->iter->rtree[1]) +
                             cm_rbf_tree_bytes(r->iter->rtree[2]) +
-                            cm_rbf_history_bytes(r->iter->hist);
+                            cm_rbf_history_bytes(r->iter->hist) + cm_rbf_exact_starts_bytes(&es);
     r->stats.column_groups = groups;
     r->stats.warm_columns = nwarm;
     r->stats.warm_residual = warm_worst;
@@ -681,6 +702,7 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
                       stagnated ? "stagnated" : maxed ? "reached max_iterations" : "stopped",
                       maxit, worst, o->tolerance, floor_max);
 done:
+    cm_rbf_exact_starts_free(&es);
     krylov_free(&kr);
     free(aw);
     return st;

@@ -58,6 +58,8 @@ typedef struct kcol {
     int state;      /* 0 running, 1 converged, 2 floor, 3 stagnated, 4 max iterations */
     int jn, iters;
     int warm;       /* in: w holds a start to try */
+    int preset;     /* in (with warm): the start's A w is in aw and its low part in wlo,
+                     * within cb (cm_rbf_exact_start): no check of the start */
     int took;       /* the start was taken (set by the solve, cleared by the caller) */
     double warm_res; /* |f - A w0| / |f| of a start taken */
     /* the refinement (fast sums) */
@@ -121,5 +123,36 @@ int cm_krylov_matvec_kind(const cm_rbf *r, krylov *kr, int kind, int lev, int n,
  * the status of a progress report that said stop. */
 cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, const double *f,
                                 int ns, const int *sel, double *w, double *aw, int threads);
+
+/* The first group's solutions with the products its solve ended on, from which the later
+ * warm groups start with a residual known without a pass (rbf_exact_start.c). Why: at a
+ * tolerance below CM_RBF_PLAIN_RES_TOL a warm start is checked by a compensated product of
+ * its column, about 45 % of a warm group of 15 columns on the bore (20.6k centres); a
+ * combination of solutions whose products are known within the solve's own bounds (cb) has
+ * the combination of those products as its own, within their bounds times its coefficients
+ * (on the bore 2e-14..7e-12 of the data, against a tolerance of 1e-10). */
+typedef struct cm_rbf_exact_starts {
+    size_t m;
+    int n;                   /* columns kept (0: none) */
+    double *whi, *wlo, *aw;  /* n x m each: the weights' high and low parts, A (whi + wlo) */
+    double *err;             /* n: bound on |A (whi + wlo) - aw|_inf */
+    double *qr, *tau;        /* LAPACK's QR of Pi aw (m x n), its reflectors' factors */
+    double diam3;            /* diam^3 of the centres: phi_ij <= diam3 */
+} cm_rbf_exact_starts;
+#define CM_RBF_EXACT_MAX 64 /* the most columns kept */
+
+/* Keeps the n columns whi + wlo (m each: the first group's weights, the group's columns of
+ * kr) and their products aw with the bounds the group's solve kept on them. 0, or -1 out of
+ * memory, for more than CM_RBF_EXACT_MAX columns, or when their projected products are
+ * nearly dependent (es->n = 0: no exact starts). */
+int cm_rbf_exact_starts_make(const cm_rbf *r, const krylov *kr, int n, const double *whi,
+                             const double *wlo, const double *aw, cm_rbf_exact_starts *es);
+void cm_rbf_exact_starts_free(cm_rbf_exact_starts *es);
+size_t cm_rbf_exact_starts_bytes(const cm_rbf_exact_starts *es);
+/* The start of a column with data f (m): the combination of the kept columns whose product
+ * fits Pi f best, as whi + wlo (m each), its product aw (m); returns the bound on
+ * |A (whi + wlo) - aw|_inf, or -1 out of memory. */
+double cm_rbf_exact_start(const cm_rbf *r, const cm_rbf_exact_starts *es, const double *f,
+                          double *whi, double *wlo, double *aw);
 
 #endif
