@@ -10,9 +10,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Kept columns whose QR has a diagonal below this share of its largest are nearly dependent:
- * their coefficients would be large and so would the bound, so none are kept. */
-#define CM_RBF_EXACT_RANK 1e-10
+/* Columns that the pivoted QR of the kept products finds within this share of its largest
+ * diagonal of the span of those before them are left out: their coefficients would be large,
+ * and so would the bound (a family whose fields are nearly proportional, as the bracket's). */
+#define CM_RBF_EXACT_RANK 1e-8
 
 void cm_rbf_exact_starts_free(cm_rbf_exact_starts *es)
 {
@@ -58,19 +59,20 @@ int cm_rbf_exact_starts_make(const cm_rbf *r, const krylov *kr, int n, const dou
                      4.0 * DBL_EPSILON * cm_krylov_norm_inf(m, es->aw + (size_t)c * m);
     memcpy(es->qr, es->aw, nm * sizeof *es->qr);
     for (int c = 0; c < n; ++c) cm_krylov_project(r->iter->q1, m, r->k, es->qr + (size_t)c * m);
-    lapack_int info = LAPACKE_dgeqrf(LAPACK_COL_MAJOR, (lapack_int)m, n, es->qr, (lapack_int)m,
-                                     es->tau);
-    double dmax = 0.0, dmin = INFINITY;
-    for (int c = 0; info == 0 && c < n; ++c) {
-        const double d = fabs(es->qr[(size_t)c * m + (size_t)c]);
-        dmax = fmax(dmax, d);
-        dmin = fmin(dmin, d);
-    }
-    if (info != 0 || !(dmin > CM_RBF_EXACT_RANK * dmax)) {
+    lapack_int jpvt[CM_RBF_EXACT_MAX] = {0};
+    lapack_int info = LAPACKE_dgeqp3(LAPACK_COL_MAJOR, (lapack_int)m, n, es->qr, (lapack_int)m,
+                                     jpvt, es->tau);
+    int rank = 0;
+    while (info == 0 && rank < n &&
+           fabs(es->qr[(size_t)rank * m + (size_t)rank]) > CM_RBF_EXACT_RANK * fabs(es->qr[0]))
+        ++rank;
+    if (rank == 0) {
         cm_rbf_exact_starts_free(es);
         return -1;
     }
+    for (int j = 0; j < rank; ++j) es->col[j] = (int)jpvt[j] - 1;
     es->n = n;
+    es->rank = rank;
     return 0;
 }
 
@@ -83,19 +85,18 @@ double cm_rbf_exact_start(const cm_rbf *r, const cm_rbf_exact_starts *es, const 
     if (!y) return -1.0;
     memcpy(y, f, m * sizeof *y);
     cm_krylov_project(r->iter->q1, m, r->k, y);
-    /* c = R^-1 (Q' Pi f)[0..n) */
-    if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', (lapack_int)m, 1, n, es->qr, (lapack_int)m,
-                       es->tau, y, (lapack_int)m) != 0 ||
-        LAPACKE_dtrtrs(LAPACK_COL_MAJOR, 'U', 'N', 'N', n, 1, es->qr, (lapack_int)m, y,
+    /* over the rank independent columns col[]: c = R^-1 (Q' Pi f)[0..rank), the others 0 */
+    const int rank = es->rank;
+    if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', (lapack_int)m, 1, rank, es->qr,
+                       (lapack_int)m, es->tau, y, (lapack_int)m) != 0 ||
+        LAPACKE_dtrtrs(LAPACK_COL_MAJOR, 'U', 'N', 'N', rank, 1, es->qr, (lapack_int)m, y,
                        (lapack_int)m) != 0) {
         free(y);
         return -1.0;
     }
-    double c[CM_RBF_EXACT_MAX], bound = 0.0;
-    for (int j = 0; j < n; ++j) {
-        c[j] = y[j];
-        bound += fabs(c[j]) * es->err[j];
-    }
+    double c[CM_RBF_EXACT_MAX] = {0.0}, bound = 0.0;
+    for (int j = 0; j < rank; ++j) c[es->col[j]] = y[j];
+    for (int j = 0; j < n; ++j) bound += fabs(c[j]) * es->err[j];
     free(y);
     /* whi + wlo = sum c_j (whi_j + wlo_j) in double-double (each term by TwoProduct, their sum
      * by TwoSum), off the exact combination by a few eps^2 sum |c_j whi_j| per entry; aw =

@@ -131,20 +131,22 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
  * combination of solutions whose products are known within the solve's own bounds (cb) has
  * the combination of those products as its own, within their bounds times its coefficients
  * (on the bore 2e-14..7e-12 of the data, against a tolerance of 1e-10). */
+#define CM_RBF_EXACT_MAX 64 /* the most columns kept */
 typedef struct cm_rbf_exact_starts {
     size_t m;
     int n;                   /* columns kept (0: none) */
     double *whi, *wlo, *aw;  /* n x m each: the weights' high and low parts, A (whi + wlo) */
     double *err;             /* n: bound on |A (whi + wlo) - aw|_inf */
-    double *qr, *tau;        /* LAPACK's QR of Pi aw (m x n), its reflectors' factors */
+    double *qr, *tau;        /* LAPACK's pivoted QR of Pi aw (m x n), its reflectors' factors */
+    int rank;                /* the columns it found independent: col[0..rank) */
+    int col[CM_RBF_EXACT_MAX];
     double diam3;            /* diam^3 of the centres: phi_ij <= diam3 */
 } cm_rbf_exact_starts;
-#define CM_RBF_EXACT_MAX 64 /* the most columns kept */
 
 /* Keeps the n columns whi + wlo (m each: the first group's weights, the group's columns of
- * kr) and their products aw with the bounds the group's solve kept on them. 0, or -1 out of
- * memory, for more than CM_RBF_EXACT_MAX columns, or when their projected products are
- * nearly dependent (es->n = 0: no exact starts). */
+ * kr) and their products aw with the bounds the group's solve kept on them; the starts
+ * combine those the pivoted QR of the products finds independent. 0, or -1 out of memory or
+ * for more than CM_RBF_EXACT_MAX columns (es->n = 0: no exact starts). */
 int cm_rbf_exact_starts_make(const cm_rbf *r, const krylov *kr, int n, const double *whi,
                              const double *wlo, const double *aw, cm_rbf_exact_starts *es);
 void cm_rbf_exact_starts_free(cm_rbf_exact_starts *es);
