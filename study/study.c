@@ -492,7 +492,9 @@ static void study_free(study *w)
  * flattened by 60 columns, the same section). Memory per variant: for each of its 3 columns
  * of an iterative RBF solve the Krylov storage, (2 restart + 9) doubles per boundary node
  * (rbf.h, cm_rbf_solve; the default restart, 40), while its group solves (one in
- * CM_STUDY_WARM_GROUPS at a time: counted for all, a margin), and its columns' data and
+ * CM_STUDY_WARM_GROUPS at a time: counted for all, a margin that also holds the first group's
+ * weights and products kept for the later groups' starts, 4 doubles per boundary node and
+ * column of that group), and its columns' data and
  * weights once more in the order the groups take them; the apply's fields, the evaluation's
  * values, the result and, where the evaluation goes through the span of others, the summed
  * and the combined columns' values (3 doubles per node each); its loaded model (a few MB:
