@@ -4,6 +4,7 @@
  * in double-double so that its product is the same combination of theirs, within a bound. */
 #include "rbf_krylov.h"
 
+#include <cblas.h>
 #include <float.h>
 #include <lapacke.h>
 #include <math.h>
@@ -36,7 +37,6 @@ int cm_rbf_exact_starts_make(const cm_rbf *r, const krylov *kr, int n, const dou
     const size_t m = r->m, nm = (size_t)n * m;
     memset(es, 0, sizeof *es);
     es->m = m;
-    es->diam3 = kr->diam3;
     if (n <= 0 || n > CM_RBF_EXACT_MAX) return -1;
     es->whi = malloc(3 * nm * sizeof *es->whi);
     es->err = malloc(2 * (size_t)n * sizeof *es->err);
@@ -51,12 +51,18 @@ int cm_rbf_exact_starts_make(const cm_rbf *r, const krylov *kr, int n, const dou
     memcpy(es->whi, whi, nm * sizeof *whi);
     memcpy(es->wlo, wlo, nm * sizeof *wlo);
     memcpy(es->aw, aw, nm * sizeof *aw);
-    /* the solve's own account of its last A w: within cb of the column's scale (a check by
-     * the Arnoldi relation, by plain sums), or exact to its rounding (compensated sums, which
-     * the checks count exact; a few eps of it here) */
-    for (int c = 0; c < n; ++c)
-        es->err[c] = kr->col[c].cb * kr->col[c].fnorm +
-                     4.0 * DBL_EPSILON * cm_krylov_norm_inf(m, es->aw + (size_t)c * m);
+    /* per unit of its coefficient, what a column adds to a start's error: the solve's own
+     * account of its last A w, within cb of the column's scale (a check by the Arnoldi
+     * relation, by plain sums) or exact to its rounding (compensated sums, which the checks
+     * count exact; a few eps of it here); the rounding of the start's double-double weights
+     * (cm_rbf_combine_dd: a few eps^2 |w_j| per entry, summed through diam^3 >= phi_ij); and
+     * that of its product, the combination of the aw_j in double (n eps |aw_j|) */
+    const double rd = (2.0 * n + 4.0) * DBL_EPSILON * DBL_EPSILON;
+    for (int c = 0; c < n; ++c) {
+        const double ainf = cm_krylov_norm_inf(m, es->aw + (size_t)c * m);
+        es->err[c] = kr->col[c].cb * kr->col[c].fnorm + (n + 5.0) * DBL_EPSILON * ainf +
+                     rd * kr->diam3 * cblas_dasum((int)m, es->whi + (size_t)c * m, 1);
+    }
     memcpy(es->qr, es->aw, nm * sizeof *es->qr);
     for (int c = 0; c < n; ++c) cm_krylov_project(r->iter->q1, m, r->k, es->qr + (size_t)c * m);
     lapack_int jpvt[CM_RBF_EXACT_MAX] = {0};
@@ -98,30 +104,7 @@ double cm_rbf_exact_start(const cm_rbf *r, const cm_rbf_exact_starts *es, const 
     for (int j = 0; j < rank; ++j) c[es->col[j]] = y[j];
     for (int j = 0; j < n; ++j) bound += fabs(c[j]) * es->err[j];
     free(y);
-    /* whi + wlo = sum c_j (whi_j + wlo_j) in double-double (each term by TwoProduct, their sum
-     * by TwoSum), off the exact combination by a few eps^2 sum |c_j whi_j| per entry; aw =
-     * sum c_j aw_j in double, off by n eps sum |c_j aw_j|. Both go into the bound, the first
-     * through diam^3 >= phi_ij. */
-    double dd = 0.0, awe = 0.0;
-    for (size_t i = 0; i < m; ++i) {
-        double hi = 0.0, lo = 0.0, mag = 0.0, a = 0.0, amag = 0.0;
-        for (int j = 0; j < n; ++j) {
-            const double x = es->whi[(size_t)j * m + i], p = c[j] * x, pe = fma(c[j], x, -p);
-            const double t = hi + p, bv = t - hi;
-            lo += ((hi - (t - bv)) + (p - bv)) + pe + c[j] * es->wlo[(size_t)j * m + i];
-            hi = t;
-            mag += fabs(p);
-            const double b = c[j] * es->aw[(size_t)j * m + i];
-            a += b;
-            amag += fabs(b);
-        }
-        const double t = hi + lo;
-        wlo[i] = lo - (t - hi);
-        whi[i] = t;
-        aw[i] = a;
-        dd += mag;
-        awe = fmax(awe, amag);
-    }
-    const double rd = (2.0 * n + 4.0) * DBL_EPSILON * DBL_EPSILON;
-    return bound + rd * es->diam3 * dd + (n + 1.0) * DBL_EPSILON * awe;
+    cm_rbf_combine_dd(m, n, es->whi, es->wlo, c, whi, wlo);
+    cblas_dgemv(CblasColMajor, CblasNoTrans, (int)m, n, 1.0, es->aw, (int)m, c, 1, 0.0, aw, 1);
+    return bound;
 }

@@ -394,28 +394,6 @@ static int check_products(const cm_rbf *r, krylov *kr, int n, const int *cols,
     return na;
 }
 
-/* dh + dl = Z y, the cycle's step of a column (jn directions), in double-double (each term
- * y_i z_i by TwoProduct, their sum by TwoSum): the terms are much larger than their sum (the
- * preconditioned directions cancel), and a plain sum's rounding left the true residual of a
- * cycle 10-100x above GMRES's estimate, which cost a whole restart cycle (bracket 59k: 7 of
- * 21 iterations). dh is the step rounded to double. */
-static void step_of(const krylov *kr, const kcol *k, const double *y, double *dh, double *dl)
-{
-    const size_t m = kr->m;
-    for (size_t q = 0; q < m; ++q) {
-        double hi = 0.0, lo = 0.0;
-        for (int i = 0; i < k->jn; ++i) {
-            const double zi = k->z[(size_t)i * m + q], p = y[i] * zi, pe = fma(y[i], zi, -p);
-            const double t = hi + p, bv = t - hi;
-            lo += ((hi - (t - bv)) + (p - bv)) + pe;
-            hi = t;
-        }
-        const double t = hi + lo; /* to double, the remainder kept */
-        dl[q] = lo - (t - hi);
-        dh[q] = t;
-    }
-}
-
 /* S(w + dw) between S(w) - S(dw) and S(w) + S(dw), S(dw) <= diam^3 sum |dw| = diam3 l1 */
 static void step_s(const krylov *kr, kcol *k, double l1)
 {
@@ -791,7 +769,11 @@ cm_status cm_krylov_solve_group(cm_context *ctx, const cm_rbf *r, krylov *kr, co
              * free until then), added to w = wh + wl */
             double *wh = w + (size_t)c * m, *wl = kr->wlo + (size_t)c * m;
             double *dh = kr->aux + (size_t)c * m, *dl = kr->awlo + (size_t)c * m;
-            step_of(kr, k, y, dh, dl);
+            /* in double-double (cm_rbf_combine_dd): the terms are much larger than their
+             * sum (the preconditioned directions cancel), and a plain sum's rounding left the
+             * true residual of a cycle 10-100x above GMRES's estimate, which cost a whole
+             * restart cycle (bracket 59k: 7 of 21 iterations) */
+            cm_rbf_combine_dd(m, k->jn, k->z, NULL, y, dh, dl);
             cm_krylov_add_dd(m, wh, wl, dh, dl);
         }
     }

@@ -139,6 +139,14 @@ static inline size_t cm_rbf_sum_passes(size_t nc)
 /* (the diameter of the box around the centres and the n points p, 3 x n SoA)^3: no phi_ij
  * between them exceeds it (rbf_iterative.c) */
 double cm_rbf_diam3(const cm_rbf *r, size_t n, const double *p);
+/* hi + lo = sum_j c_j (x_j + xlo_j) over n columns of m (x, xlo: n x m; xlo NULL: none), in
+ * double-double: each term c_j x_j by TwoProduct, their sum by TwoSum, the low parts' terms
+ * added to the remainder; hi is the sum rounded to double. Off the exact combination by a
+ * few eps^2 sum_j |c_j x_j| per entry (rbf_iterative.c). For sums whose terms are much
+ * larger than the result: a Krylov step (rbf_fgmres.c), a start combined from earlier
+ * weights (rbf_exact_start.c). */
+void cm_rbf_combine_dd(size_t m, int n, const double *x, const double *xlo, const double *c,
+                       double *hi, double *lo);
 /* The direct sums of the nc columns w (m each) at the n points p into out (n x nc), plain or
  * compensated, in passes of CM_RBF_SUM_MAX_NC; tick as the kernel sums'. Nonzero: stopped
  * (rbf_evaluate_tree.c). */

@@ -31,6 +31,24 @@ double cm_rbf_diam3(const cm_rbf *r, size_t n, const double *p)
     return d2 * sqrt(d2);
 }
 
+void cm_rbf_combine_dd(size_t m, int n, const double *x, const double *xlo, const double *c,
+                       double *hi, double *lo)
+{
+    for (size_t q = 0; q < m; ++q) {
+        double h = 0.0, l = 0.0;
+        for (int j = 0; j < n; ++j) {
+            const double xj = x[(size_t)j * m + q], p = c[j] * xj, pe = fma(c[j], xj, -p);
+            const double t = h + p, bv = t - h;
+            l += ((h - (t - bv)) + (p - bv)) + pe;
+            if (xlo) l += c[j] * xlo[(size_t)j * m + q];
+            h = t;
+        }
+        const double t = h + l; /* to double, the remainder kept */
+        lo[q] = l - (t - h);
+        hi[q] = t;
+    }
+}
+
 int cm_rbf_iterative_scales_begin(cm_rbf *r, size_t nc, double fmax)
 {
     cm_rbf_scales *s = &r->iter->next;

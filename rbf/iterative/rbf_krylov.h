@@ -136,11 +136,11 @@ typedef struct cm_rbf_exact_starts {
     size_t m;
     int n;                   /* columns kept (0: none) */
     double *whi, *wlo, *aw;  /* n x m each: the weights' high and low parts, A (whi + wlo) */
-    double *err;             /* n: bound on |A (whi + wlo) - aw|_inf */
+    double *err;             /* n: per unit of a coefficient, the bound a column adds to a
+                              * start's |A (whi + wlo) - aw|_inf */
     double *qr, *tau;        /* LAPACK's pivoted QR of Pi aw (m x n), its reflectors' factors */
     int rank;                /* the columns it found independent: col[0..rank) */
     int col[CM_RBF_EXACT_MAX];
-    double diam3;            /* diam^3 of the centres: phi_ij <= diam3 */
 } cm_rbf_exact_starts;
 
 /* Keeps the n columns whi + wlo (m each: the first group's weights, the group's columns of
