@@ -951,6 +951,7 @@ double *out);
 int cm_warp_method_is_linear(cm_warp_method method);
 cm_warp_method cm_warp_get_method(const cm_warp *warp);
 double cm_warp_residual(const cm_warp *warp);
+double cm_warp_tolerance(const cm_warp *warp);
 size_t cm_warp_fallback_nodes(const cm_warp *warp);
 typedef struct cm_warp_mesh_stats {
 size_t boundary_nodes, constrained_nodes, components;

@@ -168,6 +168,11 @@ cm_warp_method cm_warp_get_method(const cm_warp *warp) { return warp->method; }
 
 double cm_warp_residual(const cm_warp *warp) { return warp ? warp->residual : 0; }
 
+double cm_warp_tolerance(const cm_warp *warp)
+{
+    return warp && warp->ops->tolerance ? warp->ops->tolerance(warp->state) : 0;
+}
+
 size_t cm_warp_fallback_nodes(const cm_warp *warp)
 {
     return warp && warp->ops->fallback_nodes ? warp->ops->fallback_nodes(warp->state) : 0;

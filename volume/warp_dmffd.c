@@ -173,4 +173,5 @@ static cm_status dmffd_apply_transpose(cm_context *ctx, void *state, const doubl
 }
 
 const cm_warp_method_ops cm_warp_dmffd = {
-    "dmffd", dmffd_create, dmffd_apply, dmffd_destroy, NULL, dmffd_apply_transpose, NULL};
+    "dmffd", dmffd_create, dmffd_apply, dmffd_destroy, NULL, dmffd_apply_transpose, NULL,
+    NULL};

@@ -453,4 +453,4 @@ static cm_status femwarp_apply_transpose(cm_context *ctx, void *state, const dou
 
 const cm_warp_method_ops cm_warp_femwarp = {
     "femwarp", femwarp_create, femwarp_apply, femwarp_destroy, NULL, femwarp_apply_transpose,
-    NULL};
+    NULL, NULL};

@@ -466,4 +466,4 @@ static cm_status lbwarp_apply_transpose(cm_context *ctx, void *state, const doub
 const cm_warp_method_ops cm_warp_lbwarp = {
     "lbwarp",       lbwarp_create,         lbwarp_apply,
     lbwarp_destroy, lbwarp_fallback_nodes, lbwarp_apply_transpose,
-    NULL};
+    NULL, NULL};

@@ -21,10 +21,12 @@ typedef struct cm_warp_method_ops {
      * at the constrained nodes. NULL: the method's apply is not linear in disp. */
     cm_status (*apply_transpose)(cm_context *ctx, void *state, const double *v, double *out);
     /* cm_warp_apply_many: k blocks of #nodes x 3 at once; *residual the largest over them.
-     * NULL: warp.c calls apply block by block. The last member, so that the positional
-     * initialisers of the rows only grow at their end. */
+     * NULL: warp.c calls apply block by block. */
     cm_status (*apply_many)(cm_context *ctx, void *state, size_t k, double *disp,
                             double *residual);
+    /* cm_warp_tolerance (NULL: the method has none: 0). The last member, so that the
+     * positional initialisers of the rows only grow at their end. */
+    double (*tolerance)(const void *state);
 } cm_warp_method_ops;
 
 /* The RBF methods (warp_rbf.c). */

@@ -60,4 +60,4 @@ static cm_status mls_apply_transpose(cm_context *ctx, void *state, const double 
 }
 
 const cm_warp_method_ops cm_warp_mls = {
-    "mls", mls_create, mls_apply, mls_destroy, NULL, mls_apply_transpose, NULL};
+    "mls", mls_create, mls_apply, mls_destroy, NULL, mls_apply_transpose, NULL, NULL};

@@ -6,6 +6,7 @@
 
 #include "cadmorph/deform.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,6 +20,7 @@ typedef struct warp_component {
     int64_t *fixed; /* constrained nodes of the component, ascending */
     size_t n_free;
     int64_t *free_nodes; /* unconstrained nodes owned by the component, ascending */
+    double tolerance;    /* its iterative solver's (the option, or from the mesh) */
 } warp_component;
 
 typedef struct rbf_warp {
@@ -113,10 +115,73 @@ static cm_status split_component(cm_context *ctx, const unsigned char *constrain
     return CM_OK;
 }
 
+/* The tolerance from the mesh (cm_warp_options.tolerance 0; docs/DESIGN.md, "The warp's
+ * tolerance"): the iterative solve misses the data at the centres by up to tolerance x the
+ * largest displacement, and the constrained nodes are then set exactly, so a free node next
+ * to the wall moves by about that miss against its wall neighbour. A share of the shortest
+ * such spacing over the centres' diagonal keeps that within CM_WARP_TOL_SHARE of the
+ * thinnest wall cell for any motion up to the diagonal; never looser than CM_WARP_TOL_MAX
+ * (what studies have been measured at), never tighter than the RBF's own default. */
+#define CM_WARP_TOL_SHARE 1e-3
+#define CM_WARP_TOL_MAX 1e-6
+#define CM_WARP_TOL_MIN 1e-10
+
+/* The nodes of cell c into *buf (grown as needed; polyhedra list a node once per face):
+ * their count, or -1 out of memory. */
+static int64_t cell_nodes(const cm_mesh *mesh, size_t c, int64_t **buf, size_t *cap)
+{
+    const int64_t *conn = mesh->conn, b = mesh->offset[c], e = mesh->offset[c + 1];
+    size_t n = 0;
+    if (*cap < (size_t)(e - b)) { /* enough for either: a polyhedron's stream is longer */
+        int64_t *t = realloc(*buf, (size_t)(e - b) * sizeof *t);
+        if (!t) return -1;
+        *buf = t, *cap = (size_t)(e - b);
+    }
+    if (mesh->type[c] != CM_CELL_POLYHEDRON) {
+        memcpy(*buf, conn + b, (size_t)(e - b) * sizeof **buf);
+        return e - b;
+    }
+    for (cm_polyhedron_face f = cm_polyhedron_begin(conn + b, e - b); cm_polyhedron_more(&f);
+         cm_polyhedron_next(&f))
+        for (int64_t i = 0; i < f.n; ++i)
+            (*buf)[n++] = f.nodes[i];
+    return (int64_t)n;
+}
+
+/* The shortest distance between a constrained and a free node of one cell, over the cells
+ * cells[0..n) (INFINITY: no cell has both; -1: out of memory). */
+static double wall_spacing(const cm_mesh *mesh, const unsigned char *constrained,
+                           const size_t *cells, size_t n)
+{
+    double d2 = INFINITY;
+    int64_t *nb = NULL;
+    size_t cap = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const int64_t k = cell_nodes(mesh, cells[i], &nb, &cap);
+        if (k < 0) {
+            free(nb);
+            return -1;
+        }
+        for (int64_t p = 0; p < k; ++p) {
+            if (!constrained[nb[p]]) continue;
+            const double *x = mesh->xyz + 3 * nb[p];
+            for (int64_t q = 0; q < k; ++q) {
+                if (constrained[nb[q]]) continue;
+                const double *y = mesh->xyz + 3 * nb[q];
+                const double dx = x[0] - y[0], dy = x[1] - y[1], dz = x[2] - y[2];
+                d2 = fmin(d2, dx * dx + dy * dy + dz * dz);
+            }
+        }
+    }
+    free(nb);
+    return sqrt(d2);
+}
+
 /* The RBF of component k; its errors (coplanar centres, failed factorisation) get the
- * component number in front. */
+ * component number in front. spacing: wall_spacing of its cells. */
 static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel,
-                               const cm_warp_options *opt, size_t k, warp_component *wc)
+                               const cm_warp_options *opt, size_t k, double spacing,
+                               warp_component *wc)
 {
     if (wc->n_free == 0) return CM_OK; /* nothing to interpolate: every node is prescribed */
     if (wc->n_fixed == 0)
@@ -136,12 +201,23 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
     }
     for (size_t i = 0; i < wc->n_free; ++i)
         memcpy(xyz + 3 * (wc->n_fixed + i), mesh->xyz + 3 * wc->free_nodes[i], 3 * sizeof(double));
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < wc->n_fixed; ++i)
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = fmin(lo[a], xyz[3 * i + a]);
+            hi[a] = fmax(hi[a], xyz[3 * i + a]);
+        }
+    const double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                             (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    const double from_mesh = diag > 0 ? CM_WARP_TOL_SHARE * spacing / diag : CM_WARP_TOL_MIN;
+    wc->tolerance = opt->tolerance > 0 ? opt->tolerance
+                                       : fmax(CM_WARP_TOL_MIN, fmin(CM_WARP_TOL_MAX, from_mesh));
     cm_deform_options o;
     cm_deform_options_init(&o);
     o.method = CM_DEFORM_RBF;
     o.kernel = kernel;
     o.solver = opt->solver;
-    o.tolerance = opt->tolerance;
+    o.tolerance = wc->tolerance;
     o.solves = opt->solves;
     o.warm_groups = opt->warm_groups;
     cm_status s = cm_deform_create(ctx, &o, np, xyz, con, NULL, &wc->def);
@@ -151,10 +227,15 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
                                wc->n_fixed);
     cm_deform_stats st;
     cm_deform_get_stats(wc->def, &st);
+    char why[96] = "";
+    if (!(opt->tolerance > 0))
+        snprintf(why, sizeof why, " (from the mesh: wall spacing %.3g, centres' diagonal %.3g)",
+                 spacing, diag);
     cm_log(ctx, CM_LOG_DEBUG, "cm_warp_create: component %zu: %zu centres, %s solver%s, for %d "
-           "solve(s)", k, wc->n_fixed, st.rbf.solver == CM_RBF_SOLVER_DENSE ? "dense" :
-           st.rbf.solver == CM_RBF_SOLVER_PETSC ? "petsc" : "iterative",
-           opt->solver == CM_RBF_SOLVER_AUTO ? " (auto)" : "", opt->solves > 1 ? opt->solves : 1);
+           "solve(s), tolerance %.3g%s", k, wc->n_fixed, st.rbf.solver == CM_RBF_SOLVER_DENSE ?
+           "dense" : st.rbf.solver == CM_RBF_SOLVER_PETSC ? "petsc" : "iterative",
+           opt->solver == CM_RBF_SOLVER_AUTO ? " (auto)" : "", opt->solves > 1 ? opt->solves : 1,
+           wc->tolerance, st.rbf.solver == CM_RBF_SOLVER_DENSE ? " (unused: exact)" : why);
     return CM_OK;
 }
 
@@ -206,7 +287,13 @@ static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm
         s = split_component(ctx, constrained, (int)k, list, vis.n, owner, &w->comp[k],
                             n_shared_free);
         if (s < 0) goto done;
-        s = fit_component(ctx, mesh, kernel, opt, k, &w->comp[k]);
+        const double spacing =
+            wall_spacing(mesh, constrained, cells + start[k], start[k + 1] - start[k]);
+        if (spacing < 0) {
+            s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
+            goto done;
+        }
+        s = fit_component(ctx, mesh, kernel, opt, k, spacing, &w->comp[k]);
         if (s < 0) goto done;
         if ((s = cm_progress(ctx, "warp factorise", (double)(k + 1), (double)nc)) < 0) goto done;
     }
@@ -401,9 +488,19 @@ static cm_status biharmonic_create(cm_context *ctx, const cm_mesh *mesh,
     return rbf_create(ctx, mesh, b, constrained, CM_RBF_BIHARMONIC, opt, state);
 }
 
+/* the tightest of the components' tolerances (0: no component has a fit) */
+static double rbf_tolerance(const void *state)
+{
+    const rbf_warp *w = state;
+    double t = INFINITY;
+    for (size_t k = 0; k < w->n_components; ++k)
+        if (w->comp[k].def) t = fmin(t, w->comp[k].tolerance);
+    return t < INFINITY ? t : 0.0;
+}
+
 const cm_warp_method_ops cm_warp_rbf_triharmonic = {
     "rbf", triharmonic_create, rbf_apply, rbf_destroy, NULL, rbf_apply_transpose,
-    rbf_apply_many};
+    rbf_apply_many, rbf_tolerance};
 const cm_warp_method_ops cm_warp_rbf_biharmonic = {
     "rbf-biharmonic", biharmonic_create, rbf_apply, rbf_destroy, NULL, rbf_apply_transpose,
-    rbf_apply_many};
+    rbf_apply_many, rbf_tolerance};

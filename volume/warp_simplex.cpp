@@ -386,4 +386,4 @@ cm_status simplex_apply_transpose(cm_context *, void *state, const double *v, do
 extern "C" const cm_warp_method_ops cm_warp_simplex = {
     "simplex",       simplex_create,         simplex_apply,
     simplex_destroy, simplex_fallback_nodes, simplex_apply_transpose,
-    NULL};
+    NULL, NULL};

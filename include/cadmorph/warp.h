@@ -53,10 +53,14 @@ typedef struct cm_warp_options {
      * apply collective over the MPI ranks) */
     cm_rbf_solver solver;
     /* RBF methods, iterative solvers: stop when the largest miss at the centres is
-     * <= tolerance x the largest prescribed displacement; 0 = the RBF's default (1e-10,
-     * the exact interpolant). The warp puts the constrained nodes at their prescribed values
-     * anyway, so a looser tolerance only perturbs the interior by about tolerance x the
-     * motion: 1e-6 of a 0.02 motion is 2e-8, far below any cell. */
+     * <= tolerance x the largest prescribed displacement. The warp puts the constrained nodes
+     * at their prescribed values anyway, so the tolerance only perturbs the interior, by
+     * about tolerance x the motion, most visibly as a step between a wall node and its free
+     * neighbour. 0 (default): from the mesh, per component, 1e-3 x h / D within [1e-10,
+     * 1e-6], h the shortest distance between a constrained and a free node of one cell, D
+     * the constrained nodes' bounding-box diagonal: that step stays within 1e-3 of the
+     * thinnest wall cell for motions up to D (cm_warp_tolerance says what was taken;
+     * docs/DESIGN.md, "The warp's tolerance"). The dense solver is exact to rounding. */
     double tolerance;
     /* RBF methods, AUTO solver: how many displacement fields the caller expects to apply
      * with this warp over its life (cm_warp_apply_many's k fields counting k), weighed by
@@ -144,6 +148,10 @@ CM_API cm_warp_method cm_warp_get_method(const cm_warp *warp);
  * methods that interpolate exactly (RBF, FEMWARP); what approximating methods (DM-FFD, MLS)
  * miss by. */
 CM_API double cm_warp_residual(const cm_warp *warp);
+
+/* The tolerance the warp's iterative RBF solves stop at (cm_warp_options.tolerance, or the
+ * one from the mesh; with several components the tightest): 0 for the other methods. */
+CM_API double cm_warp_tolerance(const cm_warp *warp);
 
 /* Nodes the method could not treat by its own rule and gave its documented fallback: LBWARP,
  * nodes without positive log-barrier weights (outside the convex hull of their neighbours);

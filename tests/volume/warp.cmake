@@ -7,6 +7,9 @@ cm_add_unit_test(test_warp_transpose_rbf test_warp_transpose_rbf.c LIBS cm_volum
 # the forward product of k fields in one call against k applies: the RBF's many-column solve
 # (dense, iterative), FEMWARP's loop over apply, stopping on request
 cm_add_unit_test(test_warp_apply_many test_warp_apply_many.c LIBS cm_volume)
+# the tolerance from the mesh: the rule on tets, hexes and polyhedra, and the wall step it
+# promises (iterative against dense on a block with a thin wall layer)
+cm_add_unit_test(test_warp_tolerance test_warp_tolerance.c LIBS cm_volume)
 
 # Cross-check on a real mesh: gmsh meshes a sphere cut out of a box (setup, also used by the
 # CLI tests), cadmorph warps it (test_warp_sphere), scipy's RBFInterpolator redoes it (scipy).
