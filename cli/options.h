@@ -89,9 +89,10 @@ extern const int cli_solver_values[];
     .name = "--rbf-tol", .kind = CLI_DOUBLE, .lo = 0, .hi = 0.5,                               \
     .bad = "%s: expected a tolerance in 0..0.5, got '%s'", .label = "--rbf-tol T",             \
     .help = "RBF warps, iterative solvers: stop at a miss at the centres of T x the\n"         \
-            "largest displacement (default 1e-10; the boundary is set exactly anyway,\n"       \
-            "the interior moves by about T x the motion; 1e-6 halves a cold solve,\n"          \
-            "a study of 20 variants 1.2-1.6x)"
+            "largest displacement. The boundary is set exactly anyway; the interior\n"         \
+            "moves by about T x the motion. Default: from the mesh, 1e-3 x the\n"              \
+            "shortest wall-to-interior spacing of a cell over the boundary's diagonal,\n"      \
+            "within [1e-10, 1e-6] (-v names it)"
 /* -1 if the --solver value can run in this build, else the usage exit code after saying why
  * (petsc without PETSc). */
 int cli_check_solver(const char *cmd, const char *usage, int solver);

@@ -119,9 +119,10 @@ static cm_status split_component(cm_context *ctx, const unsigned char *constrain
  * tolerance"): the iterative solve misses the data at the centres by up to tolerance x the
  * largest displacement, and the constrained nodes are then set exactly, so a free node next
  * to the wall moves by about that miss against its wall neighbour. A share of the shortest
- * such spacing over the centres' diagonal keeps that within CM_WARP_TOL_SHARE of the
- * thinnest wall cell for any motion up to the diagonal; never looser than CM_WARP_TOL_MAX
- * (what studies have been measured at), never tighter than the RBF's own default. */
+ * such spacing over the centres' diagonal keeps the error's stretch of any cell's edges
+ * within about CM_WARP_TOL_SHARE for motions up to the diagonal (checked in strain, not in
+ * displacement: tests/volume/test_warp_tolerance.c); never looser than CM_WARP_TOL_MAX (what
+ * studies have been measured at), never tighter than the RBF's own default. */
 #define CM_WARP_TOL_SHARE 1e-3
 #define CM_WARP_TOL_MAX 1e-6
 #define CM_WARP_TOL_MIN 1e-10

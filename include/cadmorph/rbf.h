@@ -213,7 +213,9 @@ CM_API cm_status cm_rbf_evaluate(cm_context *ctx, const cm_rbf *rbf, size_t n, c
  * the factorisation or preconditioner of create, the right-hand side [E^T v; P^T v] (E: the
  * kernel values from the centres to the points) summed as evaluate sums (an iterative fit:
  * compensated sums, or the treecode where its checked error is within the tolerance).
- * Exact as cm_rbf_solve is: to rounding (dense), to the tolerance (iterative, PETSc).
+ * Exact as cm_rbf_solve is: to rounding (dense), to the tolerance (iterative, PETSc), but
+ * never looser than 1e-10: a residual moves these weights by itself times their growth, where
+ * it moves an evaluation by about itself.
  * Merged duplicate centres: all of a merged centre's share goes to the first of its input
  * centres (the one whose value the solve takes), 0 to the others.
  * Keeps the weights of the last cm_rbf_solve (evaluate still uses them; none are needed

@@ -36,8 +36,10 @@ class Warp:
             name for method "rbf" / "rbf-biharmonic").
         solver: RBF methods: "auto" (dense below a measured size, iterative above), "dense",
             "iterative", "petsc" (only in a build with PETSc).
-        tolerance: RBF, iterative solvers: the CLI's --rbf-tol, in [0, 0.5]; 0 = the
-            library's 1e-10.
+        tolerance: RBF, iterative solvers: the CLI's --rbf-tol, in [0, 0.5]; 0 = from the
+            mesh: 1e-3 x the shortest spacing between a constrained and a free node of a
+            cell over the constrained nodes' diagonal, within [1e-10, 1e-6] (the property
+            tolerance says what was taken).
         solves: RBF methods, solver "auto": how many displacement fields you expect to apply
             with this warp (apply_many's k counting k), >= 1 (default 1); the dense
             factorisation, shared by them all, then wins to more nodes
@@ -124,6 +126,12 @@ class Warp:
         """Largest |displacement - prescribed| at the constrained nodes after the last apply:
         0 for the interpolating methods (RBF, FEMWARP); what DM-FFD and MLS miss by."""
         return float(lib.cm_warp_residual(self._warp))
+
+    @property
+    def tolerance(self) -> float:
+        """The tolerance the RBF methods' iterative solves stop at: the one given, or the one
+        from the mesh (the tightest over the mesh's components); 0 for the other methods."""
+        return float(lib.cm_warp_tolerance(self._warp))
 
     @property
     def fallback_nodes(self) -> int:

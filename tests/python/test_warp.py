@@ -76,6 +76,8 @@ def test_warp_constrained_nodes_and_properties(bore_mesh):
     assert out.shape == (mesh.n_nodes, 3) and out.dtype == np.float64
     assert np.array_equal(out[b], D)  # the prescribed rows exactly
     assert w.residual == 0.0 and w.fallback_nodes == 0
+    assert 1e-10 <= w.tolerance <= 1e-6  # from the mesh (tests/volume/test_warp_tolerance.c)
+    assert cadmorph.Warp(mesh, tolerance=3e-8, progress=False).tolerance == 3e-8
     free = np.setdiff1d(np.arange(mesh.n_nodes), b)
     assert np.abs(out[free]).max() > 1e-3  # the interior follows
     # explicitly listing the boundary (in another order) is the same warp
@@ -89,7 +91,7 @@ def test_warp_constrained_nodes_and_properties(bore_mesh):
     # dmffd misses by a residual; its Warp says which method it is
     wd = cadmorph.Warp(mesh, method="dmffd", lattice=5, progress=False)
     wd.apply(D)
-    assert wd.method == "dmffd" and wd.residual > 0
+    assert wd.method == "dmffd" and wd.residual > 0 and wd.tolerance == 0
     # kernel= is the CLI's other name for the RBF methods
     assert cadmorph.Warp(mesh, kernel="biharmonic", progress=False).method == "rbf-biharmonic"
     # solves= only weighs AUTO's choice: 1728 centres are dense either way, the same warp

@@ -6,7 +6,7 @@
 # floor applies), and the iterative warp takes at most 15 iterations (measured 5 and 6: a
 # bound with margin, not a count). At the default tolerance, from the mesh (docs/DESIGN.md,
 # "The warp's tolerance": 1e-6 on both), the iterative mesh is within 1e-5 of the range of
-# the dense one (measured 3.6e-8 and MEASURED_BRACKET). Each stage is a fixture of the next, so
+# the dense one (measured 3.6e-8 and 1.8e-8). Each stage is a fixture of the next, so
 # any one test runs alone (ctest -R).
 set(SV ${CM_TEST_WORK}/morph_solvers)
 add_test(NAME morph_solvers_dir COMMAND ${CMAKE_COMMAND} -E make_directory ${SV})
