@@ -58,7 +58,7 @@ void cm_rbf_options_init(cm_rbf_options *opt)
     if (!opt) return;
     memset(opt, 0, sizeof *opt);
     opt->solver = CM_RBF_SOLVER_AUTO;
-    opt->tolerance = 1e-10;
+    opt->tolerance = CM_RBF_DEFAULT_TOL;
     opt->max_iterations = 300;
     opt->restart = 40;
     opt->fast_sum = -1;

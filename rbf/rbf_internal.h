@@ -92,6 +92,10 @@ long cm_rbf_tick_chunk(const cm_rbf_tick *tick, double per_item, long items, int
  * a pass (the self product keeps about 2 (threads + 1) nc m doubles). */
 #define CM_RBF_SUM_MAX_NC 64
 
+/* cm_rbf_options.tolerance's default, and the loosest the reverse product solves to
+ * (rbf_transpose.c) */
+#define CM_RBF_DEFAULT_TOL 1e-10
+
 /* out[i * ldo + c] = sum_j phi(|p_i - c_j|) w[c * m + j] for c < nc (any nc >= 1), i < n.
  * p: dim x n SoA with stride ldp (p + d * ldp is coordinate d), centres as in rbf (SoA,
  * stride m). The sum over j runs in the same order for every i whatever the thread count,

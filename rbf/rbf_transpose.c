@@ -38,11 +38,6 @@
  * 2,818 centres: 2.8e-13 -> 1e-15 in one step; a second to 8e-17 cost another 40 % of the
  * product for nothing a gradient sees). */
 #define CM_RBF_TRANSPOSE_REFINE_TOL 1e-14
-/* The iterative reverse solve never stops looser than this (the RBF's default tolerance), for
- * the same reason: a tolerance chosen for the forward field (a study's 1e-6, the warp's from
- * the mesh: docs/DESIGN.md, "The warp's tolerance") moves a forward result by about itself,
- * but the reverse result by itself times the growth of the weights */
-#define CM_RBF_REVERSE_TOL 1e-10
 
 /* The distance of centre u (unit box) from the affine hull of the picked centres s[0..np),
  * squared, by Gram-Schmidt against the directions e (np - 1 orthonormal rows of 3). */
@@ -114,8 +109,13 @@ cm_status cm_rbf_evaluate_transpose(cm_context *ctx, cm_rbf *rbf, size_t n, cons
     memset(out, 0, rbf->m_in * nc * sizeof *out);
     if (n == 0) return CM_OK;
     cm_status st = CM_OK;
-    const double forward_tol = rbf->opt.tolerance; /* restored at the end */
-    rbf->opt.tolerance = fmin(forward_tol, CM_RBF_REVERSE_TOL);
+    /* The iterative reverse solve never stops looser than the RBF's default tolerance, for
+     * the reason above: a tolerance chosen for the forward field (a study's 1e-6, the warp's
+     * from the mesh: docs/DESIGN.md, "The warp's tolerance") moves a forward result by about
+     * itself, but the reverse result by itself times the growth of the weights. Restored at
+     * the end. */
+    const double forward_tol = rbf->opt.tolerance;
+    rbf->opt.tolerance = fmin(forward_tol, CM_RBF_DEFAULT_TOL);
     double *p = malloc(n * (size_t)dim * sizeof *p); /* dim x n SoA, unit-box coordinates */
     double *vs = malloc(n * nc * sizeof *vs);        /* nc x n SoA */
     double *g = malloc(m * nc * sizeof *g);          /* m x nc row-major: E' v, then Phi w0 */

@@ -125,7 +125,6 @@ static cm_status split_component(cm_context *ctx, const unsigned char *constrain
  * studies have been measured at), never tighter than the RBF's own default. */
 #define CM_WARP_TOL_SHARE 1e-3
 #define CM_WARP_TOL_MAX 1e-6
-#define CM_WARP_TOL_MIN 1e-10
 
 /* The nodes of cell c into *buf (grown as needed; polyhedra list a node once per face):
  * their count, or -1 out of memory. */
@@ -202,17 +201,19 @@ static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kern
     }
     for (size_t i = 0; i < wc->n_free; ++i)
         memcpy(xyz + 3 * (wc->n_fixed + i), mesh->xyz + 3 * wc->free_nodes[i], 3 * sizeof(double));
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    double bb[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < wc->n_fixed; ++i)
         for (int a = 0; a < 3; ++a) {
-            lo[a] = fmin(lo[a], xyz[3 * i + a]);
-            hi[a] = fmax(hi[a], xyz[3 * i + a]);
+            bb[a] = fmin(bb[a], xyz[3 * i + a]);
+            bb[3 + a] = fmax(bb[3 + a], xyz[3 * i + a]);
         }
-    const double diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                             (hi[2] - lo[2]) * (hi[2] - lo[2]));
-    const double from_mesh = diag > 0 ? CM_WARP_TOL_SHARE * spacing / diag : CM_WARP_TOL_MIN;
+    const double diag = cm_bbox_diagonal(bb);
+    cm_rbf_options rbf_default;
+    cm_rbf_options_init(&rbf_default);
+    const double tol_min = rbf_default.tolerance; /* the RBF's own default */
+    const double from_mesh = diag > 0 ? CM_WARP_TOL_SHARE * spacing / diag : tol_min;
     wc->tolerance = opt->tolerance > 0 ? opt->tolerance
-                                       : fmax(CM_WARP_TOL_MIN, fmin(CM_WARP_TOL_MAX, from_mesh));
+                                       : fmax(tol_min, fmin(CM_WARP_TOL_MAX, from_mesh));
     cm_deform_options o;
     cm_deform_options_init(&o);
     o.method = CM_DEFORM_RBF;
