@@ -10,6 +10,12 @@ cm_add_unit_test(test_warp_apply_many test_warp_apply_many.c LIBS cm_volume)
 # the tolerance from the mesh: the rule on tets, hexes and polyhedra, and the wall step it
 # promises (iterative against dense on a block with a thin wall layer)
 cm_add_unit_test(test_warp_tolerance test_warp_tolerance.c LIBS cm_volume)
+# ... and on a boundary-layer mesh gmsh writes (prisms, a 1e-4 wall layer): `cadmorph warp -v`
+# names the rule's tolerance, and its mesh stays within the strain it allows
+add_test(NAME warp_layer_gmsh
+  COMMAND ${CM_PYTHON} ${CMAKE_CURRENT_LIST_DIR}/warp_layer.py $<TARGET_FILE:cadmorph>
+          ${CM_TEST_WORK}/warp_layer)
+set_tests_properties(warp_layer_gmsh PROPERTIES LABELS "unit;cli")
 
 # Cross-check on a real mesh: gmsh meshes a sphere cut out of a box (setup, also used by the
 # CLI tests), cadmorph warps it (test_warp_sphere), scipy's RBFInterpolator redoes it (scipy).
