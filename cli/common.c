@@ -55,20 +55,16 @@ static void format_duration(double sec, char *buf, size_t size)
  * batch is done, the time it has run ("1m12s so far"): one batch may be the whole study. */
 static void draw_study(cli_sink *s, double now)
 {
-    char left[64] = "estimating the time left", last[48] = "";
-    if (s->study_done <= 0 && now - s->study_start >= 1.0) {
-        char d[24];
-        format_duration(now - s->study_start, d, sizeof d);
+    char left[64] = "estimating the time left", last[48] = "", d[24];
+    const double run = now - s->study_start;
+    if (s->study_done > 0) {
+        format_duration(run / s->study_done * (s->study_total - s->study_done), d, sizeof d);
+        snprintf(left, sizeof left, "about %s left", d);
+    } else if (run >= 1.0) {
+        format_duration(run, d, sizeof d);
         snprintf(left, sizeof left, "%s so far, estimating the time left", d);
     }
-    if (s->study_done > 0) {
-        char d[24];
-        format_duration((now - s->study_start) / s->study_done * (s->study_total - s->study_done),
-                        d, sizeof d);
-        snprintf(left, sizeof left, "about %s left", d);
-    }
     if (s->per_variant > 0) {
-        char d[24];
         if (s->per_variant < 10)
             snprintf(d, sizeof d, "%.2g s", s->per_variant);
         else

@@ -36,7 +36,7 @@ static void uf_union(cm_idx *parent, cm_idx a, cm_idx b)
 static int same_node_set(const cm_mesh *mesh, size_t a, size_t b)
 {
     int64_t sa[64], sb[64];
-    const int na = cm_topology_cell_nodes(mesh, a, sa, 64), nb = cm_topology_cell_nodes(mesh, b, sb, 64);
+    const int na = cm_mesh_cell_nodes(mesh, a, sa, 64), nb = cm_mesh_cell_nodes(mesh, b, sb, 64);
     if (na < 0 || nb < 0 || na != nb) return 0;
     return memcmp(sa, sb, (size_t)na * sizeof *sa) == 0;
 }

@@ -111,7 +111,7 @@ static inline int face_nodes(const cm_mesh *mesh, const faces_of_types *ft, size
     return t->size[f];
 }
 
-int cm_topology_cell_nodes(const cm_mesh *mesh, size_t c, int64_t *out, int cap)
+int cm_mesh_cell_nodes(const cm_mesh *mesh, size_t c, int64_t *out, int cap)
 {
     const int64_t *conn = mesh->conn + mesh->offset[c];
     const int64_t len = mesh->offset[c + 1] - mesh->offset[c];

@@ -89,8 +89,4 @@ int64_t cm_topology_find(const cm_topology *t, const cm_mesh *mesh, int64_t *nod
 /* The first instance, in instance order, that is the third (or later) of its face, or -1. */
 int64_t cm_topology_first_overshared(const cm_topology *t);
 
-/* Cell -> node incidence: the sorted distinct nodes of cell c (all its nodes; for a polyhedron
- * those of its face stream); -1 if more than cap. */
-int cm_topology_cell_nodes(const cm_mesh *mesh, size_t c, int64_t *out, int cap);
-
 #endif

@@ -374,6 +374,7 @@ cm_status cm_mesh_add_entity(cm_context *ctx, cm_mesh *mesh, const cm_mesh_entit
 cm_status cm_mesh_copy(cm_context *ctx, const cm_mesh *mesh, cm_mesh **copy);
 cm_status cm_mesh_validate(cm_context *ctx, const cm_mesh *mesh, const char *what);
 size_t cm_mesh_count_dim(const cm_mesh *mesh, int dim);
+int cm_mesh_cell_nodes(const cm_mesh *mesh, size_t c, int64_t *out, int cap);
 typedef struct cm_polyhedron_face {
 int64_t face;
 int64_t n_faces;

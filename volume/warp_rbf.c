@@ -126,28 +126,6 @@ static cm_status split_component(cm_context *ctx, const unsigned char *constrain
 #define CM_WARP_TOL_SHARE 1e-3
 #define CM_WARP_TOL_MAX 1e-6
 
-/* The nodes of cell c into *buf (grown as needed; polyhedra list a node once per face):
- * their count, or -1 out of memory. */
-static int64_t cell_nodes(const cm_mesh *mesh, size_t c, int64_t **buf, size_t *cap)
-{
-    const int64_t *conn = mesh->conn, b = mesh->offset[c], e = mesh->offset[c + 1];
-    size_t n = 0;
-    if (*cap < (size_t)(e - b)) { /* enough for either: a polyhedron's stream is longer */
-        int64_t *t = realloc(*buf, (size_t)(e - b) * sizeof *t);
-        if (!t) return -1;
-        *buf = t, *cap = (size_t)(e - b);
-    }
-    if (mesh->type[c] != CM_CELL_POLYHEDRON) {
-        memcpy(*buf, conn + b, (size_t)(e - b) * sizeof **buf);
-        return e - b;
-    }
-    for (cm_polyhedron_face f = cm_polyhedron_begin(conn + b, e - b); cm_polyhedron_more(&f);
-         cm_polyhedron_next(&f))
-        for (int64_t i = 0; i < f.n; ++i)
-            (*buf)[n++] = f.nodes[i];
-    return (int64_t)n;
-}
-
 /* The shortest distance between a constrained and a free node of one cell, over the cells
  * cells[0..n) (INFINITY: no cell has both; -1: out of memory). */
 static double wall_spacing(const cm_mesh *mesh, const unsigned char *constrained,
@@ -157,15 +135,21 @@ static double wall_spacing(const cm_mesh *mesh, const unsigned char *constrained
     int64_t *nb = NULL;
     size_t cap = 0;
     for (size_t i = 0; i < n; ++i) {
-        const int64_t k = cell_nodes(mesh, cells[i], &nb, &cap);
-        if (k < 0) {
-            free(nb);
-            return -1;
+        /* a cell has no more distinct nodes than connectivity entries */
+        const size_t len = (size_t)(mesh->offset[cells[i] + 1] - mesh->offset[cells[i]]);
+        if (len > cap) {
+            int64_t *t = realloc(nb, len * sizeof *t);
+            if (!t) {
+                free(nb);
+                return -1;
+            }
+            nb = t, cap = len;
         }
-        for (int64_t p = 0; p < k; ++p) {
+        const int k = cm_mesh_cell_nodes(mesh, cells[i], nb, (int)cap);
+        for (int p = 0; p < k; ++p) {
             if (!constrained[nb[p]]) continue;
             const double *x = mesh->xyz + 3 * nb[p];
-            for (int64_t q = 0; q < k; ++q) {
+            for (int q = 0; q < k; ++q) {
                 if (constrained[nb[q]]) continue;
                 const double *y = mesh->xyz + 3 * nb[q];
                 const double dx = x[0] - y[0], dy = x[1] - y[1], dz = x[2] - y[2];
@@ -178,7 +162,8 @@ static double wall_spacing(const cm_mesh *mesh, const unsigned char *constrained
 }
 
 /* The RBF of component k; its errors (coplanar centres, failed factorisation) get the
- * component number in front. spacing: wall_spacing of its cells. */
+ * component number in front. spacing: wall_spacing of its cells (unused where opt gives the
+ * tolerance). */
 static cm_status fit_component(cm_context *ctx, const cm_mesh *mesh, cm_rbf_kernel kernel,
                                const cm_warp_options *opt, size_t k, double spacing,
                                warp_component *wc)
@@ -289,8 +274,11 @@ static cm_status build_components(cm_context *ctx, const cm_mesh *mesh, const cm
         s = split_component(ctx, constrained, (int)k, list, vis.n, owner, &w->comp[k],
                             n_shared_free);
         if (s < 0) goto done;
+        /* (only a tolerance from the mesh needs it) */
         const double spacing =
-            wall_spacing(mesh, constrained, cells + start[k], start[k + 1] - start[k]);
+            opt->tolerance > 0
+                ? 0.0
+                : wall_spacing(mesh, constrained, cells + start[k], start[k + 1] - start[k]);
         if (spacing < 0) {
             s = cm_error(ctx, CM_ERR_NOMEM, "cm_warp_create: out of memory");
             goto done;

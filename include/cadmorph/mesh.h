@@ -166,6 +166,10 @@ CM_API cm_status cm_mesh_validate(cm_context *ctx, const cm_mesh *mesh, const ch
 /* Number of cells of dimension dim. */
 CM_API size_t cm_mesh_count_dim(const cm_mesh *mesh, int dim);
 
+/* The distinct nodes of cell c, sorted, into out (a polyhedron's: those of its face stream):
+ * their count, or -1 if more than cap (never more than the cell's connectivity entries). */
+CM_API int cm_mesh_cell_nodes(const cm_mesh *mesh, size_t c, int64_t *out, int cap);
+
 /* ---- the face stream of a polyhedron ----
  * One walk for every reader of CM_CELL_POLYHEDRON's stream (nf, n0, ids of face 0, n1, ...):
  *

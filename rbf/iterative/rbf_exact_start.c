@@ -83,12 +83,10 @@ int cm_rbf_exact_starts_make(const cm_rbf *r, const krylov *kr, int n, const dou
 }
 
 double cm_rbf_exact_start(const cm_rbf *r, const cm_rbf_exact_starts *es, const double *f,
-                          double *whi, double *wlo, double *aw)
+                          double *y, double *whi, double *wlo, double *aw)
 {
     const size_t m = es->m;
     const int n = es->n;
-    double *y = malloc(m * sizeof *y);
-    if (!y) return -1.0;
     memcpy(y, f, m * sizeof *y);
     cm_krylov_project(r->iter->q1, m, r->k, y);
     /* over the rank independent columns col[]: c = R^-1 (Q' Pi f)[0..rank), the others 0 */
@@ -96,14 +94,11 @@ double cm_rbf_exact_start(const cm_rbf *r, const cm_rbf_exact_starts *es, const 
     if (LAPACKE_dormqr(LAPACK_COL_MAJOR, 'L', 'T', (lapack_int)m, 1, rank, es->qr,
                        (lapack_int)m, es->tau, y, (lapack_int)m) != 0 ||
         LAPACKE_dtrtrs(LAPACK_COL_MAJOR, 'U', 'N', 'N', rank, 1, es->qr, (lapack_int)m, y,
-                       (lapack_int)m) != 0) {
-        free(y);
+                       (lapack_int)m) != 0)
         return -1.0;
-    }
     double c[CM_RBF_EXACT_MAX] = {0.0}, bound = 0.0;
     for (int j = 0; j < rank; ++j) c[es->col[j]] = y[j];
     for (int j = 0; j < n; ++j) bound += fabs(c[j]) * es->err[j];
-    free(y);
     cm_rbf_combine_dd(m, n, es->whi, es->wlo, c, whi, wlo);
     cblas_dgemv(CblasColMajor, CblasNoTrans, (int)m, n, 1.0, es->aw, (int)m, c, 1, 0.0, aw, 1);
     return bound;

@@ -577,7 +577,7 @@ static cm_status solve_in_order(cm_context *ctx, cm_rbf *r, size_t nc, const dou
             kc->warm_res = 0.0;
             kc->preset = 0;
             if (es.n > 0) { /* a start whose product is known: taken if known well enough */
-                const double b = cm_rbf_exact_start(r, &es, f + o0, w + o0,
+                const double b = cm_rbf_exact_start(r, &es, f + o0, kc->v, w + o0,
                                                     kr.wlo + (size_t)c * m, aw + o0);
                 if (b >= 0.0 && b <= CM_RBF_PLAIN_RES_SHARE * kc->tol * kc->fnorm) {
                     kc->warm = kc->preset = 1;

@@ -152,9 +152,9 @@ int cm_rbf_exact_starts_make(const cm_rbf *r, const krylov *kr, int n, const dou
 void cm_rbf_exact_starts_free(cm_rbf_exact_starts *es);
 size_t cm_rbf_exact_starts_bytes(const cm_rbf_exact_starts *es);
 /* The start of a column with data f (m): the combination of the kept columns whose product
- * fits Pi f best, as whi + wlo (m each), its product aw (m); returns the bound on
- * |A (whi + wlo) - aw|_inf, or -1 out of memory. */
+ * fits Pi f best, as whi + wlo (m each), its product aw (m); y: m scratch. Returns the bound
+ * on |A (whi + wlo) - aw|_inf, or -1 if LAPACK failed. */
 double cm_rbf_exact_start(const cm_rbf *r, const cm_rbf_exact_starts *es, const double *f,
-                          double *whi, double *wlo, double *aw);
+                          double *y, double *whi, double *wlo, double *aw);
 
 #endif

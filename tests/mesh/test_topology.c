@@ -69,7 +69,7 @@ static cm_mesh *mixed_mesh(void)
 static void centroid(const cm_mesh *m, size_t c, double out[3])
 {
     int64_t nodes[64];
-    const int n = cm_topology_cell_nodes(m, c, nodes, 64);
+    const int n = cm_mesh_cell_nodes(m, c, nodes, 64);
     CHECK(n > 0);
     out[0] = out[1] = out[2] = 0;
     for (int i = 0; i < n; ++i)
